@@ -1,0 +1,6 @@
+//! impact: finite-strain elastoplastic contact-impact in 2D (plane strain, plane stress,
+//! axisymmetric) and 1D rods, after Hughes et al. (1975), Erklig et al. (2010) and
+//! Greco & Coda (2003). See docs/theory.md for the equations and their sources.
+
+pub mod mesh;
+pub mod output;

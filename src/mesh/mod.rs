@@ -1,0 +1,113 @@
+//! Meshes: nodes, cells and named node / edge / element sets.
+//!
+//! Legend
+//! ```text
+//! nodes          node coordinates [x, y] (axisymmetric: [r, z]; rods: any 2D line)
+//! cells          Quad4 (counter-clockwise node order, det J > 0) or Rod2 connectivity
+//! node_sets      name -> sorted, unique node ids
+//! edge_sets      name -> boundary edges [a, b], oriented so the body lies on the left
+//!                of a -> b (counter-clockwise around the body)
+//! element_sets   name -> element ids
+//! ```
+//! Every generator and the Gmsh reader fill `element_sets["all"]`, and every edge set also
+//! appears as a node set of the same name (the union of its edge nodes).
+
+pub mod generate;
+pub mod gmsh;
+
+use std::collections::BTreeMap;
+
+pub use generate::MeshSpec;
+
+/// Cell connectivity of a body: one element kind per body.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cells {
+    /// Four-node quadrilaterals, nodes counter-clockwise.
+    Quad4(Vec<[usize; 4]>),
+    /// Two-node rods (bars).
+    Rod2(Vec<[usize; 2]>),
+}
+
+impl Cells {
+    pub fn len(&self) -> usize {
+        match self {
+            Cells::Quad4(c) => c.len(),
+            Cells::Rod2(c) => c.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Node ids of element `e`.
+    pub fn nodes_of(&self, e: usize) -> &[usize] {
+        match self {
+            Cells::Quad4(c) => &c[e],
+            Cells::Rod2(c) => &c[e],
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    pub nodes: Vec<[f64; 2]>,
+    pub cells: Cells,
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
+    pub element_sets: BTreeMap<String, Vec<usize>>,
+}
+
+/// Errors from building or reading a mesh. `Display` names the file and line where there is one.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("mesh parameter `{key}`: {reason}")]
+    Parameter { key: String, reason: String },
+    #[error("cannot read mesh file {path}: {reason}")]
+    Io { path: String, reason: String },
+    #[error("mesh file {path}, line {line}: {reason}")]
+    Parse { path: String, line: usize, reason: String },
+    #[error("mesh file {path}: {reason}")]
+    Content { path: String, reason: String },
+}
+
+impl Mesh {
+    /// A mesh with the given nodes and cells and only the `all` element set.
+    pub fn new(nodes: Vec<[f64; 2]>, cells: Cells) -> Mesh {
+        let all = (0..cells.len()).collect();
+        let mut element_sets = BTreeMap::new();
+        element_sets.insert("all".to_string(), all);
+        Mesh { nodes, cells, node_sets: BTreeMap::new(), edge_sets: BTreeMap::new(), element_sets }
+    }
+
+    /// Adds an edge set and the node set of the same name (its nodes, sorted and unique).
+    pub fn add_edge_set(&mut self, name: &str, edges: Vec<[usize; 2]>) {
+        let mut nodes: Vec<usize> = edges.iter().flat_map(|e| e.iter().copied()).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        self.node_sets.insert(name.to_string(), nodes);
+        self.edge_sets.insert(name.to_string(), edges);
+    }
+
+    /// Adds a node set (sorted and deduplicated).
+    pub fn add_node_set(&mut self, name: &str, mut nodes: Vec<usize>) {
+        nodes.sort_unstable();
+        nodes.dedup();
+        self.node_sets.insert(name.to_string(), nodes);
+    }
+
+    /// Boundary edges of a Quad4 mesh (edges used by one element), oriented counter-clockwise
+    /// around the body. Empty for rods.
+    pub fn boundary_edges(&self) -> Vec<[usize; 2]> {
+        let Cells::Quad4(quads) = &self.cells else { return Vec::new() };
+        let mut count: BTreeMap<(usize, usize), ([usize; 2], usize)> = BTreeMap::new();
+        for q in quads {
+            for k in 0..4 {
+                let edge = [q[k], q[(k + 1) % 4]];
+                let key = (edge[0].min(edge[1]), edge[0].max(edge[1]));
+                count.entry(key).or_insert((edge, 0)).1 += 1;
+            }
+        }
+        count.into_values().filter(|(_, n)| *n == 1).map(|(e, _)| e).collect()
+    }
+}
