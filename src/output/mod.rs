@@ -1,1 +1,174 @@
-//! Output (placeholder: being written).
+//! Output files read by other tools (DESIGN.md section 5): the VTK time series
+//! (`vtk`: DIR/NAME.pvd + DIR/vtk/NAME_NNNNN.vtu) and the history table (`history`: history.csv).
+//!
+//! Every file is written whole to a temporary name and renamed, so a crash leaves either the
+//! previous version or the new one, never a truncated file. Numbers are written at full
+//! precision (shortest text that parses back to the same f64).
+
+pub mod history;
+pub mod vtk;
+
+use std::fs;
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// What went wrong writing or reading an output file; the message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// A file system call failed (`action` says which: "create folder", "write", ...).
+    #[error("{}: cannot {action}: {source}", .path.display())]
+    Io {
+        path: PathBuf,
+        action: &'static str,
+        #[source]
+        source: io::Error,
+    },
+    /// vtkio could not encode a frame.
+    #[error("{}: cannot encode the VTK file: {source}", .path.display())]
+    Vtk {
+        path: PathBuf,
+        #[source]
+        source: vtkio::Error,
+    },
+    /// An array (a field, a history row) has the wrong number of entries.
+    #[error("{}: {what} has {found} entries, expected {expected}", .path.display())]
+    Length {
+        path: PathBuf,
+        what: String,
+        expected: usize,
+        found: usize,
+    },
+    /// NaN or infinity in a field: ParaView would silently leave it out of the colour range.
+    #[error("{}: {field}[{index}] component {component} is {value}; only finite values can be written", .path.display())]
+    NonFinite {
+        path: PathBuf,
+        field: &'static str,
+        index: usize,
+        component: usize,
+        value: f64,
+    },
+    /// Frame times must increase strictly: ParaView merges equal timesteps silently.
+    #[error("{}: frame time {time} does not come after the previous frame's {previous}", .path.display())]
+    TimeNotIncreasing {
+        path: PathBuf,
+        time: f64,
+        previous: f64,
+    },
+    /// Anything else that makes the input unusable (bad name, bad connectivity, bad .pvd).
+    #[error("{}: {reason}", .path.display())]
+    Invalid { path: PathBuf, reason: String },
+}
+
+impl OutputError {
+    pub(crate) fn io(path: &Path, action: &'static str, source: io::Error) -> OutputError {
+        OutputError::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        }
+    }
+
+    pub(crate) fn invalid(path: &Path, reason: impl Into<String>) -> OutputError {
+        OutputError::Invalid {
+            path: path.to_path_buf(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Writes bytes to `path` atomically: a temporary file in the same folder, fsync-free flush, then rename.
+///
+/// The temporary file is `path` with `.tmp` appended. A crash leaves the old `path` (or none)
+/// and possibly a stale `.tmp`, never a truncated `path`.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    let tmp = temporary_path(path);
+    fs::write(&tmp, bytes).map_err(|e| OutputError::io(&tmp, "write", e))?;
+    fs::rename(&tmp, path).map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        OutputError::io(path, "rename the temporary file onto", e)
+    })
+}
+
+/// `path` with `.tmp` appended to its file name.
+pub(crate) fn temporary_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".tmp");
+    path.with_file_name(name)
+}
+
+/// Shortest text of `x` that parses back to the same bits: `{}` or `{:e}`, whichever is shorter.
+///
+/// Never fixed decimals: 1e-12 stays 1e-12, 0.1 stays 0.1.
+pub(crate) fn format_f64(x: f64) -> String {
+    let plain = format!("{x}");
+    let exponent = format!("{x:e}");
+    if exponent.len() < plain.len() {
+        exponent
+    } else {
+        plain
+    }
+}
+
+/// A fresh, empty folder under the system temp dir for one test.
+#[cfg(test)]
+pub(crate) fn test_dir(name: &str) -> PathBuf {
+    use std::time::{SystemTime, UNIX_EPOCH};
+    let nanos = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let dir = std::env::temp_dir().join(format!(
+        "impact-output-{name}-{}-{nanos}",
+        std::process::id()
+    ));
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Goal: write_atomic replaces the file's contents and leaves no temporary file behind.
+    #[test]
+    fn write_atomic_replaces_contents_without_leftovers() {
+        let dir = test_dir("atomic");
+        let path = dir.join("a.txt");
+        write_atomic(&path, b"first").unwrap();
+        write_atomic(&path, b"second").unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"second");
+        assert!(!temporary_path(&path).exists());
+        let missing = dir.join("no_such_folder").join("a.txt");
+        let err = write_atomic(&missing, b"x").unwrap_err();
+        assert!(err.to_string().contains("no_such_folder"), "{err}");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Goal: numbers round-trip bit-exactly and never use fixed decimals.
+    #[test]
+    fn format_f64_round_trips_and_is_short() {
+        let values = [
+            0.0,
+            -0.0,
+            0.1,
+            1.0 / 3.0,
+            1e-12,
+            -2.5e-300,
+            6.02e23,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+            5e-324,
+            123456.789,
+        ];
+        for x in values {
+            let text = format_f64(x);
+            assert_eq!(
+                text.parse::<f64>().unwrap().to_bits(),
+                x.to_bits(),
+                "{text}"
+            );
+        }
+        assert_eq!(format_f64(0.1), "0.1");
+        assert_eq!(format_f64(1e-12), "1e-12");
+        assert_eq!(format_f64(2.0), "2");
+    }
+}

@@ -1,0 +1,117 @@
+//! External forces and prescribed displacements at a given (pseudo) time.
+
+use crate::assembly::State;
+use crate::element::quad4;
+use crate::scene::{BodyKind, Load, Model};
+
+/// Constrained DOFs: supports and prescribed-displacement loads (sorted, unique).
+pub fn constrained_dofs(model: &Model) -> Vec<usize> {
+    let mut dofs = model.fixed_dofs.clone();
+    for load in &model.loads {
+        match load {
+            Load::Displacement { nodes, x, y, .. } => {
+                for n in nodes {
+                    if x.is_some() {
+                        dofs.push(2 * n);
+                    }
+                    if y.is_some() {
+                        dofs.push(2 * n + 1);
+                    }
+                }
+            }
+            Load::Rotation { nodes, .. } => dofs.extend(nodes.iter().flat_map(|n| [2 * n, 2 * n + 1])),
+            _ => {}
+        }
+    }
+    dofs.sort_unstable();
+    dofs.dedup();
+    dofs
+}
+
+/// Prescribed total displacements (DOF, value) at time t: supports give 0; a DOF named by
+/// several loads takes the last one's value.
+pub fn prescribed(model: &Model, initial: &[[f64; 2]], t: f64) -> Vec<(usize, f64)> {
+    let mut out: Vec<(usize, f64)> = model.fixed_dofs.iter().map(|d| (*d, 0.0)).collect();
+    for load in &model.loads {
+        match load {
+            Load::Displacement { nodes, x, y, curve } => {
+                let s = curve.value(t);
+                for n in nodes {
+                    if let Some(x) = x {
+                        out.push((2 * n, x * s));
+                    }
+                    if let Some(y) = y {
+                        out.push((2 * n + 1, y * s));
+                    }
+                }
+            }
+            Load::Rotation { nodes, center, angle, curve } => {
+                let (sin, cos) = (angle * curve.value(t)).sin_cos();
+                for n in nodes {
+                    let (dx, dy) = (initial[*n][0] - center[0], initial[*n][1] - center[1]);
+                    out.push((2 * n, cos * dx - sin * dy - dx));
+                    out.push((2 * n + 1, sin * dx + cos * dy - dy));
+                }
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// External force vector over all DOFs at time t. Tractions act on the initial edges;
+/// pressures on the edges of the reference (last converged) configuration.
+pub fn external_force(model: &Model, state: &State, initial: &[[f64; 2]], t: f64) -> Vec<f64> {
+    let mut f = vec![0.0; model.dofs()];
+    for load in &model.loads {
+        match load {
+            Load::NodalForce { nodes, force, curve } => {
+                let s = curve.value(t);
+                for n in nodes {
+                    f[2 * n] += force[0] * s;
+                    f[2 * n + 1] += force[1] * s;
+                }
+            }
+            Load::Traction { body, edges, traction, curve } => {
+                let s = curve.value(t);
+                let t = [traction[0] * s, traction[1] * s];
+                add_edge_forces(model, *body, edges, initial, |_, _| t, &mut f);
+            }
+            Load::Pressure { body, edges, pressure, curve } => {
+                let p = pressure * curve.value(t);
+                add_edge_forces(
+                    model,
+                    *body,
+                    edges,
+                    &state.reference,
+                    |a, b| {
+                        let n = quad4::outward_normal(a, b);
+                        [-p * n[0], -p * n[1]]
+                    },
+                    &mut f,
+                );
+            }
+            Load::Displacement { .. } | Load::Rotation { .. } => {}
+        }
+    }
+    f
+}
+
+fn add_edge_forces(
+    model: &Model,
+    body: usize,
+    edges: &[[usize; 2]],
+    coords: &[[f64; 2]],
+    traction: impl Fn([f64; 2], [f64; 2]) -> [f64; 2],
+    f: &mut [f64],
+) {
+    let BodyKind::Continuum { formulation, thickness, .. } = model.bodies[body].kind else { return };
+    for [a, b] in edges {
+        let (xa, xb) = (coords[*a], coords[*b]);
+        let fe = quad4::edge_force(xa, xb, traction(xa, xb), formulation, thickness);
+        f[2 * a] += fe[0];
+        f[2 * a + 1] += fe[1];
+        f[2 * b] += fe[2];
+        f[2 * b + 1] += fe[3];
+    }
+}

@@ -1,0 +1,196 @@
+//! What a run writes: VTK frames (every `frame_every` steps, and the last), one history.csv
+//! row per converged step, summary.json at the end (also after a failure).
+
+use super::Summary;
+use crate::assembly::State;
+use crate::material::{pressure, von_mises};
+use crate::mesh::Cells;
+use crate::output::history::History;
+use crate::output::vtk::{Fields, Grid, Series};
+use crate::output::{OutputError, write_atomic};
+use crate::scene::Model;
+use crate::scene::spec::Quantity;
+use std::path::{Path, PathBuf};
+
+/// Energies of one step (history.csv columns 2-6).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Energies {
+    pub kinetic: f64,
+    pub internal: f64,
+    pub plastic_work: f64,
+    pub external_work: f64,
+    pub contact_work: f64,
+}
+
+/// Nodal kinematic fields beyond the displacement (zero in statics).
+pub struct Motion<'a> {
+    pub velocity: &'a [f64],
+    pub acceleration: &'a [f64],
+}
+
+pub struct Recorder {
+    dir: PathBuf,
+    grid: Grid,
+    series: Option<Series>,
+    history: History,
+    frame_every: usize,
+    steps_since_frame: usize,
+    last_frame_time: Option<f64>,
+}
+
+impl Recorder {
+    /// Creates the output folder, the .pvd series and history.csv with its header.
+    pub fn create(model: &Model, dir: &Path) -> Result<Recorder, OutputError> {
+        std::fs::create_dir_all(dir)
+            .map_err(|source| OutputError::Io { path: dir.to_path_buf(), action: "cannot create folder", source })?;
+        let series = if model.output.frame_every > 0 {
+            Some(Series::create(dir, &model.name, model.output.compression)?)
+        } else {
+            None
+        };
+        let mut columns: Vec<String> =
+            ["time", "kinetic_energy", "internal_energy", "plastic_work", "external_work", "contact_work"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+        columns.extend(model.probes.iter().map(|p| p.column.clone()));
+        let history = History::create(&dir.join("history.csv"), &columns)?;
+        Ok(Recorder {
+            dir: dir.to_path_buf(),
+            grid: grid(model),
+            series,
+            history,
+            frame_every: model.output.frame_every,
+            steps_since_frame: 0,
+            last_frame_time: None,
+        })
+    }
+
+    /// Records a converged step: a history row, and a frame when due (`force_frame` for the
+    /// first and last).
+    pub fn step(
+        &mut self,
+        model: &Model,
+        state: &State,
+        motion: &Motion,
+        energies: &Energies,
+        force_frame: bool,
+    ) -> Result<(), OutputError> {
+        let mut row = vec![
+            state.time,
+            energies.kinetic,
+            energies.internal,
+            energies.plastic_work,
+            energies.external_work,
+            energies.contact_work,
+        ];
+        row.extend(model.probes.iter().map(|p| probe_value(model, state, motion, p)));
+        self.history.append(&row)?;
+        self.steps_since_frame += 1;
+        if force_frame || (self.frame_every > 0 && self.steps_since_frame >= self.frame_every) {
+            self.frame(model, state, motion)?;
+        }
+        Ok(())
+    }
+
+    /// Writes a frame of the state unless one was written at this time already.
+    pub fn frame(&mut self, model: &Model, state: &State, motion: &Motion) -> Result<(), OutputError> {
+        let Some(series) = self.series.as_mut() else { return Ok(()) };
+        if self.last_frame_time == Some(state.time) {
+            return Ok(());
+        }
+        let cells = cell_fields(model, state);
+        let vectors = |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
+        let n = state.reference.len();
+        let zeros2 = vec![[0.0; 2]; n];
+        let zeros = vec![0.0; n];
+        let fields = Fields {
+            displacement: &vectors(&state.displacement),
+            velocity: &vectors(motion.velocity),
+            acceleration: &vectors(motion.acceleration),
+            contact_force: &zeros2,
+            gap: &zeros,
+            contact_status: &zeros,
+            stress: &cells.stress,
+            von_mises: &cells.von_mises,
+            eq_plastic_strain: &cells.eq_plastic_strain,
+            pressure: &cells.pressure,
+        };
+        series.write_frame(state.time, &self.grid, &fields)?;
+        self.steps_since_frame = 0;
+        self.last_frame_time = Some(state.time);
+        Ok(())
+    }
+
+    pub fn write_summary(&self, summary: &Summary) -> Result<(), OutputError> {
+        let path = self.dir.join("summary.json");
+        let text = serde_json::to_string_pretty(summary).expect("the summary serializes");
+        write_atomic(&path, text.as_bytes())
+    }
+}
+
+/// All bodies in one grid: initial coordinates, quads first, then rods.
+fn grid(model: &Model) -> Grid {
+    let mut quads = Vec::new();
+    let mut lines = Vec::new();
+    for body in &model.bodies {
+        match &body.mesh.cells {
+            Cells::Quad4(q) => quads.extend(q.iter().map(|c| c.map(|n| body.global(n)))),
+            Cells::Rod2(r) => lines.extend(r.iter().map(|c| c.map(|n| body.global(n)))),
+        }
+    }
+    Grid { points: model.coordinates(), quads, lines }
+}
+
+struct CellFields {
+    stress: Vec<[f64; 6]>,
+    von_mises: Vec<f64>,
+    eq_plastic_strain: Vec<f64>,
+    pressure: Vec<f64>,
+}
+
+/// Per cell, the mean over its points; quads first, then rods (as in `grid`).
+fn cell_fields(model: &Model, state: &State) -> CellFields {
+    let mut out = CellFields { stress: Vec::new(), von_mises: Vec::new(), eq_plastic_strain: Vec::new(), pressure: Vec::new() };
+    let quads_first =
+        model.bodies.iter().enumerate().filter(|(_, b)| b.points_per_element() == 4).chain(
+            model.bodies.iter().enumerate().filter(|(_, b)| b.points_per_element() == 1),
+        );
+    for (b, body) in quads_first {
+        let ppe = body.points_per_element();
+        for points in state.bodies[b].points.chunks_exact(ppe) {
+            let mean = |f: &dyn Fn(&crate::material::PointState) -> f64| points.iter().map(f).sum::<f64>() / ppe as f64;
+            let s: [f64; 4] = std::array::from_fn(|k| mean(&|p| p.stress[k]));
+            out.stress.push([s[0], s[1], s[2], s[3], 0.0, 0.0]);
+            out.von_mises.push(mean(&|p| von_mises(&p.stress)));
+            out.eq_plastic_strain.push(mean(&|p| p.eq_plastic_strain));
+            out.pressure.push(mean(&|p| pressure(&p.stress)));
+        }
+    }
+    out
+}
+
+fn probe_value(model: &Model, state: &State, motion: &Motion, probe: &crate::scene::model::Probe) -> f64 {
+    let n = probe.members.len().max(1) as f64;
+    let nodal = |v: &[f64], c: usize| probe.members.iter().map(|m| v[2 * m + c]).sum::<f64>() / n;
+    let points = |f: &dyn Fn(&crate::material::PointState) -> f64| {
+        let body = &model.bodies[probe.body];
+        let ppe = body.points_per_element();
+        let pts = &state.bodies[probe.body].points;
+        probe.members.iter().flat_map(|e| &pts[e * ppe..(e + 1) * ppe]).map(f).sum::<f64>() / (n * ppe as f64)
+    };
+    match probe.quantity {
+        Quantity::DisplacementX => nodal(&state.displacement, 0),
+        Quantity::DisplacementY => nodal(&state.displacement, 1),
+        Quantity::VelocityX => nodal(motion.velocity, 0),
+        Quantity::VelocityY => nodal(motion.velocity, 1),
+        Quantity::AccelerationX => nodal(motion.acceleration, 0),
+        Quantity::AccelerationY => nodal(motion.acceleration, 1),
+        Quantity::StressXX => points(&|p| p.stress[0]),
+        Quantity::StressYY => points(&|p| p.stress[1]),
+        Quantity::StressZZ => points(&|p| p.stress[2]),
+        Quantity::StressXY => points(&|p| p.stress[3]),
+        Quantity::VonMises => points(&|p| von_mises(&p.stress)),
+        Quantity::EqPlasticStrain => points(&|p| p.eq_plastic_strain),
+    }
+}

@@ -1,0 +1,357 @@
+//! Global assembly: DOF numbering with constrained DOFs eliminated, the sparsity pattern and
+//! every element's scatter positions computed once per topology, and the element loop
+//! (rayon over elements, deterministic: element results are collected in order, then
+//! scattered serially).
+//!
+//! Legend
+//! ```text
+//! d          global displacement increment since the reference (last converged) configuration
+//! f_int      internal force sum_e f_e(d)          (Erklig eq 25)
+//! K_T        sum_e K_e(d), lower triangle over the free DOFs (Erklig eq 32)
+//! W_int      work of the internal forces, sum_q w_q 1/2 (sigma_n + S) . dE (trapezoid)
+//! ```
+
+use crate::element::{Formulation, Geometry, KernelError, Mat4, Vec4, Vec8, Voigt, quad4, rod2};
+use crate::kinematics;
+use crate::material::{PointState, StressState};
+use crate::scene::{Body, BodyKind, Model};
+use crate::solver::Pattern;
+use rayon::prelude::*;
+
+/// Per body, per material point (element-major: element e's points are e*ppe .. (e+1)*ppe).
+#[derive(Debug, Clone)]
+pub struct BodyState {
+    pub points: Vec<PointState>,
+    /// Current thickness per point (plane stress); 1 otherwise.
+    pub thickness: Vec<f64>,
+}
+
+/// The committed state of the whole model.
+#[derive(Debug, Clone)]
+pub struct State {
+    pub time: f64,
+    /// Coordinates of the reference (last converged) configuration, global nodes.
+    pub reference: Vec<[f64; 2]>,
+    /// Total displacement since the initial configuration, 2 per node.
+    pub displacement: Vec<f64>,
+    pub bodies: Vec<BodyState>,
+    /// Accumulated work of the internal forces.
+    pub internal_work: f64,
+}
+
+impl State {
+    pub fn initial(model: &Model) -> State {
+        let bodies = model
+            .bodies
+            .iter()
+            .map(|b| {
+                let n = b.elements() * b.points_per_element();
+                let thickness = match b.kind {
+                    BodyKind::Continuum { thickness, .. } => thickness,
+                    BodyKind::Rod { .. } => 1.0,
+                };
+                let stress = match b.kind {
+                    BodyKind::Continuum { .. } => b.initial_stress,
+                    BodyKind::Rod { .. } => Voigt::new(b.initial_stress[0], 0.0, 0.0, 0.0),
+                };
+                BodyState { points: vec![PointState { stress, ..Default::default() }; n], thickness: vec![thickness; n] }
+            })
+            .collect();
+        State {
+            time: 0.0,
+            reference: model.coordinates(),
+            displacement: vec![0.0; model.dofs()],
+            bodies,
+            internal_work: 0.0,
+        }
+    }
+}
+
+/// An element kernel failed: which body and element, and why.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("body `{body}`, element {element}: {error}")]
+pub struct ElementFailure {
+    pub body: String,
+    pub element: usize,
+    pub error: KernelError,
+}
+
+/// The trial result of an evaluation at a given increment d.
+#[derive(Debug, Clone)]
+pub struct Evaluation {
+    /// Internal force over all DOFs.
+    pub force: Vec<f64>,
+    /// Trial point states (stress still the second Piola-Kirchhoff stress of the increment).
+    pub trial: Vec<Vec<PointState>>,
+    /// Out-of-plane Green-Lagrange strain per point (plane stress), else 0.
+    pub strain_zz: Vec<Vec<f64>>,
+    /// Increment of the internal work.
+    pub work: f64,
+}
+
+/// DOF numbering, sparsity and scatter positions of one topology.
+pub struct System {
+    /// Global DOF -> free equation number (None: constrained).
+    pub equation: Vec<Option<usize>>,
+    pub free: usize,
+    pub pattern: Pattern,
+    /// Per body: scatter positions, element-major, (2 nn)^2 per element.
+    scatter: Vec<Vec<usize>>,
+    /// Lower-triangle values of the last assembled matrix.
+    pub values: Vec<f64>,
+}
+
+/// Global DOFs of element e of body b.
+fn element_dofs(body: &Body, e: usize) -> Vec<usize> {
+    body.mesh.cells.nodes_of(e).iter().flat_map(|n| [2 * body.global(*n), 2 * body.global(*n) + 1]).collect()
+}
+
+impl System {
+    /// Numbers the DOFs not in `constrained` (sorted or not) and builds pattern and scatter.
+    pub fn new(model: &Model, constrained: &[usize]) -> System {
+        let mut equation = vec![Some(0); model.dofs()];
+        for c in constrained {
+            equation[*c] = None;
+        }
+        let mut free = 0;
+        for eq in equation.iter_mut().flatten() {
+            *eq = free;
+            free += 1;
+        }
+        let element_equations: Vec<Vec<Vec<Option<usize>>>> = model
+            .bodies
+            .iter()
+            .map(|b| (0..b.elements()).map(|e| element_dofs(b, e).iter().map(|g| equation[*g]).collect()).collect())
+            .collect();
+        let pattern = Pattern::from_elements(free, element_equations.iter().flatten().map(|v| v.as_slice()));
+        let scatter = element_equations
+            .iter()
+            .map(|body| body.iter().flat_map(|eqs| pattern.scatter(eqs)).collect())
+            .collect();
+        let values = vec![0.0; pattern.nonzeros()];
+        System { equation, free, pattern, scatter, values }
+    }
+
+    /// Restricts a global vector to the free equations.
+    pub fn gather(&self, global: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.free];
+        for (g, eq) in self.equation.iter().enumerate() {
+            if let Some(i) = eq {
+                out[*i] = global[g];
+            }
+        }
+        out
+    }
+
+    /// Adds a free-equation vector into a global one.
+    pub fn scatter_add(&self, free: &[f64], global: &mut [f64]) {
+        for (g, eq) in self.equation.iter().enumerate() {
+            if let Some(i) = eq {
+                global[g] += free[*i];
+            }
+        }
+    }
+}
+
+struct ElementResult {
+    force: Vec8,
+    matrix: Option<[f64; 64]>,
+    trial: [PointState; 4],
+    strain_zz: [f64; 4],
+    work: f64,
+}
+
+/// Internal force (and, when `system` is given, the tangent into `system.values`) at the
+/// increment `d` from the committed `state`.
+pub fn evaluate(
+    model: &Model,
+    state: &State,
+    d: &[f64],
+    geometry: Geometry,
+    mut system: Option<&mut System>,
+) -> Result<Evaluation, ElementFailure> {
+    let want_tangent = system.is_some();
+    if let Some(s) = system.as_deref_mut() {
+        s.values.iter_mut().for_each(|v| *v = 0.0);
+    }
+    let mut force = vec![0.0; model.dofs()];
+    let mut trial = Vec::with_capacity(model.bodies.len());
+    let mut strain_zz = Vec::with_capacity(model.bodies.len());
+    let mut work = 0.0;
+    for (b, body) in model.bodies.iter().enumerate() {
+        let results: Vec<ElementResult> = (0..body.elements())
+            .into_par_iter()
+            .map(|e| element(body, &state.bodies[b], &state.reference, d, e, geometry, want_tangent))
+            .collect::<Result<_, _>>()
+            .map_err(|(element, error)| ElementFailure { body: body.name.clone(), element, error })?;
+        let ppe = body.points_per_element();
+        let mut body_trial = Vec::with_capacity(results.len() * ppe);
+        let mut body_zz = Vec::with_capacity(results.len() * ppe);
+        for (e, r) in results.iter().enumerate() {
+            let dofs = element_dofs(body, e);
+            for (a, g) in dofs.iter().enumerate() {
+                force[*g] += r.force[a];
+            }
+            if let (Some(s), Some(m)) = (system.as_deref_mut(), &r.matrix) {
+                let n = dofs.len();
+                let positions = &s.scatter[b][e * n * n..(e + 1) * n * n];
+                for (k, p) in positions.iter().enumerate() {
+                    if *p != usize::MAX {
+                        s.values[*p] += m[k];
+                    }
+                }
+            }
+            body_trial.extend_from_slice(&r.trial[..ppe]);
+            body_zz.extend_from_slice(&r.strain_zz[..ppe]);
+            work += r.work;
+        }
+        trial.push(body_trial);
+        strain_zz.push(body_zz);
+    }
+    Ok(Evaluation { force, trial, strain_zz, work })
+}
+
+fn element(
+    body: &Body,
+    committed: &BodyState,
+    reference: &[[f64; 2]],
+    d: &[f64],
+    e: usize,
+    geometry: Geometry,
+    want_tangent: bool,
+) -> Result<ElementResult, (usize, KernelError)> {
+    let nodes = body.mesh.cells.nodes_of(e);
+    match body.kind {
+        BodyKind::Continuum { formulation, bbar, .. } => {
+            let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
+            let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
+            let geom = quad4::geometry(&x, formulation, &thickness).map_err(|err| (e, err))?;
+            let de = Vec8::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
+            if geometry == Geometry::Nonlinear {
+                check_orientation(&geom, &de).map_err(|err| (e, err))?;
+            }
+            let strains = quad4::strains(&geom, &de, geometry, bbar);
+            let stress_state =
+                if formulation == Formulation::PlaneStress { StressState::PlaneStress } else { StressState::General };
+            let responses: [_; 4] =
+                std::array::from_fn(|q| body.material.update(&committed.points[4 * e + q], &strains[q], stress_state));
+            let stress = responses.map(|r| r.stress);
+            let mut work = 0.0;
+            for q in 0..4 {
+                let mut strain = strains[q];
+                strain[2] = responses[q].strain_zz;
+                work += geom.points[q].weight * 0.5 * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
+            }
+            let force = quad4::internal_force(&geom, &de, &stress, geometry, bbar);
+            let matrix = want_tangent.then(|| {
+                let k = quad4::tangent(&geom, &de, &stress, &responses.map(|r| r.moduli), geometry, bbar);
+                let mut m = [0.0; 64];
+                m.copy_from_slice(k.transpose().as_slice()); // row-major
+                m
+            });
+            Ok(ElementResult {
+                force,
+                matrix,
+                trial: responses.map(|r| r.state),
+                strain_zz: responses.map(|r| r.strain_zz),
+                work,
+            })
+        }
+        BodyKind::Rod { area } => {
+            let x = [reference[body.global(nodes[0])], reference[body.global(nodes[1])]];
+            let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
+            let strain = rod2::strain(&x, &de, geometry).map_err(|err| (e, err))?;
+            let (stress, modulus, state) = body.material.update_uniaxial(&committed.points[e], strain);
+            let length = rod2::length(&x).map_err(|err| (e, err))?;
+            let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
+            let f4 = rod2::internal_force(&x, &de, stress, area, geometry).map_err(|err| (e, err))?;
+            let matrix = if want_tangent {
+                let k: Mat4 = rod2::tangent(&x, &de, stress, modulus, area, geometry).map_err(|err| (e, err))?;
+                let mut m = [0.0; 64];
+                m[..16].copy_from_slice(k.transpose().as_slice());
+                Some(m)
+            } else {
+                None
+            };
+            let mut force = Vec8::zeros();
+            force.fixed_rows_mut::<4>(0).copy_from(&f4);
+            Ok(ElementResult { force, matrix, trial: [state; 4], strain_zz: [0.0; 4], work })
+        }
+    }
+}
+
+/// det F > 0 at every Gauss point of the increment (the element does not turn inside out).
+fn check_orientation(geom: &quad4::QuadGeometry, d: &Vec8) -> Result<(), KernelError> {
+    for (point, (f, f_zz)) in quad4::deformation(geom, d).iter().enumerate() {
+        let det = f.determinant() * f_zz;
+        if !(det > 0.0) {
+            return Err(KernelError::NegativeJacobian { point, det });
+        }
+    }
+    Ok(())
+}
+
+/// Commits an evaluation: pushes the stresses forward to the new configuration (nonlinear
+/// geometry), updates the reference coordinates, thickness and the accumulated work.
+pub fn commit(model: &Model, state: &mut State, d: &[f64], evaluation: Evaluation, geometry: Geometry) {
+    let Evaluation { trial, strain_zz, work, .. } = evaluation;
+    for (b, body) in model.bodies.iter().enumerate() {
+        let mut points = trial[b].clone();
+        if geometry == Geometry::Nonlinear {
+            push_forward_body(body, &state.bodies[b], &state.reference, d, &strain_zz[b], &mut points);
+            let bs = &mut state.bodies[b];
+            if let BodyKind::Continuum { formulation: Formulation::PlaneStress, .. } = body.kind {
+                for (t, ezz) in bs.thickness.iter_mut().zip(&strain_zz[b]) {
+                    *t *= kinematics::plane_stress_stretch(*ezz);
+                }
+            }
+        }
+        state.bodies[b].points = points;
+    }
+    if geometry == Geometry::Nonlinear {
+        for (n, x) in state.reference.iter_mut().enumerate() {
+            x[0] += d[2 * n];
+            x[1] += d[2 * n + 1];
+        }
+    }
+    for (u, du) in state.displacement.iter_mut().zip(d) {
+        *u += du;
+    }
+    state.internal_work += work;
+}
+
+fn push_forward_body(
+    body: &Body,
+    committed: &BodyState,
+    reference: &[[f64; 2]],
+    d: &[f64],
+    strain_zz: &[f64],
+    points: &mut [PointState],
+) {
+    for e in 0..body.elements() {
+        let nodes = body.mesh.cells.nodes_of(e);
+        match body.kind {
+            BodyKind::Continuum { formulation, .. } => {
+                let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
+                let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
+                let geom = quad4::geometry(&x, formulation, &thickness).expect("checked during the evaluation");
+                let de = Vec8::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
+                for (q, (f, hoop)) in quad4::deformation(&geom, &de).iter().enumerate() {
+                    let f_zz = match formulation {
+                        Formulation::PlaneStress => kinematics::plane_stress_stretch(strain_zz[4 * e + q]),
+                        Formulation::Axisymmetric => *hoop,
+                        Formulation::PlaneStrain => 1.0,
+                    };
+                    let p = &mut points[4 * e + q];
+                    p.stress = kinematics::push_forward(&p.stress, f, f_zz);
+                }
+            }
+            BodyKind::Rod { .. } => {
+                let x = [reference[body.global(nodes[0])], reference[body.global(nodes[1])]];
+                let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
+                let stretch = rod2::stretch(&x, &de).expect("checked during the evaluation");
+                points[e].stress[0] *= stretch;
+            }
+        }
+    }
+}

@@ -1,0 +1,59 @@
+//! Element kernels: pure functions on small fixed-size nalgebra types.
+//!
+//! A kernel sees one element's reference coordinates (the last converged configuration,
+//! updated Lagrangian), its displacement increment and its per-point stresses; it never sees
+//! global indices, never calls the material and never allocates.
+//!
+//! Voigt order of strains and stresses everywhere: `[xx, yy, zz, xy]`, shear strain as the
+//! engineering value `2 E_xy` (so `stress . strain` is the work density). For axisymmetric
+//! bodies x = r, y = z and zz is the hoop (theta theta) component.
+
+pub mod quad4;
+pub mod rod2;
+
+use nalgebra::{Matrix4, SMatrix, SVector, Vector4};
+
+/// Strain or stress in Voigt order `[xx, yy, zz, xy]`.
+pub type Voigt = Vector4<f64>;
+/// Material tangent in Voigt order.
+pub type Moduli = Matrix4<f64>;
+pub type Vec8 = SVector<f64, 8>;
+pub type Mat8 = SMatrix<f64, 8, 8>;
+pub type Vec4 = SVector<f64, 4>;
+pub type Mat4 = SMatrix<f64, 4, 4>;
+
+/// The 2D idealization of a Quad4 body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Formulation {
+    /// eps_zz = 0; forces per unit depth.
+    PlaneStrain,
+    /// sigma_zz = 0; the thickness follows the out-of-plane stretch.
+    PlaneStress,
+    /// x = r >= 0, y = z; forces are totals over the full ring (2 pi r).
+    Axisymmetric,
+}
+
+/// Small-strain (linear) or updated-Lagrangian finite-strain kinematics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Geometry {
+    /// B = B_s, no geometric stiffness, the reference configuration is never updated.
+    Linear,
+    /// B = B_s + B_L(theta), K_T = K_0 + K_sigma, reference = last converged configuration.
+    #[default]
+    Nonlinear,
+}
+
+/// A failure inside an element kernel: the caller knows the element id and adds it.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum KernelError {
+    /// det J <= 0 at a Gauss point: the element is inverted or degenerate.
+    #[error("non-positive Jacobian det J = {det:.3e} at Gauss point {point}")]
+    NegativeJacobian { point: usize, det: f64 },
+    /// An axisymmetric Gauss point at r <= 0.
+    #[error("Gauss point {point} at radius r = {radius:.3e} <= 0 in an axisymmetric body")]
+    NonPositiveRadius { point: usize, radius: f64 },
+    /// A rod of zero length.
+    #[error("rod of zero length")]
+    ZeroLength,
+}

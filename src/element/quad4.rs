@@ -1,0 +1,383 @@
+//! Four-node quadrilateral, 2x2 Gauss, updated Lagrangian (Erklig et al. 2010, eqs 9-34).
+//!
+//! Legend (one Gauss point; derivatives with respect to the reference configuration X,
+//! the last converged one)
+//! ```text
+//! d         element displacement increment [u1 v1 u2 v2 u3 v3 u4 v4] since the reference
+//! theta     slope vector [u,x  u,y  v,x  v,y] = G d                      (Erklig eq 12, 17)
+//! hoop      u_r / r (axisymmetric only)
+//! dE        Green-Lagrange strain increment [xx yy zz xy]
+//!           = B_s d + 1/2 A(theta) theta  (+ hoop: u/r + 1/2 (u/r)^2)     (Erklig eq 9, 24)
+//! B         dE/dd = B_s + B_L(theta),  B_L = A(theta) G                  (Erklig eq 21, 22)
+//! S         second Piola-Kirchhoff stress relative to the reference configuration
+//! K_0       sum w B^T D B                                                 (Erklig eq 33)
+//! K_sigma   sum w G^T S G (+ hoop S_zz N_i N_j / r^2)                      (Erklig eq 34)
+//! w         reference volume of the point: det J (x 2 pi r | x thickness | x 1)
+//! ```
+//! B-bar (mean dilatation, Hughes 1980) replaces the trace of dE by its volume average over
+//! the element: dE_bar = dE + 1/3 (avg(tr dE) - tr dE) m, m = [1 1 1 0]. Its exact
+//! linearization adds (tr S / 3)(avg(M) - M) to K_sigma, M = d^2 tr(dE) / dd^2, so the
+//! tangent stays the exact derivative of the internal force (checked by finite differences).
+
+use super::{Formulation, Geometry, KernelError, Mat4, Mat8, Moduli, Vec8, Voigt};
+use nalgebra::{Matrix2, SMatrix};
+use std::f64::consts::PI;
+
+/// Node coordinates, counter-clockwise.
+pub type Coords = [[f64; 2]; 4];
+type BMatrix = SMatrix<f64, 4, 8>;
+
+const GAUSS: f64 = 0.577_350_269_189_625_8; // 1 / sqrt(3)
+/// Gauss points in the order of the nodes: (-,-), (+,-), (+,+), (-,+).
+pub const POINTS: [[f64; 2]; 4] = [[-GAUSS, -GAUSS], [GAUSS, -GAUSS], [GAUSS, GAUSS], [-GAUSS, GAUSS]];
+const NODE_SIGNS: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+
+/// Shape functions and their reference derivatives at one Gauss point.
+#[derive(Debug, Clone, Copy)]
+pub struct PointGeometry {
+    pub shape: [f64; 4],
+    /// dN_i/dX, dN_i/dY
+    pub dndx: [[f64; 2]; 4],
+    /// Radius of the point (x coordinate); used by axisymmetric bodies.
+    pub radius: f64,
+    /// Reference volume of the point (see the legend).
+    pub weight: f64,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct QuadGeometry {
+    pub points: [PointGeometry; 4],
+    pub formulation: Formulation,
+}
+
+impl QuadGeometry {
+    pub fn volume(&self) -> f64 {
+        self.points.iter().map(|p| p.weight).sum()
+    }
+}
+
+fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
+    let mut n = [0.0; 4];
+    let mut dn = [[0.0; 2]; 4];
+    for (i, [si, ti]) in NODE_SIGNS.iter().enumerate() {
+        n[i] = 0.25 * (1.0 + si * xi) * (1.0 + ti * eta);
+        dn[i] = [0.25 * si * (1.0 + ti * eta), 0.25 * ti * (1.0 + si * xi)];
+    }
+    (n, dn)
+}
+
+/// Shape-function derivatives, radii and point volumes on the reference configuration `x`.
+/// `thickness` is per Gauss point and used only in plane stress.
+pub fn geometry(x: &Coords, formulation: Formulation, thickness: &[f64; 4]) -> Result<QuadGeometry, KernelError> {
+    let mut points = [PointGeometry { shape: [0.0; 4], dndx: [[0.0; 2]; 4], radius: 0.0, weight: 0.0 }; 4];
+    for (q, [xi, eta]) in POINTS.iter().enumerate() {
+        let (n, dn) = shape(*xi, *eta);
+        let mut jac = Matrix2::zeros(); // J_ab = dX_a / dxi_b
+        for i in 0..4 {
+            for a in 0..2 {
+                for b in 0..2 {
+                    jac[(a, b)] += x[i][a] * dn[i][b];
+                }
+            }
+        }
+        let det = jac.determinant();
+        if !(det > 0.0) {
+            return Err(KernelError::NegativeJacobian { point: q, det });
+        }
+        let inv = Matrix2::new(jac[(1, 1)], -jac[(0, 1)], -jac[(1, 0)], jac[(0, 0)]) / det;
+        let mut dndx = [[0.0; 2]; 4];
+        for i in 0..4 {
+            // dN/dX_a = dN/dxi_b (J^-1)_ba
+            for a in 0..2 {
+                dndx[i][a] = dn[i][0] * inv[(0, a)] + dn[i][1] * inv[(1, a)];
+            }
+        }
+        let radius: f64 = (0..4).map(|i| n[i] * x[i][0]).sum();
+        let weight = match formulation {
+            Formulation::PlaneStrain => det,
+            Formulation::PlaneStress => det * thickness[q],
+            Formulation::Axisymmetric => {
+                if !(radius > 0.0) {
+                    return Err(KernelError::NonPositiveRadius { point: q, radius });
+                }
+                det * 2.0 * PI * radius
+            }
+        };
+        points[q] = PointGeometry { shape: n, dndx, radius, weight };
+    }
+    Ok(QuadGeometry { points, formulation })
+}
+
+/// Kinematics of one point for a given increment d.
+struct PointKinematics {
+    /// [u,x u,y v,x v,y]
+    theta: [f64; 4],
+    /// u_r / r (zero unless axisymmetric)
+    hoop: f64,
+    strain: Voigt,
+    b: BMatrix,
+}
+
+fn point_kinematics(p: &PointGeometry, d: &Vec8, formulation: Formulation, geometry: Geometry) -> PointKinematics {
+    let mut theta = [0.0; 4];
+    for i in 0..4 {
+        let [nx, ny] = p.dndx[i];
+        theta[0] += nx * d[2 * i];
+        theta[1] += ny * d[2 * i];
+        theta[2] += nx * d[2 * i + 1];
+        theta[3] += ny * d[2 * i + 1];
+    }
+    let axisymmetric = formulation == Formulation::Axisymmetric;
+    let hoop = if axisymmetric { (0..4).map(|i| p.shape[i] * d[2 * i]).sum::<f64>() / p.radius } else { 0.0 };
+    // Nonlinear parts switched off by a zero factor in linear kinematics.
+    let nl = if geometry == Geometry::Nonlinear { 1.0 } else { 0.0 };
+    let [ux, uy, vx, vy] = theta;
+    let strain = Voigt::new(
+        ux + 0.5 * nl * (ux * ux + vx * vx),
+        vy + 0.5 * nl * (uy * uy + vy * vy),
+        hoop + 0.5 * nl * hoop * hoop,
+        uy + vx + nl * (ux * uy + vx * vy),
+    );
+    let mut b = BMatrix::zeros();
+    for i in 0..4 {
+        let [nx, ny] = p.dndx[i];
+        let (cu, cv) = (2 * i, 2 * i + 1);
+        b[(0, cu)] = nx * (1.0 + nl * ux);
+        b[(0, cv)] = nx * nl * vx;
+        b[(1, cu)] = ny * nl * uy;
+        b[(1, cv)] = ny * (1.0 + nl * vy);
+        if axisymmetric {
+            b[(2, cu)] = p.shape[i] / p.radius * (1.0 + nl * hoop);
+        }
+        b[(3, cu)] = ny * (1.0 + nl * ux) + nx * nl * uy;
+        b[(3, cv)] = nx * (1.0 + nl * vy) + ny * nl * vx;
+    }
+    PointKinematics { theta, hoop, strain, b }
+}
+
+/// The four points' kinematics with the B-bar modification applied when asked.
+fn kinematics(geom: &QuadGeometry, d: &Vec8, geometry: Geometry, bbar: bool) -> [PointKinematics; 4] {
+    let mut k = geom.points.map(|p| point_kinematics(&p, d, geom.formulation, geometry));
+    if bbar {
+        let volume = geom.volume();
+        let mut mean_trace = 0.0;
+        let mut mean_b = SMatrix::<f64, 1, 8>::zeros();
+        for (p, kp) in geom.points.iter().zip(&k) {
+            mean_trace += p.weight * trace(&kp.strain) / volume;
+            mean_b += (kp.b.row(0) + kp.b.row(1) + kp.b.row(2)) * (p.weight / volume);
+        }
+        for kp in &mut k {
+            let dev_trace = (mean_trace - trace(&kp.strain)) / 3.0;
+            let dev_b = (mean_b - (kp.b.row(0) + kp.b.row(1) + kp.b.row(2))) / 3.0;
+            for r in 0..3 {
+                kp.strain[r] += dev_trace;
+                let row = kp.b.row(r) + dev_b;
+                kp.b.set_row(r, &row);
+            }
+        }
+    }
+    k
+}
+
+fn trace(v: &Voigt) -> f64 {
+    v[0] + v[1] + v[2]
+}
+
+/// Green-Lagrange strain increments at the four Gauss points (zz = 0 in plane stress: the
+/// material decides it).
+pub fn strains(geom: &QuadGeometry, d: &Vec8, geometry: Geometry, bbar: bool) -> [Voigt; 4] {
+    kinematics(geom, d, geometry, bbar).map(|k| k.strain)
+}
+
+/// In-plane deformation gradient F = I + [[u,x u,y] [v,x v,y]] and the hoop stretch 1 + u/r
+/// (1 unless axisymmetric) at the four Gauss points.
+pub fn deformation(geom: &QuadGeometry, d: &Vec8) -> [(Matrix2<f64>, f64); 4] {
+    geom.points.map(|p| {
+        let k = point_kinematics(&p, d, geom.formulation, Geometry::Nonlinear);
+        let [ux, uy, vx, vy] = k.theta;
+        (Matrix2::new(1.0 + ux, uy, vx, 1.0 + vy), 1.0 + k.hoop)
+    })
+}
+
+/// Internal force f = sum_q w_q B_q^T S_q (Erklig eq 25).
+pub fn internal_force(geom: &QuadGeometry, d: &Vec8, stress: &[Voigt; 4], geometry: Geometry, bbar: bool) -> Vec8 {
+    let k = kinematics(geom, d, geometry, bbar);
+    let mut f = Vec8::zeros();
+    for q in 0..4 {
+        f += k[q].b.transpose() * stress[q] * geom.points[q].weight;
+    }
+    f
+}
+
+/// Tangent K_T = K_0 + K_sigma (Erklig eqs 32-34), the exact derivative of `internal_force`
+/// for the given material moduli dS/dE.
+pub fn tangent(
+    geom: &QuadGeometry,
+    d: &Vec8,
+    stress: &[Voigt; 4],
+    moduli: &[Moduli; 4],
+    geometry: Geometry,
+    bbar: bool,
+) -> Mat8 {
+    let k = kinematics(geom, d, geometry, bbar);
+    let mut kt = Mat8::zeros();
+    for q in 0..4 {
+        let w = geom.points[q].weight;
+        kt += k[q].b.transpose() * (moduli[q] * k[q].b) * w;
+    }
+    if geometry == Geometry::Linear {
+        return kt;
+    }
+    let axisymmetric = geom.formulation == Formulation::Axisymmetric;
+    let mut mean_m = Mat8::zeros();
+    let mut ms = [Mat8::zeros(); 4];
+    for q in 0..4 {
+        let p = &geom.points[q];
+        let s = &stress[q];
+        for i in 0..4 {
+            for j in 0..4 {
+                let [xi, yi] = p.dndx[i];
+                let [xj, yj] = p.dndx[j];
+                let g = xi * (s[0] * xj + s[3] * yj) + yi * (s[3] * xj + s[1] * yj);
+                let mut guu = g;
+                let mut m_uu = xi * xj + yi * yj;
+                let m_vv = m_uu;
+                if axisymmetric {
+                    let nn = p.shape[i] * p.shape[j] / (p.radius * p.radius);
+                    guu += s[2] * nn;
+                    m_uu += nn;
+                }
+                kt[(2 * i, 2 * j)] += p.weight * guu;
+                kt[(2 * i + 1, 2 * j + 1)] += p.weight * g;
+                ms[q][(2 * i, 2 * j)] = m_uu;
+                ms[q][(2 * i + 1, 2 * j + 1)] = m_vv;
+            }
+        }
+        mean_m += ms[q] * (p.weight / geom.volume());
+    }
+    if bbar {
+        for q in 0..4 {
+            let w = geom.points[q].weight;
+            kt += (mean_m - ms[q]) * (w * trace(&stress[q]) / 3.0);
+        }
+    }
+    kt
+}
+
+/// Consistent mass per unit density, the same for both directions: M_ij = sum w N_i N_j.
+pub fn mass(geom: &QuadGeometry) -> Mat4 {
+    let mut m = Mat4::zeros();
+    for p in &geom.points {
+        for i in 0..4 {
+            for j in 0..4 {
+                m[(i, j)] += p.weight * p.shape[i] * p.shape[j];
+            }
+        }
+    }
+    m
+}
+
+/// Consistent nodal forces [fa_x fa_y fb_x fb_y] of a constant traction `t` (force per unit
+/// reference length; per unit area in plane stress with `thickness`, per unit area of the
+/// surface of revolution in axisymmetry) on the straight edge a -> b.
+pub fn edge_force(a: [f64; 2], b: [f64; 2], t: [f64; 2], formulation: Formulation, thickness: f64) -> [f64; 4] {
+    let length = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    let (wa, wb) = match formulation {
+        Formulation::PlaneStrain => (0.5 * length, 0.5 * length),
+        Formulation::PlaneStress => (0.5 * length * thickness, 0.5 * length * thickness),
+        // integral of N_a 2 pi r ds with r linear along the edge
+        Formulation::Axisymmetric => {
+            (2.0 * PI * length * (2.0 * a[0] + b[0]) / 6.0, 2.0 * PI * length * (a[0] + 2.0 * b[0]) / 6.0)
+        }
+    };
+    [wa * t[0], wa * t[1], wb * t[0], wb * t[1]]
+}
+
+/// Outward unit normal of the edge a -> b of a body that lies on its left.
+pub fn outward_normal(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let length = (dx * dx + dy * dy).sqrt();
+    [dy / length, -dx / length]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::element::Moduli;
+
+    fn distorted() -> Coords {
+        [[1.0, 0.1], [2.2, -0.1], [2.0, 1.3], [0.9, 0.8]]
+    }
+
+    fn moduli() -> Moduli {
+        let (lambda, mu) = (1.2, 0.8);
+        let mut d = Moduli::zeros();
+        for a in 0..3 {
+            for b in 0..3 {
+                d[(a, b)] = lambda;
+            }
+            d[(a, a)] += 2.0 * mu;
+        }
+        d[(3, 3)] = mu;
+        d
+    }
+
+    fn stress_of(strain: &Voigt, s0: &Voigt) -> Voigt {
+        s0 + moduli() * strain
+    }
+
+    /// The tangent is the derivative of the internal force (central differences, h = 1e-6:
+    /// truncation O(h^2) ~ 1e-12 against entries O(1)).
+    #[test]
+    fn tangent_matches_finite_differences_of_internal_force() {
+        let d = Vec8::from_fn(|i, _| 0.05 * ((i as f64) * 1.7).sin());
+        let s0 = Voigt::new(0.3, -0.2, 0.1, 0.15);
+        for form in [Formulation::PlaneStrain, Formulation::PlaneStress, Formulation::Axisymmetric] {
+            for bbar in [false, true] {
+                let geom = geometry(&distorted(), form, &[0.7; 4]).unwrap();
+                let force = |d: &Vec8| {
+                    let e = strains(&geom, d, Geometry::Nonlinear, bbar);
+                    internal_force(&geom, d, &e.map(|e| stress_of(&e, &s0)), Geometry::Nonlinear, bbar)
+                };
+                let e = strains(&geom, &d, Geometry::Nonlinear, bbar);
+                let kt = tangent(&geom, &d, &e.map(|e| stress_of(&e, &s0)), &[moduli(); 4], Geometry::Nonlinear, bbar);
+                let h = 1e-6;
+                for j in 0..8 {
+                    let mut dp = d;
+                    let mut dm = d;
+                    dp[j] += h;
+                    dm[j] -= h;
+                    let col = (force(&dp) - force(&dm)) / (2.0 * h);
+                    for i in 0..8 {
+                        approx::assert_abs_diff_eq!(kt[(i, j)], col[i], epsilon = 1e-7 * (1.0 + col[i].abs()));
+                    }
+                }
+                assert!((kt - kt.transpose()).abs().max() < 1e-12, "{form:?} bbar={bbar}");
+            }
+        }
+    }
+
+    /// A rigid translation gives no strain, no force; volume of the reference element is its area.
+    #[test]
+    fn rigid_translation_is_strain_free() {
+        let geom = geometry(&distorted(), Formulation::PlaneStrain, &[1.0; 4]).unwrap();
+        let d = Vec8::from_fn(|i, _| if i % 2 == 0 { 0.3 } else { -0.7 });
+        for e in strains(&geom, &d, Geometry::Nonlinear, true) {
+            assert!(e.norm() < 1e-14);
+        }
+        // shoelace area of the quad
+        let x = distorted();
+        let area: f64 = (0..4).map(|i| x[i][0] * x[(i + 1) % 4][1] - x[(i + 1) % 4][0] * x[i][1]).sum::<f64>() / 2.0;
+        approx::assert_relative_eq!(geom.volume(), area, max_relative = 1e-14);
+    }
+
+    #[test]
+    fn inverted_element_is_an_error() {
+        let mut x = distorted();
+        x.swap(1, 3);
+        assert!(matches!(
+            geometry(&x, Formulation::PlaneStrain, &[1.0; 4]),
+            Err(KernelError::NegativeJacobian { .. })
+        ));
+    }
+}

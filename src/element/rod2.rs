@@ -1,0 +1,127 @@
+//! Two-node rod (bar) in the plane, updated Lagrangian with constant area.
+//!
+//! Legend
+//! ```text
+//! X1, X2   reference (last converged) node positions,   L = |X2 - X1|
+//! x = X + d current positions,                            l = |x2 - x1|,  dx = x2 - x1
+//! dE       Green-Lagrange strain increment (l^2 - L^2) / (2 L^2)
+//! B        dE/dd = [-dx, dx] / L^2
+//! S        second Piola-Kirchhoff stress relative to the reference;  N = S A l / L
+//! K_T      A L (B^T E_t B + S / L^2 [[I, -I], [-I, I]])
+//! ```
+//! Linear kinematics keeps B = [-e, e] / L with e the reference direction and no K_sigma.
+
+use super::{Geometry, KernelError, Mat4, Vec4};
+
+/// Reference length and unit direction of the rod X1 -> X2.
+pub fn length(x: &[[f64; 2]; 2]) -> Result<f64, KernelError> {
+    let l = ((x[1][0] - x[0][0]).powi(2) + (x[1][1] - x[0][1]).powi(2)).sqrt();
+    if l > 0.0 { Ok(l) } else { Err(KernelError::ZeroLength) }
+}
+
+fn b_vector(x: &[[f64; 2]; 2], d: &Vec4, length: f64, geometry: Geometry) -> Vec4 {
+    let mut dx = [x[1][0] - x[0][0], x[1][1] - x[0][1]];
+    if geometry == Geometry::Nonlinear {
+        dx[0] += d[2] - d[0];
+        dx[1] += d[3] - d[1];
+    }
+    let l2 = length * length;
+    Vec4::new(-dx[0], -dx[1], dx[0], dx[1]) / l2
+}
+
+/// Axial Green-Lagrange strain increment.
+pub fn strain(x: &[[f64; 2]; 2], d: &Vec4, geometry: Geometry) -> Result<f64, KernelError> {
+    let l = length(x)?;
+    let e = [(x[1][0] - x[0][0]) / l, (x[1][1] - x[0][1]) / l];
+    let du = [d[2] - d[0], d[3] - d[1]];
+    let linear = (e[0] * du[0] + e[1] * du[1]) / l;
+    Ok(match geometry {
+        Geometry::Linear => linear,
+        Geometry::Nonlinear => linear + 0.5 * (du[0] * du[0] + du[1] * du[1]) / (l * l),
+    })
+}
+
+/// Stretch l / L of the increment (pushes S forward to the Cauchy stress S l / L).
+pub fn stretch(x: &[[f64; 2]; 2], d: &Vec4) -> Result<f64, KernelError> {
+    let l = length(x)?;
+    let dx = [x[1][0] - x[0][0] + d[2] - d[0], x[1][1] - x[0][1] + d[3] - d[1]];
+    Ok((dx[0] * dx[0] + dx[1] * dx[1]).sqrt() / l)
+}
+
+/// Internal force A L B^T S.
+pub fn internal_force(x: &[[f64; 2]; 2], d: &Vec4, stress: f64, area: f64, geometry: Geometry) -> Result<Vec4, KernelError> {
+    let l = length(x)?;
+    Ok(b_vector(x, d, l, geometry) * (area * l * stress))
+}
+
+/// Tangent: the exact derivative of `internal_force` for dS/dE = `modulus`.
+pub fn tangent(
+    x: &[[f64; 2]; 2],
+    d: &Vec4,
+    stress: f64,
+    modulus: f64,
+    area: f64,
+    geometry: Geometry,
+) -> Result<Mat4, KernelError> {
+    let l = length(x)?;
+    let b = b_vector(x, d, l, geometry);
+    let mut k = b * b.transpose() * (area * l * modulus);
+    if geometry == Geometry::Nonlinear {
+        let g = area * stress / l;
+        for a in 0..2 {
+            k[(a, a)] += g;
+            k[(a + 2, a + 2)] += g;
+            k[(a, a + 2)] -= g;
+            k[(a + 2, a)] -= g;
+        }
+    }
+    Ok(k)
+}
+
+/// Lumped (diagonal) and consistent mass per unit density and area: L/2 per node, and
+/// L/6 [[2, 1], [1, 2]] per direction.
+pub fn mass(x: &[[f64; 2]; 2]) -> Result<[[f64; 2]; 2], KernelError> {
+    let l = length(x)?;
+    Ok([[l / 3.0, l / 6.0], [l / 6.0, l / 3.0]])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tangent_matches_finite_differences() {
+        let x = [[0.2, 0.1], [1.3, 0.6]];
+        let d = Vec4::new(0.01, -0.03, 0.08, 0.05);
+        let (s0, modulus, area) = (0.4, 3.0, 0.7);
+        let force = |d: &Vec4| {
+            let e = strain(&x, d, Geometry::Nonlinear).unwrap();
+            internal_force(&x, d, s0 + modulus * e, area, Geometry::Nonlinear).unwrap()
+        };
+        let e = strain(&x, &d, Geometry::Nonlinear).unwrap();
+        let k = tangent(&x, &d, s0 + modulus * e, modulus, area, Geometry::Nonlinear).unwrap();
+        let h = 1e-6;
+        for j in 0..4 {
+            let (mut dp, mut dm) = (d, d);
+            dp[j] += h;
+            dm[j] -= h;
+            let col = (force(&dp) - force(&dm)) / (2.0 * h);
+            for i in 0..4 {
+                approx::assert_abs_diff_eq!(k[(i, j)], col[i], epsilon = 1e-8);
+            }
+        }
+    }
+
+    /// Green-Lagrange strain equals (l^2 - L^2) / (2 L^2) exactly.
+    #[test]
+    fn strain_is_green_lagrange() {
+        let x = [[0.0, 0.0], [2.0, 0.0]];
+        let d = Vec4::new(0.0, 0.0, 0.5, 1.0);
+        let l2: f64 = 2.5f64.powi(2) + 1.0;
+        approx::assert_relative_eq!(
+            strain(&x, &d, Geometry::Nonlinear).unwrap(),
+            (l2 - 4.0) / 8.0,
+            max_relative = 1e-14
+        );
+    }
+}

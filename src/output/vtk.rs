@@ -1,0 +1,806 @@
+//! VTK time series for ParaView: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu (DESIGN.md section 5).
+//!
+//! Legend
+//! ```text
+//! Grid        all bodies merged, global node numbers
+//! cells       quads (VTK_QUAD = 9) first, then rods (VTK_LINE = 3)
+//! points      reference (initial) coordinates, z = 0
+//! point data  displacement, velocity, acceleration, contact_force   3 components, z = 0
+//!             gap, contact_status                                   1 component
+//! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure
+//! ```
+//! The points never move: show the deformed mesh in ParaView with Warp By Vector on
+//! `displacement` (the active vectors, so the filter picks it by default), scale factor 1.
+//!
+//! Each frame is encoded by vtkio (XML, inline base64, optionally LZ4/ZLib) into memory, written
+//! to a temporary name and renamed; the .pvd is then rewritten the same way. A crash therefore
+//! never leaves a truncated frame or a listed frame that is missing.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use vtkio::model::{
+    Attribute, Attributes, ByteOrder, CellType, Cells, DataArray, DataSet, ElementType,
+    UnstructuredGridPiece, Version, VertexNumbers, Vtk,
+};
+use vtkio::xml::Compressor;
+
+use super::{OutputError, format_f64, write_atomic};
+
+/// All bodies merged into one grid with global node numbering; cells are the quads first, then the lines.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Grid {
+    pub points: Vec<[f64; 2]>,
+    pub quads: Vec<[usize; 4]>,
+    pub lines: Vec<[usize; 2]>,
+}
+
+impl Grid {
+    pub fn cells(&self) -> usize {
+        self.quads.len() + self.lines.len()
+    }
+}
+
+/// One frame's fields. Point fields have one entry per grid point, cell fields one per cell (quads then lines).
+#[derive(Clone, Copy, Debug)]
+pub struct Fields<'a> {
+    pub displacement: &'a [[f64; 2]],
+    pub velocity: &'a [[f64; 2]],
+    pub acceleration: &'a [[f64; 2]],
+    pub contact_force: &'a [[f64; 2]],
+    pub gap: &'a [f64],
+    pub contact_status: &'a [f64],
+    /// XX YY ZZ XY YZ XZ (ParaView's order, so it names the components).
+    pub stress: &'a [[f64; 6]],
+    pub von_mises: &'a [f64],
+    pub eq_plastic_strain: &'a [f64],
+    pub pressure: &'a [f64],
+}
+
+/// Compression of the binary arrays inside each .vtu (ParaView reads all three).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Compression {
+    #[default]
+    None,
+    Lz4,
+    Zlib,
+}
+
+impl Compression {
+    /// vtkio's compressor and level (level 0 would switch compression off; LZ4 ignores it).
+    fn vtkio(self) -> (Compressor, u32) {
+        match self {
+            Compression::None => (Compressor::None, 0),
+            Compression::Lz4 => (Compressor::LZ4, 1),
+            Compression::Zlib => (Compressor::ZLib, 6),
+        }
+    }
+}
+
+/// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
+#[derive(Debug)]
+pub struct Series {
+    dir: PathBuf,
+    name: String,
+    compression: Compression,
+    /// The .pvd's `<DataSet .../>` lines, one per frame written.
+    entries: Vec<String>,
+    last_time: Option<f64>,
+}
+
+impl Series {
+    /// Creates DIR/vtk/ (removes stale NAME_*.vtu frames of an earlier run there) and remembers the name.
+    ///
+    /// Also writes DIR/NAME.pvd listing no frames, so an old .pvd never points at removed files.
+    /// `name` may hold ASCII letters, digits, `_`, `-` and `.` (not first).
+    pub fn create(dir: &Path, name: &str, compression: Compression) -> Result<Series, OutputError> {
+        check_name(dir, name)?;
+        let vtk_dir = dir.join("vtk");
+        fs::create_dir_all(&vtk_dir).map_err(|e| OutputError::io(&vtk_dir, "create folder", e))?;
+        remove_stale_frames(&vtk_dir, name)?;
+        let series = Series {
+            dir: dir.to_path_buf(),
+            name: name.to_string(),
+            compression,
+            entries: Vec::new(),
+            last_time: None,
+        };
+        series.write_pvd()?;
+        Ok(series)
+    }
+
+    /// Writes the next frame (to a temporary name, then renamed), then rewrites NAME.pvd atomically
+    /// listing every frame written so far. Returns the frame's path.
+    ///
+    /// Errors, with nothing written: `time` not finite or not after the previous frame's, a field
+    /// of the wrong length, NaN or infinity in a field or a point, a cell naming a missing point.
+    pub fn write_frame(
+        &mut self,
+        time: f64,
+        grid: &Grid,
+        fields: &Fields,
+    ) -> Result<PathBuf, OutputError> {
+        let file_name = format!("{}_{:05}.vtu", self.name, self.frames());
+        let path = self.dir.join("vtk").join(&file_name);
+        self.check_time(&path, time)?;
+        let vtk = unstructured_grid(&path, grid, fields)?;
+        write_atomic(&path, &encode(&path, vtk, self.compression)?)?;
+        self.entries
+            .push(pvd_entry(time, &format!("vtk/{file_name}")));
+        self.last_time = Some(time);
+        self.write_pvd()?;
+        Ok(path)
+    }
+
+    pub fn frames(&self) -> usize {
+        self.entries.len()
+    }
+
+    pub fn pvd_path(&self) -> PathBuf {
+        self.dir.join(format!("{}.pvd", self.name))
+    }
+
+    fn check_time(&self, path: &Path, time: f64) -> Result<(), OutputError> {
+        if !time.is_finite() {
+            return Err(OutputError::invalid(
+                path,
+                format!("frame time {time} is not finite"),
+            ));
+        }
+        match self.last_time {
+            Some(previous) if time <= previous => Err(OutputError::TimeNotIncreasing {
+                path: path.to_path_buf(),
+                time,
+                previous,
+            }),
+            _ => Ok(()),
+        }
+    }
+
+    fn write_pvd(&self) -> Result<(), OutputError> {
+        let mut text = String::from(concat!(
+            "<?xml version=\"1.0\"?>\n",
+            "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n",
+            "  <Collection>\n",
+        ));
+        self.entries.iter().for_each(|entry| text.push_str(entry));
+        text.push_str("  </Collection>\n</VTKFile>\n");
+        write_atomic(&self.pvd_path(), text.as_bytes())
+    }
+}
+
+/// One `<DataSet>` line of the .pvd; `file` is relative to the .pvd, with forward slashes.
+fn pvd_entry(time: f64, file: &str) -> String {
+    let time = format_f64(time);
+    format!("    <DataSet timestep=\"{time}\" group=\"\" part=\"0\" file=\"{file}\"/>\n")
+}
+
+/// Reads back a .pvd's listed (time, path) entries, for tests and tools.
+///
+/// Paths are resolved against the .pvd's folder. Handles the simple files written here and by
+/// ParaView (attributes in any order, either quote); XML entities and comments are not supported.
+pub fn read_pvd(path: &Path) -> Result<Vec<(f64, PathBuf)>, OutputError> {
+    let text = fs::read_to_string(path).map_err(|e| OutputError::io(path, "read", e))?;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let mut listed = Vec::new();
+    for (i, tag) in text.split("<DataSet").skip(1).enumerate() {
+        let tag = tag.split('>').next().unwrap_or_default();
+        let attribute = |key: &str| {
+            attributes(tag)
+                .find(|(k, _)| *k == key)
+                .map(|(_, v)| v)
+                .ok_or_else(|| OutputError::invalid(path, format!("DataSet {i} has no `{key}`")))
+        };
+        let (time, file) = (attribute("timestep")?, attribute("file")?);
+        let time: f64 = time.parse().map_err(|_| {
+            OutputError::invalid(path, format!("DataSet {i} has timestep {time:?}"))
+        })?;
+        if file.contains('&') {
+            let reason = format!("DataSet {i}: XML entities in {file:?} are not supported");
+            return Err(OutputError::invalid(path, reason));
+        }
+        listed.push((time, folder.join(file)));
+    }
+    Ok(listed)
+}
+
+/// The `name="value"` pairs of a tag's text (after the element name, before `>`).
+fn attributes(mut tag: &str) -> impl Iterator<Item = (&str, &str)> {
+    std::iter::from_fn(move || {
+        let (name, rest) = tag.split_once('=')?;
+        let rest = rest.trim_start();
+        let quote = rest.chars().next().filter(|c| *c == '"' || *c == '\'')?;
+        let (value, rest) = rest[1..].split_once(quote)?;
+        tag = rest;
+        Some((name.trim(), value))
+    })
+}
+
+fn check_name(dir: &Path, name: &str) -> Result<(), OutputError> {
+    let allowed = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.');
+    if name.is_empty() || name.starts_with('.') || !name.chars().all(allowed) {
+        let reason = format!("series name {name:?} must be ASCII letters, digits, `_`, `-`, `.`");
+        return Err(OutputError::invalid(dir, reason));
+    }
+    Ok(())
+}
+
+/// Removes `NAME_NNNNN.vtu` (and leftover `.vtu.tmp`) files of an earlier run from `vtk_dir`.
+fn remove_stale_frames(vtk_dir: &Path, name: &str) -> Result<(), OutputError> {
+    let listing = fs::read_dir(vtk_dir).map_err(|e| OutputError::io(vtk_dir, "list", e))?;
+    for entry in listing {
+        let entry = entry.map_err(|e| OutputError::io(vtk_dir, "list", e))?;
+        let file_name = entry.file_name();
+        if file_name.to_str().is_some_and(|f| is_frame_file(f, name)) {
+            let path = entry.path();
+            fs::remove_file(&path).map_err(|e| OutputError::io(&path, "remove stale frame", e))?;
+        }
+    }
+    Ok(())
+}
+
+/// True for `NAME_` + at least five digits + `.vtu`, optionally followed by `.tmp`.
+fn is_frame_file(file_name: &str, name: &str) -> bool {
+    let file_name = file_name.strip_suffix(".tmp").unwrap_or(file_name);
+    file_name
+        .strip_suffix(".vtu")
+        .and_then(|f| f.strip_prefix(name))
+        .and_then(|f| f.strip_prefix('_'))
+        .is_some_and(|digits| digits.len() >= 5 && digits.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Checks the grid and the fields and builds vtkio's model of one frame.
+fn unstructured_grid(path: &Path, grid: &Grid, fields: &Fields) -> Result<Vtk, OutputError> {
+    use ElementType::{Generic, Vectors};
+    let (n, m) = (grid.points.len(), grid.cells());
+    let point = vec![
+        array(path, "displacement", Vectors, rows(fields.displacement), n)?,
+        array(path, "velocity", Generic(3), rows(fields.velocity), n)?,
+        array(
+            path,
+            "acceleration",
+            Generic(3),
+            rows(fields.acceleration),
+            n,
+        )?,
+        array(
+            path,
+            "contact_force",
+            Generic(3),
+            rows(fields.contact_force),
+            n,
+        )?,
+        array(path, "gap", Generic(1), singles(fields.gap), n)?,
+        array(
+            path,
+            "contact_status",
+            Generic(1),
+            singles(fields.contact_status),
+            n,
+        )?,
+    ];
+    let cell = vec![
+        array(path, "stress", Generic(6), rows(fields.stress), m)?,
+        array(path, "von_mises", Generic(1), singles(fields.von_mises), m)?,
+        array(
+            path,
+            "eq_plastic_strain",
+            Generic(1),
+            singles(fields.eq_plastic_strain),
+            m,
+        )?,
+        array(path, "pressure", Generic(1), singles(fields.pressure), m)?,
+    ];
+    let piece = UnstructuredGridPiece {
+        points: flatten(path, "points", rows(&grid.points), n, 3)?.into(),
+        cells: vtk_cells(path, grid)?,
+        data: Attributes { point, cell },
+    };
+    Ok(Vtk {
+        version: Version::new_xml(1, 0),
+        title: String::new(),
+        byte_order: ByteOrder::LittleEndian,
+        data: DataSet::inline(piece),
+        file_path: None,
+    })
+}
+
+/// A named point or cell array of `count` checked entries, zero-padded to `elem`'s width.
+fn array<'v>(
+    path: &Path,
+    name: &'static str,
+    elem: ElementType,
+    entries: impl ExactSizeIterator<Item = &'v [f64]>,
+    count: usize,
+) -> Result<Attribute, OutputError> {
+    let data = flatten(path, name, entries, count, elem.num_comp() as usize)?;
+    Ok(Attribute::DataArray(DataArray {
+        name: name.to_string(),
+        elem,
+        data: data.into(),
+    }))
+}
+
+fn rows<const N: usize>(values: &[[f64; N]]) -> impl ExactSizeIterator<Item = &[f64]> {
+    values.iter().map(|v| v.as_slice())
+}
+
+fn singles(values: &[f64]) -> impl ExactSizeIterator<Item = &[f64]> {
+    values.iter().map(std::slice::from_ref)
+}
+
+/// Checks a field's length and values and flattens it, padding each entry with zeros to `width`.
+fn flatten<'v>(
+    path: &Path,
+    field: &'static str,
+    entries: impl ExactSizeIterator<Item = &'v [f64]>,
+    expected: usize,
+    width: usize,
+) -> Result<Vec<f64>, OutputError> {
+    if entries.len() != expected {
+        return Err(OutputError::Length {
+            path: path.to_path_buf(),
+            what: format!("field `{field}`"),
+            expected,
+            found: entries.len(),
+        });
+    }
+    let mut flat = Vec::with_capacity(expected * width);
+    for (index, entry) in entries.enumerate() {
+        if let Some(component) = entry.iter().position(|x| !x.is_finite()) {
+            let value = entry[component];
+            return Err(OutputError::NonFinite {
+                path: path.to_path_buf(),
+                field,
+                index,
+                component,
+                value,
+            });
+        }
+        flat.extend_from_slice(entry);
+        flat.resize(flat.len() + width - entry.len(), 0.0);
+    }
+    Ok(flat)
+}
+
+/// Quads then lines, as XML connectivity and end offsets; every node must be a point of the grid.
+fn vtk_cells(path: &Path, grid: &Grid) -> Result<Cells, OutputError> {
+    let quads = grid.quads.iter().map(|q| &q[..]);
+    let lines = grid.lines.iter().map(|l| &l[..]);
+    let mut connectivity = Vec::with_capacity(4 * grid.quads.len() + 2 * grid.lines.len());
+    let mut offsets = Vec::with_capacity(grid.cells());
+    for (cell, nodes) in quads.chain(lines).enumerate() {
+        if let Some(&node) = nodes.iter().find(|&&n| n >= grid.points.len()) {
+            let reason = format!(
+                "cell {cell} refers to node {node}, but the grid has {} points",
+                grid.points.len()
+            );
+            return Err(OutputError::invalid(path, reason));
+        }
+        connectivity.extend(nodes.iter().map(|&n| n as u64));
+        offsets.push(connectivity.len() as u64);
+    }
+    let mut types = vec![CellType::Quad; grid.quads.len()];
+    types.resize(grid.cells(), CellType::Line);
+    Ok(Cells {
+        cell_verts: VertexNumbers::XML {
+            connectivity,
+            offsets,
+        },
+        types,
+    })
+}
+
+/// Encodes the frame into XML bytes in memory (vtkio's own file writer ignores short writes).
+fn encode(path: &Path, vtk: Vtk, compression: Compression) -> Result<Vec<u8>, OutputError> {
+    let vtk_error = |source: vtkio::xml::Error| OutputError::Vtk {
+        path: path.to_path_buf(),
+        source: source.into(),
+    };
+    let (compressor, level) = compression.vtkio();
+    let file = vtk
+        .try_into_xml_format(compressor, level)
+        .map_err(vtk_error)?;
+    let mut bytes = Vec::new();
+    file.write(&mut bytes).map_err(vtk_error)?;
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::{temporary_path, test_dir};
+    use vtkio::model::{Attribute, IOBuffer};
+
+    /// Owned fields of one frame, with values that differ per entry, component and frame.
+    struct Frame {
+        vectors: [Vec<[f64; 2]>; 4],
+        point_scalars: [Vec<f64>; 2],
+        stress: Vec<[f64; 6]>,
+        cell_scalars: [Vec<f64>; 3],
+    }
+
+    impl Frame {
+        fn new(grid: &Grid, k: usize) -> Frame {
+            let value = |field: usize, i: usize, c: usize| {
+                (k as f64 + 1.0) * (1.0 / 3.0 + field as f64) + i as f64 * 1e-3 - c as f64 * 1e-7
+            };
+            let (np, nc) = (grid.points.len(), grid.cells());
+            let vector = |f| (0..np).map(|i| [value(f, i, 0), value(f, i, 1)]).collect();
+            let scalar = |f, n| (0..n).map(|i| value(f, i, 0)).collect();
+            Frame {
+                vectors: [vector(0), vector(1), vector(2), vector(3)],
+                point_scalars: [scalar(4, np), scalar(5, np)],
+                stress: (0..nc)
+                    .map(|i| std::array::from_fn(|c| value(6, i, c)))
+                    .collect(),
+                cell_scalars: [scalar(7, nc), scalar(8, nc), scalar(9, nc)],
+            }
+        }
+
+        fn fields(&self) -> Fields<'_> {
+            Fields {
+                displacement: &self.vectors[0],
+                velocity: &self.vectors[1],
+                acceleration: &self.vectors[2],
+                contact_force: &self.vectors[3],
+                gap: &self.point_scalars[0],
+                contact_status: &self.point_scalars[1],
+                stress: &self.stress,
+                von_mises: &self.cell_scalars[0],
+                eq_plastic_strain: &self.cell_scalars[1],
+                pressure: &self.cell_scalars[2],
+            }
+        }
+
+        /// (name, components, flattened values as they should appear in the file).
+        fn point_arrays(&self) -> Vec<(&'static str, usize, Vec<f64>)> {
+            let pad = |v: &[[f64; 2]]| v.iter().flat_map(|a| [a[0], a[1], 0.0]).collect();
+            let names = ["displacement", "velocity", "acceleration", "contact_force"];
+            let mut arrays: Vec<_> = (0..4)
+                .map(|f| (names[f], 3, pad(&self.vectors[f])))
+                .collect();
+            arrays.push(("gap", 1, self.point_scalars[0].clone()));
+            arrays.push(("contact_status", 1, self.point_scalars[1].clone()));
+            arrays
+        }
+
+        fn cell_arrays(&self) -> Vec<(&'static str, usize, Vec<f64>)> {
+            vec![
+                ("stress", 6, self.stress.concat()),
+                ("von_mises", 1, self.cell_scalars[0].clone()),
+                ("eq_plastic_strain", 1, self.cell_scalars[1].clone()),
+                ("pressure", 1, self.cell_scalars[2].clone()),
+            ]
+        }
+    }
+
+    /// Two quads side by side and a separate rod.
+    fn two_quads_and_a_rod() -> Grid {
+        Grid {
+            points: vec![
+                [0.0, 0.0],
+                [1.0, 0.0],
+                [2.0, 0.0],
+                [0.0, 1.0],
+                [1.0, 1.0],
+                [2.0, 1.0],
+                [3.0, 0.5],
+                [4.0, 0.5],
+            ],
+            quads: vec![[0, 1, 4, 3], [1, 2, 5, 4]],
+            lines: vec![[6, 7]],
+        }
+    }
+
+    fn import(path: &Path) -> UnstructuredGridPiece {
+        let vtk = Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let DataSet::UnstructuredGrid { mut pieces, .. } = vtk.data else {
+            panic!("{} is not an unstructured grid", path.display())
+        };
+        assert_eq!(pieces.len(), 1);
+        pieces.remove(0).into_loaded_piece_data(None).unwrap()
+    }
+
+    fn floats(buffer: &IOBuffer) -> Vec<f64> {
+        buffer.cast_into::<f64>().expect("a Float64 array")
+    }
+
+    fn bits(values: &[f64]) -> Vec<u64> {
+        values.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// Checks that `attributes` hold exactly the `expected` arrays, bit for bit.
+    fn assert_arrays(path: &Path, attributes: &[Attribute], expected: &[(&str, usize, Vec<f64>)]) {
+        assert_eq!(attributes.len(), expected.len(), "{}", path.display());
+        for (name, components, values) in expected {
+            let array = attributes
+                .iter()
+                .find_map(|a| match a {
+                    Attribute::DataArray(array) if array.name == *name => Some(array),
+                    _ => None,
+                })
+                .unwrap_or_else(|| panic!("{}: no array {name}", path.display()));
+            assert_eq!(array.num_comp(), *components, "{name}");
+            assert_eq!(bits(&floats(&array.data)), bits(values), "{name}");
+        }
+    }
+
+    /// Checks one written frame against the grid and the fields it was written from.
+    fn assert_frame(path: &Path, grid: &Grid, frame: &Frame) {
+        let piece = import(path);
+        let points: Vec<f64> = grid.points.iter().flat_map(|p| [p[0], p[1], 0.0]).collect();
+        assert_eq!(bits(&floats(&piece.points)), bits(&points));
+        let mut types = vec![CellType::Quad; grid.quads.len()];
+        types.resize(grid.cells(), CellType::Line);
+        assert_eq!(piece.cells.types, types);
+        let (connectivity, offsets) = piece.cells.cell_verts.into_xml();
+        let nodes = grid
+            .quads
+            .iter()
+            .map(|q| &q[..])
+            .chain(grid.lines.iter().map(|l| &l[..]));
+        let expected: Vec<u64> = nodes.flatten().map(|&n| n as u64).collect();
+        assert_eq!(connectivity, expected);
+        assert_eq!(offsets.len(), grid.cells());
+        assert_arrays(path, &piece.data.point, &frame.point_arrays());
+        assert_arrays(path, &piece.data.cell, &frame.cell_arrays());
+    }
+
+    const TIMES: [f64; 3] = [0.0, 1e-5, 1.0 / 3.0];
+
+    /// Goal: a 3-frame series reads back through the .pvd and vtkio exactly as written.
+    /// Setup: 2 quads + 1 rod, all fields distinct per entry, times 0, 1e-5, 1/3.
+    /// Reference: the written values themselves (binary arrays must be bit-exact).
+    fn assert_series_round_trips(compression: Compression) {
+        let dir = test_dir(&format!("series-{compression:?}"));
+        let grid = two_quads_and_a_rod();
+        let frames: Vec<Frame> = (0..3).map(|k| Frame::new(&grid, k)).collect();
+        let mut series = Series::create(&dir, "run", compression).unwrap();
+        let written: Vec<PathBuf> = (0..3)
+            .map(|k| {
+                series
+                    .write_frame(TIMES[k], &grid, &frames[k].fields())
+                    .unwrap()
+            })
+            .collect();
+        assert_eq!(series.frames(), 3);
+        assert_eq!(written[2], dir.join("vtk").join("run_00002.vtu"));
+
+        let listed = read_pvd(&dir.join("run.pvd")).unwrap();
+        let times: Vec<f64> = listed.iter().map(|(t, _)| *t).collect();
+        assert_eq!(bits(&times), bits(&TIMES));
+        assert!(times.windows(2).all(|w| w[0] < w[1]));
+        let pvd = fs::read_to_string(dir.join("run.pvd")).unwrap();
+        assert!(pvd.contains("timestep=\"0.3333333333333333\""), "{pvd}");
+        assert!(pvd.contains("file=\"vtk/run_00001.vtu\""), "{pvd}");
+        for ((_, path), (frame, written)) in listed.iter().zip(frames.iter().zip(&written)) {
+            assert_eq!(path, written);
+            assert!(!temporary_path(path).exists());
+            assert_frame(path, &grid, frame);
+        }
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn series_round_trips_through_pvd_and_vtkio_uncompressed() {
+        assert_series_round_trips(Compression::None);
+    }
+
+    #[test]
+    fn series_round_trips_through_pvd_and_vtkio_lz4() {
+        assert_series_round_trips(Compression::Lz4);
+    }
+
+    #[test]
+    fn series_round_trips_through_pvd_and_vtkio_zlib() {
+        assert_series_round_trips(Compression::Zlib);
+    }
+
+    /// A 64 x 64 node grid with 63 x 63 quads and 127 rods: 4096 points and 4096 cells, so
+    /// every array is a whole number of vtkio's 32768-byte compression blocks.
+    fn block_sized_grid() -> Grid {
+        let n = 64;
+        let points = (0..n * n)
+            .map(|i| [(i % n) as f64, (i / n) as f64])
+            .collect();
+        let quads = (0..n - 1)
+            .flat_map(|j| (0..n - 1).map(move |i| j * n + i))
+            .map(|a| [a, a + 1, a + n + 1, a + n])
+            .collect();
+        let lines = (0..127).map(|i| [i, i + 1]).collect();
+        Grid {
+            points,
+            quads,
+            lines,
+        }
+    }
+
+    /// Goal: compressed arrays whose size is an exact multiple of the 32768-byte block
+    /// (vtkio then writes an empty last block) still read back exactly.
+    #[test]
+    fn compressed_arrays_of_whole_blocks_round_trip() {
+        let grid = block_sized_grid();
+        assert_eq!((grid.points.len(), grid.cells()), (4096, 4096));
+        let frame = Frame::new(&grid, 0);
+        for compression in [Compression::Lz4, Compression::Zlib] {
+            let dir = test_dir(&format!("blocks-{compression:?}"));
+            let mut series = Series::create(&dir, "big", compression).unwrap();
+            let path = series.write_frame(0.5, &grid, &frame.fields()).unwrap();
+            assert_frame(&path, &grid, &frame);
+            fs::remove_dir_all(&dir).unwrap();
+        }
+    }
+
+    /// Goal: a bad frame is an error naming the problem, and the frames and .pvd already
+    /// written stay as they were; the next good frame still gets the next number.
+    #[test]
+    fn bad_frames_are_rejected_and_earlier_output_kept() {
+        let dir = test_dir("bad-frames");
+        let grid = two_quads_and_a_rod();
+        let good = Frame::new(&grid, 0);
+        let mut series = Series::create(&dir, "run", Compression::None).unwrap();
+        for time in [0.0, 1.0] {
+            series.write_frame(time, &grid, &good.fields()).unwrap();
+        }
+        let pvd_before = fs::read(dir.join("run.pvd")).unwrap();
+        let frames_before: Vec<Vec<u8>> = (0..2)
+            .map(|k| fs::read(dir.join(format!("vtk/run_{k:05}.vtu"))).unwrap())
+            .collect();
+
+        let mut nan = Frame::new(&grid, 1);
+        nan.vectors[1][5][1] = f64::NAN;
+        let err = series.write_frame(2.0, &grid, &nan.fields()).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                OutputError::NonFinite {
+                    field: "velocity",
+                    index: 5,
+                    component: 1,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("run_00002.vtu"), "{err}");
+
+        let mut inf = Frame::new(&grid, 1);
+        inf.cell_scalars[2][2] = f64::INFINITY;
+        let err = series.write_frame(2.0, &grid, &inf.fields()).unwrap_err();
+        assert!(matches!(
+            err,
+            OutputError::NonFinite {
+                field: "pressure",
+                index: 2,
+                ..
+            }
+        ));
+
+        let mut short = Frame::new(&grid, 1);
+        short.stress.pop();
+        let err = series.write_frame(2.0, &grid, &short.fields()).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                OutputError::Length {
+                    expected: 3,
+                    found: 2,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("stress"), "{err}");
+
+        let err = series.write_frame(1.0, &grid, &good.fields()).unwrap_err();
+        assert!(
+            matches!(err, OutputError::TimeNotIncreasing { .. }),
+            "{err}"
+        );
+        let err = series
+            .write_frame(f64::NAN, &grid, &good.fields())
+            .unwrap_err();
+        assert!(matches!(err, OutputError::Invalid { .. }), "{err}");
+
+        let mut broken = grid.clone();
+        broken.lines[0][1] = 8;
+        let err = series
+            .write_frame(2.0, &broken, &good.fields())
+            .unwrap_err();
+        assert!(err.to_string().contains("cell 2 refers to node 8"), "{err}");
+
+        assert_eq!(series.frames(), 2);
+        assert_eq!(fs::read(dir.join("run.pvd")).unwrap(), pvd_before);
+        for (k, bytes) in frames_before.iter().enumerate() {
+            assert_eq!(
+                &fs::read(dir.join(format!("vtk/run_{k:05}.vtu"))).unwrap(),
+                bytes
+            );
+        }
+        let mut files: Vec<_> = fs::read_dir(dir.join("vtk"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        files.sort();
+        assert_eq!(files, ["run_00000.vtu", "run_00001.vtu"]);
+
+        let path = series.write_frame(2.0, &grid, &good.fields()).unwrap();
+        assert!(path.ends_with("vtk/run_00002.vtu"));
+        assert_eq!(read_pvd(&series.pvd_path()).unwrap().len(), 3);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Goal: a new series removes the earlier run's frames of its own name, and only those,
+    /// and lists no frames until it writes one.
+    #[test]
+    fn create_removes_only_stale_frames_of_its_name() {
+        let dir = test_dir("stale");
+        let grid = two_quads_and_a_rod();
+        let frame = Frame::new(&grid, 0);
+        let mut old = Series::create(&dir, "run", Compression::None).unwrap();
+        let mut other = Series::create(&dir, "run_1", Compression::None).unwrap();
+        for time in [0.0, 1.0] {
+            old.write_frame(time, &grid, &frame.fields()).unwrap();
+            other.write_frame(time, &grid, &frame.fields()).unwrap();
+        }
+        fs::write(dir.join("vtk/run_00007.vtu.tmp"), b"crashed").unwrap();
+        fs::write(dir.join("vtk/run_notes.vtu"), b"keep").unwrap();
+
+        let new = Series::create(&dir, "run", Compression::None).unwrap();
+        assert_eq!(new.frames(), 0);
+        assert!(read_pvd(&dir.join("run.pvd")).unwrap().is_empty());
+        let mut files: Vec<_> = fs::read_dir(dir.join("vtk"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        files.sort();
+        assert_eq!(
+            files,
+            ["run_1_00000.vtu", "run_1_00001.vtu", "run_notes.vtu"]
+        );
+        assert_eq!(read_pvd(&dir.join("run_1.pvd")).unwrap().len(), 2);
+
+        for bad in ["", ".hidden", "a/b", "a b", "x&y"] {
+            assert!(
+                Series::create(&dir, bad, Compression::None).is_err(),
+                "{bad:?}"
+            );
+        }
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Goal: read_pvd takes ParaView-style files too (attribute order, quotes, no part).
+    #[test]
+    fn read_pvd_accepts_other_writers_layout() {
+        let dir = test_dir("pvd");
+        let path = dir.join("x.pvd");
+        let text = "<VTKFile type='Collection'><Collection>\n<DataSet file='a/f0.vtu' timestep='1e-3'/>\n<DataSet part=\"0\" timestep=\"2.5\" file=\"f1.vtu\"></DataSet></Collection></VTKFile>";
+        fs::write(&path, text).unwrap();
+        let listed = read_pvd(&path).unwrap();
+        assert_eq!(
+            listed,
+            [(1e-3, dir.join("a/f0.vtu")), (2.5, dir.join("f1.vtu"))]
+        );
+        fs::write(&path, "<DataSet file=\"f.vtu\"/>").unwrap();
+        assert!(
+            read_pvd(&path)
+                .unwrap_err()
+                .to_string()
+                .contains("timestep")
+        );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Goal: the scene's spelling of the compression option.
+    #[test]
+    fn compression_uses_snake_case_names() {
+        let names: Vec<String> = [Compression::None, Compression::Lz4, Compression::Zlib]
+            .iter()
+            .map(|c| serde_json::to_string(c).unwrap())
+            .collect();
+        assert_eq!(names, ["\"none\"", "\"lz4\"", "\"zlib\""]);
+        assert_eq!(Compression::default(), Compression::None);
+    }
+}

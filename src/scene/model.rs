@@ -1,0 +1,500 @@
+//! The validated model: bodies with meshes and materials placed in one global node numbering,
+//! supports as constrained DOFs, loads resolved to global nodes, curves resolved.
+//!
+//! Global numbering: body b's node i is global node `node_offset[b] + i`; DOF `2 n + c`
+//! (c = 0 for x / r, 1 for y / z).
+
+use super::InputError;
+use super::spec::{
+    AnalysisSpec, BodySpec, Component, FormulationSpec, LoadSpec, NewtonSpec, OutputSpec, ProbeSpec, Quantity, Scene,
+    StaticSpec,
+};
+use crate::element::{Formulation, Geometry, Voigt, quad4, rod2};
+use crate::material::{Elastic, Material};
+use crate::mesh::{Cells, Mesh};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BodyKind {
+    Continuum { formulation: Formulation, bbar: bool, thickness: f64 },
+    Rod { area: f64 },
+}
+
+#[derive(Debug, Clone)]
+pub struct Body {
+    pub name: String,
+    pub mesh: Mesh,
+    pub kind: BodyKind,
+    pub material: Material,
+    pub node_offset: usize,
+    pub initial_stress: Voigt,
+    pub velocity: [f64; 2],
+}
+
+impl Body {
+    pub fn global(&self, node: usize) -> usize {
+        self.node_offset + node
+    }
+
+    pub fn elements(&self) -> usize {
+        self.mesh.cells.len()
+    }
+
+    /// Material points per element: 4 for Quad4, 1 for rods.
+    pub fn points_per_element(&self) -> usize {
+        match self.kind {
+            BodyKind::Continuum { .. } => 4,
+            BodyKind::Rod { .. } => 1,
+        }
+    }
+}
+
+/// A piecewise-linear curve, constant beyond its ends.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    pub points: Vec<[f64; 2]>,
+}
+
+impl Curve {
+    pub fn value(&self, t: f64) -> f64 {
+        let p = &self.points;
+        if t <= p[0][0] {
+            return p[0][1];
+        }
+        for w in p.windows(2) {
+            if t <= w[1][0] {
+                let s = (t - w[0][0]) / (w[1][0] - w[0][0]);
+                return w[0][1] + s * (w[1][1] - w[0][1]);
+            }
+        }
+        p[p.len() - 1][1]
+    }
+}
+
+#[derive(Debug, Clone)]
+pub enum Load {
+    /// The same force on each listed global node.
+    NodalForce { nodes: Vec<usize>, force: [f64; 2], curve: Curve },
+    /// Dead traction on edges (global node pairs) of a body.
+    Traction { body: usize, edges: Vec<[usize; 2]>, traction: [f64; 2], curve: Curve },
+    /// Pressure normal to the edges at the start of the increment.
+    Pressure { body: usize, edges: Vec<[usize; 2]>, pressure: f64, curve: Curve },
+    /// Prescribed total displacement components.
+    Displacement { nodes: Vec<usize>, x: Option<f64>, y: Option<f64>, curve: Curve },
+    /// Prescribed rigid rotation about `center` (initial coordinates).
+    Rotation { nodes: Vec<usize>, center: [f64; 2], angle: f64, curve: Curve },
+}
+
+#[derive(Debug, Clone)]
+pub struct Probe {
+    pub quantity: Quantity,
+    pub body: usize,
+    /// Node ids (nodal quantities, global) or element ids of the body.
+    pub members: Vec<usize>,
+    pub column: String,
+}
+
+#[derive(Debug, Clone)]
+pub enum Analysis {
+    Static(StaticSpec),
+}
+
+impl Analysis {
+    pub fn geometry(&self) -> Geometry {
+        match self {
+            Analysis::Static(s) => s.geometry,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Scene file stem: names the output folder and the .pvd.
+    pub name: String,
+    pub file: PathBuf,
+    pub title: String,
+    pub bodies: Vec<Body>,
+    pub node_count: usize,
+    /// DOFs fixed by supports (sorted, unique).
+    pub fixed_dofs: Vec<usize>,
+    pub loads: Vec<Load>,
+    pub analysis: Analysis,
+    pub output: OutputSpec,
+    pub probes: Vec<Probe>,
+}
+
+impl Model {
+    pub fn dofs(&self) -> usize {
+        2 * self.node_count
+    }
+
+    pub fn elements(&self) -> usize {
+        self.bodies.iter().map(Body::elements).sum()
+    }
+
+    /// Initial coordinates of all nodes in global numbering.
+    pub fn coordinates(&self) -> Vec<[f64; 2]> {
+        self.bodies.iter().flat_map(|b| b.mesh.nodes.iter().copied()).collect()
+    }
+}
+
+struct Context<'a> {
+    file: &'a Path,
+}
+
+impl Context<'_> {
+    fn err(&self, message: impl Into<String>) -> InputError {
+        InputError::new(self.file, message)
+    }
+}
+
+pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputError> {
+    let cx = Context { file };
+    let materials = materials(&cx, &scene)?;
+    let mut bodies = Vec::new();
+    let mut node_count = 0;
+    for (b, spec) in scene.body.iter().enumerate() {
+        if scene.body[..b].iter().any(|o| o.name == spec.name) {
+            return Err(cx.err(format!("body[{b}]: the name `{}` is used twice", spec.name)));
+        }
+        let body = body(&cx, spec, &materials, base_dir, node_count)?;
+        node_count += body.mesh.nodes.len();
+        bodies.push(body);
+    }
+    if bodies.is_empty() {
+        return Err(cx.err("the scene has no [[body]]"));
+    }
+    let analysis = analysis(&cx, &scene.analysis)?;
+    let curves = curves(&cx, &scene)?;
+    let default_curve = match &analysis {
+        Analysis::Static(s) => Curve { points: vec![[0.0, 0.0], [s.end_time, 1.0]] },
+    };
+    let mut fixed_dofs = Vec::new();
+    for (k, s) in scene.support.iter().enumerate() {
+        let key = format!("support[{k}]");
+        let (b, nodes) = node_set(&cx, &bodies, s.body.as_deref(), &s.set, &key)?;
+        if s.fix.is_empty() {
+            return Err(cx.err(format!("{key}.fix: list at least one of \"x\", \"y\"")));
+        }
+        for n in nodes {
+            for c in &s.fix {
+                fixed_dofs.push(2 * bodies[b].global(n) + (*c == Component::Y) as usize);
+            }
+        }
+    }
+    fixed_dofs.sort_unstable();
+    fixed_dofs.dedup();
+    let loads = scene
+        .load
+        .iter()
+        .enumerate()
+        .map(|(k, l)| load(&cx, &bodies, &curves, &default_curve, k, l))
+        .collect::<Result<Vec<_>, _>>()?;
+    let probes = probes(&cx, &bodies, &scene.output.probe)?;
+    let name = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    Ok(Model {
+        name,
+        file: file.to_path_buf(),
+        title: scene.title,
+        bodies,
+        node_count,
+        fixed_dofs,
+        loads,
+        analysis,
+        output: scene.output,
+        probes,
+    })
+}
+
+fn positive(cx: &Context, key: &str, value: f64) -> Result<f64, InputError> {
+    if value > 0.0 && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(cx.err(format!("{key}: must be a positive number, got {value}")))
+    }
+}
+
+fn materials(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Material>, InputError> {
+    let mut out = BTreeMap::new();
+    for (k, m) in scene.material.iter().enumerate() {
+        let key = format!("material[{k}] (`{}`)", m.name);
+        positive(cx, &format!("{key}.young"), m.young)?;
+        if !(m.poisson > -1.0 && m.poisson < 0.5) {
+            return Err(cx.err(format!("{key}.poisson: must lie in (-1, 0.5), got {}", m.poisson)));
+        }
+        if !(m.density >= 0.0 && m.density.is_finite()) {
+            return Err(cx.err(format!("{key}.density: must be >= 0, got {}", m.density)));
+        }
+        let material = Material {
+            name: m.name.clone(),
+            density: m.density,
+            elastic: Elastic { young: m.young, poisson: m.poisson },
+        };
+        if out.insert(m.name.clone(), material).is_some() {
+            return Err(cx.err(format!("{key}.name: `{}` is used twice", m.name)));
+        }
+    }
+    Ok(out)
+}
+
+fn body(
+    cx: &Context,
+    spec: &BodySpec,
+    materials: &BTreeMap<String, Material>,
+    base_dir: &Path,
+    node_offset: usize,
+) -> Result<Body, InputError> {
+    let key = format!("body `{}`", spec.name);
+    let material = materials.get(&spec.material).cloned().ok_or_else(|| {
+        let known: Vec<&String> = materials.keys().collect();
+        cx.err(format!("{key}.material: no material named `{}` (known: {known:?})", spec.material))
+    })?;
+    let mesh = spec.mesh.build(base_dir).map_err(|e| cx.err(format!("{key}.mesh: {e}")))?;
+    let is_rod = spec.formulation == FormulationSpec::Rod;
+    if spec.thickness.is_some() && spec.formulation != FormulationSpec::PlaneStress {
+        return Err(cx.err(format!("{key}.thickness: only plane_stress bodies have a thickness")));
+    }
+    if spec.area.is_some() && !is_rod {
+        return Err(cx.err(format!("{key}.area: only rod bodies have an area")));
+    }
+    let bbar = spec.bbar.unwrap_or(false);
+    if bbar && matches!(spec.formulation, FormulationSpec::PlaneStress | FormulationSpec::Rod) {
+        return Err(cx.err(format!("{key}.bbar: B-bar applies to plane_strain and axisymmetric bodies only")));
+    }
+    let kind = match spec.formulation {
+        FormulationSpec::Rod => {
+            let area = spec.area.ok_or_else(|| cx.err(format!("{key}.area: a rod body needs its cross-section area")))?;
+            BodyKind::Rod { area: positive(cx, &format!("{key}.area"), area)? }
+        }
+        f => {
+            let formulation = match f {
+                FormulationSpec::PlaneStrain => Formulation::PlaneStrain,
+                FormulationSpec::PlaneStress => Formulation::PlaneStress,
+                _ => Formulation::Axisymmetric,
+            };
+            let thickness = positive(cx, &format!("{key}.thickness"), spec.thickness.unwrap_or(1.0))?;
+            BodyKind::Continuum { formulation, bbar, thickness }
+        }
+    };
+    check_cells(cx, &key, &mesh, &kind)?;
+    let initial_stress = Voigt::from(spec.initial_stress.unwrap_or([0.0; 4]));
+    Ok(Body {
+        name: spec.name.clone(),
+        mesh,
+        kind,
+        material,
+        node_offset,
+        initial_stress,
+        velocity: spec.velocity.unwrap_or([0.0; 2]),
+    })
+}
+
+/// Every element of the initial mesh must be valid: det J > 0 at the Gauss points, r > 0 in
+/// axisymmetry, rods of non-zero length, and cells of the kind the formulation needs.
+fn check_cells(cx: &Context, key: &str, mesh: &Mesh, kind: &BodyKind) -> Result<(), InputError> {
+    if mesh.nodes.iter().flatten().any(|c| !c.is_finite()) {
+        return Err(cx.err(format!("{key}.mesh: a node coordinate is not finite")));
+    }
+    match (&mesh.cells, kind) {
+        (Cells::Quad4(quads), BodyKind::Continuum { formulation, .. }) => {
+            for (e, q) in quads.iter().enumerate() {
+                let x = q.map(|n| mesh.nodes[n]);
+                quad4::geometry(&x, *formulation, &[1.0; 4])
+                    .map_err(|err| cx.err(format!("{key}: element {e} (nodes {q:?}) is invalid: {err}")))?;
+            }
+        }
+        (Cells::Rod2(rods), BodyKind::Rod { .. }) => {
+            for (e, r) in rods.iter().enumerate() {
+                rod2::length(&r.map(|n| mesh.nodes[n]))
+                    .map_err(|err| cx.err(format!("{key}: element {e} (nodes {r:?}) is invalid: {err}")))?;
+            }
+        }
+        (Cells::Rod2(_), _) => return Err(cx.err(format!("{key}: the mesh has rods but the formulation is 2D"))),
+        (Cells::Quad4(_), _) => return Err(cx.err(format!("{key}: the mesh has quads but the formulation is rod"))),
+    }
+    Ok(())
+}
+
+fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, InputError> {
+    match spec {
+        AnalysisSpec::Static(s) => {
+            if s.steps == 0 {
+                return Err(cx.err("analysis.steps: must be at least 1"));
+            }
+            positive(cx, "analysis.end_time", s.end_time)?;
+            newton(cx, &s.newton)?;
+            Ok(Analysis::Static(s.clone()))
+        }
+    }
+}
+
+fn newton(cx: &Context, n: &NewtonSpec) -> Result<(), InputError> {
+    if n.max_iterations == 0 {
+        return Err(cx.err("analysis.newton.max_iterations: must be at least 1"));
+    }
+    positive(cx, "analysis.newton.tol_displacement", n.tol_displacement)?;
+    positive(cx, "analysis.newton.tol_force", n.tol_force)?;
+    if !(n.contraction > 0.0 && n.contraction <= 1.0) {
+        return Err(cx.err(format!("analysis.newton.contraction: must lie in (0, 1], got {}", n.contraction)));
+    }
+    Ok(())
+}
+
+fn curves(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Curve>, InputError> {
+    let mut out = BTreeMap::new();
+    for (k, c) in scene.curve.iter().enumerate() {
+        let key = format!("curve[{k}] (`{}`)", c.name);
+        if c.points.is_empty() {
+            return Err(cx.err(format!("{key}.points: give at least one [time, factor] pair")));
+        }
+        if c.points.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(cx.err(format!("{key}.points: values must be finite")));
+        }
+        if c.points.windows(2).any(|w| w[1][0] <= w[0][0]) {
+            return Err(cx.err(format!("{key}.points: times must increase strictly")));
+        }
+        if out.insert(c.name.clone(), Curve { points: c.points.clone() }).is_some() {
+            return Err(cx.err(format!("{key}.name: `{}` is used twice", c.name)));
+        }
+    }
+    Ok(out)
+}
+
+/// Index of the body a load/support/probe refers to: by name, or the only body.
+fn body_index(cx: &Context, bodies: &[Body], name: Option<&str>, key: &str) -> Result<usize, InputError> {
+    match name {
+        Some(n) => bodies.iter().position(|b| b.name == n).ok_or_else(|| {
+            let known: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
+            cx.err(format!("{key}.body: no body named `{n}` (bodies: {known:?})"))
+        }),
+        None if bodies.len() == 1 => Ok(0),
+        None => Err(cx.err(format!("{key}.body: the scene has several bodies; name one"))),
+    }
+}
+
+fn node_set(
+    cx: &Context,
+    bodies: &[Body],
+    body: Option<&str>,
+    set: &str,
+    key: &str,
+) -> Result<(usize, Vec<usize>), InputError> {
+    let b = body_index(cx, bodies, body, key)?;
+    let sets = &bodies[b].mesh.node_sets;
+    let nodes = sets.get(set).ok_or_else(|| {
+        let known: Vec<&String> = sets.keys().collect();
+        cx.err(format!("{key}.set: body `{}` has no node set `{set}` (node sets: {known:?})", bodies[b].name))
+    })?;
+    Ok((b, nodes.clone()))
+}
+
+fn edge_set(
+    cx: &Context,
+    bodies: &[Body],
+    body: Option<&str>,
+    set: &str,
+    key: &str,
+) -> Result<(usize, Vec<[usize; 2]>), InputError> {
+    let b = body_index(cx, bodies, body, key)?;
+    let sets = &bodies[b].mesh.edge_sets;
+    let edges = sets.get(set).ok_or_else(|| {
+        let known: Vec<&String> = sets.keys().collect();
+        cx.err(format!("{key}.set: body `{}` has no edge set `{set}` (edge sets: {known:?})", bodies[b].name))
+    })?;
+    if !matches!(bodies[b].kind, BodyKind::Continuum { .. }) {
+        return Err(cx.err(format!("{key}: edge loads apply to 2D bodies only")));
+    }
+    let global = edges.iter().map(|e| e.map(|n| bodies[b].global(n))).collect();
+    Ok((b, global))
+}
+
+fn curve(
+    cx: &Context,
+    curves: &BTreeMap<String, Curve>,
+    default: &Curve,
+    name: &Option<String>,
+    key: &str,
+) -> Result<Curve, InputError> {
+    match name {
+        None => Ok(default.clone()),
+        Some(n) => curves.get(n).cloned().ok_or_else(|| {
+            let known: Vec<&String> = curves.keys().collect();
+            cx.err(format!("{key}.curve: no curve named `{n}` (curves: {known:?})"))
+        }),
+    }
+}
+
+fn finite(cx: &Context, key: &str, values: &[f64]) -> Result<(), InputError> {
+    if values.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(cx.err(format!("{key}: values must be finite"))) }
+}
+
+fn load(
+    cx: &Context,
+    bodies: &[Body],
+    curves: &BTreeMap<String, Curve>,
+    default: &Curve,
+    k: usize,
+    spec: &LoadSpec,
+) -> Result<Load, InputError> {
+    let key = format!("load[{k}]");
+    let globals = |b: usize, nodes: Vec<usize>| nodes.into_iter().map(|n| bodies[b].global(n)).collect();
+    Ok(match spec {
+        LoadSpec::NodalForce(s) => {
+            finite(cx, &format!("{key}.force"), &s.force)?;
+            let (b, nodes) = node_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
+            Load::NodalForce { nodes: globals(b, nodes), force: s.force, curve: curve(cx, curves, default, &s.curve, &key)? }
+        }
+        LoadSpec::Traction(s) => {
+            finite(cx, &format!("{key}.traction"), &s.traction)?;
+            let (body, edges) = edge_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
+            Load::Traction { body, edges, traction: s.traction, curve: curve(cx, curves, default, &s.curve, &key)? }
+        }
+        LoadSpec::Pressure(s) => {
+            finite(cx, &format!("{key}.pressure"), &[s.pressure])?;
+            let (body, edges) = edge_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
+            Load::Pressure { body, edges, pressure: s.pressure, curve: curve(cx, curves, default, &s.curve, &key)? }
+        }
+        LoadSpec::Displacement(s) => {
+            if s.x.is_none() && s.y.is_none() {
+                return Err(cx.err(format!("{key}: give `x`, `y` or both")));
+            }
+            finite(cx, &key, &[s.x.unwrap_or(0.0), s.y.unwrap_or(0.0)])?;
+            let (b, nodes) = node_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
+            Load::Displacement { nodes: globals(b, nodes), x: s.x, y: s.y, curve: curve(cx, curves, default, &s.curve, &key)? }
+        }
+        LoadSpec::Rotation(s) => {
+            finite(cx, &key, &[s.center[0], s.center[1], s.angle])?;
+            let (b, nodes) = node_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
+            Load::Rotation {
+                nodes: globals(b, nodes),
+                center: s.center,
+                angle: s.angle,
+                curve: curve(cx, curves, default, &s.curve, &key)?,
+            }
+        }
+    })
+}
+
+fn probes(cx: &Context, bodies: &[Body], specs: &[ProbeSpec]) -> Result<Vec<Probe>, InputError> {
+    let mut out = Vec::new();
+    for (k, p) in specs.iter().enumerate() {
+        let key = format!("output.probe[{k}]");
+        let b = body_index(cx, bodies, p.body.as_deref(), &key)?;
+        let members = if p.quantity.is_nodal() {
+            node_set(cx, bodies, p.body.as_deref(), &p.set, &key)?.1.into_iter().map(|n| bodies[b].global(n)).collect()
+        } else {
+            let sets = &bodies[b].mesh.element_sets;
+            sets.get(&p.set).cloned().ok_or_else(|| {
+                let known: Vec<&String> = sets.keys().collect();
+                cx.err(format!(
+                    "{key}.set: body `{}` has no element set `{}` (element sets: {known:?})",
+                    bodies[b].name, p.set
+                ))
+            })?
+        };
+        let set = if bodies.len() > 1 { format!("{}.{}", bodies[b].name, p.set) } else { p.set.clone() };
+        out.push(Probe { quantity: p.quantity, body: b, members, column: format!("{}[{set}]", p.quantity.name()) });
+    }
+    Ok(out)
+}

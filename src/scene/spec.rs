@@ -1,0 +1,340 @@
+//! The scene file's schema. Each struct denies unknown fields; each enum variant wraps its own
+//! struct so unknown keys are caught inside internally tagged enums too (serde #2123, #2294).
+
+use crate::element::Geometry;
+use crate::mesh::MeshSpec;
+use crate::output::vtk::Compression;
+use serde::Deserialize;
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Free text shown in the summary. Default: empty.
+    #[serde(default)]
+    pub title: String,
+    pub material: Vec<MaterialSpec>,
+    pub body: Vec<BodySpec>,
+    #[serde(default)]
+    pub support: Vec<SupportSpec>,
+    #[serde(default)]
+    pub load: Vec<LoadSpec>,
+    #[serde(default)]
+    pub curve: Vec<CurveSpec>,
+    pub analysis: AnalysisSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    pub name: String,
+    /// Young's modulus E > 0.
+    pub young: f64,
+    /// Poisson's ratio, -1 < nu < 0.5.
+    pub poisson: f64,
+    /// Mass density >= 0. Default 0 (statics needs none).
+    #[serde(default)]
+    pub density: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FormulationSpec {
+    PlaneStrain,
+    PlaneStress,
+    Axisymmetric,
+    Rod,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub name: String,
+    /// Name of a `[[material]]`.
+    pub material: String,
+    pub formulation: FormulationSpec,
+    /// Out-of-plane thickness, plane stress only. Default 1.
+    pub thickness: Option<f64>,
+    /// Cross-section area, rods only (required there).
+    pub area: Option<f64>,
+    /// Mean-dilatation B-bar (plane strain and axisymmetric only). Default false.
+    pub bbar: Option<bool>,
+    /// Initial Cauchy stress [xx, yy, zz, xy] in every point. Default zero.
+    pub initial_stress: Option<[f64; 4]>,
+    /// Initial velocity [vx, vy] of every node (dynamic analyses). Default zero.
+    pub velocity: Option<[f64; 2]>,
+    pub mesh: MeshSpec,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Component {
+    X,
+    Y,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupportSpec {
+    /// The body; may be left out when the scene has one body.
+    pub body: Option<String>,
+    /// A node set of that body.
+    pub set: String,
+    /// The fixed components: ["x", "y"] fixes the nodes, ["x"] or ["y"] is a roller.
+    pub fix: Vec<Component>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum LoadSpec {
+    NodalForce(NodalForceSpec),
+    Traction(TractionSpec),
+    Pressure(PressureSpec),
+    Displacement(DisplacementSpec),
+    Rotation(RotationSpec),
+}
+
+/// The same force on each node of a node set.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodalForceSpec {
+    pub body: Option<String>,
+    pub set: String,
+    pub force: [f64; 2],
+    pub curve: Option<String>,
+}
+
+/// A dead traction (force per unit reference area) on an edge set.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TractionSpec {
+    pub body: Option<String>,
+    pub set: String,
+    pub traction: [f64; 2],
+    pub curve: Option<String>,
+}
+
+/// A pressure on an edge set, normal to the edges at the start of each increment; positive
+/// pushes into the body.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureSpec {
+    pub body: Option<String>,
+    pub set: String,
+    pub pressure: f64,
+    pub curve: Option<String>,
+}
+
+/// Prescribed displacement components of a node set (the total value, times the curve).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DisplacementSpec {
+    pub body: Option<String>,
+    pub set: String,
+    pub x: Option<f64>,
+    pub y: Option<f64>,
+    pub curve: Option<String>,
+}
+
+/// A prescribed rigid rotation of a node set about `center` by `angle` radians (times the
+/// curve), counter-clockwise positive.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotationSpec {
+    pub body: Option<String>,
+    pub set: String,
+    pub center: [f64; 2],
+    pub angle: f64,
+    pub curve: Option<String>,
+}
+
+/// A piecewise-linear load curve, constant beyond its ends.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurveSpec {
+    pub name: String,
+    /// [time, factor] pairs with increasing times.
+    pub points: Vec<[f64; 2]>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum AnalysisSpec {
+    Static(StaticSpec),
+}
+
+/// Static load stepping: `steps` equal increments of pseudo time up to `end_time`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticSpec {
+    pub steps: usize,
+    /// Default 1.
+    #[serde(default = "one")]
+    pub end_time: f64,
+    /// `nonlinear` (default, updated Lagrangian) or `linear` (small strain).
+    #[serde(default)]
+    pub geometry: Geometry,
+    #[serde(default)]
+    pub newton: NewtonSpec,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// How often K_T is factored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Strategy {
+    /// Factor at the start of each increment; refactor only when the residual stops
+    /// contracting (the seed's modified Newton-Raphson).
+    #[default]
+    Modified,
+    /// Factor the current tangent at every iteration.
+    Full,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSpec {
+    /// Default `modified`.
+    #[serde(default)]
+    pub strategy: Strategy,
+    /// Iterations per increment before it is cut. Default 30.
+    #[serde(default = "default_iterations")]
+    pub max_iterations: usize,
+    /// Tolerance on ||d delta|| / ||delta|| (Erklig 2.1.2 (viii)). Default 1e-8.
+    #[serde(default = "default_tolerance")]
+    pub tol_displacement: f64,
+    /// Tolerance on ||R|| / ||F|| (Erklig 2.1.2 (viii)). Default 1e-8.
+    #[serde(default = "default_tolerance")]
+    pub tol_force: f64,
+    /// Modified Newton refactors when ||R_k|| > contraction ||R_k-1||. Default 0.8.
+    #[serde(default = "default_contraction")]
+    pub contraction: f64,
+    /// Halvings of an increment that does not converge before the run stops `diverged`. Default 6.
+    #[serde(default = "default_cuts")]
+    pub max_cuts: usize,
+}
+
+impl Default for NewtonSpec {
+    fn default() -> Self {
+        NewtonSpec {
+            strategy: Strategy::default(),
+            max_iterations: default_iterations(),
+            tol_displacement: default_tolerance(),
+            tol_force: default_tolerance(),
+            contraction: default_contraction(),
+            max_cuts: default_cuts(),
+        }
+    }
+}
+
+fn default_iterations() -> usize {
+    30
+}
+fn default_tolerance() -> f64 {
+    1e-8
+}
+fn default_contraction() -> f64 {
+    0.8
+}
+fn default_cuts() -> usize {
+    6
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Write a VTK frame every N steps (and always the first and last). 0 writes none. Default 1.
+    #[serde(default = "default_frame_every")]
+    pub frame_every: usize,
+    /// `none` (default), `lz4` or `zlib` for the .vtu arrays.
+    #[serde(default)]
+    pub compression: Compression,
+    #[serde(default)]
+    pub probe: Vec<ProbeSpec>,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { frame_every: default_frame_every(), compression: Compression::default(), probe: Vec::new() }
+    }
+}
+
+fn default_frame_every() -> usize {
+    1
+}
+
+/// A probed quantity; the name in the scene and in history.csv is the serde name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum Quantity {
+    #[serde(rename = "u_x")]
+    DisplacementX,
+    #[serde(rename = "u_y")]
+    DisplacementY,
+    #[serde(rename = "v_x")]
+    VelocityX,
+    #[serde(rename = "v_y")]
+    VelocityY,
+    #[serde(rename = "a_x")]
+    AccelerationX,
+    #[serde(rename = "a_y")]
+    AccelerationY,
+    #[serde(rename = "s_xx")]
+    StressXX,
+    #[serde(rename = "s_yy")]
+    StressYY,
+    #[serde(rename = "s_xy")]
+    StressXY,
+    #[serde(rename = "s_zz")]
+    StressZZ,
+    #[serde(rename = "von_mises")]
+    VonMises,
+    #[serde(rename = "eq_plastic_strain")]
+    EqPlasticStrain,
+}
+
+impl Quantity {
+    /// The name used in scenes and history.csv.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::DisplacementX => "u_x",
+            Quantity::DisplacementY => "u_y",
+            Quantity::VelocityX => "v_x",
+            Quantity::VelocityY => "v_y",
+            Quantity::AccelerationX => "a_x",
+            Quantity::AccelerationY => "a_y",
+            Quantity::StressXX => "s_xx",
+            Quantity::StressYY => "s_yy",
+            Quantity::StressXY => "s_xy",
+            Quantity::StressZZ => "s_zz",
+            Quantity::VonMises => "von_mises",
+            Quantity::EqPlasticStrain => "eq_plastic_strain",
+        }
+    }
+
+    /// Nodal quantities are averaged over node sets, the others over element sets.
+    pub fn is_nodal(self) -> bool {
+        matches!(
+            self,
+            Quantity::DisplacementX
+                | Quantity::DisplacementY
+                | Quantity::VelocityX
+                | Quantity::VelocityY
+                | Quantity::AccelerationX
+                | Quantity::AccelerationY
+        )
+    }
+}
+
+/// A history column: the mean of a nodal quantity over a node set, or of a stress quantity
+/// over an element set. Written as `QUANTITY[SET]` (`QUANTITY[BODY.SET]` with several bodies).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    pub quantity: Quantity,
+    pub body: Option<String>,
+    pub set: String,
+}
