@@ -12,5 +12,6 @@ pub mod kinematics;
 pub mod material;
 pub mod mesh;
 pub mod output;
+pub mod reference;
 pub mod scene;
 pub mod solver;

@@ -19,7 +19,9 @@ pub fn constrained_dofs(model: &Model) -> Vec<usize> {
                     }
                 }
             }
-            Load::Rotation { nodes, .. } => dofs.extend(nodes.iter().flat_map(|n| [2 * n, 2 * n + 1])),
+            Load::Rotation { nodes, .. } | Load::Affine { nodes, .. } => {
+                dofs.extend(nodes.iter().flat_map(|n| [2 * n, 2 * n + 1]))
+            }
             _ => {}
         }
     }
@@ -51,6 +53,14 @@ pub fn prescribed(model: &Model, initial: &[[f64; 2]], t: f64) -> Vec<(usize, f6
                     let (dx, dy) = (initial[*n][0] - center[0], initial[*n][1] - center[1]);
                     out.push((2 * n, cos * dx - sin * dy - dx));
                     out.push((2 * n + 1, sin * dx + cos * dy - dy));
+                }
+            }
+            Load::Affine { nodes, gradient: g, offset, curve } => {
+                let s = curve.value(t);
+                for n in nodes {
+                    let [x, y] = initial[*n];
+                    out.push((2 * n, s * (offset[0] + g[0][0] * x + g[0][1] * y)));
+                    out.push((2 * n + 1, s * (offset[1] + g[1][0] * x + g[1][1] * y)));
                 }
             }
             _ => {}
@@ -91,7 +101,7 @@ pub fn external_force(model: &Model, state: &State, initial: &[[f64; 2]], t: f64
                     &mut f,
                 );
             }
-            Load::Displacement { .. } | Load::Rotation { .. } => {}
+            Load::Displacement { .. } | Load::Rotation { .. } | Load::Affine { .. } => {}
         }
     }
     f

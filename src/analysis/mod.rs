@@ -5,6 +5,7 @@ pub mod loads;
 pub mod record;
 pub mod statics;
 
+use crate::assembly::State;
 use crate::output::OutputError;
 use crate::scene::{InputError, Model};
 use serde::Serialize;
@@ -101,6 +102,11 @@ pub struct RunOptions {
 
 /// Runs the scene's analysis, writing into `out_dir`.
 pub fn run(model: &Model, out_dir: &Path, options: RunOptions) -> Result<Summary, RunError> {
+    run_to_state(model, out_dir, options).map(|(summary, _)| summary)
+}
+
+/// As [`run`], also returning the final committed state (for tests and studies).
+pub fn run_to_state(model: &Model, out_dir: &Path, options: RunOptions) -> Result<(Summary, State), RunError> {
     match &model.analysis {
         crate::scene::model::Analysis::Static(spec) => statics::run(model, spec, out_dir, options),
     }

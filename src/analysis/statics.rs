@@ -35,7 +35,7 @@ pub struct Counters {
 pub struct IncrementFailure(pub String);
 
 /// Runs a static analysis and writes its output into `dir`.
-pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) -> Result<Summary, RunError> {
+pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) -> Result<(Summary, State), RunError> {
     let start = Instant::now();
     let mut recorder = Recorder::create(model, dir)?;
     let initial = model.coordinates();
@@ -81,7 +81,7 @@ pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) ->
     let mut step_dt = dt;
     let mut cuts_in_a_row = 0;
     while state.time < spec.end_time * (1.0 - 1e-12) {
-        let target = (state.time + step_dt).min(spec.end_time);
+        let target = snap((state.time + step_dt).min(spec.end_time), dt);
         match increment(model, spec, &state, &initial, target, &mut system, &mut solver, &mut counters) {
             Ok((d, evaluation)) => {
                 let force = evaluation.force.clone();
@@ -120,7 +120,7 @@ pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) ->
     progress.finish_and_clear();
     finish(&mut summary, &energies, &counters, &solver, start);
     recorder.write_summary(&summary)?;
-    Ok(summary)
+    Ok((summary, state))
 }
 
 fn finish(summary: &mut Summary, energies: &Energies, counters: &Counters, solver: &Solver, start: Instant) {
@@ -146,6 +146,13 @@ fn progress_bar(show: bool, steps: usize) -> ProgressBar {
             .progress_chars("=> "),
     );
     bar
+}
+
+/// Rounds a time that is a whole number of nominal steps up to round-off onto that multiple,
+/// so history rows fall on k dt exactly.
+fn snap(t: f64, dt: f64) -> f64 {
+    let k = (t / dt).round();
+    if (t - k * dt).abs() <= 1e-9 * dt { k * dt } else { t }
 }
 
 fn norm(v: &[f64]) -> f64 {

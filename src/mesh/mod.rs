@@ -112,9 +112,3 @@ impl Mesh {
     }
 }
 
-// TEMPORARY until generate.rs lands
-impl MeshSpec {
-    pub fn build(&self, _base_dir: &std::path::Path) -> Result<Mesh, MeshError> {
-        match *self {}
-    }
-}

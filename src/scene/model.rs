@@ -84,6 +84,8 @@ pub enum Load {
     Displacement { nodes: Vec<usize>, x: Option<f64>, y: Option<f64>, curve: Curve },
     /// Prescribed rigid rotation about `center` (initial coordinates).
     Rotation { nodes: Vec<usize>, center: [f64; 2], angle: f64, curve: Curve },
+    /// Prescribed affine displacement u = offset + gradient X (initial coordinates).
+    Affine { nodes: Vec<usize>, gradient: [[f64; 2]; 2], offset: [f64; 2], curve: Curve },
 }
 
 #[derive(Debug, Clone)]
@@ -250,7 +252,10 @@ fn body(
         let known: Vec<&String> = materials.keys().collect();
         cx.err(format!("{key}.material: no material named `{}` (known: {known:?})", spec.material))
     })?;
-    let mesh = spec.mesh.build(base_dir).map_err(|e| cx.err(format!("{key}.mesh: {e}")))?;
+    let mut mesh = spec.mesh.build(base_dir).map_err(|e| cx.err(format!("{key}.mesh: {e}")))?;
+    if !mesh.node_sets.contains_key("all") {
+        mesh.add_node_set("all", (0..mesh.nodes.len()).collect());
+    }
     let is_rod = spec.formulation == FormulationSpec::Rod;
     if spec.thickness.is_some() && spec.formulation != FormulationSpec::PlaneStress {
         return Err(cx.err(format!("{key}.thickness: only plane_stress bodies have a thickness")));
@@ -470,6 +475,18 @@ fn load(
                 nodes: globals(b, nodes),
                 center: s.center,
                 angle: s.angle,
+                curve: curve(cx, curves, default, &s.curve, &key)?,
+            }
+        }
+        LoadSpec::Affine(s) => {
+            let offset = s.offset.unwrap_or([0.0; 2]);
+            finite(cx, &key, &[s.gradient[0][0], s.gradient[0][1], s.gradient[1][0], s.gradient[1][1]])?;
+            finite(cx, &key, &offset)?;
+            let (b, nodes) = node_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
+            Load::Affine {
+                nodes: globals(b, nodes),
+                gradient: s.gradient,
+                offset,
                 curve: curve(cx, curves, default, &s.curve, &key)?,
             }
         }

@@ -93,6 +93,7 @@ pub enum LoadSpec {
     Pressure(PressureSpec),
     Displacement(DisplacementSpec),
     Rotation(RotationSpec),
+    Affine(AffineSpec),
 }
 
 /// The same force on each node of a node set.
@@ -146,6 +147,20 @@ pub struct RotationSpec {
     pub set: String,
     pub center: [f64; 2],
     pub angle: f64,
+    pub curve: Option<String>,
+}
+
+/// A prescribed affine displacement field u(X) = offset + gradient X (initial coordinates X,
+/// times the curve) on a node set: a homogeneous deformation for patch tests and cells.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AffineSpec {
+    pub body: Option<String>,
+    pub set: String,
+    /// [[du_x/dX, du_x/dY], [du_y/dX, du_y/dY]]
+    pub gradient: [[f64; 2]; 2],
+    /// Default [0, 0].
+    pub offset: Option<[f64; 2]>,
     pub curve: Option<String>,
 }
 

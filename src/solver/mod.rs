@@ -99,7 +99,8 @@ pub enum SolverError {
 /// Sparse Cholesky with the symbolic analysis reused and counters for the summary.
 pub struct Solver {
     matrix: SymbolicSparseColMat<usize>,
-    symbolic: SymbolicLlt<usize>,
+    /// None for an empty system (every DOF prescribed): factor and solve do nothing.
+    symbolic: Option<SymbolicLlt<usize>>,
     factor: Option<Llt<usize, f64>>,
     pub factorizations: usize,
     pub solves: usize,
@@ -114,36 +115,42 @@ impl Solver {
             None,
             pattern.row_idx.clone(),
         );
-        let symbolic = SymbolicLlt::try_new(matrix.as_ref(), Side::Lower)
-            .map_err(|e| SolverError::Factorization(format!("{e:?}")))?;
+        let symbolic = if pattern.size == 0 {
+            None
+        } else {
+            Some(
+                SymbolicLlt::try_new(matrix.as_ref(), Side::Lower)
+                    .map_err(|e| SolverError::Factorization(format!("{e:?}")))?,
+            )
+        };
         Ok(Solver { matrix, symbolic, factor: None, factorizations: 0, solves: 0 })
     }
 
     /// Numeric factorization of the matrix with the given lower-triangle values.
     pub fn factor(&mut self, values: &[f64]) -> Result<(), SolverError> {
         self.factor = None;
+        self.factorizations += 1;
+        let Some(symbolic) = &self.symbolic else { return Ok(()) };
         let a = SparseColMatRef::new(self.matrix.as_ref(), values);
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), a, Side::Lower).map_err(|e| match e {
+        let llt = Llt::try_new_with_symbolic(symbolic.clone(), a, Side::Lower).map_err(|e| match e {
             faer::sparse::linalg::LltError::Numeric(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
                 index,
             }) => SolverError::NotPositiveDefinite { index },
             other => SolverError::Factorization(format!("{other:?}")),
         });
-        self.factorizations += 1;
         self.factor = Some(llt?);
         Ok(())
     }
 
-    pub fn is_factored(&self) -> bool {
-        self.factor.is_some()
-    }
-
     /// Solves in place with the current factorization.
     pub fn solve(&mut self, rhs: &mut [f64]) {
+        self.solves += 1;
+        if self.symbolic.is_none() {
+            return;
+        }
         let factor = self.factor.as_ref().expect("solve after a successful factor");
         let n = rhs.len();
         factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
-        self.solves += 1;
     }
 }
 

@@ -1,0 +1,29 @@
+//! Shared by the integration tests: run a scene given as text, in a fresh output folder.
+#![allow(dead_code)]
+
+use impact::analysis::{self, RunOptions, Summary};
+use impact::assembly::State;
+use impact::scene::{self, Model};
+use std::path::{Path, PathBuf};
+
+/// A fresh, empty output folder under the system temp dir, unique per test name.
+pub fn out_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("impact-tests-{}", std::process::id())).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Builds the model of a scene text as if it were the file `tests/<name>.toml` (so mesh
+/// files resolve against tests/), with `--set` overrides.
+pub fn model(name: &str, text: &str, overrides: &[&str]) -> Model {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::from_str(text, &Path::new("tests").join(format!("{name}.toml")), &overrides)
+        .unwrap_or_else(|e| panic!("scene `{name}` is invalid: {e}"))
+}
+
+/// Runs a model and returns its summary and final state.
+pub fn run(name: &str, model: &Model) -> (Summary, State) {
+    analysis::run_to_state(model, &out_dir(name), RunOptions::default())
+        .unwrap_or_else(|e| panic!("run `{name}` failed: {e}"))
+}
