@@ -8,7 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "impact", version, about = "Finite-strain elastoplastic contact-impact in 2D and 1D")]
+#[command(
+    name = "impact",
+    version,
+    about = "Finite-strain elastoplastic contact-impact in 2D and 1D"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -41,7 +45,12 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { scene, out, set, quiet } => run(&scene, out, &set, quiet),
+        Command::Run {
+            scene,
+            out,
+            set,
+            quiet,
+        } => run(&scene, out, &set, quiet),
         Command::Check { scene, set } => check(&scene, &set),
     };
     match result {
@@ -56,7 +65,9 @@ fn main() -> ExitCode {
 fn run(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result<(), RunError> {
     let model = scene::load(path, set)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
-    let options = RunOptions { progress: !quiet && std::io::stderr().is_terminal() };
+    let options = RunOptions {
+        progress: !quiet && std::io::stderr().is_terminal(),
+    };
     let summary = analysis::run(&model, &dir, options)?;
     if !quiet {
         println!(
@@ -85,6 +96,11 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
             body.material.name
         );
     }
-    println!("  total: {} nodes, {} elements, {} DOFs", model.node_count, model.elements(), model.dofs());
+    println!(
+        "  total: {} nodes, {} elements, {} DOFs",
+        model.node_count,
+        model.elements(),
+        model.dofs()
+    );
     Ok(())
 }

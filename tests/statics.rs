@@ -33,7 +33,11 @@ newton = { strategy = "full", tol_displacement = 1e-13, tol_force = 1e-13 }
 "#;
 
 fn stress_state(formulation: &str) -> StressState {
-    if formulation == "plane_stress" { StressState::PlaneStress } else { StressState::General }
+    if formulation == "plane_stress" {
+        StressState::PlaneStress
+    } else {
+        StressState::General
+    }
 }
 
 /// The gradient of the patch field: u_r must be proportional to r in axisymmetry (constant
@@ -47,7 +51,10 @@ fn patch_gradient(formulation: &str, scale: f64) -> [[f64; 2]; 2] {
 }
 
 fn gradient_text(g: [[f64; 2]; 2]) -> String {
-    format!("load.0.gradient=[[{:e},{:e}],[{:e},{:e}]]", g[0][0], g[0][1], g[1][0], g[1][1])
+    format!(
+        "load.0.gradient=[[{:e},{:e}],[{:e},{:e}]]",
+        g[0][0], g[0][1], g[1][0], g[1][1]
+    )
 }
 
 /// Patch test (MacNeal-Harder distorted 5-element patch, boundary nodes prescribed by a
@@ -60,18 +67,30 @@ fn patch_test_reproduces_constant_stress_small_strain() {
         let model = common::model(
             "patch_linear",
             PATCH,
-            &[&format!("body.patch.formulation={formulation}"), &gradient_text(g), "load.0.offset=[0,0]"],
+            &[
+                &format!("body.patch.formulation={formulation}"),
+                &gradient_text(g),
+                "load.0.offset=[0,0]",
+            ],
         );
         let (_, state) = common::run(&format!("patch_linear_{formulation}"), &model);
         let mut strain = Voigt::new(g[0][0], g[1][1], 0.0, g[0][1] + g[1][0]);
         if formulation == "axisymmetric" {
             strain[2] = g[0][0]; // u_r / r
         }
-        let elastic = Elastic { young: 1000.0, poisson: 0.3 };
+        let elastic = Elastic {
+            young: 1000.0,
+            poisson: 0.3,
+        };
         let expected = elastic.moduli(stress_state(formulation)) * strain;
         for p in &state.bodies[0].points {
             let err = (p.stress - expected).norm() / expected.norm();
-            assert!(err < 1e-10, "{formulation}: {:?} vs {:?} (rel {err:e})", p.stress, expected);
+            assert!(
+                err < 1e-10,
+                "{formulation}: {:?} vs {:?} (rel {err:e})",
+                p.stress,
+                expected
+            );
         }
     }
 }
@@ -87,12 +106,21 @@ fn patch_test_reproduces_homogeneous_finite_strain() {
         let model = common::model(
             "patch_nonlinear",
             PATCH,
-            &[&format!("body.patch.formulation={formulation}"), &gradient_text(g), "analysis.geometry=nonlinear"],
+            &[
+                &format!("body.patch.formulation={formulation}"),
+                &gradient_text(g),
+                "analysis.geometry=nonlinear",
+            ],
         );
         let (_, state) = common::run(&format!("patch_nonlinear_{formulation}"), &model);
-        let elastic = Elastic { young: 1000.0, poisson: 0.3 };
+        let elastic = Elastic {
+            young: 1000.0,
+            poisson: 0.3,
+        };
         let f2 = [[1.0 + g[0][0], g[0][1]], [g[1][0], 1.0 + g[1][1]]];
-        let e = |a: usize, b: usize| 0.5 * (f2[0][a] * f2[0][b] + f2[1][a] * f2[1][b] - if a == b { 1.0 } else { 0.0 });
+        let e = |a: usize, b: usize| {
+            0.5 * (f2[0][a] * f2[0][b] + f2[1][a] * f2[1][b] - if a == b { 1.0 } else { 0.0 })
+        };
         let mut strain = Voigt::new(e(0, 0), e(1, 1), 0.0, 2.0 * e(0, 1));
         let (lambda, mu) = elastic.lame();
         let f_zz = match formulation {
@@ -100,17 +128,26 @@ fn patch_test_reproduces_homogeneous_finite_strain() {
                 strain[2] = 0.5 * ((1.0 + g[0][0]).powi(2) - 1.0);
                 1.0 + g[0][0]
             }
-            "plane_stress" => (1.0 - 2.0 * lambda / (lambda + 2.0 * mu) * (strain[0] + strain[1])).sqrt(),
+            "plane_stress" => {
+                (1.0 - 2.0 * lambda / (lambda + 2.0 * mu) * (strain[0] + strain[1])).sqrt()
+            }
             _ => 1.0,
         };
         let s = elastic.moduli(stress_state(formulation)) * strain;
-        let f = Matrix3::new(f2[0][0], f2[0][1], 0.0, f2[1][0], f2[1][1], 0.0, 0.0, 0.0, f_zz);
+        let f = Matrix3::new(
+            f2[0][0], f2[0][1], 0.0, f2[1][0], f2[1][1], 0.0, 0.0, 0.0, f_zz,
+        );
         let s3 = Matrix3::new(s[0], s[3], 0.0, s[3], s[1], 0.0, 0.0, 0.0, s[2]);
         let sigma = f * s3 * f.transpose() / f.determinant();
         let expected = Voigt::new(sigma[(0, 0)], sigma[(1, 1)], sigma[(2, 2)], sigma[(0, 1)]);
         for p in &state.bodies[0].points {
             let err = (p.stress - expected).norm() / expected.norm();
-            assert!(err < 1e-9, "{formulation}: {:?} vs {:?} (rel {err:e})", p.stress, expected);
+            assert!(
+                err < 1e-9,
+                "{formulation}: {:?} vs {:?} (rel {err:e})",
+                p.stress,
+                expected
+            );
         }
     }
 }
@@ -155,9 +192,21 @@ fn rigid_rotation_turns_stress_and_keeps_invariants() {
         let initial = model.bodies[0].initial_stress;
         let expected = Voigt::new(initial[1], initial[0], initial[2], -initial[3]);
         for p in &state.bodies[0].points {
-            assert!((p.stress - expected).norm() < 1e-8 * expected.norm(), "{formulation}: {:?}", p.stress);
-            approx::assert_relative_eq!(von_mises(&p.stress), von_mises(&initial), max_relative = 1e-8);
-            approx::assert_relative_eq!(pressure(&p.stress), pressure(&initial), max_relative = 1e-8);
+            assert!(
+                (p.stress - expected).norm() < 1e-8 * expected.norm(),
+                "{formulation}: {:?}",
+                p.stress
+            );
+            approx::assert_relative_eq!(
+                von_mises(&p.stress),
+                von_mises(&initial),
+                max_relative = 1e-8
+            );
+            approx::assert_relative_eq!(
+                pressure(&p.stress),
+                pressure(&initial),
+                max_relative = 1e-8
+            );
         }
     }
 }
@@ -198,7 +247,10 @@ fn bore_displacement_axisymmetric(nr: usize, bbar: bool) -> f64 {
     let model = common::model(
         "lame_axi",
         CYLINDER_AXISYMMETRIC,
-        &[&format!("body.cylinder.mesh.nx={nr}"), &format!("body.cylinder.bbar={bbar}")],
+        &[
+            &format!("body.cylinder.mesh.nx={nr}"),
+            &format!("body.cylinder.bbar={bbar}"),
+        ],
     );
     let (_, state) = common::run(&format!("lame_axi_{nr}_{bbar}"), &model);
     let bore = &model.bodies[0].mesh.node_sets["left"];
@@ -214,13 +266,18 @@ fn bore_displacement_axisymmetric(nr: usize, bbar: bool) -> f64 {
 fn lame_cylinder_axisymmetric_matches_and_converges() {
     let exact = reference::lame_radial_displacement(1.0, 1.0, 2.0, 1000.0, 0.3, 1.0);
     for bbar in [false, true] {
-        let errors: Vec<f64> =
-            [4, 8, 16].iter().map(|n| (bore_displacement_axisymmetric(*n, bbar) - exact).abs() / exact).collect();
+        let errors: Vec<f64> = [4, 8, 16]
+            .iter()
+            .map(|n| (bore_displacement_axisymmetric(*n, bbar) - exact).abs() / exact)
+            .collect();
         let within = if bbar { errors[0] } else { errors[1] };
         assert!(within < 5e-3, "bbar = {bbar}: errors {errors:?}");
         for w in errors.windows(2) {
             let order = (w[0] / w[1]).log2();
-            assert!((order - 2.0).abs() < 0.3, "bbar = {bbar}: observed order {order:.2} from errors {errors:?}");
+            assert!(
+                (order - 2.0).abs() < 0.3,
+                "bbar = {bbar}: observed order {order:.2} from errors {errors:?}"
+            );
         }
     }
 }
@@ -232,7 +289,12 @@ fn lame_cylinder_axisymmetric_matches_and_converges() {
 #[test]
 fn cantilever_large_matches_elastica() {
     let text = std::fs::read_to_string("models/cantilever_large.toml").unwrap();
-    let model = impact::scene::from_str(&text, std::path::Path::new("models/cantilever_large.toml"), &[]).unwrap();
+    let model = impact::scene::from_str(
+        &text,
+        std::path::Path::new("models/cantilever_large.toml"),
+        &[],
+    )
+    .unwrap();
     let dir = common::out_dir("cantilever_large");
     impact::analysis::run(&model, &dir, Default::default()).unwrap();
     let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
@@ -243,7 +305,11 @@ fn cantilever_large_matches_elastica() {
         let row: Vec<f64> = history
             .lines()
             .skip(1)
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect::<Vec<f64>>())
+            .map(|l| {
+                l.split(',')
+                    .map(|v| v.parse().unwrap())
+                    .collect::<Vec<f64>>()
+            })
             .find(|r| (r[0] - time).abs() < 1e-12)
             .unwrap_or_else(|| panic!("no history row at t = {time}"));
         let (u, w, _) = reference::elastica_tip(k);

@@ -47,7 +47,12 @@ pub fn prescribed(model: &Model, initial: &[[f64; 2]], t: f64) -> Vec<(usize, f6
                     }
                 }
             }
-            Load::Rotation { nodes, center, angle, curve } => {
+            Load::Rotation {
+                nodes,
+                center,
+                angle,
+                curve,
+            } => {
                 let (sin, cos) = (angle * curve.value(t)).sin_cos();
                 for n in nodes {
                     let (dx, dy) = (initial[*n][0] - center[0], initial[*n][1] - center[1]);
@@ -55,7 +60,12 @@ pub fn prescribed(model: &Model, initial: &[[f64; 2]], t: f64) -> Vec<(usize, f6
                     out.push((2 * n + 1, sin * dx + cos * dy - dy));
                 }
             }
-            Load::Affine { nodes, gradient: g, offset, curve } => {
+            Load::Affine {
+                nodes,
+                gradient: g,
+                offset,
+                curve,
+            } => {
                 let s = curve.value(t);
                 for n in nodes {
                     let [x, y] = initial[*n];
@@ -75,19 +85,33 @@ pub fn external_force(model: &Model, state: &State, initial: &[[f64; 2]], t: f64
     let mut f = vec![0.0; model.dofs()];
     for load in &model.loads {
         match load {
-            Load::NodalForce { nodes, force, curve } => {
+            Load::NodalForce {
+                nodes,
+                force,
+                curve,
+            } => {
                 let s = curve.value(t);
                 for n in nodes {
                     f[2 * n] += force[0] * s;
                     f[2 * n + 1] += force[1] * s;
                 }
             }
-            Load::Traction { body, edges, traction, curve } => {
+            Load::Traction {
+                body,
+                edges,
+                traction,
+                curve,
+            } => {
                 let s = curve.value(t);
                 let t = [traction[0] * s, traction[1] * s];
                 add_edge_forces(model, *body, edges, initial, |_, _| t, &mut f);
             }
-            Load::Pressure { body, edges, pressure, curve } => {
+            Load::Pressure {
+                body,
+                edges,
+                pressure,
+                curve,
+            } => {
                 let p = pressure * curve.value(t);
                 add_edge_forces(
                     model,
@@ -115,7 +139,14 @@ fn add_edge_forces(
     traction: impl Fn([f64; 2], [f64; 2]) -> [f64; 2],
     f: &mut [f64],
 ) {
-    let BodyKind::Continuum { formulation, thickness, .. } = model.bodies[body].kind else { return };
+    let BodyKind::Continuum {
+        formulation,
+        thickness,
+        ..
+    } = model.bodies[body].kind
+    else {
+        return;
+    };
     for [a, b] in edges {
         let (xa, xb) = (coords[*a], coords[*b]);
         let fe = quad4::edge_force(xa, xb, traction(xa, xb), formulation, thickness);

@@ -78,7 +78,10 @@ pub enum RunError {
     Input(#[from] InputError),
     /// Divergence, an inverted element, NaN: the partial output and summary.json are kept.
     #[error("numerical failure: {message}")]
-    Numerical { message: String, summary: Box<Summary> },
+    Numerical {
+        message: String,
+        summary: Box<Summary>,
+    },
     #[error("{0}")]
     Output(#[from] OutputError),
 }
@@ -106,7 +109,11 @@ pub fn run(model: &Model, out_dir: &Path, options: RunOptions) -> Result<Summary
 }
 
 /// As [`run`], also returning the final committed state (for tests and studies).
-pub fn run_to_state(model: &Model, out_dir: &Path, options: RunOptions) -> Result<(Summary, State), RunError> {
+pub fn run_to_state(
+    model: &Model,
+    out_dir: &Path,
+    options: RunOptions,
+) -> Result<(Summary, State), RunError> {
     match &model.analysis {
         crate::scene::model::Analysis::Static(spec) => statics::run(model, spec, out_dir, options),
     }

@@ -41,18 +41,27 @@ pub struct Recorder {
 impl Recorder {
     /// Creates the output folder, the .pvd series and history.csv with its header.
     pub fn create(model: &Model, dir: &Path) -> Result<Recorder, OutputError> {
-        std::fs::create_dir_all(dir)
-            .map_err(|source| OutputError::Io { path: dir.to_path_buf(), action: "cannot create folder", source })?;
+        std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+            path: dir.to_path_buf(),
+            action: "cannot create folder",
+            source,
+        })?;
         let series = if model.output.frame_every > 0 {
             Some(Series::create(dir, &model.name, model.output.compression)?)
         } else {
             None
         };
-        let mut columns: Vec<String> =
-            ["time", "kinetic_energy", "internal_energy", "plastic_work", "external_work", "contact_work"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
+        let mut columns: Vec<String> = [
+            "time",
+            "kinetic_energy",
+            "internal_energy",
+            "plastic_work",
+            "external_work",
+            "contact_work",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
         columns.extend(model.probes.iter().map(|p| p.column.clone()));
         let history = History::create(&dir.join("history.csv"), &columns)?;
         Ok(Recorder {
@@ -84,7 +93,12 @@ impl Recorder {
             energies.external_work,
             energies.contact_work,
         ];
-        row.extend(model.probes.iter().map(|p| probe_value(model, state, motion, p)));
+        row.extend(
+            model
+                .probes
+                .iter()
+                .map(|p| probe_value(model, state, motion, p)),
+        );
         self.history.append(&row)?;
         self.steps_since_frame += 1;
         if force_frame || (self.frame_every > 0 && self.steps_since_frame >= self.frame_every) {
@@ -94,13 +108,21 @@ impl Recorder {
     }
 
     /// Writes a frame of the state unless one was written at this time already.
-    pub fn frame(&mut self, model: &Model, state: &State, motion: &Motion) -> Result<(), OutputError> {
-        let Some(series) = self.series.as_mut() else { return Ok(()) };
+    pub fn frame(
+        &mut self,
+        model: &Model,
+        state: &State,
+        motion: &Motion,
+    ) -> Result<(), OutputError> {
+        let Some(series) = self.series.as_mut() else {
+            return Ok(());
+        };
         if self.last_frame_time == Some(state.time) {
             return Ok(());
         }
         let cells = cell_fields(model, state);
-        let vectors = |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
+        let vectors =
+            |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
         let n = state.reference.len();
         let zeros2 = vec![[0.0; 2]; n];
         let zeros = vec![0.0; n];
@@ -139,7 +161,11 @@ fn grid(model: &Model) -> Grid {
             Cells::Rod2(r) => lines.extend(r.iter().map(|c| c.map(|n| body.global(n)))),
         }
     }
-    Grid { points: model.coordinates(), quads, lines }
+    Grid {
+        points: model.coordinates(),
+        quads,
+        lines,
+    }
 }
 
 struct CellFields {
@@ -151,15 +177,30 @@ struct CellFields {
 
 /// Per cell, the mean over its points; quads first, then rods (as in `grid`).
 fn cell_fields(model: &Model, state: &State) -> CellFields {
-    let mut out = CellFields { stress: Vec::new(), von_mises: Vec::new(), eq_plastic_strain: Vec::new(), pressure: Vec::new() };
-    let quads_first =
-        model.bodies.iter().enumerate().filter(|(_, b)| b.points_per_element() == 4).chain(
-            model.bodies.iter().enumerate().filter(|(_, b)| b.points_per_element() == 1),
+    let mut out = CellFields {
+        stress: Vec::new(),
+        von_mises: Vec::new(),
+        eq_plastic_strain: Vec::new(),
+        pressure: Vec::new(),
+    };
+    let quads_first = model
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.points_per_element() == 4)
+        .chain(
+            model
+                .bodies
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| b.points_per_element() == 1),
         );
     for (b, body) in quads_first {
         let ppe = body.points_per_element();
         for points in state.bodies[b].points.chunks_exact(ppe) {
-            let mean = |f: &dyn Fn(&crate::material::PointState) -> f64| points.iter().map(f).sum::<f64>() / ppe as f64;
+            let mean = |f: &dyn Fn(&crate::material::PointState) -> f64| {
+                points.iter().map(f).sum::<f64>() / ppe as f64
+            };
             let s: [f64; 4] = std::array::from_fn(|k| mean(&|p| p.stress[k]));
             out.stress.push([s[0], s[1], s[2], s[3], 0.0, 0.0]);
             out.von_mises.push(mean(&|p| von_mises(&p.stress)));
@@ -170,14 +211,25 @@ fn cell_fields(model: &Model, state: &State) -> CellFields {
     out
 }
 
-fn probe_value(model: &Model, state: &State, motion: &Motion, probe: &crate::scene::model::Probe) -> f64 {
+fn probe_value(
+    model: &Model,
+    state: &State,
+    motion: &Motion,
+    probe: &crate::scene::model::Probe,
+) -> f64 {
     let n = probe.members.len().max(1) as f64;
     let nodal = |v: &[f64], c: usize| probe.members.iter().map(|m| v[2 * m + c]).sum::<f64>() / n;
     let points = |f: &dyn Fn(&crate::material::PointState) -> f64| {
         let body = &model.bodies[probe.body];
         let ppe = body.points_per_element();
         let pts = &state.bodies[probe.body].points;
-        probe.members.iter().flat_map(|e| &pts[e * ppe..(e + 1) * ppe]).map(f).sum::<f64>() / (n * ppe as f64)
+        probe
+            .members
+            .iter()
+            .flat_map(|e| &pts[e * ppe..(e + 1) * ppe])
+            .map(f)
+            .sum::<f64>()
+            / (n * ppe as f64)
     };
     match probe.quantity {
         Quantity::DisplacementX => nodal(&state.displacement, 0),

@@ -35,20 +35,29 @@ pub struct Counters {
 pub struct IncrementFailure(pub String);
 
 /// Runs a static analysis and writes its output into `dir`.
-pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) -> Result<(Summary, State), RunError> {
+pub fn run(
+    model: &Model,
+    spec: &StaticSpec,
+    dir: &Path,
+    options: RunOptions,
+) -> Result<(Summary, State), RunError> {
     let start = Instant::now();
     let mut recorder = Recorder::create(model, dir)?;
     let initial = model.coordinates();
     let constrained = loads::constrained_dofs(model);
     let mut system = System::new(model, &constrained);
-    let mut solver =
-        Solver::new(&system.pattern).map_err(|e| RunError::Output(crate::output::OutputError::Invalid {
+    let mut solver = Solver::new(&system.pattern).map_err(|e| {
+        RunError::Output(crate::output::OutputError::Invalid {
             path: dir.to_path_buf(),
             reason: e.to_string(),
-        }))?;
+        })
+    })?;
     let mut state = State::initial(model);
     let zeros = vec![0.0; model.dofs()];
-    let motion = Motion { velocity: &zeros, acceleration: &zeros };
+    let motion = Motion {
+        velocity: &zeros,
+        acceleration: &zeros,
+    };
     let mut energies = Energies::default();
     let mut last_force = vec![0.0; model.dofs()];
     recorder.step(model, &state, &motion, &energies, true)?;
@@ -82,12 +91,25 @@ pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) ->
     let mut cuts_in_a_row = 0;
     while state.time < spec.end_time * (1.0 - 1e-12) {
         let target = snap((state.time + step_dt).min(spec.end_time), dt);
-        match increment(model, spec, &state, &initial, target, &mut system, &mut solver, &mut counters) {
+        match increment(
+            model,
+            spec,
+            &state,
+            &initial,
+            target,
+            &mut system,
+            &mut solver,
+            &mut counters,
+        ) {
             Ok((d, evaluation)) => {
                 let force = evaluation.force.clone();
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
                 state.time = target;
-                energies.external_work += 0.5 * d.iter().zip(force.iter().zip(&last_force)).map(|(u, (f1, f0))| u * (f1 + f0)).sum::<f64>();
+                energies.external_work += 0.5
+                    * d.iter()
+                        .zip(force.iter().zip(&last_force))
+                        .map(|(u, (f1, f0))| u * (f1 + f0))
+                        .sum::<f64>();
                 energies.internal = state.internal_work;
                 last_force = force;
                 summary.steps += 1;
@@ -106,7 +128,10 @@ pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) ->
                     summary.status = Status::Diverged;
                     summary.message = Some(message.clone());
                     recorder.write_summary(&summary)?;
-                    return Err(RunError::Numerical { message, summary: Box::new(summary) });
+                    return Err(RunError::Numerical {
+                        message,
+                        summary: Box::new(summary),
+                    });
                 }
                 step_dt *= 0.5;
                 cuts_in_a_row += 1;
@@ -123,7 +148,13 @@ pub fn run(model: &Model, spec: &StaticSpec, dir: &Path, options: RunOptions) ->
     Ok((summary, state))
 }
 
-fn finish(summary: &mut Summary, energies: &Energies, counters: &Counters, solver: &Solver, start: Instant) {
+fn finish(
+    summary: &mut Summary,
+    energies: &Energies,
+    counters: &Counters,
+    solver: &Solver,
+    start: Instant,
+) {
     summary.newton_iterations = counters.iterations;
     summary.step_cuts = counters.cuts;
     summary.factorizations = solver.factorizations;
@@ -131,8 +162,11 @@ fn finish(summary: &mut Summary, energies: &Energies, counters: &Counters, solve
     summary.wall_seconds = start.elapsed().as_secs_f64();
     summary.energy.final_ = energies.internal;
     let scale = energies.external_work.abs().max(energies.internal.abs());
-    summary.energy.max_relative_drift =
-        if scale > 0.0 { (energies.internal - energies.external_work).abs() / scale } else { 0.0 };
+    summary.energy.max_relative_drift = if scale > 0.0 {
+        (energies.internal - energies.external_work).abs() / scale
+    } else {
+        0.0
+    };
 }
 
 fn progress_bar(show: bool, steps: usize) -> ProgressBar {
@@ -152,7 +186,11 @@ fn progress_bar(show: bool, steps: usize) -> ProgressBar {
 /// so history rows fall on k dt exactly.
 fn snap(t: f64, dt: f64) -> f64 {
     let k = (t / dt).round();
-    if (t - k * dt).abs() <= 1e-9 * dt { k * dt } else { t }
+    if (t - k * dt).abs() <= 1e-9 * dt {
+        k * dt
+    } else {
+        t
+    }
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -189,14 +227,26 @@ fn increment(
         let evaluation = evaluate(model, state, &d, spec, refactor.then_some(&mut *system))?;
         let mut residual = system.gather(&external);
         let internal = system.gather(&evaluation.force);
-        residual.iter_mut().zip(&internal).for_each(|(r, f)| *r -= f);
+        residual
+            .iter_mut()
+            .zip(&internal)
+            .for_each(|(r, f)| *r -= f);
         let residual_norm = norm(&residual);
         if !residual_norm.is_finite() {
-            return Err(IncrementFailure("the residual is not finite (NaN or Inf)".into()));
+            return Err(IncrementFailure(
+                "the residual is not finite (NaN or Inf)".into(),
+            ));
         }
         let scale = external_norm.max(norm(&evaluation.force));
-        let eps_force = if scale > 0.0 { residual_norm / scale } else { 0.0 };
-        if iteration > 0 && eps_displacement < newton.tol_displacement && eps_force < newton.tol_force {
+        let eps_force = if scale > 0.0 {
+            residual_norm / scale
+        } else {
+            0.0
+        };
+        if iteration > 0
+            && eps_displacement < newton.tol_displacement
+            && eps_force < newton.tol_force
+        {
             return Ok((d, evaluation));
         }
         if iteration > 0 && residual_norm == 0.0 {
@@ -213,16 +263,25 @@ fn increment(
             evaluate(model, state, &d, spec, Some(&mut *system))?;
         }
         if refactor || stalled {
-            solver.factor(&system.values).map_err(|e| IncrementFailure(e.to_string()))?;
+            solver
+                .factor(&system.values)
+                .map_err(|e| IncrementFailure(e.to_string()))?;
         }
         solver.solve(&mut residual);
         counters.iterations += 1;
         system.scatter_add(&residual, &mut d);
         let d_norm = norm(&d);
-        eps_displacement = if d_norm > 0.0 { norm(&residual) / d_norm } else { 0.0 };
+        eps_displacement = if d_norm > 0.0 {
+            norm(&residual) / d_norm
+        } else {
+            0.0
+        };
         previous_residual = residual_norm;
     }
-    Err(IncrementFailure(format!("no convergence in {} iterations", newton.max_iterations)))
+    Err(IncrementFailure(format!(
+        "no convergence in {} iterations",
+        newton.max_iterations
+    )))
 }
 
 fn evaluate(
@@ -232,5 +291,6 @@ fn evaluate(
     spec: &StaticSpec,
     system: Option<&mut System>,
 ) -> Result<assembly::Evaluation, IncrementFailure> {
-    assembly::evaluate(model, state, d, spec.geometry, system).map_err(|e| IncrementFailure(e.to_string()))
+    assembly::evaluate(model, state, d, spec.geometry, system)
+        .map_err(|e| IncrementFailure(e.to_string()))
 }

@@ -54,7 +54,16 @@ impl State {
                     BodyKind::Continuum { .. } => b.initial_stress,
                     BodyKind::Rod { .. } => Voigt::new(b.initial_stress[0], 0.0, 0.0, 0.0),
                 };
-                BodyState { points: vec![PointState { stress, ..Default::default() }; n], thickness: vec![thickness; n] }
+                BodyState {
+                    points: vec![
+                        PointState {
+                            stress,
+                            ..Default::default()
+                        };
+                        n
+                    ],
+                    thickness: vec![thickness; n],
+                }
             })
             .collect();
         State {
@@ -103,7 +112,12 @@ pub struct System {
 
 /// Global DOFs of element e of body b.
 fn element_dofs(body: &Body, e: usize) -> Vec<usize> {
-    body.mesh.cells.nodes_of(e).iter().flat_map(|n| [2 * body.global(*n), 2 * body.global(*n) + 1]).collect()
+    body.mesh
+        .cells
+        .nodes_of(e)
+        .iter()
+        .flat_map(|n| [2 * body.global(*n), 2 * body.global(*n) + 1])
+        .collect()
 }
 
 impl System {
@@ -121,15 +135,28 @@ impl System {
         let element_equations: Vec<Vec<Vec<Option<usize>>>> = model
             .bodies
             .iter()
-            .map(|b| (0..b.elements()).map(|e| element_dofs(b, e).iter().map(|g| equation[*g]).collect()).collect())
+            .map(|b| {
+                (0..b.elements())
+                    .map(|e| element_dofs(b, e).iter().map(|g| equation[*g]).collect())
+                    .collect()
+            })
             .collect();
-        let pattern = Pattern::from_elements(free, element_equations.iter().flatten().map(|v| v.as_slice()));
+        let pattern = Pattern::from_elements(
+            free,
+            element_equations.iter().flatten().map(|v| v.as_slice()),
+        );
         let scatter = element_equations
             .iter()
             .map(|body| body.iter().flat_map(|eqs| pattern.scatter(eqs)).collect())
             .collect();
         let values = vec![0.0; pattern.nonzeros()];
-        System { equation, free, pattern, scatter, values }
+        System {
+            equation,
+            free,
+            pattern,
+            scatter,
+            values,
+        }
     }
 
     /// Restricts a global vector to the free equations.
@@ -181,9 +208,23 @@ pub fn evaluate(
     for (b, body) in model.bodies.iter().enumerate() {
         let results: Vec<ElementResult> = (0..body.elements())
             .into_par_iter()
-            .map(|e| element(body, &state.bodies[b], &state.reference, d, e, geometry, want_tangent))
+            .map(|e| {
+                element(
+                    body,
+                    &state.bodies[b],
+                    &state.reference,
+                    d,
+                    e,
+                    geometry,
+                    want_tangent,
+                )
+            })
             .collect::<Result<_, _>>()
-            .map_err(|(element, error)| ElementFailure { body: body.name.clone(), element, error })?;
+            .map_err(|(element, error)| ElementFailure {
+                body: body.name.clone(),
+                element,
+                error,
+            })?;
         let ppe = body.points_per_element();
         let mut body_trial = Vec::with_capacity(results.len() * ppe);
         let mut body_zz = Vec::with_capacity(results.len() * ppe);
@@ -208,7 +249,12 @@ pub fn evaluate(
         trial.push(body_trial);
         strain_zz.push(body_zz);
     }
-    Ok(Evaluation { force, trial, strain_zz, work })
+    Ok(Evaluation {
+        force,
+        trial,
+        strain_zz,
+        work,
+    })
 }
 
 fn element(
@@ -222,7 +268,9 @@ fn element(
 ) -> Result<ElementResult, (usize, KernelError)> {
     let nodes = body.mesh.cells.nodes_of(e);
     match body.kind {
-        BodyKind::Continuum { formulation, bbar, .. } => {
+        BodyKind::Continuum {
+            formulation, bbar, ..
+        } => {
             let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
             let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
             let geom = quad4::geometry(&x, formulation, &thickness).map_err(|err| (e, err))?;
@@ -231,20 +279,34 @@ fn element(
                 check_orientation(&geom, &de).map_err(|err| (e, err))?;
             }
             let strains = quad4::strains(&geom, &de, geometry, bbar);
-            let stress_state =
-                if formulation == Formulation::PlaneStress { StressState::PlaneStress } else { StressState::General };
-            let responses: [_; 4] =
-                std::array::from_fn(|q| body.material.update(&committed.points[4 * e + q], &strains[q], stress_state));
+            let stress_state = if formulation == Formulation::PlaneStress {
+                StressState::PlaneStress
+            } else {
+                StressState::General
+            };
+            let responses: [_; 4] = std::array::from_fn(|q| {
+                body.material
+                    .update(&committed.points[4 * e + q], &strains[q], stress_state)
+            });
             let stress = responses.map(|r| r.stress);
             let mut work = 0.0;
             for q in 0..4 {
                 let mut strain = strains[q];
                 strain[2] = responses[q].strain_zz;
-                work += geom.points[q].weight * 0.5 * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
+                work += geom.points[q].weight
+                    * 0.5
+                    * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
             }
             let force = quad4::internal_force(&geom, &de, &stress, geometry, bbar);
             let matrix = want_tangent.then(|| {
-                let k = quad4::tangent(&geom, &de, &stress, &responses.map(|r| r.moduli), geometry, bbar);
+                let k = quad4::tangent(
+                    &geom,
+                    &de,
+                    &stress,
+                    &responses.map(|r| r.moduli),
+                    geometry,
+                    bbar,
+                );
                 let mut m = [0.0; 64];
                 m.copy_from_slice(k.transpose().as_slice()); // row-major
                 m
@@ -258,15 +320,21 @@ fn element(
             })
         }
         BodyKind::Rod { area } => {
-            let x = [reference[body.global(nodes[0])], reference[body.global(nodes[1])]];
+            let x = [
+                reference[body.global(nodes[0])],
+                reference[body.global(nodes[1])],
+            ];
             let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
             let strain = rod2::strain(&x, &de, geometry).map_err(|err| (e, err))?;
-            let (stress, modulus, state) = body.material.update_uniaxial(&committed.points[e], strain);
+            let (stress, modulus, state) =
+                body.material.update_uniaxial(&committed.points[e], strain);
             let length = rod2::length(&x).map_err(|err| (e, err))?;
             let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
-            let f4 = rod2::internal_force(&x, &de, stress, area, geometry).map_err(|err| (e, err))?;
+            let f4 =
+                rod2::internal_force(&x, &de, stress, area, geometry).map_err(|err| (e, err))?;
             let matrix = if want_tangent {
-                let k: Mat4 = rod2::tangent(&x, &de, stress, modulus, area, geometry).map_err(|err| (e, err))?;
+                let k: Mat4 = rod2::tangent(&x, &de, stress, modulus, area, geometry)
+                    .map_err(|err| (e, err))?;
                 let mut m = [0.0; 64];
                 m[..16].copy_from_slice(k.transpose().as_slice());
                 Some(m)
@@ -275,7 +343,13 @@ fn element(
             };
             let mut force = Vec8::zeros();
             force.fixed_rows_mut::<4>(0).copy_from(&f4);
-            Ok(ElementResult { force, matrix, trial: [state; 4], strain_zz: [0.0; 4], work })
+            Ok(ElementResult {
+                force,
+                matrix,
+                trial: [state; 4],
+                strain_zz: [0.0; 4],
+                work,
+            })
         }
     }
 }
@@ -293,14 +367,36 @@ fn check_orientation(geom: &quad4::QuadGeometry, d: &Vec8) -> Result<(), KernelE
 
 /// Commits an evaluation: pushes the stresses forward to the new configuration (nonlinear
 /// geometry), updates the reference coordinates, thickness and the accumulated work.
-pub fn commit(model: &Model, state: &mut State, d: &[f64], evaluation: Evaluation, geometry: Geometry) {
-    let Evaluation { trial, strain_zz, work, .. } = evaluation;
+pub fn commit(
+    model: &Model,
+    state: &mut State,
+    d: &[f64],
+    evaluation: Evaluation,
+    geometry: Geometry,
+) {
+    let Evaluation {
+        trial,
+        strain_zz,
+        work,
+        ..
+    } = evaluation;
     for (b, body) in model.bodies.iter().enumerate() {
         let mut points = trial[b].clone();
         if geometry == Geometry::Nonlinear {
-            push_forward_body(body, &state.bodies[b], &state.reference, d, &strain_zz[b], &mut points);
+            push_forward_body(
+                body,
+                &state.bodies[b],
+                &state.reference,
+                d,
+                &strain_zz[b],
+                &mut points,
+            );
             let bs = &mut state.bodies[b];
-            if let BodyKind::Continuum { formulation: Formulation::PlaneStress, .. } = body.kind {
+            if let BodyKind::Continuum {
+                formulation: Formulation::PlaneStress,
+                ..
+            } = body.kind
+            {
                 for (t, ezz) in bs.thickness.iter_mut().zip(&strain_zz[b]) {
                     *t *= kinematics::plane_stress_stretch(*ezz);
                 }
@@ -334,11 +430,14 @@ fn push_forward_body(
             BodyKind::Continuum { formulation, .. } => {
                 let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
                 let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
-                let geom = quad4::geometry(&x, formulation, &thickness).expect("checked during the evaluation");
+                let geom = quad4::geometry(&x, formulation, &thickness)
+                    .expect("checked during the evaluation");
                 let de = Vec8::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
                 for (q, (f, hoop)) in quad4::deformation(&geom, &de).iter().enumerate() {
                     let f_zz = match formulation {
-                        Formulation::PlaneStress => kinematics::plane_stress_stretch(strain_zz[4 * e + q]),
+                        Formulation::PlaneStress => {
+                            kinematics::plane_stress_stretch(strain_zz[4 * e + q])
+                        }
                         Formulation::Axisymmetric => *hoop,
                         Formulation::PlaneStrain => 1.0,
                     };
@@ -347,7 +446,10 @@ fn push_forward_body(
                 }
             }
             BodyKind::Rod { .. } => {
-                let x = [reference[body.global(nodes[0])], reference[body.global(nodes[1])]];
+                let x = [
+                    reference[body.global(nodes[0])],
+                    reference[body.global(nodes[1])],
+                ];
                 let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
                 let stretch = rod2::stretch(&x, &de).expect("checked during the evaluation");
                 points[e].stress[0] *= stretch;

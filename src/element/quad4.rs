@@ -29,7 +29,12 @@ type BMatrix = SMatrix<f64, 4, 8>;
 
 const GAUSS: f64 = 0.577_350_269_189_625_8; // 1 / sqrt(3)
 /// Gauss points in the order of the nodes: (-,-), (+,-), (+,+), (-,+).
-pub const POINTS: [[f64; 2]; 4] = [[-GAUSS, -GAUSS], [GAUSS, -GAUSS], [GAUSS, GAUSS], [-GAUSS, GAUSS]];
+pub const POINTS: [[f64; 2]; 4] = [
+    [-GAUSS, -GAUSS],
+    [GAUSS, -GAUSS],
+    [GAUSS, GAUSS],
+    [-GAUSS, GAUSS],
+];
 const NODE_SIGNS: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
 
 /// Shape functions and their reference derivatives at one Gauss point.
@@ -68,8 +73,17 @@ fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
 
 /// Shape-function derivatives, radii and point volumes on the reference configuration `x`.
 /// `thickness` is per Gauss point and used only in plane stress.
-pub fn geometry(x: &Coords, formulation: Formulation, thickness: &[f64; 4]) -> Result<QuadGeometry, KernelError> {
-    let mut points = [PointGeometry { shape: [0.0; 4], dndx: [[0.0; 2]; 4], radius: 0.0, weight: 0.0 }; 4];
+pub fn geometry(
+    x: &Coords,
+    formulation: Formulation,
+    thickness: &[f64; 4],
+) -> Result<QuadGeometry, KernelError> {
+    let mut points = [PointGeometry {
+        shape: [0.0; 4],
+        dndx: [[0.0; 2]; 4],
+        radius: 0.0,
+        weight: 0.0,
+    }; 4];
     for (q, [xi, eta]) in POINTS.iter().enumerate() {
         let (n, dn) = shape(*xi, *eta);
         let mut jac = Matrix2::zeros(); // J_ab = dX_a / dxi_b
@@ -103,9 +117,17 @@ pub fn geometry(x: &Coords, formulation: Formulation, thickness: &[f64; 4]) -> R
                 det * 2.0 * PI * radius
             }
         };
-        points[q] = PointGeometry { shape: n, dndx, radius, weight };
+        points[q] = PointGeometry {
+            shape: n,
+            dndx,
+            radius,
+            weight,
+        };
     }
-    Ok(QuadGeometry { points, formulation })
+    Ok(QuadGeometry {
+        points,
+        formulation,
+    })
 }
 
 /// Kinematics of one point for a given increment d.
@@ -118,7 +140,12 @@ struct PointKinematics {
     b: BMatrix,
 }
 
-fn point_kinematics(p: &PointGeometry, d: &Vec8, formulation: Formulation, geometry: Geometry) -> PointKinematics {
+fn point_kinematics(
+    p: &PointGeometry,
+    d: &Vec8,
+    formulation: Formulation,
+    geometry: Geometry,
+) -> PointKinematics {
     let mut theta = [0.0; 4];
     for i in 0..4 {
         let [nx, ny] = p.dndx[i];
@@ -128,9 +155,17 @@ fn point_kinematics(p: &PointGeometry, d: &Vec8, formulation: Formulation, geome
         theta[3] += ny * d[2 * i + 1];
     }
     let axisymmetric = formulation == Formulation::Axisymmetric;
-    let hoop = if axisymmetric { (0..4).map(|i| p.shape[i] * d[2 * i]).sum::<f64>() / p.radius } else { 0.0 };
+    let hoop = if axisymmetric {
+        (0..4).map(|i| p.shape[i] * d[2 * i]).sum::<f64>() / p.radius
+    } else {
+        0.0
+    };
     // Nonlinear parts switched off by a zero factor in linear kinematics.
-    let nl = if geometry == Geometry::Nonlinear { 1.0 } else { 0.0 };
+    let nl = if geometry == Geometry::Nonlinear {
+        1.0
+    } else {
+        0.0
+    };
     let [ux, uy, vx, vy] = theta;
     let strain = Voigt::new(
         ux + 0.5 * nl * (ux * ux + vx * vx),
@@ -152,12 +187,24 @@ fn point_kinematics(p: &PointGeometry, d: &Vec8, formulation: Formulation, geome
         b[(3, cu)] = ny * (1.0 + nl * ux) + nx * nl * uy;
         b[(3, cv)] = nx * (1.0 + nl * vy) + ny * nl * vx;
     }
-    PointKinematics { theta, hoop, strain, b }
+    PointKinematics {
+        theta,
+        hoop,
+        strain,
+        b,
+    }
 }
 
 /// The four points' kinematics with the B-bar modification applied when asked.
-fn kinematics(geom: &QuadGeometry, d: &Vec8, geometry: Geometry, bbar: bool) -> [PointKinematics; 4] {
-    let mut k = geom.points.map(|p| point_kinematics(&p, d, geom.formulation, geometry));
+fn kinematics(
+    geom: &QuadGeometry,
+    d: &Vec8,
+    geometry: Geometry,
+    bbar: bool,
+) -> [PointKinematics; 4] {
+    let mut k = geom
+        .points
+        .map(|p| point_kinematics(&p, d, geom.formulation, geometry));
     if bbar {
         let volume = geom.volume();
         let mut mean_trace = 0.0;
@@ -200,7 +247,13 @@ pub fn deformation(geom: &QuadGeometry, d: &Vec8) -> [(Matrix2<f64>, f64); 4] {
 }
 
 /// Internal force f = sum_q w_q B_q^T S_q (Erklig eq 25).
-pub fn internal_force(geom: &QuadGeometry, d: &Vec8, stress: &[Voigt; 4], geometry: Geometry, bbar: bool) -> Vec8 {
+pub fn internal_force(
+    geom: &QuadGeometry,
+    d: &Vec8,
+    stress: &[Voigt; 4],
+    geometry: Geometry,
+    bbar: bool,
+) -> Vec8 {
     let k = kinematics(geom, d, geometry, bbar);
     let mut f = Vec8::zeros();
     for q in 0..4 {
@@ -280,15 +333,22 @@ pub fn mass(geom: &QuadGeometry) -> Mat4 {
 /// Consistent nodal forces [fa_x fa_y fb_x fb_y] of a constant traction `t` (force per unit
 /// reference length; per unit area in plane stress with `thickness`, per unit area of the
 /// surface of revolution in axisymmetry) on the straight edge a -> b.
-pub fn edge_force(a: [f64; 2], b: [f64; 2], t: [f64; 2], formulation: Formulation, thickness: f64) -> [f64; 4] {
+pub fn edge_force(
+    a: [f64; 2],
+    b: [f64; 2],
+    t: [f64; 2],
+    formulation: Formulation,
+    thickness: f64,
+) -> [f64; 4] {
     let length = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
     let (wa, wb) = match formulation {
         Formulation::PlaneStrain => (0.5 * length, 0.5 * length),
         Formulation::PlaneStress => (0.5 * length * thickness, 0.5 * length * thickness),
         // integral of N_a 2 pi r ds with r linear along the edge
-        Formulation::Axisymmetric => {
-            (2.0 * PI * length * (2.0 * a[0] + b[0]) / 6.0, 2.0 * PI * length * (a[0] + 2.0 * b[0]) / 6.0)
-        }
+        Formulation::Axisymmetric => (
+            2.0 * PI * length * (2.0 * a[0] + b[0]) / 6.0,
+            2.0 * PI * length * (a[0] + 2.0 * b[0]) / 6.0,
+        ),
     };
     [wa * t[0], wa * t[1], wb * t[0], wb * t[1]]
 }
@@ -332,15 +392,32 @@ mod tests {
     fn tangent_matches_finite_differences_of_internal_force() {
         let d = Vec8::from_fn(|i, _| 0.05 * ((i as f64) * 1.7).sin());
         let s0 = Voigt::new(0.3, -0.2, 0.1, 0.15);
-        for form in [Formulation::PlaneStrain, Formulation::PlaneStress, Formulation::Axisymmetric] {
+        for form in [
+            Formulation::PlaneStrain,
+            Formulation::PlaneStress,
+            Formulation::Axisymmetric,
+        ] {
             for bbar in [false, true] {
                 let geom = geometry(&distorted(), form, &[0.7; 4]).unwrap();
                 let force = |d: &Vec8| {
                     let e = strains(&geom, d, Geometry::Nonlinear, bbar);
-                    internal_force(&geom, d, &e.map(|e| stress_of(&e, &s0)), Geometry::Nonlinear, bbar)
+                    internal_force(
+                        &geom,
+                        d,
+                        &e.map(|e| stress_of(&e, &s0)),
+                        Geometry::Nonlinear,
+                        bbar,
+                    )
                 };
                 let e = strains(&geom, &d, Geometry::Nonlinear, bbar);
-                let kt = tangent(&geom, &d, &e.map(|e| stress_of(&e, &s0)), &[moduli(); 4], Geometry::Nonlinear, bbar);
+                let kt = tangent(
+                    &geom,
+                    &d,
+                    &e.map(|e| stress_of(&e, &s0)),
+                    &[moduli(); 4],
+                    Geometry::Nonlinear,
+                    bbar,
+                );
                 let h = 1e-6;
                 for j in 0..8 {
                     let mut dp = d;
@@ -349,10 +426,17 @@ mod tests {
                     dm[j] -= h;
                     let col = (force(&dp) - force(&dm)) / (2.0 * h);
                     for i in 0..8 {
-                        approx::assert_abs_diff_eq!(kt[(i, j)], col[i], epsilon = 1e-7 * (1.0 + col[i].abs()));
+                        approx::assert_abs_diff_eq!(
+                            kt[(i, j)],
+                            col[i],
+                            epsilon = 1e-7 * (1.0 + col[i].abs())
+                        );
                     }
                 }
-                assert!((kt - kt.transpose()).abs().max() < 1e-12, "{form:?} bbar={bbar}");
+                assert!(
+                    (kt - kt.transpose()).abs().max() < 1e-12,
+                    "{form:?} bbar={bbar}"
+                );
             }
         }
     }
@@ -367,7 +451,10 @@ mod tests {
         }
         // shoelace area of the quad
         let x = distorted();
-        let area: f64 = (0..4).map(|i| x[i][0] * x[(i + 1) % 4][1] - x[(i + 1) % 4][0] * x[i][1]).sum::<f64>() / 2.0;
+        let area: f64 = (0..4)
+            .map(|i| x[i][0] * x[(i + 1) % 4][1] - x[(i + 1) % 4][0] * x[i][1])
+            .sum::<f64>()
+            / 2.0;
         approx::assert_relative_eq!(geom.volume(), area, max_relative = 1e-14);
     }
 

@@ -16,7 +16,11 @@ use super::{Geometry, KernelError, Mat4, Vec4};
 /// Reference length and unit direction of the rod X1 -> X2.
 pub fn length(x: &[[f64; 2]; 2]) -> Result<f64, KernelError> {
     let l = ((x[1][0] - x[0][0]).powi(2) + (x[1][1] - x[0][1]).powi(2)).sqrt();
-    if l > 0.0 { Ok(l) } else { Err(KernelError::ZeroLength) }
+    if l > 0.0 {
+        Ok(l)
+    } else {
+        Err(KernelError::ZeroLength)
+    }
 }
 
 fn b_vector(x: &[[f64; 2]; 2], d: &Vec4, length: f64, geometry: Geometry) -> Vec4 {
@@ -44,12 +48,21 @@ pub fn strain(x: &[[f64; 2]; 2], d: &Vec4, geometry: Geometry) -> Result<f64, Ke
 /// Stretch l / L of the increment (pushes S forward to the Cauchy stress S l / L).
 pub fn stretch(x: &[[f64; 2]; 2], d: &Vec4) -> Result<f64, KernelError> {
     let l = length(x)?;
-    let dx = [x[1][0] - x[0][0] + d[2] - d[0], x[1][1] - x[0][1] + d[3] - d[1]];
+    let dx = [
+        x[1][0] - x[0][0] + d[2] - d[0],
+        x[1][1] - x[0][1] + d[3] - d[1],
+    ];
     Ok((dx[0] * dx[0] + dx[1] * dx[1]).sqrt() / l)
 }
 
 /// Internal force A L B^T S.
-pub fn internal_force(x: &[[f64; 2]; 2], d: &Vec4, stress: f64, area: f64, geometry: Geometry) -> Result<Vec4, KernelError> {
+pub fn internal_force(
+    x: &[[f64; 2]; 2],
+    d: &Vec4,
+    stress: f64,
+    area: f64,
+    geometry: Geometry,
+) -> Result<Vec4, KernelError> {
     let l = length(x)?;
     Ok(b_vector(x, d, l, geometry) * (area * l * stress))
 }

@@ -23,7 +23,17 @@ fn tensor(s: &Voigt) -> Matrix3<f64> {
 
 /// Cauchy stress F S F^T / J of the increment with in-plane F and out-of-plane stretch f_zz.
 pub fn push_forward(s: &Voigt, f: &Matrix2<f64>, f_zz: f64) -> Voigt {
-    let f3 = Matrix3::new(f[(0, 0)], f[(0, 1)], 0.0, f[(1, 0)], f[(1, 1)], 0.0, 0.0, 0.0, f_zz);
+    let f3 = Matrix3::new(
+        f[(0, 0)],
+        f[(0, 1)],
+        0.0,
+        f[(1, 0)],
+        f[(1, 1)],
+        0.0,
+        0.0,
+        0.0,
+        f_zz,
+    );
     let j = f.determinant() * f_zz;
     let sigma = f3 * tensor(s) * f3.transpose() / j;
     Voigt::new(sigma[(0, 0)], sigma[(1, 1)], sigma[(2, 2)], sigma[(0, 1)])

@@ -56,7 +56,10 @@ pub struct Elastic {
 impl Elastic {
     pub fn lame(&self) -> (f64, f64) {
         let (e, nu) = (self.young, self.poisson);
-        (e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)))
+        (
+            e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+            e / (2.0 * (1.0 + nu)),
+        )
     }
 
     /// Elastic moduli; in plane stress the condensed in-plane moduli with the zz row and
@@ -104,7 +107,15 @@ impl Material {
             strain[2] = -lambda / (lambda + 2.0 * mu) * (strain[0] + strain[1]);
         }
         let stress = committed.stress + moduli * strain;
-        Response { stress, moduli, strain_zz: strain[2], state: PointState { stress, ..*committed } }
+        Response {
+            stress,
+            moduli,
+            strain_zz: strain[2],
+            state: PointState {
+                stress,
+                ..*committed
+            },
+        }
     }
 
     /// Response of a rod: axial stress and modulus.
@@ -136,9 +147,24 @@ mod tests {
     /// E / (1 - nu^2) in-plane stiffness.
     #[test]
     fn plane_stress_keeps_szz_zero() {
-        let m = Material { name: "m".into(), density: 1.0, elastic: Elastic { young: 200.0, poisson: 0.3 } };
-        let r = m.update(&PointState::default(), &Voigt::new(1e-3, 0.0, 0.0, 0.0), StressState::PlaneStress);
-        approx::assert_relative_eq!(r.stress[0], 200.0 / (1.0 - 0.09) * 1e-3, max_relative = 1e-14);
+        let m = Material {
+            name: "m".into(),
+            density: 1.0,
+            elastic: Elastic {
+                young: 200.0,
+                poisson: 0.3,
+            },
+        };
+        let r = m.update(
+            &PointState::default(),
+            &Voigt::new(1e-3, 0.0, 0.0, 0.0),
+            StressState::PlaneStress,
+        );
+        approx::assert_relative_eq!(
+            r.stress[0],
+            200.0 / (1.0 - 0.09) * 1e-3,
+            max_relative = 1e-14
+        );
         assert_eq!(r.stress[2], 0.0);
         approx::assert_relative_eq!(r.strain_zz, -0.3 / 0.7 * 1e-3, max_relative = 1e-14);
     }

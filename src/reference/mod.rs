@@ -5,7 +5,8 @@
 /// plane strain (eps_zz = 0): the radial displacement at radius r,
 /// u_r = (1 + nu) p a^2 / (E (b^2 - a^2)) ((1 - 2 nu) r + b^2 / r).
 pub fn lame_radial_displacement(p: f64, a: f64, b: f64, young: f64, poisson: f64, r: f64) -> f64 {
-    (1.0 + poisson) * p * a * a / (young * (b * b - a * a)) * ((1.0 - 2.0 * poisson) * r + b * b / r)
+    (1.0 + poisson) * p * a * a / (young * (b * b - a * a))
+        * ((1.0 - 2.0 * poisson) * r + b * b / r)
 }
 
 /// Tip of an inextensible elastic cantilever (the elastica) of length 1, clamped at s = 0
@@ -38,7 +39,9 @@ fn integrate_elastica(k: f64, kappa0: f64) -> (f64, f64, f64, f64) {
     let rhs = |s: [f64; 4]| [s[2].cos(), s[2].sin(), s[3], -k * s[2].cos()];
     let mut s = [0.0, 0.0, 0.0, kappa0];
     for _ in 0..n {
-        let add = |a: [f64; 4], b: [f64; 4], f: f64| std::array::from_fn::<f64, 4, _>(|i| a[i] + f * b[i]);
+        let add = |a: [f64; 4], b: [f64; 4], f: f64| {
+            std::array::from_fn::<f64, 4, _>(|i| a[i] + f * b[i])
+        };
         let k1 = rhs(s);
         let k2 = rhs(add(s, k1, h / 2.0));
         let k3 = rhs(add(s, k2, h / 2.0));

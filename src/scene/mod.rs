@@ -23,26 +23,38 @@ pub struct InputError {
 
 impl InputError {
     pub fn new(file: &Path, message: impl Into<String>) -> InputError {
-        InputError { file: file.display().to_string(), message: message.into() }
+        InputError {
+            file: file.display().to_string(),
+            message: message.into(),
+        }
     }
 }
 
 /// Reads a scene file, applies the `--set` overrides, deserializes and validates it.
 pub fn load(path: &Path, overrides: &[String]) -> Result<Model, InputError> {
-    let text = std::fs::read_to_string(path).map_err(|e| InputError::new(path, format!("cannot read the scene: {e}")))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(path, format!("cannot read the scene: {e}")))?;
     from_str(&text, path, overrides)
 }
 
 /// As [`load`], from the scene's text; `path` names it in messages and anchors relative mesh files.
 pub fn from_str(text: &str, path: &Path, overrides: &[String]) -> Result<Model, InputError> {
-    let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| InputError::new(path, e.to_string()))?;
-    for assignment in overrides {
-        overrides::apply(&mut table, assignment).map_err(|m| InputError::new(path, format!("--set {assignment}: {m}")))?;
-    }
-    let scene: Scene = Scene::deserialize(toml::Value::Table(table))
-        .map_err(|e: toml::de::Error| InputError::new(path, e.to_string()))?;
+    let scene: Scene = if overrides.is_empty() {
+        // from the text itself, so messages point at the file's own lines
+        toml::from_str(text).map_err(|e: toml::de::Error| InputError::new(path, e.to_string()))?
+    } else {
+        let mut table: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| InputError::new(path, e.to_string()))?;
+        for assignment in overrides {
+            overrides::apply(&mut table, assignment)
+                .map_err(|m| InputError::new(path, format!("--set {assignment}: {m}")))?;
+        }
+        let edited = toml::to_string(&table).expect("a TOML table serializes");
+        toml::from_str(&edited).map_err(|e: toml::de::Error| {
+            InputError::new(path, format!("(as edited by --set) {e}"))
+        })?
+    };
     let base_dir: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
     model::build(scene, path, &base_dir)
 }
-
-use serde::Deserialize;

@@ -6,8 +6,8 @@
 
 use super::InputError;
 use super::spec::{
-    AnalysisSpec, BodySpec, Component, FormulationSpec, LoadSpec, NewtonSpec, OutputSpec, ProbeSpec, Quantity, Scene,
-    StaticSpec,
+    AnalysisKind, AnalysisSpec, BodySpec, Component, FormulationSpec, LoadSpec, NewtonSpec,
+    OutputSpec, ProbeSpec, Quantity, Scene, StaticSpec,
 };
 use crate::element::{Formulation, Geometry, Voigt, quad4, rod2};
 use crate::material::{Elastic, Material};
@@ -17,8 +17,14 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum BodyKind {
-    Continuum { formulation: Formulation, bbar: bool, thickness: f64 },
-    Rod { area: f64 },
+    Continuum {
+        formulation: Formulation,
+        bbar: bool,
+        thickness: f64,
+    },
+    Rod {
+        area: f64,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -75,17 +81,46 @@ impl Curve {
 #[derive(Debug, Clone)]
 pub enum Load {
     /// The same force on each listed global node.
-    NodalForce { nodes: Vec<usize>, force: [f64; 2], curve: Curve },
+    NodalForce {
+        nodes: Vec<usize>,
+        force: [f64; 2],
+        curve: Curve,
+    },
     /// Dead traction on edges (global node pairs) of a body.
-    Traction { body: usize, edges: Vec<[usize; 2]>, traction: [f64; 2], curve: Curve },
+    Traction {
+        body: usize,
+        edges: Vec<[usize; 2]>,
+        traction: [f64; 2],
+        curve: Curve,
+    },
     /// Pressure normal to the edges at the start of the increment.
-    Pressure { body: usize, edges: Vec<[usize; 2]>, pressure: f64, curve: Curve },
+    Pressure {
+        body: usize,
+        edges: Vec<[usize; 2]>,
+        pressure: f64,
+        curve: Curve,
+    },
     /// Prescribed total displacement components.
-    Displacement { nodes: Vec<usize>, x: Option<f64>, y: Option<f64>, curve: Curve },
+    Displacement {
+        nodes: Vec<usize>,
+        x: Option<f64>,
+        y: Option<f64>,
+        curve: Curve,
+    },
     /// Prescribed rigid rotation about `center` (initial coordinates).
-    Rotation { nodes: Vec<usize>, center: [f64; 2], angle: f64, curve: Curve },
+    Rotation {
+        nodes: Vec<usize>,
+        center: [f64; 2],
+        angle: f64,
+        curve: Curve,
+    },
     /// Prescribed affine displacement u = offset + gradient X (initial coordinates).
-    Affine { nodes: Vec<usize>, gradient: [[f64; 2]; 2], offset: [f64; 2], curve: Curve },
+    Affine {
+        nodes: Vec<usize>,
+        gradient: [[f64; 2]; 2],
+        offset: [f64; 2],
+        curve: Curve,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -137,7 +172,10 @@ impl Model {
 
     /// Initial coordinates of all nodes in global numbering.
     pub fn coordinates(&self) -> Vec<[f64; 2]> {
-        self.bodies.iter().flat_map(|b| b.mesh.nodes.iter().copied()).collect()
+        self.bodies
+            .iter()
+            .flat_map(|b| b.mesh.nodes.iter().copied())
+            .collect()
     }
 }
 
@@ -170,7 +208,9 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let analysis = analysis(&cx, &scene.analysis)?;
     let curves = curves(&cx, &scene)?;
     let default_curve = match &analysis {
-        Analysis::Static(s) => Curve { points: vec![[0.0, 0.0], [s.end_time, 1.0]] },
+        Analysis::Static(s) => Curve {
+            points: vec![[0.0, 0.0], [s.end_time, 1.0]],
+        },
     };
     let mut fixed_dofs = Vec::new();
     for (k, s) in scene.support.iter().enumerate() {
@@ -194,7 +234,10 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         .map(|(k, l)| load(&cx, &bodies, &curves, &default_curve, k, l))
         .collect::<Result<Vec<_>, _>>()?;
     let probes = probes(&cx, &bodies, &scene.output.probe)?;
-    let name = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    let name = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
     Ok(Model {
         name,
         file: file.to_path_buf(),
@@ -223,7 +266,10 @@ fn materials(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Material>, 
         let key = format!("material[{k}] (`{}`)", m.name);
         positive(cx, &format!("{key}.young"), m.young)?;
         if !(m.poisson > -1.0 && m.poisson < 0.5) {
-            return Err(cx.err(format!("{key}.poisson: must lie in (-1, 0.5), got {}", m.poisson)));
+            return Err(cx.err(format!(
+                "{key}.poisson: must lie in (-1, 0.5), got {}",
+                m.poisson
+            )));
         }
         if !(m.density >= 0.0 && m.density.is_finite()) {
             return Err(cx.err(format!("{key}.density: must be >= 0, got {}", m.density)));
@@ -231,7 +277,10 @@ fn materials(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Material>, 
         let material = Material {
             name: m.name.clone(),
             density: m.density,
-            elastic: Elastic { young: m.young, poisson: m.poisson },
+            elastic: Elastic {
+                young: m.young,
+                poisson: m.poisson,
+            },
         };
         if out.insert(m.name.clone(), material).is_some() {
             return Err(cx.err(format!("{key}.name: `{}` is used twice", m.name)));
@@ -250,27 +299,48 @@ fn body(
     let key = format!("body `{}`", spec.name);
     let material = materials.get(&spec.material).cloned().ok_or_else(|| {
         let known: Vec<&String> = materials.keys().collect();
-        cx.err(format!("{key}.material: no material named `{}` (known: {known:?})", spec.material))
+        cx.err(format!(
+            "{key}.material: no material named `{}` (known: {known:?})",
+            spec.material
+        ))
     })?;
-    let mut mesh = spec.mesh.build(base_dir).map_err(|e| cx.err(format!("{key}.mesh: {e}")))?;
+    let mut mesh = spec
+        .mesh
+        .build(base_dir)
+        .map_err(|e| cx.err(format!("{key}.mesh: {e}")))?;
     if !mesh.node_sets.contains_key("all") {
         mesh.add_node_set("all", (0..mesh.nodes.len()).collect());
     }
     let is_rod = spec.formulation == FormulationSpec::Rod;
     if spec.thickness.is_some() && spec.formulation != FormulationSpec::PlaneStress {
-        return Err(cx.err(format!("{key}.thickness: only plane_stress bodies have a thickness")));
+        return Err(cx.err(format!(
+            "{key}.thickness: only plane_stress bodies have a thickness"
+        )));
     }
     if spec.area.is_some() && !is_rod {
         return Err(cx.err(format!("{key}.area: only rod bodies have an area")));
     }
     let bbar = spec.bbar.unwrap_or(false);
-    if bbar && matches!(spec.formulation, FormulationSpec::PlaneStress | FormulationSpec::Rod) {
-        return Err(cx.err(format!("{key}.bbar: B-bar applies to plane_strain and axisymmetric bodies only")));
+    if bbar
+        && matches!(
+            spec.formulation,
+            FormulationSpec::PlaneStress | FormulationSpec::Rod
+        )
+    {
+        return Err(cx.err(format!(
+            "{key}.bbar: B-bar applies to plane_strain and axisymmetric bodies only"
+        )));
     }
     let kind = match spec.formulation {
         FormulationSpec::Rod => {
-            let area = spec.area.ok_or_else(|| cx.err(format!("{key}.area: a rod body needs its cross-section area")))?;
-            BodyKind::Rod { area: positive(cx, &format!("{key}.area"), area)? }
+            let area = spec.area.ok_or_else(|| {
+                cx.err(format!(
+                    "{key}.area: a rod body needs its cross-section area"
+                ))
+            })?;
+            BodyKind::Rod {
+                area: positive(cx, &format!("{key}.area"), area)?,
+            }
         }
         f => {
             let formulation = match f {
@@ -278,8 +348,16 @@ fn body(
                 FormulationSpec::PlaneStress => Formulation::PlaneStress,
                 _ => Formulation::Axisymmetric,
             };
-            let thickness = positive(cx, &format!("{key}.thickness"), spec.thickness.unwrap_or(1.0))?;
-            BodyKind::Continuum { formulation, bbar, thickness }
+            let thickness = positive(
+                cx,
+                &format!("{key}.thickness"),
+                spec.thickness.unwrap_or(1.0),
+            )?;
+            BodyKind::Continuum {
+                formulation,
+                bbar,
+                thickness,
+            }
         }
     };
     check_cells(cx, &key, &mesh, &kind)?;
@@ -305,31 +383,53 @@ fn check_cells(cx: &Context, key: &str, mesh: &Mesh, kind: &BodyKind) -> Result<
         (Cells::Quad4(quads), BodyKind::Continuum { formulation, .. }) => {
             for (e, q) in quads.iter().enumerate() {
                 let x = q.map(|n| mesh.nodes[n]);
-                quad4::geometry(&x, *formulation, &[1.0; 4])
-                    .map_err(|err| cx.err(format!("{key}: element {e} (nodes {q:?}) is invalid: {err}")))?;
+                quad4::geometry(&x, *formulation, &[1.0; 4]).map_err(|err| {
+                    cx.err(format!(
+                        "{key}: element {e} (nodes {q:?}) is invalid: {err}"
+                    ))
+                })?;
             }
         }
         (Cells::Rod2(rods), BodyKind::Rod { .. }) => {
             for (e, r) in rods.iter().enumerate() {
-                rod2::length(&r.map(|n| mesh.nodes[n]))
-                    .map_err(|err| cx.err(format!("{key}: element {e} (nodes {r:?}) is invalid: {err}")))?;
+                rod2::length(&r.map(|n| mesh.nodes[n])).map_err(|err| {
+                    cx.err(format!(
+                        "{key}: element {e} (nodes {r:?}) is invalid: {err}"
+                    ))
+                })?;
             }
         }
-        (Cells::Rod2(_), _) => return Err(cx.err(format!("{key}: the mesh has rods but the formulation is 2D"))),
-        (Cells::Quad4(_), _) => return Err(cx.err(format!("{key}: the mesh has quads but the formulation is rod"))),
+        (Cells::Rod2(_), _) => {
+            return Err(cx.err(format!(
+                "{key}: the mesh has rods but the formulation is 2D"
+            )));
+        }
+        (Cells::Quad4(_), _) => {
+            return Err(cx.err(format!(
+                "{key}: the mesh has quads but the formulation is rod"
+            )));
+        }
     }
     Ok(())
 }
 
 fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, InputError> {
-    match spec {
-        AnalysisSpec::Static(s) => {
-            if s.steps == 0 {
+    match spec.kind {
+        AnalysisKind::Static => {
+            let steps = spec.steps.ok_or_else(|| {
+                cx.err("analysis.steps: a static analysis needs its number of load steps")
+            })?;
+            if steps == 0 {
                 return Err(cx.err("analysis.steps: must be at least 1"));
             }
-            positive(cx, "analysis.end_time", s.end_time)?;
-            newton(cx, &s.newton)?;
-            Ok(Analysis::Static(s.clone()))
+            positive(cx, "analysis.end_time", spec.end_time)?;
+            newton(cx, &spec.newton)?;
+            Ok(Analysis::Static(StaticSpec {
+                steps,
+                end_time: spec.end_time,
+                geometry: spec.geometry,
+                newton: spec.newton.clone(),
+            }))
         }
     }
 }
@@ -341,7 +441,10 @@ fn newton(cx: &Context, n: &NewtonSpec) -> Result<(), InputError> {
     positive(cx, "analysis.newton.tol_displacement", n.tol_displacement)?;
     positive(cx, "analysis.newton.tol_force", n.tol_force)?;
     if !(n.contraction > 0.0 && n.contraction <= 1.0) {
-        return Err(cx.err(format!("analysis.newton.contraction: must lie in (0, 1], got {}", n.contraction)));
+        return Err(cx.err(format!(
+            "analysis.newton.contraction: must lie in (0, 1], got {}",
+            n.contraction
+        )));
     }
     Ok(())
 }
@@ -351,7 +454,9 @@ fn curves(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Curve>, InputE
     for (k, c) in scene.curve.iter().enumerate() {
         let key = format!("curve[{k}] (`{}`)", c.name);
         if c.points.is_empty() {
-            return Err(cx.err(format!("{key}.points: give at least one [time, factor] pair")));
+            return Err(cx.err(format!(
+                "{key}.points: give at least one [time, factor] pair"
+            )));
         }
         if c.points.iter().flatten().any(|v| !v.is_finite()) {
             return Err(cx.err(format!("{key}.points: values must be finite")));
@@ -359,7 +464,15 @@ fn curves(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Curve>, InputE
         if c.points.windows(2).any(|w| w[1][0] <= w[0][0]) {
             return Err(cx.err(format!("{key}.points: times must increase strictly")));
         }
-        if out.insert(c.name.clone(), Curve { points: c.points.clone() }).is_some() {
+        if out
+            .insert(
+                c.name.clone(),
+                Curve {
+                    points: c.points.clone(),
+                },
+            )
+            .is_some()
+        {
             return Err(cx.err(format!("{key}.name: `{}` is used twice", c.name)));
         }
     }
@@ -367,14 +480,23 @@ fn curves(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Curve>, InputE
 }
 
 /// Index of the body a load/support/probe refers to: by name, or the only body.
-fn body_index(cx: &Context, bodies: &[Body], name: Option<&str>, key: &str) -> Result<usize, InputError> {
+fn body_index(
+    cx: &Context,
+    bodies: &[Body],
+    name: Option<&str>,
+    key: &str,
+) -> Result<usize, InputError> {
     match name {
         Some(n) => bodies.iter().position(|b| b.name == n).ok_or_else(|| {
             let known: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
-            cx.err(format!("{key}.body: no body named `{n}` (bodies: {known:?})"))
+            cx.err(format!(
+                "{key}.body: no body named `{n}` (bodies: {known:?})"
+            ))
         }),
         None if bodies.len() == 1 => Ok(0),
-        None => Err(cx.err(format!("{key}.body: the scene has several bodies; name one"))),
+        None => Err(cx.err(format!(
+            "{key}.body: the scene has several bodies; name one"
+        ))),
     }
 }
 
@@ -389,7 +511,10 @@ fn node_set(
     let sets = &bodies[b].mesh.node_sets;
     let nodes = sets.get(set).ok_or_else(|| {
         let known: Vec<&String> = sets.keys().collect();
-        cx.err(format!("{key}.set: body `{}` has no node set `{set}` (node sets: {known:?})", bodies[b].name))
+        cx.err(format!(
+            "{key}.set: body `{}` has no node set `{set}` (node sets: {known:?})",
+            bodies[b].name
+        ))
     })?;
     Ok((b, nodes.clone()))
 }
@@ -405,12 +530,18 @@ fn edge_set(
     let sets = &bodies[b].mesh.edge_sets;
     let edges = sets.get(set).ok_or_else(|| {
         let known: Vec<&String> = sets.keys().collect();
-        cx.err(format!("{key}.set: body `{}` has no edge set `{set}` (edge sets: {known:?})", bodies[b].name))
+        cx.err(format!(
+            "{key}.set: body `{}` has no edge set `{set}` (edge sets: {known:?})",
+            bodies[b].name
+        ))
     })?;
     if !matches!(bodies[b].kind, BodyKind::Continuum { .. }) {
         return Err(cx.err(format!("{key}: edge loads apply to 2D bodies only")));
     }
-    let global = edges.iter().map(|e| e.map(|n| bodies[b].global(n))).collect();
+    let global = edges
+        .iter()
+        .map(|e| e.map(|n| bodies[b].global(n)))
+        .collect();
     Ok((b, global))
 }
 
@@ -425,13 +556,19 @@ fn curve(
         None => Ok(default.clone()),
         Some(n) => curves.get(n).cloned().ok_or_else(|| {
             let known: Vec<&String> = curves.keys().collect();
-            cx.err(format!("{key}.curve: no curve named `{n}` (curves: {known:?})"))
+            cx.err(format!(
+                "{key}.curve: no curve named `{n}` (curves: {known:?})"
+            ))
         }),
     }
 }
 
 fn finite(cx: &Context, key: &str, values: &[f64]) -> Result<(), InputError> {
-    if values.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(cx.err(format!("{key}: values must be finite"))) }
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(cx.err(format!("{key}: values must be finite")))
+    }
 }
 
 fn load(
@@ -443,22 +580,37 @@ fn load(
     spec: &LoadSpec,
 ) -> Result<Load, InputError> {
     let key = format!("load[{k}]");
-    let globals = |b: usize, nodes: Vec<usize>| nodes.into_iter().map(|n| bodies[b].global(n)).collect();
+    let globals =
+        |b: usize, nodes: Vec<usize>| nodes.into_iter().map(|n| bodies[b].global(n)).collect();
     Ok(match spec {
         LoadSpec::NodalForce(s) => {
             finite(cx, &format!("{key}.force"), &s.force)?;
             let (b, nodes) = node_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
-            Load::NodalForce { nodes: globals(b, nodes), force: s.force, curve: curve(cx, curves, default, &s.curve, &key)? }
+            Load::NodalForce {
+                nodes: globals(b, nodes),
+                force: s.force,
+                curve: curve(cx, curves, default, &s.curve, &key)?,
+            }
         }
         LoadSpec::Traction(s) => {
             finite(cx, &format!("{key}.traction"), &s.traction)?;
             let (body, edges) = edge_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
-            Load::Traction { body, edges, traction: s.traction, curve: curve(cx, curves, default, &s.curve, &key)? }
+            Load::Traction {
+                body,
+                edges,
+                traction: s.traction,
+                curve: curve(cx, curves, default, &s.curve, &key)?,
+            }
         }
         LoadSpec::Pressure(s) => {
             finite(cx, &format!("{key}.pressure"), &[s.pressure])?;
             let (body, edges) = edge_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
-            Load::Pressure { body, edges, pressure: s.pressure, curve: curve(cx, curves, default, &s.curve, &key)? }
+            Load::Pressure {
+                body,
+                edges,
+                pressure: s.pressure,
+                curve: curve(cx, curves, default, &s.curve, &key)?,
+            }
         }
         LoadSpec::Displacement(s) => {
             if s.x.is_none() && s.y.is_none() {
@@ -466,7 +618,12 @@ fn load(
             }
             finite(cx, &key, &[s.x.unwrap_or(0.0), s.y.unwrap_or(0.0)])?;
             let (b, nodes) = node_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
-            Load::Displacement { nodes: globals(b, nodes), x: s.x, y: s.y, curve: curve(cx, curves, default, &s.curve, &key)? }
+            Load::Displacement {
+                nodes: globals(b, nodes),
+                x: s.x,
+                y: s.y,
+                curve: curve(cx, curves, default, &s.curve, &key)?,
+            }
         }
         LoadSpec::Rotation(s) => {
             finite(cx, &key, &[s.center[0], s.center[1], s.angle])?;
@@ -480,7 +637,16 @@ fn load(
         }
         LoadSpec::Affine(s) => {
             let offset = s.offset.unwrap_or([0.0; 2]);
-            finite(cx, &key, &[s.gradient[0][0], s.gradient[0][1], s.gradient[1][0], s.gradient[1][1]])?;
+            finite(
+                cx,
+                &key,
+                &[
+                    s.gradient[0][0],
+                    s.gradient[0][1],
+                    s.gradient[1][0],
+                    s.gradient[1][1],
+                ],
+            )?;
             finite(cx, &key, &offset)?;
             let (b, nodes) = node_set(cx, bodies, s.body.as_deref(), &s.set, &key)?;
             Load::Affine {
@@ -499,7 +665,11 @@ fn probes(cx: &Context, bodies: &[Body], specs: &[ProbeSpec]) -> Result<Vec<Prob
         let key = format!("output.probe[{k}]");
         let b = body_index(cx, bodies, p.body.as_deref(), &key)?;
         let members = if p.quantity.is_nodal() {
-            node_set(cx, bodies, p.body.as_deref(), &p.set, &key)?.1.into_iter().map(|n| bodies[b].global(n)).collect()
+            node_set(cx, bodies, p.body.as_deref(), &p.set, &key)?
+                .1
+                .into_iter()
+                .map(|n| bodies[b].global(n))
+                .collect()
         } else {
             let sets = &bodies[b].mesh.element_sets;
             sets.get(&p.set).cloned().ok_or_else(|| {
@@ -510,8 +680,17 @@ fn probes(cx: &Context, bodies: &[Body], specs: &[ProbeSpec]) -> Result<Vec<Prob
                 ))
             })?
         };
-        let set = if bodies.len() > 1 { format!("{}.{}", bodies[b].name, p.set) } else { p.set.clone() };
-        out.push(Probe { quantity: p.quantity, body: b, members, column: format!("{}[{set}]", p.quantity.name()) });
+        let set = if bodies.len() > 1 {
+            format!("{}.{}", bodies[b].name, p.set)
+        } else {
+            p.set.clone()
+        };
+        out.push(Probe {
+            quantity: p.quantity,
+            body: b,
+            members,
+            column: format!("{}[{set}]", p.quantity.name()),
+        });
     }
     Ok(out)
 }

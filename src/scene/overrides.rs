@@ -32,15 +32,22 @@ fn set(table: &mut Table, segments: &[&str], value: Value, key: &str) -> Result<
         table.insert(first.to_string(), value);
         return Ok(());
     }
-    let entry = table.entry(first.to_string()).or_insert_with(|| Value::Table(Table::new()));
+    let entry = table
+        .entry(first.to_string())
+        .or_insert_with(|| Value::Table(Table::new()));
     match entry {
         Value::Table(inner) => set(inner, rest, value, key),
         Value::Array(items) => {
             let (selector, rest) = rest.split_first().expect("checked above");
-            let names: Vec<String> =
-                items.iter().filter_map(|v| v.get("name").and_then(Value::as_str).map(str::to_string)).collect();
+            let names: Vec<String> = items
+                .iter()
+                .filter_map(|v| v.get("name").and_then(Value::as_str).map(str::to_string))
+                .collect();
             let item = select(items, selector).ok_or_else(|| {
-                format!("`{first}` has no entry named `{selector}` (entries: {})", names.join(", "))
+                format!(
+                    "`{first}` has no entry named `{selector}` (entries: {})",
+                    names.join(", ")
+                )
             })?;
             if rest.is_empty() {
                 *item = value;
@@ -56,7 +63,9 @@ fn set(table: &mut Table, segments: &[&str], value: Value, key: &str) -> Result<
 }
 
 fn select<'a>(items: &'a mut [Value], selector: &str) -> Option<&'a mut Value> {
-    let by_name = items.iter().position(|v| v.get("name").and_then(Value::as_str) == Some(selector));
+    let by_name = items
+        .iter()
+        .position(|v| v.get("name").and_then(Value::as_str) == Some(selector));
     let index = by_name.or_else(|| selector.parse::<usize>().ok().filter(|i| *i < items.len()))?;
     items.get_mut(index)
 }
@@ -79,7 +88,10 @@ mod tests {
         apply(&mut t, "body.1.material=steel").unwrap();
         assert_eq!(t["analysis"]["dt"].as_float(), Some(0.001));
         assert_eq!(t["body"][0]["velocity"][0].as_integer(), Some(0));
-        assert_eq!(t["body"][0]["velocity"].as_array().unwrap()[1].as_float(), Some(-0.8));
+        assert_eq!(
+            t["body"][0]["velocity"].as_array().unwrap()[1].as_float(),
+            Some(-0.8)
+        );
         assert_eq!(t["body"][1]["material"].as_str(), Some("steel"));
     }
 

@@ -173,24 +173,38 @@ pub struct CurveSpec {
     pub points: Vec<[f64; 2]>,
 }
 
-#[derive(Debug, Clone, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
-pub enum AnalysisSpec {
-    Static(StaticSpec),
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AnalysisKind {
+    /// Load stepping in pseudo time.
+    Static,
 }
 
-/// Static load stepping: `steps` equal increments of pseudo time up to `end_time`.
+/// The analysis block. One flat table (so every message points at its key's line); keys
+/// that do not apply to the chosen `type` are refused during validation.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct StaticSpec {
-    pub steps: usize,
-    /// Default 1.
+pub struct AnalysisSpec {
+    #[serde(rename = "type")]
+    pub kind: AnalysisKind,
+    /// Static: the number of equal load increments up to `end_time` (required).
+    pub steps: Option<usize>,
+    /// Default 1 (static pseudo time).
     #[serde(default = "one")]
     pub end_time: f64,
     /// `nonlinear` (default, updated Lagrangian) or `linear` (small strain).
     #[serde(default)]
     pub geometry: Geometry,
     #[serde(default)]
+    pub newton: NewtonSpec,
+}
+
+/// The validated static analysis.
+#[derive(Debug, Clone)]
+pub struct StaticSpec {
+    pub steps: usize,
+    pub end_time: f64,
+    pub geometry: Geometry,
     pub newton: NewtonSpec,
 }
 
@@ -274,7 +288,11 @@ pub struct OutputSpec {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { frame_every: default_frame_every(), compression: Compression::default(), probe: Vec::new() }
+        OutputSpec {
+            frame_every: default_frame_every(),
+            compression: Compression::default(),
+            probe: Vec::new(),
+        }
     }
 }
 

@@ -20,7 +20,10 @@ pub struct Pattern {
 impl Pattern {
     /// Builds the pattern from the (free) DOF lists of the elements; `None` marks a constrained
     /// DOF. Every diagonal entry is present.
-    pub fn from_elements<'a>(size: usize, elements: impl Iterator<Item = &'a [Option<usize>]>) -> Pattern {
+    pub fn from_elements<'a>(
+        size: usize,
+        elements: impl Iterator<Item = &'a [Option<usize>]>,
+    ) -> Pattern {
         let mut columns: Vec<Vec<usize>> = (0..size).map(|j| vec![j]).collect();
         for dofs in elements {
             for a in dofs.iter().flatten() {
@@ -40,7 +43,11 @@ impl Pattern {
             row_idx.extend_from_slice(&col);
             col_ptr.push(row_idx.len());
         }
-        Pattern { size, col_ptr, row_idx }
+        Pattern {
+            size,
+            col_ptr,
+            row_idx,
+        }
     }
 
     pub fn nonzeros(&self) -> usize {
@@ -50,7 +57,10 @@ impl Pattern {
     /// Position of entry (row, col), row >= col, in the values array.
     pub fn position(&self, row: usize, col: usize) -> Option<usize> {
         let range = self.col_ptr[col]..self.col_ptr[col + 1];
-        self.row_idx[range.clone()].binary_search(&row).ok().map(|k| range.start + k)
+        self.row_idx[range.clone()]
+            .binary_search(&row)
+            .ok()
+            .map(|k| range.start + k)
     }
 
     /// Scatter positions of one element's matrix (row-major, n x n): `usize::MAX` where the
@@ -60,7 +70,9 @@ impl Pattern {
         for a in dofs {
             for b in dofs {
                 let pos = match (a, b) {
-                    (Some(i), Some(j)) if i >= j => self.position(*i, *j).expect("pattern holds the element"),
+                    (Some(i), Some(j)) if i >= j => {
+                        self.position(*i, *j).expect("pattern holds the element")
+                    }
                     _ => usize::MAX,
                 };
                 positions.push(pos);
@@ -123,21 +135,30 @@ impl Solver {
                     .map_err(|e| SolverError::Factorization(format!("{e:?}")))?,
             )
         };
-        Ok(Solver { matrix, symbolic, factor: None, factorizations: 0, solves: 0 })
+        Ok(Solver {
+            matrix,
+            symbolic,
+            factor: None,
+            factorizations: 0,
+            solves: 0,
+        })
     }
 
     /// Numeric factorization of the matrix with the given lower-triangle values.
     pub fn factor(&mut self, values: &[f64]) -> Result<(), SolverError> {
         self.factor = None;
         self.factorizations += 1;
-        let Some(symbolic) = &self.symbolic else { return Ok(()) };
+        let Some(symbolic) = &self.symbolic else {
+            return Ok(());
+        };
         let a = SparseColMatRef::new(self.matrix.as_ref(), values);
-        let llt = Llt::try_new_with_symbolic(symbolic.clone(), a, Side::Lower).map_err(|e| match e {
-            faer::sparse::linalg::LltError::Numeric(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
-                index,
-            }) => SolverError::NotPositiveDefinite { index },
-            other => SolverError::Factorization(format!("{other:?}")),
-        });
+        let llt =
+            Llt::try_new_with_symbolic(symbolic.clone(), a, Side::Lower).map_err(|e| match e {
+                faer::sparse::linalg::LltError::Numeric(
+                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
+                ) => SolverError::NotPositiveDefinite { index },
+                other => SolverError::Factorization(format!("{other:?}")),
+            });
         self.factor = Some(llt?);
         Ok(())
     }
@@ -148,7 +169,10 @@ impl Solver {
         if self.symbolic.is_none() {
             return;
         }
-        let factor = self.factor.as_ref().expect("solve after a successful factor");
+        let factor = self
+            .factor
+            .as_ref()
+            .expect("solve after a successful factor");
         let n = rhs.len();
         factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
     }
@@ -162,8 +186,9 @@ mod tests {
     #[test]
     fn spring_chain_solves_exactly() {
         let n = 50;
-        let elements: Vec<Vec<Option<usize>>> =
-            (0..=n).map(|e: usize| vec![e.checked_sub(1), if e < n { Some(e) } else { None }]).collect();
+        let elements: Vec<Vec<Option<usize>>> = (0..=n)
+            .map(|e: usize| vec![e.checked_sub(1), if e < n { Some(e) } else { None }])
+            .collect();
         let pattern = Pattern::from_elements(n, elements.iter().map(|e| e.as_slice()));
         let mut values = vec![0.0; pattern.nonzeros()];
         for dofs in &elements {

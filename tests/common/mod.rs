@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 
 /// A fresh, empty output folder under the system temp dir, unique per test name.
 pub fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impact-tests-{}", std::process::id())).join(name);
+    let dir = std::env::temp_dir()
+        .join(format!("impact-tests-{}", std::process::id()))
+        .join(name);
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -18,8 +20,12 @@ pub fn out_dir(name: &str) -> PathBuf {
 /// files resolve against tests/), with `--set` overrides.
 pub fn model(name: &str, text: &str, overrides: &[&str]) -> Model {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::from_str(text, &Path::new("tests").join(format!("{name}.toml")), &overrides)
-        .unwrap_or_else(|e| panic!("scene `{name}` is invalid: {e}"))
+    scene::from_str(
+        text,
+        &Path::new("tests").join(format!("{name}.toml")),
+        &overrides,
+    )
+    .unwrap_or_else(|e| panic!("scene `{name}` is invalid: {e}"))
 }
 
 /// Runs a model and returns its summary and final state.
