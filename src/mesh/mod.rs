@@ -66,7 +66,11 @@ pub enum MeshError {
     #[error("cannot read mesh file {path}: {reason}")]
     Io { path: String, reason: String },
     #[error("mesh file {path}, line {line}: {reason}")]
-    Parse { path: String, line: usize, reason: String },
+    Parse {
+        path: String,
+        line: usize,
+        reason: String,
+    },
     #[error("mesh file {path}: {reason}")]
     Content { path: String, reason: String },
 }
@@ -77,7 +81,13 @@ impl Mesh {
         let all = (0..cells.len()).collect();
         let mut element_sets = BTreeMap::new();
         element_sets.insert("all".to_string(), all);
-        Mesh { nodes, cells, node_sets: BTreeMap::new(), edge_sets: BTreeMap::new(), element_sets }
+        Mesh {
+            nodes,
+            cells,
+            node_sets: BTreeMap::new(),
+            edge_sets: BTreeMap::new(),
+            element_sets,
+        }
     }
 
     /// Adds an edge set and the node set of the same name (its nodes, sorted and unique).
@@ -99,7 +109,9 @@ impl Mesh {
     /// Boundary edges of a Quad4 mesh (edges used by one element), oriented counter-clockwise
     /// around the body. Empty for rods.
     pub fn boundary_edges(&self) -> Vec<[usize; 2]> {
-        let Cells::Quad4(quads) = &self.cells else { return Vec::new() };
+        let Cells::Quad4(quads) = &self.cells else {
+            return Vec::new();
+        };
         let mut count: BTreeMap<(usize, usize), ([usize; 2], usize)> = BTreeMap::new();
         for q in quads {
             for k in 0..4 {
@@ -108,7 +120,10 @@ impl Mesh {
                 count.entry(key).or_insert((edge, 0)).1 += 1;
             }
         }
-        count.into_values().filter(|(_, n)| *n == 1).map(|(e, _)| e).collect()
+        count
+            .into_values()
+            .filter(|(_, n)| *n == 1)
+            .map(|(e, _)| e)
+            .collect()
     }
 }
-
