@@ -8,6 +8,7 @@
 pub mod analysis;
 pub mod assembly;
 pub mod element;
+pub mod integrator;
 pub mod kinematics;
 pub mod material;
 pub mod mesh;

@@ -1,15 +1,23 @@
 //! The drivers: static load stepping (dynamic time stepping plugs in beside it), with the
 //! run's bookkeeping and its output (VTK frames, history.csv, summary.json).
 
+pub mod dynamics;
+pub mod explicit;
 pub mod loads;
+pub mod newton;
 pub mod record;
 pub mod statics;
 
 use crate::assembly::State;
 use crate::output::OutputError;
 use crate::scene::{InputError, Model};
+use crate::solver::Solver;
+use indicatif::{ProgressBar, ProgressStyle};
+use newton::Counters;
+use record::{Energies, Recorder};
 use serde::Serialize;
 use std::path::Path;
+use std::time::Instant;
 
 /// How a run ended (summary.json `status`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -71,6 +79,124 @@ pub struct Summary {
     pub buckling: Option<BucklingSummary>,
 }
 
+impl Summary {
+    /// A summary before the run: status `ok`, counters zero.
+    pub fn new(
+        model: &Model,
+        integrator: &str,
+        dt: f64,
+        end_time: f64,
+        free_dofs: usize,
+    ) -> Summary {
+        Summary {
+            scene: model.file.display().to_string(),
+            title: model.title.clone(),
+            status: Status::Ok,
+            message: None,
+            integrator: integrator.to_string(),
+            dt,
+            steps: 0,
+            end_time,
+            nodes: model.node_count,
+            elements: model.elements(),
+            dofs: model.dofs(),
+            free_dofs,
+            wall_seconds: 0.0,
+            newton_iterations: 0,
+            factorizations: 0,
+            back_substitutions: 0,
+            step_cuts: 0,
+            contact: ContactSummary::default(),
+            energy: EnergySummary::default(),
+            buckling: None,
+        }
+    }
+
+    /// Fills the counters, the wall time and the final energies.
+    /// `solver` is None for the explicit method (no factorization at all).
+    pub fn finish(
+        &mut self,
+        energies: &Energies,
+        counters: &Counters,
+        solver: Option<&Solver>,
+        start: Instant,
+    ) {
+        self.newton_iterations = counters.iterations;
+        self.step_cuts = counters.cuts;
+        self.factorizations = solver.map_or(0, |s| s.factorizations);
+        self.back_substitutions = solver.map_or(0, |s| s.solves);
+        self.wall_seconds = start.elapsed().as_secs_f64();
+        self.energy.final_ = energies.kinetic + energies.internal;
+        self.energy.plastic_dissipation = energies.plastic_work;
+    }
+}
+
+/// A failed run: the summary is written with its status and message, then returned in the error.
+fn fail(recorder: &Recorder, mut summary: Summary, status: Status, message: String) -> RunError {
+    summary.status = status;
+    summary.message = Some(message.clone());
+    match recorder.write_summary(&summary) {
+        Ok(()) => RunError::Numerical {
+            message,
+            summary: Box::new(summary),
+        },
+        Err(e) => RunError::Output(e),
+    }
+}
+
+fn setup_error(dir: &Path, e: impl std::fmt::Display) -> RunError {
+    RunError::Output(OutputError::Invalid {
+        path: dir.to_path_buf(),
+        reason: e.to_string(),
+    })
+}
+
+fn progress_bar(show: bool, steps: usize) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(steps as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// Rounds a time that is a whole number of nominal steps up to round-off onto that multiple,
+/// so history rows fall on k dt exactly.
+fn snap(t: f64, dt: f64) -> f64 {
+    let k = (t / dt).round();
+    if (t - k * dt).abs() <= 1e-9 * dt {
+        k * dt
+    } else {
+        t
+    }
+}
+
+/// Work of the nodal forces over an increment by the trapezoid rule, 1/2 (f_0 + f_1) . d.
+fn trapezoid_work(d: &[f64], f1: &[f64], f0: &[f64]) -> f64 {
+    0.5 * d
+        .iter()
+        .zip(f1.iter().zip(f0))
+        .map(|(u, (a, b))| u * (a + b))
+        .sum::<f64>()
+}
+
+/// Relative energy balance error |KE + W_int - W_ext - KE_0| / max(KE_0, |W_ext|, W_int).
+fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
+    let scale = initial_kinetic
+        .max(energies.external_work.abs())
+        .max(energies.internal.abs())
+        .max(f64::MIN_POSITIVE);
+    (energies.kinetic + energies.internal + energies.plastic_work + energies.contact_work
+        - energies.external_work
+        - initial_kinetic)
+        .abs()
+        / scale
+}
+
 /// Why a run failed; `exit_code` maps it to the CLI's contract.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
@@ -116,5 +242,12 @@ pub fn run_to_state(
 ) -> Result<(Summary, State), RunError> {
     match &model.analysis {
         crate::scene::model::Analysis::Static(spec) => statics::run(model, spec, out_dir, options),
+        crate::scene::model::Analysis::Dynamic(spec) => {
+            if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference {
+                explicit::run(model, spec, out_dir, options)
+            } else {
+                dynamics::run(model, spec, out_dir, options)
+            }
+        }
     }
 }

@@ -457,3 +457,201 @@ fn push_forward_body(
         }
     }
 }
+
+/// Consistent (sum rho N^T N over the initial configuration) or lumped (row sums) mass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MassKind {
+    #[default]
+    Consistent,
+    Lumped,
+}
+
+/// The mass matrix. In the updated-Lagrangian description rho dV is invariant, so the mass
+/// is computed once on the initial configuration and never changes.
+pub struct Mass {
+    pub kind: MassKind,
+    /// Per body, per element: the scalar nn x nn matrix (the same for x and y), row-major.
+    elements: Vec<Vec<f64>>,
+    /// Row sums per DOF (the lumped mass; also used by the explicit method).
+    pub lumped: Vec<f64>,
+}
+
+impl Mass {
+    pub fn new(model: &Model, kind: MassKind) -> Result<Mass, ElementFailure> {
+        let coords = model.coordinates();
+        let mut lumped = vec![0.0; model.dofs()];
+        let mut elements = Vec::with_capacity(model.bodies.len());
+        for body in &model.bodies {
+            let rho = body.material.density;
+            let nn = body.mesh.cells.nodes_of(0).len();
+            let mut body_m = Vec::with_capacity(body.elements() * nn * nn);
+            for e in 0..body.elements() {
+                let nodes = body.mesh.cells.nodes_of(e);
+                let failure = |error| ElementFailure {
+                    body: body.name.clone(),
+                    element: e,
+                    error,
+                };
+                let m: Vec<f64> = match body.kind {
+                    BodyKind::Continuum {
+                        formulation,
+                        thickness,
+                        ..
+                    } => {
+                        let x: quad4::Coords =
+                            std::array::from_fn(|i| coords[body.global(nodes[i])]);
+                        let geom =
+                            quad4::geometry(&x, formulation, &[thickness; 4]).map_err(failure)?;
+                        let m = quad4::mass(&geom) * rho;
+                        m.transpose().as_slice().to_vec()
+                    }
+                    BodyKind::Rod { area } => {
+                        let x = [coords[body.global(nodes[0])], coords[body.global(nodes[1])]];
+                        let m = rod2::mass(&x).map_err(failure)?;
+                        m.iter().flatten().map(|v| v * rho * area).collect()
+                    }
+                };
+                for (i, n) in nodes.iter().enumerate() {
+                    let row: f64 = m[i * nn..(i + 1) * nn].iter().sum();
+                    lumped[2 * body.global(*n)] += row;
+                    lumped[2 * body.global(*n) + 1] += row;
+                }
+                body_m.extend(m);
+            }
+            elements.push(body_m);
+        }
+        Ok(Mass {
+            kind,
+            elements,
+            lumped,
+        })
+    }
+
+    /// M x over all DOFs.
+    pub fn product(&self, model: &Model, x: &[f64]) -> Vec<f64> {
+        match self.kind {
+            MassKind::Lumped => self.lumped.iter().zip(x).map(|(m, v)| m * v).collect(),
+            MassKind::Consistent => {
+                let mut y = vec![0.0; x.len()];
+                for (b, body) in model.bodies.iter().enumerate() {
+                    let nn = body.mesh.cells.nodes_of(0).len();
+                    for e in 0..body.elements() {
+                        let nodes = body.mesh.cells.nodes_of(e);
+                        let m = &self.elements[b][e * nn * nn..(e + 1) * nn * nn];
+                        for i in 0..nn {
+                            let gi = body.global(nodes[i]);
+                            for j in 0..nn {
+                                let gj = body.global(nodes[j]);
+                                y[2 * gi] += m[i * nn + j] * x[2 * gj];
+                                y[2 * gi + 1] += m[i * nn + j] * x[2 * gj + 1];
+                            }
+                        }
+                    }
+                }
+                y
+            }
+        }
+    }
+
+    /// 1/2 v . M v
+    pub fn kinetic_energy(&self, model: &Model, v: &[f64]) -> f64 {
+        0.5 * self
+            .product(model, v)
+            .iter()
+            .zip(v)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+    }
+
+    /// Adds `coefficient` M into the free-DOF matrix of `system`.
+    pub fn add_to(&self, model: &Model, system: &mut System, coefficient: f64) {
+        for (b, body) in model.bodies.iter().enumerate() {
+            let nn = body.mesh.cells.nodes_of(0).len();
+            let n = 2 * nn;
+            for e in 0..body.elements() {
+                let positions = &system.scatter[b][e * n * n..(e + 1) * n * n];
+                let m = &self.elements[b][e * nn * nn..(e + 1) * nn * nn];
+                for i in 0..nn {
+                    for j in 0..nn {
+                        let value = match self.kind {
+                            MassKind::Consistent => m[i * nn + j],
+                            // the element's own row sum: summed over elements, the lumped diagonal
+                            MassKind::Lumped if i == j => m[i * nn..(i + 1) * nn].iter().sum(),
+                            MassKind::Lumped => 0.0,
+                        };
+                        for c in 0..2 {
+                            let p = positions[(2 * i + c) * n + 2 * j + c];
+                            if p != usize::MAX {
+                                system.values[p] += coefficient * value;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The largest element eigenvalue max_e lambda_max(M_e^-1 K_e) with the lumped element mass:
+/// an upper bound of the highest natural frequency squared of the assembled model (Irons'
+/// element eigenvalue theorem), so 2 / sqrt(it) is a safe central-difference step. Returns
+/// the bound and the (body, element) that sets it.
+pub fn max_frequency_squared(
+    model: &Model,
+    state: &State,
+    geometry: Geometry,
+) -> Result<(f64, usize, usize), ElementFailure> {
+    let zero = vec![0.0; model.dofs()];
+    let coords = model.coordinates();
+    let mut best = (0.0, 0, 0);
+    for (b, body) in model.bodies.iter().enumerate() {
+        let rho = body.material.density;
+        for e in 0..body.elements() {
+            let failure = |error| ElementFailure {
+                body: body.name.clone(),
+                element: e,
+                error,
+            };
+            let r = element(
+                body,
+                &state.bodies[b],
+                &state.reference,
+                &zero,
+                e,
+                geometry,
+                true,
+            )
+            .map_err(|(_, err)| failure(err))?;
+            let k = r.matrix.expect("tangent requested");
+            let nodes = body.mesh.cells.nodes_of(e);
+            let lumped: Vec<f64> = match body.kind {
+                BodyKind::Continuum {
+                    formulation,
+                    thickness,
+                    ..
+                } => {
+                    let x: quad4::Coords = std::array::from_fn(|i| coords[body.global(nodes[i])]);
+                    let geom =
+                        quad4::geometry(&x, formulation, &[thickness; 4]).map_err(failure)?;
+                    let m = quad4::mass(&geom);
+                    (0..4).map(|i| rho * m.row(i).sum()).collect()
+                }
+                BodyKind::Rod { area } => {
+                    let x = [coords[body.global(nodes[0])], coords[body.global(nodes[1])]];
+                    let l = rod2::length(&x).map_err(failure)?;
+                    vec![rho * area * l / 2.0; 2]
+                }
+            };
+            let n = 2 * lumped.len();
+            let scale: Vec<f64> = (0..n).map(|i| 1.0 / lumped[i / 2].sqrt()).collect();
+            let a = nalgebra::DMatrix::from_fn(n, n, |i, j| k[i * n + j] * scale[i] * scale[j]);
+            let a = (&a + a.transpose()) * 0.5;
+            let lambda = a.symmetric_eigenvalues().max();
+            if lambda > best.0 {
+                best = (lambda, b, e);
+            }
+        }
+    }
+    Ok(best)
+}

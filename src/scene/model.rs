@@ -6,9 +6,10 @@
 
 use super::InputError;
 use super::spec::{
-    AnalysisKind, AnalysisSpec, BodySpec, Component, FormulationSpec, LoadSpec, NewtonSpec,
-    OutputSpec, ProbeSpec, Quantity, Scene, StaticSpec,
+    AnalysisKind, AnalysisSpec, BodySpec, Component, DynamicSpec, FormulationSpec, IntegratorKind,
+    LoadSpec, NewtonSpec, OutputSpec, ProbeSpec, Quantity, Scene, StaticSpec,
 };
+use crate::assembly::MassKind;
 use crate::element::{Formulation, Geometry, Voigt, quad4, rod2};
 use crate::material::{Elastic, Material};
 use crate::mesh::{Cells, Mesh};
@@ -135,12 +136,14 @@ pub struct Probe {
 #[derive(Debug, Clone)]
 pub enum Analysis {
     Static(StaticSpec),
+    Dynamic(DynamicSpec),
 }
 
 impl Analysis {
     pub fn geometry(&self) -> Geometry {
         match self {
             Analysis::Static(s) => s.geometry,
+            Analysis::Dynamic(s) => s.geometry,
         }
     }
 }
@@ -159,6 +162,8 @@ pub struct Model {
     pub analysis: Analysis,
     pub output: OutputSpec,
     pub probes: Vec<Probe>,
+    /// Initial velocity per DOF (bodies' `velocity`, then `[[initial_velocity]]` sets).
+    pub initial_velocity: Vec<f64>,
 }
 
 impl Model {
@@ -208,8 +213,12 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let analysis = analysis(&cx, &scene.analysis)?;
     let curves = curves(&cx, &scene)?;
     let default_curve = match &analysis {
+        // statics ramps the loads up over the run; dynamics applies them at once (a step)
         Analysis::Static(s) => Curve {
             points: vec![[0.0, 0.0], [s.end_time, 1.0]],
+        },
+        Analysis::Dynamic(_) => Curve {
+            points: vec![[0.0, 1.0]],
         },
     };
     let mut fixed_dofs = Vec::new();
@@ -234,6 +243,27 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         .map(|(k, l)| load(&cx, &bodies, &curves, &default_curve, k, l))
         .collect::<Result<Vec<_>, _>>()?;
     let probes = probes(&cx, &bodies, &scene.output.probe)?;
+    let mut initial_velocity = vec![0.0; 2 * node_count];
+    for body in &bodies {
+        for n in 0..body.mesh.nodes.len() {
+            initial_velocity[2 * body.global(n)] = body.velocity[0];
+            initial_velocity[2 * body.global(n) + 1] = body.velocity[1];
+        }
+    }
+    for (k, v) in scene.initial_velocity.iter().enumerate() {
+        let key = format!("initial_velocity[{k}]");
+        finite(&cx, &format!("{key}.velocity"), &v.velocity)?;
+        let (b, nodes) = node_set(&cx, &bodies, v.body.as_deref(), &v.set, &key)?;
+        for n in nodes {
+            initial_velocity[2 * bodies[b].global(n)] = v.velocity[0];
+            initial_velocity[2 * bodies[b].global(n) + 1] = v.velocity[1];
+        }
+    }
+    for (b, spec) in scene.body.iter().enumerate() {
+        if let Some(v) = spec.velocity {
+            finite(&cx, &format!("body `{}`.velocity", bodies[b].name), &v)?;
+        }
+    }
     let name = file
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -249,6 +279,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         analysis,
         output: scene.output,
         probes,
+        initial_velocity,
     })
 }
 
@@ -414,27 +445,160 @@ fn check_cells(cx: &Context, key: &str, mesh: &Mesh, kind: &BodyKind) -> Result<
 }
 
 fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, InputError> {
+    let given = |present: bool, key: &str, kind: &str| {
+        if present {
+            Err(cx.err(format!(
+                "analysis.{key}: does not apply to a {kind} analysis"
+            )))
+        } else {
+            Ok(())
+        }
+    };
+    newton(cx, &spec.newton)?;
     match spec.kind {
         AnalysisKind::Static => {
+            given(spec.dt.is_some(), "dt", "static")?;
+            given(spec.integrator.is_some(), "integrator", "static")?;
+            for (present, key) in [
+                (spec.beta.is_some(), "beta"),
+                (spec.gamma.is_some(), "gamma"),
+                (spec.theta.is_some(), "theta"),
+                (spec.alpha.is_some(), "alpha"),
+                (spec.rho_infinity.is_some(), "rho_infinity"),
+                (spec.mass.is_some(), "mass"),
+                (spec.rayleigh.is_some(), "rayleigh"),
+                (spec.allow_unstable, "allow_unstable"),
+            ] {
+                given(present, key, "static")?;
+            }
             let steps = spec.steps.ok_or_else(|| {
                 cx.err("analysis.steps: a static analysis needs its number of load steps")
             })?;
             if steps == 0 {
                 return Err(cx.err("analysis.steps: must be at least 1"));
             }
-            positive(cx, "analysis.end_time", spec.end_time)?;
-            newton(cx, &spec.newton)?;
+            let end_time = positive(cx, "analysis.end_time", spec.end_time.unwrap_or(1.0))?;
             Ok(Analysis::Static(StaticSpec {
                 steps,
-                end_time: spec.end_time,
+                end_time,
                 geometry: spec.geometry,
                 newton: spec.newton.clone(),
             }))
         }
+        AnalysisKind::Dynamic => dynamic(cx, spec).map(Analysis::Dynamic),
     }
 }
 
+fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError> {
+    if spec.steps.is_some() {
+        return Err(cx.err("analysis.steps: a dynamic analysis takes `dt` and `end_time`"));
+    }
+    let dt = positive(
+        cx,
+        "analysis.dt",
+        spec.dt
+            .ok_or_else(|| cx.err("analysis.dt: a dynamic analysis needs its time step"))?,
+    )?;
+    let end_time = positive(
+        cx,
+        "analysis.end_time",
+        spec.end_time
+            .ok_or_else(|| cx.err("analysis.end_time: a dynamic analysis needs its end time"))?,
+    )?;
+    let integrator = spec.integrator.unwrap_or(IntegratorKind::Average);
+    let only_for = |present: bool, key: &str, kinds: &[IntegratorKind]| {
+        if present && !kinds.contains(&integrator) {
+            Err(cx.err(format!(
+                "analysis.{key}: does not apply to integrator {integrator:?}"
+            )))
+        } else {
+            Ok(())
+        }
+    };
+    use IntegratorKind as I;
+    only_for(spec.beta.is_some(), "beta", &[I::Newmark])?;
+    only_for(spec.gamma.is_some(), "gamma", &[I::Newmark])?;
+    only_for(spec.theta.is_some(), "theta", &[I::Wilson])?;
+    only_for(spec.alpha.is_some(), "alpha", &[I::Hht])?;
+    only_for(
+        spec.rho_infinity.is_some(),
+        "rho_infinity",
+        &[I::GeneralizedAlpha],
+    )?;
+    only_for(
+        spec.allow_unstable,
+        "allow_unstable",
+        &[I::CentralDifference],
+    )?;
+    let (beta, gamma) = match integrator {
+        I::Average => (0.25, 0.5),
+        I::Linear => (1.0 / 6.0, 0.5),
+        I::Hu => (1.0, 1.5),
+        I::Newmark => (
+            spec.beta
+                .ok_or_else(|| cx.err("analysis.beta: integrator newmark needs beta"))?,
+            spec.gamma
+                .ok_or_else(|| cx.err("analysis.gamma: integrator newmark needs gamma"))?,
+        ),
+        _ => (0.25, 0.5),
+    };
+    if integrator == I::Newmark && !(beta > 0.0 && gamma >= 0.0) {
+        return Err(cx.err(format!(
+            "analysis.beta, gamma: need beta > 0 and gamma >= 0, got {beta}, {gamma}"
+        )));
+    }
+    let theta = spec.theta.unwrap_or(1.4);
+    if !(theta >= 1.0) {
+        return Err(cx.err(format!(
+            "analysis.theta: Wilson's theta must be >= 1, got {theta}"
+        )));
+    }
+    let alpha = spec.alpha.unwrap_or(-0.05);
+    if !(-1.0 / 3.0..=0.0).contains(&alpha) {
+        return Err(cx.err(format!(
+            "analysis.alpha: HHT's alpha must lie in [-1/3, 0], got {alpha}"
+        )));
+    }
+    let rho_infinity = spec.rho_infinity.unwrap_or(0.8);
+    if !(0.0..=1.0).contains(&rho_infinity) {
+        return Err(cx.err(format!(
+            "analysis.rho_infinity: must lie in [0, 1], got {rho_infinity}"
+        )));
+    }
+    let mass = match (integrator, spec.mass) {
+        (I::CentralDifference, Some(MassKind::Consistent)) => {
+            return Err(cx.err("analysis.mass: central difference uses the lumped mass"));
+        }
+        (I::CentralDifference, _) => MassKind::Lumped,
+        (_, m) => m.unwrap_or_default(),
+    };
+    let rayleigh = spec.rayleigh.unwrap_or([0.0, 0.0]);
+    if rayleigh.iter().any(|c| !(*c >= 0.0 && c.is_finite())) {
+        return Err(cx.err(format!(
+            "analysis.rayleigh: coefficients must be >= 0, got {rayleigh:?}"
+        )));
+    }
+    Ok(DynamicSpec {
+        dt,
+        end_time,
+        integrator,
+        beta,
+        gamma,
+        theta,
+        alpha,
+        rho_infinity,
+        mass,
+        rayleigh,
+        allow_unstable: spec.allow_unstable,
+        geometry: spec.geometry,
+        newton: spec.newton.clone(),
+    })
+}
+
 fn newton(cx: &Context, n: &NewtonSpec) -> Result<(), InputError> {
+    if n.refactor_every == 0 {
+        return Err(cx.err("analysis.newton.refactor_every: must be at least 1"));
+    }
     if n.max_iterations == 0 {
         return Err(cx.err("analysis.newton.max_iterations: must be at least 1"));
     }

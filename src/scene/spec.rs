@@ -1,6 +1,7 @@
 //! The scene file's schema. Each struct denies unknown fields; each enum variant wraps its own
 //! struct so unknown keys are caught inside internally tagged enums too (serde #2123, #2294).
 
+use crate::assembly::MassKind;
 use crate::element::Geometry;
 use crate::mesh::MeshSpec;
 use crate::output::vtk::Compression;
@@ -20,6 +21,8 @@ pub struct Scene {
     pub load: Vec<LoadSpec>,
     #[serde(default)]
     pub curve: Vec<CurveSpec>,
+    #[serde(default)]
+    pub initial_velocity: Vec<InitialVelocitySpec>,
     pub analysis: AnalysisSpec,
     #[serde(default)]
     pub output: OutputSpec,
@@ -164,6 +167,15 @@ pub struct AffineSpec {
     pub curve: Option<String>,
 }
 
+/// An initial velocity for the nodes of a set (after the bodies' own `velocity`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialVelocitySpec {
+    pub body: Option<String>,
+    pub set: String,
+    pub velocity: [f64; 2],
+}
+
 /// A piecewise-linear load curve, constant beyond its ends.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -178,6 +190,32 @@ pub struct CurveSpec {
 pub enum AnalysisKind {
     /// Load stepping in pseudo time.
     Static,
+    /// Direct time integration.
+    Dynamic,
+}
+
+/// The time integrator of a dynamic analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegratorKind {
+    /// Newmark average acceleration (beta 1/4, gamma 1/2): no numerical damping.
+    Average,
+    /// Newmark linear acceleration (beta 1/6, gamma 1/2): conditionally stable.
+    Linear,
+    /// Hu's modified Newmark (beta 1.0, gamma 1.5), the Greco seed's choice.
+    Hu,
+    /// Newmark with the scene's `beta` and `gamma`.
+    Newmark,
+    /// Wilson-theta (`theta`, default 1.4).
+    Wilson,
+    /// Houbolt, started by Newmark average steps.
+    Houbolt,
+    /// Hilber-Hughes-Taylor (`alpha` in [-1/3, 0], default -0.05).
+    Hht,
+    /// Chung-Hulbert generalized-alpha (`rho_infinity` in [0, 1], default 0.8).
+    GeneralizedAlpha,
+    /// Explicit central difference with lumped mass.
+    CentralDifference,
 }
 
 /// The analysis block. One flat table (so every message points at its key's line); keys
@@ -189,13 +227,52 @@ pub struct AnalysisSpec {
     pub kind: AnalysisKind,
     /// Static: the number of equal load increments up to `end_time` (required).
     pub steps: Option<usize>,
-    /// Default 1 (static pseudo time).
-    #[serde(default = "one")]
-    pub end_time: f64,
+    /// Dynamic: the time step (required).
+    pub dt: Option<f64>,
+    /// Static: default 1 (pseudo time). Dynamic: required.
+    pub end_time: Option<f64>,
     /// `nonlinear` (default, updated Lagrangian) or `linear` (small strain).
     #[serde(default)]
     pub geometry: Geometry,
     #[serde(default)]
+    pub newton: NewtonSpec,
+    /// Dynamic: the integrator (default `average`).
+    pub integrator: Option<IntegratorKind>,
+    /// Newmark's beta (integrator `newmark`).
+    pub beta: Option<f64>,
+    /// Newmark's gamma (integrator `newmark`).
+    pub gamma: Option<f64>,
+    /// Wilson's theta (default 1.4).
+    pub theta: Option<f64>,
+    /// HHT's alpha (default -0.05).
+    pub alpha: Option<f64>,
+    /// Generalized-alpha's spectral radius at infinite frequency (default 0.8).
+    pub rho_infinity: Option<f64>,
+    /// `consistent` (default for implicit) or `lumped` (always for central difference).
+    pub mass: Option<MassKind>,
+    /// Rayleigh damping C = a M + b K (K: the tangent at the start of the step). Default [0, 0].
+    pub rayleigh: Option<[f64; 2]>,
+    /// Central difference: run even if dt exceeds the critical step, and report the blow-up
+    /// as status `unstable`. Default false (refused).
+    #[serde(default)]
+    pub allow_unstable: bool,
+}
+
+/// The validated dynamic analysis.
+#[derive(Debug, Clone)]
+pub struct DynamicSpec {
+    pub dt: f64,
+    pub end_time: f64,
+    pub integrator: IntegratorKind,
+    pub beta: f64,
+    pub gamma: f64,
+    pub theta: f64,
+    pub alpha: f64,
+    pub rho_infinity: f64,
+    pub mass: MassKind,
+    pub rayleigh: [f64; 2],
+    pub allow_unstable: bool,
+    pub geometry: Geometry,
     pub newton: NewtonSpec,
 }
 
@@ -208,10 +285,6 @@ pub struct StaticSpec {
     pub newton: NewtonSpec,
 }
 
-fn one() -> f64 {
-    1.0
-}
-
 /// How often K_T is factored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -222,6 +295,9 @@ pub enum Strategy {
     Modified,
     /// Factor the current tangent at every iteration.
     Full,
+    /// Factor once for the whole run (and again only when dt changes or the iteration stops
+    /// contracting).
+    Initial,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -245,6 +321,9 @@ pub struct NewtonSpec {
     /// Halvings of an increment that does not converge before the run stops `diverged`. Default 6.
     #[serde(default = "default_cuts")]
     pub max_cuts: usize,
+    /// Modified Newton: factor at the start of every N-th increment. Default 1.
+    #[serde(default = "default_refactor_every")]
+    pub refactor_every: usize,
 }
 
 impl Default for NewtonSpec {
@@ -256,6 +335,7 @@ impl Default for NewtonSpec {
             tol_force: default_tolerance(),
             contraction: default_contraction(),
             max_cuts: default_cuts(),
+            refactor_every: default_refactor_every(),
         }
     }
 }
@@ -271,6 +351,9 @@ fn default_contraction() -> f64 {
 }
 fn default_cuts() -> usize {
     6
+}
+fn default_refactor_every() -> usize {
+    1
 }
 
 #[derive(Debug, Clone, Deserialize)]

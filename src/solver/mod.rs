@@ -163,6 +163,11 @@ impl Solver {
         Ok(())
     }
 
+    /// Whether a factorization is at hand (an empty system counts as factored once factored).
+    pub fn is_factored(&self) -> bool {
+        self.factor.is_some() || (self.symbolic.is_none() && self.factorizations > 0)
+    }
+
     /// Solves in place with the current factorization.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         self.solves += 1;

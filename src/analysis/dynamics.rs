@@ -1,0 +1,316 @@
+//! Implicit direct time integration: any `Integrator` in effective-stiffness form, each step
+//! solved by Newton (see `newton`), K* factored once while dt and the strategy allow.
+//!
+//! Legend
+//! ```text
+//! u, v, a      committed displacement (total), velocity, acceleration, all DOFs
+//! D            the step's solved increment (at t_n + s dt; s = 1 except for Wilson)
+//! f_int,n      internal force of the committed state
+//! F            total external force: f_ext on free DOFs, reactions M a + C v + f_int on
+//!              prescribed ones (so W_ext includes the work of supports and prescribed motion)
+//! ```
+//! Prescribed DOFs follow their curves; their velocity and acceleration come from the same
+//! integrator formulas as the free ones.
+
+use super::newton::{Counters, Inertia, Step, StepFailure};
+use super::record::{Energies, Motion, Recorder};
+use super::{RunError, RunOptions, Status, Summary, loads};
+use crate::assembly::{self, Mass, State, System};
+use crate::integrator::{GeneralizedAlpha, Houbolt, Integrator, Kinematics, Wilson};
+use crate::scene::spec::{DynamicSpec, IntegratorKind, Strategy};
+use crate::scene::{InputError, Model};
+use crate::solver::Solver;
+use std::path::Path;
+use std::time::Instant;
+
+/// The integrator a scene asks for (implicit ones).
+pub fn integrator(spec: &DynamicSpec) -> Box<dyn Integrator> {
+    match spec.integrator {
+        IntegratorKind::Average => Box::new(GeneralizedAlpha::newmark("average", 0.25, 0.5)),
+        IntegratorKind::Linear => Box::new(GeneralizedAlpha::newmark("linear", 1.0 / 6.0, 0.5)),
+        IntegratorKind::Hu => Box::new(GeneralizedAlpha::newmark("hu", 1.0, 1.5)),
+        IntegratorKind::Newmark => {
+            Box::new(GeneralizedAlpha::newmark("newmark", spec.beta, spec.gamma))
+        }
+        IntegratorKind::Wilson => Box::new(Wilson { theta: spec.theta }),
+        IntegratorKind::Houbolt => Box::new(Houbolt::default()),
+        IntegratorKind::Hht => Box::new(GeneralizedAlpha::hht(spec.alpha)),
+        IntegratorKind::GeneralizedAlpha => {
+            Box::new(GeneralizedAlpha::chung_hulbert(spec.rho_infinity))
+        }
+        IntegratorKind::CentralDifference => {
+            unreachable!("the explicit driver runs central difference")
+        }
+    }
+}
+
+/// Refuses a dynamic model without mass on some free DOF (zero density).
+pub fn check_mass(model: &Model, mass: &Mass, system: &System) -> Result<(), InputError> {
+    for (dof, eq) in system.equation.iter().enumerate() {
+        if eq.is_some() && !(mass.lumped[dof] > 0.0) {
+            let node = dof / 2;
+            let body = model
+                .bodies
+                .iter()
+                .rev()
+                .find(|b| b.node_offset <= node)
+                .expect("node in a body");
+            return Err(InputError::new(
+                &model.file,
+                format!(
+                    "material `{}`.density: a dynamic analysis needs density > 0 (body `{}`)",
+                    body.material.name, body.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The initial acceleration M a_0 = f_ext(0) - f_int(0) - C v_0 on the free DOFs (zero on
+/// prescribed DOFs); solved with the mass matrix only when the right side is not zero.
+fn initial_acceleration(
+    model: &Model,
+    state: &State,
+    mass: &Mass,
+    system: &mut System,
+    solver: &mut Solver,
+    velocity: &[f64],
+    spec: &DynamicSpec,
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let initial = model.coordinates();
+    let external = loads::external_force(model, state, &initial, 0.0);
+    let evaluation =
+        assembly::evaluate(model, state, &vec![0.0; model.dofs()], spec.geometry, None)
+            .map_err(|e| e.to_string())?;
+    let damping = mass.product(model, velocity);
+    let rhs: Vec<f64> = external
+        .iter()
+        .zip(evaluation.force.iter().zip(&damping))
+        .map(|(f, (fi, c))| f - fi - spec.rayleigh[0] * c)
+        .collect();
+    let mut free = system.gather(&rhs);
+    let mut a = vec![0.0; model.dofs()];
+    if free.iter().any(|v| *v != 0.0) {
+        system.values.iter_mut().for_each(|v| *v = 0.0);
+        mass.add_to(model, system, 1.0);
+        solver.factor(&system.values).map_err(|e| e.to_string())?;
+        solver.solve(&mut free);
+        system.scatter_add(&free, &mut a);
+    }
+    Ok((a, evaluation.force))
+}
+
+pub fn run(
+    model: &Model,
+    spec: &DynamicSpec,
+    dir: &Path,
+    options: RunOptions,
+) -> Result<(Summary, State), RunError> {
+    let start = Instant::now();
+    let initial = model.coordinates();
+    let mut system = System::new(model, &loads::constrained_dofs(model));
+    let mass =
+        Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
+    check_mass(model, &mass, &system)?;
+    let mut solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
+    let mut recorder = Recorder::create(model, dir)?;
+    let mut state = State::initial(model);
+    let mut method = integrator(spec);
+    let steps = (spec.end_time / spec.dt).round().max(1.0) as usize;
+    let mut summary = Summary::new(model, &method.name(), spec.dt, spec.end_time, system.free);
+    let velocity = model.initial_velocity.clone();
+    let (acceleration, mut last_internal) = match initial_acceleration(
+        model,
+        &state,
+        &mass,
+        &mut system,
+        &mut solver,
+        &velocity,
+        spec,
+    ) {
+        Ok(x) => x,
+        Err(reason) => {
+            let message = format!("initial acceleration: {reason}");
+            return Err(super::fail(&recorder, summary, Status::Diverged, message));
+        }
+    };
+    let mut kin = Kinematics {
+        displacement: vec![0.0; model.dofs()],
+        velocity,
+        acceleration,
+    };
+    let mut energies = Energies {
+        kinetic: mass.kinetic_energy(model, &kin.velocity),
+        ..Default::default()
+    };
+    let initial_kinetic = energies.kinetic;
+    summary.energy.initial = initial_kinetic;
+    let mut last_total = total_force(
+        model,
+        &system,
+        &mass,
+        spec,
+        &kin,
+        &last_internal,
+        &state,
+        &initial,
+    );
+    recorder.step(
+        model,
+        &state,
+        &Motion {
+            velocity: &kin.velocity,
+            acceleration: &kin.acceleration,
+        },
+        &energies,
+        true,
+    )?;
+
+    let progress = super::progress_bar(options.progress, steps);
+    let mut counters = Counters::default();
+    let mut dt = spec.dt;
+    let mut factored_dt: Option<f64> = None;
+    let mut cuts_in_a_row = 0;
+    let mut increments = 0usize;
+    while state.time < spec.end_time * (1.0 - 1e-12) {
+        let target = super::snap((state.time + dt).min(spec.end_time), spec.dt);
+        let h = target - state.time;
+        let form = method.form(h, &kin);
+        let solve_time = state.time + form.solve_fraction * h;
+        let mut d: Vec<f64> = kin
+            .velocity
+            .iter()
+            .map(|v| form.solve_fraction * h * v)
+            .collect();
+        for (dof, value) in loads::prescribed(model, &initial, solve_time) {
+            d[dof] = value - kin.displacement[dof];
+        }
+        let external =
+            loads::external_force(model, &state, &initial, state.time + form.load_fraction * h);
+        let factor_first = factored_dt != Some(h)
+            || match spec.newton.strategy {
+                Strategy::Full => true,
+                Strategy::Modified => increments % spec.newton.refactor_every == 0,
+                Strategy::Initial => !solver.is_factored(),
+            };
+        let step = Step {
+            model,
+            geometry: spec.geometry,
+            newton: &spec.newton,
+            inertia: Some(Inertia {
+                mass: &mass,
+                rayleigh: spec.rayleigh,
+            }),
+            form: &form,
+            external: &external,
+            internal_start: &last_internal,
+            factor_first,
+        };
+        let solved = step.solve(&state, d, &mut system, &mut solver, &mut counters);
+        let result = solved.and_then(|(d, evaluation)| {
+            let advance = method.advance(h, &kin, &d);
+            if form.solve_fraction == 1.0 {
+                return Ok((advance, evaluation));
+            }
+            // Wilson: the state at t_{n+1} from the interpolated increment
+            let mut du = advance.increment.clone();
+            for (dof, value) in loads::prescribed(model, &initial, target) {
+                du[dof] = value - kin.displacement[dof];
+            }
+            let evaluation = assembly::evaluate(model, &state, &du, spec.geometry, None)
+                .map_err(|e| StepFailure(e.to_string()))?;
+            Ok((
+                crate::integrator::Advance {
+                    increment: du,
+                    ..advance
+                },
+                evaluation,
+            ))
+        });
+        factored_dt = if solver.is_factored() { Some(h) } else { None };
+        match result {
+            Ok((advance, evaluation)) => {
+                let internal = evaluation.force.clone();
+                assembly::commit(
+                    model,
+                    &mut state,
+                    &advance.increment,
+                    evaluation,
+                    spec.geometry,
+                );
+                state.time = target;
+                for (u, du) in kin.displacement.iter_mut().zip(&advance.increment) {
+                    *u += du;
+                }
+                kin.velocity = advance.velocity;
+                kin.acceleration = advance.acceleration;
+                let total = total_force(
+                    model, &system, &mass, spec, &kin, &internal, &state, &initial,
+                );
+                energies.external_work +=
+                    super::trapezoid_work(&advance.increment, &total, &last_total);
+                energies.kinetic = mass.kinetic_energy(model, &kin.velocity);
+                energies.internal = state.internal_work;
+                summary.energy.max_relative_drift = summary
+                    .energy
+                    .max_relative_drift
+                    .max(super::balance_error(&energies, initial_kinetic));
+                last_total = total;
+                last_internal = internal;
+                summary.steps += 1;
+                increments += 1;
+                let last = state.time >= spec.end_time * (1.0 - 1e-12);
+                let motion = Motion {
+                    velocity: &kin.velocity,
+                    acceleration: &kin.acceleration,
+                };
+                recorder.step(model, &state, &motion, &energies, last)?;
+                progress.set_position((state.time / spec.dt).round() as u64);
+                cuts_in_a_row = 0;
+                dt = (dt * 2.0).min(spec.dt);
+            }
+            Err(StepFailure(reason)) => {
+                method.reject();
+                if cuts_in_a_row >= spec.newton.max_cuts {
+                    progress.abandon();
+                    let message = format!(
+                        "step to t = {target} did not converge after {cuts_in_a_row} cuts (dt = {h:e}): {reason}"
+                    );
+                    summary.finish(&energies, &counters, Some(&solver), start);
+                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
+                }
+                dt = h * 0.5;
+                cuts_in_a_row += 1;
+                counters.cuts += 1;
+            }
+        }
+    }
+    progress.finish_and_clear();
+    summary.finish(&energies, &counters, Some(&solver), start);
+    recorder.write_summary(&summary)?;
+    Ok((summary, state))
+}
+
+/// F: f_ext on the free DOFs, the reaction M a + a_R M v + f_int on the prescribed ones.
+#[allow(clippy::too_many_arguments)]
+fn total_force(
+    model: &Model,
+    system: &System,
+    mass: &Mass,
+    spec: &DynamicSpec,
+    kin: &Kinematics,
+    internal: &[f64],
+    state: &State,
+    initial: &[[f64; 2]],
+) -> Vec<f64> {
+    let external = loads::external_force(model, state, initial, state.time);
+    let ma = mass.product(model, &kin.acceleration);
+    let mv = mass.product(model, &kin.velocity);
+    (0..model.dofs())
+        .map(|i| match system.equation[i] {
+            Some(_) => external[i],
+            None => ma[i] + spec.rayleigh[0] * mv[i] + internal[i],
+        })
+        .collect()
+}

@@ -1,0 +1,210 @@
+//! Explicit central difference with the lumped mass: no matrix, no factorization.
+//!
+//! Legend (velocity-Verlet form, identical displacements to the classical central difference)
+//! ```text
+//! v_{n+1/2} = v_n + dt/2 a_n
+//! u_{n+1}   = u_n + dt v_{n+1/2}                 (prescribed DOFs: their curve value)
+//! a_{n+1}   = (f_ext(t_{n+1}) - f_int(u_{n+1}) - a_R m v_{n+1/2}) / m
+//! v_{n+1}   = v_{n+1/2} + dt/2 a_{n+1}
+//! dt_crit   = 2 / omega_max,  omega_max^2 <= max_e lambda_max(M_e^-1 K_e)
+//! ```
+//! A dt above dt_crit is refused unless `allow_unstable`; then the run goes on and stops with
+//! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
+//! energy, the external work, or the internal energy at the first step, whichever is largest).
+
+use super::dynamics::check_mass;
+use super::newton::Counters;
+use super::record::{Energies, Motion, Recorder};
+use super::{RunError, RunOptions, Status, Summary, loads};
+use crate::assembly::{self, Mass, MassKind, State, System};
+use crate::scene::spec::DynamicSpec;
+use crate::scene::{InputError, Model};
+use std::path::Path;
+use std::time::Instant;
+
+/// The central-difference stability limit of the model in its initial state, with the
+/// element that sets it.
+pub fn critical_time_step(model: &Model) -> Result<(f64, usize, usize), InputError> {
+    let state = State::initial(model);
+    let (omega2, b, e) = assembly::max_frequency_squared(model, &state, model.analysis.geometry())
+        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    Ok((2.0 / omega2.sqrt(), b, e))
+}
+
+pub fn run(
+    model: &Model,
+    spec: &DynamicSpec,
+    dir: &Path,
+    options: RunOptions,
+) -> Result<(Summary, State), RunError> {
+    let start = Instant::now();
+    let (dt_crit, b, e) = critical_time_step(model)?;
+    if spec.dt > dt_crit && !spec.allow_unstable {
+        return Err(InputError::new(
+            &model.file,
+            format!(
+                "analysis.dt = {} exceeds the central-difference stability limit {dt_crit:.6e} (set by body `{}`, element {e}); \
+                 lower dt or set analysis.allow_unstable = true to watch it blow up",
+                spec.dt, model.bodies[b].name
+            ),
+        )
+        .into());
+    }
+    let initial = model.coordinates();
+    let system = System::new(model, &loads::constrained_dofs(model));
+    let mass = Mass::new(model, MassKind::Lumped)
+        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    check_mass(model, &mass, &system)?;
+    let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
+    let mut recorder = Recorder::create(model, dir)?;
+    let mut state = State::initial(model);
+    let mut summary = Summary::new(
+        model,
+        "central_difference",
+        spec.dt,
+        spec.end_time,
+        system.free,
+    );
+    let steps = (spec.end_time / spec.dt).round().max(1.0) as usize;
+    let m = &mass.lumped;
+    let a_r = spec.rayleigh[0];
+
+    let zero = vec![0.0; model.dofs()];
+    let first = assembly::evaluate(model, &state, &zero, spec.geometry, None).map_err(|err| {
+        super::fail(
+            &recorder,
+            summary.clone(),
+            Status::Diverged,
+            err.to_string(),
+        )
+    })?;
+    let mut internal = first.force;
+    let mut v = model.initial_velocity.clone();
+    let external = loads::external_force(model, &state, &initial, 0.0);
+    let mut a: Vec<f64> = (0..model.dofs())
+        .map(|i| {
+            if free[i] {
+                (external[i] - internal[i] - a_r * m[i] * v[i]) / m[i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let kinetic = |v: &[f64]| 0.5 * v.iter().zip(m).map(|(v, m)| m * v * v).sum::<f64>();
+    let mut energies = Energies {
+        kinetic: kinetic(&v),
+        ..Default::default()
+    };
+    let initial_kinetic = energies.kinetic;
+    summary.energy.initial = initial_kinetic;
+    let mut last_total = total_force(&free, &external, &internal, m, &a, &v, a_r);
+    recorder.step(
+        model,
+        &state,
+        &Motion {
+            velocity: &v,
+            acceleration: &a,
+        },
+        &energies,
+        true,
+    )?;
+
+    let progress = super::progress_bar(options.progress, steps);
+    let mut energy_reference = initial_kinetic;
+    for step in 1..=steps {
+        let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
+        let h = time - state.time;
+        let v_half: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v + 0.5 * h * a).collect();
+        let mut du: Vec<f64> = v_half.iter().map(|v| h * v).collect();
+        for (dof, value) in loads::prescribed(model, &initial, time) {
+            du[dof] = value - state.displacement[dof];
+        }
+        let evaluation = match assembly::evaluate(model, &state, &du, spec.geometry, None) {
+            Ok(e) => e,
+            Err(err) => {
+                progress.abandon();
+                summary.finish(&energies, &Counters::default(), None, start);
+                let status = if spec.dt > dt_crit {
+                    Status::Unstable
+                } else {
+                    Status::Diverged
+                };
+                return Err(super::fail(
+                    &recorder,
+                    summary,
+                    status,
+                    format!("at t = {time}: {err}"),
+                ));
+            }
+        };
+        internal = evaluation.force.clone();
+        assembly::commit(model, &mut state, &du, evaluation, spec.geometry);
+        state.time = time;
+        let external = loads::external_force(model, &state, &initial, time);
+        for i in 0..model.dofs() {
+            if free[i] {
+                a[i] = (external[i] - internal[i] - a_r * m[i] * v_half[i]) / m[i];
+                v[i] = v_half[i] + 0.5 * h * a[i];
+            } else {
+                a[i] = (du[i] / h - v[i]) * 2.0 / h;
+                v[i] = du[i] / h;
+            }
+        }
+        let total = total_force(&free, &external, &internal, m, &a, &v, a_r);
+        energies.external_work += super::trapezoid_work(&du, &total, &last_total);
+        last_total = total;
+        energies.kinetic = kinetic(&v);
+        energies.internal = state.internal_work;
+        summary.steps += 1;
+        summary.energy.max_relative_drift = summary
+            .energy
+            .max_relative_drift
+            .max(super::balance_error(&energies, initial_kinetic));
+        if step == 1 {
+            energy_reference = energy_reference.max(energies.internal.abs());
+        }
+        energy_reference = energy_reference.max(energies.external_work.abs());
+        let energy = energies.kinetic + energies.internal;
+        let motion = Motion {
+            velocity: &v,
+            acceleration: &a,
+        };
+        if !energy.is_finite() || energy > 100.0 * energy_reference {
+            progress.abandon();
+            recorder.frame(model, &state, &motion).ok();
+            summary.finish(&energies, &Counters::default(), None, start);
+            let message = format!(
+                "the energy grew to {energy:.3e} (reference {energy_reference:.3e}) at t = {time}: dt = {} is above the stability limit {dt_crit:.6e}",
+                spec.dt
+            );
+            return Err(super::fail(&recorder, summary, Status::Unstable, message));
+        }
+        recorder.step(model, &state, &motion, &energies, step == steps)?;
+        progress.set_position(step as u64);
+    }
+    progress.finish_and_clear();
+    summary.finish(&energies, &Counters::default(), None, start);
+    recorder.write_summary(&summary)?;
+    Ok((summary, state))
+}
+
+/// F: f_ext on the free DOFs, the reaction m a + a_R m v + f_int on the prescribed ones.
+fn total_force(
+    free: &[bool],
+    external: &[f64],
+    internal: &[f64],
+    m: &[f64],
+    a: &[f64],
+    v: &[f64],
+    a_r: f64,
+) -> Vec<f64> {
+    (0..free.len())
+        .map(|i| {
+            if free[i] {
+                external[i]
+            } else {
+                m[i] * a[i] + a_r * m[i] * v[i] + internal[i]
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,243 @@
+//! One nonlinear step by Newton-Raphson, shared by static load stepping (no inertia) and the
+//! implicit integrators (see `integrator` for the step form).
+//!
+//! Legend
+//! ```text
+//! D          solved increment since the last converged configuration (all DOFs; prescribed
+//!            DOFs hold their prescribed increments)
+//! R(D)       f_ext - M a*(D) - C v*(D) - w f_int(D) - (1 - w) f_int,n    on the free DOFs
+//! K*         ca M + cv C + w K_T,   C = a_R M + b_R K_0 (K_0: tangent at the step start)
+//! eps_1      ||delta D|| / ||D||                          (Erklig 2.1.2 (viii))
+//! eps_2      ||R|| / max(||f_ext||, ||M a*||, ||f*||)  (Erklig 2.1.2 (viii)); the last two over
+//!            all DOFs, so the reactions give the scale when only displacements are prescribed
+//! ```
+//! Factorization policy: `full` every iteration; otherwise the caller says whether the step
+//! starts with a fresh factorization, and the iteration refactors only when it stops
+//! contracting (||R_k|| > contraction ||R_k-1||).
+
+use crate::assembly::{self, Evaluation, Mass, State, System};
+use crate::element::Geometry;
+use crate::integrator::StepForm;
+use crate::scene::Model;
+use crate::scene::spec::{NewtonSpec, Strategy};
+use crate::solver::Solver;
+
+/// Counters of the nonlinear solution.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Counters {
+    pub iterations: usize,
+    pub cuts: usize,
+}
+
+/// The step failed to converge: why (reported after the last cut).
+#[derive(Debug, Clone)]
+pub struct StepFailure(pub String);
+
+/// Inertia and damping of a dynamic problem.
+pub struct Inertia<'a> {
+    pub mass: &'a Mass,
+    pub rayleigh: [f64; 2],
+}
+
+pub struct Step<'a> {
+    pub model: &'a Model,
+    pub geometry: Geometry,
+    pub newton: &'a NewtonSpec,
+    pub inertia: Option<Inertia<'a>>,
+    pub form: &'a StepForm,
+    /// External force at the load point, all DOFs.
+    pub external: &'a [f64],
+    /// Internal force of the committed state (for w < 1), all DOFs.
+    pub internal_start: &'a [f64],
+    /// Factor at the first iteration (else the solver's factorization is reused).
+    pub factor_first: bool,
+}
+
+/// Stiffness-proportional damping matrix of the step (the tangent at D = 0), free DOFs.
+struct Damping {
+    values: Vec<f64>,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+impl Step<'_> {
+    fn evaluate(
+        &self,
+        state: &State,
+        d: &[f64],
+        system: Option<&mut System>,
+    ) -> Result<Evaluation, StepFailure> {
+        assembly::evaluate(self.model, state, d, self.geometry, system)
+            .map_err(|e| StepFailure(e.to_string()))
+    }
+
+    /// a*(D) and v*(D) over all DOFs.
+    fn motion(&self, d: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let f = self.form;
+        let a = d
+            .iter()
+            .zip(&f.acceleration_offset)
+            .map(|(d, h)| f.mass_coefficient * d + h)
+            .collect();
+        let v = d
+            .iter()
+            .zip(&f.velocity_offset)
+            .map(|(d, h)| f.damping_coefficient * d + h)
+            .collect();
+        (a, v)
+    }
+
+    /// Turns the assembled K_T in `system.values` into K*.
+    fn effective(&self, system: &mut System, damping: &Option<Damping>) {
+        let Some(inertia) = &self.inertia else { return };
+        let w = self.form.internal_weight;
+        system.values.iter_mut().for_each(|v| *v *= w);
+        let [a_r, b_r] = inertia.rayleigh;
+        let f = self.form;
+        inertia.mass.add_to(
+            self.model,
+            system,
+            f.mass_coefficient + f.damping_coefficient * a_r,
+        );
+        if let Some(dm) = damping {
+            for (v, k) in system.values.iter_mut().zip(&dm.values) {
+                *v += f.damping_coefficient * b_r * k;
+            }
+        }
+    }
+
+    /// Solves the step from the start value `d` (prescribed DOFs already set).
+    pub fn solve(
+        &self,
+        state: &State,
+        mut d: Vec<f64>,
+        system: &mut System,
+        solver: &mut Solver,
+        counters: &mut Counters,
+    ) -> Result<(Vec<f64>, Evaluation), StepFailure> {
+        let newton = self.newton;
+        let damping = match &self.inertia {
+            Some(i) if i.rayleigh[1] > 0.0 => {
+                self.evaluate(state, &vec![0.0; d.len()], Some(&mut *system))?;
+                Some(Damping {
+                    values: system.values.clone(),
+                })
+            }
+            _ => None,
+        };
+        let external_norm = norm(&system.gather(self.external));
+        let mut previous_residual = f64::INFINITY;
+        let mut eps_displacement = f64::INFINITY;
+        for iteration in 0..=newton.max_iterations {
+            let refactor =
+                newton.strategy == Strategy::Full || (iteration == 0 && self.factor_first);
+            let evaluation = self.evaluate(state, &d, refactor.then_some(&mut *system))?;
+            let (residual, scale) = self.residual(&d, &evaluation, system, &damping, external_norm);
+            let residual_norm = norm(&residual);
+            if !residual_norm.is_finite() {
+                return Err(StepFailure(
+                    "the residual is not finite (NaN or Inf)".into(),
+                ));
+            }
+            let eps_force = if scale > 0.0 {
+                residual_norm / scale
+            } else {
+                0.0
+            };
+            let converged = iteration > 0
+                && ((eps_displacement < newton.tol_displacement && eps_force < newton.tol_force)
+                    || residual_norm == 0.0);
+            if converged {
+                return Ok((d, evaluation));
+            }
+            if iteration == newton.max_iterations {
+                break;
+            }
+            let stalled = iteration > 0 && residual_norm > newton.contraction * previous_residual;
+            if stalled && !refactor {
+                // the same state again, now with the tangent assembled
+                self.evaluate(state, &d, Some(&mut *system))?;
+            }
+            if refactor || stalled || !solver.is_factored() {
+                if !(refactor || stalled) {
+                    self.evaluate(state, &d, Some(&mut *system))?;
+                }
+                self.effective(system, &damping);
+                solver
+                    .factor(&system.values)
+                    .map_err(|e| StepFailure(e.to_string()))?;
+            }
+            let mut delta = residual;
+            solver.solve(&mut delta);
+            counters.iterations += 1;
+            system.scatter_add(&delta, &mut d);
+            let d_norm = norm(&d);
+            eps_displacement = if d_norm > 0.0 {
+                norm(&delta) / d_norm
+            } else {
+                0.0
+            };
+            previous_residual = residual_norm;
+        }
+        Err(StepFailure(format!(
+            "no convergence in {} iterations",
+            newton.max_iterations
+        )))
+    }
+
+    /// R on the free DOFs and the force scale of eps_2.
+    fn residual(
+        &self,
+        d: &[f64],
+        evaluation: &Evaluation,
+        system: &System,
+        damping: &Option<Damping>,
+        external_norm: f64,
+    ) -> (Vec<f64>, f64) {
+        let w = self.form.internal_weight;
+        let mut total: Vec<f64> = evaluation
+            .force
+            .iter()
+            .zip(self.internal_start)
+            .map(|(f1, f0)| w * f1 + (1.0 - w) * f0)
+            .collect();
+        // over all DOFs: with only prescribed displacements the reactions carry the scale
+        let internal_norm = norm(&total);
+        let mut inertia_norm = 0.0;
+        if let Some(inertia) = &self.inertia {
+            let (a, v) = self.motion(d);
+            let ma = inertia.mass.product(self.model, &a);
+            inertia_norm = norm(&ma);
+            let [a_r, b_r] = inertia.rayleigh;
+            let mv = if a_r > 0.0 {
+                inertia.mass.product(self.model, &v)
+            } else {
+                vec![0.0; v.len()]
+            };
+            for (t, (m_a, m_v)) in total.iter_mut().zip(ma.iter().zip(&mv)) {
+                *t += m_a + a_r * m_v;
+            }
+            if let Some(dm) = damping {
+                let v_free = system.gather(&v);
+                let mut kv = vec![0.0; v_free.len()];
+                system
+                    .pattern
+                    .symmetric_product(&dm.values, &v_free, &mut kv);
+                let mut kv_all = vec![0.0; v.len()];
+                system.scatter_add(&kv, &mut kv_all);
+                total
+                    .iter_mut()
+                    .zip(&kv_all)
+                    .for_each(|(t, k)| *t += b_r * k);
+            }
+        }
+        let mut residual = system.gather(self.external);
+        residual
+            .iter_mut()
+            .zip(system.gather(&total))
+            .for_each(|(r, t)| *r -= t);
+        (residual, external_norm.max(internal_norm).max(inertia_norm))
+    }
+}
