@@ -119,7 +119,7 @@ pub fn run(
     let mut method = integrator(spec);
     let steps = (spec.end_time / spec.dt).round().max(1.0) as usize;
     let mut summary = Summary::new(model, &method.name(), spec.dt, spec.end_time, system.free);
-    let velocity = model.initial_velocity.clone();
+    let velocity = super::initial_velocity(model, &system);
     let (acceleration, mut last_internal) = match initial_acceleration(
         model,
         &state,
@@ -170,12 +170,13 @@ pub fn run(
     let progress = super::progress_bar(options.progress, steps);
     let mut counters = Counters::default();
     let mut dt = spec.dt;
-    let mut factored_dt: Option<f64> = None;
+    // K* = ca M + cv C + w K_T: a factorization serves while these coefficients stay
+    let mut factored_for: Option<[f64; 3]> = None;
     let mut cuts_in_a_row = 0;
     let mut increments = 0usize;
     while state.time < spec.end_time * (1.0 - 1e-12) {
         let target = super::snap((state.time + dt).min(spec.end_time), spec.dt);
-        let h = target - state.time;
+        let h = super::step_length(target - state.time, spec.dt);
         let form = method.form(h, &kin);
         let solve_time = state.time + form.solve_fraction * h;
         let mut d: Vec<f64> = kin
@@ -188,7 +189,12 @@ pub fn run(
         }
         let external =
             loads::external_force(model, &state, &initial, state.time + form.load_fraction * h);
-        let factor_first = factored_dt != Some(h)
+        let coefficients = [
+            form.mass_coefficient,
+            form.damping_coefficient,
+            form.internal_weight,
+        ];
+        let factor_first = factored_for != Some(coefficients)
             || match spec.newton.strategy {
                 Strategy::Full => true,
                 Strategy::Modified => increments % spec.newton.refactor_every == 0,
@@ -228,7 +234,11 @@ pub fn run(
                 evaluation,
             ))
         });
-        factored_dt = if solver.is_factored() { Some(h) } else { None };
+        factored_for = if solver.is_factored() {
+            Some(coefficients)
+        } else {
+            None
+        };
         match result {
             Ok((advance, evaluation)) => {
                 let internal = evaluation.force.clone();

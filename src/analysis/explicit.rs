@@ -79,7 +79,7 @@ pub fn run(
         )
     })?;
     let mut internal = first.force;
-    let mut v = model.initial_velocity.clone();
+    let mut v = super::initial_velocity(model, &system);
     let external = loads::external_force(model, &state, &initial, 0.0);
     let mut a: Vec<f64> = (0..model.dofs())
         .map(|i| {
@@ -113,7 +113,7 @@ pub fn run(
     let mut energy_reference = initial_kinetic;
     for step in 1..=steps {
         let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
-        let h = time - state.time;
+        let h = super::step_length(time - state.time, spec.dt);
         let v_half: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v + 0.5 * h * a).collect();
         let mut du: Vec<f64> = v_half.iter().map(|v| h * v).collect();
         for (dof, value) in loads::prescribed(model, &initial, time) {

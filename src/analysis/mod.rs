@@ -175,6 +175,24 @@ fn snap(t: f64, dt: f64) -> f64 {
     }
 }
 
+/// A step of nominal length up to round-off is given exactly the nominal length, so methods
+/// that keep history (Houbolt) or a factorization of K*(dt) see one dt.
+fn step_length(h: f64, dt: f64) -> f64 {
+    if (h - dt).abs() <= 1e-9 * dt { dt } else { h }
+}
+
+/// The scene's initial velocity with the constrained DOFs at rest (they follow their
+/// prescriptions from t = 0).
+fn initial_velocity(model: &Model, system: &crate::assembly::System) -> Vec<f64> {
+    let mut v = model.initial_velocity.clone();
+    for (dof, eq) in system.equation.iter().enumerate() {
+        if eq.is_none() {
+            v[dof] = 0.0;
+        }
+    }
+    v
+}
+
 /// Work of the nodal forces over an increment by the trapezoid rule, 1/2 (f_0 + f_1) . d.
 fn trapezoid_work(d: &[f64], f1: &[f64], f0: &[f64]) -> f64 {
     0.5 * d

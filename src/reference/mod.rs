@@ -73,3 +73,122 @@ mod tests {
         approx::assert_relative_eq!(u, 1e-8 / 15.0, max_relative = 1e-3);
     }
 }
+
+/// A direct integrator's textbook recurrence for the undamped oscillator u'' + omega^2 u = 0,
+/// written independently of `integrator` (state and formulas as in Bathe, Finite Element
+/// Procedures, section 9.4, and Chung & Hulbert 1993).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Recurrence {
+    /// Newmark (beta, gamma); state [u, h v, h^2 a].
+    Newmark { beta: f64, gamma: f64 },
+    /// Generalized-alpha (alpha_m, alpha_f, beta, gamma); HHT is alpha_m = 0, alpha_f = -alpha.
+    GeneralizedAlpha {
+        alpha_m: f64,
+        alpha_f: f64,
+        beta: f64,
+        gamma: f64,
+    },
+    /// Wilson-theta; state [u, h v, h^2 a].
+    Wilson { theta: f64 },
+    /// Houbolt; state [u_{n+1}, u_n, u_{n-1}].
+    Houbolt,
+}
+
+/// The amplification matrix A(Omega), Omega = omega h: X_{n+1} = A X_n.
+pub fn amplification(method: Recurrence, omega_h: f64) -> nalgebra::Matrix3<f64> {
+    use nalgebra::Matrix3;
+    let w2 = omega_h * omega_h;
+    match method {
+        Recurrence::Newmark { beta, gamma } => amplification(
+            Recurrence::GeneralizedAlpha {
+                alpha_m: 0.0,
+                alpha_f: 0.0,
+                beta,
+                gamma,
+            },
+            omega_h,
+        ),
+        Recurrence::GeneralizedAlpha {
+            alpha_m,
+            alpha_f,
+            beta,
+            gamma,
+        } => {
+            // unknowns scaled: U = u, V = h v, A = h^2 a
+            // (1-am) A1 + am A0 + w2 ((1-af) U1 + af U0) = 0
+            // U1 = U0 + V0 + (1/2 - beta) A0 + beta A1
+            // V1 = V0 + (1 - gamma) A0 + gamma A1
+            let l = Matrix3::new(
+                w2 * (1.0 - alpha_f),
+                0.0,
+                1.0 - alpha_m,
+                1.0,
+                0.0,
+                -beta,
+                0.0,
+                1.0,
+                -gamma,
+            );
+            let r = Matrix3::new(
+                -w2 * alpha_f,
+                0.0,
+                -alpha_m,
+                1.0,
+                1.0,
+                0.5 - beta,
+                0.0,
+                1.0,
+                1.0 - gamma,
+            );
+            l.try_inverse().expect("regular") * r
+        }
+        Recurrence::Wilson { theta } => {
+            // equilibrium at t + theta h with linear acceleration (Bathe table 9.3):
+            // A_t = A0 + theta (A1 - A0) ... solved for A1 from
+            // A_t + w2 U_t = 0, U_t = U0 + theta V0 + theta^2/6 (A_t + 2 A0)
+            // then U1 = U0 + V0 + (A1 + 2 A0)/6, V1 = V0 + (A0 + A1)/2
+            let t = theta;
+            // A_t (1 + w2 t^2/6) = -w2 (U0 + t V0 + t^2/3 A0)
+            let c = 1.0 / (1.0 + w2 * t * t / 6.0);
+            let at = [-w2 * c, -w2 * t * c, -w2 * t * t / 3.0 * c];
+            // A1 = A0 + (A_t - A0)/theta
+            let a1 = [at[0] / t, at[1] / t, at[2] / t + 1.0 - 1.0 / t];
+            let u1 = [1.0 + a1[0] / 6.0, 1.0 + a1[1] / 6.0, (a1[2] + 2.0) / 6.0];
+            let v1 = [a1[0] / 2.0, 1.0 + a1[1] / 2.0, (1.0 + a1[2]) / 2.0];
+            Matrix3::new(
+                u1[0], u1[1], u1[2], v1[0], v1[1], v1[2], a1[0], a1[1], a1[2],
+            )
+        }
+        Recurrence::Houbolt => {
+            // (2 u_{n+1} - 5 u_n + 4 u_{n-1} - u_{n-2}) + w2 u_{n+1} = 0
+            let c = 1.0 / (2.0 + w2);
+            Matrix3::new(5.0 * c, -4.0 * c, c, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+        }
+    }
+}
+
+/// Spectral radius rho and phase Omega_bar of the principal (complex) root of A(omega h);
+/// the numerical period is 2 pi h / Omega_bar.
+pub fn principal_root(method: Recurrence, omega_h: f64) -> (f64, f64) {
+    let eig = amplification(method, omega_h).complex_eigenvalues();
+    let root = eig
+        .iter()
+        .filter(|z| z.im > 0.0)
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+        .copied();
+    let root = root.unwrap_or_else(|| {
+        *eig.iter()
+            .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+            .expect("3 roots")
+    });
+    (root.norm(), root.arg().abs())
+}
+
+/// Spectral radius (largest root modulus) of A(omega h): > 1 means the method is unstable there.
+pub fn spectral_radius(method: Recurrence, omega_h: f64) -> f64 {
+    amplification(method, omega_h)
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0, f64::max)
+}

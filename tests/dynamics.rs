@@ -1,0 +1,496 @@
+//! Dynamics verification: each integrator's period elongation and amplitude decay against
+//! its amplification matrix, stability limits, energy conservation, and the rod wave.
+
+mod common;
+
+use impact::reference::{self, Recurrence};
+use std::path::Path;
+
+/// One rod, node `start` fixed, node `end` free along x: lumped m = rho A L / 2 = 1,
+/// k = E A / L = 1, so omega = 1 and T = 2 pi. Started with v = 1: u = sin t.
+const OSCILLATOR: &str = r#"
+[[material]]
+name = "spring"
+young = 1.0
+poisson = 0.0
+density = 2.0
+
+[[body]]
+name = "rod"
+material = "spring"
+formulation = "rod"
+area = 1.0
+mesh = { type = "line", start = [0.0, 0.0], end = [1.0, 0.0], n = 1 }
+
+[[support]]
+set = "start"
+fix = ["x", "y"]
+
+[[support]]
+set = "end"
+fix = ["y"]
+
+[[initial_velocity]]
+set = "end"
+velocity = [1.0, 0.0]
+
+[analysis]
+type = "dynamic"
+geometry = "linear"
+mass = "lumped"
+dt = 0.1
+end_time = 10.0
+newton = { strategy = "initial", tol_displacement = 1e-12, tol_force = 1e-12 }
+
+[output]
+frame_every = 0
+
+[[output.probe]]
+quantity = "u_x"
+set = "end"
+"#;
+
+/// Reads one column of a run's history.csv.
+fn column(dir: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    lines
+        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+        .collect()
+}
+
+fn run_oscillator(name: &str, integrator: &[&str], dt_over_t: f64, cycles: f64) -> Vec<f64> {
+    let period = 2.0 * std::f64::consts::PI;
+    let dt = dt_over_t * period;
+    let mut overrides: Vec<String> = integrator.iter().map(|s| s.to_string()).collect();
+    overrides.push(format!("analysis.dt={dt:e}"));
+    overrides.push(format!("analysis.end_time={:e}", cycles * period));
+    let refs: Vec<&str> = overrides.iter().map(String::as_str).collect();
+    let model = common::model("oscillator", OSCILLATOR, &refs);
+    let dir = common::out_dir(name);
+    impact::analysis::run(&model, &dir, Default::default())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    column(&dir, "u_x[end]")
+}
+
+/// Least-squares fit of u_{n+1} = p u_n - q u_{n-1} on the signal after its first `skip`
+/// samples (spurious roots have died out there): rho = sqrt(q), Omega_bar = acos(p / 2 rho).
+fn measured_root(u: &[f64], skip: usize) -> (f64, f64) {
+    let (mut a11, mut a12, mut a22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for n in skip.max(1)..u.len() - 1 {
+        let (x1, x2, y) = (u[n], -u[n - 1], u[n + 1]);
+        a11 += x1 * x1;
+        a12 += x1 * x2;
+        a22 += x2 * x2;
+        b1 += x1 * y;
+        b2 += x2 * y;
+    }
+    let det = a11 * a22 - a12 * a12;
+    let p = (b1 * a22 - b2 * a12) / det;
+    let q = (a11 * b2 - a12 * b1) / det;
+    let rho = q.sqrt();
+    (rho, (p / (2.0 * rho)).acos())
+}
+
+/// Period elongation (T_bar - T) / T and amplitude decay per cycle 1 - rho^(2 pi / Omega_bar).
+fn elongation_and_decay(rho: f64, phase: f64, omega_h: f64) -> (f64, f64) {
+    (
+        omega_h / phase - 1.0,
+        1.0 - rho.powf(2.0 * std::f64::consts::PI / phase),
+    )
+}
+
+/// Goal: each implicit method reproduces its own numerical dispersion and dissipation.
+/// Setup: the undamped unit oscillator at dt/T = 0.05, 0.1, 0.2 (as in Bathe & Wilson's
+/// charts), 30 cycles. Reference: the principal root of the method's amplification matrix
+/// (reference::amplification, written from the textbook recurrences). The measured root
+/// comes from a least-squares fit of the two-term recurrence to u_n. Tolerance: 5 % of the
+/// predicted value (the issue's), or 1e-6 absolute where the prediction is zero.
+#[test]
+fn oscillator_period_elongation_and_decay_match_amplification_matrices() {
+    let cases: [(&str, &[&str], Recurrence); 7] = [
+        (
+            "average",
+            &["analysis.integrator=average"],
+            Recurrence::Newmark {
+                beta: 0.25,
+                gamma: 0.5,
+            },
+        ),
+        (
+            "linear",
+            &["analysis.integrator=linear"],
+            Recurrence::Newmark {
+                beta: 1.0 / 6.0,
+                gamma: 0.5,
+            },
+        ),
+        (
+            "hu",
+            &["analysis.integrator=hu"],
+            Recurrence::Newmark {
+                beta: 1.0,
+                gamma: 1.5,
+            },
+        ),
+        (
+            "wilson",
+            &["analysis.integrator=wilson"],
+            Recurrence::Wilson { theta: 1.4 },
+        ),
+        (
+            "houbolt",
+            &["analysis.integrator=houbolt"],
+            Recurrence::Houbolt,
+        ),
+        (
+            "hht",
+            &["analysis.integrator=hht", "analysis.alpha=-0.1"],
+            Recurrence::GeneralizedAlpha {
+                alpha_m: 0.0,
+                alpha_f: 0.1,
+                beta: 0.3025,
+                gamma: 0.6,
+            },
+        ),
+        (
+            "generalized_alpha",
+            &[
+                "analysis.integrator=generalized_alpha",
+                "analysis.rho_infinity=0.5",
+            ],
+            // rho_inf = 0.5: alpha_m = 0, alpha_f = 1/3, gamma = 5/6, beta = 4/9
+            Recurrence::GeneralizedAlpha {
+                alpha_m: 0.0,
+                alpha_f: 1.0 / 3.0,
+                beta: 4.0 / 9.0,
+                gamma: 5.0 / 6.0,
+            },
+        ),
+    ];
+    for (name, overrides, recurrence) in cases {
+        for dt_over_t in [0.05, 0.1, 0.2] {
+            let omega_h = 2.0 * std::f64::consts::PI * dt_over_t;
+            // strongly dissipative methods decay fast: fewer cycles keep the signal above round-off
+            let cycles = if matches!(name, "hu") && dt_over_t > 0.05 {
+                3.0
+            } else {
+                12.0
+            };
+            let u = run_oscillator(
+                &format!("osc_{name}_{dt_over_t}"),
+                overrides,
+                dt_over_t,
+                cycles,
+            );
+            let (rho, phase) = measured_root(&u, 10);
+            let (pe, ad) = elongation_and_decay(rho, phase, omega_h);
+            let (rho_ref, phase_ref) = reference::principal_root(recurrence, omega_h);
+            let (pe_ref, ad_ref) = elongation_and_decay(rho_ref, phase_ref, omega_h);
+            let close = |x: f64, r: f64| (x - r).abs() <= 0.05 * r.abs() + 1e-6;
+            assert!(
+                close(pe, pe_ref),
+                "{name} dt/T={dt_over_t}: period elongation {pe:.5} vs {pe_ref:.5}"
+            );
+            assert!(
+                close(ad, ad_ref),
+                "{name} dt/T={dt_over_t}: amplitude decay {ad:.5} vs {ad_ref:.5}"
+            );
+        }
+    }
+}
+
+/// Goal: unconditional stability where the theory promises it, and its loss where it does
+/// not. dt/T = 10 for 2000 steps from u = 0, v = 1. Reference: the spectral radius of the
+/// amplification matrix: Wilson 1.4, Houbolt, Newmark average and Hu <= 1; Wilson 1.2 > 1
+/// at this dt. Bounded: the last 100 steps stay below the first 100 (the first step of a
+/// velocity start overshoots at such a dt: u_1 = h v_0 (1 - 1/theta^2) for Wilson);
+/// unbounded: they exceed them a thousandfold.
+#[test]
+fn wilson_and_houbolt_stable_at_large_steps_wilson_low_theta_is_not() {
+    let omega_h = 20.0 * std::f64::consts::PI;
+    assert!(reference::spectral_radius(Recurrence::Wilson { theta: 1.4 }, omega_h) <= 1.0);
+    assert!(reference::spectral_radius(Recurrence::Houbolt, omega_h) <= 1.0);
+    assert!(reference::spectral_radius(Recurrence::Wilson { theta: 1.2 }, omega_h) > 1.0);
+    for (name, overrides, bounded) in [
+        (
+            "wilson14",
+            vec!["analysis.integrator=wilson", "analysis.theta=1.4"],
+            true,
+        ),
+        ("houbolt", vec!["analysis.integrator=houbolt"], true),
+        ("average", vec!["analysis.integrator=average"], true),
+        ("hu", vec!["analysis.integrator=hu"], true),
+        (
+            "wilson12",
+            vec!["analysis.integrator=wilson", "analysis.theta=1.2"],
+            false,
+        ),
+    ] {
+        let u = run_oscillator(&format!("stab_{name}"), &overrides, 10.0, 2000.0);
+        let peak = |s: &[f64]| s.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let (first, last) = (peak(&u[..100]), peak(&u[u.len() - 100..]));
+        if bounded {
+            assert!(
+                last <= first,
+                "{name}: |u| {first} in the first steps, {last} in the last"
+            );
+        } else {
+            assert!(
+                last > 1e3 * first,
+                "{name}: expected growth, |u| {first} -> {last}"
+            );
+        }
+    }
+}
+
+const CHAIN: &str = r#"
+[[material]]
+name = "m"
+young = 100.0
+poisson = 0.0
+density = 0.01
+
+[[body]]
+name = "rod"
+material = "m"
+formulation = "rod"
+area = 1.0
+mesh = { type = "line", start = [0.0, 0.0], end = [10.0, 0.0], n = 10 }
+
+[[support]]
+set = "start"
+fix = ["x", "y"]
+
+[[support]]
+set = "all"
+fix = ["y"]
+
+[[initial_velocity]]
+set = "all"
+velocity = [0.1, 0.0]
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+geometry = "linear"
+dt = 0.001
+end_time = 1.0
+
+[output]
+frame_every = 0
+"#;
+
+/// The exact highest frequency of the fixed-free 10-rod chain with lumped mass, from the
+/// assembled matrices (independent of the code: K tridiagonal E A / h, M diagonal rho A h
+/// with the free end's half).
+fn chain_omega_max() -> f64 {
+    let (n, h, e, rho) = (10, 1.0, 100.0, 0.01);
+    let mut k = nalgebra::DMatrix::<f64>::zeros(n, n);
+    for i in 0..n {
+        k[(i, i)] = if i == n - 1 { e / h } else { 2.0 * e / h };
+        if i + 1 < n {
+            k[(i, i + 1)] = -e / h;
+            k[(i + 1, i)] = -e / h;
+        }
+    }
+    let m: Vec<f64> = (0..n)
+        .map(|i| if i == n - 1 { rho * h / 2.0 } else { rho * h })
+        .collect();
+    let a = nalgebra::DMatrix::from_fn(n, n, |i, j| k[(i, j)] / (m[i] * m[j]).sqrt());
+    a.symmetric_eigenvalues().max().sqrt()
+}
+
+/// Goal: central difference is stable below its limit and unstable just above it.
+/// Setup: fixed-free chain of 10 rods set moving at v = 0.1. Reference: dt_crit = 2 / omega_max
+/// with omega_max from the assembled eigenproblem (chain_omega_max). At 0.95 dt_crit the run
+/// finishes with the energy balance within 5 % (the measured kinetic + strain energy of
+/// central difference oscillates about its conserved shadow energy, by O((omega dt)^2) in the
+/// highest mode); at 1.05 dt_crit (allow_unstable) it stops
+/// with status `unstable`, exit code 3. Without allow_unstable it is refused (exit 2).
+#[test]
+fn central_difference_stable_below_and_unstable_above_dt_crit() {
+    let dt_crit = 2.0 / chain_omega_max();
+    let model = common::model(
+        "chain",
+        CHAIN,
+        &[&format!("analysis.dt={:e}", 0.95 * dt_crit)],
+    );
+    let (summary, _) = common::run("chain_stable", &model);
+    assert!(
+        summary.energy.max_relative_drift < 0.05,
+        "drift {}",
+        summary.energy.max_relative_drift
+    );
+
+    let above = format!("analysis.dt={:e}", 1.05 * dt_crit);
+    let model = common::model("chain", CHAIN, &[&above, "analysis.allow_unstable=true"]);
+    let err = impact::analysis::run(
+        &model,
+        &common::out_dir("chain_unstable"),
+        Default::default(),
+    )
+    .unwrap_err();
+    assert_eq!(err.exit_code(), 3, "{err}");
+    match err {
+        impact::analysis::RunError::Numerical { summary, .. } => {
+            assert_eq!(summary.status, impact::analysis::Status::Unstable)
+        }
+        other => panic!("expected a numerical failure, got {other}"),
+    }
+    let model = common::model("chain", CHAIN, &[&above]);
+    let err = impact::analysis::run(
+        &model,
+        &common::out_dir("chain_refused"),
+        Default::default(),
+    )
+    .unwrap_err();
+    assert_eq!(err.exit_code(), 2, "{err}");
+    assert!(err.to_string().contains("analysis.dt"), "{err}");
+}
+
+const BLOCK: &str = r#"
+[[material]]
+name = "m"
+young = 1000.0
+poisson = 0.3
+density = 1.0
+
+[[body]]
+name = "block"
+material = "m"
+formulation = "plane_strain"
+mesh = { type = "rectangle", width = 2.0, height = 1.0, nx = 6, ny = 3 }
+
+[[support]]
+set = "bottom"
+fix = ["x", "y"]
+
+[[initial_velocity]]
+set = "top"
+velocity = [0.3, -0.2]
+
+[analysis]
+type = "dynamic"
+integrator = "average"
+geometry = "linear"
+dt = 0.002
+end_time = 2.0
+newton = { strategy = "initial", tol_displacement = 1e-13, tol_force = 1e-13 }
+
+[output]
+frame_every = 0
+"#;
+
+/// Goal: the trapezoidal rule conserves energy exactly on a linear system.
+/// Setup: a plane-strain Quad4 block fixed at its base, its top nodes started moving;
+/// Newmark average, consistent mass, linear kinematics, 1000 steps. Reference: energy
+/// conservation, kinetic + internal = initial kinetic, to 1e-9 relative.
+#[test]
+fn newmark_average_conserves_energy_of_elastic_block() {
+    let model = common::model("block_energy", BLOCK, &[]);
+    let dir = common::out_dir("block_energy");
+    let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
+    assert_eq!(summary.steps, 1000);
+    let kinetic = column(&dir, "kinetic_energy");
+    let internal = column(&dir, "internal_energy");
+    let e0 = kinetic[0];
+    assert!(e0 > 0.0);
+    for (k, i) in kinetic.iter().zip(&internal) {
+        approx::assert_relative_eq!(k + i, e0, max_relative = 1e-9);
+    }
+    assert_eq!(
+        summary.factorizations, 1,
+        "strategy `initial` factors K* once for a linear run"
+    );
+}
+
+const WAVE: &str = r#"
+[[material]]
+name = "m"
+young = 100.0
+poisson = 0.0
+density = 0.01
+
+[[body]]
+name = "rod"
+material = "m"
+formulation = "rod"
+area = 1.0
+mesh = { type = "line", start = [0.0, 0.0], end = [10.0, 0.0], n = 100 }
+
+[[support]]
+set = "start"
+fix = ["x", "y"]
+
+[[support]]
+set = "all"
+fix = ["y"]
+
+[[load]]
+type = "nodal_force"
+set = "end"
+force = [-1.0, 0.0]
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+geometry = "linear"
+dt = 0.000999
+end_time = 0.05
+
+[output]
+frame_every = 0
+"#;
+
+/// Goal: a step load travels at c and doubles on reflection at a fixed end.
+/// Setup: rod L = 10, E = 100, rho = 0.01 (c = 100, L/c = 0.1), 100 elements, fixed at x = 0,
+/// a compressive step force F = 1 at x = L from t = 0; central difference at Courant number
+/// 0.999 (nearly exact for lumped rods). Reference (d'Alembert): the stress at the fixed end
+/// is 0 before L/c and -2 F / A after it, until 3 L/c. Tolerance: one element transit
+/// (h/c = 0.001) in time, checked two transits before and after; 5 % on the doubled stress.
+#[test]
+fn rod_wave_arrives_at_l_over_c_and_doubles_on_reflection() {
+    let fixed_end_stress = |t: f64| {
+        let model = common::model("wave", WAVE, &[&format!("analysis.end_time={t}")]);
+        let (_, state) = common::run(&format!("wave_{t}"), &model);
+        state.bodies[0].points[0].stress[0]
+    };
+    let (f, c, l) = (1.0, 100.0, 10.0);
+    let before = fixed_end_stress(l / c - 0.002);
+    assert!(before.abs() < 0.05 * f, "stress before arrival: {before}");
+    for t in [l / c + 0.002, 0.2, 3.0 * l / c - 0.002] {
+        let after = fixed_end_stress(t);
+        approx::assert_relative_eq!(after, -2.0 * f, max_relative = 0.05);
+    }
+}
+
+/// Goal: Rayleigh damping C = a M + b K damps the oscillator at zeta = a / (2 omega) + b omega / 2.
+/// Setup: the unit oscillator (omega = 1), Newmark average at dt/T = 0.005, 5 cycles, with
+/// (a, b) = (0.1, 0) and (0, 0.1): zeta = 0.05 either way. Reference: the exact damped root
+/// exp((-zeta + i sqrt(1 - zeta^2)) omega dt): the measured zeta = -ln(rho) / (omega dt)
+/// within 1 % (the trapezoidal rule's error is O((omega dt)^2) ~ 1e-3 here).
+#[test]
+fn rayleigh_damping_gives_the_exact_decay_rate() {
+    let dt_over_t = 0.005;
+    let omega_h = 2.0 * std::f64::consts::PI * dt_over_t;
+    for rayleigh in ["[0.1,0.0]", "[0.0,0.1]"] {
+        let u = run_oscillator(
+            &format!("rayleigh_{rayleigh}"),
+            &[
+                "analysis.integrator=average",
+                &format!("analysis.rayleigh={rayleigh}"),
+            ],
+            dt_over_t,
+            5.0,
+        );
+        let (rho, _) = measured_root(&u, 2);
+        let zeta = -rho.ln() / omega_h;
+        approx::assert_relative_eq!(zeta, 0.05, max_relative = 1e-2);
+    }
+}
