@@ -336,10 +336,11 @@ impl HalfDisc {
 // ---------------------------------------------------------------------------------------------
 // Ring
 
-/// `type = "ring"`: a full annulus, n_radial x n_circ quads, closed without a seam.
+/// `type = "ring"`: an annulus, n_radial x n_circ quads: the full ring (closed without a seam)
+/// or, with `angle` < 360, the sector from 0 to `angle` degrees counter-clockwise from +x.
 ///
 /// Edge sets `outer` (counter-clockwise) and `inner` (clockwise): the body is on the left of
-/// both.
+/// both. A sector adds `start` (the radial edge at 0 degrees) and `end` (at `angle`).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Ring {
@@ -352,8 +353,18 @@ pub struct Ring {
     pub outer_radius: f64,
     /// Elements through the wall, >= 1.
     pub n_radial: usize,
-    /// Elements around, >= 3.
+    /// Elements around, >= 3 (>= 1 for a sector).
     pub n_circ: usize,
+    /// Opening angle in degrees, in (0, 360]. Default 360 (the full ring).
+    #[serde(default = "full_turn")]
+    pub angle: f64,
+    /// Ratio of the outermost to the innermost radial element size. Default 1.
+    #[serde(default = "one")]
+    pub grading: f64,
+}
+
+fn full_turn() -> f64 {
+    360.0
 }
 
 impl Ring {
@@ -366,12 +377,22 @@ impl Ring {
             return Err(param("outer_radius", reason));
         }
         let n_radial = at_least("n_radial", self.n_radial, 1)?;
-        let n_circ = at_least("n_circ", self.n_circ, 3)?;
+        if !(self.angle > 0.0 && self.angle <= 360.0) {
+            return Err(param(
+                "angle",
+                format!("must lie in (0, 360] degrees, got {}", self.angle),
+            ));
+        }
+        let sector = self.angle < 360.0;
+        let n_circ = at_least("n_circ", self.n_circ, if sector { 1 } else { 3 })?;
+        let ratio = grading("grading", self.grading)?;
+        let opening = self.angle.to_radians();
 
         let circle = |radius: f64| -> Vec<Point> {
             (0..=n_circ)
                 .map(|k| {
-                    let (sin, cos) = (2.0 * PI * (k % n_circ) as f64 / n_circ as f64).sin_cos();
+                    let k = if sector { k } else { k % n_circ };
+                    let (sin, cos) = (opening * k as f64 / n_circ as f64).sin_cos();
                     [center[0] + radius * cos, center[1] + radius * sin]
                 })
                 .collect()
@@ -379,14 +400,28 @@ impl Ring {
         let grid = ruled(
             &circle(inner_radius),
             &circle(outer_radius),
-            &uniform(n_radial),
+            &graded(n_radial, ratio),
         );
         let mut mesh = glue(&[grid]);
 
         let mid_radius = 0.5 * (inner_radius + outer_radius);
         let radius = |p: Point| norm(sub(p, center));
+        let tol = 1e-9 * outer_radius;
+        let radial_on = |p: Point, q: Point, phi: f64| {
+            let (sin, cos) = phi.sin_cos();
+            // on the ray from the centre at angle phi (not the opposite ray)
+            let on = |x: Point| {
+                let (dx, dy) = (x[0] - center[0], x[1] - center[1]);
+                (dx * sin - dy * cos).abs() < tol && dx * cos + dy * sin > 0.0
+            };
+            on(p) && on(q)
+        };
         name_boundary(&mut mesh, |p, q| {
-            if radius(p).max(radius(q)) < mid_radius {
+            if sector && radial_on(p, q, 0.0) {
+                "start"
+            } else if sector && radial_on(p, q, opening) {
+                "end"
+            } else if radius(p).max(radius(q)) < mid_radius {
                 "inner"
             } else {
                 "outer"
@@ -1440,6 +1475,8 @@ mod tests {
                 outer_radius: 3.0,
                 n_radial,
                 n_circ,
+                angle: 360.0,
+                grading: 1.0,
             };
             let mesh = spec.build().unwrap();
             assert_valid(&mesh);
@@ -1458,6 +1495,41 @@ mod tests {
             };
             assert!(loop_area("outer") > 0.0);
             assert!(loop_area("inner") < 0.0);
+        }
+    }
+
+    /// Quarter ring: sector sets `start` (on +x) and `end` (on +y), graded radially; the area
+    /// of the polygonal sector n/2 sin(theta/n) (R^2 - r^2).
+    #[test]
+    fn ring_sector_has_radial_sets_and_area() {
+        for angle in [90.0, 180.0] {
+            let spec = Ring {
+                center: [0.0, 0.0],
+                inner_radius: 1.0,
+                outer_radius: 2.0,
+                n_radial: 4,
+                n_circ: 16,
+                angle,
+                grading: 2.0,
+            };
+            let mesh = spec.build().unwrap();
+            assert_valid(&mesh);
+            assert_eq!(mesh.nodes.len(), 5 * 17);
+            let theta = f64::to_radians(angle) / 16.0;
+            let exact = 16.0 / 2.0 * theta.sin() * (4.0 - 1.0);
+            assert!((total_area(&mesh) - exact).abs() < 1e-12);
+            assert_eq!(edge_count(&mesh, "start"), 4);
+            assert_eq!(edge_count(&mesh, "end"), 4);
+            assert!(
+                mesh.node_sets["start"]
+                    .iter()
+                    .all(|n| mesh.nodes[*n][1].abs() < 1e-12)
+            );
+            assert!(
+                mesh.node_sets["start"]
+                    .iter()
+                    .all(|n| mesh.nodes[*n][0] > 0.0)
+            );
         }
     }
 
@@ -1662,6 +1734,8 @@ mod tests {
             outer_radius: 2.0,
             n_radial: 1,
             n_circ: 8,
+            angle: 360.0,
+            grading: 1.0,
         };
         assert_eq!(key_of(ring.build()), "outer_radius");
         assert_eq!(
