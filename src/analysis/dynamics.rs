@@ -261,7 +261,8 @@ pub fn run(
                 energies.external_work +=
                     super::trapezoid_work(&advance.increment, &total, &last_total);
                 energies.kinetic = mass.kinetic_energy(model, &kin.velocity);
-                energies.internal = state.internal_work;
+                energies.internal = state.internal_work - state.plastic_work;
+                energies.plastic_work = state.plastic_work;
                 summary.energy.max_relative_drift = summary
                     .energy
                     .max_relative_drift

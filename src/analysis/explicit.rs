@@ -154,7 +154,8 @@ pub fn run(
         energies.external_work += super::trapezoid_work(&du, &total, &last_total);
         last_total = total;
         energies.kinetic = kinetic(&v);
-        energies.internal = state.internal_work;
+        energies.internal = state.internal_work - state.plastic_work;
+                energies.plastic_work = state.plastic_work;
         summary.steps += 1;
         summary.energy.max_relative_drift = summary
             .energy

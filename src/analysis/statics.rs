@@ -91,7 +91,8 @@ pub fn run(
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
                 state.time = target;
                 energies.external_work += super::trapezoid_work(&d, &force, &last_force);
-                energies.internal = state.internal_work;
+                energies.internal = state.internal_work - state.plastic_work;
+                energies.plastic_work = state.plastic_work;
                 summary.energy.max_relative_drift = summary
                     .energy
                     .max_relative_drift

@@ -37,6 +37,8 @@ pub struct State {
     pub bodies: Vec<BodyState>,
     /// Accumulated work of the internal forces.
     pub internal_work: f64,
+    /// Accumulated plastic work (part of `internal_work`).
+    pub plastic_work: f64,
 }
 
 impl State {
@@ -72,6 +74,7 @@ impl State {
             displacement: vec![0.0; model.dofs()],
             bodies,
             internal_work: 0.0,
+            plastic_work: 0.0,
         }
     }
 }
@@ -96,6 +99,8 @@ pub struct Evaluation {
     pub strain_zz: Vec<Vec<f64>>,
     /// Increment of the internal work.
     pub work: f64,
+    /// Increment of the plastic work.
+    pub plastic_work: f64,
 }
 
 /// DOF numbering, sparsity and scatter positions of one topology.
@@ -186,6 +191,7 @@ struct ElementResult {
     trial: [PointState; 4],
     strain_zz: [f64; 4],
     work: f64,
+    plastic_work: f64,
 }
 
 /// Internal force (and, when `system` is given, the tangent into `system.values`) at the
@@ -205,6 +211,7 @@ pub fn evaluate(
     let mut trial = Vec::with_capacity(model.bodies.len());
     let mut strain_zz = Vec::with_capacity(model.bodies.len());
     let mut work = 0.0;
+    let mut plastic_work = 0.0;
     for (b, body) in model.bodies.iter().enumerate() {
         let results: Vec<ElementResult> = (0..body.elements())
             .into_par_iter()
@@ -245,16 +252,12 @@ pub fn evaluate(
             body_trial.extend_from_slice(&r.trial[..ppe]);
             body_zz.extend_from_slice(&r.strain_zz[..ppe]);
             work += r.work;
+            plastic_work += r.plastic_work;
         }
         trial.push(body_trial);
         strain_zz.push(body_zz);
     }
-    Ok(Evaluation {
-        force,
-        trial,
-        strain_zz,
-        work,
-    })
+    Ok(Evaluation { force, trial, strain_zz, work, plastic_work })
 }
 
 fn element(
@@ -290,7 +293,9 @@ fn element(
             });
             let stress = responses.map(|r| r.stress);
             let mut work = 0.0;
+            let mut plastic_work = 0.0;
             for q in 0..4 {
+                plastic_work += geom.points[q].weight * responses[q].plastic_work;
                 let mut strain = strains[q];
                 strain[2] = responses[q].strain_zz;
                 work += geom.points[q].weight
@@ -317,6 +322,7 @@ fn element(
                 trial: responses.map(|r| r.state),
                 strain_zz: responses.map(|r| r.strain_zz),
                 work,
+                plastic_work,
             })
         }
         BodyKind::Rod { area } => {
@@ -326,10 +332,11 @@ fn element(
             ];
             let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
             let strain = rod2::strain(&x, &de, geometry).map_err(|err| (e, err))?;
-            let (stress, modulus, state) =
+            let (stress, modulus, state, plastic_density) =
                 body.material.update_uniaxial(&committed.points[e], strain);
             let length = rod2::length(&x).map_err(|err| (e, err))?;
             let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
+            let plastic_work = area * length * plastic_density;
             let f4 =
                 rod2::internal_force(&x, &de, stress, area, geometry).map_err(|err| (e, err))?;
             let matrix = if want_tangent {
@@ -349,6 +356,7 @@ fn element(
                 trial: [state; 4],
                 strain_zz: [0.0; 4],
                 work,
+                plastic_work,
             })
         }
     }
@@ -374,12 +382,7 @@ pub fn commit(
     evaluation: Evaluation,
     geometry: Geometry,
 ) {
-    let Evaluation {
-        trial,
-        strain_zz,
-        work,
-        ..
-    } = evaluation;
+    let Evaluation { trial, strain_zz, work, plastic_work: evaluation_plastic_work, .. } = evaluation;
     for (b, body) in model.bodies.iter().enumerate() {
         let mut points = trial[b].clone();
         if geometry == Geometry::Nonlinear {
@@ -414,6 +417,7 @@ pub fn commit(
         *u += du;
     }
     state.internal_work += work;
+    state.plastic_work += evaluation_plastic_work;
 }
 
 fn push_forward_body(
@@ -443,6 +447,7 @@ fn push_forward_body(
                     };
                     let p = &mut points[4 * e + q];
                     p.stress = kinematics::push_forward(&p.stress, f, f_zz);
+                    p.back_stress = kinematics::push_forward(&p.back_stress, f, f_zz);
                 }
             }
             BodyKind::Rod { .. } => {
@@ -453,6 +458,7 @@ fn push_forward_body(
                 let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
                 let stretch = rod2::stretch(&x, &de).expect("checked during the evaluation");
                 points[e].stress[0] *= stretch;
+                points[e].back_stress[0] *= stretch;
             }
         }
     }

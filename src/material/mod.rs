@@ -12,7 +12,10 @@
 //! `&self` is never mutated: a failed iteration cannot corrupt the history; the caller
 //! commits a step by keeping the returned state.
 
+pub mod j2;
+
 use crate::element::{Moduli, Voigt};
+pub use j2::{Hardening, J2};
 
 /// How many stress components the body carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,6 +33,8 @@ pub struct PointState {
     pub stress: Voigt,
     /// Equivalent plastic strain.
     pub eq_plastic_strain: f64,
+    /// Back stress (kinematic hardening), same frame and components as `stress`.
+    pub back_stress: Voigt,
 }
 
 /// The result of a material update.
@@ -43,6 +48,8 @@ pub struct Response {
     pub strain_zz: f64,
     /// The new state, stress still in the reference configuration (the kinematics pushes it).
     pub state: PointState,
+    /// Plastic work per unit reference volume of the increment, S_{n+1} : d eps_p.
+    pub plastic_work: f64,
 }
 
 /// Isotropic linear elasticity (in the rate form S = sigma_n + D dE of the updated-Lagrangian
@@ -95,35 +102,102 @@ pub struct Material {
     pub name: String,
     pub density: f64,
     pub elastic: Elastic,
+    /// J2 plasticity; None for an elastic material.
+    pub plasticity: Option<J2>,
+}
+
+fn work(stress: &Voigt, plastic_strain: &Voigt) -> f64 {
+    let (s, e) = (stress, plastic_strain);
+    s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * s[3] * e[3]
 }
 
 impl Material {
-    /// Response of a continuum point (Quad4).
+    /// Response of a continuum point (Quad4): elastic predictor, then the return to the yield
+    /// surface when the material is plastic.
     pub fn update(&self, committed: &PointState, strain: &Voigt, state: StressState) -> Response {
-        let moduli = self.elastic.moduli(state);
-        let mut strain = *strain;
-        if state == StressState::PlaneStress {
-            let (lambda, mu) = self.elastic.lame();
-            strain[2] = -lambda / (lambda + 2.0 * mu) * (strain[0] + strain[1]);
+        match state {
+            StressState::General => self.update_general(committed, strain),
+            StressState::PlaneStress => self.update_plane_stress(committed, strain),
         }
-        let stress = committed.stress + moduli * strain;
-        Response {
-            stress,
-            moduli,
-            strain_zz: strain[2],
-            state: PointState {
-                stress,
-                ..*committed
+    }
+
+    fn update_general(&self, committed: &PointState, strain: &Voigt) -> Response {
+        let moduli = self.elastic.moduli(StressState::General);
+        let trial = committed.stress + moduli * strain;
+        let (_, mu) = self.elastic.lame();
+        let plastic = self.plasticity.as_ref().and_then(|j2| {
+            j2.general(&trial, &moduli, mu, &committed.back_stress, committed.eq_plastic_strain)
+        });
+        match plastic {
+            None => Response {
+                stress: trial,
+                moduli,
+                strain_zz: strain[2],
+                state: PointState { stress: trial, ..*committed },
+                plastic_work: 0.0,
+            },
+            Some(r) => Response {
+                stress: r.stress,
+                moduli: r.moduli,
+                strain_zz: strain[2],
+                state: PointState { stress: r.stress, eq_plastic_strain: r.eq_plastic_strain, back_stress: r.back_stress },
+                plastic_work: work(&r.stress, &r.plastic_strain),
             },
         }
     }
 
-    /// Response of a rod: axial stress and modulus.
-    pub fn update_uniaxial(&self, committed: &PointState, strain: f64) -> (f64, f64, PointState) {
-        let stress = committed.stress[0] + self.elastic.young * strain;
+    /// Plane stress: Newton on the out-of-plane strain until the 3D update gives
+    /// S_zz = 0 (to round-off: 1e-15 of the stress scale, or no further change), then the tangent condensed statically:
+    /// D_ps = D_ab - D_a,zz D_zz,b / D_zz,zz over a, b in {xx, yy, xy}.
+    fn update_plane_stress(&self, committed: &PointState, strain: &Voigt) -> Response {
+        let (lambda, mu) = self.elastic.lame();
+        let mut trial = *strain;
+        trial[2] = -(lambda * (strain[0] + strain[1]) + committed.stress[2]) / (lambda + 2.0 * mu);
+        let scale = self.plasticity.as_ref().map_or(0.0, |j| j.yield_stress).max(committed.stress.norm());
+        let mut response = self.update_general(committed, &trial);
+        for _ in 0..50 {
+            let szz = response.stress[2];
+            let step = szz / response.moduli[(2, 2)];
+            if szz.abs() <= 1e-15 * scale.max(self.elastic.young * trial.norm()) || trial[2] - step == trial[2] {
+                break;
+            }
+            trial[2] -= step;
+            response = self.update_general(committed, &trial);
+        }
+        let d = response.moduli;
+        let mut condensed = Moduli::zeros();
+        for a in [0, 1, 3] {
+            for b in [0, 1, 3] {
+                condensed[(a, b)] = d[(a, b)] - d[(a, 2)] * d[(2, b)] / d[(2, 2)];
+            }
+        }
+        response.moduli = condensed;
+        response.stress[2] = 0.0;
+        response.state.stress[2] = 0.0;
+        response.strain_zz = trial[2];
+        response
+    }
+
+    /// Response of a rod: axial stress, tangent modulus, new state, plastic work density.
+    pub fn update_uniaxial(&self, committed: &PointState, strain: f64) -> (f64, f64, PointState, f64) {
+        let young = self.elastic.young;
+        let trial = committed.stress[0] + young * strain;
+        let plastic = self.plasticity.as_ref().and_then(|j2| {
+            j2.uniaxial(trial, young, committed.back_stress[0], committed.eq_plastic_strain)
+        });
         let mut state = *committed;
-        state.stress[0] = stress;
-        (stress, self.elastic.young, state)
+        match plastic {
+            None => {
+                state.stress[0] = trial;
+                (trial, young, state, 0.0)
+            }
+            Some((stress, back, eps_p, tangent, dep)) => {
+                state.stress[0] = stress;
+                state.back_stress[0] = back;
+                state.eq_plastic_strain = eps_p;
+                (stress, tangent, state, stress * dep)
+            }
+        }
     }
 }
 
@@ -154,6 +228,7 @@ mod tests {
                 young: 200.0,
                 poisson: 0.3,
             },
+            plasticity: None,
         };
         let r = m.update(
             &PointState::default(),
@@ -167,5 +242,87 @@ mod tests {
         );
         assert_eq!(r.stress[2], 0.0);
         approx::assert_relative_eq!(r.strain_zz, -0.3 / 0.7 * 1e-3, max_relative = 1e-14);
+    }
+}
+
+#[cfg(test)]
+mod plasticity_tests {
+    use super::*;
+
+    fn steel(hardening: Hardening, kinematic: f64) -> Material {
+        Material {
+            name: "steel".into(),
+            density: 1.0,
+            elastic: Elastic { young: 200.0, poisson: 0.3 },
+            plasticity: Some(J2 { yield_stress: 0.5, hardening, kinematic_modulus: kinematic }),
+        }
+    }
+
+    fn committed() -> PointState {
+        PointState {
+            stress: Voigt::new(0.2, -0.1, 0.05, 0.15),
+            eq_plastic_strain: 0.01,
+            back_stress: Voigt::new(0.02, -0.01, -0.01, 0.01),
+        }
+    }
+
+    /// The algorithmic tangent is the derivative of the return map (central differences,
+    /// h = 1e-8 against strain increments ~ 1e-2: truncation ~ 1e-12 relative), for linear
+    /// and tabulated isotropic plus kinematic hardening, in plane strain and plane stress.
+    #[test]
+    fn tangent_matches_finite_differences_of_the_return() {
+        let laws = [
+            (Hardening::Linear { modulus: 10.0 }, 5.0),
+            (Hardening::Table { points: vec![[0.005, 0.55], [0.02, 0.6], [0.1, 0.62]] }, 0.0),
+            (Hardening::Linear { modulus: 0.0 }, 0.0),
+        ];
+        for (law, kinematic) in laws {
+            let m = steel(law, kinematic);
+            for state in [StressState::General, StressState::PlaneStress] {
+                let mut c = committed();
+                if state == StressState::PlaneStress {
+                    c.stress[2] = 0.0;
+                    c.back_stress[2] = 0.0;
+                }
+                let strain = Voigt::new(0.004, -0.001, 0.0005, 0.003);
+                let r = m.update(&c, &strain, state);
+                assert!(r.plastic_work > 0.0, "the step must be plastic");
+                let h = 1e-8;
+                let columns: &[usize] = if state == StressState::General { &[0, 1, 2, 3] } else { &[0, 1, 3] };
+                for &j in columns {
+                    let (mut p, mut q) = (strain, strain);
+                    p[j] += h;
+                    q[j] -= h;
+                    let fd = (m.update(&c, &p, state).stress - m.update(&c, &q, state).stress) / (2.0 * h);
+                    for i in 0..4 {
+                        assert!((r.moduli[(i, j)] - fd[i]).abs() <= 1e-7 * r.moduli.norm(), "{state:?} kin {kinematic} ({i},{j}): {} vs {}", r.moduli[(i, j)], fd[i]);
+                    }
+                }
+            }
+        }
+    }
+
+    /// After a plastic step the stress lies on the yield surface, sqrt(3/2) |dev S - alpha| =
+    /// sigma_y(eps_p), to round-off; in plane stress S_zz = 0.
+    #[test]
+    fn plastic_state_lies_on_the_yield_surface() {
+        let m = steel(Hardening::Linear { modulus: 10.0 }, 5.0);
+        for state in [StressState::General, StressState::PlaneStress] {
+            let mut c = committed();
+            if state == StressState::PlaneStress {
+                c.stress[2] = 0.0;
+            }
+            let r = m.update(&c, &Voigt::new(0.004, -0.001, 0.0005, 0.003), state);
+            let s = r.state.stress;
+            let p = (s[0] + s[1] + s[2]) / 3.0;
+            let a = r.state.back_stress;
+            let eta = Voigt::new(s[0] - p - a[0], s[1] - p - a[1], s[2] - p - a[2], s[3] - a[3]);
+            let mises = (1.5 * (eta[0].powi(2) + eta[1].powi(2) + eta[2].powi(2) + 2.0 * eta[3].powi(2))).sqrt();
+            let sy = 0.5 + 10.0 * r.state.eq_plastic_strain;
+            approx::assert_relative_eq!(mises, sy, max_relative = 1e-12);
+            if state == StressState::PlaneStress {
+                assert_eq!(s[2], 0.0);
+            }
+        }
     }
 }

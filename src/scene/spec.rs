@@ -39,6 +39,15 @@ pub struct MaterialSpec {
     /// Mass density >= 0. Default 0 (statics needs none).
     #[serde(default)]
     pub density: f64,
+    /// Initial yield stress > 0: makes the material J2-plastic. Default: none (elastic).
+    pub yield_stress: Option<f64>,
+    /// Linear isotropic hardening modulus d sigma_y / d eps_p >= 0. Default 0 (perfectly plastic).
+    pub hardening_modulus: Option<f64>,
+    /// Piecewise-linear isotropic hardening: [eps_p, sigma_y] points after (0, yield_stress),
+    /// increasing eps_p. Excludes `hardening_modulus`.
+    pub hardening_table: Option<Vec<[f64; 2]>>,
+    /// Linear kinematic (Prager) hardening modulus >= 0. Default 0.
+    pub kinematic_modulus: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -61,7 +70,8 @@ pub struct BodySpec {
     pub thickness: Option<f64>,
     /// Cross-section area, rods only (required there).
     pub area: Option<f64>,
-    /// Mean-dilatation B-bar (plane strain and axisymmetric only). Default false.
+    /// Mean-dilatation B-bar (plane strain and axisymmetric only). Default: true for J2
+    /// materials (plastic flow is isochoric and would lock), false otherwise.
     pub bbar: Option<bool>,
     /// Initial Cauchy stress [xx, yy, zz, xy] in every point. Default zero.
     pub initial_stress: Option<[f64; 4]>,
