@@ -155,7 +155,7 @@ pub fn run(
         last_total = total;
         energies.kinetic = kinetic(&v);
         energies.internal = state.internal_work - state.plastic_work;
-                energies.plastic_work = state.plastic_work;
+        energies.plastic_work = state.plastic_work;
         summary.steps += 1;
         summary.energy.max_relative_drift = summary
             .energy

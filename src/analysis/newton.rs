@@ -13,7 +13,8 @@
 //! ```
 //! Factorization policy: `full` every iteration; otherwise the caller says whether the step
 //! starts with a fresh factorization, and the iteration refactors only when it stops
-//! contracting (||R_k|| > contraction ||R_k-1||).
+//! contracting (||R_k|| > contraction ||R_k-1||) or when, at its current rate, it would need
+//! more than half of the iterations left to reach the force tolerance.
 
 use crate::assembly::{self, Evaluation, Mass, State, System};
 use crate::element::Geometry;
@@ -155,7 +156,12 @@ impl Step<'_> {
             if iteration == newton.max_iterations {
                 break;
             }
-            let stalled = iteration > 0 && residual_norm > newton.contraction * previous_residual;
+            // refactor when the residual stops contracting, or contracts too slowly to reach
+            // the tolerance within the iterations left (predicted from the last ratio)
+            let ratio = residual_norm / previous_residual;
+            let needed = (newton.tol_force * scale / residual_norm).ln() / ratio.ln();
+            let left = (newton.max_iterations - iteration) as f64;
+            let stalled = iteration > 0 && (ratio > newton.contraction || needed > 0.5 * left);
             if stalled && !refactor {
                 // the same state again, now with the tangent assembled
                 self.evaluate(state, &d, Some(&mut *system))?;

@@ -257,7 +257,13 @@ pub fn evaluate(
         trial.push(body_trial);
         strain_zz.push(body_zz);
     }
-    Ok(Evaluation { force, trial, strain_zz, work, plastic_work })
+    Ok(Evaluation {
+        force,
+        trial,
+        strain_zz,
+        work,
+        plastic_work,
+    })
 }
 
 fn element(
@@ -382,7 +388,13 @@ pub fn commit(
     evaluation: Evaluation,
     geometry: Geometry,
 ) {
-    let Evaluation { trial, strain_zz, work, plastic_work: evaluation_plastic_work, .. } = evaluation;
+    let Evaluation {
+        trial,
+        strain_zz,
+        work,
+        plastic_work: evaluation_plastic_work,
+        ..
+    } = evaluation;
     for (b, body) in model.bodies.iter().enumerate() {
         let mut points = trial[b].clone();
         if geometry == Geometry::Nonlinear {

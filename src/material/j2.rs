@@ -77,7 +77,11 @@ impl J2 {
                     prev = *p;
                 }
                 let n = points.len();
-                let before = if n >= 2 { points[n - 2] } else { [0.0, self.yield_stress] };
+                let before = if n >= 2 {
+                    points[n - 2]
+                } else {
+                    [0.0, self.yield_stress]
+                };
                 let slope = (prev[1] - before[1]) / (prev[0] - before[0]);
                 (prev[1] + slope * (eps_p - prev[0]), slope)
             }
@@ -105,7 +109,14 @@ impl J2 {
     }
 
     /// Radial return for plane strain and axisymmetric points.
-    pub fn general(&self, trial: &Voigt, elastic: &Moduli, mu: f64, back: &Voigt, eps_p: f64) -> Option<Return> {
+    pub fn general(
+        &self,
+        trial: &Voigt,
+        elastic: &Moduli,
+        mu: f64,
+        back: &Voigt,
+        eps_p: f64,
+    ) -> Option<Return> {
         // dev of the difference: the pushed-forward back stress need not stay traceless
         let eta = deviator(&(trial - back));
         let eta_norm = norm(&eta);
@@ -130,11 +141,23 @@ impl J2 {
         }
         i_dev[(3, 3)] = 0.5;
         let moduli = elastic - (nn * c1 + (i_dev - nn) * c2) * (2.0 * mu);
-        Some(Return { stress, back_stress, eq_plastic_strain: eps_p + SQRT_2_3 * dl, moduli, plastic_strain: n * dl })
+        Some(Return {
+            stress,
+            back_stress,
+            eq_plastic_strain: eps_p + SQRT_2_3 * dl,
+            moduli,
+            plastic_strain: n * dl,
+        })
     }
 
     /// One-dimensional return for rods: (stress, back stress, eps_p, tangent, plastic strain).
-    pub fn uniaxial(&self, trial: f64, young: f64, back: f64, eps_p: f64) -> Option<(f64, f64, f64, f64, f64)> {
+    pub fn uniaxial(
+        &self,
+        trial: f64,
+        young: f64,
+        back: f64,
+        eps_p: f64,
+    ) -> Option<(f64, f64, f64, f64, f64)> {
         let xi = trial - back;
         let (sy, _) = self.yield_stress_at(eps_p);
         if xi.abs() - sy <= 0.0 {
@@ -144,11 +167,18 @@ impl J2 {
         // |xi| - (E + H_kin) de_p = sigma_y(eps_p + de_p); reuse the scalar solver with
         // dl = sqrt(3/2) de_p: a = sqrt(2/3)|xi|, b = 2/3 (E + H_kin)
         let h_kin = self.kinematic_modulus;
-        let (dl, h_iso) = self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), eps_p);
+        let (dl, h_iso) =
+            self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), eps_p);
         let dep = SQRT_2_3 * dl;
         let stress = trial - sign * young * dep;
         let back_stress = back + sign * h_kin * dep;
         let h = h_iso + h_kin;
-        Some((stress, back_stress, eps_p + dep, young * h / (young + h), sign * dep))
+        Some((
+            stress,
+            back_stress,
+            eps_p + dep,
+            young * h / (young + h),
+            sign * dep,
+        ))
     }
 }

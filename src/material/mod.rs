@@ -126,42 +126,78 @@ impl Material {
         let trial = committed.stress + moduli * strain;
         let (_, mu) = self.elastic.lame();
         let plastic = self.plasticity.as_ref().and_then(|j2| {
-            j2.general(&trial, &moduli, mu, &committed.back_stress, committed.eq_plastic_strain)
+            j2.general(
+                &trial,
+                &moduli,
+                mu,
+                &committed.back_stress,
+                committed.eq_plastic_strain,
+            )
         });
         match plastic {
             None => Response {
                 stress: trial,
                 moduli,
                 strain_zz: strain[2],
-                state: PointState { stress: trial, ..*committed },
+                state: PointState {
+                    stress: trial,
+                    ..*committed
+                },
                 plastic_work: 0.0,
             },
             Some(r) => Response {
                 stress: r.stress,
                 moduli: r.moduli,
                 strain_zz: strain[2],
-                state: PointState { stress: r.stress, eq_plastic_strain: r.eq_plastic_strain, back_stress: r.back_stress },
+                state: PointState {
+                    stress: r.stress,
+                    eq_plastic_strain: r.eq_plastic_strain,
+                    back_stress: r.back_stress,
+                },
                 plastic_work: work(&r.stress, &r.plastic_strain),
             },
         }
     }
 
-    /// Plane stress: Newton on the out-of-plane strain until the 3D update gives
-    /// S_zz = 0 (to round-off: 1e-15 of the stress scale, or no further change), then the tangent condensed statically:
-    /// D_ps = D_ab - D_a,zz D_zz,b / D_zz,zz over a, b in {xx, yy, xy}.
+    /// Plane stress: the out-of-plane strain that makes the 3D update give S_zz = 0, by
+    /// Newton safeguarded with bisection (S_zz grows monotonically with eps_zz, but its slope
+    /// jumps where the point turns plastic), to round-off; then the tangent condensed
+    /// statically: D_ps = D_ab - D_a,zz D_zz,b / D_zz,zz over a, b in {xx, yy, xy}.
     fn update_plane_stress(&self, committed: &PointState, strain: &Voigt) -> Response {
         let (lambda, mu) = self.elastic.lame();
         let mut trial = *strain;
         trial[2] = -(lambda * (strain[0] + strain[1]) + committed.stress[2]) / (lambda + 2.0 * mu);
-        let scale = self.plasticity.as_ref().map_or(0.0, |j| j.yield_stress).max(committed.stress.norm());
+        let scale = self
+            .plasticity
+            .as_ref()
+            .map_or(0.0, |j| j.yield_stress)
+            .max(committed.stress.norm());
+        let tolerance = 1e-15 * scale.max(self.elastic.young * strain.norm());
         let mut response = self.update_general(committed, &trial);
-        for _ in 0..50 {
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for _ in 0..200 {
             let szz = response.stress[2];
-            let step = szz / response.moduli[(2, 2)];
-            if szz.abs() <= 1e-15 * scale.max(self.elastic.young * trial.norm()) || trial[2] - step == trial[2] {
+            if szz.abs() <= tolerance {
                 break;
             }
-            trial[2] -= step;
+            if szz > 0.0 {
+                hi = trial[2];
+            } else {
+                lo = trial[2];
+            }
+            let mut next = trial[2] - szz / response.moduli[(2, 2)];
+            if !(next > lo && next < hi) {
+                next = if lo.is_finite() && hi.is_finite() {
+                    0.5 * (lo + hi)
+                } else {
+                    // widen towards the missing side of the bracket
+                    trial[2] - szz.signum() * (strain.norm() + trial[2].abs() + f64::EPSILON)
+                };
+            }
+            if next == trial[2] {
+                break;
+            }
+            trial[2] = next;
             response = self.update_general(committed, &trial);
         }
         let d = response.moduli;
@@ -179,11 +215,20 @@ impl Material {
     }
 
     /// Response of a rod: axial stress, tangent modulus, new state, plastic work density.
-    pub fn update_uniaxial(&self, committed: &PointState, strain: f64) -> (f64, f64, PointState, f64) {
+    pub fn update_uniaxial(
+        &self,
+        committed: &PointState,
+        strain: f64,
+    ) -> (f64, f64, PointState, f64) {
         let young = self.elastic.young;
         let trial = committed.stress[0] + young * strain;
         let plastic = self.plasticity.as_ref().and_then(|j2| {
-            j2.uniaxial(trial, young, committed.back_stress[0], committed.eq_plastic_strain)
+            j2.uniaxial(
+                trial,
+                young,
+                committed.back_stress[0],
+                committed.eq_plastic_strain,
+            )
         });
         let mut state = *committed;
         match plastic {
@@ -253,8 +298,15 @@ mod plasticity_tests {
         Material {
             name: "steel".into(),
             density: 1.0,
-            elastic: Elastic { young: 200.0, poisson: 0.3 },
-            plasticity: Some(J2 { yield_stress: 0.5, hardening, kinematic_modulus: kinematic }),
+            elastic: Elastic {
+                young: 200.0,
+                poisson: 0.3,
+            },
+            plasticity: Some(J2 {
+                yield_stress: 0.5,
+                hardening,
+                kinematic_modulus: kinematic,
+            }),
         }
     }
 
@@ -273,7 +325,12 @@ mod plasticity_tests {
     fn tangent_matches_finite_differences_of_the_return() {
         let laws = [
             (Hardening::Linear { modulus: 10.0 }, 5.0),
-            (Hardening::Table { points: vec![[0.005, 0.55], [0.02, 0.6], [0.1, 0.62]] }, 0.0),
+            (
+                Hardening::Table {
+                    points: vec![[0.005, 0.55], [0.02, 0.6], [0.1, 0.62]],
+                },
+                0.0,
+            ),
             (Hardening::Linear { modulus: 0.0 }, 0.0),
         ];
         for (law, kinematic) in laws {
@@ -288,14 +345,24 @@ mod plasticity_tests {
                 let r = m.update(&c, &strain, state);
                 assert!(r.plastic_work > 0.0, "the step must be plastic");
                 let h = 1e-8;
-                let columns: &[usize] = if state == StressState::General { &[0, 1, 2, 3] } else { &[0, 1, 3] };
+                let columns: &[usize] = if state == StressState::General {
+                    &[0, 1, 2, 3]
+                } else {
+                    &[0, 1, 3]
+                };
                 for &j in columns {
                     let (mut p, mut q) = (strain, strain);
                     p[j] += h;
                     q[j] -= h;
-                    let fd = (m.update(&c, &p, state).stress - m.update(&c, &q, state).stress) / (2.0 * h);
+                    let fd = (m.update(&c, &p, state).stress - m.update(&c, &q, state).stress)
+                        / (2.0 * h);
                     for i in 0..4 {
-                        assert!((r.moduli[(i, j)] - fd[i]).abs() <= 1e-7 * r.moduli.norm(), "{state:?} kin {kinematic} ({i},{j}): {} vs {}", r.moduli[(i, j)], fd[i]);
+                        assert!(
+                            (r.moduli[(i, j)] - fd[i]).abs() <= 1e-7 * r.moduli.norm(),
+                            "{state:?} kin {kinematic} ({i},{j}): {} vs {}",
+                            r.moduli[(i, j)],
+                            fd[i]
+                        );
                     }
                 }
             }
@@ -316,8 +383,15 @@ mod plasticity_tests {
             let s = r.state.stress;
             let p = (s[0] + s[1] + s[2]) / 3.0;
             let a = r.state.back_stress;
-            let eta = Voigt::new(s[0] - p - a[0], s[1] - p - a[1], s[2] - p - a[2], s[3] - a[3]);
-            let mises = (1.5 * (eta[0].powi(2) + eta[1].powi(2) + eta[2].powi(2) + 2.0 * eta[3].powi(2))).sqrt();
+            let eta = Voigt::new(
+                s[0] - p - a[0],
+                s[1] - p - a[1],
+                s[2] - p - a[2],
+                s[3] - a[3],
+            );
+            let mises = (1.5
+                * (eta[0].powi(2) + eta[1].powi(2) + eta[2].powi(2) + 2.0 * eta[3].powi(2)))
+            .sqrt();
             let sy = 0.5 + 10.0 * r.state.eq_plastic_strain;
             approx::assert_relative_eq!(mises, sy, max_relative = 1e-12);
             if state == StressState::PlaneStress {

@@ -463,10 +463,16 @@ impl PlateWithHole {
         let width = positive("width", self.width)?;
         let height = positive("height", self.height)?;
         if width <= radius || height <= radius {
-            return Err(param("width", format!("width and height must exceed the radius {radius}")));
+            return Err(param(
+                "width",
+                format!("width and height must exceed the radius {radius}"),
+            ));
         }
         let n = at_least("n", self.n, 1)?;
-        let ws = graded(at_least("n_radial", self.n_radial, 1)?, grading("grading", self.grading)?);
+        let ws = graded(
+            at_least("n_radial", self.n_radial, 1)?,
+            grading("grading", self.grading)?,
+        );
         let corner = height.atan2(width);
         let arc = |from: f64, to: f64| -> Vec<Point> {
             (0..=n)
@@ -476,9 +482,16 @@ impl PlateWithHole {
                 })
                 .collect()
         };
-        let right: Vec<Point> = (0..=n).map(|k| [width, height * k as f64 / n as f64]).collect();
-        let top: Vec<Point> = (0..=n).map(|k| [width * (1.0 - k as f64 / n as f64), height]).collect();
-        let blocks = [ruled(&arc(0.0, corner), &right, &ws), ruled(&arc(corner, FRAC_PI_2), &top, &ws)];
+        let right: Vec<Point> = (0..=n)
+            .map(|k| [width, height * k as f64 / n as f64])
+            .collect();
+        let top: Vec<Point> = (0..=n)
+            .map(|k| [width * (1.0 - k as f64 / n as f64), height])
+            .collect();
+        let blocks = [
+            ruled(&arc(0.0, corner), &right, &ws),
+            ruled(&arc(corner, FRAC_PI_2), &top, &ws),
+        ];
         let mut mesh = glue(&blocks);
         let tol = 1e-9 * width.max(height);
         name_boundary(&mut mesh, |p, q| {
@@ -1605,7 +1618,16 @@ mod tests {
     /// polygonal hole (chord error < 1e-3 with 16 segments).
     #[test]
     fn plate_with_hole_has_its_sets_and_area() {
-        let mesh = PlateWithHole { width: 5.0, height: 4.0, radius: 1.0, n: 8, n_radial: 6, grading: 3.0 }.build().unwrap();
+        let mesh = PlateWithHole {
+            width: 5.0,
+            height: 4.0,
+            radius: 1.0,
+            n: 8,
+            n_radial: 6,
+            grading: 3.0,
+        }
+        .build()
+        .unwrap();
         assert_valid(&mesh);
         assert_eq!(mesh.cells.len(), 2 * 8 * 6);
         for set in ["hole", "bottom", "right", "top", "left"] {

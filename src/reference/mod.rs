@@ -192,3 +192,87 @@ pub fn spectral_radius(method: Recurrence, omega_h: f64) -> f64 {
         .map(|z| z.norm())
         .fold(0.0, f64::max)
 }
+
+/// Uniaxial stress of a bar with linear isotropic (H_iso) and kinematic (H_kin) hardening
+/// along a strain path, each step monotone: the closed-form piecewise-linear response
+/// (elastic slope E until |sigma - alpha| = sigma_y0 + H_iso eps_p, then slope
+/// E (H_iso + H_kin) / (E + H_iso + H_kin)). Returns the stress after each point of `strains`
+/// (starting from zero strain and stress).
+pub fn uniaxial_bar_stress(
+    young: f64,
+    yield_stress: f64,
+    h_iso: f64,
+    h_kin: f64,
+    strains: &[f64],
+) -> Vec<f64> {
+    let (mut eps, mut sigma, mut alpha, mut eps_p) = (0.0, 0.0, 0.0, 0.0);
+    let h = h_iso + h_kin;
+    let tangent = young * h / (young + h);
+    strains
+        .iter()
+        .map(|&target| {
+            let d = target - eps;
+            eps = target;
+            if d == 0.0 {
+                return sigma;
+            }
+            let s = d.signum();
+            // stress room before the yield surface alpha + s sigma_y(eps_p), as strain
+            let room = s * (alpha + s * (yield_stress + h_iso * eps_p) - sigma);
+            let elastic = (room / young).max(0.0);
+            if elastic >= d.abs() {
+                sigma += young * d;
+            } else {
+                let plastic = d.abs() - elastic;
+                sigma += s * (young * elastic + tangent * plastic);
+                let dep = plastic * young / (young + h); // d eps - d sigma / E
+                eps_p += dep;
+                alpha += s * h_kin * dep;
+            }
+            sigma
+        })
+        .collect()
+}
+
+/// Hill's elastic-perfectly plastic thick cylinder (Mises, plane strain, incompressible),
+/// inner radius a, outer b, yield stress sigma_y, shear modulus G, plastic front at radius c:
+/// internal pressure p(c) = (2/sqrt 3) sigma_y (ln(c/a) + (1 - c^2/b^2)/2) and bore
+/// displacement u(a) = sigma_y c^2 / (2 sqrt 3 G a). Returns (p, u_a).
+pub fn hill_cylinder(a: f64, b: f64, yield_stress: f64, shear_modulus: f64, c: f64) -> (f64, f64) {
+    let k = yield_stress / 3f64.sqrt();
+    (
+        k * (2.0 * (c / a).ln() + 1.0 - c * c / (b * b)),
+        k * c * c / (2.0 * shear_modulus * a),
+    )
+}
+
+/// Hill's limit pressure (2/sqrt 3) sigma_y ln(b/a).
+pub fn hill_limit_pressure(a: f64, b: f64, yield_stress: f64) -> f64 {
+    2.0 / 3f64.sqrt() * yield_stress * (b / a).ln()
+}
+
+/// The bore displacement of Hill's cylinder at pressure p (elastic below first yield,
+/// p < limit): the front c solved from p(c) by bisection.
+pub fn hill_bore_displacement(
+    a: f64,
+    b: f64,
+    yield_stress: f64,
+    shear_modulus: f64,
+    p: f64,
+) -> f64 {
+    let (p_first, _) = hill_cylinder(a, b, yield_stress, shear_modulus, a);
+    if p <= p_first {
+        // incompressible Lame: u(a) = p a b^2 / (2 G (b^2 - a^2))
+        return p * a * b * b / (2.0 * shear_modulus * (b * b - a * a));
+    }
+    let (mut lo, mut hi) = (a, b);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if hill_cylinder(a, b, yield_stress, shear_modulus, mid).0 < p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hill_cylinder(a, b, yield_stress, shear_modulus, 0.5 * (lo + hi)).1
+}

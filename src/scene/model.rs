@@ -7,7 +7,8 @@
 use super::InputError;
 use super::spec::{
     AnalysisKind, AnalysisSpec, BodySpec, Component, DynamicSpec, FormulationSpec, IntegratorKind,
-    LoadSpec, MaterialSpec, NewtonSpec, OutputSpec, ProbeSpec, Quantity, Scene, StaticSpec,
+    LoadSpec, MaterialSpec, NewtonSpec, NodeSetSpec, OutputSpec, ProbeSpec, Quantity, Scene,
+    StaticSpec,
 };
 use crate::assembly::MassKind;
 use crate::element::{Formulation, Geometry, Voigt, quad4, rod2};
@@ -210,6 +211,9 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     if bodies.is_empty() {
         return Err(cx.err("the scene has no [[body]]"));
     }
+    for (k, spec) in scene.node_set.iter().enumerate() {
+        add_node_set(&cx, &mut bodies, k, spec)?;
+    }
     let analysis = analysis(&cx, &scene.analysis)?;
     let curves = curves(&cx, &scene)?;
     let default_curve = match &analysis {
@@ -329,7 +333,9 @@ fn plasticity(cx: &Context, key: &str, m: &MaterialSpec) -> Result<Option<J2>, I
             (m.kinematic_modulus.is_some(), "kinematic_modulus"),
         ] {
             if present {
-                return Err(cx.err(format!("{key}.{name}: needs `yield_stress` (an elastic material does not harden)")));
+                return Err(cx.err(format!(
+                    "{key}.{name}: needs `yield_stress` (an elastic material does not harden)"
+                )));
             }
         }
         return Ok(None);
@@ -345,7 +351,9 @@ fn plasticity(cx: &Context, key: &str, m: &MaterialSpec) -> Result<Option<J2>, I
     };
     let hardening = match (&m.hardening_table, m.hardening_modulus) {
         (Some(_), Some(_)) => {
-            return Err(cx.err(format!("{key}: give `hardening_modulus` or `hardening_table`, not both")));
+            return Err(cx.err(format!(
+                "{key}: give `hardening_modulus` or `hardening_table`, not both"
+            )));
         }
         (Some(points), None) => {
             let mut previous = [0.0, yield_stress];
@@ -357,18 +365,30 @@ fn plasticity(cx: &Context, key: &str, m: &MaterialSpec) -> Result<Option<J2>, I
                     )));
                 }
                 if p[1] <= 0.0 {
-                    return Err(cx.err(format!("{key}.hardening_table[{i}]: sigma_y must stay positive")));
+                    return Err(cx.err(format!(
+                        "{key}.hardening_table[{i}]: sigma_y must stay positive"
+                    )));
                 }
                 previous = *p;
             }
             if points.is_empty() {
-                return Err(cx.err(format!("{key}.hardening_table: give at least one [eps_p, sigma_y] point")));
+                return Err(cx.err(format!(
+                    "{key}.hardening_table: give at least one [eps_p, sigma_y] point"
+                )));
             }
-            Hardening::Table { points: points.clone() }
+            Hardening::Table {
+                points: points.clone(),
+            }
         }
-        (None, h) => Hardening::Linear { modulus: non_negative("hardening_modulus", h)? },
+        (None, h) => Hardening::Linear {
+            modulus: non_negative("hardening_modulus", h)?,
+        },
     };
-    Ok(Some(J2 { yield_stress, hardening, kinematic_modulus: non_negative("kinematic_modulus", m.kinematic_modulus)? }))
+    Ok(Some(J2 {
+        yield_stress,
+        hardening,
+        kinematic_modulus: non_negative("kinematic_modulus", m.kinematic_modulus)?,
+    }))
 }
 
 fn body(
@@ -403,7 +423,10 @@ fn body(
         return Err(cx.err(format!("{key}.area: only rod bodies have an area")));
     }
     let plastic = material.plasticity.is_some()
-        && matches!(spec.formulation, FormulationSpec::PlaneStrain | FormulationSpec::Axisymmetric);
+        && matches!(
+            spec.formulation,
+            FormulationSpec::PlaneStrain | FormulationSpec::Axisymmetric
+        );
     let bbar = spec.bbar.unwrap_or(plastic);
     if bbar
         && matches!(
@@ -778,6 +801,50 @@ fn curve(
             ))
         }),
     }
+}
+
+fn add_node_set(
+    cx: &Context,
+    bodies: &mut [Body],
+    k: usize,
+    spec: &NodeSetSpec,
+) -> Result<(), InputError> {
+    let key = format!("node_set[{k}] (`{}`)", spec.name);
+    let b = body_index(cx, bodies, spec.body.as_deref(), &key)?;
+    let mesh = &mut bodies[b].mesh;
+    if mesh.node_sets.contains_key(&spec.name) {
+        return Err(cx.err(format!(
+            "{key}.name: body `{}` already has a node set `{}`",
+            bodies[b].name, spec.name
+        )));
+    }
+    let nodes: Vec<usize> = match (spec.nearest, spec.bounds) {
+        (Some(p), None) => {
+            finite(cx, &format!("{key}.nearest"), &p)?;
+            let distance = |n: &[f64; 2]| (n[0] - p[0]).powi(2) + (n[1] - p[1]).powi(2);
+            let best = (0..mesh.nodes.len())
+                .min_by(|a, b| distance(&mesh.nodes[*a]).total_cmp(&distance(&mesh.nodes[*b])));
+            best.into_iter().collect()
+        }
+        (None, Some([x0, y0, x1, y1])) => {
+            finite(cx, &format!("{key}.box"), &[x0, y0, x1, y1])?;
+            (0..mesh.nodes.len())
+                .filter(|n| {
+                    let [x, y] = mesh.nodes[*n];
+                    x >= x0 && x <= x1 && y >= y0 && y <= y1
+                })
+                .collect()
+        }
+        _ => return Err(cx.err(format!("{key}: give exactly one of `nearest` or `box`"))),
+    };
+    if nodes.is_empty() {
+        return Err(cx.err(format!(
+            "{key}.box: no node of body `{}` lies in the box",
+            bodies[b].name
+        )));
+    }
+    bodies[b].mesh.add_node_set(&spec.name, nodes);
+    Ok(())
 }
 
 fn finite(cx: &Context, key: &str, values: &[f64]) -> Result<(), InputError> {

@@ -23,6 +23,8 @@ pub struct Scene {
     pub curve: Vec<CurveSpec>,
     #[serde(default)]
     pub initial_velocity: Vec<InitialVelocitySpec>,
+    #[serde(default)]
+    pub node_set: Vec<NodeSetSpec>,
     pub analysis: AnalysisSpec,
     #[serde(default)]
     pub output: OutputSpec,
@@ -175,6 +177,20 @@ pub struct AffineSpec {
     /// Default [0, 0].
     pub offset: Option<[f64; 2]>,
     pub curve: Option<String>,
+}
+
+/// A node set defined in the scene (for probes, supports, loads): the node nearest a point,
+/// or all nodes inside a box. Added to the body's sets under `name`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeSetSpec {
+    pub name: String,
+    pub body: Option<String>,
+    /// The single node nearest this point.
+    pub nearest: Option<[f64; 2]>,
+    /// All nodes with xmin <= x <= xmax and ymin <= y <= ymax: [xmin, ymin, xmax, ymax].
+    #[serde(rename = "box")]
+    pub bounds: Option<[f64; 4]>,
 }
 
 /// An initial velocity for the nodes of a set (after the bodies' own `velocity`).
