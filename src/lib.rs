@@ -7,6 +7,7 @@
 
 pub mod analysis;
 pub mod assembly;
+pub mod contact;
 pub mod element;
 pub mod integrator;
 pub mod kinematics;

@@ -12,7 +12,8 @@
 //! Prescribed DOFs follow their curves; their velocity and acceleration come from the same
 //! integrator formulas as the free ones.
 
-use super::newton::{Counters, Inertia, Step, StepFailure};
+use super::contact::ContactState;
+use super::newton::{ContactStep, Counters, Inertia, Step, StepFailure};
 use super::record::{Energies, Motion, Recorder};
 use super::{RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, Mass, State, System};
@@ -174,93 +175,127 @@ pub fn run(
     let mut factored_for: Option<[f64; 3]> = None;
     let mut cuts_in_a_row = 0;
     let mut increments = 0usize;
+    let mut contact = ContactState::new(model);
+    let mut last_contact = vec![0.0; model.dofs()];
     while state.time < spec.end_time * (1.0 - 1e-12) {
         let target = super::snap((state.time + dt).min(spec.end_time), spec.dt);
-        let h = super::step_length(target - state.time, spec.dt);
-        let form = method.form(h, &kin);
-        let solve_time = state.time + form.solve_fraction * h;
-        let mut d: Vec<f64> = kin
-            .velocity
-            .iter()
-            .map(|v| form.solve_fraction * h * v)
-            .collect();
-        for (dof, value) in loads::prescribed(model, &initial, solve_time) {
-            d[dof] = value - kin.displacement[dof];
-        }
-        let external =
-            loads::external_force(model, &state, &initial, state.time + form.load_fraction * h);
-        let coefficients = [
-            form.mass_coefficient,
-            form.damping_coefficient,
-            form.internal_weight,
-        ];
-        let factor_first = factored_for != Some(coefficients)
-            || match spec.newton.strategy {
-                Strategy::Full => true,
-                Strategy::Modified => increments % spec.newton.refactor_every == 0,
-                Strategy::Initial => !solver.is_factored(),
-            };
-        let step = Step {
+        let nominal = super::step_length(target - state.time, spec.dt);
+        let kinetic_before_impact = mass.kinetic_energy(model, &kin.velocity);
+        contact.close_touching(
             model,
-            geometry: spec.geometry,
-            newton: &spec.newton,
-            inertia: Some(Inertia {
-                mass: &mass,
-                rayleigh: spec.rayleigh,
-            }),
-            form: &form,
-            external: &external,
-            internal_start: &last_internal,
-            factor_first,
-        };
-        let solved = step.solve(&state, d, &mut system, &mut solver, &mut counters);
-        let result = solved.and_then(|(d, evaluation)| {
-            let advance = method.advance(h, &kin, &d);
-            if form.solve_fraction == 1.0 {
-                return Ok((advance, evaluation));
+            &state.reference,
+            &mass.lumped,
+            &mut kin.velocity,
+            &mut kin.acceleration,
+        );
+        energies.contact_work += kinetic_before_impact - mass.kinetic_energy(model, &kin.velocity);
+        // one attempt of the step with a given length and active contact set
+        let attempt = |h: f64, active: &[(usize, usize)], forces: Vec<f64>| {
+            let form = method.form(h, &kin);
+            let solve_time = state.time + form.solve_fraction * h;
+            let mut d: Vec<f64> = kin
+                .velocity
+                .iter()
+                .map(|v| form.solve_fraction * h * v)
+                .collect();
+            for (dof, value) in loads::prescribed(model, &initial, solve_time) {
+                d[dof] = value - kin.displacement[dof];
             }
-            // Wilson: the state at t_{n+1} from the interpolated increment
-            let mut du = advance.increment.clone();
-            for (dof, value) in loads::prescribed(model, &initial, target) {
-                du[dof] = value - kin.displacement[dof];
-            }
-            let evaluation = assembly::evaluate(model, &state, &du, spec.geometry, None)
-                .map_err(|e| StepFailure(e.to_string()))?;
-            Ok((
-                crate::integrator::Advance {
-                    increment: du,
-                    ..advance
-                },
-                evaluation,
-            ))
-        });
-        factored_for = if solver.is_factored() {
-            Some(coefficients)
-        } else {
-            None
+            let external =
+                loads::external_force(model, &state, &initial, state.time + form.load_fraction * h);
+            let coefficients = [
+                form.mass_coefficient,
+                form.damping_coefficient,
+                form.internal_weight,
+            ];
+            let factor_first = factored_for != Some(coefficients)
+                || match spec.newton.strategy {
+                    Strategy::Full => true,
+                    Strategy::Modified => increments % spec.newton.refactor_every == 0,
+                    Strategy::Initial => !solver.is_factored(),
+                };
+            let step = Step {
+                model,
+                geometry: spec.geometry,
+                newton: &spec.newton,
+                inertia: Some(Inertia {
+                    mass: &mass,
+                    rayleigh: spec.rayleigh,
+                }),
+                form: &form,
+                external: &external,
+                internal_start: &last_internal,
+                factor_first,
+                contact: Some(ContactStep {
+                    pairs: &model.contacts,
+                    active,
+                    reference: &state.reference,
+                    forces,
+                }),
+            };
+            let result = step.solve(&state, d, &mut system, &mut solver, &mut counters);
+            factored_for = if solver.is_factored() {
+                Some(coefficients)
+            } else {
+                None
+            };
+            result
         };
-        match result {
-            Ok((advance, evaluation)) => {
+        let outcome = contact
+            .step(model, &state.reference, nominal, attempt)
+            .and_then(|mut step| {
+                let h = step.length;
+                let form = method.form(h, &kin);
+                let advance = method.advance(h, &kin, &step.solution.d);
+                if form.solve_fraction != 1.0 {
+                    // Wilson: the state at t_{n+1} from the interpolated increment
+                    let mut du = advance.increment.clone();
+                    for (dof, value) in loads::prescribed(model, &initial, state.time + h) {
+                        du[dof] = value - kin.displacement[dof];
+                    }
+                    step.solution.evaluation =
+                        assembly::evaluate(model, &state, &du, spec.geometry, None)
+                            .map_err(|e| StepFailure(e.to_string()))?;
+                    step.solution.d = du;
+                }
+                Ok((step, advance))
+            });
+        match outcome {
+            Ok((mut step, advance)) => {
+                let h = step.length;
+                let d = std::mem::take(&mut step.solution.d);
+                let evaluation =
+                    std::mem::replace(&mut step.solution.evaluation, empty_evaluation());
                 let internal = evaluation.force.clone();
-                assembly::commit(
-                    model,
-                    &mut state,
-                    &advance.increment,
-                    evaluation,
-                    spec.geometry,
-                );
-                state.time = target;
-                for (u, du) in kin.displacement.iter_mut().zip(&advance.increment) {
+                assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
+                state.time = if h == nominal { target } else { state.time + h };
+                let previous_velocity = std::mem::replace(&mut kin.velocity, advance.velocity);
+                kin.acceleration = advance.acceleration;
+                for (u, du) in kin.displacement.iter_mut().zip(&d) {
                     *u += du;
                 }
-                kin.velocity = advance.velocity;
-                kin.acceleration = advance.acceleration;
+                let kinetic_before = mass.kinetic_energy(model, &kin.velocity);
+                super::contact::apply_conditions(
+                    model,
+                    &mut step,
+                    &state.reference,
+                    &mass.lumped,
+                    &previous_velocity,
+                    &mut kin.velocity,
+                    &mut kin.acceleration,
+                );
+                contact.commit(model, &step, state.time, &state.reference);
+                let contact_force = contact.nodal_forces(model, &state.reference);
                 let total = total_force(
                     model, &system, &mass, spec, &kin, &internal, &state, &initial,
                 );
-                energies.external_work +=
-                    super::trapezoid_work(&advance.increment, &total, &last_total);
+                energies.external_work += super::trapezoid_work(&d, &total, &last_total);
                 energies.kinetic = mass.kinetic_energy(model, &kin.velocity);
+                // energy taken up by the interface: minus the work of the contact forces on
+                // the bodies, plus what the impact/release conditions removed
+                energies.contact_work += -super::trapezoid_work(&d, &contact_force, &last_contact)
+                    + kinetic_before
+                    - energies.kinetic;
                 energies.internal = state.internal_work - state.plastic_work;
                 energies.plastic_work = state.plastic_work;
                 summary.energy.max_relative_drift = summary
@@ -269,6 +304,7 @@ pub fn run(
                     .max(super::balance_error(&energies, initial_kinetic));
                 last_total = total;
                 last_internal = internal;
+                last_contact = contact_force;
                 summary.steps += 1;
                 increments += 1;
                 let last = state.time >= spec.end_time * (1.0 - 1e-12);
@@ -276,7 +312,14 @@ pub fn run(
                     velocity: &kin.velocity,
                     acceleration: &kin.acceleration,
                 };
-                recorder.step(model, &state, &motion, &energies, last)?;
+                recorder.step_with_contact(
+                    model,
+                    &state,
+                    &motion,
+                    &energies,
+                    Some(&contact),
+                    last,
+                )?;
                 progress.set_position((state.time / spec.dt).round() as u64);
                 cuts_in_a_row = 0;
                 dt = (dt * 2.0).min(spec.dt);
@@ -286,17 +329,18 @@ pub fn run(
                 if cuts_in_a_row >= spec.newton.max_cuts {
                     progress.abandon();
                     let message = format!(
-                        "step to t = {target} did not converge after {cuts_in_a_row} cuts (dt = {h:e}): {reason}"
+                        "step to t = {target} did not converge after {cuts_in_a_row} cuts (dt = {nominal:e}): {reason}"
                     );
                     summary.finish(&energies, &counters, Some(&solver), start);
                     return Err(super::fail(&recorder, summary, Status::Diverged, message));
                 }
-                dt = h * 0.5;
+                dt = nominal * 0.5;
                 cuts_in_a_row += 1;
                 counters.cuts += 1;
             }
         }
     }
+    summary.contact = contact.summary();
     progress.finish_and_clear();
     summary.finish(&energies, &counters, Some(&solver), start);
     recorder.write_summary(&summary)?;
@@ -324,4 +368,15 @@ fn total_force(
             None => ma[i] + spec.rayleigh[0] * mv[i] + internal[i],
         })
         .collect()
+}
+
+/// A placeholder taken out of a solution whose evaluation was moved into the state.
+fn empty_evaluation() -> assembly::Evaluation {
+    assembly::Evaluation {
+        force: Vec::new(),
+        trial: Vec::new(),
+        strain_zz: Vec::new(),
+        work: 0.0,
+        plastic_work: 0.0,
+    }
 }

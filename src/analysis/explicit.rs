@@ -172,7 +172,7 @@ pub fn run(
         };
         if !energy.is_finite() || energy > 100.0 * energy_reference {
             progress.abandon();
-            recorder.frame(model, &state, &motion).ok();
+            recorder.frame(model, &state, &motion, None).ok();
             summary.finish(&energies, &Counters::default(), None, start);
             let message = format!(
                 "the energy grew to {energy:.3e} (reference {energy_reference:.3e}) at t = {time}: dt = {} is above the stability limit {dt_crit:.6e}",

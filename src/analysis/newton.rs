@@ -17,6 +17,7 @@
 //! more than half of the iterations left to reach the force tolerance.
 
 use crate::assembly::{self, Evaluation, Mass, State, System};
+use crate::contact::ContactPair;
 use crate::element::Geometry;
 use crate::integrator::StepForm;
 use crate::scene::Model;
@@ -52,6 +53,107 @@ pub struct Step<'a> {
     pub internal_start: &'a [f64],
     /// Factor at the first iteration (else the solver's factorization is reused).
     pub factor_first: bool,
+    /// Active contact constraints, enforced by Lagrange multipliers.
+    pub contact: Option<ContactStep<'a>>,
+}
+
+/// The contact constraints a step enforces: (pair, slave node) entries, gaps measured at
+/// reference + d. Their multipliers start from `forces` (the last step's).
+pub struct ContactStep<'a> {
+    pub pairs: &'a [ContactPair],
+    pub active: &'a [(usize, usize)],
+    pub reference: &'a [[f64; 2]],
+    pub forces: Vec<f64>,
+}
+
+/// A converged step: the increment, its evaluation, and the contact multipliers (tau, the
+/// compressive normal forces of the active entries, in their order).
+pub struct Solution {
+    pub d: Vec<f64>,
+    pub evaluation: Evaluation,
+    pub forces: Vec<f64>,
+}
+
+/// Active constraint rows restricted to the free DOFs, and their gaps.
+struct Rows {
+    rows: Vec<Vec<(usize, f64)>>,
+    gaps: Vec<f64>,
+}
+
+impl ContactStep<'_> {
+    fn rows(&self, d: &[f64], system: &System) -> Result<Rows, StepFailure> {
+        let x = |n: usize| {
+            [
+                self.reference[n][0] + d[2 * n],
+                self.reference[n][1] + d[2 * n + 1],
+            ]
+        };
+        let mut rows = Vec::with_capacity(self.active.len());
+        let mut gaps = Vec::with_capacity(self.active.len());
+        for &(pair, slave) in self.active {
+            let gap = self.pairs[pair].gap(slave, &x).ok_or_else(|| {
+                StepFailure(format!(
+                    "contact `{}`: node {slave} lost its master",
+                    self.pairs[pair].name
+                ))
+            })?;
+            let row = gap
+                .row(slave)
+                .into_iter()
+                .filter_map(|(dof, c)| system.equation[dof].map(|eq| (eq, c)))
+                .collect();
+            rows.push(row);
+            gaps.push(gap.gap);
+        }
+        Ok(Rows { rows, gaps })
+    }
+}
+
+/// sum_i tau_i C_i^T added into a free-DOF vector.
+fn add_constraint_forces(rows: &Rows, forces: &[f64], target: &mut [f64]) {
+    for (row, tau) in rows.rows.iter().zip(forces) {
+        for (eq, c) in row {
+            target[*eq] += tau * c;
+        }
+    }
+}
+
+/// The Schur complement solve on the factored K*: delta_0 = K*^-1 R, Z = K*^-1 C^T,
+/// (C Z) tau = -g - C delta_0, delta = delta_0 + Z tau. Contact never refactors K*.
+fn constrained_solve(
+    solver: &mut Solver,
+    rows: &Rows,
+    residual: Vec<f64>,
+) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
+    let mut delta = residual;
+    solver.solve(&mut delta);
+    let m = rows.rows.len();
+    if m == 0 {
+        return Ok((delta, Vec::new()));
+    }
+    let n = delta.len();
+    let mut z = Vec::with_capacity(m);
+    for row in &rows.rows {
+        let mut column = vec![0.0; n];
+        for (eq, c) in row {
+            column[*eq] += c;
+        }
+        solver.solve(&mut column);
+        z.push(column);
+    }
+    let dot =
+        |row: &Vec<(usize, f64)>, v: &[f64]| row.iter().map(|(eq, c)| c * v[*eq]).sum::<f64>();
+    let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&rows.rows[i], &z[j]));
+    let rhs = nalgebra::DVector::from_fn(m, |i, _| -rows.gaps[i] - dot(&rows.rows[i], &delta));
+    let tau = schur.lu().solve(&rhs).ok_or_else(|| {
+        StepFailure("the contact constraints are redundant (singular Schur complement)".into())
+    })?;
+    for (j, column) in z.iter().enumerate() {
+        for (d, zj) in delta.iter_mut().zip(column) {
+            *d += tau[j] * zj;
+        }
+    }
+    Ok((delta, tau.iter().copied().collect()))
 }
 
 /// Stiffness-proportional damping matrix of the step (the tangent at D = 0), free DOFs.
@@ -117,8 +219,12 @@ impl Step<'_> {
         system: &mut System,
         solver: &mut Solver,
         counters: &mut Counters,
-    ) -> Result<(Vec<f64>, Evaluation), StepFailure> {
+    ) -> Result<Solution, StepFailure> {
         let newton = self.newton;
+        let mut forces = self
+            .contact
+            .as_ref()
+            .map_or(Vec::new(), |c| c.forces.clone());
         let damping = match &self.inertia {
             Some(i) if i.rayleigh[1] > 0.0 => {
                 self.evaluate(state, &vec![0.0; d.len()], Some(&mut *system))?;
@@ -136,7 +242,17 @@ impl Step<'_> {
                 newton.strategy == Strategy::Full || (iteration == 0 && self.factor_first);
             let evaluation = self.evaluate(state, &d, refactor.then_some(&mut *system))?;
             let (residual, scale) = self.residual(&d, &evaluation, system, &damping, external_norm);
-            let residual_norm = norm(&residual);
+            let rows = match &self.contact {
+                Some(c) => c.rows(&d, system)?,
+                None => Rows {
+                    rows: Vec::new(),
+                    gaps: Vec::new(),
+                },
+            };
+            // the equilibrium residual includes the contact forces of the last solve
+            let mut balance = residual.clone();
+            add_constraint_forces(&rows, &forces, &mut balance);
+            let residual_norm = norm(&balance);
             if !residual_norm.is_finite() {
                 return Err(StepFailure(
                     "the residual is not finite (NaN or Inf)".into(),
@@ -151,7 +267,11 @@ impl Step<'_> {
                 && ((eps_displacement < newton.tol_displacement && eps_force < newton.tol_force)
                     || residual_norm == 0.0);
             if converged {
-                return Ok((d, evaluation));
+                return Ok(Solution {
+                    d,
+                    evaluation,
+                    forces,
+                });
             }
             if iteration == newton.max_iterations {
                 break;
@@ -175,8 +295,8 @@ impl Step<'_> {
                     .factor(&system.values)
                     .map_err(|e| StepFailure(e.to_string()))?;
             }
-            let mut delta = residual;
-            solver.solve(&mut delta);
+            let (delta, tau) = constrained_solve(solver, &rows, residual)?;
+            forces = tau;
             counters.iterations += 1;
             system.scatter_add(&delta, &mut d);
             let d_norm = norm(&d);

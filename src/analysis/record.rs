@@ -2,6 +2,7 @@
 //! row per converged step, summary.json at the end (also after a failure).
 
 use super::Summary;
+use super::contact::ContactState;
 use crate::assembly::State;
 use crate::material::{pressure, von_mises};
 use crate::mesh::Cells;
@@ -62,6 +63,12 @@ impl Recorder {
         .iter()
         .map(|s| s.to_string())
         .collect();
+        columns.extend(
+            model
+                .contacts
+                .iter()
+                .map(|c| format!("contact_force[{}]", c.name)),
+        );
         columns.extend(model.probes.iter().map(|p| p.column.clone()));
         let history = History::create(&dir.join("history.csv"), &columns)?;
         Ok(Recorder {
@@ -85,6 +92,19 @@ impl Recorder {
         energies: &Energies,
         force_frame: bool,
     ) -> Result<(), OutputError> {
+        self.step_with_contact(model, state, motion, energies, None, force_frame)
+    }
+
+    /// As `step`, with the contact status for the contact columns and fields.
+    pub fn step_with_contact(
+        &mut self,
+        model: &Model,
+        state: &State,
+        motion: &Motion,
+        energies: &Energies,
+        contact: Option<&ContactState>,
+        force_frame: bool,
+    ) -> Result<(), OutputError> {
         let mut row = vec![
             state.time,
             energies.kinetic,
@@ -93,6 +113,10 @@ impl Recorder {
             energies.external_work,
             energies.contact_work,
         ];
+        match contact {
+            Some(c) => row.extend(c.pair_forces()),
+            None => row.extend(std::iter::repeat_n(0.0, model.contacts.len())),
+        }
         row.extend(
             model
                 .probes
@@ -102,7 +126,7 @@ impl Recorder {
         self.history.append(&row)?;
         self.steps_since_frame += 1;
         if force_frame || (self.frame_every > 0 && self.steps_since_frame >= self.frame_every) {
-            self.frame(model, state, motion)?;
+            self.frame(model, state, motion, contact)?;
         }
         Ok(())
     }
@@ -113,6 +137,7 @@ impl Recorder {
         model: &Model,
         state: &State,
         motion: &Motion,
+        contact: Option<&ContactState>,
     ) -> Result<(), OutputError> {
         let Some(series) = self.series.as_mut() else {
             return Ok(());
@@ -124,15 +149,20 @@ impl Recorder {
         let vectors =
             |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
         let n = state.reference.len();
-        let zeros2 = vec![[0.0; 2]; n];
-        let zeros = vec![0.0; n];
+        let (contact_force, gap, status) = match contact {
+            Some(c) => {
+                let (gap, status) = c.nodal_status(model, &state.reference);
+                (c.nodal_forces(model, &state.reference), gap, status)
+            }
+            None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
+        };
         let fields = Fields {
             displacement: &vectors(&state.displacement),
             velocity: &vectors(motion.velocity),
             acceleration: &vectors(motion.acceleration),
-            contact_force: &zeros2,
-            gap: &zeros,
-            contact_status: &zeros,
+            contact_force: &vectors(&contact_force),
+            gap: &gap,
+            contact_status: &status,
             stress: &cells.stress,
             von_mises: &cells.von_mises,
             eq_plastic_strain: &cells.eq_plastic_strain,

@@ -84,9 +84,10 @@ pub fn run(
             external: &external,
             internal_start: &last_force,
             factor_first,
+            contact: None,
         };
         match step.solve(&state, d, &mut system, &mut solver, &mut counters) {
-            Ok((d, evaluation)) => {
+            Ok(super::newton::Solution { d, evaluation, .. }) => {
                 let force = evaluation.force.clone();
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
                 state.time = target;

@@ -25,6 +25,10 @@ pub struct Scene {
     pub initial_velocity: Vec<InitialVelocitySpec>,
     #[serde(default)]
     pub node_set: Vec<NodeSetSpec>,
+    #[serde(default)]
+    pub obstacle: Vec<ObstacleSpec>,
+    #[serde(default)]
+    pub contact: Vec<ContactSpec>,
     pub analysis: AnalysisSpec,
     #[serde(default)]
     pub output: OutputSpec,
@@ -177,6 +181,64 @@ pub struct AffineSpec {
     /// Default [0, 0].
     pub offset: Option<[f64; 2]>,
     pub curve: Option<String>,
+}
+
+/// A rigid obstacle: a fixed polyline with the solid on its left (counter-clockwise closed
+/// polygon: a finite obstacle; clockwise: a cavity; open: the boundary of a half-space).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleSpec {
+    pub name: String,
+    pub points: Vec<[f64; 2]>,
+    /// Default false.
+    #[serde(default)]
+    pub closed: bool,
+}
+
+/// A surface of a body: a node set (slaves, node-to-node masters) or an edge set (masters).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceSpec {
+    pub body: Option<String>,
+    pub set: String,
+    /// Node-to-node masters only: the master's outward unit normal.
+    pub normal: Option<[f64; 2]>,
+}
+
+/// A contact pair: slave nodes against a master surface of a body or a rigid obstacle.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    pub name: String,
+    pub slave: SurfaceSpec,
+    /// A master surface (an edge set, or a node set with `normal`); or give `obstacle`.
+    pub master: Option<SurfaceSpec>,
+    /// The name of an `[[obstacle]]`.
+    pub obstacle: Option<String>,
+    /// Hughes' impact conditions II-8 when a pair closes. Default true.
+    #[serde(default = "yes")]
+    pub impact_conditions: bool,
+    /// Hughes' release conditions II-11, II-12 when a pair opens. Default true.
+    #[serde(default = "yes")]
+    pub release_conditions: bool,
+    /// Release when the force falls below this fraction of the last step's. Default 0.02.
+    #[serde(default = "default_release_fraction")]
+    pub release_fraction: f64,
+    /// TOL of Hughes II-7 (length). Default 1e-9 of the model's size.
+    pub tolerance: Option<f64>,
+    /// Slaves farther than this from the master are skipped (length). Default: no limit.
+    pub search_distance: Option<f64>,
+    /// Split a step at the first contact event inside it (Erklig 2.1.4). Default true.
+    #[serde(default = "yes")]
+    pub split_at_events: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn default_release_fraction() -> f64 {
+    0.02
 }
 
 /// A node set defined in the scene (for probes, supports, loads): the node nearest a point,

@@ -1,0 +1,599 @@
+//! Contact in the drivers: the active set across steps, the event logic inside a step, and
+//! Hughes' impact and release conditions after it.
+//!
+//! Legend (per active entry: a slave node of a pair)
+//! ```text
+//! tau          compressive normal force (Lagrange multiplier)
+//! Z            rho c A: the normal impedance of a node (c the dilatational wave speed,
+//!              A its tributary contact area)
+//! M            the node's lumped mass
+//! v_n, a_n     normal components of velocity and acceleration, n out of the master
+//! ```
+//! In a step: solve with the current active set; release entries in tension (tau < 0) and
+//! solve again; if inactive slaves penetrate beyond TOL, either shorten the step to the first
+//! contact event (Erklig 2.1.4: the fraction alpha = g_0 / (g_0 - g_1), once per step) or
+//! activate them and solve again (Hughes II-7). After the step, entries whose force fell
+//! below `release_fraction` of the last step's are released. Dynamics then applies, for
+//! entries that closed, the impact conditions (Hughes II-8)
+//! ```text
+//! V+ = (Z_s v_s,n-1 + Z_m v_m,n-1) / (Z_s + Z_m)       velocities of the previous step
+//! a+ = (M_s a_s + M_m a_m) / (M_s + M_m),  tau+ = tau + M_s (a+ - a_s)
+//! ```
+//! and for entries released by the fraction rule the release conditions (II-11, II-12)
+//! ```text
+//! v_s,n += tau / Z_s,  v_m,n -= tau / Z_m,  a_s,n -= tau / M_s,  a_m,n += tau / M_m
+//! ```
+//! A rigid obstacle is a master of infinite mass and impedance at rest.
+
+use super::newton::{Solution, StepFailure};
+use crate::contact::{ContactPair, Gap, Master};
+use crate::element::Formulation;
+use crate::scene::{BodyKind, Model};
+use std::f64::consts::PI;
+
+/// The contact status carried from step to step.
+#[derive(Debug, Clone)]
+pub struct ContactState {
+    /// Per pair, per slave (in the pair's order): active?
+    pub active: Vec<Vec<bool>>,
+    /// Per pair, per slave: the last converged force.
+    pub force: Vec<Vec<f64>>,
+    pub first_contact_time: Option<f64>,
+    pub last_release_time: Option<f64>,
+    pub peak_force: f64,
+    pub peak_extent: f64,
+}
+
+/// What happened in a step, for the conditions and the bookkeeping.
+#[derive(Debug, Clone, Default)]
+pub struct Events {
+    /// (pair, slave index) entries that closed in the step.
+    pub closed: Vec<(usize, usize)>,
+    /// Entries released by the fraction rule, with their last force.
+    pub released: Vec<(usize, usize, f64)>,
+    /// Entries released because they went into tension.
+    pub separated: Vec<(usize, usize)>,
+}
+
+/// The result of a step with contact.
+pub struct ContactStep {
+    pub solution: Solution,
+    /// The step length actually taken (shorter when split at an event).
+    pub length: f64,
+    /// Active entries and their forces after the step.
+    pub active: Vec<(usize, usize)>,
+    pub forces: Vec<f64>,
+    pub events: Events,
+}
+
+impl ContactState {
+    /// Every pair starts open: slaves touching at the start (|g| <= TOL) close in the first
+    /// step they press on their master, so the impact conditions see that closure.
+    pub fn new(model: &Model) -> ContactState {
+        let active = model
+            .contacts
+            .iter()
+            .map(|p| vec![false; p.slaves.len()])
+            .collect();
+        let force = model
+            .contacts
+            .iter()
+            .map(|p| vec![0.0; p.slaves.len()])
+            .collect();
+        ContactState {
+            active,
+            force,
+            first_contact_time: None,
+            last_release_time: None,
+            peak_force: 0.0,
+            peak_extent: 0.0,
+        }
+    }
+
+    fn entries(&self) -> (Vec<(usize, usize)>, Vec<f64>) {
+        let mut entries = Vec::new();
+        let mut forces = Vec::new();
+        for (p, flags) in self.active.iter().enumerate() {
+            for (k, a) in flags.iter().enumerate() {
+                if *a {
+                    entries.push((p, k));
+                    forces.push(self.force[p][k]);
+                }
+            }
+        }
+        (entries, forces)
+    }
+
+    /// Runs one step with contact. `solve(length, active (pair, slave node), forces)`
+    /// solves the step for a given active set.
+    pub fn step(
+        &self,
+        model: &Model,
+        reference: &[[f64; 2]],
+        length: f64,
+        mut solve: impl FnMut(f64, &[(usize, usize)], Vec<f64>) -> Result<Solution, StepFailure>,
+    ) -> Result<ContactStep, StepFailure> {
+        let pairs = &model.contacts;
+        let (mut entries, mut forces) = self.entries();
+        let mut length = length;
+        let mut split = false;
+        for _ in 0..100 {
+            let nodes: Vec<(usize, usize)> = entries
+                .iter()
+                .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
+                .collect();
+            let solution = solve(length, &nodes, forces.clone())?;
+            // release entries in tension, most negative first, and solve again
+            if let Some(worst) = (0..entries.len())
+                .filter(|i| solution.forces[*i] < 0.0)
+                .min_by(|a, b| solution.forces[*a].total_cmp(&solution.forces[*b]))
+            {
+                entries.remove(worst);
+                forces = solution.forces.clone();
+                forces.remove(worst);
+                continue;
+            }
+            let end = |n: usize| {
+                [
+                    reference[n][0] + solution.d[2 * n],
+                    reference[n][1] + solution.d[2 * n + 1],
+                ]
+            };
+            let start = |n: usize| reference[n];
+            let mut penetrating = Vec::new();
+            let mut alpha = 1.0f64;
+            for (p, pair) in pairs.iter().enumerate() {
+                for (k, s) in pair.slaves.iter().enumerate() {
+                    if entries.contains(&(p, k)) {
+                        continue;
+                    }
+                    let Some(g1) = pair.gap(*s, &end) else {
+                        continue;
+                    };
+                    if g1.gap >= -pair.options.tolerance {
+                        continue;
+                    }
+                    penetrating.push((p, k));
+                    let g0 = pair.gap(*s, &start).map_or(0.0, |g| g.gap);
+                    if pair.options.split_at_events && g0 > pair.options.tolerance {
+                        alpha = alpha.min(g0 / (g0 - g1.gap));
+                    } else {
+                        alpha = 0.0;
+                    }
+                }
+            }
+            if penetrating.is_empty() {
+                let forces = solution.forces.clone();
+                return Ok(self.finish(model, reference, solution, length, entries, forces));
+            }
+            if !split && alpha > 1e-6 && alpha < 1.0 {
+                // Erklig 2.1.4: end the step where the first slave touches
+                length *= alpha;
+                split = true;
+                forces = solution.forces.clone();
+                continue;
+            }
+            forces = solution.forces.clone();
+            for e in penetrating {
+                entries.push(e);
+                forces.push(0.0);
+            }
+        }
+        Err(StepFailure(
+            "the contact active set did not settle in 100 passes".into(),
+        ))
+    }
+
+    /// The fraction release rule and the event lists of a converged step.
+    fn finish(
+        &self,
+        model: &Model,
+        _reference: &[[f64; 2]],
+        solution: Solution,
+        length: f64,
+        mut entries: Vec<(usize, usize)>,
+        mut forces: Vec<f64>,
+    ) -> ContactStep {
+        let mut events = Events::default();
+        let mut i = 0;
+        while i < entries.len() {
+            let (p, k) = entries[i];
+            let previous = self.force[p][k];
+            let was_active = self.active[p][k];
+            let fraction = model.contacts[p].options.release_fraction;
+            if was_active && previous > 0.0 && forces[i] < fraction * previous {
+                events.released.push((p, k, forces[i]));
+                entries.remove(i);
+                forces.remove(i);
+                continue;
+            }
+            if !was_active {
+                events.closed.push((p, k));
+            }
+            i += 1;
+        }
+        for (p, flags) in self.active.iter().enumerate() {
+            for (k, a) in flags.iter().enumerate() {
+                if *a
+                    && !entries.contains(&(p, k))
+                    && !events.released.iter().any(|r| (r.0, r.1) == (p, k))
+                {
+                    events.separated.push((p, k));
+                }
+            }
+        }
+        ContactStep {
+            solution,
+            length,
+            active: entries,
+            forces,
+            events,
+        }
+    }
+
+    /// Closes, at the start of a step, the open slaves that touch their master (|g| <= TOL)
+    /// and approach it: the moment of impact. With impact conditions the pair's normal
+    /// velocities and accelerations are made compatible there (Hughes II-8, with the
+    /// velocities of the end of the previous step, which these are). Returns the entries
+    /// closed.
+    pub fn close_touching(
+        &mut self,
+        model: &Model,
+        coords: &[[f64; 2]],
+        lumped: &[f64],
+        velocity: &mut [f64],
+        acceleration: &mut [f64],
+    ) -> Vec<(usize, usize)> {
+        let x = |n: usize| coords[n];
+        let mut closed = Vec::new();
+        for (p, pair) in model.contacts.iter().enumerate() {
+            for (k, s) in pair.slaves.iter().enumerate() {
+                if self.active[p][k] {
+                    continue;
+                }
+                let Some(gap) = pair.gap(*s, &x) else {
+                    continue;
+                };
+                if gap.gap.abs() > pair.options.tolerance {
+                    continue;
+                }
+                let n = gap.normal;
+                let master = master_side(model, pair, &gap, lumped, coords);
+                let vm = master
+                    .as_ref()
+                    .map_or(0.0, |m| interpolated(velocity, m, n));
+                if normal_component(velocity, *s, n) - vm >= 0.0 {
+                    continue; // touching but not approaching
+                }
+                self.active[p][k] = true;
+                self.force[p][k] = 0.0;
+                closed.push((p, k));
+                if pair.options.impact_conditions {
+                    let previous = velocity.to_vec();
+                    let mut step_forces = vec![0.0];
+                    impact(
+                        model,
+                        pair,
+                        *s,
+                        &gap,
+                        coords,
+                        lumped,
+                        &previous,
+                        velocity,
+                        acceleration,
+                        &mut step_forces[0],
+                    );
+                    self.force[p][k] = step_forces[0].max(0.0);
+                }
+            }
+        }
+        closed
+    }
+
+    /// Takes a step's outcome as the new status; `time` is the end of the step.
+    pub fn commit(&mut self, model: &Model, step: &ContactStep, time: f64, coords: &[[f64; 2]]) {
+        for flags in &mut self.active {
+            flags.iter_mut().for_each(|a| *a = false);
+        }
+        for forces in &mut self.force {
+            forces.iter_mut().for_each(|f| *f = 0.0);
+        }
+        for (i, (p, k)) in step.active.iter().enumerate() {
+            self.active[*p][*k] = true;
+            self.force[*p][*k] = step.forces[i];
+        }
+        if !step.active.is_empty() && self.first_contact_time.is_none() {
+            self.first_contact_time = Some(time);
+        }
+        if !step.events.released.is_empty() || !step.events.separated.is_empty() {
+            self.last_release_time = Some(time);
+        }
+        let total: f64 = step.forces.iter().sum();
+        self.peak_force = self.peak_force.max(total);
+        self.peak_extent = self.peak_extent.max(extent(model, &step.active, coords));
+    }
+
+    /// The contact block of summary.json.
+    pub fn summary(&self) -> super::ContactSummary {
+        super::ContactSummary {
+            first_contact_time: self.first_contact_time,
+            last_release_time: self.last_release_time,
+            peak_force: self.peak_force,
+            peak_contact_radius: self.peak_extent,
+        }
+    }
+
+    /// Total normal force per pair.
+    pub fn pair_forces(&self) -> Vec<f64> {
+        self.force.iter().map(|f| f.iter().sum()).collect()
+    }
+
+    /// Nodal contact forces (all DOFs) at positions `coords`: +tau n on slaves, -w tau n on
+    /// master nodes.
+    pub fn nodal_forces(&self, model: &Model, coords: &[[f64; 2]]) -> Vec<f64> {
+        let mut f = vec![0.0; 2 * coords.len()];
+        let x = |n: usize| coords[n];
+        for (p, pair) in model.contacts.iter().enumerate() {
+            for (k, s) in pair.slaves.iter().enumerate() {
+                if !self.active[p][k] {
+                    continue;
+                }
+                let Some(gap) = pair.gap(*s, &x) else {
+                    continue;
+                };
+                for (dof, c) in gap.row(*s) {
+                    f[dof] += self.force[p][k] * c;
+                }
+            }
+        }
+        f
+    }
+
+    /// Per node: (gap, status) of slave nodes (status 1 active, 0 open), NaN-free zeros
+    /// elsewhere.
+    pub fn nodal_status(&self, model: &Model, coords: &[[f64; 2]]) -> (Vec<f64>, Vec<f64>) {
+        let mut gap = vec![0.0; coords.len()];
+        let mut status = vec![0.0; coords.len()];
+        let x = |n: usize| coords[n];
+        for (p, pair) in model.contacts.iter().enumerate() {
+            for (k, s) in pair.slaves.iter().enumerate() {
+                if let Some(g) = pair.gap(*s, &x) {
+                    gap[*s] = g.gap;
+                }
+                status[*s] = if self.active[p][k] { 1.0 } else { 0.0 };
+            }
+        }
+        (gap, status)
+    }
+}
+
+/// Largest extent of the closed entries: the largest radius for axisymmetric slaves, else
+/// the largest distance between two closed slaves of a pair.
+fn extent(model: &Model, active: &[(usize, usize)], coords: &[[f64; 2]]) -> f64 {
+    let mut best: f64 = 0.0;
+    for (p, pair) in model.contacts.iter().enumerate() {
+        let nodes: Vec<[f64; 2]> = active
+            .iter()
+            .filter(|(q, _)| *q == p)
+            .map(|(_, k)| coords[pair.slaves[*k]])
+            .collect();
+        let axisymmetric = matches!(
+            model.bodies[pair.slave_body].kind,
+            BodyKind::Continuum {
+                formulation: Formulation::Axisymmetric,
+                ..
+            }
+        );
+        for (i, a) in nodes.iter().enumerate() {
+            if axisymmetric {
+                best = best.max(a[0]);
+                continue;
+            }
+            for b in &nodes[i + 1..] {
+                best = best.max(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt());
+            }
+        }
+    }
+    best
+}
+
+/// The impedance rho c A of node `node` of body `body` (A: its tributary contact area).
+fn impedance(model: &Model, body: usize, node: usize, coords: &[[f64; 2]]) -> f64 {
+    let b = &model.bodies[body];
+    let m = &b.material;
+    let e = &m.elastic;
+    let (lambda, mu) = e.lame();
+    let (modulus, area) = match b.kind {
+        BodyKind::Rod { area } => (e.young, area),
+        BodyKind::Continuum {
+            formulation,
+            thickness,
+            ..
+        } => {
+            let local = node - b.node_offset;
+            let half_edges: f64 = b
+                .mesh
+                .boundary_edges()
+                .iter()
+                .filter(|e| e.contains(&local))
+                .map(|[p, q]| {
+                    let (a, c) = (coords[b.global(*p)], coords[b.global(*q)]);
+                    0.5 * ((a[0] - c[0]).powi(2) + (a[1] - c[1]).powi(2)).sqrt()
+                })
+                .sum();
+            match formulation {
+                Formulation::PlaneStrain => (lambda + 2.0 * mu, half_edges),
+                Formulation::PlaneStress => (
+                    e.young / (1.0 - e.poisson * e.poisson),
+                    half_edges * thickness,
+                ),
+                Formulation::Axisymmetric => (
+                    lambda + 2.0 * mu,
+                    half_edges * 2.0 * PI * coords[node][0].max(0.0),
+                ),
+            }
+        }
+    };
+    (modulus * m.density).sqrt() * area
+}
+
+fn normal_component(v: &[f64], node: usize, n: [f64; 2]) -> f64 {
+    v[2 * node] * n[0] + v[2 * node + 1] * n[1]
+}
+
+fn add_normal(v: &mut [f64], node: usize, n: [f64; 2], amount: f64) {
+    v[2 * node] += amount * n[0];
+    v[2 * node + 1] += amount * n[1];
+}
+
+/// The master side of an entry: nodes with weights, their interpolated mass, impedance, and
+/// normal velocity/acceleration; a rigid obstacle has none (infinite mass, at rest).
+struct MasterSide {
+    nodes: Vec<(usize, f64)>,
+    mass: f64,
+    impedance: f64,
+}
+
+fn master_side(
+    model: &Model,
+    pair: &ContactPair,
+    gap: &Gap,
+    lumped: &[f64],
+    coords: &[[f64; 2]],
+) -> Option<MasterSide> {
+    let body = match &pair.master {
+        Master::Obstacle(_) => return None,
+        Master::Segments { body, .. } | Master::Nodes { body, .. } => *body,
+    };
+    let mass = gap.masters.iter().map(|(m, w)| w * lumped[2 * m]).sum();
+    let impedance = gap
+        .masters
+        .iter()
+        .map(|(m, w)| w * impedance(model, body, *m, coords))
+        .sum();
+    Some(MasterSide {
+        nodes: gap.masters.clone(),
+        mass,
+        impedance,
+    })
+}
+
+/// Spreads a change of the interpolated normal component over the master nodes so that the
+/// interpolation sum w_i x_i changes by exactly `change`.
+fn spread(v: &mut [f64], side: &MasterSide, n: [f64; 2], change: f64) {
+    let w2: f64 = side.nodes.iter().map(|(_, w)| w * w).sum();
+    if w2 > 0.0 {
+        for (m, w) in &side.nodes {
+            add_normal(v, *m, n, change * w / w2);
+        }
+    }
+}
+
+fn interpolated(v: &[f64], side: &MasterSide, n: [f64; 2]) -> f64 {
+    side.nodes
+        .iter()
+        .map(|(m, w)| w * normal_component(v, *m, n))
+        .sum()
+}
+
+/// Hughes II-8 for one slave: the common normal velocity from the impedances and the
+/// previous velocities, the common acceleration from the masses, and the force that keeps
+/// the equations of motion.
+#[allow(clippy::too_many_arguments)]
+fn impact(
+    model: &Model,
+    pair: &ContactPair,
+    s: usize,
+    gap: &Gap,
+    coords: &[[f64; 2]],
+    lumped: &[f64],
+    previous_velocity: &[f64],
+    velocity: &mut [f64],
+    acceleration: &mut [f64],
+    force: &mut f64,
+) {
+    let n = gap.normal;
+    let (ms, zs) = (lumped[2 * s], impedance(model, pair.slave_body, s, coords));
+    let (vs_prev, as_now) = (
+        normal_component(previous_velocity, s, n),
+        normal_component(acceleration, s, n),
+    );
+    let master = master_side(model, pair, gap, lumped, coords);
+    let (v_plus, a_plus) = match &master {
+        None => (0.0, 0.0),
+        Some(side) => {
+            let vm_prev = interpolated(previous_velocity, side, n);
+            let am_now = interpolated(acceleration, side, n);
+            (
+                (zs * vs_prev + side.impedance * vm_prev) / (zs + side.impedance),
+                (ms * as_now + side.mass * am_now) / (ms + side.mass),
+            )
+        }
+    };
+    *force += ms * (a_plus - as_now);
+    add_normal(velocity, s, n, v_plus - normal_component(velocity, s, n));
+    add_normal(acceleration, s, n, a_plus - as_now);
+    if let Some(side) = &master {
+        let vm = interpolated(velocity, side, n);
+        let am = interpolated(acceleration, side, n);
+        spread(velocity, side, n, v_plus - vm);
+        spread(acceleration, side, n, a_plus - am);
+    }
+}
+
+/// Hughes II-8 for the entries that closed and II-11, II-12 for those released by the
+/// fraction rule: corrects `velocity` and `acceleration` (all DOFs) in place, and the forces
+/// of closed entries. `previous_velocity` is the velocity at the start of the step.
+#[allow(clippy::too_many_arguments)]
+pub fn apply_conditions(
+    model: &Model,
+    step: &mut ContactStep,
+    coords: &[[f64; 2]],
+    lumped: &[f64],
+    previous_velocity: &[f64],
+    velocity: &mut [f64],
+    acceleration: &mut [f64],
+) {
+    let x = |n: usize| coords[n];
+    for &(p, k) in &step.events.closed {
+        let pair = &model.contacts[p];
+        if !pair.options.impact_conditions {
+            continue;
+        }
+        let s = pair.slaves[k];
+        let Some(gap) = pair.gap(s, &x) else { continue };
+        let i = step
+            .active
+            .iter()
+            .position(|e| *e == (p, k))
+            .expect("closed entries are active");
+        impact(
+            model,
+            pair,
+            s,
+            &gap,
+            coords,
+            lumped,
+            previous_velocity,
+            velocity,
+            acceleration,
+            &mut step.forces[i],
+        );
+    }
+    for &(p, k, tau) in &step.events.released {
+        let pair = &model.contacts[p];
+        if !pair.options.release_conditions {
+            continue;
+        }
+        let s = pair.slaves[k];
+        let Some(gap) = pair.gap(s, &x) else { continue };
+        let n = gap.normal;
+        let (ms, zs) = (lumped[2 * s], impedance(model, pair.slave_body, s, coords));
+        add_normal(velocity, s, n, tau / zs);
+        add_normal(acceleration, s, n, -tau / ms);
+        if let Some(side) = master_side(model, pair, &gap, lumped, coords) {
+            spread(velocity, &side, n, -tau / side.impedance);
+            spread(acceleration, &side, n, tau / side.mass);
+        }
+    }
+}

@@ -1,0 +1,393 @@
+//! Contact: surfaces, detection and the constraint rows of active pairs. The solver owns the
+//! system; this module only says where the slaves are, how far from their masters, and
+//! along which direction (Hughes et al. 1975, section II; Greco & Coda 2003, section 2).
+//!
+//! Legend
+//! ```text
+//! slave s        a node of the slave set, position x_s
+//! master         a polyline of segments [a, b] with the solid on the left of a -> b (the
+//!                master body's boundary edges, or a rigid obstacle), or single nodes with a
+//!                given normal (node-to-node, Hughes II-4)
+//! xi             projection parameter of x_s on the nearest segment, p = (1 - xi) a + xi b
+//! n              unit normal out of the master at p (right of a -> b)
+//! g              gap (x_s - p) . n: > 0 apart, < 0 penetrated (Hughes II-7: d = x^1 - x^2)
+//! c(S)           winding number -1/(2 pi) sum of the angle increments seen from S over a
+//!                closed boundary (Greco eq 17): 1 inside, 0 outside, alpha/(2 pi) on a
+//!                corner of angle alpha, 1/2 on a smooth edge
+//! C              constraint row, g(d + delta) = g + C delta: n on the slave DOFs,
+//!                -(1 - xi) n on a's, -xi n on b's (Hughes II-13..II-16)
+//! tau            Lagrange multiplier: the compressive normal force, +tau n on the slave
+//! ```
+
+use std::f64::consts::PI;
+
+/// A rigid obstacle: a fixed polyline, solid on its left (a closed counter-clockwise polygon
+/// is a finite obstacle, a clockwise one a cavity, an open polyline a half-space boundary).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Obstacle {
+    pub name: String,
+    pub points: Vec<[f64; 2]>,
+    pub closed: bool,
+}
+
+impl Obstacle {
+    pub fn segments(&self) -> Vec<[[f64; 2]; 2]> {
+        let n = self.points.len();
+        let count = if self.closed { n } else { n - 1 };
+        (0..count)
+            .map(|i| [self.points[i], self.points[(i + 1) % n]])
+            .collect()
+    }
+}
+
+/// What the slaves of a pair meet.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Master {
+    /// Boundary edges of a deformable body (global node ids), and the body's whole boundary
+    /// for the inside test.
+    Segments {
+        body: usize,
+        edges: Vec<[usize; 2]>,
+        boundary: Vec<[usize; 2]>,
+    },
+    /// Node-to-node: each slave meets its nearest master node along a fixed master normal.
+    Nodes {
+        body: usize,
+        nodes: Vec<usize>,
+        normal: [f64; 2],
+    },
+    /// A rigid obstacle.
+    Obstacle(Obstacle),
+}
+
+/// How a pair behaves; every switch of the seeds is here so its effect can be shown.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairOptions {
+    /// Hughes II-8 when a pair closes (dynamics).
+    pub impact_conditions: bool,
+    /// Hughes II-11, II-12 when a pair opens (dynamics).
+    pub release_conditions: bool,
+    /// Release when tau falls below this fraction of the last step's value (Hughes: 0.02).
+    pub release_fraction: f64,
+    /// TOL of Hughes II-7 (length).
+    pub tolerance: f64,
+    /// Slaves farther than this from the master are not candidates (length).
+    pub search_distance: f64,
+    /// Split a step (or load increment) at the first contact event inside it.
+    pub split_at_events: bool,
+}
+
+/// A validated contact pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactPair {
+    pub name: String,
+    pub slave_body: usize,
+    /// Global node ids.
+    pub slaves: Vec<usize>,
+    pub master: Master,
+    pub options: PairOptions,
+}
+
+/// A slave node's relation to its master at a given configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gap {
+    pub gap: f64,
+    pub normal: [f64; 2],
+    /// Master nodes and their weights (empty for a rigid obstacle).
+    pub masters: Vec<(usize, f64)>,
+}
+
+impl Gap {
+    /// The constraint row as (DOF, coefficient) pairs for slave node `slave`.
+    pub fn row(&self, slave: usize) -> Vec<(usize, f64)> {
+        let n = self.normal;
+        let mut row = vec![(2 * slave, n[0]), (2 * slave + 1, n[1])];
+        for (m, w) in &self.masters {
+            row.push((2 * m, -w * n[0]));
+            row.push((2 * m + 1, -w * n[1]));
+        }
+        row
+    }
+}
+
+fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+fn length(a: [f64; 2]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Greco eq 17: c(S) = -1/(2 pi) sum over the segments [A, B] of the angle increment
+/// phi_B - phi_A seen from S (wrapped into (-pi, pi]); segments run with the solid on their
+/// left, so a point inside a counter-clockwise boundary gets 1. A point on a segment gets
+/// 1/2 and a point on a corner alpha / (2 pi).
+pub fn winding_number(s: [f64; 2], segments: &[[[f64; 2]; 2]]) -> f64 {
+    let mut total = 0.0;
+    for [a, b] in segments {
+        let (ra, rb) = (sub(*a, s), sub(*b, s));
+        if length(ra) == 0.0 || length(rb) == 0.0 {
+            continue; // S on a node: the two adjacent segments give the corner angle
+        }
+        let mut delta = rb[1].atan2(rb[0]) - ra[1].atan2(ra[0]);
+        if delta > PI {
+            delta -= 2.0 * PI;
+        } else if delta <= -PI {
+            delta += 2.0 * PI;
+        }
+        // S on the segment itself sees it under +-pi: it contributes nothing, the rest of the
+        // boundary sums to the half turn
+        if (delta.abs() - PI).abs() < 1e-12 {
+            continue;
+        }
+        total += delta;
+    }
+    // counter-clockwise boundaries sum to +2 pi around interior points
+    total / (2.0 * PI)
+}
+
+/// Nearest point of segment [a, b] to x: (xi, distance).
+fn project(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
+    let ab = sub(b, a);
+    let l2 = dot(ab, ab);
+    let xi = if l2 > 0.0 {
+        (dot(sub(x, a), ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let p = [a[0] + xi * ab[0], a[1] + xi * ab[1]];
+    (xi, length(sub(x, p)))
+}
+
+/// Outward unit normal of a -> b (solid on the left).
+fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    let d = sub(b, a);
+    let l = length(d);
+    [d[1] / l, -d[0] / l]
+}
+
+/// The gap of a point to a polyline of (possibly degenerate) segments with the solid on the
+/// left; `inside` decides the sign where the nearest point is a corner.
+fn gap_to_segments(
+    x: [f64; 2],
+    segments: &[[[f64; 2]; 2]],
+    inside: impl Fn() -> bool,
+) -> Option<(usize, f64, f64, [f64; 2])> {
+    let mut best: Option<(usize, f64, f64)> = None;
+    for (k, [a, b]) in segments.iter().enumerate() {
+        let (xi, d) = project(x, *a, *b);
+        let interior = xi > 0.0 && xi < 1.0;
+        let better = match best {
+            None => true,
+            Some((kb, _, db)) => {
+                let (xib, _) = project(x, segments[kb][0], segments[kb][1]);
+                d < db - 1e-12 * db.max(1e-300)
+                    || ((d - db).abs() <= 1e-12 * db.max(1e-300)
+                        && interior
+                        && !(xib > 0.0 && xib < 1.0))
+            }
+        };
+        if better {
+            best = Some((k, xi, d));
+        }
+    }
+    let (k, xi, d) = best?;
+    let [a, b] = segments[k];
+    let n = outward(a, b);
+    let p = [a[0] + xi * (b[0] - a[0]), a[1] + xi * (b[1] - a[1])];
+    let along_normal = dot(sub(x, p), n);
+    let (gap, normal) = if xi > 0.0 && xi < 1.0 || d == 0.0 {
+        (along_normal, n)
+    } else {
+        // nearest point is a corner: the normal points from it to the slave, the sign from
+        // the inside test
+        let sign = if inside() { -1.0 } else { 1.0 };
+        let dir = sub(x, p);
+        let l = length(dir);
+        (sign * d, [sign * dir[0] / l, sign * dir[1] / l])
+    };
+    Some((k, xi, gap, normal))
+}
+
+impl ContactPair {
+    /// The gap of slave node `slave` at positions `x` (global node -> position), or None
+    /// when there is no master within the search distance.
+    pub fn gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
+        let xs = x(slave);
+        let result = match &self.master {
+            Master::Nodes { nodes, normal, .. } => {
+                let m = *nodes
+                    .iter()
+                    .min_by(|a, b| length(sub(x(**a), xs)).total_cmp(&length(sub(x(**b), xs))))?;
+                Gap {
+                    gap: dot(sub(xs, x(m)), *normal),
+                    normal: *normal,
+                    masters: vec![(m, 1.0)],
+                }
+            }
+            Master::Segments {
+                edges, boundary, ..
+            } => {
+                let segments: Vec<[[f64; 2]; 2]> =
+                    edges.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
+                let inside = || {
+                    let closed: Vec<[[f64; 2]; 2]> =
+                        boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
+                    winding_number(xs, &closed) > 0.5
+                };
+                let (k, xi, gap, normal) = gap_to_segments(xs, &segments, inside)?;
+                let [a, b] = edges[k];
+                Gap {
+                    gap,
+                    normal,
+                    masters: vec![(a, 1.0 - xi), (b, xi)],
+                }
+            }
+            Master::Obstacle(o) => {
+                let segments = o.segments();
+                let inside = || {
+                    if o.closed {
+                        winding_number(xs, &segments) > 0.5
+                    } else {
+                        // a half-space boundary: the side of the nearest segment
+                        let (k, _, _) = segments
+                            .iter()
+                            .enumerate()
+                            .map(|(k, [a, b])| (k, project(xs, *a, *b)))
+                            .map(|(k, (xi, d))| (k, xi, d))
+                            .min_by(|a, b| a.2.total_cmp(&b.2))
+                            .expect("segments");
+                        let [a, b] = segments[k];
+                        dot(sub(xs, a), outward(a, b)) < 0.0
+                    }
+                };
+                let (_, _, gap, normal) = gap_to_segments(xs, &segments, inside)?;
+                Gap {
+                    gap,
+                    normal,
+                    masters: Vec::new(),
+                }
+            }
+        };
+        (result.gap <= self.options.search_distance).then_some(result)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Vec<[[f64; 2]; 2]> {
+        let p = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        (0..4).map(|i| [p[i], p[(i + 1) % 4]]).collect()
+    }
+
+    /// Greco eq 17 on a convex square: 1 inside, 0 outside, 1/2 on an edge, 1/4 at a corner
+    /// (alpha = pi/2).
+    #[test]
+    fn winding_number_of_convex_polygon() {
+        let s = square();
+        approx::assert_abs_diff_eq!(winding_number([0.3, 0.6], &s), 1.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([1.3, 0.6], &s), 0.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([0.5, 0.0], &s), 0.5, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([1.0, 1.0], &s), 0.25, epsilon = 1e-12);
+    }
+
+    /// A concave L-shape: points in the notch are outside; the reflex corner (alpha = 3 pi/2)
+    /// gives 3/4. A clockwise square (a cavity) gives -1 inside: its solid is outside.
+    #[test]
+    fn winding_number_of_concave_polygon_and_cavity() {
+        let p = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ];
+        let l: Vec<[[f64; 2]; 2]> = (0..6).map(|i| [p[i], p[(i + 1) % 6]]).collect();
+        approx::assert_abs_diff_eq!(winding_number([1.5, 1.5], &l), 0.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([0.5, 1.5], &l), 1.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([1.0, 1.0], &l), 0.75, epsilon = 1e-12);
+        let cavity: Vec<[[f64; 2]; 2]> = square().iter().rev().map(|[a, b]| [*b, *a]).collect();
+        approx::assert_abs_diff_eq!(winding_number([0.5, 0.5], &cavity), -1.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([3.0, 0.5], &cavity), 0.0, epsilon = 1e-12);
+    }
+
+    fn options() -> PairOptions {
+        PairOptions {
+            impact_conditions: true,
+            release_conditions: true,
+            release_fraction: 0.02,
+            tolerance: 1e-10,
+            search_distance: f64::INFINITY,
+            split_at_events: true,
+        }
+    }
+
+    /// Gap and weights to a wall (open polyline, solid below y = 0): signed distance, the
+    /// normal +y, no master nodes; the row is the normal on the slave DOFs.
+    #[test]
+    fn gap_to_a_rigid_wall_and_its_row() {
+        let wall = Obstacle {
+            name: "w".into(),
+            points: vec![[2.0, 0.0], [-2.0, 0.0]],
+            closed: false,
+        };
+        let pair = ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master: Master::Obstacle(wall),
+            options: options(),
+        };
+        for (y, expected) in [(0.3, 0.3), (-0.2, -0.2)] {
+            let g = pair.gap(0, &|_| [0.5, y]).unwrap();
+            approx::assert_abs_diff_eq!(g.gap, expected, epsilon = 1e-15);
+            approx::assert_abs_diff_eq!(g.normal[1], 1.0, epsilon = 1e-15);
+            assert_eq!(g.row(0), vec![(0, 0.0), (1, 1.0)]);
+        }
+    }
+
+    /// Node-to-segment weights (Hughes II-13..16): the projection parameter splits the
+    /// constraint between the two master nodes; with the slave over a master node the row
+    /// reduces to node-to-node (II-4).
+    #[test]
+    fn segment_weights_reduce_to_node_to_node() {
+        let coords = [
+            [0.25, 0.1],
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, -1.0],
+            [0.0, -1.0],
+        ];
+        let pair = ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master: Master::Segments {
+                body: 1,
+                edges: vec![[2, 1]],
+                boundary: vec![[1, 4], [4, 3], [3, 2], [2, 1]],
+            },
+            options: options(),
+        };
+        let g = pair.gap(0, &|n| coords[n]).unwrap();
+        approx::assert_abs_diff_eq!(g.gap, 0.1, epsilon = 1e-15);
+        assert_eq!(g.masters, vec![(2, 0.25), (1, 0.75)]);
+        let over_node = [
+            [1.0, -0.05],
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, -1.0],
+            [0.0, -1.0],
+        ];
+        let g = pair.gap(0, &|n| over_node[n]).unwrap();
+        approx::assert_abs_diff_eq!(g.gap, -0.05, epsilon = 1e-15);
+        assert_eq!(g.masters, vec![(2, 1.0), (1, 0.0)]);
+    }
+}
