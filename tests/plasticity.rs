@@ -132,48 +132,7 @@ fn uniaxial_cycle_matches_closed_form_isotropic_and_kinematic() {
     }
 }
 
-const HILL: &str = r#"
-[[material]]
-name = "m"
-young = 1000.0
-poisson = 0.4999
-yield_stress = 1.0
-
-[[body]]
-name = "cylinder"
-material = "m"
-formulation = "plane_strain"
-mesh = { type = "ring", inner_radius = 1.0, outer_radius = 2.0, n_radial = 20, n_circ = 16, angle = 90.0 }
-
-[[node_set]]
-name = "bore"
-nearest = [1.0, 0.0]
-
-[[support]]
-set = "start"
-fix = ["y"]
-
-[[support]]
-set = "end"
-fix = ["x"]
-
-[[load]]
-type = "pressure"
-set = "inner"
-pressure = 0.78443   # 0.98 of Hill's limit pressure 0.80044
-
-[analysis]
-type = "static"
-steps = 20
-geometry = "linear"
-
-[output]
-frame_every = 0
-
-[[output.probe]]
-quantity = "u_x"
-set = "bore"
-"#;
+const HILL: &str = include_str!("../models/hill_cylinder.toml");
 
 /// Pressure-bore displacement pairs of a Hill run.
 fn hill_curve(
@@ -238,45 +197,7 @@ fn hill_cylinder_limit_pressure() {
     approx::assert_relative_eq!(*p.last().unwrap(), limit, max_relative = 0.01);
 }
 
-const PLATE: &str = r#"
-[[material]]
-name = "m"
-young = 1000.0
-poisson = 0.3
-yield_stress = 1.0
-hardening_modulus = 10.0
-
-[[body]]
-name = "plate"
-material = "m"
-formulation = "plane_stress"
-thickness = 0.1
-mesh = { type = "plate_with_hole", width = 5.0, height = 5.0, radius = 1.0, n = 4, n_radial = 4, grading = 3.0 }
-
-[[support]]
-set = "left"
-fix = ["x"]
-
-[[support]]
-set = "bottom"
-fix = ["y"]
-
-[[load]]
-type = "traction"
-set = "top"
-traction = [0.0, 0.75]   # net-section yield at 0.8
-
-[analysis]
-type = "static"
-steps = 15
-
-[output]
-frame_every = 0
-
-[[output.probe]]
-quantity = "u_y"
-set = "top"
-"#;
+const PLATE: &str = include_str!("../models/plate_with_hole.toml");
 
 /// Goal: the plane-stress return converges under refinement and keeps sigma_zz = 0.
 /// Setup: quarter of a square plate (half width 5) with a hole (radius 1), plane stress, J2
