@@ -2,7 +2,9 @@
 
 use clap::{Parser, Subcommand};
 use impact::analysis::{self, RunError, RunOptions};
-use impact::scene;
+use impact::output::OutputError;
+use impact::output::plot::{self, Chart, Series, SeriesStyle};
+use impact::scene::{self, InputError};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -40,6 +42,25 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
+    /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
+    Plot {
+        history: PathBuf,
+        /// A column to plot (repeat for more; one series each).
+        #[arg(long = "y", value_name = "COLUMN", required = true)]
+        y: Vec<String>,
+        /// The column on the horizontal axis.
+        #[arg(long = "x", value_name = "COLUMN", default_value = "time")]
+        x: String,
+        /// Chart file, .svg or .png. Default: plot_<columns>.svg next to the history.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Chart title. Default: the history's path.
+        #[arg(long)]
+        title: Option<String>,
+        /// Another run's history.csv whose same columns are overlaid, labelled with its name.
+        #[arg(long)]
+        reference: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -52,6 +73,14 @@ fn main() -> ExitCode {
             quiet,
         } => run(&scene, out, &set, quiet),
         Command::Check { scene, set } => check(&scene, &set),
+        Command::Plot {
+            history,
+            y,
+            x,
+            out,
+            title,
+            reference,
+        } => plot_history(&history, &x, &y, out, title, reference.as_deref()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -110,4 +139,96 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
         );
     }
     Ok(())
+}
+
+fn plot_history(
+    history: &Path,
+    x: &str,
+    y: &[String],
+    out: Option<PathBuf>,
+    title: Option<String>,
+    reference: Option<&Path>,
+) -> Result<(), RunError> {
+    let names: Vec<&str> = std::iter::once(x)
+        .chain(y.iter().map(String::as_str))
+        .collect();
+    let columns = plot::history_columns(history, &names).map_err(bad_input)?;
+    let mut series = history_series(&columns, y, None);
+    if let Some(reference) = reference {
+        let file_name = |p: &Path| p.file_name().map(|n| n.to_string_lossy().into_owned());
+        // two runs' files are usually both history.csv: then the path tells them apart
+        let name = match file_name(reference) {
+            Some(name) if file_name(history).as_ref() != Some(&name) => name,
+            _ => reference.display().to_string(),
+        };
+        let columns = plot::history_columns(reference, &names).map_err(bad_input)?;
+        series.extend(history_series(&columns, y, Some(&name)));
+    }
+    let out = out.unwrap_or_else(|| {
+        let stem: String = y
+            .join("_")
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        history.with_file_name(format!("plot_{stem}.svg"))
+    });
+    let chart = Chart {
+        title: title.unwrap_or_else(|| history.display().to_string()),
+        x_label: x.to_string(),
+        y_label: y.join(", "),
+        series,
+        log_x: false,
+        log_y: false,
+    };
+    plot::write(&chart, &out).map_err(|e| match e {
+        OutputError::Invalid { .. } => bad_input(e),
+        other => RunError::Output(other),
+    })?;
+    println!("{}", out.display());
+    Ok(())
+}
+
+/// One line series per y column of `columns` (x first, then the y columns in order).
+fn history_series(columns: &[Vec<f64>], y: &[String], run: Option<&str>) -> Vec<Series> {
+    let (x, ys) = columns.split_first().expect("the x column is asked first");
+    y.iter()
+        .zip(ys)
+        .map(|(name, values)| Series {
+            label: match run {
+                Some(run) => format!("{name} ({run})"),
+                None => name.clone(),
+            },
+            points: x.iter().copied().zip(values.iter().copied()).collect(),
+            style: SeriesStyle::Line,
+        })
+        .collect()
+}
+
+/// A history that cannot be read, lacks a column or cannot be plotted is bad input (exit 2).
+fn bad_input(e: OutputError) -> RunError {
+    match e {
+        OutputError::Io {
+            path,
+            action,
+            source,
+        } => InputError::new(&path, format!("cannot {action}: {source}")).into(),
+        OutputError::Invalid { path, reason } => InputError::new(&path, reason).into(),
+        OutputError::Length {
+            path,
+            what,
+            expected,
+            found,
+        } => InputError::new(
+            &path,
+            format!("{what} has {found} entries, expected {expected}"),
+        )
+        .into(),
+        other => RunError::Output(other),
+    }
 }

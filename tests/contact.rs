@@ -179,3 +179,24 @@ fn bar_wall_force_duration_and_rebound() {
     );
     approx::assert_relative_eq!(r.summary.contact.peak_force, 0.1, max_relative = 0.06);
 }
+
+/// Goal: Hertz impact of an elastic sphere on a rigid wall (Hughes Table I-1, whose program
+/// came within 11 %). Setup: models/sphere_wall.toml (axisymmetric, graded to the pole,
+/// dt = 0.01, V = 0.8). Reference: Hertz's quasi-static impact theory
+/// (reference::hertz_sphere_impact): a = 0.590, t = 0.256, P = 60.2. Tolerance 5 % (the
+/// issue's); measured +3.6 % (P), -1.9 % (a, the outermost closed node), +0.4 % (t).
+#[test]
+fn sphere_wall_matches_hertz_at_low_speed() {
+    let r = run("sphere_wall", "sphere_wall", &[]);
+    let (a, t, p) = impact::reference::hertz_sphere_impact(5.0, 0.01, 1000.0, 0.3, 0.8);
+    let c = &r.summary.contact;
+    let duration = c.last_release_time.unwrap() - c.first_contact_time.unwrap();
+    approx::assert_relative_eq!(c.peak_force, p, max_relative = 0.05);
+    approx::assert_relative_eq!(c.peak_contact_radius, a, max_relative = 0.05);
+    approx::assert_relative_eq!(duration, t, max_relative = 0.05);
+    assert!(
+        r.summary.energy.max_relative_drift < 0.01,
+        "drift {}",
+        r.summary.energy.max_relative_drift
+    );
+}

@@ -192,6 +192,9 @@ fn oscillator_period_elongation_and_decay_match_amplification_matrices() {
             let (pe, ad) = elongation_and_decay(rho, phase, omega_h);
             let (rho_ref, phase_ref) = reference::principal_root(recurrence, omega_h);
             let (pe_ref, ad_ref) = elongation_and_decay(rho_ref, phase_ref, omega_h);
+            eprintln!(
+                "{name} dt/T={dt_over_t}: PE {pe:.5} (ref {pe_ref:.5}), AD {ad:.5} (ref {ad_ref:.5})"
+            );
             let close = |x: f64, r: f64| (x - r).abs() <= 0.05 * r.abs() + 1e-6;
             assert!(
                 close(pe, pe_ref),

@@ -19,7 +19,14 @@ fn scenes() -> Vec<std::path::PathBuf> {
 #[test]
 fn every_scene_runs_and_writes_the_output_contract() {
     let all = scenes();
-    for name in ["cantilever_large", "two_bars", "bar_wall"] {
+    for name in [
+        "cantilever_large",
+        "two_bars",
+        "bar_wall",
+        "sphere_wall",
+        "hill_cylinder",
+        "plate_with_hole",
+    ] {
         assert!(
             all.iter().any(|p| p.file_stem().unwrap() == name),
             "models/{name}.toml is missing"

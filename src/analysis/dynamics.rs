@@ -332,6 +332,7 @@ pub fn run(
                         "step to t = {target} did not converge after {cuts_in_a_row} cuts (dt = {nominal:e}): {reason}"
                     );
                     summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
                     return Err(super::fail(&recorder, summary, Status::Diverged, message));
                 }
                 dt = nominal * 0.5;

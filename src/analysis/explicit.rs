@@ -65,7 +65,8 @@ pub fn run(
         spec.end_time,
         system.free,
     );
-    let steps = (spec.end_time / spec.dt).round().max(1.0) as usize;
+    // whole steps, and a shorter last one that ends exactly at end_time
+    let steps = ((spec.end_time / spec.dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
     let m = &mass.lumped;
     let a_r = spec.rayleigh[0];
 

@@ -42,7 +42,8 @@ pub struct EnergySummary {
     pub initial: f64,
     #[serde(rename = "final")]
     pub final_: f64,
-    /// max over the steps of |W_int + KE - KE_0 - W_ext| / max(|W_ext|, KE_0, W_int).
+    /// max over the steps of |KE + W_elastic + W_plastic + W_contact - KE_0 - W_ext| /
+    /// max(KE_0, |W_ext|, |W_elastic|).
     pub max_relative_drift: f64,
     pub plastic_dissipation: f64,
 }

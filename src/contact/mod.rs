@@ -31,6 +31,18 @@ pub struct Obstacle {
 }
 
 impl Obstacle {
+    /// Whether a closed polygon runs clockwise (a cavity: its solid lies outside the loop).
+    pub fn is_cavity(&self) -> bool {
+        let n = self.points.len();
+        let area: f64 = (0..n)
+            .map(|i| {
+                let (a, b) = (self.points[i], self.points[(i + 1) % n]);
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum();
+        self.closed && area < 0.0
+    }
+
     pub fn segments(&self) -> Vec<[[f64; 2]; 2]> {
         let n = self.points.len();
         let count = if self.closed { n } else { n - 1 };
@@ -251,7 +263,10 @@ impl ContactPair {
                 let segments = o.segments();
                 let inside = || {
                     if o.closed {
-                        winding_number(xs, &segments) > 0.5
+                        // a cavity's loop winds -1 around its void: the solid is where the
+                        // winding number plus the boundary at infinity (1) exceeds 1/2
+                        let infinity = if o.is_cavity() { 1.0 } else { 0.0 };
+                        winding_number(xs, &segments) + infinity > 0.5
                     } else {
                         // a half-space boundary: the side of the nearest segment
                         let (k, _, _) = segments
@@ -316,6 +331,29 @@ mod tests {
         let cavity: Vec<[[f64; 2]; 2]> = square().iter().rev().map(|[a, b]| [*b, *a]).collect();
         approx::assert_abs_diff_eq!(winding_number([0.5, 0.5], &cavity), -1.0, epsilon = 1e-12);
         approx::assert_abs_diff_eq!(winding_number([3.0, 0.5], &cavity), 0.0, epsilon = 1e-12);
+    }
+
+    /// A rigid cavity (clockwise square): a slave pushed out through a corner is inside the
+    /// solid and gets a negative gap; one in the void near the corner a positive gap.
+    #[test]
+    fn cavity_corner_signs() {
+        let cavity = Obstacle {
+            name: "box".into(),
+            points: vec![[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]],
+            closed: true,
+        };
+        assert!(cavity.is_cavity());
+        let pair = ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master: Master::Obstacle(cavity),
+            options: options(),
+        };
+        let outside = pair.gap(0, &|_| [1.1, 1.2]).unwrap();
+        assert!(outside.gap < 0.0, "{outside:?}");
+        let inside = pair.gap(0, &|_| [0.9, 0.95]).unwrap();
+        approx::assert_abs_diff_eq!(inside.gap, 0.05, epsilon = 1e-12);
     }
 
     fn options() -> PairOptions {

@@ -6,6 +6,7 @@
 //! precision (shortest text that parses back to the same f64).
 
 pub mod history;
+pub mod plot;
 pub mod vtk;
 
 use std::fs;

@@ -276,3 +276,51 @@ pub fn hill_bore_displacement(
     }
     hill_cylinder(a, b, yield_stress, shear_modulus, 0.5 * (lo + hi)).1
 }
+
+/// Hertz impact of an elastic sphere (radius R, density rho, E, nu) on a rigid plane at
+/// speed V (Johnson, Contact Mechanics, section 11.4): the maximum approach
+/// delta = (15 m V^2 / (16 E* sqrt R))^(2/5) with m = 4/3 pi R^3 rho, E* = E / (1 - nu^2);
+/// returns (maximum contact radius sqrt(R delta), contact duration 2.9432 delta / V,
+/// peak force 4/3 E* sqrt(R) delta^(3/2)).
+pub fn hertz_sphere_impact(
+    radius: f64,
+    density: f64,
+    young: f64,
+    poisson: f64,
+    speed: f64,
+) -> (f64, f64, f64) {
+    let mass = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3) * density;
+    let e_star = young / (1.0 - poisson * poisson);
+    let delta = (15.0 * mass * speed * speed / (16.0 * e_star * radius.sqrt())).powf(0.4);
+    (
+        (radius * delta).sqrt(),
+        2.9432 * delta / speed,
+        4.0 / 3.0 * e_star * radius.sqrt() * delta.powf(1.5),
+    )
+}
+
+/// Static Hertz contact of a sphere (radius R) pressed by a force P on a rigid plane:
+/// contact radius a = (3 P R / (4 E*))^(1/3) and peak pressure p0 = 3 P / (2 pi a^2).
+pub fn hertz_static(radius: f64, young: f64, poisson: f64, force: f64) -> (f64, f64) {
+    let e_star = young / (1.0 - poisson * poisson);
+    let a = (3.0 * force * radius / (4.0 * e_star)).cbrt();
+    (a, 3.0 * force / (2.0 * std::f64::consts::PI * a * a))
+}
+
+#[cfg(test)]
+mod hertz_tests {
+    /// Hughes et al. 1975, Table I-1 (their Hertz column): a = 0.59, t = 0.256, p = 60.2 at
+    /// V = 0.8 and a = 1.00, t = 0.197, p = 294 at V = 3.0 (R = 5, rho = 0.01, E = 1000,
+    /// nu = 0.3), to their printed digits.
+    #[test]
+    fn hertz_impact_matches_the_seed_table() {
+        let (a, t, p) = super::hertz_sphere_impact(5.0, 0.01, 1000.0, 0.3, 0.8);
+        approx::assert_abs_diff_eq!(a, 0.59, epsilon = 0.005);
+        approx::assert_abs_diff_eq!(t, 0.256, epsilon = 0.0005);
+        approx::assert_abs_diff_eq!(p, 60.2, epsilon = 0.05);
+        let (a, t, p) = super::hertz_sphere_impact(5.0, 0.01, 1000.0, 0.3, 3.0);
+        approx::assert_abs_diff_eq!(a, 1.00, epsilon = 0.005);
+        approx::assert_abs_diff_eq!(t, 0.197, epsilon = 0.0005);
+        approx::assert_abs_diff_eq!(p, 294.0, epsilon = 0.5);
+    }
+}

@@ -667,6 +667,11 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
         (_, m) => m.unwrap_or_default(),
     };
     let rayleigh = spec.rayleigh.unwrap_or([0.0, 0.0]);
+    if integrator == I::CentralDifference && rayleigh[1] != 0.0 {
+        return Err(cx.err(
+            "analysis.rayleigh: central difference takes mass-proportional damping only (b = 0)",
+        ));
+    }
     if rayleigh.iter().any(|c| !(*c >= 0.0 && c.is_finite())) {
         return Err(cx.err(format!(
             "analysis.rayleigh: coefficients must be >= 0, got {rayleigh:?}"

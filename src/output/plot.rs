@@ -1,0 +1,486 @@
+//! Charts of x-y series as PNG or SVG, drawn by plotters: `impact plot` now, convergence and
+//! sweep studies later.
+//!
+//! ```text
+//! Chart   title, axis labels, linear or logarithmic axes, one or more Series
+//! Series  label (shown in the legend when the chart has more than one), points (x, y),
+//!         style: Line, Markers or LineAndMarkers
+//! write   800 x 500 pixels; the format follows the extension (.png or .svg); the file is
+//!         written whole to a temporary name and renamed, like every output file
+//! ```
+//!
+//! Text in the PNG is rasterized from DejaVu Sans embedded in the binary (no system font, no
+//! fontconfig or freetype). The SVG names the family `sans-serif` and leaves rendering to the
+//! viewer; the same embedded font measures the text for the layout.
+
+use super::{OutputError, write_atomic};
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{Ranged, ValueFormatter};
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+/// Width and height of every chart, in pixels (PNG) or user units (SVG).
+pub const SIZE: (u32, u32) = (800, 500);
+
+// DejaVu Sans 2.37 (Debian fonts-dejavu-core), Bitstream Vera license: redistribution permitted,
+// see DejaVuSans.LICENSE next to it.
+const DEJAVU_SANS: &[u8] = include_bytes!("DejaVuSans.ttf");
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeriesStyle {
+    /// A polyline through the points in the given order.
+    Line,
+    /// A filled circle at each point.
+    Markers,
+    /// Both.
+    LineAndMarkers,
+}
+
+/// One curve of a chart.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend text (the legend is drawn only when the chart has more than one series).
+    pub label: String,
+    /// (x, y) pairs; all finite, and positive on a logarithmic axis.
+    pub points: Vec<(f64, f64)>,
+    pub style: SeriesStyle,
+}
+
+/// A chart to write with [`write`].
+#[derive(Debug, Clone)]
+pub struct Chart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub log_x: bool,
+    pub log_y: bool,
+}
+
+/// Writes `chart` to `path`: PNG or SVG by the extension, 800 x 500, legend when more than one series.
+///
+/// An unknown extension, a chart without series, a series without points, a NaN or infinite
+/// value, or a value <= 0 on a logarithmic axis is an [`OutputError::Invalid`] naming the file;
+/// nothing is written then.
+pub fn write(chart: &Chart, path: &Path) -> Result<(), OutputError> {
+    let format = Format::of(path)?;
+    let x = axis_range(chart, path, Axis::X)?;
+    let y = axis_range(chart, path, Axis::Y)?;
+    register_embedded_font();
+    let drawing_error =
+        |e: String| OutputError::invalid(path, format!("cannot draw the chart: {e}"));
+    match format {
+        Format::Svg => {
+            let mut text = String::new();
+            draw(
+                SVGBackend::with_string(&mut text, SIZE).into_drawing_area(),
+                chart,
+                x,
+                y,
+            )
+            .map_err(drawing_error)?;
+            write_atomic(path, text.as_bytes())
+        }
+        Format::Png => {
+            let (width, height) = SIZE;
+            let mut pixels = vec![0u8; 3 * width as usize * height as usize];
+            draw(
+                BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(),
+                chart,
+                x,
+                y,
+            )
+            .map_err(drawing_error)?;
+            let bytes = encode_png(&pixels, SIZE)
+                .map_err(|e| OutputError::invalid(path, format!("cannot encode the PNG: {e}")))?;
+            write_atomic(path, &bytes)
+        }
+    }
+}
+
+/// Reads the columns `names` of a history.csv (header line of names, first `time`; one row of
+/// numbers per line), each as a vector over the rows, in the order asked.
+///
+/// A missing column is an [`OutputError::Invalid`] that names it and lists the columns there are.
+pub fn history_columns(path: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, OutputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| OutputError::io(path, "read", e))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    if header.first() != Some(&"time") {
+        return Err(OutputError::invalid(
+            path,
+            format!(
+                "not a history file: the first column is `{}`, expected `time`",
+                header.first().unwrap_or(&"")
+            ),
+        ));
+    }
+    let mut indices = Vec::with_capacity(names.len());
+    for name in names {
+        let index = header.iter().position(|h| h == name).ok_or_else(|| {
+            OutputError::invalid(
+                path,
+                format!("no column `{name}`; the columns are: {}", header.join(", ")),
+            )
+        })?;
+        indices.push(index);
+    }
+    let mut columns = vec![Vec::new(); names.len()];
+    for (row, line) in lines.enumerate().filter(|(_, line)| !line.is_empty()) {
+        let line_number = row + 2;
+        let values: Vec<&str> = line.split(',').collect();
+        if values.len() != header.len() {
+            return Err(OutputError::Length {
+                path: path.to_path_buf(),
+                what: format!("line {line_number}"),
+                expected: header.len(),
+                found: values.len(),
+            });
+        }
+        for (column, &index) in columns.iter_mut().zip(&indices) {
+            let value = values[index].trim().parse::<f64>().map_err(|_| {
+                OutputError::invalid(
+                    path,
+                    format!(
+                        "line {line_number}, column `{}`: `{}` is not a number",
+                        header[index], values[index]
+                    ),
+                )
+            })?;
+            column.push(value);
+        }
+    }
+    Ok(columns)
+}
+
+enum Format {
+    Png,
+    Svg,
+}
+
+impl Format {
+    fn of(path: &Path) -> Result<Format, OutputError> {
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match extension.as_deref() {
+            Some("png") => Ok(Format::Png),
+            Some("svg") => Ok(Format::Svg),
+            _ => Err(OutputError::invalid(
+                path,
+                "unknown chart format: the file name must end in .png or .svg",
+            )),
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Axis {
+    X,
+    Y,
+}
+
+/// The axis range (low, high) covering every point with a margin; checks the values on the way.
+fn axis_range(chart: &Chart, path: &Path, axis: Axis) -> Result<(f64, f64), OutputError> {
+    let (log, name) = match axis {
+        Axis::X => (chart.log_x, "x"),
+        Axis::Y => (chart.log_y, "y"),
+    };
+    if chart.series.is_empty() {
+        return Err(OutputError::invalid(path, "the chart has no series"));
+    }
+    let mut low = f64::INFINITY;
+    let mut high = f64::NEG_INFINITY;
+    for series in &chart.series {
+        if series.points.is_empty() {
+            return Err(OutputError::invalid(
+                path,
+                format!("series `{}` has no points", series.label),
+            ));
+        }
+        for (index, &(x, y)) in series.points.iter().enumerate() {
+            let value = match axis {
+                Axis::X => x,
+                Axis::Y => y,
+            };
+            let problem = if !value.is_finite() {
+                "only finite values can be plotted"
+            } else if log && value <= 0.0 {
+                "only positive values can be plotted on a logarithmic axis"
+            } else {
+                ""
+            };
+            if !problem.is_empty() {
+                return Err(OutputError::invalid(
+                    path,
+                    format!(
+                        "series `{}` point {index} has {name} = {value}; {problem}",
+                        series.label
+                    ),
+                ));
+            }
+            low = low.min(value);
+            high = high.max(value);
+        }
+    }
+    // markers at the ends of the x range would be cut in half without a margin
+    let markers = chart.series.iter().any(|s| s.style != SeriesStyle::Line);
+    let margin = match axis {
+        Axis::X if !markers => 0.0,
+        Axis::X => 0.03,
+        Axis::Y => 0.05,
+    };
+    Ok(if log {
+        let factor = if high > low {
+            (high / low).powf(margin)
+        } else {
+            2.0
+        };
+        (low / factor, high * factor)
+    } else if high > low {
+        let pad = margin * (high - low);
+        (low - pad, high + pad)
+    } else {
+        let pad = if low == 0.0 { 1.0 } else { 0.1 * low.abs() };
+        (low - pad, high + pad)
+    })
+}
+
+/// Makes the embedded font the `sans-serif` family plotters measures and rasterizes text with.
+fn register_embedded_font() {
+    static REGISTER: Once = Once::new();
+    REGISTER.call_once(|| {
+        if plotters::style::register_font("sans-serif", FontStyle::Normal, DEJAVU_SANS).is_err() {
+            panic!("the embedded DejaVu Sans does not parse as a font");
+        }
+    });
+}
+
+/// Draws the whole chart on `root` and presents it (SVG: fills the string; bitmap: the buffer).
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    chart: &Chart,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let mut builder = ChartBuilder::on(&root);
+    builder
+        .caption(&chart.title, (FontFamily::SansSerif, 22))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(80);
+    let (x_span, y_span) = (x.1 - x.0, y.1 - y.0);
+    match (chart.log_x, chart.log_y) {
+        (false, false) => draw_series(
+            builder.build_cartesian_2d(x.0..x.1, y.0..y.1).map_err(e)?,
+            chart,
+            x_span,
+            y_span,
+        ),
+        (true, false) => draw_series(
+            builder
+                .build_cartesian_2d((x.0..x.1).log_scale(), y.0..y.1)
+                .map_err(e)?,
+            chart,
+            0.0,
+            y_span,
+        ),
+        (false, true) => draw_series(
+            builder
+                .build_cartesian_2d(x.0..x.1, (y.0..y.1).log_scale())
+                .map_err(e)?,
+            chart,
+            x_span,
+            0.0,
+        ),
+        (true, true) => draw_series(
+            builder
+                .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+                .map_err(e)?,
+            chart,
+            0.0,
+            0.0,
+        ),
+    }
+    .map_err(e)?;
+    root.present().map_err(e)
+}
+
+/// Colours of the series in order (the matplotlib "tab10" cycle), repeated past ten.
+const COLORS: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// Mesh, axis labels, the series and the legend, on axes of any kind (linear or log).
+///
+/// `x_span`, `y_span`: widths of linear axes (tick labels much smaller than it print as 0);
+/// 0 for a logarithmic axis.
+fn draw_series<'a, DB, X, Y>(
+    mut context: ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    chart: &Chart,
+    x_span: f64,
+    y_span: f64,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let x_ticks = |v: &f64| tick_label(*v, x_span);
+    let y_ticks = |v: &f64| tick_label(*v, y_span);
+    context
+        .configure_mesh()
+        .x_desc(chart.x_label.as_str())
+        .y_desc(chart.y_label.as_str())
+        .x_label_formatter(&x_ticks)
+        .y_label_formatter(&y_ticks)
+        .label_style((FontFamily::SansSerif, 14))
+        .axis_desc_style((FontFamily::SansSerif, 16))
+        .bold_line_style(BLACK.mix(0.15))
+        .light_line_style(BLACK.mix(0.05))
+        .draw()?;
+    let legend = chart.series.len() > 1;
+    for (index, series) in chart.series.iter().enumerate() {
+        let color = COLORS[index % COLORS.len()];
+        let line = color.stroke_width(2);
+        let dot = color.filled();
+        let with_line = series.style != SeriesStyle::Markers;
+        let with_markers = series.style != SeriesStyle::Line;
+        if with_line {
+            let annotation = context.draw_series(std::iter::once(PathElement::new(
+                series.points.clone(),
+                line,
+            )))?;
+            if legend && !with_markers {
+                annotation
+                    .label(series.label.as_str())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+            }
+        }
+        if with_markers {
+            let annotation = context.draw_series(
+                series
+                    .points
+                    .iter()
+                    .map(|&point| Circle::new(point, 3, dot)),
+            )?;
+            if legend {
+                annotation
+                    .label(series.label.as_str())
+                    .legend(move |(x, y)| {
+                        let stroke = if with_line { line } else { TRANSPARENT.into() };
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (20, 0)], stroke)
+                            + Circle::new((10, 0), 3, dot)
+                    });
+            }
+        }
+    }
+    if legend {
+        context
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.4))
+            .label_font((FontFamily::SansSerif, 14))
+            .draw()?;
+    }
+    Ok(())
+}
+
+/// A tick value in at most four significant digits, `0` for values negligible against `span`
+/// (linear axes), exponent notation outside [1e-3, 1e5).
+fn tick_label(value: f64, span: f64) -> String {
+    if value == 0.0 || value.abs() < 1e-9 * span {
+        return "0".to_string();
+    }
+    let magnitude = value.abs();
+    if (1e-3..1e5).contains(&magnitude) {
+        let decimals = (3 - magnitude.log10().floor() as i32).max(0) as usize;
+        trim_zeros(&format!("{value:.decimals$}"))
+    } else {
+        let text = format!("{value:.3e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        format!("{}e{exponent}", trim_zeros(mantissa))
+    }
+}
+
+/// "1.2500" -> "1.25", "2.000" -> "2", "40" -> "40".
+fn trim_zeros(text: &str) -> String {
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text.to_string()
+    }
+}
+
+/// 8-bit RGB pixels (row-major, as plotters' bitmap backend leaves them) as a PNG file.
+fn encode_png(pixels: &[u8], (width, height): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(pixels)?;
+    writer.finish()?;
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Goal: tick labels are short and free of floating-point noise.
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick_label(0.30000000000000004, 1.0), "0.3");
+        assert_eq!(tick_label(1e-17, 1.0), "0");
+        assert_eq!(tick_label(2.0, 10.0), "2");
+        assert_eq!(tick_label(1234.5678, 1e4), "1235");
+        assert_eq!(tick_label(-0.0125, 0.1), "-0.0125");
+        assert_eq!(tick_label(1e-6, 0.0), "1e-6");
+        assert_eq!(tick_label(2.5e7, 1e8), "2.5e7");
+    }
+
+    /// Goal: the axis range covers the data with a margin, and a single value gets a range too.
+    #[test]
+    fn axis_range_pads_and_handles_constant_data() {
+        let series = |points: Vec<(f64, f64)>| Series {
+            label: "s".into(),
+            points,
+            style: SeriesStyle::Line,
+        };
+        let mut chart = Chart {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            series: vec![series(vec![(0.0, -1.0), (2.0, 1.0)])],
+            log_x: false,
+            log_y: false,
+        };
+        let path = Path::new("a.svg");
+        assert_eq!(axis_range(&chart, path, Axis::X).unwrap(), (0.0, 2.0));
+        assert_eq!(axis_range(&chart, path, Axis::Y).unwrap(), (-1.1, 1.1));
+        chart.series = vec![series(vec![(1.0, 3.0)])];
+        assert_eq!(axis_range(&chart, path, Axis::X).unwrap(), (0.9, 1.1));
+        chart.log_y = true;
+        assert_eq!(axis_range(&chart, path, Axis::Y).unwrap(), (1.5, 6.0));
+        chart.series = vec![series(vec![(1.0, 0.0)])];
+        let err = axis_range(&chart, path, Axis::Y).unwrap_err().to_string();
+        assert!(err.contains("logarithmic"), "{err}");
+    }
+}
