@@ -81,9 +81,15 @@ fn initial_acceleration(
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
     let initial = model.coordinates();
     let external = loads::external_force(model, state, &initial, 0.0);
-    let evaluation =
-        assembly::evaluate(model, state, &vec![0.0; model.dofs()], spec.geometry, None)
-            .map_err(|e| e.to_string())?;
+    let evaluation = assembly::evaluate(
+        model,
+        state,
+        &vec![0.0; model.dofs()],
+        spec.geometry,
+        None,
+        spec.newton.tangent,
+    )
+    .map_err(|e| e.to_string())?;
     let damping = mass.product(model, velocity);
     let rhs: Vec<f64> = external
         .iter()
@@ -253,9 +259,15 @@ pub fn run(
                     for (dof, value) in loads::prescribed(model, &initial, state.time + h) {
                         du[dof] = value - kin.displacement[dof];
                     }
-                    step.solution.evaluation =
-                        assembly::evaluate(model, &state, &du, spec.geometry, None)
-                            .map_err(|e| StepFailure(e.to_string()))?;
+                    step.solution.evaluation = assembly::evaluate(
+                        model,
+                        &state,
+                        &du,
+                        spec.geometry,
+                        None,
+                        spec.newton.tangent,
+                    )
+                    .map_err(|e| StepFailure(e.to_string()))?;
                     step.solution.d = du;
                 }
                 Ok((step, advance))

@@ -71,7 +71,15 @@ pub fn run(
     let a_r = spec.rayleigh[0];
 
     let zero = vec![0.0; model.dofs()];
-    let first = assembly::evaluate(model, &state, &zero, spec.geometry, None).map_err(|err| {
+    let first = assembly::evaluate(
+        model,
+        &state,
+        &zero,
+        spec.geometry,
+        None,
+        spec.newton.tangent,
+    )
+    .map_err(|err| {
         super::fail(
             &recorder,
             summary.clone(),
@@ -120,7 +128,14 @@ pub fn run(
         for (dof, value) in loads::prescribed(model, &initial, time) {
             du[dof] = value - state.displacement[dof];
         }
-        let evaluation = match assembly::evaluate(model, &state, &du, spec.geometry, None) {
+        let evaluation = match assembly::evaluate(
+            model,
+            &state,
+            &du,
+            spec.geometry,
+            None,
+            spec.newton.tangent,
+        ) {
             Ok(e) => e,
             Err(err) => {
                 progress.abandon();

@@ -21,7 +21,7 @@ use crate::contact::ContactPair;
 use crate::element::Geometry;
 use crate::integrator::StepForm;
 use crate::scene::Model;
-use crate::scene::spec::{NewtonSpec, Strategy};
+use crate::scene::spec::{NewtonSpec, Strategy, Tangent};
 use crate::solver::Solver;
 
 /// Counters of the nonlinear solution.
@@ -172,8 +172,15 @@ impl Step<'_> {
         d: &[f64],
         system: Option<&mut System>,
     ) -> Result<Evaluation, StepFailure> {
-        assembly::evaluate(self.model, state, d, self.geometry, system)
-            .map_err(|e| StepFailure(e.to_string()))
+        assembly::evaluate(
+            self.model,
+            state,
+            d,
+            self.geometry,
+            system,
+            self.newton.tangent,
+        )
+        .map_err(|e| StepFailure(e.to_string()))
     }
 
     /// a*(D) and v*(D) over all DOFs.
@@ -281,7 +288,13 @@ impl Step<'_> {
             let ratio = residual_norm / previous_residual;
             let needed = (newton.tol_force * scale / residual_norm).ln() / ratio.ln();
             let left = (newton.max_iterations - iteration) as f64;
-            let stalled = iteration > 0 && (ratio > newton.contraction || needed > 0.5 * left);
+            // (refactoring cannot help where the factorized matrix would not change: an
+            // elastic tangent on linear kinematics)
+            let refactor_helps =
+                newton.tangent == Tangent::Consistent || self.geometry == Geometry::Nonlinear;
+            let stalled = iteration > 0
+                && refactor_helps
+                && (ratio > newton.contraction || needed > 0.5 * left);
             if stalled && !refactor {
                 // the same state again, now with the tangent assembled
                 self.evaluate(state, &d, Some(&mut *system))?;

@@ -14,6 +14,7 @@
 use crate::element::{Formulation, Geometry, KernelError, Mat4, Vec4, Vec8, Voigt, quad4, rod2};
 use crate::kinematics;
 use crate::material::{PointState, StressState};
+use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind, Model};
 use crate::solver::Pattern;
 use rayon::prelude::*;
@@ -202,6 +203,7 @@ pub fn evaluate(
     d: &[f64],
     geometry: Geometry,
     mut system: Option<&mut System>,
+    tangent: Tangent,
 ) -> Result<Evaluation, ElementFailure> {
     let want_tangent = system.is_some();
     if let Some(s) = system.as_deref_mut() {
@@ -223,7 +225,7 @@ pub fn evaluate(
                     d,
                     e,
                     geometry,
-                    want_tangent,
+                    want_tangent.then_some(tangent),
                 )
             })
             .collect::<Result<_, _>>()
@@ -273,8 +275,11 @@ fn element(
     d: &[f64],
     e: usize,
     geometry: Geometry,
-    want_tangent: bool,
+    tangent: Option<Tangent>,
 ) -> Result<ElementResult, (usize, KernelError)> {
+    // the material's tangent, or D_e (Erklig's modified Newton); K_sigma unless `elastic`
+    let elastic_moduli = tangent.is_some_and(|t| t != Tangent::Consistent);
+    let geometric = tangent != Some(Tangent::Elastic);
     let nodes = body.mesh.cells.nodes_of(e);
     match body.kind {
         BodyKind::Continuum {
@@ -309,15 +314,13 @@ fn element(
                     * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
             }
             let force = quad4::internal_force(&geom, &de, &stress, geometry, bbar);
-            let matrix = want_tangent.then(|| {
-                let k = quad4::tangent(
-                    &geom,
-                    &de,
-                    &stress,
-                    &responses.map(|r| r.moduli),
-                    geometry,
-                    bbar,
-                );
+            let matrix = tangent.map(|_| {
+                let moduli = if elastic_moduli {
+                    [body.material.elastic.moduli(stress_state); 4]
+                } else {
+                    responses.map(|r| r.moduli)
+                };
+                let k = quad4::tangent(&geom, &de, &stress, &moduli, geometry, bbar, geometric);
                 let mut m = [0.0; 64];
                 m.copy_from_slice(k.transpose().as_slice()); // row-major
                 m
@@ -345,8 +348,13 @@ fn element(
             let plastic_work = area * length * plastic_density;
             let f4 =
                 rod2::internal_force(&x, &de, stress, area, geometry).map_err(|err| (e, err))?;
-            let matrix = if want_tangent {
-                let k: Mat4 = rod2::tangent(&x, &de, stress, modulus, area, geometry)
+            let matrix = if tangent.is_some() {
+                let modulus = if elastic_moduli {
+                    body.material.elastic.young
+                } else {
+                    modulus
+                };
+                let k: Mat4 = rod2::tangent(&x, &de, stress, modulus, area, geometry, geometric)
                     .map_err(|err| (e, err))?;
                 let mut m = [0.0; 64];
                 m[..16].copy_from_slice(k.transpose().as_slice());
@@ -638,7 +646,7 @@ pub fn max_frequency_squared(
                 &zero,
                 e,
                 geometry,
-                true,
+                Some(Tangent::Consistent),
             )
             .map_err(|(_, err)| failure(err))?;
             let k = r.matrix.expect("tangent requested");

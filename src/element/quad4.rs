@@ -263,7 +263,7 @@ pub fn internal_force(
 }
 
 /// Tangent K_T = K_0 + K_sigma (Erklig eqs 32-34), the exact derivative of `internal_force`
-/// for the given material moduli dS/dE.
+/// for the given material moduli dS/dE; without K_sigma when `geometric` is false.
 pub fn tangent(
     geom: &QuadGeometry,
     d: &Vec8,
@@ -271,6 +271,7 @@ pub fn tangent(
     moduli: &[Moduli; 4],
     geometry: Geometry,
     bbar: bool,
+    geometric: bool,
 ) -> Mat8 {
     let k = kinematics(geom, d, geometry, bbar);
     let mut kt = Mat8::zeros();
@@ -278,7 +279,7 @@ pub fn tangent(
         let w = geom.points[q].weight;
         kt += k[q].b.transpose() * (moduli[q] * k[q].b) * w;
     }
-    if geometry == Geometry::Linear {
+    if geometry == Geometry::Linear || !geometric {
         return kt;
     }
     let axisymmetric = geom.formulation == Formulation::Axisymmetric;
@@ -417,6 +418,7 @@ mod tests {
                     &[moduli(); 4],
                     Geometry::Nonlinear,
                     bbar,
+                    true,
                 );
                 let h = 1e-6;
                 for j in 0..8 {

@@ -67,7 +67,8 @@ pub fn internal_force(
     Ok(b_vector(x, d, l, geometry) * (area * l * stress))
 }
 
-/// Tangent: the exact derivative of `internal_force` for dS/dE = `modulus`.
+/// Tangent: the exact derivative of `internal_force` for dS/dE = `modulus`; without the
+/// geometric term when `geometric` is false.
 pub fn tangent(
     x: &[[f64; 2]; 2],
     d: &Vec4,
@@ -75,11 +76,12 @@ pub fn tangent(
     modulus: f64,
     area: f64,
     geometry: Geometry,
+    geometric: bool,
 ) -> Result<Mat4, KernelError> {
     let l = length(x)?;
     let b = b_vector(x, d, l, geometry);
     let mut k = b * b.transpose() * (area * l * modulus);
-    if geometry == Geometry::Nonlinear {
+    if geometry == Geometry::Nonlinear && geometric {
         let g = area * stress / l;
         for a in 0..2 {
             k[(a, a)] += g;
@@ -112,7 +114,16 @@ mod tests {
             internal_force(&x, d, s0 + modulus * e, area, Geometry::Nonlinear).unwrap()
         };
         let e = strain(&x, &d, Geometry::Nonlinear).unwrap();
-        let k = tangent(&x, &d, s0 + modulus * e, modulus, area, Geometry::Nonlinear).unwrap();
+        let k = tangent(
+            &x,
+            &d,
+            s0 + modulus * e,
+            modulus,
+            area,
+            Geometry::Nonlinear,
+            true,
+        )
+        .unwrap();
         let h = 1e-6;
         for j in 0..4 {
             let (mut dp, mut dm) = (d, d);

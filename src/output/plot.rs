@@ -274,37 +274,38 @@ fn draw<DB: DrawingBackend>(
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(80);
-    let (x_span, y_span) = (x.1 - x.0, y.1 - y.0);
+    let x_scale = Scale::of(x, chart.log_x);
+    let y_scale = Scale::of(y, chart.log_y);
     match (chart.log_x, chart.log_y) {
         (false, false) => draw_series(
             builder.build_cartesian_2d(x.0..x.1, y.0..y.1).map_err(e)?,
             chart,
-            x_span,
-            y_span,
+            x_scale,
+            y_scale,
         ),
         (true, false) => draw_series(
             builder
                 .build_cartesian_2d((x.0..x.1).log_scale(), y.0..y.1)
                 .map_err(e)?,
             chart,
-            0.0,
-            y_span,
+            x_scale,
+            y_scale,
         ),
         (false, true) => draw_series(
             builder
                 .build_cartesian_2d(x.0..x.1, (y.0..y.1).log_scale())
                 .map_err(e)?,
             chart,
-            x_span,
-            0.0,
+            x_scale,
+            y_scale,
         ),
         (true, true) => draw_series(
             builder
                 .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
                 .map_err(e)?,
             chart,
-            0.0,
-            0.0,
+            x_scale,
+            y_scale,
         ),
     }
     .map_err(e)?;
@@ -327,21 +328,20 @@ const COLORS: [RGBColor; 10] = [
 
 /// Mesh, axis labels, the series and the legend, on axes of any kind (linear or log).
 ///
-/// `x_span`, `y_span`: widths of linear axes (tick labels much smaller than it print as 0);
-/// 0 for a logarithmic axis.
+/// `x_scale`, `y_scale`: what the tick labels need to know about each axis.
 fn draw_series<'a, DB, X, Y>(
     mut context: ChartContext<'a, DB, Cartesian2d<X, Y>>,
     chart: &Chart,
-    x_span: f64,
-    y_span: f64,
+    x_scale: Scale,
+    y_scale: Scale,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
 where
     DB: DrawingBackend + 'a,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
-    let x_ticks = |v: &f64| tick_label(*v, x_span);
-    let y_ticks = |v: &f64| tick_label(*v, y_span);
+    let x_ticks = |v: &f64| tick_label(*v, x_scale);
+    let y_ticks = |v: &f64| tick_label(*v, y_scale);
     context
         .configure_mesh()
         .x_desc(chart.x_label.as_str())
@@ -402,11 +402,50 @@ where
     Ok(())
 }
 
-/// A tick value in at most four significant digits, `0` for values negligible against `span`
-/// (linear axes), exponent notation outside [1e-3, 1e5).
-fn tick_label(value: f64, span: f64) -> String {
-    if value == 0.0 || value.abs() < 1e-9 * span {
-        return "0".to_string();
+/// An axis as its tick labels see it.
+#[derive(Clone, Copy)]
+enum Scale {
+    /// Linear, `span` = high - low: labels much smaller than the span print as 0.
+    Linear { span: f64 },
+    /// Logarithmic over `decades` = log10(high / low): plotters puts a tick at every
+    /// 1..9 x 10^k, too many to label once the axis covers a decade.
+    Log { decades: f64 },
+}
+
+impl Scale {
+    fn of((low, high): (f64, f64), log: bool) -> Scale {
+        if log {
+            Scale::Log {
+                decades: (high / low).log10(),
+            }
+        } else {
+            Scale::Linear { span: high - low }
+        }
+    }
+}
+
+/// A tick value in at most four significant digits, exponent notation outside [1e-3, 1e5);
+/// `0` for values negligible on a linear axis; on a log axis over a decade or more only
+/// 1, 2 and 5 x 10^k are labelled (only 10^k over three decades or more), the rest left blank.
+fn tick_label(value: f64, scale: Scale) -> String {
+    match scale {
+        Scale::Linear { span } if value == 0.0 || value.abs() < 1e-9 * span => {
+            return "0".to_string();
+        }
+        Scale::Log { decades } if decades >= 1.0 => {
+            let mantissa = value / 10f64.powf(value.log10().floor());
+            let labelled: &[f64] = if decades >= 3.0 {
+                &[1.0]
+            } else {
+                &[1.0, 2.0, 5.0]
+            };
+            // mantissa 9.9999999 is 10^(k+1) seen from below
+            let near = |m: f64| (mantissa - m).abs() < 1e-6 || (mantissa - 10.0 * m).abs() < 1e-5;
+            if !labelled.iter().any(|&m| near(m)) {
+                return String::new();
+            }
+        }
+        _ => {}
     }
     let magnitude = value.abs();
     if (1e-3..1e5).contains(&magnitude) {
@@ -447,13 +486,21 @@ mod tests {
     /// Goal: tick labels are short and free of floating-point noise.
     #[test]
     fn tick_labels_are_short() {
-        assert_eq!(tick_label(0.30000000000000004, 1.0), "0.3");
-        assert_eq!(tick_label(1e-17, 1.0), "0");
-        assert_eq!(tick_label(2.0, 10.0), "2");
-        assert_eq!(tick_label(1234.5678, 1e4), "1235");
-        assert_eq!(tick_label(-0.0125, 0.1), "-0.0125");
-        assert_eq!(tick_label(1e-6, 0.0), "1e-6");
-        assert_eq!(tick_label(2.5e7, 1e8), "2.5e7");
+        let linear = |span| Scale::Linear { span };
+        assert_eq!(tick_label(0.30000000000000004, linear(1.0)), "0.3");
+        assert_eq!(tick_label(1e-17, linear(1.0)), "0");
+        assert_eq!(tick_label(2.0, linear(10.0)), "2");
+        assert_eq!(tick_label(1234.5678, linear(1e4)), "1235");
+        assert_eq!(tick_label(-0.0125, linear(0.1)), "-0.0125");
+        assert_eq!(tick_label(2.5e7, linear(1e8)), "2.5e7");
+        let log = |decades| Scale::Log { decades };
+        assert_eq!(tick_label(1e-6, log(0.5)), "1e-6");
+        assert_eq!(tick_label(0.3, log(0.5)), "0.3");
+        assert_eq!(tick_label(0.3, log(2.0)), "");
+        assert_eq!(tick_label(0.05, log(2.0)), "0.05");
+        assert_eq!(tick_label(0.009999999999999998, log(2.0)), "0.01");
+        assert_eq!(tick_label(0.02, log(4.0)), "");
+        assert_eq!(tick_label(1e-4, log(4.0)), "1e-4");
     }
 
     /// Goal: the axis range covers the data with a margin, and a single value gets a range too.

@@ -388,12 +388,28 @@ pub enum Strategy {
     Initial,
 }
 
+/// Which matrix the factorized tangent holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Tangent {
+    /// The algorithmic (consistent) material tangent plus K_sigma: the exact derivative.
+    #[default]
+    Consistent,
+    /// D_e only (Erklig 2.1.2 (c)(ii): "D_r is taken as the elastic stress-strain matrix").
+    Elastic,
+    /// D_e plus the geometric stiffness K_sigma.
+    ElasticGeometric,
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NewtonSpec {
     /// Default `modified`.
     #[serde(default)]
     pub strategy: Strategy,
+    /// Default `consistent`.
+    #[serde(default)]
+    pub tangent: Tangent,
     /// Iterations per increment before it is cut. Default 30.
     #[serde(default = "default_iterations")]
     pub max_iterations: usize,
@@ -418,6 +434,7 @@ impl Default for NewtonSpec {
     fn default() -> Self {
         NewtonSpec {
             strategy: Strategy::default(),
+            tangent: Tangent::default(),
             max_iterations: default_iterations(),
             tol_displacement: default_tolerance(),
             tol_force: default_tolerance(),
