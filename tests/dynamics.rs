@@ -3,8 +3,9 @@
 
 mod common;
 
+use common::column;
+
 use impact::reference::{self, Recurrence};
-use std::path::Path;
 
 /// One rod, node `start` fixed, node `end` free along x: lumped m = rho A L / 2 = 1,
 /// k = E A / L = 1, so omega = 1 and T = 2 pi. Started with v = 1: u = sin t.
@@ -49,20 +50,6 @@ frame_every = 0
 quantity = "u_x"
 set = "end"
 "#;
-
-/// Reads one column of a run's history.csv.
-fn column(dir: &Path, name: &str) -> Vec<f64> {
-    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = header
-        .iter()
-        .position(|h| *h == name)
-        .unwrap_or_else(|| panic!("no column {name}"));
-    lines
-        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
-        .collect()
-}
 
 fn run_oscillator(name: &str, integrator: &[&str], dt_over_t: f64, cycles: f64) -> Vec<f64> {
     let period = 2.0 * std::f64::consts::PI;

@@ -3,21 +3,9 @@
 
 mod common;
 
-use impact::reference;
-use std::path::Path;
+use common::column;
 
-fn column(dir: &Path, name: &str) -> Vec<f64> {
-    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = header
-        .iter()
-        .position(|h| *h == name)
-        .unwrap_or_else(|| panic!("no column {name}"));
-    lines
-        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
-        .collect()
-}
+use impact::reference;
 
 const CYCLE: &str = r#"
 [[curve]]

@@ -269,8 +269,9 @@ impl ContactState {
                 self.force[p][k] = 0.0;
                 closed.push((p, k));
                 if pair.options.impact_conditions {
+                    // the velocities before the impact are the previous step's
                     let previous = velocity.to_vec();
-                    let mut step_forces = vec![0.0];
+                    let mut force = 0.0;
                     impact(
                         model,
                         pair,
@@ -281,9 +282,9 @@ impl ContactState {
                         &previous,
                         velocity,
                         acceleration,
-                        &mut step_forces[0],
+                        &mut force,
                     );
-                    self.force[p][k] = step_forces[0].max(0.0);
+                    self.force[p][k] = force.max(0.0);
                 }
             }
         }

@@ -183,22 +183,6 @@ impl Step<'_> {
         .map_err(|e| StepFailure(e.to_string()))
     }
 
-    /// a*(D) and v*(D) over all DOFs.
-    fn motion(&self, d: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let f = self.form;
-        let a = d
-            .iter()
-            .zip(&f.acceleration_offset)
-            .map(|(d, h)| f.mass_coefficient * d + h)
-            .collect();
-        let v = d
-            .iter()
-            .zip(&f.velocity_offset)
-            .map(|(d, h)| f.damping_coefficient * d + h)
-            .collect();
-        (a, v)
-    }
-
     /// Turns the assembled K_T in `system.values` into K*.
     fn effective(&self, system: &mut System, damping: &Option<Damping>) {
         let Some(inertia) = &self.inertia else { return };
@@ -346,7 +330,7 @@ impl Step<'_> {
         let internal_norm = norm(&total);
         let mut inertia_norm = 0.0;
         if let Some(inertia) = &self.inertia {
-            let (a, v) = self.motion(d);
+            let (a, v) = self.form.motion(d);
             let ma = inertia.mass.product(self.model, &a);
             inertia_norm = norm(&ma);
             let [a_r, b_r] = inertia.rayleigh;

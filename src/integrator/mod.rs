@@ -34,6 +34,23 @@ pub struct StepForm {
     pub internal_weight: f64,
 }
 
+impl StepForm {
+    /// a*(D) and v*(D) over all DOFs.
+    pub fn motion(&self, d: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let a = d
+            .iter()
+            .zip(&self.acceleration_offset)
+            .map(|(d, h)| self.mass_coefficient * d + h)
+            .collect();
+        let v = d
+            .iter()
+            .zip(&self.velocity_offset)
+            .map(|(d, h)| self.damping_coefficient * d + h)
+            .collect();
+        (a, v)
+    }
+}
+
 /// The end-of-step kinematics from the converged D.
 #[derive(Debug, Clone)]
 pub struct Advance {
@@ -329,17 +346,7 @@ impl Integrator for Houbolt {
 
     fn advance(&mut self, dt: f64, k: &Kinematics, solved: &[f64]) -> Advance {
         let advance = if self.ready(dt) {
-            let form = self.form(dt, k);
-            let acceleration = solved
-                .iter()
-                .zip(&form.acceleration_offset)
-                .map(|(d, h)| form.mass_coefficient * d + h)
-                .collect();
-            let velocity = solved
-                .iter()
-                .zip(&form.velocity_offset)
-                .map(|(d, h)| form.damping_coefficient * d + h)
-                .collect();
+            let (acceleration, velocity) = self.form(dt, k).motion(solved);
             Advance {
                 increment: solved.to_vec(),
                 velocity,

@@ -33,3 +33,17 @@ pub fn run(name: &str, model: &Model) -> (Summary, State) {
     analysis::run_to_state(model, &out_dir(name), RunOptions::default())
         .unwrap_or_else(|e| panic!("run `{name}` failed: {e}"))
 }
+
+/// One column of a run's history.csv, by name.
+pub fn column(dir: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    lines
+        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+        .collect()
+}
