@@ -1,5 +1,6 @@
 //! Output files read by other tools (DESIGN.md section 5): the VTK time series
-//! (`vtk`: DIR/NAME.pvd + DIR/vtk/NAME_NNNNN.vtu) and the history table (`history`: history.csv).
+//! (`vtk`: DIR/NAME.pvd + DIR/vtk/NAME_NNNNN.vtu), the history table (`history`: history.csv),
+//! and charts drawn from them (`plot`: SVG and PNG with plotters).
 //!
 //! Every file is written whole to a temporary name and renamed, so a crash leaves either the
 //! previous version or the new one, never a truncated file. Numbers are written at full

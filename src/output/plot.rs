@@ -15,6 +15,7 @@
 
 use super::{OutputError, write_atomic};
 use plotters::coord::Shift;
+use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::prelude::*;
 use std::path::Path;
@@ -274,38 +275,39 @@ fn draw<DB: DrawingBackend>(
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(80);
-    let x_scale = Scale::of(x, chart.log_x);
-    let y_scale = Scale::of(y, chart.log_y);
+    // tick labels much smaller than a linear axis' span print as 0; log axes pass 0
+    let span = |(low, high): (f64, f64), log: bool| if log { 0.0 } else { high - low };
+    let (x_span, y_span) = (span(x, chart.log_x), span(y, chart.log_y));
     match (chart.log_x, chart.log_y) {
         (false, false) => draw_series(
             builder.build_cartesian_2d(x.0..x.1, y.0..y.1).map_err(e)?,
             chart,
-            x_scale,
-            y_scale,
+            x_span,
+            y_span,
         ),
         (true, false) => draw_series(
             builder
-                .build_cartesian_2d((x.0..x.1).log_scale(), y.0..y.1)
+                .build_cartesian_2d(log_axis(x), y.0..y.1)
                 .map_err(e)?,
             chart,
-            x_scale,
-            y_scale,
+            x_span,
+            y_span,
         ),
         (false, true) => draw_series(
             builder
-                .build_cartesian_2d(x.0..x.1, (y.0..y.1).log_scale())
+                .build_cartesian_2d(x.0..x.1, log_axis(y))
                 .map_err(e)?,
             chart,
-            x_scale,
-            y_scale,
+            x_span,
+            y_span,
         ),
         (true, true) => draw_series(
             builder
-                .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+                .build_cartesian_2d(log_axis(x), log_axis(y))
                 .map_err(e)?,
             chart,
-            x_scale,
-            y_scale,
+            x_span,
+            y_span,
         ),
     }
     .map_err(e)?;
@@ -328,20 +330,21 @@ const COLORS: [RGBColor; 10] = [
 
 /// Mesh, axis labels, the series and the legend, on axes of any kind (linear or log).
 ///
-/// `x_scale`, `y_scale`: what the tick labels need to know about each axis.
+/// `x_span`, `y_span`: widths of linear axes (tick labels much smaller than it print as 0);
+/// 0 for a logarithmic axis.
 fn draw_series<'a, DB, X, Y>(
     mut context: ChartContext<'a, DB, Cartesian2d<X, Y>>,
     chart: &Chart,
-    x_scale: Scale,
-    y_scale: Scale,
+    x_span: f64,
+    y_span: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
 where
     DB: DrawingBackend + 'a,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
-    let x_ticks = |v: &f64| tick_label(*v, x_scale);
-    let y_ticks = |v: &f64| tick_label(*v, y_scale);
+    let x_ticks = |v: &f64| tick_label(*v, x_span);
+    let y_ticks = |v: &f64| tick_label(*v, y_span);
     context
         .configure_mesh()
         .x_desc(chart.x_label.as_str())
@@ -402,50 +405,57 @@ where
     Ok(())
 }
 
-/// An axis as its tick labels see it.
-#[derive(Clone, Copy)]
-enum Scale {
-    /// Linear, `span` = high - low: labels much smaller than the span print as 0.
-    Linear { span: f64 },
-    /// Logarithmic over `decades` = log10(high / low): plotters puts a tick at every
-    /// 1..9 x 10^k, too many to label once the axis covers a decade.
-    Log { decades: f64 },
-}
-
-impl Scale {
-    fn of((low, high): (f64, f64), log: bool) -> Scale {
-        if log {
-            Scale::Log {
-                decades: (high / low).log10(),
-            }
-        } else {
-            Scale::Linear { span: high - low }
-        }
+/// A logarithmic axis over `low..high` with its own ticks.
+///
+/// plotters' log axis puts ticks at 1..9 x 10^k computed by multiplication (0.00999.. and 0.01
+/// both appear, labelled twice a pixel apart) and up to a hundred light lines a decade. Here
+/// the ticks are parsed from text (`2e-3` is exactly 0.002): labelled (bold) at 1..9 x 10^k
+/// within a decade, 1, 2, 5 x 10^k over one to three, 10^k beyond (every n-th decade past
+/// eight); light lines at 1..9 x 10^k up to six decades.
+fn log_axis((low, high): (f64, f64)) -> WithKeyPoints<LogCoord<f64>> {
+    let decades = (high / low).log10();
+    let ticks = |mantissas: &[u32], every: i32| -> Vec<f64> {
+        let first = low.log10().floor() as i32;
+        let last = high.log10().ceil() as i32;
+        (first..=last)
+            .filter(|k| k.rem_euclid(every) == 0)
+            .flat_map(|k| mantissas.iter().map(move |m| format!("{m}e{k}")))
+            .filter_map(|text| text.parse::<f64>().ok())
+            .filter(|v| (low..=high).contains(v))
+            .collect()
+    };
+    const ALL: [u32; 9] = [1, 2, 3, 4, 5, 6, 7, 8, 9];
+    let mut bold = if decades >= 3.0 {
+        ticks(&[1], (decades / 8.0).ceil() as i32)
+    } else if decades >= 1.0 {
+        ticks(&[1, 2, 5], 1)
+    } else {
+        ticks(&ALL, 1)
+    };
+    if bold.len() < 2 {
+        // a narrow range between two ticks: five geometric steps in two significant digits
+        bold = (0..5)
+            .map(|i| low * (high / low).powf(0.1 + 0.2 * f64::from(i)))
+            .filter_map(|v| format!("{v:.1e}").parse::<f64>().ok())
+            .collect();
+        bold.dedup();
     }
+    let light = if decades <= 6.0 {
+        ticks(&ALL, 1)
+    } else {
+        ticks(&[1], 1)
+    };
+    (low..high)
+        .log_scale()
+        .with_key_points(bold)
+        .with_light_points(light)
 }
 
-/// A tick value in at most four significant digits, exponent notation outside [1e-3, 1e5);
-/// `0` for values negligible on a linear axis; on a log axis over a decade or more only
-/// 1, 2 and 5 x 10^k are labelled (only 10^k over three decades or more), the rest left blank.
-fn tick_label(value: f64, scale: Scale) -> String {
-    match scale {
-        Scale::Linear { span } if value == 0.0 || value.abs() < 1e-9 * span => {
-            return "0".to_string();
-        }
-        Scale::Log { decades } if decades >= 1.0 => {
-            let mantissa = value / 10f64.powf(value.log10().floor());
-            let labelled: &[f64] = if decades >= 3.0 {
-                &[1.0]
-            } else {
-                &[1.0, 2.0, 5.0]
-            };
-            // mantissa 9.9999999 is 10^(k+1) seen from below
-            let near = |m: f64| (mantissa - m).abs() < 1e-6 || (mantissa - 10.0 * m).abs() < 1e-5;
-            if !labelled.iter().any(|&m| near(m)) {
-                return String::new();
-            }
-        }
-        _ => {}
+/// A tick value in at most four significant digits, `0` for values negligible against `span`
+/// (linear axes; 0 for logarithmic ones), exponent notation outside [1e-3, 1e5).
+fn tick_label(value: f64, span: f64) -> String {
+    if value == 0.0 || value.abs() < 1e-9 * span {
+        return "0".to_string();
     }
     let magnitude = value.abs();
     if (1e-3..1e5).contains(&magnitude) {
@@ -486,21 +496,28 @@ mod tests {
     /// Goal: tick labels are short and free of floating-point noise.
     #[test]
     fn tick_labels_are_short() {
-        let linear = |span| Scale::Linear { span };
-        assert_eq!(tick_label(0.30000000000000004, linear(1.0)), "0.3");
-        assert_eq!(tick_label(1e-17, linear(1.0)), "0");
-        assert_eq!(tick_label(2.0, linear(10.0)), "2");
-        assert_eq!(tick_label(1234.5678, linear(1e4)), "1235");
-        assert_eq!(tick_label(-0.0125, linear(0.1)), "-0.0125");
-        assert_eq!(tick_label(2.5e7, linear(1e8)), "2.5e7");
-        let log = |decades| Scale::Log { decades };
-        assert_eq!(tick_label(1e-6, log(0.5)), "1e-6");
-        assert_eq!(tick_label(0.3, log(0.5)), "0.3");
-        assert_eq!(tick_label(0.3, log(2.0)), "");
-        assert_eq!(tick_label(0.05, log(2.0)), "0.05");
-        assert_eq!(tick_label(0.009999999999999998, log(2.0)), "0.01");
-        assert_eq!(tick_label(0.02, log(4.0)), "");
-        assert_eq!(tick_label(1e-4, log(4.0)), "1e-4");
+        assert_eq!(tick_label(0.30000000000000004, 1.0), "0.3");
+        assert_eq!(tick_label(1e-17, 1.0), "0");
+        assert_eq!(tick_label(2.0, 10.0), "2");
+        assert_eq!(tick_label(1234.5678, 1e4), "1235");
+        assert_eq!(tick_label(-0.0125, 0.1), "-0.0125");
+        assert_eq!(tick_label(1e-6, 0.0), "1e-6");
+        assert_eq!(tick_label(2.5e7, 1e8), "2.5e7");
+    }
+
+    /// Goal: log-axis ticks are exact 1-2-5 values inside the range, once each, and a range
+    /// narrower than a tick step still gets labels.
+    #[test]
+    fn log_axis_ticks_are_exact_and_sparse() {
+        let bold = |range| log_axis(range).bold_points().to_vec();
+        assert_eq!(bold((8e-4, 0.09)), [1e-3, 2e-3, 5e-3, 0.01, 0.02, 0.05]);
+        assert_eq!(bold((0.5, 2e4)), [1.0, 10.0, 100.0, 1e3, 1e4]);
+        assert_eq!(bold((1e-20, 1.0)).len(), 7);
+        assert_eq!(bold((0.25, 0.55)), [0.3, 0.4, 0.5]);
+        assert_eq!(bold((0.31, 0.39)).len(), 5);
+        let light = log_axis((8e-4, 0.09)).light_points().to_vec();
+        assert_eq!(light.len(), 2 + 9 + 9);
+        assert!(light.contains(&0.01) && !light.contains(&0.09999999999999999));
     }
 
     /// Goal: the axis range covers the data with a margin, and a single value gets a range too.
