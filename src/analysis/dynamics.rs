@@ -15,7 +15,7 @@
 use super::contact::ContactState;
 use super::newton::{ContactStep, Counters, Inertia, Step, StepFailure};
 use super::record::{Energies, Motion, Recorder};
-use super::{RunError, RunOptions, Status, Summary, loads};
+use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, Mass, State, System};
 use crate::integrator::{GeneralizedAlpha, Houbolt, Integrator, Kinematics, Wilson};
 use crate::scene::spec::{DynamicSpec, IntegratorKind, Strategy};
@@ -113,7 +113,7 @@ pub fn run(
     spec: &DynamicSpec,
     dir: &Path,
     options: RunOptions,
-) -> Result<(Summary, State), RunError> {
+) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let initial = model.coordinates();
     let mut system = System::new(model, &loads::constrained_dofs(model));
@@ -186,10 +186,11 @@ pub fn run(
     while state.time < spec.end_time * (1.0 - 1e-12) {
         let target = super::snap((state.time + dt).min(spec.end_time), spec.dt);
         let nominal = super::step_length(target - state.time, spec.dt);
+        let positions = state.positions(spec.geometry);
         let kinetic_before_impact = mass.kinetic_energy(model, &kin.velocity);
         contact.close_touching(
             model,
-            &state.reference,
+            &positions,
             &mass.lumped,
             &mut kin.velocity,
             &mut kin.acceleration,
@@ -235,7 +236,7 @@ pub fn run(
                 contact: Some(ContactStep {
                     pairs: &model.contacts,
                     active,
-                    reference: &state.reference,
+                    reference: &positions,
                     forces,
                 }),
             };
@@ -248,7 +249,7 @@ pub fn run(
             result
         };
         let outcome = contact
-            .step(model, &state.reference, nominal, attempt)
+            .step(model, &positions, nominal, attempt)
             .and_then(|mut step| {
                 let h = step.length;
                 let form = method.form(h, &kin);
@@ -276,8 +277,10 @@ pub fn run(
             Ok((mut step, advance)) => {
                 let h = step.length;
                 let d = std::mem::take(&mut step.solution.d);
-                let evaluation =
-                    std::mem::replace(&mut step.solution.evaluation, empty_evaluation());
+                let evaluation = std::mem::replace(
+                    &mut step.solution.evaluation,
+                    assembly::Evaluation::default(),
+                );
                 let internal = evaluation.force.clone();
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
                 state.time = if h == nominal { target } else { state.time + h };
@@ -287,17 +290,18 @@ pub fn run(
                     *u += du;
                 }
                 let kinetic_before = mass.kinetic_energy(model, &kin.velocity);
+                let positions = state.positions(spec.geometry);
                 super::contact::apply_conditions(
                     model,
                     &mut step,
-                    &state.reference,
+                    &positions,
                     &mass.lumped,
                     &previous_velocity,
                     &mut kin.velocity,
                     &mut kin.acceleration,
                 );
-                contact.commit(model, &step, state.time, &state.reference);
-                let contact_force = contact.nodal_forces(model, &state.reference);
+                contact.commit(model, &step, state.time, &positions);
+                let contact_force = contact.nodal_forces(model, &positions);
                 let total = total_force(
                     model, &system, &mass, spec, &kin, &internal, &state, &initial,
                 );
@@ -357,7 +361,12 @@ pub fn run(
     progress.finish_and_clear();
     summary.finish(&energies, &counters, Some(&solver), start);
     recorder.write_summary(&summary)?;
-    Ok((summary, state))
+    let contact_force = contact.nodal_forces(model, &state.positions(spec.geometry));
+    Ok(Outcome {
+        summary,
+        state,
+        contact_force,
+    })
 }
 
 /// F: f_ext on the free DOFs, the reaction M a + a_R M v + f_int on the prescribed ones.
@@ -381,15 +390,4 @@ fn total_force(
             None => ma[i] + spec.rayleigh[0] * mv[i] + internal[i],
         })
         .collect()
-}
-
-/// A placeholder taken out of a solution whose evaluation was moved into the state.
-fn empty_evaluation() -> assembly::Evaluation {
-    assembly::Evaluation {
-        force: Vec::new(),
-        trial: Vec::new(),
-        strain_zz: Vec::new(),
-        work: 0.0,
-        plastic_work: 0.0,
-    }
 }

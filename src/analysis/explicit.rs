@@ -15,7 +15,7 @@
 use super::dynamics::check_mass;
 use super::newton::Counters;
 use super::record::{Energies, Motion, Recorder};
-use super::{RunError, RunOptions, Status, Summary, loads};
+use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, Mass, MassKind, State, System};
 use crate::scene::spec::DynamicSpec;
 use crate::scene::{InputError, Model};
@@ -36,7 +36,7 @@ pub fn run(
     spec: &DynamicSpec,
     dir: &Path,
     options: RunOptions,
-) -> Result<(Summary, State), RunError> {
+) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let (dt_crit, b, e) = critical_time_step(model)?;
     if spec.dt > dt_crit && !spec.allow_unstable {
@@ -202,7 +202,12 @@ pub fn run(
     progress.finish_and_clear();
     summary.finish(&energies, &Counters::default(), None, start);
     recorder.write_summary(&summary)?;
-    Ok((summary, state))
+    let contact_force = vec![0.0; model.dofs()];
+    Ok(Outcome {
+        summary,
+        state,
+        contact_force,
+    })
 }
 
 /// F: f_ext on the free DOFs, the reaction m a + a_R m v + f_int on the prescribed ones.

@@ -260,6 +260,23 @@ pub fn run_to_state(
     out_dir: &Path,
     options: RunOptions,
 ) -> Result<(Summary, State), RunError> {
+    run_outcome(model, out_dir, options).map(|o| (o.summary, o.state))
+}
+
+/// What a run leaves besides its files: the summary, the final committed state and the
+/// final nodal contact forces (all DOFs; zero without contact).
+pub struct Outcome {
+    pub summary: Summary,
+    pub state: State,
+    pub contact_force: Vec<f64>,
+}
+
+/// As [`run`], returning the whole [`Outcome`].
+pub fn run_outcome(
+    model: &Model,
+    out_dir: &Path,
+    options: RunOptions,
+) -> Result<Outcome, RunError> {
     match &model.analysis {
         crate::scene::model::Analysis::Static(spec) => statics::run(model, spec, out_dir, options),
         crate::scene::model::Analysis::Dynamic(spec) => {

@@ -249,6 +249,10 @@ impl Step<'_> {
                     "the residual is not finite (NaN or Inf)".into(),
                 ));
             }
+            // the force scale cannot fall below what the stiffness makes of the increment:
+            // a rigid motion has no loads and no reactions, only round-off to compare with
+            let d_max = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let scale = scale.max(system.diagonal_max * d_max);
             let eps_force = if scale > 0.0 {
                 residual_norm / scale
             } else {
@@ -288,6 +292,7 @@ impl Step<'_> {
                     self.evaluate(state, &d, Some(&mut *system))?;
                 }
                 self.effective(system, &damping);
+                system.diagonal_max = system.diagonal().fold(0.0, f64::max);
                 solver
                     .factor(&system.values)
                     .map_err(|e| StepFailure(e.to_string()))?;

@@ -151,8 +151,9 @@ impl Recorder {
         let n = state.reference.len();
         let (contact_force, gap, status) = match contact {
             Some(c) => {
-                let (gap, status) = c.nodal_status(model, &state.reference);
-                (c.nodal_forces(model, &state.reference), gap, status)
+                let positions = state.positions(model.analysis.geometry());
+                let (gap, status) = c.nodal_status(model, &positions);
+                (c.nodal_forces(model, &positions), gap, status)
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };

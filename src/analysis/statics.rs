@@ -9,10 +9,11 @@
 //! tangent that is not positive definite) is halved, at most `max_cuts` times in a row; then
 //! the run stops `diverged` with its output so far kept. After a cut the step grows back.
 
-use super::newton::{Counters, Step, StepFailure};
+use super::contact::ContactState;
+use super::newton::{ContactStep, Counters, Step, StepFailure};
 use super::record::{Energies, Motion, Recorder};
-use super::{RunError, RunOptions, Status, Summary, loads};
-use crate::assembly::{self, State, System};
+use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
+use crate::assembly::{self, Evaluation, State, System};
 use crate::integrator::StepForm;
 use crate::scene::Model;
 use crate::scene::spec::{StaticSpec, Strategy};
@@ -39,7 +40,7 @@ pub fn run(
     spec: &StaticSpec,
     dir: &Path,
     options: RunOptions,
-) -> Result<(Summary, State), RunError> {
+) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let mut recorder = Recorder::create(model, dir)?;
     let initial = model.coordinates();
@@ -63,34 +64,62 @@ pub fn run(
     let mut step_dt = dt;
     let mut cuts_in_a_row = 0;
     let mut increments = 0usize;
+    let mut contact = ContactState::new(model);
     while state.time < spec.end_time * (1.0 - 1e-12) {
         let target = super::snap((state.time + step_dt).min(spec.end_time), dt);
-        let mut d = vec![0.0; model.dofs()];
-        for (dof, value) in loads::prescribed(model, &initial, target) {
-            d[dof] = value - state.displacement[dof];
-        }
-        let external = loads::external_force(model, &state, &initial, target);
+        let positions = state.positions(spec.geometry);
         let factor_first = match spec.newton.strategy {
             Strategy::Full => true,
             Strategy::Modified => increments % spec.newton.refactor_every == 0 || cuts_in_a_row > 0,
             Strategy::Initial => !solver.is_factored() || cuts_in_a_row > 0,
         };
-        let step = Step {
-            model,
-            geometry: spec.geometry,
-            newton: &spec.newton,
-            inertia: None,
-            form: &form,
-            external: &external,
-            internal_start: &last_force,
-            factor_first,
-            contact: None,
+        // one attempt of the increment with a given length and active contact set
+        let attempt = |h: f64, active: &[(usize, usize)], forces: Vec<f64>| {
+            let end = if state.time + h >= target {
+                target
+            } else {
+                state.time + h
+            };
+            let mut d = vec![0.0; model.dofs()];
+            for (dof, value) in loads::prescribed(model, &initial, end) {
+                d[dof] = value - state.displacement[dof];
+            }
+            let external = loads::external_force(model, &state, &initial, end);
+            let step = Step {
+                model,
+                geometry: spec.geometry,
+                newton: &spec.newton,
+                inertia: None,
+                form: &form,
+                external: &external,
+                internal_start: &last_force,
+                factor_first,
+                contact: Some(ContactStep {
+                    pairs: &model.contacts,
+                    active,
+                    reference: &positions,
+                    forces,
+                }),
+            };
+            step.solve(&state, d, &mut system, &mut solver, &mut counters)
         };
-        match step.solve(&state, d, &mut system, &mut solver, &mut counters) {
-            Ok(super::newton::Solution { d, evaluation, .. }) => {
+        // an event inside the increment ends it early (Erklig 2.1.4: alpha brings the next
+        // node exactly into contact before the boundary conditions change)
+        match contact.step(model, &positions, target - state.time, attempt) {
+            Ok(mut step) => {
+                let end = if state.time + step.length >= target {
+                    target
+                } else {
+                    state.time + step.length
+                };
+                let d = std::mem::take(&mut step.solution.d);
+                let evaluation =
+                    std::mem::replace(&mut step.solution.evaluation, Evaluation::default());
                 let force = evaluation.force.clone();
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
-                state.time = target;
+                state.time = end;
+                contact.commit(model, &step, state.time, &state.positions(spec.geometry));
+                // the work of all nodal forces (loads, reactions and contact forces)
                 energies.external_work += super::trapezoid_work(&d, &force, &last_force);
                 energies.internal = state.internal_work - state.plastic_work;
                 energies.plastic_work = state.plastic_work;
@@ -102,10 +131,19 @@ pub fn run(
                 summary.steps += 1;
                 increments += 1;
                 let last = state.time >= spec.end_time * (1.0 - 1e-12);
-                recorder.step(model, &state, &motion, &energies, last)?;
+                recorder.step_with_contact(
+                    model,
+                    &state,
+                    &motion,
+                    &energies,
+                    Some(&contact),
+                    last,
+                )?;
                 progress.set_position((state.time / dt).round() as u64);
                 cuts_in_a_row = 0;
-                step_dt = (step_dt * 2.0).min(dt);
+                if end == target {
+                    step_dt = (step_dt * 2.0).min(dt);
+                }
             }
             Err(StepFailure(reason)) => {
                 if cuts_in_a_row >= spec.newton.max_cuts {
@@ -124,6 +162,12 @@ pub fn run(
     }
     progress.finish_and_clear();
     summary.finish(&energies, &counters, Some(&solver), start);
+    summary.contact = contact.summary();
     recorder.write_summary(&summary)?;
-    Ok((summary, state))
+    let contact_force = contact.nodal_forces(model, &state.positions(spec.geometry));
+    Ok(Outcome {
+        summary,
+        state,
+        contact_force,
+    })
 }

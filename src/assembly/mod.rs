@@ -43,6 +43,25 @@ pub struct State {
 }
 
 impl State {
+    /// Current node positions: the reference configuration in finite strain; the initial
+    /// one plus the displacement in small strain (whose reference never moves).
+    pub fn positions(&self, geometry: Geometry) -> Vec<[f64; 2]> {
+        match geometry {
+            Geometry::Nonlinear => self.reference.clone(),
+            Geometry::Linear => self
+                .reference
+                .iter()
+                .enumerate()
+                .map(|(n, x)| {
+                    [
+                        x[0] + self.displacement[2 * n],
+                        x[1] + self.displacement[2 * n + 1],
+                    ]
+                })
+                .collect(),
+        }
+    }
+
     pub fn initial(model: &Model) -> State {
         let bodies = model
             .bodies
@@ -90,7 +109,7 @@ pub struct ElementFailure {
 }
 
 /// The trial result of an evaluation at a given increment d.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Evaluation {
     /// Internal force over all DOFs.
     pub force: Vec<f64>,
@@ -114,6 +133,8 @@ pub struct System {
     scatter: Vec<Vec<usize>>,
     /// Lower-triangle values of the last assembled matrix.
     pub values: Vec<f64>,
+    /// The largest diagonal entry of the last factored matrix (a stiffness scale).
+    pub diagonal_max: f64,
 }
 
 /// Global DOFs of element e of body b.
@@ -162,7 +183,13 @@ impl System {
             pattern,
             scatter,
             values,
+            diagonal_max: 0.0,
         }
+    }
+
+    /// The diagonal of the assembled matrix (the first entry of each lower-triangle column).
+    pub fn diagonal(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..self.free).map(|j| self.values[self.pattern.col_ptr[j]])
     }
 
     /// Restricts a global vector to the free equations.
