@@ -164,7 +164,7 @@ impl ContactState {
             }
             if penetrating.is_empty() {
                 let forces = solution.forces.clone();
-                return Ok(self.finish(model, reference, solution, length, entries, forces));
+                return Ok(self.finish(model, solution, length, entries, forces));
             }
             if !split && alpha > 1e-6 && alpha < 1.0 {
                 // Erklig 2.1.4: end the step where the first slave touches
@@ -188,7 +188,6 @@ impl ContactState {
     fn finish(
         &self,
         model: &Model,
-        _reference: &[[f64; 2]],
         solution: Solution,
         length: f64,
         mut entries: Vec<(usize, usize)>,
