@@ -218,7 +218,7 @@ pub fn run(
             let factor_first = factored_for != Some(coefficients)
                 || match spec.newton.strategy {
                     Strategy::Full => true,
-                    Strategy::Modified => increments % spec.newton.refactor_every == 0,
+                    Strategy::Modified => increments.is_multiple_of(spec.newton.refactor_every),
                     Strategy::Initial => !solver.is_factored(),
                 };
             let step = Step {
@@ -277,10 +277,7 @@ pub fn run(
             Ok((mut step, advance)) => {
                 let h = step.length;
                 let d = std::mem::take(&mut step.solution.d);
-                let evaluation = std::mem::replace(
-                    &mut step.solution.evaluation,
-                    assembly::Evaluation::default(),
-                );
+                let evaluation = std::mem::take(&mut step.solution.evaluation);
                 let internal = evaluation.force.clone();
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
                 state.time = if h == nominal { target } else { state.time + h };

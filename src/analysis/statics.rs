@@ -13,7 +13,7 @@ use super::contact::ContactState;
 use super::newton::{ContactStep, Counters, Step, StepFailure};
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
-use crate::assembly::{self, Evaluation, State, System};
+use crate::assembly::{self, State, System};
 use crate::integrator::StepForm;
 use crate::scene::Model;
 use crate::scene::spec::{StaticSpec, Strategy};
@@ -70,7 +70,9 @@ pub fn run(
         let positions = state.positions(spec.geometry);
         let factor_first = match spec.newton.strategy {
             Strategy::Full => true,
-            Strategy::Modified => increments % spec.newton.refactor_every == 0 || cuts_in_a_row > 0,
+            Strategy::Modified => {
+                increments.is_multiple_of(spec.newton.refactor_every) || cuts_in_a_row > 0
+            }
             Strategy::Initial => !solver.is_factored() || cuts_in_a_row > 0,
         };
         // one attempt of the increment with a given length and active contact set
@@ -113,8 +115,7 @@ pub fn run(
                     state.time + step.length
                 };
                 let d = std::mem::take(&mut step.solution.d);
-                let evaluation =
-                    std::mem::replace(&mut step.solution.evaluation, Evaluation::default());
+                let evaluation = std::mem::take(&mut step.solution.evaluation);
                 let force = evaluation.force.clone();
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
                 state.time = end;
