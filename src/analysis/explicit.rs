@@ -12,6 +12,7 @@
 //! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
+use super::contact::ContactState;
 use super::dynamics::check_mass;
 use super::newton::Counters;
 use super::record::{Energies, Motion, Recorder};
@@ -120,6 +121,11 @@ pub fn run(
 
     let progress = super::progress_bar(options.progress, steps);
     let mut energy_reference = initial_kinetic;
+    let mut contact = ContactState::new(model);
+    // zero on prescribed DOFs: contact corrections never move them
+    let inverse_mass: Vec<f64> = (0..model.dofs())
+        .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
+        .collect();
     for step in 1..=steps {
         let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
         let h = super::step_length(time - state.time, spec.dt);
@@ -127,6 +133,17 @@ pub fn run(
         let mut du: Vec<f64> = v_half.iter().map(|v| h * v).collect();
         for (dof, value) in loads::prescribed(model, &initial, time) {
             du[dof] = value - state.displacement[dof];
+        }
+        let mut v_half = v_half;
+        if !model.contacts.is_empty() {
+            let positions = state.positions(spec.geometry);
+            let correction = contact.explicit_step(model, &positions, &du, &inverse_mass, h, time);
+            for i in 0..model.dofs() {
+                du[i] += correction[i];
+                v_half[i] += correction[i] / h;
+            }
+            let force = contact.nodal_forces(model, &positions);
+            energies.contact_work -= force.iter().zip(&du).map(|(f, u)| f * u).sum::<f64>();
         }
         let evaluation = match assembly::evaluate(
             model,
@@ -196,11 +213,19 @@ pub fn run(
             );
             return Err(super::fail(&recorder, summary, Status::Unstable, message));
         }
-        recorder.step(model, &state, &motion, &energies, step == steps)?;
+        recorder.step_with_contact(
+            model,
+            &state,
+            &motion,
+            &energies,
+            Some(&contact),
+            step == steps,
+        )?;
         progress.set_position(step as u64);
     }
     progress.finish_and_clear();
     summary.finish(&energies, &Counters::default(), None, start);
+    summary.contact = contact.summary();
     recorder.write_summary(&summary)?;
     let contact_force = vec![0.0; model.dofs()];
     Ok(Outcome {
