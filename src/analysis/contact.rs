@@ -42,6 +42,8 @@ pub struct ContactState {
     pub last_release_time: Option<f64>,
     pub peak_force: f64,
     pub peak_extent: f64,
+    /// The most negative gap of any slave after any step (penetration), or None.
+    pub min_gap: Option<f64>,
 }
 
 /// What happened in a step, for the conditions and the bookkeeping.
@@ -87,6 +89,7 @@ impl ContactState {
             last_release_time: None,
             peak_force: 0.0,
             peak_extent: 0.0,
+            min_gap: None,
         }
     }
 
@@ -324,6 +327,14 @@ impl ContactState {
         }
         let total: f64 = forces.iter().sum();
         self.peak_force = self.peak_force.max(total);
+        let x = |n: usize| coords[n];
+        for pair in &model.contacts {
+            for s in &pair.slaves {
+                if let Some(g) = pair.gap(*s, &x) {
+                    self.min_gap = Some(self.min_gap.map_or(g.gap, |m| m.min(g.gap)));
+                }
+            }
+        }
         self.peak_extent = self.peak_extent.max(extent(model, active, coords));
     }
 
@@ -460,6 +471,7 @@ impl ContactState {
             last_release_time: self.last_release_time,
             peak_force: self.peak_force,
             peak_contact_radius: self.peak_extent,
+            min_gap: self.min_gap,
         }
     }
 

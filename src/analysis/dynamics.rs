@@ -169,6 +169,7 @@ pub fn run(
         &Motion {
             velocity: &kin.velocity,
             acceleration: &kin.acceleration,
+            mass: &mass.lumped,
         },
         &energies,
         true,
@@ -324,6 +325,7 @@ pub fn run(
                 let motion = Motion {
                     velocity: &kin.velocity,
                     acceleration: &kin.acceleration,
+                    mass: &mass.lumped,
                 };
                 recorder.step_with_contact(
                     model,

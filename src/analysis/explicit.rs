@@ -114,6 +114,7 @@ pub fn run(
         &Motion {
             velocity: &v,
             acceleration: &a,
+            mass: m,
         },
         &energies,
         true,
@@ -202,6 +203,7 @@ pub fn run(
         let motion = Motion {
             velocity: &v,
             acceleration: &a,
+            mass: m,
         };
         if !energy.is_finite() || energy > 100.0 * energy_reference {
             progress.abandon();

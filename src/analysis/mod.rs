@@ -35,6 +35,8 @@ pub struct ContactSummary {
     pub last_release_time: Option<f64>,
     pub peak_force: f64,
     pub peak_contact_radius: f64,
+    /// The most negative slave gap after any step (penetration if < 0), null without contact.
+    pub min_gap: Option<f64>,
 }
 
 #[derive(Debug, Clone, Default, Serialize)]

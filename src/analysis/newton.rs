@@ -291,8 +291,10 @@ impl Step<'_> {
                 if !(refactor || stalled) {
                     self.evaluate(state, &d, Some(&mut *system))?;
                 }
-                self.effective(system, &damping);
+                // the stiffness alone sets the floor of the force scale (K*'s mass term
+                // would make any residual look small next to a rigid motion)
                 system.diagonal_max = system.diagonal().fold(0.0, f64::max);
+                self.effective(system, &damping);
                 solver
                     .factor(&system.values)
                     .map_err(|e| StepFailure(e.to_string()))?;

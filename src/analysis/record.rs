@@ -27,6 +27,8 @@ pub struct Energies {
 pub struct Motion<'a> {
     pub velocity: &'a [f64],
     pub acceleration: &'a [f64],
+    /// Lumped mass per DOF (for the momentum probes); empty in statics.
+    pub mass: &'a [f64],
 }
 
 pub struct Recorder {
@@ -269,6 +271,19 @@ fn probe_value(
         Quantity::VelocityY => nodal(motion.velocity, 1),
         Quantity::AccelerationX => nodal(motion.acceleration, 0),
         Quantity::AccelerationY => nodal(motion.acceleration, 1),
+        Quantity::MomentumX | Quantity::MomentumY => {
+            let c = (probe.quantity == Quantity::MomentumY) as usize;
+            probe
+                .members
+                .iter()
+                .map(|m| {
+                    motion
+                        .mass
+                        .get(2 * m + c)
+                        .map_or(0.0, |mass| mass * motion.velocity[2 * m + c])
+                })
+                .sum()
+        }
         Quantity::StressXX => points(&|p| p.stress[0]),
         Quantity::StressYY => points(&|p| p.stress[1]),
         Quantity::StressZZ => points(&|p| p.stress[2]),

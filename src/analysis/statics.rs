@@ -51,6 +51,7 @@ pub fn run(
     let motion = Motion {
         velocity: &zeros,
         acceleration: &zeros,
+        mass: &[],
     };
     let mut energies = Energies::default();
     let mut last_force = vec![0.0; model.dofs()];

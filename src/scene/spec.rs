@@ -503,6 +503,11 @@ pub enum Quantity {
     AccelerationX,
     #[serde(rename = "a_y")]
     AccelerationY,
+    /// Linear momentum sum m v of the set (lumped mass), not a mean.
+    #[serde(rename = "p_x")]
+    MomentumX,
+    #[serde(rename = "p_y")]
+    MomentumY,
     #[serde(rename = "s_xx")]
     StressXX,
     #[serde(rename = "s_yy")]
@@ -527,6 +532,8 @@ impl Quantity {
             Quantity::VelocityY => "v_y",
             Quantity::AccelerationX => "a_x",
             Quantity::AccelerationY => "a_y",
+            Quantity::MomentumX => "p_x",
+            Quantity::MomentumY => "p_y",
             Quantity::StressXX => "s_xx",
             Quantity::StressYY => "s_yy",
             Quantity::StressXY => "s_xy",
@@ -546,6 +553,8 @@ impl Quantity {
                 | Quantity::VelocityY
                 | Quantity::AccelerationX
                 | Quantity::AccelerationY
+                | Quantity::MomentumX
+                | Quantity::MomentumY
         )
     }
 }
