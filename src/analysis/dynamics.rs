@@ -177,15 +177,14 @@ pub fn run(
 
     let progress = super::progress_bar(options.progress, steps);
     let mut counters = Counters::default();
-    let mut dt = spec.dt;
+    let mut control = super::StepControl::new(spec.dt, spec.newton.max_cuts);
     // K* = ca M + cv C + w K_T: a factorization serves while these coefficients stay
     let mut factored_for: Option<[f64; 3]> = None;
-    let mut cuts_in_a_row = 0;
     let mut increments = 0usize;
     let mut contact = ContactState::new(model);
     let mut last_contact = vec![0.0; model.dofs()];
     while state.time < spec.end_time * (1.0 - 1e-12) {
-        let target = super::snap((state.time + dt).min(spec.end_time), spec.dt);
+        let target = super::snap((state.time + control.length).min(spec.end_time), spec.dt);
         let nominal = super::step_length(target - state.time, spec.dt);
         let positions = state.positions(spec.geometry);
         let kinetic_before_impact = mass.kinetic_energy(model, &kin.velocity);
@@ -336,23 +335,17 @@ pub fn run(
                     last,
                 )?;
                 progress.set_position((state.time / spec.dt).round() as u64);
-                cuts_in_a_row = 0;
-                dt = (dt * 2.0).min(spec.dt);
+                control.accept(true);
             }
             Err(StepFailure(reason)) => {
                 method.reject();
-                if cuts_in_a_row >= spec.newton.max_cuts {
+                if let Err(why) = control.reject(nominal, &mut counters) {
                     progress.abandon();
-                    let message = format!(
-                        "step to t = {target} did not converge after {cuts_in_a_row} cuts (dt = {nominal:e}): {reason}"
-                    );
+                    let message = format!("step to t = {target} {why}: {reason}");
                     summary.finish(&energies, &counters, Some(&solver), start);
                     summary.contact = contact.summary();
                     return Err(super::fail(&recorder, summary, Status::Diverged, message));
                 }
-                dt = nominal * 0.5;
-                cuts_in_a_row += 1;
-                counters.cuts += 1;
             }
         }
     }

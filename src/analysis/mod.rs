@@ -179,6 +179,52 @@ fn snap(t: f64, dt: f64) -> f64 {
     }
 }
 
+/// The step length of a driver: halved when a step fails (at most `max_cuts` times in a
+/// row), grown back towards the nominal length after each success.
+struct StepControl {
+    nominal: f64,
+    length: f64,
+    cuts_in_a_row: usize,
+    max_cuts: usize,
+}
+
+impl StepControl {
+    fn new(nominal: f64, max_cuts: usize) -> StepControl {
+        StepControl {
+            nominal,
+            length: nominal,
+            cuts_in_a_row: 0,
+            max_cuts,
+        }
+    }
+
+    /// A step ending at its target succeeded (`grow`: it was not ended early by an event).
+    fn accept(&mut self, grow: bool) {
+        self.cuts_in_a_row = 0;
+        if grow {
+            self.length = (2.0 * self.length).min(self.nominal);
+        }
+    }
+
+    /// A step of length `attempted` failed: halve it, or say why the run must stop.
+    fn reject(&mut self, attempted: f64, counters: &mut Counters) -> Result<(), String> {
+        if self.cuts_in_a_row >= self.max_cuts {
+            return Err(format!(
+                "did not converge after {} cuts (dt = {attempted:e})",
+                self.cuts_in_a_row
+            ));
+        }
+        self.length = 0.5 * attempted;
+        self.cuts_in_a_row += 1;
+        counters.cuts += 1;
+        Ok(())
+    }
+
+    fn after_cut(&self) -> bool {
+        self.cuts_in_a_row > 0
+    }
+}
+
 /// A step of nominal length up to round-off is given exactly the nominal length, so methods
 /// that keep history (Houbolt) or a factorization of K*(dt) see one dt.
 fn step_length(h: f64, dt: f64) -> f64 {

@@ -62,19 +62,18 @@ pub fn run(
     let progress = super::progress_bar(options.progress, spec.steps);
     let form = static_form(model.dofs());
     let mut counters = Counters::default();
-    let mut step_dt = dt;
-    let mut cuts_in_a_row = 0;
+    let mut control = super::StepControl::new(dt, spec.newton.max_cuts);
     let mut increments = 0usize;
     let mut contact = ContactState::new(model);
     while state.time < spec.end_time * (1.0 - 1e-12) {
-        let target = super::snap((state.time + step_dt).min(spec.end_time), dt);
+        let target = super::snap((state.time + control.length).min(spec.end_time), dt);
         let positions = state.positions(spec.geometry);
         let factor_first = match spec.newton.strategy {
             Strategy::Full => true,
             Strategy::Modified => {
-                increments.is_multiple_of(spec.newton.refactor_every) || cuts_in_a_row > 0
+                increments.is_multiple_of(spec.newton.refactor_every) || control.after_cut()
             }
-            Strategy::Initial => !solver.is_factored() || cuts_in_a_row > 0,
+            Strategy::Initial => !solver.is_factored() || control.after_cut(),
         };
         // one attempt of the increment with a given length and active contact set
         let attempt = |h: f64, active: &[(usize, usize)], forces: Vec<f64>| {
@@ -142,23 +141,16 @@ pub fn run(
                     last,
                 )?;
                 progress.set_position((state.time / dt).round() as u64);
-                cuts_in_a_row = 0;
-                if end == target {
-                    step_dt = (step_dt * 2.0).min(dt);
-                }
+                control.accept(end == target);
             }
             Err(StepFailure(reason)) => {
-                if cuts_in_a_row >= spec.newton.max_cuts {
+                if let Err(why) = control.reject(target - state.time, &mut counters) {
                     progress.abandon();
-                    let message = format!(
-                        "increment to t = {target} did not converge after {cuts_in_a_row} cuts (dt = {step_dt:e}): {reason}"
-                    );
+                    let message = format!("increment to t = {target} {why}: {reason}");
                     summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
                     return Err(super::fail(&recorder, summary, Status::Diverged, message));
                 }
-                step_dt *= 0.5;
-                cuts_in_a_row += 1;
-                counters.cuts += 1;
             }
         }
     }
