@@ -126,7 +126,7 @@ pub fn run(
     let mut method = integrator(spec);
     let steps = (spec.end_time / spec.dt).round().max(1.0) as usize;
     let mut summary = Summary::new(model, &method.name(), spec.dt, spec.end_time, system.free);
-    let velocity = super::initial_velocity(model, &system);
+    let velocity = super::initial_velocity(model, &system, spec.dt);
     let (acceleration, mut last_internal) = match initial_acceleration(
         model,
         &state,

@@ -89,7 +89,7 @@ pub fn run(
         )
     })?;
     let mut internal = first.force;
-    let mut v = super::initial_velocity(model, &system);
+    let mut v = super::initial_velocity(model, &system, spec.dt);
     let external = loads::external_force(model, &state, &initial, 0.0);
     let mut a: Vec<f64> = (0..model.dofs())
         .map(|i| {

@@ -231,13 +231,24 @@ fn step_length(h: f64, dt: f64) -> f64 {
     if (h - dt).abs() <= 1e-9 * dt { dt } else { h }
 }
 
-/// The scene's initial velocity with the constrained DOFs at rest (they follow their
-/// prescriptions from t = 0).
-fn initial_velocity(model: &Model, system: &crate::assembly::System) -> Vec<f64> {
+/// The scene's initial velocity, with the constrained DOFs moving as their prescriptions do
+/// at t = 0 (the slope of the first curve segment; supports at rest): a prescribed motion
+/// then starts without a velocity jump the trapezoidal rule would carry as an oscillation.
+fn initial_velocity(model: &Model, system: &crate::assembly::System, dt: f64) -> Vec<f64> {
     let mut v = model.initial_velocity.clone();
+    let initial = model.coordinates();
+    let eps = 1e-6 * dt;
+    let at = |t: f64| {
+        let mut u = vec![0.0; model.dofs()];
+        for (dof, value) in loads::prescribed(model, &initial, t) {
+            u[dof] = value;
+        }
+        u
+    };
+    let (u0, u1) = (at(0.0), at(eps));
     for (dof, eq) in system.equation.iter().enumerate() {
         if eq.is_none() {
-            v[dof] = 0.0;
+            v[dof] = (u1[dof] - u0[dof]) / eps;
         }
     }
     v
