@@ -731,6 +731,8 @@ pub fn apply_conditions(
             acceleration,
             &mut step.forces[i],
         );
+        // a compressive multiplier: II-8's correction may not turn it into a pull
+        step.forces[i] = step.forces[i].max(0.0);
     }
     for &(p, k, tau) in &step.events.released {
         let pair = &model.contacts[p];
