@@ -214,13 +214,15 @@ fn gap_to_segments(
     let along_normal = dot(sub(x, p), n);
     let (gap, normal) = if xi > 0.0 && xi < 1.0 || d == 0.0 {
         (along_normal, n)
+    } else if inside() {
+        // penetrated near a vertex: the segment's own normal. The direction to the vertex
+        // would turn with every small tangential offset (at a vertex between collinear
+        // segments it flips from side to side) and Newton could not settle.
+        (along_normal, n)
     } else {
-        // nearest point is a corner: the normal points from it to the slave, the sign from
-        // the inside test
-        let sign = if inside() { -1.0 } else { 1.0 };
+        // outside a convex corner: the normal points from the corner to the slave
         let dir = sub(x, p);
-        let l = length(dir);
-        (sign * d, [sign * dir[0] / l, sign * dir[1] / l])
+        (d, [dir[0] / d, dir[1] / d])
     };
     Some((k, xi, gap, normal))
 }
@@ -354,6 +356,38 @@ mod tests {
         assert!(outside.gap < 0.0, "{outside:?}");
         let inside = pair.gap(0, &|_| [0.9, 0.95]).unwrap();
         approx::assert_abs_diff_eq!(inside.gap, 0.05, epsilon = 1e-12);
+    }
+
+    /// A slave pressed in just below a vertex between two collinear master segments keeps
+    /// the surface normal and the gap -depth whichever side of the vertex it drifts to
+    /// (the direction to the vertex would swing through 180 degrees).
+    #[test]
+    fn penetration_below_a_flat_vertex_keeps_the_surface_normal() {
+        let coords = [
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [0.0, 0.0],
+            [-1.0, 0.0],
+            [-1.0, -1.0],
+            [1.0, -1.0],
+        ];
+        let pair = ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master: Master::Segments {
+                body: 1,
+                edges: vec![[1, 2], [2, 3]],
+                boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
+            },
+            options: options(),
+        };
+        for dx in [-1e-9, 0.0, 1e-9] {
+            let x = |n: usize| if n == 0 { [dx, -1e-6] } else { coords[n] };
+            let g = pair.gap(0, &x).unwrap();
+            approx::assert_abs_diff_eq!(g.gap, -1e-6, epsilon = 1e-15);
+            approx::assert_abs_diff_eq!(g.normal[1], 1.0, epsilon = 1e-12);
+        }
     }
 
     fn options() -> PairOptions {
