@@ -253,8 +253,35 @@ impl ContactPair {
                         boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
                     winding_number(xs, &closed) > 0.5
                 };
-                let (k, xi, gap, normal) = gap_to_segments(xs, &segments, inside)?;
+                let (k, xi, _, _) = gap_to_segments(xs, &segments, inside)?;
                 let [a, b] = edges[k];
+                // the normal interpolated between the master nodes' averaged normals: it
+                // turns continuously across a vertex, where a dented deformable surface would
+                // otherwise flip the slave's row between its two segments
+                let nodal = |node: usize| -> [f64; 2] {
+                    let mut sum = [0.0; 2];
+                    for [p, q] in edges.iter().filter(|e| e.contains(&node)) {
+                        let n = outward(x(*p), x(*q));
+                        sum = [sum[0] + n[0], sum[1] + n[1]];
+                    }
+                    sum
+                };
+                let (na, nb) = (nodal(a), nodal(b));
+                let raw = [
+                    (1.0 - xi) * na[0] + xi * nb[0],
+                    (1.0 - xi) * na[1] + xi * nb[1],
+                ];
+                let l = length(raw);
+                let normal = if l > 0.0 {
+                    [raw[0] / l, raw[1] / l]
+                } else {
+                    outward(x(a), x(b))
+                };
+                let p = [
+                    (1.0 - xi) * x(a)[0] + xi * x(b)[0],
+                    (1.0 - xi) * x(a)[1] + xi * x(b)[1],
+                ];
+                let gap = dot(sub(xs, p), normal);
                 Gap {
                     gap,
                     normal,
@@ -388,6 +415,42 @@ mod tests {
             approx::assert_abs_diff_eq!(g.gap, -1e-6, epsilon = 1e-15);
             approx::assert_abs_diff_eq!(g.normal[1], 1.0, epsilon = 1e-12);
         }
+    }
+
+    /// On a dented deformable master (a V at a vertex) the interpolated normal is continuous
+    /// across the vertex: slaves just left and right of it (at 0.001 above, projecting at
+    /// xi = 1e-4 from the vertex) get the averaged vertex normal to within 1e-4, where the
+    /// segments' own normals differ by 0.2 in their x component.
+    #[test]
+    fn smoothed_normal_is_continuous_across_a_dented_vertex() {
+        let coords = [
+            [0.0, 0.0],
+            [1.0, 0.1],
+            [0.0, 0.0],
+            [-1.0, 0.1],
+            [-1.0, -1.0],
+            [1.0, -1.0],
+        ];
+        let pair = ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master: Master::Segments {
+                body: 1,
+                edges: vec![[1, 2], [2, 3]],
+                boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
+            },
+            options: options(),
+        };
+        let normal_at = |dx: f64| {
+            pair.gap(0, &|n: usize| if n == 0 { [dx, 0.001] } else { coords[n] })
+                .unwrap()
+                .normal
+        };
+        let (left, right) = (normal_at(-1e-7), normal_at(1e-7));
+        approx::assert_abs_diff_eq!(left[0], right[0], epsilon = 1e-4);
+        approx::assert_abs_diff_eq!(left[1], 1.0, epsilon = 1e-6);
+        approx::assert_abs_diff_eq!(right[1], 1.0, epsilon = 1e-6);
     }
 
     fn options() -> PairOptions {
