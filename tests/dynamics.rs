@@ -239,7 +239,8 @@ fn wilson_and_houbolt_stable_at_large_steps_wilson_low_theta_is_not() {
     }
 }
 
-const CHAIN: &str = r#"
+/// A fixed-free rod (L = 10, E = 100, rho = 0.01, c = 100), 10 elements unless overridden.
+const FIXED_FREE_ROD: &str = r#"
 [[material]]
 name = "m"
 young = 100.0
@@ -260,7 +261,13 @@ fix = ["x", "y"]
 [[support]]
 set = "all"
 fix = ["y"]
+"#;
 
+/// The fixed-free rod set moving at 0.1, central difference.
+fn chain() -> String {
+    format!(
+        "{FIXED_FREE_ROD}{}",
+        r#"
 [[initial_velocity]]
 set = "all"
 velocity = [0.1, 0.0]
@@ -274,7 +281,9 @@ end_time = 1.0
 
 [output]
 frame_every = 0
-"#;
+"#
+    )
+}
 
 /// The exact highest frequency of the fixed-free 10-rod chain with lumped mass, from the
 /// assembled matrices (independent of the code: K tridiagonal E A / h, M diagonal rho A h
@@ -308,7 +317,7 @@ fn central_difference_stable_below_and_unstable_above_dt_crit() {
     let dt_crit = 2.0 / chain_omega_max();
     let model = common::model(
         "chain",
-        CHAIN,
+        &chain(),
         &[&format!("analysis.dt={:e}", 0.95 * dt_crit)],
     );
     let (summary, _) = common::run("chain_stable", &model);
@@ -319,7 +328,7 @@ fn central_difference_stable_below_and_unstable_above_dt_crit() {
     );
 
     let above = format!("analysis.dt={:e}", 1.05 * dt_crit);
-    let model = common::model("chain", CHAIN, &[&above, "analysis.allow_unstable=true"]);
+    let model = common::model("chain", &chain(), &[&above, "analysis.allow_unstable=true"]);
     let err = impact::analysis::run(
         &model,
         &common::out_dir("chain_unstable"),
@@ -333,7 +342,7 @@ fn central_difference_stable_below_and_unstable_above_dt_crit() {
         }
         other => panic!("expected a numerical failure, got {other}"),
     }
-    let model = common::model("chain", CHAIN, &[&above]);
+    let model = common::model("chain", &chain(), &[&above]);
     let err = impact::analysis::run(
         &model,
         &common::out_dir("chain_refused"),
@@ -400,28 +409,12 @@ fn newmark_average_conserves_energy_of_elastic_block() {
     );
 }
 
-const WAVE: &str = r#"
-[[material]]
-name = "m"
-young = 100.0
-poisson = 0.0
-density = 0.01
-
-[[body]]
-name = "rod"
-material = "m"
-formulation = "rod"
-area = 1.0
-mesh = { type = "line", start = [0.0, 0.0], end = [10.0, 0.0], n = 100 }
-
-[[support]]
-set = "start"
-fix = ["x", "y"]
-
-[[support]]
-set = "all"
-fix = ["y"]
-
+/// The fixed-free rod with 100 elements and a step force at its free end.
+fn wave() -> String {
+    format!(
+        "{}{}",
+        FIXED_FREE_ROD.replace("n = 10 }", "n = 100 }"),
+        r#"
 [[load]]
 type = "nodal_force"
 set = "end"
@@ -436,7 +429,9 @@ end_time = 0.05
 
 [output]
 frame_every = 0
-"#;
+"#
+    )
+}
 
 /// Goal: a step load travels at c and doubles on reflection at a fixed end.
 /// Setup: rod L = 10, E = 100, rho = 0.01 (c = 100, L/c = 0.1), 100 elements, fixed at x = 0,
@@ -447,7 +442,7 @@ frame_every = 0
 #[test]
 fn rod_wave_arrives_at_l_over_c_and_doubles_on_reflection() {
     let fixed_end_stress = |t: f64| {
-        let model = common::model("wave", WAVE, &[&format!("analysis.end_time={t}")]);
+        let model = common::model("wave", &wave(), &[&format!("analysis.end_time={t}")]);
         let (_, state) = common::run(&format!("wave_{t}"), &model);
         state.bodies[0].points[0].stress[0]
     };

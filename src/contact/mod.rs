@@ -372,13 +372,7 @@ mod tests {
             closed: true,
         };
         assert!(cavity.is_cavity());
-        let pair = ContactPair {
-            name: "p".into(),
-            slave_body: 0,
-            slaves: vec![0],
-            master: Master::Obstacle(cavity),
-            options: options(),
-        };
+        let pair = slave_node_0(Master::Obstacle(cavity));
         let outside = pair.gap(0, &|_| [1.1, 1.2]).unwrap();
         assert!(outside.gap < 0.0, "{outside:?}");
         let inside = pair.gap(0, &|_| [0.9, 0.95]).unwrap();
@@ -398,17 +392,11 @@ mod tests {
             [-1.0, -1.0],
             [1.0, -1.0],
         ];
-        let pair = ContactPair {
-            name: "p".into(),
-            slave_body: 0,
-            slaves: vec![0],
-            master: Master::Segments {
-                body: 1,
-                edges: vec![[1, 2], [2, 3]],
-                boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
-            },
-            options: options(),
-        };
+        let pair = slave_node_0(Master::Segments {
+            body: 1,
+            edges: vec![[1, 2], [2, 3]],
+            boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
+        });
         for dx in [-1e-9, 0.0, 1e-9] {
             let x = |n: usize| if n == 0 { [dx, -1e-6] } else { coords[n] };
             let g = pair.gap(0, &x).unwrap();
@@ -431,17 +419,11 @@ mod tests {
             [-1.0, -1.0],
             [1.0, -1.0],
         ];
-        let pair = ContactPair {
-            name: "p".into(),
-            slave_body: 0,
-            slaves: vec![0],
-            master: Master::Segments {
-                body: 1,
-                edges: vec![[1, 2], [2, 3]],
-                boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
-            },
-            options: options(),
-        };
+        let pair = slave_node_0(Master::Segments {
+            body: 1,
+            edges: vec![[1, 2], [2, 3]],
+            boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
+        });
         let normal_at = |dx: f64| {
             pair.gap(0, &|n: usize| if n == 0 { [dx, 0.001] } else { coords[n] })
                 .unwrap()
@@ -451,6 +433,17 @@ mod tests {
         approx::assert_abs_diff_eq!(left[0], right[0], epsilon = 1e-4);
         approx::assert_abs_diff_eq!(left[1], 1.0, epsilon = 1e-6);
         approx::assert_abs_diff_eq!(right[1], 1.0, epsilon = 1e-6);
+    }
+
+    /// A pair whose only slave is node 0.
+    fn slave_node_0(master: Master) -> ContactPair {
+        ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master,
+            options: options(),
+        }
     }
 
     fn options() -> PairOptions {
@@ -473,13 +466,7 @@ mod tests {
             points: vec![[2.0, 0.0], [-2.0, 0.0]],
             closed: false,
         };
-        let pair = ContactPair {
-            name: "p".into(),
-            slave_body: 0,
-            slaves: vec![0],
-            master: Master::Obstacle(wall),
-            options: options(),
-        };
+        let pair = slave_node_0(Master::Obstacle(wall));
         for (y, expected) in [(0.3, 0.3), (-0.2, -0.2)] {
             let g = pair.gap(0, &|_| [0.5, y]).unwrap();
             approx::assert_abs_diff_eq!(g.gap, expected, epsilon = 1e-15);
@@ -500,17 +487,11 @@ mod tests {
             [1.0, -1.0],
             [0.0, -1.0],
         ];
-        let pair = ContactPair {
-            name: "p".into(),
-            slave_body: 0,
-            slaves: vec![0],
-            master: Master::Segments {
-                body: 1,
-                edges: vec![[2, 1]],
-                boundary: vec![[1, 4], [4, 3], [3, 2], [2, 1]],
-            },
-            options: options(),
-        };
+        let pair = slave_node_0(Master::Segments {
+            body: 1,
+            edges: vec![[2, 1]],
+            boundary: vec![[1, 4], [4, 3], [3, 2], [2, 1]],
+        });
         let g = pair.gap(0, &|n| coords[n]).unwrap();
         approx::assert_abs_diff_eq!(g.gap, 0.1, epsilon = 1e-15);
         assert_eq!(g.masters, vec![(2, 0.25), (1, 0.75)]);
