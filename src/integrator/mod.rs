@@ -365,11 +365,6 @@ impl Integrator for Houbolt {
     }
 }
 
-/// The explicit central-difference method (lumped mass, no factorization): driven by the
-/// explicit driver, which needs only its stability limit dt <= 2 / omega_max.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CentralDifference;
-
 #[cfg(test)]
 mod tests {
     use super::*;
