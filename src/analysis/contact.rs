@@ -25,11 +25,15 @@
 //! ```
 //! A rigid obstacle is a master of infinite mass and impedance at rest.
 
-use super::newton::{Solution, StepFailure};
-use crate::contact::{ContactPair, Gap, Master};
+use super::newton::{Solution, StepFailure, Tangential};
+use crate::contact::{ContactPair, Friction, Gap, Master};
 use crate::element::Formulation;
 use crate::scene::{BodyKind, Model};
 use std::f64::consts::PI;
+
+/// The shortest fraction of a step an event split may leave: an event closer to the step
+/// start than this closes in the full step (Hughes II-7) instead.
+const MIN_SPLIT: f64 = 0.1;
 
 /// The contact status carried from step to step.
 #[derive(Debug, Clone)]
@@ -38,6 +42,10 @@ pub struct ContactState {
     pub active: Vec<Vec<bool>>,
     /// Per pair, per slave: the last converged force.
     pub force: Vec<Vec<f64>>,
+    /// Per pair, per slave: the last converged tangential (friction) force along t.
+    pub tangential: Vec<Vec<f64>>,
+    /// Per pair, per slave: the signed Coulomb coefficient of a sliding entry, 0 sticking.
+    pub sliding: Vec<Vec<f64>>,
     pub first_contact_time: Option<f64>,
     pub last_release_time: Option<f64>,
     pub peak_force: f64,
@@ -65,7 +73,46 @@ pub struct ContactStep {
     /// Active entries and their forces after the step.
     pub active: Vec<(usize, usize)>,
     pub forces: Vec<f64>,
+    /// Per active entry: the tangential force, and the signed coefficient when sliding.
+    pub tangential: Vec<f64>,
+    pub sliding: Vec<f64>,
     pub events: Events,
+}
+
+/// The tangential conditions of the entries' friction status, in entry order.
+fn tangential_conditions(slips: &[Slip]) -> Vec<Tangential> {
+    slips
+        .iter()
+        .enumerate()
+        .filter_map(|(entry, s)| match *s {
+            Slip::Free => None,
+            Slip::Stick => Some(Tangential::Fixed { entry, target: 0.0 }),
+            Slip::Return(target) => Some(Tangential::Fixed { entry, target }),
+            Slip::Slide(coefficient) => Some(Tangential::Sliding { entry, coefficient }),
+        })
+        .collect()
+}
+
+/// The tangential forces of a solve (in the order of `tangential_conditions`) per entry.
+fn per_entry(slips: &[Slip], forces: &[f64]) -> Vec<f64> {
+    let mut next = forces.iter();
+    slips
+        .iter()
+        .map(|s| match s {
+            Slip::Free => 0.0,
+            _ => *next.next().expect("one force per condition"),
+        })
+        .collect()
+}
+
+/// The friction status of an active entry inside a step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Slip {
+    /// No tangential condition (frictionless, or Greco's return before its target is known).
+    Free,
+    Stick,
+    Slide(f64),
+    Return(f64),
 }
 
 impl ContactState {
@@ -77,13 +124,16 @@ impl ContactState {
             .iter()
             .map(|p| vec![false; p.slaves.len()])
             .collect();
-        let force = model
+        let force: Vec<Vec<f64>> = model
             .contacts
             .iter()
             .map(|p| vec![0.0; p.slaves.len()])
             .collect();
+        let zeros: Vec<Vec<f64>> = force.clone();
         ContactState {
             active,
+            tangential: zeros.clone(),
+            sliding: zeros,
             force,
             first_contact_time: None,
             last_release_time: None,
@@ -107,31 +157,51 @@ impl ContactState {
         (entries, forces)
     }
 
-    /// Runs one step with contact. `solve(length, active (pair, slave node), forces)`
-    /// solves the step for a given active set.
+    /// The friction status an entry starts a step with.
+    fn slip_start(&self, model: &Model, (p, k): (usize, usize)) -> Slip {
+        match model.contacts[p].options.friction {
+            Friction::None | Friction::Return { .. } => Slip::Free,
+            Friction::Coulomb { .. } if self.active[p][k] && self.sliding[p][k] != 0.0 => {
+                Slip::Slide(self.sliding[p][k])
+            }
+            Friction::Coulomb { .. } => Slip::Stick,
+        }
+    }
+
+    /// Runs one step with contact. `solve(length, active (pair, slave node), forces,
+    /// tangential conditions)` solves the step for a given active set.
     pub fn step(
         &self,
         model: &Model,
         reference: &[[f64; 2]],
         length: f64,
-        mut solve: impl FnMut(f64, &[(usize, usize)], Vec<f64>) -> Result<Solution, StepFailure>,
+        mut solve: impl FnMut(
+            f64,
+            &[(usize, usize)],
+            Vec<f64>,
+            &[Tangential],
+        ) -> Result<Solution, StepFailure>,
     ) -> Result<ContactStep, StepFailure> {
         let pairs = &model.contacts;
         let (mut entries, mut forces) = self.entries();
+        let mut slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(model, *e)).collect();
+        let mut returned = false;
         let mut length = length;
         let mut split = false;
-        for _ in 0..100 {
+        for pass in 0..100 {
             let nodes: Vec<(usize, usize)> = entries
                 .iter()
                 .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
                 .collect();
-            let solution = solve(length, &nodes, forces.clone())?;
+            let tangential = tangential_conditions(&slips);
+            let solution = solve(length, &nodes, forces.clone(), &tangential)?;
             // release entries in tension, most negative first, and solve again
             if let Some(worst) = (0..entries.len())
                 .filter(|i| solution.forces[*i] < 0.0)
                 .min_by(|a, b| solution.forces[*a].total_cmp(&solution.forces[*b]))
             {
                 entries.remove(worst);
+                slips.remove(worst);
                 forces = solution.forces.clone();
                 forces.remove(worst);
                 continue;
@@ -166,19 +236,80 @@ impl ContactState {
                 }
             }
             if penetrating.is_empty() {
+                // friction: Greco's return targets from this (frictionless) slip, once per
+                // step; Coulomb stick <-> slide switches. A cycling status is accepted after
+                // half the passes.
+                let slip_of = |i: usize| -> f64 {
+                    let (p, k) = entries[i];
+                    let s = pairs[p].slaves[k];
+                    pairs[p].gap(s, &end).map_or(0.0, |g| {
+                        g.tangent_row(s)
+                            .iter()
+                            .map(|(dof, c)| c * solution.d[*dof])
+                            .sum()
+                    })
+                };
+                let forces_t = per_entry(&slips, &solution.tangential);
+                let mut changed = false;
+                if !returned {
+                    returned = true;
+                    for i in 0..entries.len() {
+                        if let Friction::Return { r } = pairs[entries[i].0].options.friction
+                            && r > 0.0
+                        {
+                            slips[i] = Slip::Return((1.0 - r) * slip_of(i));
+                            changed = true;
+                        }
+                    }
+                }
+                for i in 0..entries.len() {
+                    let Friction::Coulomb { mu } = pairs[entries[i].0].options.friction else {
+                        continue;
+                    };
+                    let tau = solution.forces[i];
+                    let tol = pairs[entries[i].0].options.tolerance;
+                    match slips[i] {
+                        Slip::Stick if forces_t[i].abs() > mu * tau * (1.0 + 1e-9) => {
+                            slips[i] = Slip::Slide(mu * forces_t[i].signum());
+                            changed = true;
+                        }
+                        // the friction force may not push along the slip
+                        Slip::Slide(c) if c * slip_of(i) > 1e-3 * tol.max(1e-300) => {
+                            slips[i] = Slip::Stick;
+                            changed = true;
+                        }
+                        _ => {}
+                    }
+                }
+                if changed && pass < 50 {
+                    forces = solution.forces.clone();
+                    continue;
+                }
                 let forces = solution.forces.clone();
-                return Ok(self.finish(model, solution, length, entries, forces));
+                let sliding = slips
+                    .iter()
+                    .map(|s| match s {
+                        Slip::Slide(c) => *c,
+                        _ => 0.0,
+                    })
+                    .collect();
+                return Ok(self.finish(model, solution, length, entries, forces, forces_t, sliding));
             }
-            if !split && alpha > 1e-6 && alpha < 1.0 {
+            if !split && alpha > MIN_SPLIT && alpha < 1.0 {
                 // Erklig 2.1.4: end the step where the first slave touches
                 length *= alpha;
                 split = true;
+                returned = false;
                 forces = solution.forces.clone();
                 continue;
             }
             forces = solution.forces.clone();
             for e in penetrating {
                 entries.push(e);
+                slips.push(match pairs[e.0].options.friction {
+                    Friction::Coulomb { .. } => Slip::Stick,
+                    _ => Slip::Free,
+                });
                 forces.push(0.0);
             }
         }
@@ -195,6 +326,8 @@ impl ContactState {
         length: f64,
         mut entries: Vec<(usize, usize)>,
         mut forces: Vec<f64>,
+        mut tangential: Vec<f64>,
+        mut sliding: Vec<f64>,
     ) -> ContactStep {
         let mut events = Events::default();
         let mut i = 0;
@@ -207,6 +340,8 @@ impl ContactState {
                 events.released.push((p, k, forces[i]));
                 entries.remove(i);
                 forces.remove(i);
+                tangential.remove(i);
+                sliding.remove(i);
                 continue;
             }
             if !was_active {
@@ -229,6 +364,8 @@ impl ContactState {
             length,
             active: entries,
             forces,
+            tangential,
+            sliding,
             events,
         }
     }
@@ -297,6 +434,10 @@ impl ContactState {
     pub fn commit(&mut self, model: &Model, step: &ContactStep, time: f64, coords: &[[f64; 2]]) {
         let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
         self.set(model, &step.active, &step.forces, released, time, coords);
+        for (i, (p, k)) in step.active.iter().enumerate() {
+            self.tangential[*p][*k] = step.tangential[i];
+            self.sliding[*p][*k] = step.sliding[i];
+        }
     }
 
     /// Sets the status: the active entries and their forces after a step ending at `time`.
@@ -312,7 +453,12 @@ impl ContactState {
         for flags in &mut self.active {
             flags.iter_mut().for_each(|a| *a = false);
         }
-        for forces in &mut self.force {
+        for forces in self
+            .force
+            .iter_mut()
+            .chain(&mut self.tangential)
+            .chain(&mut self.sliding)
+        {
             forces.iter_mut().for_each(|f| *f = 0.0);
         }
         for (i, (p, k)) in active.iter().enumerate() {
@@ -480,6 +626,11 @@ impl ContactState {
         self.force.iter().map(|f| f.iter().sum()).collect()
     }
 
+    /// Total tangential (friction) force along t per pair.
+    pub fn pair_tangential_forces(&self) -> Vec<f64> {
+        self.tangential.iter().map(|f| f.iter().sum()).collect()
+    }
+
     /// Nodal contact forces (all DOFs) at positions `coords`: +tau n on slaves, -w tau n on
     /// master nodes.
     pub fn nodal_forces(&self, model: &Model, coords: &[[f64; 2]]) -> Vec<f64> {
@@ -495,6 +646,9 @@ impl ContactState {
                 };
                 for (dof, c) in gap.row(*s) {
                     f[dof] += self.force[p][k] * c;
+                }
+                for (dof, c) in gap.tangent_row(*s) {
+                    f[dof] += self.tangential[p][k] * c;
                 }
             }
         }
@@ -648,6 +802,39 @@ fn interpolated(v: &[f64], side: &MasterSide, n: [f64; 2]) -> f64 {
         .sum()
 }
 
+/// The tangential counterpart of II-8 with friction: the relative tangential velocity v_t of
+/// the slave and the master point changes at the impact by at most mu times the normal
+/// change (Coulomb: the impulses of the impact obey the friction law, so a slave sticks when
+/// |v_t| <= mu |dv_n| and slides on otherwise), or by R v_t (Greco's return: R = 0 keeps
+/// the tangential motion, R = 1 stops it). Momentum is shared by the lumped masses.
+fn tangential_impact(
+    pair: &ContactPair,
+    s: usize,
+    gap: &Gap,
+    master: Option<&MasterSide>,
+    lumped: &[f64],
+    velocity: &mut [f64],
+    normal_change: f64,
+) {
+    let t = gap.tangent();
+    let vm = master.map_or(0.0, |m| interpolated(velocity, m, t));
+    let relative = normal_component(velocity, s, t) - vm;
+    let change = match pair.options.friction {
+        Friction::None => return,
+        Friction::Coulomb { mu } => -relative.signum() * relative.abs().min(mu * normal_change),
+        Friction::Return { r } => -r * relative,
+    };
+    let ms = lumped[2 * s];
+    match master {
+        None => add_normal(velocity, s, t, change),
+        Some(side) => {
+            let share = side.mass / (ms + side.mass);
+            add_normal(velocity, s, t, share * change);
+            spread(velocity, side, t, -(1.0 - share) * change);
+        }
+    }
+}
+
 /// Hughes II-8 for one slave: the common normal velocity from the impedances and the
 /// previous velocities, the common acceleration from the masses, and the force that keeps
 /// the equations of motion.
@@ -683,6 +870,16 @@ fn impact(
         }
     };
     *force += ms * (a_plus - as_now);
+    let normal_change = (v_plus - normal_component(velocity, s, n)).abs();
+    tangential_impact(
+        pair,
+        s,
+        gap,
+        master.as_ref(),
+        lumped,
+        velocity,
+        normal_change,
+    );
     add_normal(velocity, s, n, v_plus - normal_component(velocity, s, n));
     add_normal(acceleration, s, n, a_plus - as_now);
     if let Some(side) = &master {
@@ -731,8 +928,13 @@ pub fn apply_conditions(
             acceleration,
             &mut step.forces[i],
         );
-        // a compressive multiplier: II-8's correction may not turn it into a pull
+        // a compressive multiplier: II-8's correction may not turn it into a pull; the
+        // friction force follows the corrected normal force
         step.forces[i] = step.forces[i].max(0.0);
+        if let Friction::Coulomb { mu } = pair.options.friction {
+            let limit = mu * step.forces[i];
+            step.tangential[i] = step.tangential[i].clamp(-limit, limit);
+        }
     }
     for &(p, k, tau) in &step.events.released {
         let pair = &model.contacts[p];

@@ -13,7 +13,7 @@
 //! integrator formulas as the free ones.
 
 use super::contact::ContactState;
-use super::newton::{ContactStep, Counters, Inertia, Step, StepFailure};
+use super::newton::{ContactStep, Counters, Inertia, Step, StepFailure, Tangential};
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, Mass, State, System};
@@ -197,7 +197,10 @@ pub fn run(
         );
         energies.contact_work += kinetic_before_impact - mass.kinetic_energy(model, &kin.velocity);
         // one attempt of the step with a given length and active contact set
-        let attempt = |h: f64, active: &[(usize, usize)], forces: Vec<f64>| {
+        let attempt = |h: f64,
+                       active: &[(usize, usize)],
+                       forces: Vec<f64>,
+                       tangential: &[Tangential]| {
             let form = method.form(h, &kin);
             let solve_time = state.time + form.solve_fraction * h;
             let mut d: Vec<f64> = kin
@@ -238,6 +241,7 @@ pub fn run(
                     active,
                     reference: &positions,
                     forces,
+                    tangential,
                 }),
             };
             let result = step.solve(&state, d, &mut system, &mut solver, &mut counters);

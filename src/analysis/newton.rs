@@ -64,20 +64,78 @@ pub struct ContactStep<'a> {
     pub active: &'a [(usize, usize)],
     pub reference: &'a [[f64; 2]],
     pub forces: Vec<f64>,
+    /// Friction on some of the active entries.
+    pub tangential: &'a [Tangential],
 }
 
-/// A converged step: the increment, its evaluation, and the contact multipliers (tau, the
-/// compressive normal forces of the active entries, in their order).
+/// A tangential condition on active entry `entry` (an index into `active`). The slip s of a
+/// step is t . (d_s - sum w_m d_m), t = (-n_y, n_x); a tangential force f acts as f t on
+/// the slave and -w_m f t on the master nodes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tangential {
+    /// s = target, by a Lagrange multiplier (Coulomb stick: 0; Greco's return: (1 - R) times
+    /// the frictionless slip).
+    Fixed { entry: usize, target: f64 },
+    /// f = coefficient x tau of the entry (Coulomb slide: +-mu), a known force in each
+    /// iteration (tau of the last solve).
+    Sliding { entry: usize, coefficient: f64 },
+}
+
+/// A converged step: the increment, its evaluation, the contact multipliers (tau, the
+/// compressive normal forces of the active entries, in their order) and the tangential
+/// forces of the `tangential` conditions (in theirs).
 pub struct Solution {
     pub d: Vec<f64>,
     pub evaluation: Evaluation,
     pub forces: Vec<f64>,
+    pub tangential: Vec<f64>,
 }
 
-/// Active constraint rows restricted to the free DOFs, and their gaps.
+/// Active constraint rows restricted to the free DOFs, and their gaps (normal rows first,
+/// then the fixed tangential ones); the sliding rows carry known forces.
 struct Rows {
     rows: Vec<Vec<(usize, f64)>>,
     gaps: Vec<f64>,
+    /// The number of normal rows (the first ones).
+    normal: usize,
+    sliding: Vec<(Vec<(usize, f64)>, usize, f64)>,
+}
+
+impl Rows {
+    fn empty() -> Rows {
+        Rows {
+            rows: Vec::new(),
+            gaps: Vec::new(),
+            normal: 0,
+            sliding: Vec::new(),
+        }
+    }
+
+    /// The sliding forces for normal multipliers `forces`, added into a free-DOF vector.
+    fn add_sliding_forces(&self, forces: &[f64], target: &mut [f64]) {
+        for (row, entry, coefficient) in &self.sliding {
+            let f = coefficient * forces.get(*entry).copied().unwrap_or(0.0);
+            for (eq, c) in row {
+                target[*eq] += f * c;
+            }
+        }
+    }
+
+    /// The tangential forces in the order of `ContactStep::tangential`, from the multipliers
+    /// of a solve (normal rows, then fixed tangential rows).
+    fn tangential_forces(&self, tangential: &[Tangential], multipliers: &[f64]) -> Vec<f64> {
+        let mut fixed = self.normal;
+        tangential
+            .iter()
+            .map(|t| match t {
+                Tangential::Fixed { .. } => {
+                    fixed += 1;
+                    multipliers[fixed - 1]
+                }
+                Tangential::Sliding { entry, coefficient } => coefficient * multipliers[*entry],
+            })
+            .collect()
+    }
 }
 
 impl ContactStep<'_> {
@@ -88,7 +146,12 @@ impl ContactStep<'_> {
                 self.reference[n][1] + d[2 * n + 1],
             ]
         };
-        let mut rows = Vec::with_capacity(self.active.len());
+        let free = |row: Vec<(usize, f64)>| -> Vec<(usize, f64)> {
+            row.into_iter()
+                .filter_map(|(dof, c)| system.equation[dof].map(|eq| (eq, c)))
+                .collect()
+        };
+        let mut rows = Rows::empty();
         let mut gaps = Vec::with_capacity(self.active.len());
         for &(pair, slave) in self.active {
             let gap = self.pairs[pair].gap(slave, &x).ok_or_else(|| {
@@ -97,15 +160,26 @@ impl ContactStep<'_> {
                     self.pairs[pair].name
                 ))
             })?;
-            let row = gap
-                .row(slave)
-                .into_iter()
-                .filter_map(|(dof, c)| system.equation[dof].map(|eq| (eq, c)))
-                .collect();
-            rows.push(row);
-            gaps.push(gap.gap);
+            rows.rows.push(free(gap.row(slave)));
+            rows.gaps.push(gap.gap);
+            gaps.push(gap);
         }
-        Ok(Rows { rows, gaps })
+        rows.normal = rows.rows.len();
+        for t in self.tangential {
+            match *t {
+                Tangential::Fixed { entry, target } => {
+                    let row = gaps[entry].tangent_row(self.active[entry].1);
+                    let slip: f64 = row.iter().map(|(dof, c)| c * d[*dof]).sum();
+                    rows.rows.push(free(row));
+                    rows.gaps.push(slip - target);
+                }
+                Tangential::Sliding { entry, coefficient } => {
+                    let row = free(gaps[entry].tangent_row(self.active[entry].1));
+                    rows.sliding.push((row, entry, coefficient));
+                }
+            }
+        }
+        Ok(rows)
     }
 }
 
@@ -212,10 +286,17 @@ impl Step<'_> {
         counters: &mut Counters,
     ) -> Result<Solution, StepFailure> {
         let newton = self.newton;
-        let mut forces = self
-            .contact
-            .as_ref()
-            .map_or(Vec::new(), |c| c.forces.clone());
+        // the multipliers: normal, then the fixed tangential rows (which start from zero)
+        let mut forces = self.contact.as_ref().map_or(Vec::new(), |c| {
+            let fixed = c
+                .tangential
+                .iter()
+                .filter(|t| matches!(t, Tangential::Fixed { .. }))
+                .count();
+            let mut f = c.forces.clone();
+            f.resize(f.len() + fixed, 0.0);
+            f
+        });
         let damping = match &self.inertia {
             Some(i) if i.rayleigh[1] > 0.0 => {
                 self.evaluate(state, &vec![0.0; d.len()], Some(&mut *system))?;
@@ -233,13 +314,13 @@ impl Step<'_> {
                 newton.strategy == Strategy::Full || (iteration == 0 && self.factor_first);
             let evaluation = self.evaluate(state, &d, refactor.then_some(&mut *system))?;
             let (residual, scale) = self.residual(&d, &evaluation, system, &damping, external_norm);
+            let (mut residual, scale) = (residual, scale);
             let rows = match &self.contact {
                 Some(c) => c.rows(&d, system)?,
-                None => Rows {
-                    rows: Vec::new(),
-                    gaps: Vec::new(),
-                },
+                None => Rows::empty(),
             };
+            // sliding friction: known forces from the last solve's normal multipliers
+            rows.add_sliding_forces(&forces, &mut residual);
             // the equilibrium residual includes the contact forces of the last solve
             let mut balance = residual.clone();
             add_constraint_forces(&rows, &forces, &mut balance);
@@ -262,10 +343,16 @@ impl Step<'_> {
                 && ((eps_displacement < newton.tol_displacement && eps_force < newton.tol_force)
                     || residual_norm == 0.0);
             if converged {
+                let tangential = match &self.contact {
+                    Some(c) => rows.tangential_forces(c.tangential, &forces),
+                    None => Vec::new(),
+                };
+                forces.truncate(rows.normal);
                 return Ok(Solution {
                     d,
                     evaluation,
                     forces,
+                    tangential,
                 });
             }
             if iteration == newton.max_iterations {

@@ -4,6 +4,7 @@
 use super::Summary;
 use super::contact::ContactState;
 use crate::assembly::State;
+use crate::contact::Friction;
 use crate::material::{pressure, von_mises};
 use crate::mesh::Cells;
 use crate::output::history::History;
@@ -71,6 +72,13 @@ impl Recorder {
                 .iter()
                 .map(|c| format!("contact_force[{}]", c.name)),
         );
+        columns.extend(
+            model
+                .contacts
+                .iter()
+                .filter(|c| c.options.friction != Friction::None)
+                .map(|c| format!("tangential_force[{}]", c.name)),
+        );
         columns.extend(model.probes.iter().map(|p| p.column.clone()));
         let history = History::create(&dir.join("history.csv"), &columns)?;
         Ok(Recorder {
@@ -115,9 +123,25 @@ impl Recorder {
             energies.external_work,
             energies.contact_work,
         ];
+        let friction: Vec<bool> = model
+            .contacts
+            .iter()
+            .map(|c| c.options.friction != Friction::None)
+            .collect();
         match contact {
-            Some(c) => row.extend(c.pair_forces()),
-            None => row.extend(std::iter::repeat_n(0.0, model.contacts.len())),
+            Some(c) => {
+                row.extend(c.pair_forces());
+                row.extend(
+                    c.pair_tangential_forces()
+                        .into_iter()
+                        .zip(&friction)
+                        .filter_map(|(f, on)| on.then_some(f)),
+                );
+            }
+            None => row.extend(std::iter::repeat_n(
+                0.0,
+                model.contacts.len() + friction.iter().filter(|f| **f).count(),
+            )),
         }
         row.extend(
             model

@@ -10,7 +10,7 @@
 //! the run stops `diverged` with its output so far kept. After a cut the step grows back.
 
 use super::contact::ContactState;
-use super::newton::{ContactStep, Counters, Step, StepFailure};
+use super::newton::{ContactStep, Counters, Step, StepFailure, Tangential};
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, State, System};
@@ -76,35 +76,37 @@ pub fn run(
             Strategy::Initial => !solver.is_factored() || control.after_cut(),
         };
         // one attempt of the increment with a given length and active contact set
-        let attempt = |h: f64, active: &[(usize, usize)], forces: Vec<f64>| {
-            let end = if state.time + h >= target {
-                target
-            } else {
-                state.time + h
+        let attempt =
+            |h: f64, active: &[(usize, usize)], forces: Vec<f64>, tangential: &[Tangential]| {
+                let end = if state.time + h >= target {
+                    target
+                } else {
+                    state.time + h
+                };
+                let mut d = vec![0.0; model.dofs()];
+                for (dof, value) in loads::prescribed(model, &initial, end) {
+                    d[dof] = value - state.displacement[dof];
+                }
+                let external = loads::external_force(model, &state, &initial, end);
+                let step = Step {
+                    model,
+                    geometry: spec.geometry,
+                    newton: &spec.newton,
+                    inertia: None,
+                    form: &form,
+                    external: &external,
+                    internal_start: &last_force,
+                    factor_first,
+                    contact: Some(ContactStep {
+                        pairs: &model.contacts,
+                        active,
+                        reference: &positions,
+                        forces,
+                        tangential,
+                    }),
+                };
+                step.solve(&state, d, &mut system, &mut solver, &mut counters)
             };
-            let mut d = vec![0.0; model.dofs()];
-            for (dof, value) in loads::prescribed(model, &initial, end) {
-                d[dof] = value - state.displacement[dof];
-            }
-            let external = loads::external_force(model, &state, &initial, end);
-            let step = Step {
-                model,
-                geometry: spec.geometry,
-                newton: &spec.newton,
-                inertia: None,
-                form: &form,
-                external: &external,
-                internal_start: &last_force,
-                factor_first,
-                contact: Some(ContactStep {
-                    pairs: &model.contacts,
-                    active,
-                    reference: &positions,
-                    forces,
-                }),
-            };
-            step.solve(&state, d, &mut system, &mut solver, &mut counters)
-        };
         // an event inside the increment ends it early (Erklig 2.1.4: alpha brings the next
         // node exactly into contact before the boundary conditions change)
         match contact.step(model, &positions, target - state.time, attempt) {

@@ -87,6 +87,21 @@ pub struct PairOptions {
     pub search_distance: f64,
     /// Split a step (or load increment) at the first contact event inside it.
     pub split_at_events: bool,
+    /// The tangential law of the interface.
+    pub friction: Friction,
+}
+
+/// The tangential law of a contact pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Friction {
+    /// No tangential force.
+    None,
+    /// Coulomb: stick (a tangential Lagrange multiplier) while |t| <= mu tau, else slide with
+    /// |t| = mu tau against the slip.
+    Coulomb { mu: f64 },
+    /// Greco's geometric return (eq 36): the slide of each step is (1 - R) times the slide
+    /// the step would have without friction (R = 0 frictionless, R = 1 adherence).
+    Return { r: f64 },
 }
 
 /// A validated contact pair.
@@ -117,6 +132,23 @@ impl Gap {
         for (m, w) in &self.masters {
             row.push((2 * m, -w * n[0]));
             row.push((2 * m + 1, -w * n[1]));
+        }
+        row
+    }
+
+    /// The tangent t = (-n_y, n_x): the direction of positive slip.
+    pub fn tangent(&self) -> [f64; 2] {
+        [-self.normal[1], self.normal[0]]
+    }
+
+    /// The tangential row t . (x_s - sum w_m x_m) as (DOF, coefficient) pairs: applied to an
+    /// increment it gives the relative slip of the slave along the master.
+    pub fn tangent_row(&self, slave: usize) -> Vec<(usize, f64)> {
+        let t = self.tangent();
+        let mut row = vec![(2 * slave, t[0]), (2 * slave + 1, t[1])];
+        for (m, w) in &self.masters {
+            row.push((2 * m, -w * t[0]));
+            row.push((2 * m + 1, -w * t[1]));
         }
         row
     }
@@ -454,6 +486,7 @@ mod tests {
             tolerance: 1e-10,
             search_distance: f64::INFINITY,
             split_at_events: true,
+            friction: Friction::None,
         }
     }
 

@@ -11,7 +11,7 @@ use super::spec::{
     Quantity, Scene, StaticSpec,
 };
 use crate::assembly::MassKind;
-use crate::contact::{ContactPair, Master, Obstacle, PairOptions};
+use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
 use crate::element::{Formulation, Geometry, Voigt, quad4, rod2};
 use crate::material::{Elastic, Hardening, J2, Material};
 use crate::mesh::{Cells, Mesh};
@@ -262,6 +262,17 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         return Err(cx.err(format!(
             "contact[{k}].name: `{}` is used twice",
             contacts[k].name
+        )));
+    }
+    if let Analysis::Dynamic(d) = &analysis
+        && d.integrator == crate::scene::spec::IntegratorKind::CentralDifference
+        && let Some(c) = contacts
+            .iter()
+            .find(|c| c.options.friction != Friction::None)
+    {
+        return Err(cx.err(format!(
+            "contact `{}`: friction is implemented for the implicit integrators and statics; the explicit central difference contact is frictionless",
+            c.name
         )));
     }
     let mut initial_velocity = vec![0.0; 2 * node_count];
@@ -939,6 +950,26 @@ fn contact(
             spec.release_fraction
         )));
     }
+    let friction = match (spec.friction, spec.return_coefficient) {
+        (None, None) => Friction::None,
+        (Some(mu), None) if mu >= 0.0 && mu.is_finite() => Friction::Coulomb { mu },
+        (Some(mu), None) => {
+            return Err(cx.err(format!(
+                "{key}.friction: the Coulomb coefficient must be finite and >= 0, got {mu}"
+            )));
+        }
+        (None, Some(r)) if (0.0..=1.0).contains(&r) => Friction::Return { r },
+        (None, Some(r)) => {
+            return Err(cx.err(format!(
+                "{key}.return_coefficient: must lie in [0, 1] (0 frictionless, 1 adherence), got {r}"
+            )));
+        }
+        (Some(_), Some(_)) => {
+            return Err(cx.err(format!(
+                "{key}: give `friction` (Coulomb) or `return_coefficient` (Greco), not both"
+            )));
+        }
+    };
     let size = model_size(bodies);
     let tolerance = spec.tolerance.unwrap_or(1e-9 * size);
     if !(tolerance >= 0.0 && tolerance.is_finite()) {
@@ -960,6 +991,7 @@ fn contact(
             tolerance,
             search_distance,
             split_at_events: spec.split_at_events,
+            friction,
         },
     })
 }

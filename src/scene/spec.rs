@@ -231,6 +231,10 @@ pub struct ContactSpec {
     /// Split a step at the first contact event inside it (Erklig 2.1.4). Default true.
     #[serde(default = "yes")]
     pub split_at_events: bool,
+    /// Coulomb friction coefficient mu (stick/slip). Default: frictionless.
+    pub friction: Option<f64>,
+    /// Greco's return coefficient R in [0, 1] (eq 36), instead of `friction`.
+    pub return_coefficient: Option<f64>,
 }
 
 fn yes() -> bool {
