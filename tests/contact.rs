@@ -409,7 +409,7 @@ fn ring_wall(name: &str, overrides: &[&str]) -> (Run, f64, [f64; 2]) {
 /// momentum stays to 1e-8 relative (round-off: measured 1e-11); the trapezoidal rule keeps
 /// kinetic plus strain energy once the ring has left the wall, within 1 % (the impact
 /// conditions take the closing nodes' normal kinetic energy, the event splits leave a
-/// small gain: measured +0.3 %); the ring leaves at a steeper angle than it came (45
+/// small gain: measured +0.13 %); the ring leaves at a steeper angle than it came (45
 /// degrees from the normal) because its vibration keeps part of the normal energy.
 #[test]
 fn ring_wall_frictionless_keeps_tangential_momentum_and_energy() {
@@ -434,8 +434,9 @@ fn ring_wall_frictionless_keeps_tangential_momentum_and_energy() {
 }
 
 /// Goal: Coulomb friction in an oblique impact. Setup: ring_wall with mu = 0.3. Reference
-/// (the friction law on impulses): the wall's tangential impulse (the change of tangential
-/// momentum) is at most mu times its normal impulse (1e-9); the friction force never exceeds
+/// (the friction law on impulses): at every step the wall's tangential impulse so far (the
+/// change of tangential momentum) is at most mu times its normal impulse (1e-8: the Newton
+/// tolerance; while the ring slides the two are equal to 4e-9); the friction force never exceeds
 /// mu N in a step; friction turns the rebound towards the normal (angle below 45 degrees:
 /// the tangential velocity falls, the normal rebound does not grow).
 #[test]
@@ -443,10 +444,12 @@ fn ring_wall_coulomb_friction_obeys_the_impulse_bound() {
     let mu = 0.3;
     let (r, angle, impulse) = ring_wall("ring_wall_coulomb", &["contact.floor.friction=0.3"]);
     assert!(impulse[0] < 0.0, "friction slows the tangential motion");
-    assert!(
-        impulse[0].abs() <= mu * impulse[1] * (1.0 + 1e-9),
-        "{impulse:?}"
-    );
+    // at every step, the impulses so far: the momentum changes since the start
+    let (px, py) = (column(&r.dir, "p_x[all]"), column(&r.dir, "p_y[all]"));
+    for (x, y) in px.iter().zip(&py) {
+        let (jt, jn) = (x - px[0], y - py[0]);
+        assert!(jt.abs() <= mu * jn * (1.0 + 1e-8) + 1e-12, "{jt} > mu {jn}");
+    }
     let normal = column(&r.dir, "contact_force[floor]");
     let tangential = column(&r.dir, "tangential_force[floor]");
     for (t, n) in tangential.iter().zip(&normal) {

@@ -59,8 +59,8 @@ pub struct ContactState {
 pub struct Events {
     /// (pair, slave index) entries that closed in the step.
     pub closed: Vec<(usize, usize)>,
-    /// Entries released by the fraction rule, with their last force.
-    pub released: Vec<(usize, usize, f64)>,
+    /// Entries released by the fraction rule, with their last normal and tangential forces.
+    pub released: Vec<(usize, usize, f64, f64)>,
     /// Entries released because they went into tension.
     pub separated: Vec<(usize, usize)>,
 }
@@ -337,7 +337,7 @@ impl ContactState {
             let was_active = self.active[p][k];
             let fraction = model.contacts[p].options.release_fraction;
             if was_active && previous > 0.0 && forces[i] < fraction * previous {
-                events.released.push((p, k, forces[i]));
+                events.released.push((p, k, forces[i], tangential[i]));
                 entries.remove(i);
                 forces.remove(i);
                 tangential.remove(i);
@@ -802,17 +802,20 @@ fn interpolated(v: &[f64], side: &MasterSide, n: [f64; 2]) -> f64 {
         .sum()
 }
 
-/// The tangential counterpart of II-8 with friction: the relative tangential velocity v_t of
-/// the slave and the master point changes at the impact by at most mu times the normal
-/// change (Coulomb: the impulses of the impact obey the friction law, so a slave sticks when
-/// |v_t| <= mu |dv_n| and slides on otherwise), or by R v_t (Greco's return: R = 0 keeps
-/// the tangential motion, R = 1 stops it). Momentum is shared by the lumped masses.
+/// The tangential counterpart of II-8 with friction: a change dv_n of the normal velocity
+/// (positive: a push out of the master) comes with a change of the relative tangential
+/// velocity v_t by -sign(v_t) mu dv_n, at most down to v_t = 0 (Coulomb: the impulse of the
+/// condition obeys the friction law; a pull, which takes back part of the step's normal
+/// impulse, gives back the friction that came with it), or by -R v_t (Greco's return: R = 0
+/// keeps the tangential motion, R = 1 stops it). The give-back turns v_t towards its value
+/// before the step and stops there. Momentum is shared by the lumped masses.
 fn tangential_impact(
     pair: &ContactPair,
     s: usize,
     gap: &Gap,
     master: Option<&MasterSide>,
     lumped: &[f64],
+    previous_velocity: &[f64],
     velocity: &mut [f64],
     normal_change: f64,
 ) {
@@ -821,17 +824,23 @@ fn tangential_impact(
     let relative = normal_component(velocity, s, t) - vm;
     let change = match pair.options.friction {
         Friction::None => return,
-        Friction::Coulomb { mu } => -relative.signum() * relative.abs().min(mu * normal_change),
+        Friction::Coulomb { mu } if normal_change > 0.0 => {
+            -relative.signum() * relative.abs().min(mu * normal_change)
+        }
+        Friction::Coulomb { mu } => {
+            // towards the tangential velocity before the step, and no further
+            let before = normal_component(previous_velocity, s, t)
+                - master.map_or(0.0, |m| interpolated(previous_velocity, m, t));
+            let limit = -mu * normal_change;
+            (before - relative).clamp(-limit, limit)
+        }
         Friction::Return { r } => -r * relative,
     };
     let ms = lumped[2 * s];
-    match master {
-        None => add_normal(velocity, s, t, change),
-        Some(side) => {
-            let share = side.mass / (ms + side.mass);
-            add_normal(velocity, s, t, share * change);
-            spread(velocity, side, t, -(1.0 - share) * change);
-        }
+    let share = master.map_or(1.0, |side| side.mass / (ms + side.mass));
+    add_normal(velocity, s, t, share * change);
+    if let Some(side) = master {
+        spread(velocity, side, t, -(1.0 - share) * change);
     }
 }
 
@@ -869,14 +878,29 @@ fn impact(
             )
         }
     };
-    *force += ms * (a_plus - as_now);
-    let normal_change = (v_plus - normal_component(velocity, s, n)).abs();
+    // II-8's force; were it a pull, the pair's accelerations only lose the present force
+    // (the multiplier stays compressive and the equations of motion hold with it)
+    let tau_plus = *force + ms * (a_plus - as_now);
+    let (a_plus, master_acceleration) = if tau_plus >= 0.0 {
+        (a_plus, None)
+    } else {
+        let released = *force;
+        (
+            as_now - released / ms,
+            master.as_ref().map(|side| {
+                interpolated(acceleration, side, n) + released / side.mass.max(f64::MIN_POSITIVE)
+            }),
+        )
+    };
+    *force = tau_plus.max(0.0);
+    let normal_change = v_plus - normal_component(velocity, s, n);
     tangential_impact(
         pair,
         s,
         gap,
         master.as_ref(),
         lumped,
+        previous_velocity,
         velocity,
         normal_change,
     );
@@ -886,7 +910,12 @@ fn impact(
         let vm = interpolated(velocity, side, n);
         let am = interpolated(acceleration, side, n);
         spread(velocity, side, n, v_plus - vm);
-        spread(acceleration, side, n, a_plus - am);
+        spread(
+            acceleration,
+            side,
+            n,
+            master_acceleration.unwrap_or(a_plus) - am,
+        );
     }
 }
 
@@ -929,14 +958,28 @@ pub fn apply_conditions(
             &mut step.forces[i],
         );
         // a compressive multiplier: II-8's correction may not turn it into a pull; the
-        // friction force follows the corrected normal force
+        // friction force follows the corrected normal force (a sliding entry's stays mu tau,
+        // a sticking one's is held within it), and the slave's tangential acceleration with it
         step.forces[i] = step.forces[i].max(0.0);
         if let Friction::Coulomb { mu } = pair.options.friction {
+            let old = step.tangential[i];
             let limit = mu * step.forces[i];
-            step.tangential[i] = step.tangential[i].clamp(-limit, limit);
+            step.tangential[i] = if step.sliding[i] != 0.0 {
+                step.sliding[i] * step.forces[i]
+            } else {
+                old.clamp(-limit, limit)
+            };
+            let t = gap.tangent();
+            let change = step.tangential[i] - old;
+            add_normal(acceleration, s, t, change / lumped[2 * s]);
+            if let Some(side) = master_side(model, pair, &gap, lumped, coords)
+                && side.mass > 0.0
+            {
+                spread(acceleration, &side, t, -change / side.mass);
+            }
         }
     }
-    for &(p, k, tau) in &step.events.released {
+    for &(p, k, tau, friction) in &step.events.released {
         let pair = &model.contacts[p];
         if !pair.options.release_conditions {
             continue;
@@ -947,9 +990,13 @@ pub fn apply_conditions(
         let (ms, zs) = (lumped[2 * s], impedance(model, pair.slave_body, s, coords));
         add_normal(velocity, s, n, tau / zs);
         add_normal(acceleration, s, n, -tau / ms);
+        // the friction force goes with the normal one (its acceleration, as in II-12)
+        let t = gap.tangent();
+        add_normal(acceleration, s, t, -friction / ms);
         if let Some(side) = master_side(model, pair, &gap, lumped, coords) {
             spread(velocity, &side, n, -tau / side.impedance);
             spread(acceleration, &side, n, tau / side.mass);
+            spread(acceleration, &side, t, friction / side.mass);
         }
     }
 }
