@@ -1,6 +1,7 @@
 //! The drivers: static load stepping (dynamic time stepping plugs in beside it), with the
 //! run's bookkeeping and its output (VTK frames, history.csv, summary.json).
 
+pub mod buckling;
 pub mod contact;
 pub mod dynamics;
 pub mod explicit;

@@ -9,6 +9,27 @@ pub fn lame_radial_displacement(p: f64, a: f64, b: f64, young: f64, poisson: f64
         * ((1.0 - 2.0 * poisson) * r + b * b / r)
 }
 
+/// Euler's critical load of an elastic column, P_E = pi^2 E I / (K L)^2 (effective-length
+/// factor K = 1 pinned-pinned, 2 cantilever). A plane-stress strip of depth h and thickness t
+/// has I = t h^3 / 12.
+pub fn euler_load(young: f64, inertia: f64, length: f64, k: f64) -> f64 {
+    std::f64::consts::PI.powi(2) * young * inertia / (k * length).powi(2)
+}
+
+/// Euler's load reduced by the shear flexibility (Engesser; Timoshenko and Gere, Theory of
+/// Elastic Stability, section 2.16): P = P_E / (1 + P_E / (kappa G A)), kappa = 5/6 for a
+/// rectangle.
+pub fn shear_corrected_load(euler: f64, shear_modulus: f64, area: f64, kappa: f64) -> f64 {
+    euler / (1.0 + euler / (kappa * shear_modulus * area))
+}
+
+/// Large deflection of a pinned-pinned elastica beyond P_E (Timoshenko and Gere, section
+/// 2.7, first terms of the elliptic-integral series): P / P_E = 1 + (pi^2 / 8) (w / L)^2,
+/// so the midspan deflection w / L = sqrt(8 (P / P_E - 1)) / pi (valid for w / L < ~0.2).
+pub fn elastica_midspan_deflection(load_ratio: f64) -> f64 {
+    (8.0 * (load_ratio - 1.0).max(0.0)).sqrt() / std::f64::consts::PI
+}
+
 /// Tip of an inextensible elastic cantilever (the elastica) of length 1, clamped at s = 0
 /// along x, under a dead tip load perpendicular to the initial axis with k = P L^2 / (E I).
 /// Returns (shortening u / L, deflection w / L, tip rotation).
