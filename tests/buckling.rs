@@ -265,3 +265,174 @@ fn study_other_columns() {
         }
     }
 }
+
+/// The pinned column (L / h = 25, 200 x 4 elements) load-stepped in pseudo time: the end
+/// load P(t) = P_E c(t) with the curve c below, fine steps (0.6 % of P_E) around P_E.
+const STEPPED: &str = r#"
+[[material]]
+name = "steel"
+young = 1.2e6
+poisson = 0.3
+
+[[body]]
+name = "column"
+material = "steel"
+formulation = "plane_stress"
+mesh = { type = "rectangle", width = 10.0, height = 0.4, nx = 200, ny = 4 }
+
+[[node_set]]
+name = "mid_left"
+nearest = [0.0, 0.2]
+
+[[node_set]]
+name = "mid_right"
+nearest = [10.0, 0.2]
+
+[[node_set]]
+name = "mid"
+nearest = [5.0, 0.2]
+
+[[support]]
+set = "mid_left"
+fix = ["x", "y"]
+
+[[support]]
+set = "mid_right"
+fix = ["y"]
+
+[[curve]]
+name = "ramp"
+points = [[0.0, 0.0], [0.5, 0.97], [1.0, 1.03]]
+
+[[load]]
+type = "traction"
+set = "left"
+traction = [1579.1367, 0.0]     # P_E / h
+curve = "ramp"
+
+[[load]]
+type = "traction"
+set = "right"
+traction = [-1579.1367, 0.0]
+curve = "ramp"
+
+[analysis]
+type = "static"
+steps = 20
+geometry = "nonlinear"
+
+[analysis.buckling]
+check = true
+
+[output]
+frame_every = 0
+
+[[output.probe]]
+quantity = "u_y"
+set = "mid"
+"#;
+
+/// Goal: load stepping a perfect column, the inertia of K_T changes (one negative pivot)
+/// within 2 % of Euler's load. Setup: STEPPED; Newton with the elastic tangent (K_0: the
+/// straight path beyond P_E is unstable, K_T indefinite, so Cholesky of K_T would fail;
+/// the check assembles and counts K_T itself). Reference: P_E. Tolerance 2 % (the issue's):
+/// this mesh's lambda_1 is 0.7 % above P_E, the prebuckling shortening adds ~0.3 %, and the
+/// steps are 0.6 % of P_E.
+#[test]
+fn load_stepping_perfect_column_loses_definiteness_at_euler_load() {
+    let model = common::model(
+        "stepped_perfect",
+        STEPPED,
+        &["analysis.newton.tangent=elastic"],
+    );
+    let (summary, _) = common::run("stepped_perfect", &model);
+    let b = summary.buckling.expect("buckling summary");
+    assert_eq!(b.initial_negative_pivots, Some(0));
+    let t = b.inertia_change_time.expect("the inertia changes");
+    let ramp = |t: f64| {
+        if t <= 0.5 {
+            0.97 * t / 0.5
+        } else {
+            0.97 + 0.06 * (t - 0.5) / 0.5
+        }
+    };
+    let ratio = ramp(t);
+    eprintln!("perfect column: inertia change at t = {t}, P / P_E = {ratio}");
+    assert_eq!(b.negative_pivots_at_change, Some(1));
+    assert!(
+        ratio > 1.0 && ratio < 1.02,
+        "P / P_E = {ratio} at the change"
+    );
+    // history.csv: zero negative pivots up to the change, one from there on
+    let dir = std::env::temp_dir()
+        .join(format!("impact-tests-{}", std::process::id()))
+        .join("stepped_perfect");
+    let time = common::column(&dir, "time");
+    let pivots = common::column(&dir, "tangent_negative_pivots");
+    for (t_row, n) in time.iter().zip(&pivots) {
+        assert_eq!(
+            *n,
+            if *t_row < t - 1e-12 { 0.0 } else { 1.0 },
+            "t = {t_row}"
+        );
+    }
+}
+
+/// Goal: with an imperfection, load stepping follows the post-buckling path: the lateral
+/// deflection grows as the amplification e / (1 - P / P_E) before P_E and as the elastica
+/// beyond it. Setup: STEPPED with the imperfection amplitude e = 1e-3 L times mode 1 (a
+/// half sine), 200 x 8 elements, full Newton, loads up to 1.05 P_E. References: linear amplification of a
+/// sinusoidal imperfection, w = e (P / P_E) / (1 - P / P_E) added (Timoshenko and Gere 1.12);
+/// the elastica's midspan deflection at P / P_E = 1.05, w / L = sqrt(8 * 0.05) / pi.
+#[test]
+fn imperfect_column_follows_amplification_and_elastica() {
+    let model = common::model(
+        "stepped_imperfect",
+        STEPPED,
+        &[
+            "analysis.newton.strategy=full",
+            "analysis.steps=40",
+            "curve.ramp.points=[[0.0,0.0],[0.25,0.5],[0.5,0.8],[0.75,1.0],[1.0,1.05]]",
+            "analysis.buckling.imperfection.amplitude=0.01",
+            "body.column.mesh.ny=8",
+        ],
+    );
+    let (summary, _) = common::run("stepped_imperfect", &model);
+    let dir = std::env::temp_dir()
+        .join(format!("impact-tests-{}", std::process::id()))
+        .join("stepped_imperfect");
+    let time = common::column(&dir, "time");
+    let w = common::column(&dir, "u_y[mid]");
+    let pivots = common::column(&dir, "tangent_negative_pivots");
+    let at = |t: f64| {
+        let k = time.iter().position(|x| (x - t).abs() < 1e-9).unwrap();
+        w[k].abs()
+    };
+    let e = 0.01;
+    let amplified = |r: f64| e * r / (1.0 - r);
+    eprintln!(
+        "imperfect column: w(0.5 P_E) = {} (ref {}), w(0.8 P_E) = {} (ref {}), w(1.05 P_E) / L = {} (elastica {})",
+        at(0.25),
+        amplified(0.5),
+        at(0.5),
+        amplified(0.8),
+        at(1.0) / 10.0,
+        reference::elastica_midspan_deflection(1.05)
+    );
+    // this mesh's P_cr is ~0.5 % above P_E (Q4 +0.23 %, the prebuckling shortening
+    // +0.26 %); the amplification magnifies that by P_E / (P_E - P): measured -1.3 % at
+    // 0.5 P_E, -3.2 % at 0.8 P_E
+    approx::assert_relative_eq!(at(0.25), amplified(0.5), max_relative = 0.02);
+    approx::assert_relative_eq!(at(0.5), amplified(0.8), max_relative = 0.05);
+    // beyond P_E, w ~ sqrt(P / P_cr - 1): a 0.5 % shift of P_cr against the 5 % excess load
+    // is worth ~5 % in w, the imperfection adds ~1 %: measured -3.4 %
+    approx::assert_relative_eq!(
+        at(1.0) / 10.0,
+        reference::elastica_midspan_deflection(1.05),
+        max_relative = 0.08
+    );
+    // a stable-symmetric bifurcation: the imperfect path never loses definiteness
+    assert!(pivots.iter().all(|n| *n == 0.0));
+    let b = summary.buckling.expect("buckling summary");
+    assert_eq!(b.inertia_change_time, None);
+}

@@ -23,11 +23,33 @@ pub fn shear_corrected_load(euler: f64, shear_modulus: f64, area: f64, kappa: f6
     euler / (1.0 + euler / (kappa * shear_modulus * area))
 }
 
-/// Large deflection of a pinned-pinned elastica beyond P_E (Timoshenko and Gere, section
-/// 2.7, first terms of the elliptic-integral series): P / P_E = 1 + (pi^2 / 8) (w / L)^2,
-/// so the midspan deflection w / L = sqrt(8 (P / P_E - 1)) / pi (valid for w / L < ~0.2).
+/// Midspan deflection w / L of the pinned-pinned elastica (inextensible, dead axial load)
+/// at P / P_E = `load_ratio` >= 1 (Timoshenko and Gere, Theory of Elastic Stability,
+/// section 2.7): P / P_E = (2 K(k) / pi)^2, w / L = 2 k / pi, k = sin(alpha / 2), K the
+/// complete elliptic integral of the first kind (by the arithmetic-geometric mean), k by
+/// bisection. Zero below P_E.
 pub fn elastica_midspan_deflection(load_ratio: f64) -> f64 {
-    (8.0 * (load_ratio - 1.0).max(0.0)).sqrt() / std::f64::consts::PI
+    if load_ratio <= 1.0 {
+        return 0.0;
+    }
+    let elliptic_k = |k: f64| {
+        let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
+        for _ in 0..60 {
+            (a, b) = (0.5 * (a + b), (a * b).sqrt());
+        }
+        std::f64::consts::PI / (2.0 * a)
+    };
+    let ratio = |k: f64| (2.0 * elliptic_k(k) / std::f64::consts::PI).powi(2);
+    let (mut lo, mut hi) = (0.0, 1.0 - 1e-15);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if ratio(mid) < load_ratio {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    2.0 * 0.5 * (lo + hi) / std::f64::consts::PI
 }
 
 /// Tip of an inextensible elastic cantilever (the elastica) of length 1, clamped at s = 0
