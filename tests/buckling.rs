@@ -436,3 +436,92 @@ fn imperfect_column_follows_amplification_and_elastica() {
     let b = summary.buckling.expect("buckling summary");
     assert_eq!(b.inertia_change_time, None);
 }
+
+/// A clamped-clamped column (L = 20, h = 0.4: effective length L / 2, so the same Euler load
+/// as the pinned column of length 10; 400 x 4 elements; rho = 1: wave speed c = 1095) driven
+/// axially by a rigid wall moving at v = 0.0072: its right face moves as one (x prescribed
+/// on the whole face), the left face is held in x; y is fixed at the centres only, so the
+/// Poisson expansion is free and the axial strain uniform.
+const STRUCK: &str = r#"
+[[material]]
+name = "steel"
+young = 1.2e6
+poisson = 0.3
+density = 1.0
+
+[[body]]
+name = "column"
+material = "steel"
+formulation = "plane_stress"
+mesh = { type = "rectangle", width = 20.0, height = 0.4, nx = 400, ny = 4 }
+
+[[node_set]]
+name = "mid_left"
+nearest = [0.0, 0.2]
+
+[[node_set]]
+name = "mid_right"
+nearest = [20.0, 0.2]
+
+[[support]]
+set = "left"
+fix = ["x"]
+
+[[support]]
+set = "mid_left"
+fix = ["y"]
+
+[[support]]
+set = "mid_right"
+fix = ["y"]
+
+[[curve]]
+name = "wall"
+points = [[0.0, 0.0], [10.0, 10.0]]
+
+[[load]]
+type = "displacement"
+set = "right"
+x = -0.0072
+curve = "wall"
+
+[analysis]
+type = "dynamic"
+dt = 0.02
+end_time = 4.0
+geometry = "nonlinear"
+
+[analysis.buckling]
+check = true
+on_critical = "stop"
+
+[output]
+frame_every = 0
+"#;
+
+/// Goal: in a dynamic run, the check reports the time at which K_T (no mass) loses positive
+/// definiteness, and `on_critical = "stop"` ends the run there. Setup: STRUCK, Newmark
+/// average acceleration (K* = a0 M + K_T stays positive definite, so the straight path is
+/// followed). Reference: quasi-static, the axial force E A v t / L reaches the Euler load
+/// P_E = pi^2 E I / (0.5 L)^2 at t_cr = P_E L / (E A v) = 3.655, 200 wave transits L / c,
+/// so the stress wave's ripple is ~L / (c t_cr) = 0.5 % of the force. Tolerance 3 %: the
+/// mesh's P_cr is ~1 % above P_E (Q4 +0.7 %, shortening), the steps are 0.55 % of t_cr,
+/// plus the ripple.
+#[test]
+fn moving_wall_column_reports_loss_of_definiteness_time() {
+    let model = common::model("struck", STRUCK, &[]);
+    let (summary, state) = common::run("struck", &model);
+    let b = summary.buckling.expect("buckling summary");
+    let t = b.inertia_change_time.expect("the inertia changes");
+    let (l, h, v) = (20.0, 0.4, 0.0072);
+    let t_cr = euler(l, h, 0.5) * l / (YOUNG * h * v);
+    eprintln!("struck column: K_T indefinite at t = {t}, quasi-static t_cr = {t_cr}");
+    approx::assert_relative_eq!(t, t_cr, max_relative = 0.03);
+    assert!(b.stopped);
+    assert!(
+        (state.time - t).abs() < 1e-12,
+        "the run went on to {}",
+        state.time
+    );
+    assert!(summary.message.unwrap().contains("on_critical"));
+}
