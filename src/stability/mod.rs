@@ -184,7 +184,8 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The lowest `count` positive load factors of (K_0 + lambda K_sigma) phi = 0 at the
-/// committed state, ascending. Fewer are returned when fewer converge.
+/// committed state, ascending. Fewer are returned when fewer converge; none (an error) when
+/// no mu = 1 / lambda exceeds 1e-8 of the largest |mu| (tension everywhere).
 pub fn eigen_buckling(
     model: &Model,
     state: &State,
@@ -267,7 +268,12 @@ pub fn eigen_buckling(
                 }
             });
             let eigen = t.symmetric_eigen();
-            let mut order: Vec<usize> = (0..m).filter(|&i| eigen.eigenvalues[i] > 0.0).collect();
+            // mu below 1e-8 of the spectrum's largest |mu| is round-off of a zero (a mode
+            // the stresses leave alone), not a buckling load
+            let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let mut order: Vec<usize> = (0..m)
+                .filter(|&i| eigen.eigenvalues[i] > 1e-8 * largest)
+                .collect();
             order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
             let wanted: Vec<usize> = order.into_iter().take(count).collect();
             let residual =
