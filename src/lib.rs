@@ -17,3 +17,4 @@ pub mod output;
 pub mod reference;
 pub mod scene;
 pub mod solver;
+pub mod stability;

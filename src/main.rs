@@ -42,6 +42,20 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
+    /// Linearized buckling of the scene's end loads: prints the load factors lambda_i (the
+    /// end loads times lambda_i are the critical loads) and writes the mode shapes as the
+    /// frames of DIR/NAME_buckling.pvd.
+    Buckle {
+        scene: PathBuf,
+        /// How many modes. Default: `analysis.buckling.modes` of the scene, else 3.
+        #[arg(long)]
+        modes: Option<usize>,
+        /// Output folder. Default: output/<scene name>/
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
     Plot {
         history: PathBuf,
@@ -73,6 +87,12 @@ fn main() -> ExitCode {
             quiet,
         } => run(&scene, out, &set, quiet),
         Command::Check { scene, set } => check(&scene, &set),
+        Command::Buckle {
+            scene,
+            modes,
+            out,
+            set,
+        } => buckle(&scene, modes, out, &set),
         Command::Plot {
             history,
             y,
@@ -138,6 +158,46 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
             model.bodies[b].name
         );
     }
+    Ok(())
+}
+
+fn buckle(
+    path: &Path,
+    modes: Option<usize>,
+    out: Option<PathBuf>,
+    set: &[String],
+) -> Result<(), RunError> {
+    let model = scene::load(path, set)?;
+    let count = modes
+        .or(model
+            .analysis
+            .buckling()
+            .map(|b| b.modes)
+            .filter(|m| *m > 0))
+        .unwrap_or(3);
+    if count == 0 {
+        return Err(InputError::new(path, "--modes: ask for at least one mode").into());
+    }
+    let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
+    let found = analysis::buckling::linear_modes(&model, count)
+        .map_err(|e| InputError::new(path, format!("linearized buckling: {e}")))?;
+    analysis::buckling::write_modes(&model, &found, &dir)?;
+    println!(
+        "{}: linearized buckling of the loads at t = {} ({} free DOFs)",
+        model.name,
+        model.analysis.end_time(),
+        model.dofs() - analysis::loads::constrained_dofs(&model).len()
+    );
+    for (i, mode) in found.iter().enumerate() {
+        println!("  mode {}: lambda = {:.6e}", i + 1, mode.lambda);
+    }
+    if found.len() < count {
+        println!("  ({} of {count} modes converged)", found.len());
+    }
+    println!(
+        "  mode shapes: {}",
+        dir.join(format!("{}_buckling.pvd", model.name)).display()
+    );
     Ok(())
 }
 

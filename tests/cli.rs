@@ -266,3 +266,134 @@ fn run_writes_a_loadable_series_and_check_reports_size() {
         "{stdout}"
     );
 }
+
+/// A small pinned column (L / h = 25, 50 x 2 elements) for the buckling subcommand and keys.
+const COLUMN: &str = r#"
+[[material]]
+name = "steel"
+young = 1.2e6
+poisson = 0.3
+
+[[body]]
+name = "column"
+material = "steel"
+formulation = "plane_stress"
+mesh = { type = "rectangle", width = 10.0, height = 0.4, nx = 50, ny = 2 }
+
+[[node_set]]
+name = "mid_left"
+nearest = [0.0, 0.2]
+
+[[node_set]]
+name = "mid_right"
+nearest = [10.0, 0.2]
+
+[[support]]
+set = "mid_left"
+fix = ["x", "y"]
+
+[[support]]
+set = "mid_right"
+fix = ["y"]
+
+[[load]]
+type = "traction"
+set = "left"
+traction = [2.5, 0.0]
+
+[[load]]
+type = "traction"
+set = "right"
+traction = [-2.5, 0.0]
+
+[analysis]
+type = "static"
+steps = 1
+
+[analysis.buckling]
+modes = 2
+"#;
+
+/// Bad `[analysis.buckling]` input exits 2 with a message naming the key, never a panic:
+/// a misspelled key, an enum value, a zero imperfection, and loads that buckle nothing
+/// (tension: no positive load factor).
+#[test]
+fn bad_buckling_input_is_refused_with_its_key() {
+    assert_input_error(
+        "buckling_key",
+        &COLUMN.replace("modes = 2", "modes = 2\nmode = 1"),
+        &[],
+        &["mode"],
+    );
+    assert_input_error(
+        "buckling_on_critical",
+        &COLUMN.replace("modes = 2", "modes = 2\non_critical = \"halt\""),
+        &[],
+        &["halt"],
+    );
+    assert_input_error(
+        "buckling_amplitude",
+        &COLUMN.replace("modes = 2", "modes = 2\nimperfection = { amplitude = 0.0 }"),
+        &[],
+        &["analysis.buckling.imperfection.amplitude"],
+    );
+    assert_input_error(
+        "buckling_tension",
+        &COLUMN
+            .replace("[2.5, 0.0]", "[-2.5, 0.0]")
+            .replace("[-2.5, 0.0]\n\n[analysis]", "[2.5, 0.0]\n\n[analysis]"),
+        &[],
+        &["analysis.buckling", "no buckling mode"],
+    );
+}
+
+/// `impact buckle` prints the load factors and writes the modes as a loadable series;
+/// `impact run` with the check writes the history column and the summary block.
+#[test]
+fn buckle_prints_load_factors_and_writes_modes() {
+    let dir = common::out_dir("cli_buckle");
+    let scene = write_scene(&dir, "column", COLUMN);
+    let out = dir.join("out");
+    let o = impact(&[
+        "buckle",
+        scene.to_str().unwrap(),
+        "--modes",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{stdout} {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("mode 3: lambda = "), "{stdout}");
+    let frames = impact::output::vtk::read_pvd(&out.join("column_buckling.pvd")).unwrap();
+    assert_eq!(frames.len(), 3);
+    let run_out = dir.join("run");
+    let o = impact(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        run_out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        common::column(&run_out, "tangent_negative_pivots"),
+        vec![0.0, 0.0]
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_out.join("summary.json")).unwrap())
+            .unwrap();
+    let factors = summary["buckling"]["load_factors"].as_array().unwrap();
+    assert_eq!(factors.len(), 2);
+    assert!(
+        summary["buckling"]["critical_load_factor"]
+            .as_f64()
+            .unwrap()
+            > 1.0
+    );
+}

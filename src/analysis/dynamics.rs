@@ -153,6 +153,14 @@ pub fn run(
     };
     let initial_kinetic = energies.kinetic;
     summary.energy.initial = initial_kinetic;
+    let mut monitor =
+        super::buckling::Monitor::new(model, dir).map_err(|e| super::monitor_error(model, e))?;
+    if let Some(m) = &mut monitor {
+        recorder.negative_pivots = m
+            .observe(model, &state)
+            .map_err(|e| super::monitor_error(model, e.into()))?
+            .0;
+    }
     let mut last_total = total_force(
         model,
         &system,
@@ -324,7 +332,23 @@ pub fn run(
                 last_contact = contact_force;
                 summary.steps += 1;
                 increments += 1;
-                let last = state.time >= spec.end_time * (1.0 - 1e-12);
+                let mut stop = false;
+                if let Some(m) = &mut monitor {
+                    match m.observe(model, &state) {
+                        Ok((count, halt)) => {
+                            recorder.negative_pivots = count;
+                            stop = halt;
+                        }
+                        Err(e) => {
+                            progress.abandon();
+                            summary.finish(&energies, &counters, Some(&solver), start);
+                            summary.buckling = Some(m.summary.clone());
+                            let message = format!("buckling check at t = {}: {e}", state.time);
+                            return Err(super::fail(&recorder, summary, Status::Diverged, message));
+                        }
+                    }
+                }
+                let last = stop || state.time >= spec.end_time * (1.0 - 1e-12);
                 let motion = Motion {
                     velocity: &kin.velocity,
                     acceleration: &kin.acceleration,
@@ -340,6 +364,10 @@ pub fn run(
                 )?;
                 progress.set_position((state.time / spec.dt).round() as u64);
                 control.accept(true);
+                if stop {
+                    summary.message = Some(super::statics::stop_message(&state, &recorder));
+                    break;
+                }
             }
             Err(StepFailure(reason)) => {
                 method.reject();
@@ -348,6 +376,7 @@ pub fn run(
                     let message = format!("step to t = {target} {why}: {reason}");
                     summary.finish(&energies, &counters, Some(&solver), start);
                     summary.contact = contact.summary();
+                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
                     return Err(super::fail(&recorder, summary, Status::Diverged, message));
                 }
             }
@@ -356,6 +385,7 @@ pub fn run(
     summary.contact = contact.summary();
     progress.finish_and_clear();
     summary.finish(&energies, &counters, Some(&solver), start);
+    summary.buckling = monitor.map(|m| m.summary);
     recorder.write_summary(&summary)?;
     let contact_force = contact.nodal_forces(model, &state.positions(spec.geometry));
     Ok(Outcome {

@@ -1,6 +1,7 @@
 //! The drivers: static load stepping (dynamic time stepping plugs in beside it), with the
 //! run's bookkeeping and its output (VTK frames, history.csv, summary.json).
 
+pub mod buckling;
 pub mod contact;
 pub mod dynamics;
 pub mod explicit;
@@ -50,10 +51,7 @@ pub struct EnergySummary {
     pub plastic_dissipation: f64,
 }
 
-#[derive(Debug, Clone, Serialize)]
-pub struct BucklingSummary {
-    pub critical_load_factor: f64,
-}
+pub use buckling::BucklingSummary;
 
 /// summary.json (DESIGN section 5): other tools read it; fields are only ever added.
 #[derive(Debug, Clone, Serialize)]
@@ -145,6 +143,18 @@ fn fail(recorder: &Recorder, mut summary: Summary, status: Status, message: Stri
             summary: Box::new(summary),
         },
         Err(e) => RunError::Output(e),
+    }
+}
+
+/// The buckling check could not be set up: its modes (bad input: nothing to buckle, missing
+/// supports) or its frames.
+fn monitor_error(model: &Model, e: buckling::MonitorError) -> RunError {
+    match e {
+        buckling::MonitorError::Stability(e) => RunError::Input(InputError::new(
+            &model.file,
+            format!("analysis.buckling: {e}"),
+        )),
+        buckling::MonitorError::Output(e) => RunError::Output(e),
     }
 }
 
@@ -336,6 +346,13 @@ pub fn run_outcome(
     out_dir: &Path,
     options: RunOptions,
 ) -> Result<Outcome, RunError> {
+    let imperfect = buckling::with_imperfection(model).map_err(|e| {
+        InputError::new(
+            &model.file,
+            format!("analysis.buckling.imperfection: the mode cannot be computed: {e}"),
+        )
+    })?;
+    let model = imperfect.as_ref().unwrap_or(model);
     match &model.analysis {
         crate::scene::model::Analysis::Static(spec) => statics::run(model, spec, out_dir, options),
         crate::scene::model::Analysis::Dynamic(spec) => {

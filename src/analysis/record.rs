@@ -40,6 +40,10 @@ pub struct Recorder {
     frame_every: usize,
     steps_since_frame: usize,
     last_frame_time: Option<f64>,
+    /// Whether history.csv has the `tangent_negative_pivots` column.
+    pivots_column: bool,
+    /// Its value for the next row (the buckling check sets it before each step is recorded).
+    pub negative_pivots: Option<usize>,
 }
 
 impl Recorder {
@@ -80,6 +84,10 @@ impl Recorder {
                 .map(|c| format!("tangential_force[{}]", c.name)),
         );
         columns.extend(model.probes.iter().map(|p| p.column.clone()));
+        let pivots_column = model.analysis.buckling().is_some_and(|b| b.check);
+        if pivots_column {
+            columns.push("tangent_negative_pivots".to_string());
+        }
         let history = History::create(&dir.join("history.csv"), &columns)?;
         Ok(Recorder {
             dir: dir.to_path_buf(),
@@ -89,6 +97,8 @@ impl Recorder {
             frame_every: model.output.frame_every,
             steps_since_frame: 0,
             last_frame_time: None,
+            pivots_column,
+            negative_pivots: None,
         })
     }
 
@@ -149,6 +159,9 @@ impl Recorder {
                 .iter()
                 .map(|p| probe_value(model, state, motion, p)),
         );
+        if self.pivots_column {
+            row.push(self.negative_pivots.map_or(f64::NAN, |n| n as f64));
+        }
         self.history.append(&row)?;
         self.steps_since_frame += 1;
         if force_frame || (self.frame_every > 0 && self.steps_since_frame >= self.frame_every) {
@@ -209,7 +222,7 @@ impl Recorder {
 }
 
 /// All bodies in one grid: initial coordinates, quads first, then rods.
-fn grid(model: &Model) -> Grid {
+pub(crate) fn grid(model: &Model) -> Grid {
     let mut quads = Vec::new();
     let mut lines = Vec::new();
     for body in &model.bodies {

@@ -55,6 +55,14 @@ pub fn run(
     };
     let mut energies = Energies::default();
     let mut last_force = vec![0.0; model.dofs()];
+    let mut monitor =
+        super::buckling::Monitor::new(model, dir).map_err(|e| super::monitor_error(model, e))?;
+    if let Some(m) = &mut monitor {
+        recorder.negative_pivots = m
+            .observe(model, &state)
+            .map_err(|e| super::monitor_error(model, e.into()))?
+            .0;
+    }
     recorder.step(model, &state, &motion, &energies, true)?;
 
     let dt = spec.end_time / spec.steps as f64;
@@ -133,7 +141,23 @@ pub fn run(
                 last_force = force;
                 summary.steps += 1;
                 increments += 1;
-                let last = state.time >= spec.end_time * (1.0 - 1e-12);
+                let mut stop = false;
+                if let Some(m) = &mut monitor {
+                    match m.observe(model, &state) {
+                        Ok((count, halt)) => {
+                            recorder.negative_pivots = count;
+                            stop = halt;
+                        }
+                        Err(e) => {
+                            progress.abandon();
+                            summary.finish(&energies, &counters, Some(&solver), start);
+                            summary.buckling = Some(m.summary.clone());
+                            let message = format!("buckling check at t = {}: {e}", state.time);
+                            return Err(super::fail(&recorder, summary, Status::Diverged, message));
+                        }
+                    }
+                }
+                let last = stop || state.time >= spec.end_time * (1.0 - 1e-12);
                 recorder.step_with_contact(
                     model,
                     &state,
@@ -144,6 +168,10 @@ pub fn run(
                 )?;
                 progress.set_position((state.time / dt).round() as u64);
                 control.accept(end == target);
+                if stop {
+                    summary.message = Some(stop_message(&state, &recorder));
+                    break;
+                }
             }
             Err(StepFailure(reason)) => {
                 if let Err(why) = control.reject(target - state.time, &mut counters) {
@@ -151,6 +179,7 @@ pub fn run(
                     let message = format!("increment to t = {target} {why}: {reason}");
                     summary.finish(&energies, &counters, Some(&solver), start);
                     summary.contact = contact.summary();
+                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
                     return Err(super::fail(&recorder, summary, Status::Diverged, message));
                 }
             }
@@ -159,6 +188,7 @@ pub fn run(
     progress.finish_and_clear();
     summary.finish(&energies, &counters, Some(&solver), start);
     summary.contact = contact.summary();
+    summary.buckling = monitor.map(|m| m.summary);
     recorder.write_summary(&summary)?;
     let contact_force = contact.nodal_forces(model, &state.positions(spec.geometry));
     Ok(Outcome {
@@ -166,4 +196,13 @@ pub fn run(
         state,
         contact_force,
     })
+}
+
+/// summary.json `message` of a run stopped by `on_critical = "stop"`.
+pub(super) fn stop_message(state: &State, recorder: &Recorder) -> String {
+    format!(
+        "stopped by analysis.buckling.on_critical at t = {}: K_T has {} negative pivot(s)",
+        state.time,
+        recorder.negative_pivots.unwrap_or(0)
+    )
 }

@@ -9,6 +9,49 @@ pub fn lame_radial_displacement(p: f64, a: f64, b: f64, young: f64, poisson: f64
         * ((1.0 - 2.0 * poisson) * r + b * b / r)
 }
 
+/// Euler's critical load of an elastic column, P_E = pi^2 E I / (K L)^2 (effective-length
+/// factor K = 1 pinned-pinned, 2 cantilever). A plane-stress strip of depth h and thickness t
+/// has I = t h^3 / 12.
+pub fn euler_load(young: f64, inertia: f64, length: f64, k: f64) -> f64 {
+    std::f64::consts::PI.powi(2) * young * inertia / (k * length).powi(2)
+}
+
+/// Euler's load reduced by the shear flexibility (Engesser; Timoshenko and Gere, Theory of
+/// Elastic Stability, section 2.16): P = P_E / (1 + P_E / (kappa G A)), kappa = 5/6 for a
+/// rectangle.
+pub fn shear_corrected_load(euler: f64, shear_modulus: f64, area: f64, kappa: f64) -> f64 {
+    euler / (1.0 + euler / (kappa * shear_modulus * area))
+}
+
+/// Midspan deflection w / L of the pinned-pinned elastica (inextensible, dead axial load)
+/// at P / P_E = `load_ratio` >= 1 (Timoshenko and Gere, Theory of Elastic Stability,
+/// section 2.7): P / P_E = (2 K(k) / pi)^2, w / L = 2 k / pi, k = sin(alpha / 2), K the
+/// complete elliptic integral of the first kind (by the arithmetic-geometric mean), k by
+/// bisection. Zero below P_E.
+pub fn elastica_midspan_deflection(load_ratio: f64) -> f64 {
+    if load_ratio <= 1.0 {
+        return 0.0;
+    }
+    let elliptic_k = |k: f64| {
+        let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
+        for _ in 0..60 {
+            (a, b) = (0.5 * (a + b), (a * b).sqrt());
+        }
+        std::f64::consts::PI / (2.0 * a)
+    };
+    let ratio = |k: f64| (2.0 * elliptic_k(k) / std::f64::consts::PI).powi(2);
+    let (mut lo, mut hi) = (0.0, 1.0 - 1e-15);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if ratio(mid) < load_ratio {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    2.0 * 0.5 * (lo + hi) / std::f64::consts::PI
+}
+
 /// Tip of an inextensible elastic cantilever (the elastica) of length 1, clamped at s = 0
 /// along x, under a dead tip load perpendicular to the initial axis with k = P L^2 / (E I).
 /// Returns (shortening u / L, deflection w / L, tip rotation).

@@ -6,9 +6,9 @@
 
 use super::InputError;
 use super::spec::{
-    AnalysisKind, AnalysisSpec, BodySpec, Component, ContactSpec, DynamicSpec, FormulationSpec,
-    IntegratorKind, LoadSpec, MaterialSpec, NewtonSpec, NodeSetSpec, OutputSpec, ProbeSpec,
-    Quantity, Scene, StaticSpec,
+    AnalysisKind, AnalysisSpec, BodySpec, BucklingSpec, Component, ContactSpec, DynamicSpec,
+    FormulationSpec, IntegratorKind, LoadSpec, MaterialSpec, NewtonSpec, NodeSetSpec, OutputSpec,
+    ProbeSpec, Quantity, Scene, StaticSpec,
 };
 use crate::assembly::MassKind;
 use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
@@ -146,6 +146,21 @@ impl Analysis {
         match self {
             Analysis::Static(s) => s.geometry,
             Analysis::Dynamic(s) => s.geometry,
+        }
+    }
+
+    pub fn end_time(&self) -> f64 {
+        match self {
+            Analysis::Static(s) => s.end_time,
+            Analysis::Dynamic(s) => s.end_time,
+        }
+    }
+
+    /// The `[analysis.buckling]` table, if the scene has one.
+    pub fn buckling(&self) -> Option<&BucklingSpec> {
+        match self {
+            Analysis::Static(s) => s.buckling.as_ref(),
+            Analysis::Dynamic(s) => s.buckling.as_ref(),
         }
     }
 }
@@ -588,6 +603,7 @@ fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, InputError> {
                 end_time,
                 geometry: spec.geometry,
                 newton: spec.newton.clone(),
+                buckling: buckling(cx, spec)?,
             }))
         }
         AnalysisKind::Dynamic => dynamic(cx, spec).map(Analysis::Dynamic),
@@ -702,7 +718,31 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
         allow_unstable: spec.allow_unstable,
         geometry: spec.geometry,
         newton: spec.newton.clone(),
+        buckling: buckling(cx, spec)?,
     })
+}
+
+fn buckling(cx: &Context, spec: &AnalysisSpec) -> Result<Option<BucklingSpec>, InputError> {
+    let Some(b) = &spec.buckling else {
+        return Ok(None);
+    };
+    if spec.integrator == Some(IntegratorKind::CentralDifference) {
+        return Err(cx.err(
+            "analysis.buckling: the explicit method assembles no tangent; use an implicit integrator",
+        ));
+    }
+    if let Some(imperfection) = &b.imperfection {
+        if imperfection.mode == 0 {
+            return Err(cx.err("analysis.buckling.imperfection.mode: modes count from 1"));
+        }
+        if !(imperfection.amplitude.is_finite() && imperfection.amplitude != 0.0) {
+            return Err(cx.err(format!(
+                "analysis.buckling.imperfection.amplitude: a finite, non-zero length, got {}",
+                imperfection.amplitude
+            )));
+        }
+    }
+    Ok(Some(b.clone()))
 }
 
 fn newton(cx: &Context, n: &NewtonSpec) -> Result<(), InputError> {

@@ -348,6 +348,55 @@ pub struct AnalysisSpec {
     /// as status `unstable`. Default false (refused).
     #[serde(default)]
     pub allow_unstable: bool,
+    /// The buckling check (Erklig 2.1.3). Default: none.
+    pub buckling: Option<BucklingSpec>,
+}
+
+/// `[analysis.buckling]`: the inertia of the tangent after every converged state, the
+/// linearized buckling modes of the end loads, what to do when the tangent loses positive
+/// definiteness, and an initial imperfection.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BucklingSpec {
+    /// Count the negative pivots of K_T (no mass) after every converged state: history.csv
+    /// column `tangent_negative_pivots`. Default true.
+    #[serde(default = "yes")]
+    pub check: bool,
+    /// The number of linearized buckling modes of the end loads computed before the run
+    /// (summary.json `buckling.load_factors`, frames NAME_buckling.pvd). Default 0.
+    #[serde(default)]
+    pub modes: usize,
+    /// `continue` (default) or `stop` (the run ends, status ok, when the negative-pivot
+    /// count first changes).
+    #[serde(default)]
+    pub on_critical: OnCritical,
+    /// A buckling mode added to the initial coordinates. Default: none.
+    pub imperfection: Option<ImperfectionSpec>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OnCritical {
+    #[default]
+    Continue,
+    Stop,
+}
+
+/// The initial imperfection: `amplitude` times linearized buckling mode `mode` (of the end
+/// loads), the mode scaled so its largest nodal displacement is 1: `amplitude` is the
+/// largest nodal offset (a length).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImperfectionSpec {
+    /// Mode number, >= 1. Default 1.
+    #[serde(default = "one")]
+    pub mode: usize,
+    /// The largest nodal offset (length), finite and non-zero.
+    pub amplitude: f64,
+}
+
+fn one() -> usize {
+    1
 }
 
 /// The validated dynamic analysis.
@@ -366,6 +415,7 @@ pub struct DynamicSpec {
     pub allow_unstable: bool,
     pub geometry: Geometry,
     pub newton: NewtonSpec,
+    pub buckling: Option<BucklingSpec>,
 }
 
 /// The validated static analysis.
@@ -375,6 +425,7 @@ pub struct StaticSpec {
     pub end_time: f64,
     pub geometry: Geometry,
     pub newton: NewtonSpec,
+    pub buckling: Option<BucklingSpec>,
 }
 
 /// How often K_T is factored.

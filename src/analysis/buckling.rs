@@ -1,0 +1,245 @@
+//! The buckling check of a run (Erklig 2.1.3, DESIGN section 3): the inertia of K_T after each
+//! converged state, the linearized buckling load factors of the scene's loads, and the
+//! imperfection (a buckling mode added to the coordinates). The numerics are in `stability`.
+//!
+//! Legend
+//! ```text
+//! prebuckling state   the small-strain linear-elastic solution for the loads at end_time
+//!                     (one solve with K_0 of the initial configuration)
+//! lambda_i            load factors of (K_0 + lambda K_sigma) phi = 0 at that state: the
+//!                     scene's end loads times lambda_1 are the linearized critical loads
+//! ```
+//! Contact constraints are not part of the checked tangent (the check sees the bodies with
+//! their supports and prescribed displacements only).
+
+use super::loads;
+use super::record;
+use crate::assembly::{self, State, System};
+use crate::element::Geometry;
+use crate::output::OutputError;
+use crate::output::vtk::{Fields, Series};
+use crate::scene::Model;
+use crate::scene::spec::OnCritical;
+use crate::scene::spec::Tangent;
+use crate::solver::Solver;
+use crate::stability::{self, InertiaCounter, Mode, StabilityError};
+use serde::Serialize;
+use std::path::Path;
+
+/// The prebuckling state (see the legend).
+pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
+    let end = match &model.analysis {
+        crate::scene::model::Analysis::Static(s) => s.end_time,
+        crate::scene::model::Analysis::Dynamic(s) => s.end_time,
+    };
+    let initial = model.coordinates();
+    let mut state = State::initial(model);
+    let mut system = System::new(model, &loads::constrained_dofs(model));
+    let mut d = vec![0.0; model.dofs()];
+    for (dof, value) in loads::prescribed(model, &initial, end) {
+        d[dof] = value;
+    }
+    let linear = |d: &[f64], system: Option<&mut System>| {
+        assembly::evaluate(model, &state, d, Geometry::Linear, system, Tangent::Elastic)
+    };
+    let evaluation = linear(&d, Some(&mut system))?;
+    let mut solver = Solver::new(&system.pattern)?;
+    solver
+        .factor(&system.values)
+        .map_err(|_| StabilityError::MaterialStiffness)?;
+    let external = loads::external_force(model, &state, &initial, end);
+    let mut residual = system.gather(&external);
+    residual
+        .iter_mut()
+        .zip(system.gather(&evaluation.force))
+        .for_each(|(r, f)| *r -= f);
+    solver.solve(&mut residual);
+    system.scatter_add(&residual, &mut d);
+    let evaluation = linear(&d, None)?;
+    assembly::commit(model, &mut state, &d, evaluation, Geometry::Linear);
+    state.time = end;
+    Ok(state)
+}
+
+/// The lowest `count` linearized buckling modes of the scene's end loads (at the prebuckling
+/// state), ascending load factors.
+pub fn linear_modes(model: &Model, count: usize) -> Result<Vec<Mode>, StabilityError> {
+    let state = prebuckling_state(model)?;
+    let mut system = System::new(model, &loads::constrained_dofs(model));
+    stability::eigen_buckling(model, &state, &mut system, count)
+}
+
+/// The lowest `count` buckling modes at a committed state of a run.
+pub fn modes_at(model: &Model, state: &State, count: usize) -> Result<Vec<Mode>, StabilityError> {
+    let mut system = System::new(model, &loads::constrained_dofs(model));
+    stability::eigen_buckling(model, state, &mut system, count)
+}
+
+/// The inertia check of a run: K_T at each committed state, its negative pivots counted.
+pub struct InertiaCheck {
+    system: System,
+    counter: InertiaCounter,
+}
+
+impl InertiaCheck {
+    pub fn new(model: &Model) -> Result<InertiaCheck, StabilityError> {
+        let system = System::new(model, &loads::constrained_dofs(model));
+        let counter = InertiaCounter::new(&system.pattern)?;
+        Ok(InertiaCheck { system, counter })
+    }
+
+    /// Negative pivots of K_T (no mass) at the committed state.
+    pub fn negative_pivots(
+        &mut self,
+        model: &Model,
+        state: &State,
+    ) -> Result<usize, StabilityError> {
+        stability::assemble_tangent(model, state, &mut self.system)?;
+        Ok(self.counter.negative_pivots(&self.system.values)?)
+    }
+}
+
+/// summary.json `buckling` (present when the scene has `[analysis.buckling]`).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct BucklingSummary {
+    /// lambda_1 of the end loads at the prebuckling state (`modes` > 0), else null.
+    pub critical_load_factor: Option<f64>,
+    /// lambda_1 .. lambda_modes, ascending.
+    pub load_factors: Vec<f64>,
+    /// Negative pivots of K_T at the start and after the last converged state (`check`).
+    pub initial_negative_pivots: Option<usize>,
+    pub final_negative_pivots: Option<usize>,
+    /// The first time (load factor in statics with the default ramp) at which the count
+    /// differed from the initial one, and the count then.
+    pub inertia_change_time: Option<f64>,
+    pub negative_pivots_at_change: Option<usize>,
+    /// The run stopped there (`on_critical = "stop"`).
+    pub stopped: bool,
+}
+
+/// The check of a run: set up from `[analysis.buckling]`, fed every committed state.
+pub struct Monitor {
+    check: Option<InertiaCheck>,
+    on_critical: OnCritical,
+    pub summary: BucklingSummary,
+}
+
+impl Monitor {
+    /// None without `[analysis.buckling]`. Computes the requested modes and writes them into
+    /// `dir` (NAME_buckling.pvd).
+    pub fn new(model: &Model, dir: &Path) -> Result<Option<Monitor>, MonitorError> {
+        let Some(spec) = model.analysis.buckling() else {
+            return Ok(None);
+        };
+        let mut summary = BucklingSummary::default();
+        if spec.modes > 0 {
+            let modes = linear_modes(model, spec.modes)?;
+            summary.load_factors = modes.iter().map(|m| m.lambda).collect();
+            summary.critical_load_factor = summary.load_factors.first().copied();
+            write_modes(model, &modes, dir)?;
+        }
+        let check = if spec.check {
+            Some(InertiaCheck::new(model)?)
+        } else {
+            None
+        };
+        Ok(Some(Monitor {
+            check,
+            on_critical: spec.on_critical,
+            summary,
+        }))
+    }
+
+    /// Checks a committed state: the negative-pivot count (None when `check` is off), and
+    /// whether the run should stop here.
+    pub fn observe(
+        &mut self,
+        model: &Model,
+        state: &State,
+    ) -> Result<(Option<usize>, bool), StabilityError> {
+        let Some(check) = &mut self.check else {
+            return Ok((None, false));
+        };
+        let count = check.negative_pivots(model, state)?;
+        let s = &mut self.summary;
+        let initial = *s.initial_negative_pivots.get_or_insert(count);
+        s.final_negative_pivots = Some(count);
+        let mut stop = false;
+        if count != initial && s.inertia_change_time.is_none() {
+            s.inertia_change_time = Some(state.time);
+            s.negative_pivots_at_change = Some(count);
+            stop = self.on_critical == OnCritical::Stop;
+            s.stopped = stop;
+        }
+        Ok((Some(count), stop))
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MonitorError {
+    #[error("buckling modes: {0}")]
+    Stability(#[from] StabilityError),
+    #[error("{0}")]
+    Output(#[from] OutputError),
+}
+
+/// Writes the modes as the frames of DIR/NAME_buckling.pvd: frame i (its "time") is mode i,
+/// the `displacement` field the mode shape (largest nodal value 1; scale it with Warp By
+/// Vector).
+pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|e| OutputError::io(dir, "create folder", e))?;
+    let mut series = Series::create(
+        dir,
+        &format!("{}_buckling", model.name),
+        model.output.compression,
+    )?;
+    let grid = record::grid(model);
+    let points = grid.points.len();
+    let cells = grid.cells();
+    let zeros2 = vec![[0.0; 2]; points];
+    let zeros = vec![0.0; points];
+    let cell_zeros = vec![0.0; cells];
+    let stress = vec![[0.0; 6]; cells];
+    for (i, mode) in modes.iter().enumerate() {
+        let shape: Vec<[f64; 2]> = mode.shape.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        let fields = Fields {
+            displacement: &shape,
+            velocity: &zeros2,
+            acceleration: &zeros2,
+            contact_force: &zeros2,
+            gap: &zeros,
+            contact_status: &zeros,
+            stress: &stress,
+            von_mises: &cell_zeros,
+            eq_plastic_strain: &cell_zeros,
+            pressure: &cell_zeros,
+        };
+        series.write_frame((i + 1) as f64, &grid, &fields)?;
+    }
+    Ok(())
+}
+
+/// The model with `amplitude` times mode `mode` of the end loads added to its initial
+/// coordinates (`[analysis.buckling.imperfection]`); None without an imperfection.
+pub fn with_imperfection(model: &Model) -> Result<Option<Model>, StabilityError> {
+    let Some(imperfection) = model
+        .analysis
+        .buckling()
+        .and_then(|b| b.imperfection.as_ref())
+    else {
+        return Ok(None);
+    };
+    let modes = linear_modes(model, imperfection.mode)?;
+    let mode = modes
+        .get(imperfection.mode - 1)
+        .ok_or(StabilityError::NoMode)?;
+    let mut imperfect = model.clone();
+    for body in &mut imperfect.bodies {
+        let offset = body.node_offset;
+        for (i, x) in body.mesh.nodes.iter_mut().enumerate() {
+            x[0] += imperfection.amplitude * mode.shape[2 * (offset + i)];
+            x[1] += imperfection.amplitude * mode.shape[2 * (offset + i) + 1];
+        }
+    }
+    Ok(Some(imperfect))
+}
