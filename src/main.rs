@@ -71,9 +71,10 @@ enum Command {
         /// Chart title. Default: the history's path.
         #[arg(long)]
         title: Option<String>,
-        /// Another run's history.csv whose same columns are overlaid, labelled with its name.
+        /// Another run's history.csv whose same columns are overlaid, labelled with its name
+        /// (its folder's when the file names agree). Repeat for more runs.
         #[arg(long)]
-        reference: Option<PathBuf>,
+        reference: Vec<PathBuf>,
     },
 }
 
@@ -100,7 +101,7 @@ fn main() -> ExitCode {
             out,
             title,
             reference,
-        } => plot_history(&history, &x, &y, out, title, reference.as_deref()),
+        } => plot_history(&history, &x, &y, out, title, &reference),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -207,22 +208,28 @@ fn plot_history(
     y: &[String],
     out: Option<PathBuf>,
     title: Option<String>,
-    reference: Option<&Path>,
+    references: &[PathBuf],
 ) -> Result<(), RunError> {
     let names: Vec<&str> = std::iter::once(x)
         .chain(y.iter().map(String::as_str))
         .collect();
     let columns = plot::history_columns(history, &names).map_err(bad_input)?;
-    let mut series = history_series(&columns, y, None);
-    if let Some(reference) = reference {
-        let file_name = |p: &Path| p.file_name().map(|n| n.to_string_lossy().into_owned());
-        // two runs' files are usually both history.csv: then the path tells them apart
-        let name = match file_name(reference) {
+    let file_name = |p: &Path| p.file_name().map(|n| n.to_string_lossy().into_owned());
+    // runs' files are usually all history.csv: then their folders tell them apart
+    let run_name = |p: &Path| -> String {
+        match file_name(p) {
             Some(name) if file_name(history).as_ref() != Some(&name) => name,
-            _ => reference.display().to_string(),
-        };
+            _ => p
+                .parent()
+                .and_then(file_name)
+                .unwrap_or_else(|| p.display().to_string()),
+        }
+    };
+    let own = (!references.is_empty()).then(|| run_name(history));
+    let mut series = history_series(&columns, y, own.as_deref());
+    for reference in references {
         let columns = plot::history_columns(reference, &names).map_err(bad_input)?;
-        series.extend(history_series(&columns, y, Some(&name)));
+        series.extend(history_series(&columns, y, Some(&run_name(reference))));
     }
     let out = out.unwrap_or_else(|| {
         let stem: String = y

@@ -29,3 +29,6 @@ impact run models/hill_cylinder.toml --quiet --out $out/hill_cylinder_no_bbar --
 impact plot $out/hill_cylinder/history.csv --y 'u_x[bore]' --reference $out/hill_cylinder_no_bbar/history.csv \
   --title 'Hill cylinder: bore displacement against p / (0.98 p_lim), B-bar and locking plain Q4' \
   --out $fig/hill_bore.svg
+
+# the Erklig impact study (issue #7): both bars, elastic and elastoplastic, five methods
+bash models/impact_study.sh $out/impact_study $fig

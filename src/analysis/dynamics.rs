@@ -192,7 +192,20 @@ pub fn run(
     let mut contact = ContactState::new(model);
     let mut last_contact = vec![0.0; model.dofs()];
     while state.time < spec.end_time * (1.0 - 1e-12) {
-        let target = super::snap((state.time + control.length).min(spec.end_time), spec.dt);
+        // steps end at the listed frame times
+        let next_frame = model
+            .output
+            .frame_times
+            .iter()
+            .copied()
+            .find(|t| *t > state.time * (1.0 + 1e-9) + 1e-12 * spec.dt)
+            .unwrap_or(f64::INFINITY);
+        let target = super::snap(
+            (state.time + control.length)
+                .min(spec.end_time)
+                .min(next_frame),
+            spec.dt,
+        );
         let nominal = super::step_length(target - state.time, spec.dt);
         let positions = state.positions(spec.geometry);
         let kinetic_before_impact = mass.kinetic_energy(model, &kin.velocity);

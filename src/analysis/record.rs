@@ -11,7 +11,7 @@ use crate::output::history::History;
 use crate::output::vtk::{Fields, Grid, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
-use crate::scene::spec::Quantity;
+use crate::scene::spec::{Quantity, Statistic};
 use std::path::{Path, PathBuf};
 
 /// Energies of one step (history.csv columns 2-6).
@@ -54,7 +54,7 @@ impl Recorder {
             action: "cannot create folder",
             source,
         })?;
-        let series = if model.output.frame_every > 0 {
+        let series = if model.output.frame_every > 0 || !model.output.frame_times.is_empty() {
             Some(Series::create(dir, &model.name, model.output.compression)?)
         } else {
             None
@@ -164,7 +164,15 @@ impl Recorder {
         }
         self.history.append(&row)?;
         self.steps_since_frame += 1;
-        if force_frame || (self.frame_every > 0 && self.steps_since_frame >= self.frame_every) {
+        let listed = model
+            .output
+            .frame_times
+            .iter()
+            .any(|t| (t - state.time).abs() <= 1e-9 * t.abs().max(1e-300));
+        if force_frame
+            || listed
+            || (self.frame_every > 0 && self.steps_since_frame >= self.frame_every)
+        {
             self.frame(model, state, motion, contact)?;
         }
         Ok(())
@@ -287,19 +295,28 @@ fn probe_value(
     motion: &Motion,
     probe: &crate::scene::model::Probe,
 ) -> f64 {
-    let n = probe.members.len().max(1) as f64;
-    let nodal = |v: &[f64], c: usize| probe.members.iter().map(|m| v[2 * m + c]).sum::<f64>() / n;
+    let combine = |values: &mut dyn Iterator<Item = f64>| -> f64 {
+        match probe.statistic {
+            Statistic::Mean => {
+                let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
+                sum / count.max(1) as f64
+            }
+            Statistic::Max => values.fold(f64::NEG_INFINITY, f64::max),
+            Statistic::Min => values.fold(f64::INFINITY, f64::min),
+        }
+    };
+    let nodal = |v: &[f64], c: usize| combine(&mut probe.members.iter().map(|m| v[2 * m + c]));
     let points = |f: &dyn Fn(&crate::material::PointState) -> f64| {
         let body = &model.bodies[probe.body];
         let ppe = body.points_per_element();
         let pts = &state.bodies[probe.body].points;
-        probe
-            .members
-            .iter()
-            .flat_map(|e| &pts[e * ppe..(e + 1) * ppe])
-            .map(f)
-            .sum::<f64>()
-            / (n * ppe as f64)
+        combine(
+            &mut probe
+                .members
+                .iter()
+                .flat_map(|e| &pts[e * ppe..(e + 1) * ppe])
+                .map(f),
+        )
     };
     match probe.quantity {
         Quantity::DisplacementX => nodal(&state.displacement, 0),

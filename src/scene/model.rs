@@ -8,7 +8,7 @@ use super::InputError;
 use super::spec::{
     AnalysisKind, AnalysisSpec, BodySpec, BucklingSpec, Component, ContactSpec, DynamicSpec,
     FormulationSpec, IntegratorKind, LoadSpec, MaterialSpec, NewtonSpec, NodeSetSpec, OutputSpec,
-    ProbeSpec, Quantity, Scene, StaticSpec,
+    ProbeSpec, Quantity, Scene, StaticSpec, Statistic,
 };
 use crate::assembly::MassKind;
 use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
@@ -129,6 +129,7 @@ pub enum Load {
 #[derive(Debug, Clone)]
 pub struct Probe {
     pub quantity: Quantity,
+    pub statistic: Statistic,
     pub body: usize,
     /// Node ids (nodal quantities, global) or element ids of the body.
     pub members: Vec<usize>,
@@ -264,6 +265,13 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         .map(|(k, l)| load(&cx, &bodies, &curves, &default_curve, k, l))
         .collect::<Result<Vec<_>, _>>()?;
     let probes = probes(&cx, &bodies, &scene.output.probe)?;
+    let times = &scene.output.frame_times;
+    if times.iter().any(|t| !(t.is_finite() && *t >= 0.0)) || times.windows(2).any(|w| w[1] <= w[0])
+    {
+        return Err(cx.err(format!(
+            "output.frame_times: must be finite, >= 0 and increasing, got {times:?}"
+        )));
+    }
     let obstacles = obstacles(&cx, &scene)?;
     let contacts = scene
         .contact
@@ -1201,25 +1209,39 @@ fn probes(cx: &Context, bodies: &[Body], specs: &[ProbeSpec]) -> Result<Vec<Prob
                 .map(|n| bodies[b].global(n))
                 .collect()
         } else {
-            let sets = &bodies[b].mesh.element_sets;
-            sets.get(&p.set).cloned().ok_or_else(|| {
-                let known: Vec<&String> = sets.keys().collect();
-                cx.err(format!(
-                    "{key}.set: body `{}` has no element set `{}` (element sets: {known:?})",
-                    bodies[b].name, p.set
-                ))
-            })?
+            // an element set, or the elements around the nodes of a node set
+            let mesh = &bodies[b].mesh;
+            let sets = &mesh.element_sets;
+            match (sets.get(&p.set), mesh.node_sets.get(&p.set)) {
+                (Some(elements), _) => elements.clone(),
+                (None, Some(nodes)) => (0..mesh.cells.len())
+                    .filter(|e| mesh.cells.nodes_of(*e).iter().any(|n| nodes.contains(n)))
+                    .collect(),
+                (None, None) => {
+                    let known: Vec<&String> = sets.keys().chain(mesh.node_sets.keys()).collect();
+                    return Err(cx.err(format!(
+                        "{key}.set: body `{}` has no element or node set `{}` (sets: {known:?})",
+                        bodies[b].name, p.set
+                    )));
+                }
+            }
         };
         let set = if bodies.len() > 1 {
             format!("{}.{}", bodies[b].name, p.set)
         } else {
             p.set.clone()
         };
+        let column = match p.statistic {
+            Statistic::Mean => format!("{}[{set}]", p.quantity.name()),
+            Statistic::Max => format!("max_{}[{set}]", p.quantity.name()),
+            Statistic::Min => format!("min_{}[{set}]", p.quantity.name()),
+        };
         out.push(Probe {
+            statistic: p.statistic,
             quantity: p.quantity,
             body: b,
             members,
-            column: format!("{}[{set}]", p.quantity.name()),
+            column,
         });
     }
     Ok(out)

@@ -522,6 +522,9 @@ pub struct OutputSpec {
     /// Write a VTK frame every N steps (and always the first and last). 0 writes none. Default 1.
     #[serde(default = "default_frame_every")]
     pub frame_every: usize,
+    /// Times at which a frame is written besides (dynamic steps end exactly there).
+    #[serde(default)]
+    pub frame_times: Vec<f64>,
     /// `none` (default), `lz4` or `zlib` for the .vtu arrays.
     #[serde(default)]
     pub compression: Compression,
@@ -533,6 +536,7 @@ impl Default for OutputSpec {
     fn default() -> Self {
         OutputSpec {
             frame_every: default_frame_every(),
+            frame_times: Vec::new(),
             compression: Compression::default(),
             probe: Vec::new(),
         }
@@ -622,4 +626,18 @@ pub struct ProbeSpec {
     pub quantity: Quantity,
     pub body: Option<String>,
     pub set: String,
+    /// How the set's values combine: `mean` (default; momentum: the sum), `max` or `min`
+    /// (over nodes, or over the elements' integration points).
+    #[serde(default)]
+    pub statistic: Statistic,
+}
+
+/// How a probe combines the values of its set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Statistic {
+    #[default]
+    Mean,
+    Max,
+    Min,
 }
