@@ -107,6 +107,8 @@ pub fn write(chart: &Chart, path: &Path) -> Result<(), OutputError> {
 pub enum CellKind {
     /// Green.
     Stable,
+    /// Light blue (bounded but dissipative).
+    Damped,
     /// Amber.
     Drift,
     /// Red.
@@ -204,6 +206,7 @@ fn draw_map<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, map: &Map) -> Resu
                 Some(cell) => {
                     let color = match cell.kind {
                         CellKind::Stable => RGBColor(150, 210, 150),
+                        CellKind::Damped => RGBColor(160, 200, 235),
                         CellKind::Drift => RGBColor(250, 200, 110),
                         CellKind::Unstable => RGBColor(235, 120, 110),
                         CellKind::Other => RGBColor(200, 200, 200),

@@ -6,8 +6,10 @@
 //! error_vs_dt     the errors against dt, with the least-squares slope of log e against
 //!                 log dt of each series printed in its fit line's legend entry
 //! error_vs_h      the same against the shortest element edge h
-//! stability_map   dt / dt_crit (columns) against the series (rows): stable, drift
-//!                 (|energy drift| > 5 %), unstable (status unstable or diverged), refused
+//! stability_map   dt / dt_crit (columns) against the series (rows): unstable (status
+//!                 unstable or diverged), drift (energy gained: balance error > 5 % and the
+//!                 final energy above the initial), damped (bounded, more than 5 % of the
+//!                 energy lost: numerical dissipation), stable, refused
 //! ```
 //! primary error: force_l2, else |peak_force_error| (measure::Row::primary_error).
 
@@ -40,12 +42,27 @@ pub fn fitted_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
     Some((slope, mean_y - slope * mean_x))
 }
 
+/// Whether a key is a refinement or the method: dt, the integrator, a mesh parameter.
+fn is_method_or_refinement(key: &str) -> bool {
+    key == "analysis.dt" || key == "analysis.integrator" || key.contains(".mesh.")
+}
+
+/// Keys that do not name a series: those varied together with a refinement or the method
+/// (`--vary "analysis.integrator,analysis.mass=..."`).
+fn unlabelled_keys(plan: &Plan) -> Vec<String> {
+    plan.variations
+        .iter()
+        .filter(|v| v.keys.iter().any(|k| is_method_or_refinement(k)))
+        .flat_map(|v| v.keys.iter().cloned())
+        .collect()
+}
+
 /// The series a row belongs to: its integrator and the varied values that are not dt,
-/// the integrator or a mesh parameter.
-pub fn series_label(row: &Row) -> String {
+/// the integrator, a mesh parameter or varied together with one of those.
+pub fn series_label(row: &Row, unlabelled: &[String]) -> String {
     let mut label = row.integrator.clone();
     for (key, value) in &row.case.values {
-        if key == "analysis.dt" || key == "analysis.integrator" || key.contains(".mesh.") {
+        if unlabelled.contains(key) {
             continue;
         }
         let short = key.rsplit('.').next().unwrap_or(key);
@@ -54,10 +71,11 @@ pub fn series_label(row: &Row) -> String {
     label
 }
 
-fn grouped<'a>(rows: &'a [Row]) -> Vec<(String, Vec<&'a Row>)> {
+fn grouped<'a>(plan: &Plan, rows: &'a [Row]) -> Vec<(String, Vec<&'a Row>)> {
+    let unlabelled = unlabelled_keys(plan);
     let mut groups: Vec<(String, Vec<&Row>)> = Vec::new();
     for row in rows {
-        let label = series_label(row);
+        let label = series_label(row, &unlabelled);
         match groups.iter_mut().find(|(l, _)| *l == label) {
             Some((_, members)) => members.push(row),
             None => groups.push((label, vec![row])),
@@ -68,13 +86,13 @@ fn grouped<'a>(rows: &'a [Row]) -> Vec<(String, Vec<&'a Row>)> {
 
 /// Writes the charts that the rows support; returns their paths.
 pub fn write_all(
-    _plan: &Plan,
+    plan: &Plan,
     rows: &[Row],
     title: &str,
     out: &Path,
 ) -> Result<Vec<PathBuf>, RunError> {
     let mut written = Vec::new();
-    let groups = grouped(rows);
+    let groups = grouped(plan, rows);
     let ok = |r: &&&Row| r.status == "ok";
     let primary_name = if rows.iter().any(|r| r.measures.force_l2.is_some()) {
         "contact force L2 error (relative)"
@@ -211,17 +229,20 @@ pub fn write_all(
 
 /// A stability map cell of a case.
 pub fn cell(row: &Row) -> Cell {
-    let drift = row.measures.energy_drift;
+    let drift = row.measures.energy_drift.unwrap_or(0.0);
+    let change = row.measures.energy_change.unwrap_or(0.0);
     match row.status.as_str() {
-        "ok" => match drift {
-            Some(d) if d > DRIFT_LIMIT => Cell {
-                text: format!("drift {:.0}%", 100.0 * d),
-                kind: CellKind::Drift,
-            },
-            _ => Cell {
-                text: "stable".into(),
-                kind: CellKind::Stable,
-            },
+        "ok" if drift > DRIFT_LIMIT && change > 0.0 => Cell {
+            text: format!("drift +{:.0}%", 100.0 * change),
+            kind: CellKind::Drift,
+        },
+        "ok" if change < -DRIFT_LIMIT => Cell {
+            text: format!("damped {:.0}%", 100.0 * change),
+            kind: CellKind::Damped,
+        },
+        "ok" => Cell {
+            text: "stable".into(),
+            kind: CellKind::Stable,
         },
         "unstable" | "diverged" => Cell {
             text: row.status.clone(),

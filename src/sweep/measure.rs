@@ -9,7 +9,8 @@
 //! force_l2_smooth  the same over the t_k farther than T/8 from the pulse's jumps (t = 0, T)
 //! release_error    last release time minus T (pulse), Hertz duration, or the extrapolation
 //! peak_force_error, duration_error, radius_error: relative, (value - reference) / reference
-//! energy_drift  summary.json energy.max_relative_drift
+//! energy_drift  summary.json energy.max_relative_drift (the balance error)
+//! energy_change (energy.final - energy.initial) / energy.initial
 //! h             the shortest element edge of the initial mesh
 //! ```
 //!
@@ -49,6 +50,9 @@ pub struct Measures {
     pub duration_error: Option<f64>,
     pub radius_error: Option<f64>,
     pub energy_drift: Option<f64>,
+    /// (energy.final - energy.initial) / energy.initial: negative when the method (or the
+    /// impact conditions) dissipated energy.
+    pub energy_change: Option<f64>,
     pub steps: Option<f64>,
     pub newton_iterations: Option<f64>,
     pub factorizations: Option<f64>,
@@ -158,6 +162,12 @@ pub fn tabulate(
             measures.release_time = num(&["contact", "last_release_time"]);
             measures.peak_force = num(&["contact", "peak_force"]);
             measures.energy_drift = num(&["energy", "max_relative_drift"]);
+            if let (Some(initial), Some(last)) =
+                (num(&["energy", "initial"]), num(&["energy", "final"]))
+                && initial > 0.0
+            {
+                measures.energy_change = Some(last / initial - 1.0);
+            }
             measures.steps = num(&["steps"]);
             measures.newton_iterations = num(&["newton_iterations"]);
             measures.factorizations = num(&["factorizations"]);
@@ -488,6 +498,7 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
             "duration_error",
             "radius_error",
             "energy_drift",
+            "energy_change",
             "steps",
             "newton_iterations",
             "factorizations",
@@ -518,6 +529,7 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
                 m.duration_error,
                 m.radius_error,
                 m.energy_drift,
+                m.energy_change,
             ]
             .map(num),
         );
