@@ -18,3 +18,4 @@ pub mod reference;
 pub mod scene;
 pub mod solver;
 pub mod stability;
+pub mod sweep;

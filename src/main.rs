@@ -56,6 +56,35 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
+    /// Run the cross product of `--vary` variations of a scene (in parallel across cases),
+    /// measure each against the scene's [reference] (else the finest case), write
+    /// sweep.csv and charts. A rerun skips finished cases.
+    Sweep {
+        /// The scene (not with --merge).
+        scene: Option<PathBuf>,
+        /// KEY=v1,v2,... or KEY1,KEY2=a1,a2;b1,b2 (keys varied together); repeat for a
+        /// cross product, the first outermost.
+        #[arg(long = "vary", value_name = "KEYS=VALUES")]
+        vary: Vec<String>,
+        /// Override a scene value in every case.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Cases run at once. Default: one per core.
+        #[arg(long, default_value_t = 0)]
+        jobs: usize,
+        /// Run only the cases k with k mod n = i (0 <= i < n), e.g. --shard $SLURM_ARRAY_TASK_ID/8.
+        #[arg(long, value_name = "i/n")]
+        shard: Option<String>,
+        /// Join the case folders of these sweep folders (shards) into --out.
+        #[arg(long, value_name = "DIR", num_args = 1..)]
+        merge: Vec<PathBuf>,
+        /// Output folder. Default: output/<scene name>_sweep/
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// No progress bar and no closing lines.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
     Plot {
         history: PathBuf,
@@ -94,6 +123,25 @@ fn main() -> ExitCode {
             out,
             set,
         } => buckle(&scene, modes, out, &set),
+        Command::Sweep {
+            scene,
+            vary,
+            set,
+            jobs,
+            shard,
+            merge,
+            out,
+            quiet,
+        } => sweep(
+            scene,
+            &vary,
+            &set,
+            jobs,
+            shard.as_deref(),
+            &merge,
+            out,
+            quiet,
+        ),
         Command::Plot {
             history,
             y,
@@ -199,6 +247,81 @@ fn buckle(
         "  mode shapes: {}",
         dir.join(format!("{}_buckling.pvd", model.name)).display()
     );
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    scene: Option<PathBuf>,
+    vary: &[String],
+    set: &[String],
+    jobs: usize,
+    shard: Option<&str>,
+    merge: &[PathBuf],
+    out: Option<PathBuf>,
+    quiet: bool,
+) -> Result<(), RunError> {
+    use impact::sweep::{self, Plan, SweepOptions, plan};
+    let report = if !merge.is_empty() {
+        let here = Path::new("--merge");
+        if scene.is_some() || !vary.is_empty() || !set.is_empty() || shard.is_some() {
+            return Err(InputError::new(
+                here,
+                "--merge takes the sweep folders only (their sweep.json holds the scene, --set and --vary)",
+            )
+            .into());
+        }
+        let out = out.ok_or_else(|| InputError::new(here, "--merge needs --out DIR"))?;
+        sweep::merge(merge, &out)?
+    } else {
+        let scene = scene.ok_or_else(|| {
+            InputError::new(
+                Path::new("impact sweep"),
+                "name a scene (or --merge DIR...)",
+            )
+        })?;
+        let variations = vary
+            .iter()
+            .map(|v| {
+                plan::parse_variation(v)
+                    .map_err(|m| InputError::new(&scene, format!("--vary {v}: {m}")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let shard = shard
+            .map(plan::parse_shard)
+            .transpose()
+            .map_err(|m| InputError::new(&scene, m))?;
+        let stem = scene
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into());
+        let out = out.unwrap_or_else(|| PathBuf::from("output").join(format!("{stem}_sweep")));
+        let plan = Plan {
+            scene,
+            sets: set.to_vec(),
+            variations,
+        };
+        let options = SweepOptions {
+            jobs,
+            shard,
+            progress: !quiet && std::io::stderr().is_terminal(),
+        };
+        sweep::run(&plan, &out, options)?
+    };
+    if !quiet {
+        println!(
+            "sweep: {} cases, {} in this shard, {} executed, {} skipped (finished before), {} not ok -> {}",
+            report.cases,
+            report.in_shard,
+            report.executed,
+            report.skipped,
+            report.not_ok,
+            report.csv.display()
+        );
+        for chart in &report.charts {
+            println!("  {}", chart.display());
+        }
+    }
     Ok(())
 }
 

@@ -32,3 +32,30 @@ impact plot $out/hill_cylinder/history.csv --y 'u_x[bore]' --reference $out/hill
 
 # the Erklig impact study (issue #7): both bars, elastic and elastoplastic, five methods
 bash models/impact_study.sh $out/impact_study $fig
+
+# Sweeps (issue #8): convergence, speed against accuracy, stability maps.
+# Each writes DIR/sweep.csv and charts; the docs' copies are taken from there.
+sweep() { impact sweep "$@" --quiet; }
+copy() { for ext in png svg; do cp "$1.$ext" "$fig/$2.$ext"; done; }
+refine_bars='body.bar1.mesh.n,body.bar2.mesh.n,analysis.dt=14,14,0.005;28,28,0.0025;56,56,0.00125;112,112,0.000625;224,224,0.0003125'
+sweep models/two_bars.toml --vary "$refine_bars" --out $out/sweep_two_bars_courant
+copy $out/sweep_two_bars_courant/error_vs_dt sweep_two_bars_courant_dt
+sweep models/two_bars.toml --set body.bar1.mesh.n=56 --set body.bar2.mesh.n=56 \
+  --vary 'analysis.dt=0.005,0.0025,0.00125,0.000625,0.0003125' --out $out/sweep_two_bars_dt
+copy $out/sweep_two_bars_dt/error_vs_dt sweep_two_bars_dt
+sweep models/bar_wall.toml --vary 'body.bar.mesh.n,analysis.dt=14,0.005;28,0.0025;56,0.00125;112,0.000625;224,0.0003125' \
+  --out $out/sweep_bar_wall_courant
+copy $out/sweep_bar_wall_courant/error_vs_h sweep_bar_wall_courant_h
+methods='analysis.integrator,analysis.allow_unstable,analysis.mass=central_difference,true,lumped;average,false,consistent;hu,false,consistent;houbolt,false,consistent;wilson,false,consistent'
+sweep models/two_bars.toml --vary "$methods" --vary "$refine_bars" \
+  --out $out/sweep_two_bars_methods
+copy $out/sweep_two_bars_methods/error_vs_wall sweep_two_bars_speed
+# dt_crit of bar_wall and two_bars: h / c = 1/140 (impact check)
+ratios=$(python3 -c "print(','.join(repr(r / 140) for r in (0.5, 0.9, 0.95, 1.05, 2, 10)))")
+sweep models/bar_wall.toml --vary "$methods" --vary "analysis.dt=$ratios" --out $out/sweep_bar_wall_stability
+copy $out/sweep_bar_wall_stability/stability_map sweep_bar_wall_stability
+sweep models/two_bars.toml --vary "$methods" --vary "analysis.dt=$ratios" --out $out/sweep_two_bars_stability
+copy $out/sweep_two_bars_stability/stability_map sweep_two_bars_stability
+sweep models/sphere_wall.toml --vary 'analysis.integrator=average,hu,houbolt,wilson' \
+  --vary 'analysis.dt=0.02,0.01,0.005,0.0025' --out $out/sweep_sphere_wall_methods
+copy $out/sweep_sphere_wall_methods/error_vs_wall sweep_sphere_wall_speed

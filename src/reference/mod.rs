@@ -342,6 +342,29 @@ pub fn hertz_sphere_impact(
     )
 }
 
+/// A rod (density rho, Young's modulus E, section A, length L) striking a rigid wall at speed V
+/// (Hughes, Taylor & Sackman 1975, section I-3; d'Alembert): the contact force is
+/// rho c A V (c = sqrt(E / rho)) for 0 < t < 2 L / c, then the rod leaves at -V.
+/// Returns (force, duration 2 L / c).
+pub fn rod_wall_impact(density: f64, young: f64, area: f64, length: f64, speed: f64) -> (f64, f64) {
+    let c = (young / density).sqrt();
+    (density * c * area * speed, 2.0 * length / c)
+}
+
+/// Two equal rods (rho, E, A, L) meeting at relative speed V (same source): the contact
+/// force is rho c A V / 2 for 0 < t < 2 L / c, then they release, the striker at rest and
+/// the struck rod at V. Returns (force, duration 2 L / c).
+pub fn equal_bars_impact(
+    density: f64,
+    young: f64,
+    area: f64,
+    length: f64,
+    speed: f64,
+) -> (f64, f64) {
+    let (force, duration) = rod_wall_impact(density, young, area, length, speed);
+    (0.5 * force, duration)
+}
+
 /// Static Hertz contact of a sphere (radius R) pressed by a force P on a rigid plane:
 /// contact radius a = (3 P R / (4 E*))^(1/3) and peak pressure p0 = 3 P / (2 pi a^2).
 pub fn hertz_static(radius: f64, young: f64, poisson: f64, force: f64) -> (f64, f64) {

@@ -8,7 +8,7 @@ use super::InputError;
 use super::spec::{
     AnalysisKind, AnalysisSpec, BodySpec, BucklingSpec, Component, ContactSpec, DynamicSpec,
     FormulationSpec, IntegratorKind, LoadSpec, MaterialSpec, NewtonSpec, NodeSetSpec, OutputSpec,
-    ProbeSpec, Quantity, Scene, StaticSpec, Statistic,
+    ProbeSpec, Quantity, ReferenceKind, ReferenceSpec, Scene, StaticSpec, Statistic,
 };
 use crate::assembly::MassKind;
 use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
@@ -183,6 +183,38 @@ pub struct Model {
     /// Initial velocity per DOF (bodies' `velocity`, then `[[initial_velocity]]` sets).
     pub initial_velocity: Vec<f64>,
     pub contacts: Vec<ContactPair>,
+    /// The `[reference]` solution with its numbers (None without the table).
+    pub reference: Option<Reference>,
+}
+
+/// A validated `[reference]`: a closed-form solution with its numbers read from the model.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reference {
+    /// A constant contact force `force` for 0 < t < `duration`, zero after (rod impacts,
+    /// reference::rod_wall_impact and reference::equal_bars_impact).
+    ForcePulse {
+        kind: ReferenceKind,
+        pair: String,
+        force: f64,
+        duration: f64,
+    },
+    /// Hertz impact (reference::hertz_sphere_impact): peak force, largest contact radius and
+    /// contact duration.
+    Hertz {
+        pair: String,
+        peak_force: f64,
+        radius: f64,
+        duration: f64,
+    },
+}
+
+impl Reference {
+    /// The contact pair the reference speaks of.
+    pub fn pair(&self) -> &str {
+        match self {
+            Reference::ForcePulse { pair, .. } | Reference::Hertz { pair, .. } => pair,
+        }
+    }
 }
 
 impl Model {
@@ -319,6 +351,10 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
             finite(&cx, &format!("body `{}`.velocity", bodies[b].name), &v)?;
         }
     }
+    let reference = match &scene.reference {
+        Some(spec) => Some(reference(&cx, &bodies, &contacts, spec)?),
+        None => None,
+    };
     let name = file
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -335,8 +371,149 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         output: scene.output,
         probes,
         initial_velocity,
+        reference,
         contacts,
     })
+}
+
+/// Reads the numbers of a `[reference]` from the model: the pair's slave body (and master
+/// body for `bars`), their material, section, length and initial velocities.
+fn reference(
+    cx: &Context,
+    bodies: &[Body],
+    contacts: &[ContactPair],
+    spec: &ReferenceSpec,
+) -> Result<Reference, InputError> {
+    let pair = match &spec.contact {
+        Some(name) => contacts
+            .iter()
+            .find(|c| &c.name == name)
+            .ok_or_else(|| cx.err(format!("reference.contact: no contact pair named `{name}`")))?,
+        None if contacts.len() == 1 => &contacts[0],
+        None => {
+            return Err(cx.err(format!(
+                "reference.contact: the scene has {} contact pairs; name the one the reference speaks of",
+                contacts.len()
+            )));
+        }
+    };
+    let kind_name = match spec.kind {
+        ReferenceKind::Bars => "bars",
+        ReferenceKind::RodWall => "rod_wall",
+        ReferenceKind::HertzImpact => "hertz_impact",
+    };
+    let wrong = |what: &str| {
+        cx.err(format!(
+            "reference.kind = \"{kind_name}\" needs {what} (contact pair `{}`)",
+            pair.name
+        ))
+    };
+    let rod = |b: usize| -> Option<(f64, f64, f64, f64)> {
+        let body = &bodies[b];
+        let BodyKind::Rod { area } = body.kind else {
+            return None;
+        };
+        let Cells::Rod2(cells) = &body.mesh.cells else {
+            return None;
+        };
+        let length: f64 = cells
+            .iter()
+            .map(|[i, j]| {
+                let (a, b) = (body.mesh.nodes[*i], body.mesh.nodes[*j]);
+                (b[0] - a[0]).hypot(b[1] - a[1])
+            })
+            .sum();
+        Some((
+            body.material.density,
+            body.material.elastic.young,
+            area,
+            length,
+        ))
+    };
+    let speed = |v: [f64; 2]| v[0].hypot(v[1]);
+    let slave = &bodies[pair.slave_body];
+    match spec.kind {
+        ReferenceKind::Bars => {
+            let master = match &pair.master {
+                Master::Segments { body, .. } | Master::Nodes { body, .. } => *body,
+                Master::Obstacle(_) => return Err(wrong("a rod as master, not an obstacle")),
+            };
+            let (Some(a), Some(b)) = (rod(pair.slave_body), rod(master)) else {
+                return Err(wrong("two rods"));
+            };
+            let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(y.abs());
+            if !(same(a.0, b.0) && same(a.1, b.1) && same(a.2, b.2) && same(a.3, b.3)) {
+                return Err(wrong(
+                    "two equal rods (same density, Young's modulus, area and length)",
+                ));
+            }
+            let v = bodies[master].velocity;
+            let relative = [slave.velocity[0] - v[0], slave.velocity[1] - v[1]];
+            let (force, duration) =
+                crate::reference::equal_bars_impact(a.0, a.1, a.2, a.3, speed(relative));
+            Ok(Reference::ForcePulse {
+                kind: spec.kind,
+                pair: pair.name.clone(),
+                force,
+                duration,
+            })
+        }
+        ReferenceKind::RodWall => {
+            if !matches!(pair.master, Master::Obstacle(_)) {
+                return Err(wrong("a rigid obstacle as master"));
+            }
+            let (density, young, area, length) =
+                rod(pair.slave_body).ok_or_else(|| wrong("a rod as slave body"))?;
+            let (force, duration) = crate::reference::rod_wall_impact(
+                density,
+                young,
+                area,
+                length,
+                speed(slave.velocity),
+            );
+            Ok(Reference::ForcePulse {
+                kind: spec.kind,
+                pair: pair.name.clone(),
+                force,
+                duration,
+            })
+        }
+        ReferenceKind::HertzImpact => {
+            if !matches!(pair.master, Master::Obstacle(_)) {
+                return Err(wrong("a rigid obstacle as master"));
+            }
+            if !matches!(
+                slave.kind,
+                BodyKind::Continuum {
+                    formulation: Formulation::Axisymmetric,
+                    ..
+                }
+            ) {
+                return Err(wrong("an axisymmetric sphere (half disc) as slave body"));
+            }
+            // the half disc spans the sphere's diameter along the axis
+            let (low, high) = slave
+                .mesh
+                .nodes
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                    (l.min(p[1]), h.max(p[1]))
+                });
+            let (radius, duration, peak_force) = crate::reference::hertz_sphere_impact(
+                0.5 * (high - low),
+                slave.material.density,
+                slave.material.elastic.young,
+                slave.material.elastic.poisson,
+                speed(slave.velocity),
+            );
+            Ok(Reference::Hertz {
+                pair: pair.name.clone(),
+                peak_force,
+                radius,
+                duration,
+            })
+        }
+    }
 }
 
 fn positive(cx: &Context, key: &str, value: f64) -> Result<f64, InputError> {

@@ -32,6 +32,31 @@ pub struct Scene {
     pub analysis: AnalysisSpec,
     #[serde(default)]
     pub output: OutputSpec,
+    /// The analytical solution `impact sweep` measures errors against. Default: none (the
+    /// sweep's finest case, with Richardson extrapolation of scalar measures).
+    pub reference: Option<ReferenceSpec>,
+}
+
+/// `[reference]`: which closed-form solution the scene is an instance of; its numbers
+/// (material, length, speed) are read from the model.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    pub kind: ReferenceKind,
+    /// The contact pair whose force is compared. Default: the scene's only pair.
+    pub contact: Option<String>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReferenceKind {
+    /// Two equal rods, the slave's body striking the master's (reference::equal_bars_impact).
+    Bars,
+    /// A rod striking a rigid obstacle (reference::rod_wall_impact).
+    RodWall,
+    /// An elastic sphere (axisymmetric half disc) striking a rigid obstacle
+    /// (reference::hertz_sphere_impact).
+    HertzImpact,
 }
 
 #[derive(Debug, Clone, Deserialize)]

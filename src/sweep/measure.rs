@@ -1,0 +1,585 @@
+//! Errors of each case against the scene's `[reference]`, or else against the finest case
+//! (scalar measures Richardson-extrapolated from the three finest), and the sweep.csv table.
+//!
+//! ```text
+//! F_h(t_k)      the case's contact force history (history.csv `contact_force[PAIR]`)
+//! F_ref(t)      the reference force: a pulse F_0 on 0 < t < T (mean of the limits at a jump),
+//!               or the finest case's history interpolated linearly
+//! force_l2      sqrt( int (F_h - F_ref)^2 dt / int F_ref^2 dt ), trapezoid rule on the t_k
+//! force_l2_smooth  the same over the t_k farther than T/8 from the pulse's jumps (t = 0, T)
+//! release_error    last release time minus T (pulse), Hertz duration, or the extrapolation
+//! peak_force_error, duration_error, radius_error: relative, (value - reference) / reference
+//! energy_drift  summary.json energy.max_relative_drift (the balance error)
+//! energy_change (energy.final - energy.initial) / energy.initial
+//! h             the shortest element edge of the initial mesh
+//! ```
+//!
+//! A jump in F_ref limits the L2 error to order 1/2 under refinement (an O(dt) shift of the
+//! jump or an O(1) ripple over a fixed number of steps costs O(dt) in the squared norm);
+//! force_l2_smooth shows the order of the scheme away from the jumps (docs/validation.md 6).
+
+use super::plan::{Case, Plan};
+use crate::analysis::explicit::critical_time_step;
+use crate::mesh::Cells;
+use crate::scene::model::{Analysis, Reference};
+use crate::scene::{InputError, Model};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// DIR/CASE/case.json: written last, atomically; a case is finished when it exists.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CaseRecord {
+    pub index: usize,
+    pub values: Vec<(String, String)>,
+    /// `ok`, `diverged`, `unstable` (summary.json) or `refused` (the run rejected the input,
+    /// e.g. central difference above dt_crit without `analysis.allow_unstable`).
+    pub status: String,
+    pub message: Option<String>,
+    pub wall_seconds: f64,
+}
+
+/// What one case measured (None where it does not apply or is unknown).
+#[derive(Debug, Clone, Default)]
+pub struct Measures {
+    pub force_l2: Option<f64>,
+    pub force_l2_smooth: Option<f64>,
+    pub release_time: Option<f64>,
+    pub release_error: Option<f64>,
+    pub peak_force: Option<f64>,
+    pub peak_force_error: Option<f64>,
+    pub duration_error: Option<f64>,
+    pub radius_error: Option<f64>,
+    pub energy_drift: Option<f64>,
+    /// (energy.final - energy.initial) / energy.initial: negative when the method (or the
+    /// impact conditions) dissipated energy.
+    pub energy_change: Option<f64>,
+    pub steps: Option<f64>,
+    pub newton_iterations: Option<f64>,
+    pub factorizations: Option<f64>,
+}
+
+/// One row of sweep.csv.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub case: Case,
+    pub folder: String,
+    pub status: String,
+    /// The integrator's scene name (`average`, `hu`, ..., `static`).
+    pub integrator: String,
+    pub dt: Option<f64>,
+    pub h: f64,
+    pub dt_crit: Option<f64>,
+    pub wall_seconds: Option<f64>,
+    pub measures: Measures,
+}
+
+impl Row {
+    pub fn dt_over_dt_crit(&self) -> Option<f64> {
+        Some(self.dt? / self.dt_crit?)
+    }
+
+    /// The error the charts plot: force_l2 (pulse or finest-case reference), else |peak
+    /// force error| (Hertz).
+    pub fn primary_error(&self) -> Option<f64> {
+        self.measures
+            .force_l2
+            .or(self.measures.peak_force_error.map(f64::abs))
+    }
+}
+
+/// The reference used, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReferenceUsed {
+    /// `bars`, `rod_wall`, `hertz_impact`, or `finest case` / `richardson`.
+    pub kind: String,
+    pub pair: Option<String>,
+    pub force: Option<f64>,
+    pub release_time: Option<f64>,
+    pub peak_force: Option<f64>,
+    pub radius: Option<f64>,
+    pub duration: Option<f64>,
+    /// The finest case's folder (finest-case references).
+    pub finest: Option<String>,
+    /// The observed order of the Richardson extrapolation of the peak force.
+    pub richardson_order: Option<f64>,
+}
+
+/// A finished case's files.
+struct Loaded {
+    summary: serde_json::Value,
+    time: Vec<f64>,
+    force: Option<Vec<f64>>,
+}
+
+fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Option<T> {
+    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
+}
+
+/// The cases' rows, measured against the scene's reference or the finest case. `folders`
+/// gives the folder holding each case (None: missing). `models` are the cases' models.
+pub fn tabulate(
+    plan: &Plan,
+    cases: &[Case],
+    models: &[Model],
+    folders: &[Option<PathBuf>],
+) -> Result<(Vec<Row>, ReferenceUsed), InputError> {
+    let reference = models.first().and_then(|m| m.reference.clone());
+    let pair = reference
+        .as_ref()
+        .map(|r| r.pair().to_string())
+        .or_else(|| models.first()?.contacts.first().map(|c| c.name.clone()));
+    let column = pair.as_ref().map(|p| format!("contact_force[{p}]"));
+    let mut rows = Vec::with_capacity(cases.len());
+    let mut loaded = Vec::with_capacity(cases.len());
+    for ((case, model), folder) in cases.iter().zip(models).zip(folders) {
+        let record: Option<CaseRecord> = folder
+            .as_ref()
+            .and_then(|f| read_json(&f.join("case.json")));
+        let files = folder.as_ref().and_then(|f| load(f, column.as_deref()));
+        let dt_crit = if model.bodies.iter().all(|b| b.material.density > 0.0) {
+            Some(critical_time_step(model)?.0)
+        } else {
+            None
+        };
+        let (integrator, dt) = match &model.analysis {
+            Analysis::Dynamic(d) => (
+                serde_json::to_value(d.integrator)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default(),
+                Some(d.dt),
+            ),
+            Analysis::Static(_) => ("static".to_string(), None),
+        };
+        let mut measures = Measures::default();
+        if let Some(files) = &files {
+            let s = &files.summary;
+            let num = |path: &[&str]| {
+                path.iter()
+                    .try_fold(s, |v, k| v.get(k))
+                    .and_then(serde_json::Value::as_f64)
+            };
+            measures.release_time = num(&["contact", "last_release_time"]);
+            measures.peak_force = num(&["contact", "peak_force"]);
+            measures.energy_drift = num(&["energy", "max_relative_drift"]);
+            if let (Some(initial), Some(last)) =
+                (num(&["energy", "initial"]), num(&["energy", "final"]))
+                && initial > 0.0
+            {
+                measures.energy_change = Some(last / initial - 1.0);
+            }
+            measures.steps = num(&["steps"]);
+            measures.newton_iterations = num(&["newton_iterations"]);
+            measures.factorizations = num(&["factorizations"]);
+        }
+        rows.push(Row {
+            case: case.clone(),
+            folder: plan.folder(case),
+            status: record
+                .as_ref()
+                .map_or("missing".to_string(), |r| r.status.clone()),
+            integrator,
+            dt,
+            h: shortest_edge(model),
+            dt_crit,
+            wall_seconds: record.as_ref().map(|r| r.wall_seconds),
+            measures,
+        });
+        loaded.push((files, record));
+    }
+    let used = match &reference {
+        Some(Reference::ForcePulse {
+            kind,
+            pair,
+            force,
+            duration,
+        }) => {
+            for (row, (files, _)) in rows.iter_mut().zip(&loaded) {
+                let m = &mut row.measures;
+                if let Some(Loaded {
+                    time,
+                    force: Some(f),
+                    ..
+                }) = files
+                {
+                    let pulse = |t: f64| pulse(t, *force, *duration);
+                    m.force_l2 = relative_l2(time, f, &pulse, |_| true);
+                    let margin = duration / 8.0;
+                    m.force_l2_smooth = relative_l2(time, f, &pulse, |t| {
+                        t.abs() >= margin && (t - duration).abs() >= margin
+                    });
+                }
+                m.release_error = m.release_time.map(|t| t - duration);
+                m.peak_force_error = m.peak_force.map(|p| p / force - 1.0);
+                m.duration_error = m.release_time.map(|t| t / duration - 1.0);
+            }
+            ReferenceUsed {
+                kind: serde_json::to_value(kind)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default(),
+                pair: Some(pair.clone()),
+                force: Some(*force),
+                release_time: Some(*duration),
+                peak_force: Some(*force),
+                radius: None,
+                duration: Some(*duration),
+                finest: None,
+                richardson_order: None,
+            }
+        }
+        Some(Reference::Hertz {
+            pair,
+            peak_force,
+            radius,
+            duration,
+        }) => {
+            for (row, (files, _)) in rows.iter_mut().zip(&loaded) {
+                let m = &mut row.measures;
+                m.peak_force_error = m.peak_force.map(|p| p / peak_force - 1.0);
+                m.release_error = m.release_time.map(|t| t - duration);
+                if let Some(files) = files {
+                    let s = &files.summary["contact"];
+                    if let (Some(first), Some(last)) = (
+                        s["first_contact_time"].as_f64(),
+                        s["last_release_time"].as_f64(),
+                    ) {
+                        m.duration_error = Some((last - first) / duration - 1.0);
+                    }
+                    m.radius_error = s["peak_contact_radius"].as_f64().map(|a| a / radius - 1.0);
+                }
+            }
+            ReferenceUsed {
+                kind: "hertz_impact".into(),
+                pair: Some(pair.clone()),
+                force: None,
+                release_time: Some(*duration),
+                peak_force: Some(*peak_force),
+                radius: Some(*radius),
+                duration: Some(*duration),
+                finest: None,
+                richardson_order: None,
+            }
+        }
+        None => finest_reference(&mut rows, &loaded, pair),
+    };
+    Ok((rows, used))
+}
+
+/// Without a declared reference: the finest ok case (smallest dt, then the most elements
+/// by the shortest edge) gives the force history; peak force and release time are
+/// Richardson-extrapolated from the three finest dt when they are in a constant ratio.
+fn finest_reference(
+    rows: &mut [Row],
+    loaded: &[(Option<Loaded>, Option<CaseRecord>)],
+    pair: Option<String>,
+) -> ReferenceUsed {
+    let mut ok: Vec<usize> = (0..rows.len())
+        .filter(|&k| rows[k].status == "ok" && loaded[k].0.is_some())
+        .collect();
+    ok.sort_by(|&a, &b| {
+        let key = |k: usize| (rows[k].dt.unwrap_or(0.0), rows[k].h);
+        key(a)
+            .partial_cmp(&key(b))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    let mut used = ReferenceUsed {
+        kind: "finest case".into(),
+        pair,
+        force: None,
+        release_time: None,
+        peak_force: None,
+        radius: None,
+        duration: None,
+        finest: None,
+        richardson_order: None,
+    };
+    let Some(&finest) = ok.first() else {
+        return used;
+    };
+    used.finest = Some(rows[finest].folder.clone());
+    // the three finest distinct dt
+    let mut levels: Vec<usize> = Vec::new();
+    for &k in &ok {
+        if levels
+            .last()
+            .is_none_or(|&l| rows[k].dt.unwrap_or(0.0) > rows[l].dt.unwrap_or(0.0) * (1.0 + 1e-9))
+        {
+            levels.push(k);
+        }
+    }
+    let scalar = |get: &dyn Fn(&Measures) -> Option<f64>| -> (Option<f64>, Option<f64>) {
+        let finest_value = get(&rows[finest].measures);
+        if levels.len() < 3 {
+            return (finest_value, None);
+        }
+        let (a, b, c) = (levels[0], levels[1], levels[2]);
+        let (Some(f1), Some(f2), Some(f3)) = (
+            get(&rows[a].measures),
+            get(&rows[b].measures),
+            get(&rows[c].measures),
+        ) else {
+            return (finest_value, None);
+        };
+        let dt = |k: usize| rows[k].dt.unwrap_or(0.0);
+        let (r1, r2) = (dt(b) / dt(a), dt(c) / dt(b));
+        match richardson(f1, f2, f3, r1, r2) {
+            Some((value, order)) => (Some(value), Some(order)),
+            None => (finest_value, None),
+        }
+    };
+    let (peak, order) = scalar(&|m: &Measures| m.peak_force);
+    let (release, _) = scalar(&|m: &Measures| m.release_time);
+    if order.is_some() {
+        used.kind = "richardson".into();
+    }
+    used.peak_force = peak;
+    used.release_time = release;
+    used.richardson_order = order;
+    let reference_history = loaded[finest]
+        .0
+        .as_ref()
+        .and_then(|l| Some((l.time.clone(), l.force.clone()?)));
+    for (k, row) in rows.iter_mut().enumerate() {
+        let m = &mut row.measures;
+        if let (Some(p), Some(p_ref)) = (m.peak_force, peak) {
+            m.peak_force_error = Some(p / p_ref - 1.0);
+        }
+        if let (Some(t), Some(t_ref)) = (m.release_time, release) {
+            m.release_error = Some(t - t_ref);
+        }
+        if let (
+            Some((t_ref, f_ref)),
+            Some(Loaded {
+                time,
+                force: Some(f),
+                ..
+            }),
+        ) = (&reference_history, &loaded[k].0)
+        {
+            let interpolate = |t: f64| interpolate(t_ref, f_ref, t);
+            m.force_l2 = relative_l2(time, f, &interpolate, |_| true);
+        }
+    }
+    used
+}
+
+/// Richardson extrapolation from values on three levels f1 (finest), f2, f3 with step
+/// ratios r = h2/h1 = h3/h2 (within 1 %): p = ln((f3 - f2) / (f2 - f1)) / ln r,
+/// f = f1 + (f1 - f2) / (r^p - 1). None when the ratios differ or the differences do not
+/// shrink monotonically (no asymptotic range).
+pub fn richardson(f1: f64, f2: f64, f3: f64, r1: f64, r2: f64) -> Option<(f64, f64)> {
+    if r1 <= 1.0 || (r1 / r2 - 1.0).abs() > 0.01 {
+        return None;
+    }
+    let ratio = (f3 - f2) / (f2 - f1);
+    if !(ratio.is_finite() && ratio > 1.0) {
+        return None;
+    }
+    let p = ratio.ln() / r1.ln();
+    Some((f1 + (f1 - f2) / (r1.powf(p) - 1.0), p))
+}
+
+/// The pulse F_0 on 0 < t < T, the mean of the one-sided limits at t = 0 and t = T.
+fn pulse(t: f64, force: f64, duration: f64) -> f64 {
+    let eps = 1e-9 * duration;
+    if (t.abs() <= eps) || ((t - duration).abs() <= eps) {
+        0.5 * force
+    } else if t > 0.0 && t < duration {
+        force
+    } else {
+        0.0
+    }
+}
+
+/// Linear interpolation in a sampled history (constant beyond its ends).
+fn interpolate(time: &[f64], value: &[f64], t: f64) -> f64 {
+    let k = time.partition_point(|s| *s < t);
+    if k == 0 {
+        return value[0];
+    }
+    if k >= time.len() {
+        return value[value.len() - 1];
+    }
+    let (t0, t1) = (time[k - 1], time[k]);
+    if t1 <= t0 {
+        return value[k];
+    }
+    value[k - 1] + (t - t0) / (t1 - t0) * (value[k] - value[k - 1])
+}
+
+/// sqrt(int (f - g)^2 dt / int g^2 dt) by the trapezoid rule over the samples, counting only
+/// the intervals whose both ends pass `keep`. None if the reference norm is zero.
+fn relative_l2(
+    time: &[f64],
+    value: &[f64],
+    reference: &dyn Fn(f64) -> f64,
+    keep: impl Fn(f64) -> bool,
+) -> Option<f64> {
+    let (mut error, mut norm) = (0.0, 0.0);
+    for k in 1..time.len() {
+        let (t0, t1) = (time[k - 1], time[k]);
+        if !(keep(t0) && keep(t1)) {
+            continue;
+        }
+        let (g0, g1) = (reference(t0), reference(t1));
+        let h = t1 - t0;
+        error += 0.5 * h * ((value[k - 1] - g0).powi(2) + (value[k] - g1).powi(2));
+        norm += 0.5 * h * (g0 * g0 + g1 * g1);
+    }
+    (norm > 0.0).then(|| (error / norm).sqrt())
+}
+
+/// summary.json and the time and force columns of a finished case.
+fn load(folder: &Path, column: Option<&str>) -> Option<Loaded> {
+    let summary: serde_json::Value = read_json(&folder.join("summary.json"))?;
+    let history = folder.join("history.csv");
+    let time = crate::output::plot::history_columns(&history, &["time"])
+        .ok()?
+        .remove(0);
+    let force = column.and_then(|c| {
+        crate::output::plot::history_columns(&history, &[c])
+            .ok()
+            .map(|mut v| v.remove(0))
+    });
+    Some(Loaded {
+        summary,
+        time,
+        force,
+    })
+}
+
+/// The shortest element edge of the initial mesh over all bodies.
+pub fn shortest_edge(model: &Model) -> f64 {
+    let mut shortest = f64::INFINITY;
+    for body in &model.bodies {
+        let length = |a: usize, b: usize| {
+            let (p, q) = (body.mesh.nodes[a], body.mesh.nodes[b]);
+            (q[0] - p[0]).hypot(q[1] - p[1])
+        };
+        match &body.mesh.cells {
+            Cells::Quad4(cells) => {
+                for c in cells {
+                    for i in 0..4 {
+                        shortest = shortest.min(length(c[i], c[(i + 1) % 4]));
+                    }
+                }
+            }
+            Cells::Rod2(cells) => {
+                for c in cells {
+                    shortest = shortest.min(length(c[0], c[1]));
+                }
+            }
+        }
+    }
+    shortest
+}
+
+/// sweep.csv: one row per case; the varied values as given, then the measures. Numbers in
+/// shortest round-trip exponent form; empty where not applicable.
+pub fn csv(plan: &Plan, rows: &[Row]) -> String {
+    let keys = plan.keys();
+    let mut header: Vec<String> = vec!["case".into(), "folder".into()];
+    header.extend(keys.iter().cloned());
+    header.extend(
+        [
+            "status",
+            "integrator",
+            "dt",
+            "h",
+            "dt_crit",
+            "dt_over_dt_crit",
+            "force_l2",
+            "force_l2_smooth",
+            "release_time",
+            "release_error",
+            "peak_force",
+            "peak_force_error",
+            "duration_error",
+            "radius_error",
+            "energy_drift",
+            "energy_change",
+            "steps",
+            "newton_iterations",
+            "factorizations",
+            "wall_seconds",
+        ]
+        .map(String::from),
+    );
+    let mut text = header.join(",");
+    text.push('\n');
+    let num = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
+    for row in rows {
+        let m = &row.measures;
+        let mut cells = vec![row.case.index.to_string(), row.folder.clone()];
+        cells.extend(row.case.values.iter().map(|(_, v)| quote(v)));
+        cells.extend([row.status.clone(), row.integrator.clone()]);
+        cells.extend(
+            [
+                row.dt,
+                Some(row.h),
+                row.dt_crit,
+                row.dt_over_dt_crit(),
+                m.force_l2,
+                m.force_l2_smooth,
+                m.release_time,
+                m.release_error,
+                m.peak_force,
+                m.peak_force_error,
+                m.duration_error,
+                m.radius_error,
+                m.energy_drift,
+                m.energy_change,
+            ]
+            .map(num),
+        );
+        let count = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.0}"));
+        cells.extend([m.steps, m.newton_iterations, m.factorizations].map(count));
+        cells.push(num(row.wall_seconds));
+        text.push_str(&cells.join(","));
+        text.push('\n');
+    }
+    text
+}
+
+/// A CSV field: quoted when it holds a comma or a quote.
+fn quote(v: &str) -> String {
+    if v.contains([',', '"']) {
+        format!("\"{}\"", v.replace('"', "\"\""))
+    } else {
+        v.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Richardson on f(h) = 1 + h^2 recovers 1 and order 2 exactly.
+    #[test]
+    fn richardson_recovers_a_quadratic() {
+        let f = |h: f64| 1.0 + h * h;
+        let (value, order) = richardson(f(0.25), f(0.5), f(1.0), 2.0, 2.0).unwrap();
+        approx::assert_abs_diff_eq!(value, 1.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(order, 2.0, epsilon = 1e-12);
+        assert!(richardson(1.0, 1.0, 1.0, 2.0, 2.0).is_none());
+        assert!(richardson(f(0.25), f(0.5), f(1.0), 2.0, 3.0).is_none());
+    }
+
+    /// Goal: the L2 measure of a pulse released one sample late. Reference (by hand): the
+    /// differences are F/2 at t = T and at T + h (the mean of the limits at each jump), so
+    /// the trapezoid rule gives int e^2 = h F^2 / 2 against int g^2 = F^2 T (to O(h)):
+    /// e = sqrt(h / (2 T)); 1 % for the O(h) end weights of the norm.
+    #[test]
+    fn relative_l2_of_a_pulse_released_one_sample_late() {
+        let (force, duration, h) = (2.0, 1.0, 0.01);
+        let time: Vec<f64> = (0..=200).map(|k| k as f64 * h).collect();
+        let value: Vec<f64> = time
+            .iter()
+            .map(|&t| pulse(t, force, duration + h))
+            .collect();
+        let e = relative_l2(&time, &value, &|t| pulse(t, force, duration), |_| true).unwrap();
+        let exact = (h / (2.0 * duration)).sqrt();
+        approx::assert_relative_eq!(e, exact, max_relative = 0.01);
+    }
+}

@@ -1,0 +1,257 @@
+//! `impact sweep`: runs the cross product of `--vary` variations of a scene in parallel
+//! across cases, measures each against the scene's `[reference]` (or the finest case), and
+//! writes sweep.csv and the charts.
+//!
+//! ```text
+//! DIR/sweep.json         the plan (scene, --set, --vary); a rerun must have the same plan
+//! DIR/case-HASH/         one case: history.csv, summary.json (analysis::run, no VTK frames),
+//!                        case.json written last and atomically: the case is finished
+//! DIR/sweep.csv          one row per case (measure::csv)
+//! DIR/reference.json     the reference the errors are measured against
+//! DIR/*.png, DIR/*.svg   charts (charts.rs)
+//! ```
+//! A rerun skips finished cases. `--shard i/n` runs the cases k with k mod n = i; `merge`
+//! joins the case folders of several DIRs into one table and charts. Each case runs on one
+//! thread (its element loops in a one-thread pool), so results do not depend on `--jobs`.
+
+pub mod charts;
+pub mod measure;
+pub mod plan;
+
+use crate::analysis::{self, RunError, RunOptions};
+use crate::output::{OutputError, write_atomic};
+use crate::scene::{self, InputError, Model};
+use indicatif::{ProgressBar, ProgressStyle};
+use measure::CaseRecord;
+pub use plan::{Case, Plan, Variation};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Options of a sweep that are not part of its plan.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SweepOptions {
+    /// Cases run at once; 0: one per core.
+    pub jobs: usize,
+    /// (i, n): run only the cases k with k mod n = i.
+    pub shard: Option<(usize, usize)>,
+    /// Show a progress bar over the cases.
+    pub progress: bool,
+}
+
+/// What a sweep did.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// Cases in the plan.
+    pub cases: usize,
+    /// Cases of this shard (all without a shard).
+    pub in_shard: usize,
+    /// Cases run now.
+    pub executed: usize,
+    /// Cases of this shard finished before (skipped).
+    pub skipped: usize,
+    /// Rows whose status is not `ok` (including `missing`).
+    pub not_ok: usize,
+    pub rows: Vec<measure::Row>,
+    pub csv: PathBuf,
+    pub charts: Vec<PathBuf>,
+}
+
+fn output_error(path: &Path, action: &'static str, e: std::io::Error) -> RunError {
+    RunError::Output(OutputError::io(path, action, e))
+}
+
+/// Builds every case's model (bad keys and values are input errors before anything runs).
+fn models(plan: &Plan, cases: &[Case]) -> Result<Vec<Model>, RunError> {
+    plan.validate()
+        .map_err(|m| InputError::new(&plan.scene, format!("--vary: {m}")))?;
+    cases
+        .iter()
+        .map(|case| {
+            scene::load(&plan.scene, &plan.overrides(case)).map_err(|e| {
+                let values: Vec<String> = case
+                    .values
+                    .iter()
+                    .map(|(k, v)| format!("{k}={v}"))
+                    .collect();
+                RunError::Input(InputError {
+                    file: e.file,
+                    message: format!("case {} ({}): {}", case.index, values.join(" "), e.message),
+                })
+            })
+        })
+        .collect()
+}
+
+/// Runs the plan's cases (of the shard) not finished in `dir`, then writes sweep.csv, the
+/// reference and the charts of the cases found in `dir`.
+pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, RunError> {
+    let cases = plan.cases();
+    let models = models(plan, &cases)?;
+    std::fs::create_dir_all(dir).map_err(|e| output_error(dir, "create", e))?;
+    let plan_path = dir.join("sweep.json");
+    if let Ok(text) = std::fs::read_to_string(&plan_path) {
+        let existing: Option<Plan> = serde_json::from_str(&text).ok();
+        if existing.as_ref() != Some(plan) {
+            return Err(InputError::new(
+                &plan_path,
+                "this folder holds another sweep (scene, --set or --vary differ); choose another --out",
+            )
+            .into());
+        }
+    } else {
+        let text = serde_json::to_string_pretty(plan).expect("the plan serializes");
+        write_atomic(&plan_path, text.as_bytes())?;
+    }
+    let mine: Vec<usize> = (0..cases.len())
+        .filter(|k| options.shard.is_none_or(|(i, n)| k % n == i))
+        .collect();
+    let todo: Vec<usize> = mine
+        .iter()
+        .copied()
+        .filter(|&k| !dir.join(plan.folder(&cases[k])).join("case.json").is_file())
+        .collect();
+    let bar = if options.progress && !todo.is_empty() {
+        let bar = ProgressBar::new(todo.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} cases {msg}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.jobs)
+        .build()
+        .map_err(|e| output_error(dir, "start the threads of", std::io::Error::other(e)))?;
+    let results: Vec<Result<(), RunError>> = pool.install(|| {
+        todo.par_iter()
+            .map(|&k| {
+                let result = run_case(plan, &cases[k], &models[k], dir);
+                bar.inc(1);
+                result
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    for result in results {
+        result?;
+    }
+    let folders: Vec<Option<PathBuf>> = cases
+        .iter()
+        .map(|c| Some(dir.join(plan.folder(c))).filter(|f| f.join("case.json").is_file()))
+        .collect();
+    let mut report = write_results(plan, &cases, &models, &folders, dir)?;
+    report.in_shard = mine.len();
+    report.executed = todo.len();
+    report.skipped = mine.len() - todo.len();
+    Ok(report)
+}
+
+/// Runs one case into DIR/FOLDER (cleared first) on one thread; writes case.json last.
+fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<(), RunError> {
+    let folder = dir.join(plan.folder(case));
+    if folder.exists() {
+        std::fs::remove_dir_all(&folder).map_err(|e| output_error(&folder, "clear", e))?;
+    }
+    std::fs::create_dir_all(&folder).map_err(|e| output_error(&folder, "create", e))?;
+    let single = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| output_error(&folder, "start the thread of", std::io::Error::other(e)))?;
+    let start = Instant::now();
+    let result = single.install(|| analysis::run(model, &folder, RunOptions::default()));
+    let wall = start.elapsed().as_secs_f64();
+    let (status, message, wall_seconds) = match result {
+        Ok(summary) => ("ok".to_string(), None, summary.wall_seconds),
+        Err(RunError::Numerical { message, summary }) => {
+            let status = serde_json::to_value(summary.status)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_else(|| "diverged".into());
+            (status, Some(message), summary.wall_seconds)
+        }
+        Err(RunError::Input(e)) => ("refused".to_string(), Some(e.message), wall),
+        Err(e @ RunError::Output(_)) => return Err(e),
+    };
+    let record = CaseRecord {
+        index: case.index,
+        values: case.values.clone(),
+        status,
+        message,
+        wall_seconds,
+    };
+    let text = serde_json::to_string_pretty(&record).expect("the record serializes");
+    write_atomic(&folder.join("case.json"), text.as_bytes())?;
+    Ok(())
+}
+
+/// Joins the finished cases of sweeps run into `dirs` (shards of one plan) and writes the
+/// table and charts into `out`.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Report, RunError> {
+    let mut plan: Option<Plan> = None;
+    for dir in dirs {
+        let path = dir.join("sweep.json");
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| InputError::new(&path, format!("cannot read the sweep's plan: {e}")))?;
+        let this: Plan = serde_json::from_str(&text)
+            .map_err(|e| InputError::new(&path, format!("not a sweep plan: {e}")))?;
+        match &plan {
+            Some(first) if *first != this => {
+                return Err(InputError::new(
+                    &path,
+                    format!(
+                        "another sweep than {} (scene, --set or --vary differ)",
+                        dirs[0].join("sweep.json").display()
+                    ),
+                )
+                .into());
+            }
+            _ => plan = Some(this),
+        }
+    }
+    let plan = plan.ok_or_else(|| InputError::new(out, "--merge: name at least one folder"))?;
+    let cases = plan.cases();
+    let models = models(&plan, &cases)?;
+    let folders: Vec<Option<PathBuf>> = cases
+        .iter()
+        .map(|c| {
+            dirs.iter()
+                .map(|d| d.join(plan.folder(c)))
+                .find(|f| f.join("case.json").is_file())
+        })
+        .collect();
+    std::fs::create_dir_all(out).map_err(|e| output_error(out, "create", e))?;
+    let text = serde_json::to_string_pretty(&plan).expect("the plan serializes");
+    write_atomic(&out.join("sweep.json"), text.as_bytes())?;
+    write_results(&plan, &cases, &models, &folders, out)
+}
+
+/// Measures the cases, writes sweep.csv, reference.json and the charts into `out`.
+fn write_results(
+    plan: &Plan,
+    cases: &[Case],
+    models: &[Model],
+    folders: &[Option<PathBuf>],
+    out: &Path,
+) -> Result<Report, RunError> {
+    let (rows, reference) = measure::tabulate(plan, cases, models, folders)?;
+    let csv = out.join("sweep.csv");
+    write_atomic(&csv, measure::csv(plan, &rows).as_bytes())?;
+    let text = serde_json::to_string_pretty(&reference).expect("the reference serializes");
+    write_atomic(&out.join("reference.json"), text.as_bytes())?;
+    let title = models.first().map(|m| m.name.clone()).unwrap_or_default();
+    let charts = charts::write_all(plan, &rows, &title, out)?;
+    Ok(Report {
+        cases: cases.len(),
+        in_shard: cases.len(),
+        executed: 0,
+        skipped: 0,
+        not_ok: rows.iter().filter(|r| r.status != "ok").count(),
+        rows,
+        csv,
+        charts,
+    })
+}
