@@ -36,7 +36,7 @@ use std::f64::consts::PI;
 const MIN_SPLIT: f64 = 0.1;
 
 /// The contact status carried from step to step.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ContactState {
     /// Per pair, per slave (in the pair's order): active?
     pub active: Vec<Vec<bool>>,

@@ -25,7 +25,7 @@ use crate::scene::spec::{NewtonSpec, Strategy, Tangent};
 use crate::solver::Solver;
 
 /// Counters of the nonlinear solution.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Counters {
     pub iterations: usize,
     pub cuts: usize,

@@ -182,6 +182,18 @@ pub struct Model {
     /// Initial velocity per DOF (bodies' `velocity`, then `[[initial_velocity]]` sets).
     pub initial_velocity: Vec<f64>,
     pub contacts: Vec<ContactPair>,
+    /// `analysis.checkpoint_every`: a checkpoint every N converged steps (0: none).
+    pub checkpoint_every: usize,
+    /// The scene's text and `--set` overrides, embedded in checkpoints so `impact resume`
+    /// needs nothing else (empty for a model not read from text).
+    pub source: SceneSource,
+}
+
+/// Where a model came from: the scene text as read and the overrides applied to it.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SceneSource {
+    pub text: String,
+    pub overrides: Vec<String>,
 }
 
 impl Model {
@@ -328,6 +340,8 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         probes,
         initial_velocity,
         contacts,
+        checkpoint_every: scene.analysis.checkpoint_every,
+        source: SceneSource::default(),
     })
 }
 
