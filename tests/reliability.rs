@@ -246,8 +246,8 @@ impl SplitMix {
 /// The long explicit scene of the signal tests: PLASTIC_BLOCK, central difference, finer.
 const LONG: [&str; 7] = [
     "analysis.integrator=central_difference",
-    "body.block.mesh.nx=60",
-    "body.block.mesh.ny=30",
+    "body.block.mesh.nx=30",
+    "body.block.mesh.ny=15",
     "analysis.dt=0.00025",
     "analysis.end_time=0.5",
     "analysis.checkpoint_every=100",
