@@ -185,6 +185,7 @@ pub fn run(
     let mut factored_for: Option<[f64; 3]> = None;
     let mut increments = 0usize;
     let mut contact = ContactState::new(model);
+    let penetration_limits = super::contact::penetration_limits(model);
     let mut last_contact = vec![0.0; model.dofs()];
     match resume {
         Some((checkpoint, carry)) => {
@@ -431,6 +432,17 @@ pub fn run(
                     Some(&contact),
                     last,
                 )?;
+                if let Some(message) = contact.runaway_penetration(
+                    model,
+                    &state.positions(spec.geometry),
+                    &penetration_limits,
+                ) {
+                    progress.abandon();
+                    summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
+                    let message = format!("at t = {}: {message}", state.time);
+                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
+                }
                 progress.set_position((state.time / spec.dt).round() as u64);
                 control.accept(true);
                 if stop {

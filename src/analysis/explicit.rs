@@ -123,6 +123,7 @@ pub fn run(
     let mut last_total = total_force(&free, &external, &internal, m, &a, &v, a_r);
     let mut energy_reference = initial_kinetic;
     let mut contact = ContactState::new(model);
+    let penetration_limits = super::contact::penetration_limits(model);
     let mut first_step = 1;
     match resume {
         Some((checkpoint, carry)) => {
@@ -300,6 +301,15 @@ pub fn run(
             Some(&contact),
             step == steps,
         )?;
+        if let Some(message) =
+            contact.runaway_penetration(model, &state.positions(spec.geometry), &penetration_limits)
+        {
+            progress.abandon();
+            summary.finish(&energies, &Counters::default(), None, start);
+            summary.contact = contact.summary();
+            let message = format!("at t = {}: {message}", state.time);
+            return Err(super::fail(&recorder, summary, Status::Diverged, message));
+        }
         progress.set_position(step as u64);
         let interrupted = step < steps && options.interrupted();
         if interrupted {

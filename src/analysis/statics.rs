@@ -77,6 +77,7 @@ pub fn run(
     let mut control = super::StepControl::new(dt, spec.newton.max_cuts);
     let mut increments = 0usize;
     let mut contact = ContactState::new(model);
+    let penetration_limits = super::contact::penetration_limits(model);
     match resume {
         Some((checkpoint, carry)) => {
             state = carry.state;
@@ -230,6 +231,17 @@ pub fn run(
                     Some(&contact),
                     last,
                 )?;
+                if let Some(message) = contact.runaway_penetration(
+                    model,
+                    &state.positions(spec.geometry),
+                    &penetration_limits,
+                ) {
+                    progress.abandon();
+                    summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
+                    let message = format!("at t = {}: {message}", state.time);
+                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
+                }
                 progress.set_position((state.time / dt).round() as u64);
                 control.accept(end == target);
                 if stop {
