@@ -326,7 +326,7 @@ fn sigkill_at_random_moments_then_resume_completes_identically() {
         let mut child = spawn_run(&scene, &out);
         let wait = 0.05 + 0.9 * duration * rng.next();
         std::thread::sleep(Duration::from_secs_f64(wait));
-        let _ = signal(&child, libc::SIGKILL);
+        signal(&child, libc::SIGKILL);
         let _ = child.wait();
         if !out.join("block.pvd").exists() {
             continue; // killed before the output existed

@@ -367,7 +367,12 @@ struct Bookkeeping<'a> {
 impl Bookkeeping<'_> {
     fn save(&self, carry: checkpoint::Carry) -> Result<(), RunError> {
         let checkpoint = checkpoint::Checkpoint {
-            scene_path: self.model.file.display().to_string(),
+            // absolute when the file exists, so `impact resume` works from any folder (mesh
+            // files are found next to the scene)
+            scene_path: std::fs::canonicalize(&self.model.file)
+                .unwrap_or_else(|_| self.model.file.clone())
+                .display()
+                .to_string(),
             source: self.model.source.clone(),
             summary: self.summary.clone(),
             counters: *self.counters,
