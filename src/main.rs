@@ -8,6 +8,8 @@ use impact::scene::{self, InputError};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 #[derive(Parser)]
 #[command(
@@ -32,6 +34,17 @@ enum Command {
         /// or --set body.beam.velocity=[0,-1] (arrays of tables addressed by name).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// No progress bar and no closing line.
+        #[arg(long)]
+        quiet: bool,
+        /// Write DIR/checkpoint.bin every N steps (same as --set analysis.checkpoint_every=N).
+        #[arg(long, value_name = "N")]
+        checkpoint_every: Option<usize>,
+    },
+    /// Continue a run from DIR/checkpoint.bin (written with analysis.checkpoint_every, or when
+    /// a run is interrupted by Ctrl-C / SIGTERM). The scene is the one stored in the checkpoint.
+    Resume {
+        dir: PathBuf,
         /// No progress bar and no closing line.
         #[arg(long)]
         quiet: bool,
@@ -115,7 +128,15 @@ fn main() -> ExitCode {
             out,
             set,
             quiet,
-        } => run(&scene, out, &set, quiet),
+            checkpoint_every,
+        } => {
+            let mut set = set;
+            if let Some(n) = checkpoint_every {
+                set.push(format!("analysis.checkpoint_every={n}"));
+            }
+            run(&scene, out, &set, quiet)
+        }
+        Command::Resume { dir, quiet } => resume(&dir, quiet),
         Command::Check { scene, set } => check(&scene, &set),
         Command::Buckle {
             scene,
@@ -160,13 +181,27 @@ fn main() -> ExitCode {
     }
 }
 
+/// Options of a run, with SIGINT and SIGTERM turned into a request to stop after the step in
+/// progress (a second signal while that step finishes is the same request).
+fn run_options(quiet: bool) -> RunOptions {
+    let flag: &'static Arc<AtomicBool> = Box::leak(Box::new(Arc::new(AtomicBool::new(false))));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        // without a handler the default action still stops the run, only less tidily
+        if let Err(e) = signal_hook::flag::register(signal, Arc::clone(flag)) {
+            eprintln!("warning: cannot catch signal {signal}: {e}");
+        }
+    }
+    RunOptions {
+        progress: !quiet && std::io::stderr().is_terminal(),
+        interrupt: Some(&**flag),
+        halt_after_steps: None,
+    }
+}
+
 fn run(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result<(), RunError> {
     let model = scene::load(path, set)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
-    let options = RunOptions {
-        progress: !quiet && std::io::stderr().is_terminal(),
-    };
-    let summary = analysis::run(&model, &dir, options)?;
+    let summary = analysis::run(&model, &dir, run_options(quiet))?;
     if !quiet {
         println!(
             "{}: {} steps, {} Newton iterations, {} factorizations, {:.2} s -> {}",
@@ -175,6 +210,20 @@ fn run(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result
             summary.newton_iterations,
             summary.factorizations,
             summary.wall_seconds,
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+fn resume(dir: &Path, quiet: bool) -> Result<(), RunError> {
+    let summary = analysis::resume(dir, run_options(quiet))?;
+    if !quiet {
+        println!(
+            "resumed {}: {} steps in all, t = {} -> {}",
+            summary.scene,
+            summary.steps,
+            summary.end_time,
             dir.display()
         );
     }

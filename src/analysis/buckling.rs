@@ -100,7 +100,7 @@ impl InertiaCheck {
 }
 
 /// summary.json `buckling` (present when the scene has `[analysis.buckling]`).
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, serde::Deserialize)]
 pub struct BucklingSummary {
     /// lambda_1 of the end loads at the prebuckling state (`modes` > 0), else null.
     pub critical_load_factor: Option<f64>,

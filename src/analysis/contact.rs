@@ -36,7 +36,7 @@ use std::f64::consts::PI;
 const MIN_SPLIT: f64 = 0.1;
 
 /// The contact status carried from step to step.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ContactState {
     /// Per pair, per slave (in the pair's order): active?
     pub active: Vec<Vec<bool>>,
@@ -113,6 +113,34 @@ enum Slip {
     Stick,
     Slide(f64),
     Return(f64),
+}
+
+/// Per pair, the penetration beyond which a run stops: half the smallest distance between
+/// two of its slave nodes in the initial configuration (infinite with one slave).
+pub fn penetration_limits(model: &Model) -> Vec<f64> {
+    let x = model.coordinates();
+    model
+        .contacts
+        .iter()
+        .map(|pair| {
+            let mut nodes: Vec<[f64; 2]> = pair.slaves.iter().map(|s| x[*s]).collect();
+            nodes.sort_by(|a, b| a[0].total_cmp(&b[0]));
+            let mut h = f64::INFINITY;
+            for i in 0..nodes.len() {
+                for j in i + 1..nodes.len() {
+                    let dx = nodes[j][0] - nodes[i][0];
+                    if dx >= h {
+                        break;
+                    }
+                    let d = dx.hypot(nodes[j][1] - nodes[i][1]);
+                    if d > 0.0 {
+                        h = h.min(d);
+                    }
+                }
+            }
+            0.5 * h
+        })
+        .collect()
 }
 
 impl ContactState {
@@ -619,6 +647,37 @@ impl ContactState {
             peak_contact_radius: self.peak_extent,
             min_gap: self.min_gap,
         }
+    }
+
+    /// The deepest slave penetration beyond the pair's limit after a converged step, as a
+    /// message naming the pair, the node, the gap and the limit (half the smallest spacing
+    /// of the pair's slave nodes: a node that deep has passed its neighbours' master
+    /// segments, the contact no longer holds).
+    pub fn runaway_penetration(
+        &self,
+        model: &Model,
+        coords: &[[f64; 2]],
+        limits: &[f64],
+    ) -> Option<String> {
+        let x = |n: usize| coords[n];
+        let mut worst: Option<(f64, usize, usize, f64)> = None;
+        for (p, pair) in model.contacts.iter().enumerate() {
+            for s in &pair.slaves {
+                if let Some(g) = pair.gap(*s, &x)
+                    && (g.gap < -limits[p] || !g.gap.is_finite())
+                    && worst.is_none_or(|w| g.gap / limits[p] < w.0 / w.3)
+                {
+                    worst = Some((g.gap, p, *s, limits[p]));
+                }
+            }
+        }
+        worst.map(|(gap, p, node, limit)| {
+            format!(
+                "runaway penetration: contact `{}`, node {node}: gap = {gap:e} beyond -{limit:e} \
+                 (half the slave node spacing)",
+                model.contacts[p].name
+            )
+        })
     }
 
     /// Total normal force per pair.

@@ -12,6 +12,7 @@
 //! Prescribed DOFs follow their curves; their velocity and acceleration come from the same
 //! integrator formulas as the free ones.
 
+use super::checkpoint::{Carry, Checkpoint, DynamicCarry};
 use super::contact::ContactState;
 use super::newton::{ContactStep, Counters, Inertia, Step, StepFailure, Tangential};
 use super::record::{Energies, Motion, Recorder};
@@ -113,15 +114,27 @@ pub fn run(
     spec: &DynamicSpec,
     dir: &Path,
     options: RunOptions,
+    resume: Option<Checkpoint>,
 ) -> Result<Outcome, RunError> {
-    let start = Instant::now();
+    let mut start = Instant::now();
     let initial = model.coordinates();
     let mut system = System::new(model, &loads::constrained_dofs(model));
     let mass =
         Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
     check_mass(model, &mass, &system)?;
     let mut solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
-    let mut recorder = Recorder::create(model, dir)?;
+    let (mut recorder, resume) = match resume {
+        Some(c) => {
+            let Carry::Dynamic(carry) = c.carry.clone() else {
+                return Err(super::wrong_carry(dir, "implicit dynamic"));
+            };
+            (
+                Recorder::resume(model, dir, c.recorder.clone())?,
+                Some((c, carry)),
+            )
+        }
+        None => (Recorder::create(model, dir)?, None),
+    };
     let mut state = State::initial(model);
     let mut method = integrator(spec);
     let steps = (spec.end_time / spec.dt).round().max(1.0) as usize;
@@ -151,16 +164,10 @@ pub fn run(
         kinetic: mass.kinetic_energy(model, &kin.velocity),
         ..Default::default()
     };
-    let initial_kinetic = energies.kinetic;
+    let mut initial_kinetic = energies.kinetic;
     summary.energy.initial = initial_kinetic;
     let mut monitor =
         super::buckling::Monitor::new(model, dir).map_err(|e| super::monitor_error(model, e))?;
-    if let Some(m) = &mut monitor {
-        recorder.negative_pivots = m
-            .observe(model, &state)
-            .map_err(|e| super::monitor_error(model, e.into()))?
-            .0;
-    }
     let mut last_total = total_force(
         model,
         &system,
@@ -171,26 +178,89 @@ pub fn run(
         &state,
         &initial,
     );
-    recorder.step(
-        model,
-        &state,
-        &Motion {
-            velocity: &kin.velocity,
-            acceleration: &kin.acceleration,
-            mass: &mass.lumped,
-        },
-        &energies,
-        true,
-    )?;
-
-    let progress = super::progress_bar(options.progress, steps);
     let mut counters = Counters::default();
     let mut control = super::StepControl::new(spec.dt, spec.newton.max_cuts);
-    // K* = ca M + cv C + w K_T: a factorization serves while these coefficients stay
+    // K* = ca M + cv C + w K_T: a factorization serves while these coefficients stay (the
+    // step after a checkpoint factors afresh: a resumed run has no factorization)
     let mut factored_for: Option<[f64; 3]> = None;
     let mut increments = 0usize;
     let mut contact = ContactState::new(model);
+    let penetration_limits = super::contact::penetration_limits(model);
     let mut last_contact = vec![0.0; model.dofs()];
+    match resume {
+        Some((checkpoint, carry)) => {
+            state = carry.state;
+            kin = carry.kinematics;
+            method.restore(carry.method);
+            energies = carry.energies;
+            initial_kinetic = carry.initial_kinetic;
+            last_total = carry.last_total;
+            last_internal = carry.last_internal;
+            last_contact = carry.last_contact;
+            control = carry.control;
+            increments = carry.increments;
+            contact = carry.contact;
+            summary = checkpoint.summary;
+            counters = checkpoint.counters;
+            solver.factorizations = checkpoint.factorizations;
+            solver.solves = checkpoint.back_substitutions;
+            start = super::resumed_start(checkpoint.wall_seconds);
+            if let (Some(m), Some(b)) = (&mut monitor, checkpoint.buckling) {
+                m.summary = b;
+            }
+        }
+        None => {
+            if let Some(m) = &mut monitor {
+                recorder.negative_pivots = m
+                    .observe(model, &state)
+                    .map_err(|e| super::monitor_error(model, e.into()))?
+                    .0;
+            }
+            recorder.step(
+                model,
+                &state,
+                &Motion {
+                    velocity: &kin.velocity,
+                    acceleration: &kin.acceleration,
+                    mass: &mass.lumped,
+                },
+                &energies,
+                true,
+            )?;
+        }
+    }
+    let progress = super::progress_bar(options.progress, steps);
+    macro_rules! save {
+        () => {{
+            let carry = DynamicCarry {
+                state: state.clone(),
+                kinematics: kin.clone(),
+                method: method.history(),
+                energies,
+                initial_kinetic,
+                last_total: last_total.clone(),
+                last_internal: last_internal.clone(),
+                last_contact: last_contact.clone(),
+                control: control.clone(),
+                increments,
+                contact: contact.clone(),
+            };
+            super::Bookkeeping {
+                model,
+                recorder: &recorder,
+                summary: &summary,
+                counters: &counters,
+                solver: Some(&solver),
+                start,
+                buckling: monitor.as_ref().map(|m| &m.summary),
+            }
+            .save(Carry::Dynamic(carry))?;
+            factored_for = None;
+        }};
+    }
+    if summary.steps == 0 && model.checkpoint_every > 0 {
+        save!();
+    }
     while state.time < spec.end_time * (1.0 - 1e-12) {
         // steps end at the listed frame times
         let next_frame = model
@@ -375,11 +445,42 @@ pub fn run(
                     Some(&contact),
                     last,
                 )?;
+                if let Some(message) = contact.runaway_penetration(
+                    model,
+                    &state.positions(spec.geometry),
+                    &penetration_limits,
+                ) {
+                    progress.abandon();
+                    summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
+                    let message = format!("at t = {}: {message}", state.time);
+                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
+                }
                 progress.set_position((state.time / spec.dt).round() as u64);
                 control.accept(true);
                 if stop {
                     summary.message = Some(super::statics::stop_message(&state, &recorder));
                     break;
+                }
+                let interrupted = !last && options.interrupted();
+                if interrupted {
+                    let motion = Motion {
+                        velocity: &kin.velocity,
+                        acceleration: &kin.acceleration,
+                        mass: &mass.lumped,
+                    };
+                    recorder.frame(model, &state, &motion, Some(&contact))?;
+                }
+                if interrupted || (!last && super::checkpoint_due(model, summary.steps)) {
+                    save!();
+                }
+                options.halt(&summary)?;
+                if interrupted {
+                    progress.abandon();
+                    summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
+                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
+                    return Err(super::interrupted(&recorder, summary, state.time));
                 }
             }
             Err(StepFailure(reason)) => {

@@ -12,6 +12,7 @@
 //! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
+use super::checkpoint::{Carry, Checkpoint, ExplicitCarry};
 use super::contact::ContactState;
 use super::dynamics::check_mass;
 use super::newton::Counters;
@@ -37,8 +38,9 @@ pub fn run(
     spec: &DynamicSpec,
     dir: &Path,
     options: RunOptions,
+    resume: Option<Checkpoint>,
 ) -> Result<Outcome, RunError> {
-    let start = Instant::now();
+    let mut start = Instant::now();
     let (dt_crit, b, e) = critical_time_step(model)?;
     if spec.dt > dt_crit && !spec.allow_unstable {
         return Err(InputError::new(
@@ -57,7 +59,18 @@ pub fn run(
         .map_err(|err| InputError::new(&model.file, err.to_string()))?;
     check_mass(model, &mass, &system)?;
     let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
-    let mut recorder = Recorder::create(model, dir)?;
+    let (mut recorder, resume) = match resume {
+        Some(c) => {
+            let Carry::Explicit(carry) = c.carry.clone() else {
+                return Err(super::wrong_carry(dir, "explicit"));
+            };
+            (
+                Recorder::resume(model, dir, c.recorder.clone())?,
+                Some((c, carry)),
+            )
+        }
+        None => (Recorder::create(model, dir)?, None),
+    };
     let mut state = State::initial(model);
     let mut summary = Summary::new(
         model,
@@ -105,29 +118,94 @@ pub fn run(
         kinetic: kinetic(&v),
         ..Default::default()
     };
-    let initial_kinetic = energies.kinetic;
+    let mut initial_kinetic = energies.kinetic;
     summary.energy.initial = initial_kinetic;
     let mut last_total = total_force(&free, &external, &internal, m, &a, &v, a_r);
-    recorder.step(
-        model,
-        &state,
-        &Motion {
-            velocity: &v,
-            acceleration: &a,
-            mass: m,
-        },
-        &energies,
-        true,
-    )?;
-
-    let progress = super::progress_bar(options.progress, steps);
     let mut energy_reference = initial_kinetic;
     let mut contact = ContactState::new(model);
+    let penetration_limits = super::contact::penetration_limits(model);
+    let mut first_step = 1;
+    match resume {
+        Some((checkpoint, carry)) => {
+            state = carry.state;
+            v = carry.velocity;
+            a = carry.acceleration;
+            energies = carry.energies;
+            initial_kinetic = carry.initial_kinetic;
+            last_total = carry.last_total;
+            energy_reference = carry.energy_reference;
+            contact = carry.contact;
+            first_step = carry.step + 1;
+            summary = checkpoint.summary;
+            start = super::resumed_start(checkpoint.wall_seconds);
+        }
+        None => {
+            recorder.step(
+                model,
+                &state,
+                &Motion {
+                    velocity: &v,
+                    acceleration: &a,
+                    mass: m,
+                },
+                &energies,
+                true,
+            )?;
+        }
+    }
+    let save = |recorder: &Recorder,
+                summary: &Summary,
+                step: usize,
+                state: &State,
+                v: &[f64],
+                a: &[f64],
+                energies: &Energies,
+                last_total: &[f64],
+                energy_reference: f64,
+                contact: &ContactState| {
+        let carry = ExplicitCarry {
+            state: state.clone(),
+            velocity: v.to_vec(),
+            acceleration: a.to_vec(),
+            energies: *energies,
+            initial_kinetic,
+            last_total: last_total.to_vec(),
+            energy_reference,
+            step,
+            contact: contact.clone(),
+        };
+        super::Bookkeeping {
+            model,
+            recorder,
+            summary,
+            counters: &Counters::default(),
+            solver: None,
+            start,
+            buckling: None,
+        }
+        .save(Carry::Explicit(carry))
+    };
+    if first_step == 1 && model.checkpoint_every > 0 {
+        save(
+            &recorder,
+            &summary,
+            0,
+            &state,
+            &v,
+            &a,
+            &energies,
+            &last_total,
+            energy_reference,
+            &contact,
+        )?;
+    }
+
+    let progress = super::progress_bar(options.progress, steps);
     // zero on prescribed DOFs: contact corrections never move them
     let inverse_mass: Vec<f64> = (0..model.dofs())
         .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
         .collect();
-    for step in 1..=steps {
+    for step in first_step..=steps {
         let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
         let h = super::step_length(time - state.time, spec.dt);
         let v_half: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v + 0.5 * h * a).collect();
@@ -223,7 +301,41 @@ pub fn run(
             Some(&contact),
             step == steps,
         )?;
+        if let Some(message) =
+            contact.runaway_penetration(model, &state.positions(spec.geometry), &penetration_limits)
+        {
+            progress.abandon();
+            summary.finish(&energies, &Counters::default(), None, start);
+            summary.contact = contact.summary();
+            let message = format!("at t = {}: {message}", state.time);
+            return Err(super::fail(&recorder, summary, Status::Diverged, message));
+        }
         progress.set_position(step as u64);
+        let interrupted = step < steps && options.interrupted();
+        if interrupted {
+            recorder.frame(model, &state, &motion, Some(&contact))?;
+        }
+        if interrupted || (step < steps && super::checkpoint_due(model, step)) {
+            save(
+                &recorder,
+                &summary,
+                step,
+                &state,
+                &v,
+                &a,
+                &energies,
+                &last_total,
+                energy_reference,
+                &contact,
+            )?;
+        }
+        options.halt(&summary)?;
+        if interrupted {
+            progress.abandon();
+            summary.finish(&energies, &Counters::default(), None, start);
+            summary.contact = contact.summary();
+            return Err(super::interrupted(&recorder, summary, state.time));
+        }
     }
     progress.finish_and_clear();
     summary.finish(&energies, &Counters::default(), None, start);

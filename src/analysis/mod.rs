@@ -2,6 +2,7 @@
 //! run's bookkeeping and its output (VTK frames, history.csv, summary.json).
 
 pub mod buckling;
+pub mod checkpoint;
 pub mod contact;
 pub mod dynamics;
 pub mod explicit;
@@ -17,20 +18,23 @@ use crate::solver::Solver;
 use indicatif::{ProgressBar, ProgressStyle};
 use newton::Counters;
 use record::{Energies, Recorder};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// How a run ended (summary.json `status`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     Ok,
     Diverged,
     Unstable,
+    /// Stopped by SIGINT or SIGTERM after a whole step; `impact resume DIR` continues it.
+    Interrupted,
 }
 
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct ContactSummary {
     pub first_contact_time: Option<f64>,
     pub last_release_time: Option<f64>,
@@ -40,7 +44,7 @@ pub struct ContactSummary {
     pub min_gap: Option<f64>,
 }
 
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct EnergySummary {
     pub initial: f64,
     #[serde(rename = "final")]
@@ -54,7 +58,7 @@ pub struct EnergySummary {
 pub use buckling::BucklingSummary;
 
 /// summary.json (DESIGN section 5): other tools read it; fields are only ever added.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Summary {
     pub scene: String,
     pub title: String,
@@ -191,7 +195,8 @@ fn snap(t: f64, dt: f64) -> f64 {
 
 /// The step length of a driver: halved when a step fails (at most `max_cuts` times in a
 /// row), grown back towards the nominal length after each success.
-struct StepControl {
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct StepControl {
     nominal: f64,
     length: f64,
     cuts_in_a_row: usize,
@@ -299,6 +304,13 @@ pub enum RunError {
     },
     #[error("{0}")]
     Output(#[from] OutputError),
+    /// SIGINT or SIGTERM: the step in progress was finished and written, with a frame, a
+    /// checkpoint and summary.json (status `interrupted`).
+    #[error("interrupted: {message}")]
+    Interrupted {
+        message: String,
+        summary: Box<Summary>,
+    },
 }
 
 impl RunError {
@@ -307,6 +319,7 @@ impl RunError {
             RunError::Input(_) => 2,
             RunError::Numerical { .. } => 3,
             RunError::Output(_) => 1,
+            RunError::Interrupted { .. } => 130,
         }
     }
 }
@@ -316,6 +329,113 @@ impl RunError {
 pub struct RunOptions {
     /// Show a progress bar (on a terminal).
     pub progress: bool,
+    /// Set (by a signal handler) to stop the run after the step in progress.
+    pub interrupt: Option<&'static AtomicBool>,
+    /// For tests: stop dead after this many converged steps, writing nothing more (as a
+    /// SIGKILL would), returning `RunError::Interrupted`.
+    pub halt_after_steps: Option<usize>,
+}
+
+impl RunOptions {
+    fn interrupted(&self) -> bool {
+        self.interrupt.is_some_and(|f| f.load(Ordering::SeqCst))
+    }
+
+    /// The test hook `halt_after_steps`: the error to return after `steps` steps.
+    fn halt(&self, summary: &Summary) -> Result<(), RunError> {
+        if self.halt_after_steps == Some(summary.steps) {
+            return Err(RunError::Interrupted {
+                message: format!("halted after {} steps (test hook)", summary.steps),
+                summary: Box::new(summary.clone()),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// What every driver stores in a checkpoint besides its own carry.
+struct Bookkeeping<'a> {
+    model: &'a Model,
+    recorder: &'a Recorder,
+    summary: &'a Summary,
+    counters: &'a Counters,
+    solver: Option<&'a Solver>,
+    start: Instant,
+    buckling: Option<&'a BucklingSummary>,
+}
+
+impl Bookkeeping<'_> {
+    fn save(&self, carry: checkpoint::Carry) -> Result<(), RunError> {
+        let checkpoint = checkpoint::Checkpoint {
+            // absolute when the file exists, so `impact resume` works from any folder (mesh
+            // files are found next to the scene)
+            scene_path: std::fs::canonicalize(&self.model.file)
+                .unwrap_or_else(|_| self.model.file.clone())
+                .display()
+                .to_string(),
+            source: self.model.source.clone(),
+            summary: self.summary.clone(),
+            counters: *self.counters,
+            factorizations: self.solver.map_or(0, |s| s.factorizations),
+            back_substitutions: self.solver.map_or(0, |s| s.solves),
+            wall_seconds: self.start.elapsed().as_secs_f64(),
+            recorder: self.recorder.position()?,
+            buckling: self.buckling.cloned(),
+            carry,
+        };
+        checkpoint::write(self.recorder.dir(), &checkpoint)?;
+        Ok(())
+    }
+}
+
+/// Whether a checkpoint is due after `steps` converged steps.
+fn checkpoint_due(model: &Model, steps: usize) -> bool {
+    model.checkpoint_every > 0 && steps.is_multiple_of(model.checkpoint_every)
+}
+
+/// A checkpoint whose carry is not the scene's driver's: damaged or hand-edited.
+fn wrong_carry(dir: &Path, driver: &str) -> RunError {
+    RunError::Input(InputError::new(
+        &checkpoint::path(dir),
+        format!("the checkpoint does not hold the state of the scene's {driver} analysis"),
+    ))
+}
+
+/// The start instant of a resumed run: as if it had been running for `wall_seconds`.
+fn resumed_start(wall_seconds: f64) -> Instant {
+    let now = Instant::now();
+    now.checked_sub(std::time::Duration::from_secs_f64(wall_seconds.max(0.0)))
+        .unwrap_or(now)
+}
+
+/// An interrupted run: summary.json with status `interrupted`, exit 130.
+fn interrupted(recorder: &Recorder, mut summary: Summary, time: f64) -> RunError {
+    let message = format!(
+        "interrupted by a signal at t = {time} after {} steps; `impact resume {}` continues",
+        summary.steps,
+        recorder.dir().display()
+    );
+    summary.status = Status::Interrupted;
+    summary.message = Some(message.clone());
+    match recorder.write_summary(&summary) {
+        Ok(()) => RunError::Interrupted {
+            message,
+            summary: Box::new(summary),
+        },
+        Err(e) => RunError::Output(e),
+    }
+}
+
+/// Continues the run checkpointed in `dir` (DIR/checkpoint.bin), writing into `dir`.
+pub fn resume(dir: &Path, options: RunOptions) -> Result<Summary, RunError> {
+    let checkpoint = checkpoint::read(dir)?;
+    let scene_path = Path::new(&checkpoint.scene_path).to_path_buf();
+    let model = crate::scene::from_str(
+        &checkpoint.source.text,
+        &scene_path,
+        &checkpoint.source.overrides,
+    )?;
+    run_from(&model, dir, options, Some(checkpoint)).map(|o| o.summary)
 }
 
 /// Runs the scene's analysis, writing into `out_dir`.
@@ -346,6 +466,16 @@ pub fn run_outcome(
     out_dir: &Path,
     options: RunOptions,
 ) -> Result<Outcome, RunError> {
+    run_from(model, out_dir, options, None)
+}
+
+/// A run from the start, or from a checkpoint of the same scene.
+fn run_from(
+    model: &Model,
+    out_dir: &Path,
+    options: RunOptions,
+    resume: Option<checkpoint::Checkpoint>,
+) -> Result<Outcome, RunError> {
     let imperfect = buckling::with_imperfection(model).map_err(|e| {
         InputError::new(
             &model.file,
@@ -354,12 +484,14 @@ pub fn run_outcome(
     })?;
     let model = imperfect.as_ref().unwrap_or(model);
     match &model.analysis {
-        crate::scene::model::Analysis::Static(spec) => statics::run(model, spec, out_dir, options),
+        crate::scene::model::Analysis::Static(spec) => {
+            statics::run(model, spec, out_dir, options, resume)
+        }
         crate::scene::model::Analysis::Dynamic(spec) => {
             if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference {
-                explicit::run(model, spec, out_dir, options)
+                explicit::run(model, spec, out_dir, options, resume)
             } else {
-                dynamics::run(model, spec, out_dir, options)
+                dynamics::run(model, spec, out_dir, options, resume)
             }
         }
     }

@@ -25,7 +25,7 @@ use crate::scene::spec::{NewtonSpec, Strategy, Tangent};
 use crate::solver::Solver;
 
 /// Counters of the nonlinear solution.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Counters {
     pub iterations: usize,
     pub cuts: usize,
@@ -235,6 +235,30 @@ struct Damping {
     values: Vec<f64>,
 }
 
+/// Names the first DOF whose residual (or displacement) is NaN or infinite.
+fn non_finite(system: &System, residual: &[f64], d: &[f64]) -> String {
+    let name = |dof: usize| format!("node {} {}", dof / 2, ["x", "y"][dof % 2]);
+    if let Some(dof) = d.iter().position(|v| !v.is_finite()) {
+        return format!("the displacement is {} at {}", d[dof], name(dof));
+    }
+    // a NaN or infinite entry, else the largest one (whose square overflowed the norm)
+    let equation = residual.iter().position(|v| !v.is_finite()).or_else(|| {
+        (0..residual.len()).max_by(|a, b| residual[*a].abs().total_cmp(&residual[*b].abs()))
+    });
+    let dof = equation.and_then(|eq| system.equation.iter().position(|e| *e == Some(eq)));
+    match (equation, dof) {
+        (Some(eq), Some(dof)) if !residual[eq].is_finite() => {
+            format!("the residual is {} at {}", residual[eq], name(dof))
+        }
+        (Some(eq), Some(dof)) => format!(
+            "the residual norm overflows (not finite); its largest entry is {:e} at {}",
+            residual[eq],
+            name(dof)
+        ),
+        _ => "the residual norm is not finite (NaN or Inf)".into(),
+    }
+}
+
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
@@ -326,9 +350,7 @@ impl Step<'_> {
             add_constraint_forces(&rows, &forces, &mut balance);
             let residual_norm = norm(&balance);
             if !residual_norm.is_finite() {
-                return Err(StepFailure(
-                    "the residual is not finite (NaN or Inf)".into(),
-                ));
+                return Err(StepFailure(non_finite(system, &balance, &d)));
             }
             // the force scale cannot fall below what the stiffness makes of the increment:
             // a rigid motion has no loads and no reactions, only round-off to compare with

@@ -15,7 +15,7 @@ use crate::scene::spec::{Quantity, Statistic};
 use std::path::{Path, PathBuf};
 
 /// Energies of one step (history.csv columns 2-6).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     pub kinetic: f64,
     pub internal: f64,
@@ -59,35 +59,7 @@ impl Recorder {
         } else {
             None
         };
-        let mut columns: Vec<String> = [
-            "time",
-            "kinetic_energy",
-            "internal_energy",
-            "plastic_work",
-            "external_work",
-            "contact_work",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        columns.extend(
-            model
-                .contacts
-                .iter()
-                .map(|c| format!("contact_force[{}]", c.name)),
-        );
-        columns.extend(
-            model
-                .contacts
-                .iter()
-                .filter(|c| c.options.friction != Friction::None)
-                .map(|c| format!("tangential_force[{}]", c.name)),
-        );
-        columns.extend(model.probes.iter().map(|p| p.column.clone()));
-        let pivots_column = model.analysis.buckling().is_some_and(|b| b.check);
-        if pivots_column {
-            columns.push("tangent_negative_pivots".to_string());
-        }
+        let (columns, pivots_column) = columns(model);
         let history = History::create(&dir.join("history.csv"), &columns)?;
         Ok(Recorder {
             dir: dir.to_path_buf(),
@@ -100,6 +72,52 @@ impl Recorder {
             pivots_column,
             negative_pivots: None,
         })
+    }
+
+    /// Where the output stands, for a checkpoint.
+    pub fn position(&self) -> Result<RecorderPosition, OutputError> {
+        Ok(RecorderPosition {
+            series: self.series.as_ref().map(Series::position),
+            history_bytes: self.history.byte_len()?,
+            steps_since_frame: self.steps_since_frame,
+            last_frame_time: self.last_frame_time,
+            negative_pivots: self.negative_pivots,
+        })
+    }
+
+    /// Continues the output of a checkpointed run in `dir`: history.csv cut back to its
+    /// rows at the checkpoint, frames after it removed, the .pvd listing the rest.
+    pub fn resume(
+        model: &Model,
+        dir: &Path,
+        position: RecorderPosition,
+    ) -> Result<Recorder, OutputError> {
+        let series = match position.series {
+            Some(p) if model.output.frame_every > 0 => Some(Series::resume(
+                dir,
+                &model.name,
+                model.output.compression,
+                p,
+            )?),
+            _ => None,
+        };
+        let (columns, pivots_column) = columns(model);
+        let history = History::resume(&dir.join("history.csv"), &columns, position.history_bytes)?;
+        Ok(Recorder {
+            dir: dir.to_path_buf(),
+            grid: grid(model),
+            series,
+            history,
+            frame_every: model.output.frame_every,
+            steps_since_frame: position.steps_since_frame,
+            last_frame_time: position.last_frame_time,
+            pivots_column,
+            negative_pivots: position.negative_pivots,
+        })
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
     }
 
     /// Records a converged step: a history row, and a frame when due (`force_frame` for the
@@ -345,4 +363,48 @@ fn probe_value(
         Quantity::VonMises => points(&|p| von_mises(&p.stress)),
         Quantity::EqPlasticStrain => points(&|p| p.eq_plastic_strain),
     }
+}
+
+/// The history.csv columns of a model, and whether the negative-pivot column is among them.
+fn columns(model: &Model) -> (Vec<String>, bool) {
+    let mut columns: Vec<String> = [
+        "time",
+        "kinetic_energy",
+        "internal_energy",
+        "plastic_work",
+        "external_work",
+        "contact_work",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    columns.extend(
+        model
+            .contacts
+            .iter()
+            .map(|c| format!("contact_force[{}]", c.name)),
+    );
+    columns.extend(
+        model
+            .contacts
+            .iter()
+            .filter(|c| c.options.friction != Friction::None)
+            .map(|c| format!("tangential_force[{}]", c.name)),
+    );
+    columns.extend(model.probes.iter().map(|p| p.column.clone()));
+    let pivots_column = model.analysis.buckling().is_some_and(|b| b.check);
+    if pivots_column {
+        columns.push("tangent_negative_pivots".to_string());
+    }
+    (columns, pivots_column)
+}
+/// Where a run's output stands at a checkpoint: the frames listed, the bytes of
+/// history.csv (whole rows), and the frame cadence.
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub struct RecorderPosition {
+    pub series: Option<crate::output::vtk::SeriesPosition>,
+    pub history_bytes: u64,
+    pub steps_since_frame: usize,
+    pub last_frame_time: Option<f64>,
+    pub negative_pivots: Option<usize>,
 }

@@ -9,6 +9,7 @@
 //! tangent that is not positive definite) is halved, at most `max_cuts` times in a row; then
 //! the run stops `diverged` with its output so far kept. After a cut the step grows back.
 
+use super::checkpoint::{Carry, Checkpoint, StaticCarry};
 use super::contact::ContactState;
 use super::newton::{ContactStep, Counters, Step, StepFailure, Tangential};
 use super::record::{Energies, Motion, Recorder};
@@ -40,9 +41,21 @@ pub fn run(
     spec: &StaticSpec,
     dir: &Path,
     options: RunOptions,
+    resume: Option<Checkpoint>,
 ) -> Result<Outcome, RunError> {
-    let start = Instant::now();
-    let mut recorder = Recorder::create(model, dir)?;
+    let mut start = Instant::now();
+    let (mut recorder, resume) = match resume {
+        Some(c) => {
+            let Carry::Static(carry) = c.carry.clone() else {
+                return Err(super::wrong_carry(dir, "static"));
+            };
+            (
+                Recorder::resume(model, dir, c.recorder.clone())?,
+                Some((c, carry)),
+            )
+        }
+        None => (Recorder::create(model, dir)?, None),
+    };
     let initial = model.coordinates();
     let mut system = System::new(model, &loads::constrained_dofs(model));
     let mut solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
@@ -57,32 +70,84 @@ pub fn run(
     let mut last_force = vec![0.0; model.dofs()];
     let mut monitor =
         super::buckling::Monitor::new(model, dir).map_err(|e| super::monitor_error(model, e))?;
-    if let Some(m) = &mut monitor {
-        recorder.negative_pivots = m
-            .observe(model, &state)
-            .map_err(|e| super::monitor_error(model, e.into()))?
-            .0;
-    }
-    recorder.step(model, &state, &motion, &energies, true)?;
-
     let dt = spec.end_time / spec.steps as f64;
     let mut summary = Summary::new(model, "static", dt, spec.end_time, system.free);
-    let progress = super::progress_bar(options.progress, spec.steps);
     let form = static_form(model.dofs());
     let mut counters = Counters::default();
     let mut control = super::StepControl::new(dt, spec.newton.max_cuts);
     let mut increments = 0usize;
     let mut contact = ContactState::new(model);
+    let penetration_limits = super::contact::penetration_limits(model);
+    match resume {
+        Some((checkpoint, carry)) => {
+            state = carry.state;
+            energies = carry.energies;
+            last_force = carry.last_force;
+            control = carry.control;
+            increments = carry.increments;
+            contact = carry.contact;
+            summary = checkpoint.summary;
+            counters = checkpoint.counters;
+            solver.factorizations = checkpoint.factorizations;
+            solver.solves = checkpoint.back_substitutions;
+            start = super::resumed_start(checkpoint.wall_seconds);
+            if let (Some(m), Some(b)) = (&mut monitor, checkpoint.buckling) {
+                m.summary = b;
+            }
+        }
+        None => {
+            if let Some(m) = &mut monitor {
+                recorder.negative_pivots = m
+                    .observe(model, &state)
+                    .map_err(|e| super::monitor_error(model, e.into()))?
+                    .0;
+            }
+            recorder.step(model, &state, &motion, &energies, true)?;
+        }
+    }
+    let progress = super::progress_bar(options.progress, spec.steps);
+    // the step after a checkpoint factors K* afresh (a resumed run has no factorization)
+    let mut refresh = model.checkpoint_every > 0;
+    let save = |recorder: &Recorder,
+                summary: &Summary,
+                counters: &Counters,
+                solver: &Solver,
+                monitor: &Option<super::buckling::Monitor>,
+                carry: StaticCarry| {
+        super::Bookkeeping {
+            model,
+            recorder,
+            summary,
+            counters,
+            solver: Some(solver),
+            start,
+            buckling: monitor.as_ref().map(|m| &m.summary),
+        }
+        .save(Carry::Static(carry))
+    };
+    if summary.steps == 0 && model.checkpoint_every > 0 {
+        let carry = StaticCarry {
+            state: state.clone(),
+            energies,
+            last_force: last_force.clone(),
+            control: control.clone(),
+            increments,
+            contact: contact.clone(),
+        };
+        save(&recorder, &summary, &counters, &solver, &monitor, carry)?;
+    }
     while state.time < spec.end_time * (1.0 - 1e-12) {
         let target = super::snap((state.time + control.length).min(spec.end_time), dt);
         let positions = state.positions(spec.geometry);
-        let factor_first = match spec.newton.strategy {
-            Strategy::Full => true,
-            Strategy::Modified => {
-                increments.is_multiple_of(spec.newton.refactor_every) || control.after_cut()
-            }
-            Strategy::Initial => !solver.is_factored() || control.after_cut(),
-        };
+        let refresh_now = std::mem::take(&mut refresh);
+        let factor_first = refresh_now
+            || match spec.newton.strategy {
+                Strategy::Full => true,
+                Strategy::Modified => {
+                    increments.is_multiple_of(spec.newton.refactor_every) || control.after_cut()
+                }
+                Strategy::Initial => !solver.is_factored() || control.after_cut(),
+            };
         // one attempt of the increment with a given length and active contact set
         let attempt =
             |h: f64, active: &[(usize, usize)], forces: Vec<f64>, tangential: &[Tangential]| {
@@ -166,11 +231,46 @@ pub fn run(
                     Some(&contact),
                     last,
                 )?;
+                if let Some(message) = contact.runaway_penetration(
+                    model,
+                    &state.positions(spec.geometry),
+                    &penetration_limits,
+                ) {
+                    progress.abandon();
+                    summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
+                    let message = format!("at t = {}: {message}", state.time);
+                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
+                }
                 progress.set_position((state.time / dt).round() as u64);
                 control.accept(end == target);
                 if stop {
                     summary.message = Some(stop_message(&state, &recorder));
                     break;
+                }
+                let interrupted = !last && options.interrupted();
+                if interrupted {
+                    recorder.frame(model, &state, &motion, Some(&contact))?;
+                }
+                if interrupted || (!last && super::checkpoint_due(model, summary.steps)) {
+                    let carry = StaticCarry {
+                        state: state.clone(),
+                        energies,
+                        last_force: last_force.clone(),
+                        control: control.clone(),
+                        increments,
+                        contact: contact.clone(),
+                    };
+                    save(&recorder, &summary, &counters, &solver, &monitor, carry)?;
+                    refresh = true;
+                }
+                options.halt(&summary)?;
+                if interrupted {
+                    progress.abandon();
+                    summary.finish(&energies, &counters, Some(&solver), start);
+                    summary.contact = contact.summary();
+                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
+                    return Err(super::interrupted(&recorder, summary, state.time));
                 }
             }
             Err(StepFailure(reason)) => {

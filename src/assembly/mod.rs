@@ -20,7 +20,7 @@ use crate::solver::Pattern;
 use rayon::prelude::*;
 
 /// Per body, per material point (element-major: element e's points are e*ppe .. (e+1)*ppe).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BodyState {
     pub points: Vec<PointState>,
     /// Current thickness per point (plane stress); 1 otherwise.
@@ -28,7 +28,7 @@ pub struct BodyState {
 }
 
 /// The committed state of the whole model.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct State {
     pub time: f64,
     /// Coordinates of the reference (last converged) configuration, global nodes.

@@ -68,6 +68,20 @@ pub trait Integrator: Send {
     fn advance(&mut self, dt: f64, k: &Kinematics, solved: &[f64]) -> Advance;
     /// Called when a step is abandoned (cut): history stays as before the step.
     fn reject(&mut self) {}
+    /// What the method carries from step to step besides u, v, a (for checkpoints).
+    fn history(&self) -> MethodHistory {
+        MethodHistory::default()
+    }
+    /// Continues from a saved [`MethodHistory`] (a resumed run).
+    fn restore(&mut self, _history: MethodHistory) {}
+}
+
+/// A method's own history between steps: Houbolt's u_{n-1}, u_{n-2} and their dt; empty for
+/// one-step methods.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct MethodHistory {
+    pub past: Vec<Vec<f64>>,
+    pub dt: Option<f64>,
 }
 
 fn affine(c: f64, terms: &[(f64, &[f64])], n: usize) -> (f64, Vec<f64>) {
@@ -362,6 +376,18 @@ impl Integrator for Houbolt {
         self.past.insert(0, k.displacement.clone());
         self.past.truncate(2);
         advance
+    }
+
+    fn history(&self) -> MethodHistory {
+        MethodHistory {
+            past: self.past.clone(),
+            dt: self.dt,
+        }
+    }
+
+    fn restore(&mut self, history: MethodHistory) {
+        self.past = history.past;
+        self.dt = history.dt;
     }
 }
 

@@ -118,6 +118,10 @@ impl Rectangle {
         let height = positive("height", self.height)?;
         let nx = at_least("nx", self.nx, 1)?;
         let ny = at_least("ny", self.ny, 1)?;
+        if nx * ny > MAX_ELEMENTS {
+            let reason = format!("nx x ny = {} exceeds {MAX_ELEMENTS} elements", nx * ny);
+            return Err(param("ny", reason));
+        }
         let grading_x = grading("grading_x", self.grading_x)?;
         let grading_y = grading("grading_y", self.grading_y)?;
         let (x_at_right, y_at_top) = self.graded_ends()?;
@@ -637,7 +641,8 @@ impl RoundBar {
 }
 
 fn even_width_count(nx: usize) -> Result<usize, MeshError> {
-    if nx < 4 || !nx.is_multiple_of(2) {
+    at_least("nx", nx, 4)?;
+    if !nx.is_multiple_of(2) {
         let reason = format!(
             "must be even and >= 4 (the axis is a grid line so the tip is a node), got {nx}"
         );
@@ -773,8 +778,19 @@ fn grading(key: &str, value: f64) -> Result<f64, MeshError> {
     }
 }
 
+/// The most divisions along one direction of a generated mesh (a count beyond it is a typo
+/// that would allocate without end, not a mesh).
+pub const MAX_DIVISIONS: usize = 20_000;
+/// The most elements a `rectangle` may generate (4000 x 2500; a million load in about a second).
+pub const MAX_ELEMENTS: usize = 10_000_000;
+
 fn at_least(key: &str, value: usize, min: usize) -> Result<usize, MeshError> {
-    if value >= min {
+    if value > MAX_DIVISIONS {
+        Err(param(
+            key,
+            format!("must be at most {MAX_DIVISIONS}, got {value}"),
+        ))
+    } else if value >= min {
         Ok(value)
     } else {
         Err(param(key, format!("must be >= {min}, got {value}")))

@@ -59,6 +59,59 @@ impl History {
         &self.path
     }
 
+    /// The file's length in bytes so far (whole rows only), for a checkpoint.
+    pub fn byte_len(&self) -> Result<u64, OutputError> {
+        self.file
+            .metadata()
+            .map(|m| m.len())
+            .map_err(|e| OutputError::io(&self.path, "measure", e))
+    }
+
+    /// Reopens a history for appending, cut back to `len` bytes (its length at a checkpoint:
+    /// rows written after it, by a run that was then killed, are dropped). The header must
+    /// be the one given.
+    pub fn resume(path: &Path, columns: &[String], len: u64) -> Result<History, OutputError> {
+        check_columns(path, columns)?;
+        let file = fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(|e| OutputError::io(path, "open", e))?;
+        let found = file
+            .metadata()
+            .map_err(|e| OutputError::io(path, "measure", e))?
+            .len();
+        if found < len {
+            return Err(OutputError::invalid(
+                path,
+                format!("has {found} bytes, fewer than the {len} at the checkpoint"),
+            ));
+        }
+        let header = format!("{}\n", columns.join(","));
+        let mut start = vec![0u8; header.len()];
+        use std::io::Read;
+        (&file)
+            .read_exact(&mut start)
+            .map_err(|e| OutputError::io(path, "read", e))?;
+        if start != header.as_bytes() {
+            return Err(OutputError::invalid(
+                path,
+                "its header is not the scene's (another run wrote it)",
+            ));
+        }
+        file.set_len(len)
+            .map_err(|e| OutputError::io(path, "truncate", e))?;
+        let mut file = file;
+        use std::io::Seek;
+        file.seek(std::io::SeekFrom::End(0))
+            .map_err(|e| OutputError::io(path, "seek", e))?;
+        Ok(History {
+            path: path.to_path_buf(),
+            file,
+            columns: columns.len(),
+        })
+    }
+
     /// Writes `text` and a newline in one call on the unbuffered file, so rows land whole.
     fn write_line(&mut self, text: &str) -> Result<(), OutputError> {
         let line = format!("{text}\n");

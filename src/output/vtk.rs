@@ -137,6 +137,62 @@ impl Series {
         self.entries.len()
     }
 
+    /// Where the series stands (the frames listed so far), for a checkpoint.
+    pub fn position(&self) -> SeriesPosition {
+        SeriesPosition {
+            entries: self.entries.clone(),
+            last_time: self.last_time,
+        }
+    }
+
+    /// Continues a series from a checkpoint's [`SeriesPosition`]: frames numbered past it
+    /// (written after the checkpoint, or half-written when the run was killed) are removed
+    /// and DIR/NAME.pvd is rewritten listing exactly the checkpoint's frames.
+    pub fn resume(
+        dir: &Path,
+        name: &str,
+        compression: Compression,
+        position: SeriesPosition,
+    ) -> Result<Series, OutputError> {
+        check_name(dir, name)?;
+        let vtk_dir = dir.join("vtk");
+        fs::create_dir_all(&vtk_dir).map_err(|e| OutputError::io(&vtk_dir, "create folder", e))?;
+        let listing = fs::read_dir(&vtk_dir).map_err(|e| OutputError::io(&vtk_dir, "list", e))?;
+        for entry in listing {
+            let entry = entry.map_err(|e| OutputError::io(&vtk_dir, "list", e))?;
+            let file_name = entry.file_name();
+            let Some(file_name) = file_name.to_str() else {
+                continue;
+            };
+            let later = file_name.ends_with(".tmp")
+                || frame_number(file_name, name).is_some_and(|k| k >= position.entries.len());
+            if is_frame_file(file_name, name) && later {
+                let path = entry.path();
+                fs::remove_file(&path).map_err(|e| {
+                    OutputError::io(&path, "remove a frame after the checkpoint", e)
+                })?;
+            }
+        }
+        for k in 0..position.entries.len() {
+            let path = vtk_dir.join(format!("{name}_{k:05}.vtu"));
+            if !path.is_file() {
+                return Err(OutputError::invalid(
+                    &path,
+                    "a frame listed at the checkpoint is missing",
+                ));
+            }
+        }
+        let series = Series {
+            dir: dir.to_path_buf(),
+            name: name.to_string(),
+            compression,
+            entries: position.entries,
+            last_time: position.last_time,
+        };
+        series.write_pvd()?;
+        Ok(series)
+    }
+
     pub fn pvd_path(&self) -> PathBuf {
         self.dir.join(format!("{}.pvd", self.name))
     }
@@ -238,6 +294,22 @@ fn remove_stale_frames(vtk_dir: &Path, name: &str) -> Result<(), OutputError> {
         }
     }
     Ok(())
+}
+
+/// The number of a frame file `NAME_NNNNN.vtu`.
+fn frame_number(file_name: &str, name: &str) -> Option<usize> {
+    file_name
+        .strip_suffix(".vtu")
+        .and_then(|f| f.strip_prefix(name))
+        .and_then(|f| f.strip_prefix('_'))
+        .and_then(|digits| digits.parse().ok())
+}
+
+/// A series' frames so far (the .pvd lines and the last frame time), kept in checkpoints.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SeriesPosition {
+    entries: Vec<String>,
+    last_time: Option<f64>,
 }
 
 /// True for `NAME_` + at least five digits + `.vtu`, optionally followed by `.tmp`.

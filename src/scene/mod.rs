@@ -8,7 +8,7 @@ pub mod model;
 pub mod overrides;
 pub mod spec;
 
-pub use model::{Body, BodyKind, Curve, Load, Model};
+pub use model::{Body, BodyKind, Curve, Load, Model, SceneSource};
 pub use spec::Scene;
 
 use std::path::{Path, PathBuf};
@@ -56,5 +56,10 @@ pub fn from_str(text: &str, path: &Path, overrides: &[String]) -> Result<Model, 
         })?
     };
     let base_dir: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    model::build(scene, path, &base_dir)
+    let mut model = model::build(scene, path, &base_dir)?;
+    model.source = SceneSource {
+        text: text.to_string(),
+        overrides: overrides.to_vec(),
+    };
+    Ok(model)
 }

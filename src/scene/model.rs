@@ -185,6 +185,18 @@ pub struct Model {
     pub contacts: Vec<ContactPair>,
     /// The `[reference]` solution with its numbers (None without the table).
     pub reference: Option<Reference>,
+    /// `analysis.checkpoint_every`: a checkpoint every N converged steps (0: none).
+    pub checkpoint_every: usize,
+    /// The scene's text and `--set` overrides, embedded in checkpoints so `impact resume`
+    /// needs nothing else (empty for a model not read from text).
+    pub source: SceneSource,
+}
+
+/// Where a model came from: the scene text as read and the overrides applied to it.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SceneSource {
+    pub text: String,
+    pub overrides: Vec<String>,
 }
 
 /// A validated `[reference]`: a closed-form solution with its numbers read from the model.
@@ -373,6 +385,8 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         initial_velocity,
         reference,
         contacts,
+        checkpoint_every: scene.analysis.checkpoint_every,
+        source: SceneSource::default(),
     })
 }
 

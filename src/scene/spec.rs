@@ -375,6 +375,10 @@ pub struct AnalysisSpec {
     pub allow_unstable: bool,
     /// The buckling check (Erklig 2.1.3). Default: none.
     pub buckling: Option<BucklingSpec>,
+    /// Write DIR/checkpoint.bin (the whole run state) at the start and every N converged
+    /// steps, so `impact resume DIR` can continue the run. Default 0: no checkpoints.
+    #[serde(default)]
+    pub checkpoint_every: usize,
 }
 
 /// `[analysis.buckling]`: the inertia of the tangent after every converged state, the

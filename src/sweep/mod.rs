@@ -174,7 +174,8 @@ fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<(), R
             (status, Some(message), summary.wall_seconds)
         }
         Err(RunError::Input(e)) => ("refused".to_string(), Some(e.message), wall),
-        Err(e @ RunError::Output(_)) => return Err(e),
+        // an interrupted case writes no record: a rerun runs it again
+        Err(e @ (RunError::Output(_) | RunError::Interrupted { .. })) => return Err(e),
     };
     let record = CaseRecord {
         index: case.index,

@@ -1,0 +1,139 @@
+//! Checkpoints: DIR/checkpoint.bin holds everything a driver's step loop carries, so
+//! `impact resume DIR` continues a stopped run and ends bit-identical to an uninterrupted one.
+//!
+//! Layout
+//! ```text
+//! b"IMPACTCP"  magic (8 bytes)
+//! u32 LE       format version (FORMAT)
+//! postcard     Checkpoint: the scene text and --set overrides, the summary so far, the
+//!              counters, the output position and the driver's carry (state, kinematics,
+//!              contact status, step control, energies)
+//! ```
+//! The file is written whole to a temporary name and renamed. The solver's factorization is
+//! not stored: the step after a checkpoint refactors K* in the run that wrote it and in the
+//! resumed one alike, so both take the same path (one extra factorization per checkpoint).
+
+use super::contact::ContactState;
+use super::newton::Counters;
+use super::record::{Energies, RecorderPosition};
+use super::{StepControl, Summary};
+use crate::assembly::State;
+use crate::integrator::{Kinematics, MethodHistory};
+use crate::output::{OutputError, write_atomic};
+use crate::scene::{InputError, SceneSource};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The checkpoint's file name inside the output folder.
+pub const FILE: &str = "checkpoint.bin";
+const MAGIC: &[u8; 8] = b"IMPACTCP";
+/// Bumped whenever a stored type changes: an old checkpoint is refused, not misread.
+const FORMAT: u32 = 1;
+
+/// A whole run at the end of a converged step.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Checkpoint {
+    /// The scene file as the run named it (messages, relative mesh files).
+    pub scene_path: String,
+    pub source: SceneSource,
+    /// The summary so far (steps, drift, counters are filled from `counters` at the end).
+    pub summary: Summary,
+    pub counters: Counters,
+    pub factorizations: usize,
+    pub back_substitutions: usize,
+    pub wall_seconds: f64,
+    pub recorder: RecorderPosition,
+    pub buckling: Option<super::BucklingSummary>,
+    pub carry: Carry,
+}
+
+/// What each driver's loop carries from step to step.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub enum Carry {
+    Static(StaticCarry),
+    Dynamic(DynamicCarry),
+    Explicit(ExplicitCarry),
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct StaticCarry {
+    pub state: State,
+    pub energies: Energies,
+    pub last_force: Vec<f64>,
+    pub control: StepControl,
+    pub increments: usize,
+    pub contact: ContactState,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DynamicCarry {
+    pub state: State,
+    pub kinematics: Kinematics,
+    pub method: MethodHistory,
+    pub energies: Energies,
+    pub initial_kinetic: f64,
+    pub last_total: Vec<f64>,
+    pub last_internal: Vec<f64>,
+    pub last_contact: Vec<f64>,
+    pub control: StepControl,
+    pub increments: usize,
+    pub contact: ContactState,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ExplicitCarry {
+    pub state: State,
+    pub velocity: Vec<f64>,
+    pub acceleration: Vec<f64>,
+    pub energies: Energies,
+    pub initial_kinetic: f64,
+    pub last_total: Vec<f64>,
+    pub energy_reference: f64,
+    /// The last step taken (the loop goes on with step + 1).
+    pub step: usize,
+    pub contact: ContactState,
+}
+
+pub fn path(dir: &Path) -> PathBuf {
+    dir.join(FILE)
+}
+
+/// Writes DIR/checkpoint.bin atomically.
+pub fn write(dir: &Path, checkpoint: &Checkpoint) -> Result<(), OutputError> {
+    let path = path(dir);
+    let body = postcard::to_stdvec(checkpoint)
+        .map_err(|e| OutputError::invalid(&path, format!("cannot encode the checkpoint: {e}")))?;
+    let mut bytes = Vec::with_capacity(body.len() + 12);
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&FORMAT.to_le_bytes());
+    bytes.extend_from_slice(&body);
+    write_atomic(&path, &bytes)
+}
+
+/// Reads DIR/checkpoint.bin; a missing, foreign, old or damaged file is bad input.
+pub fn read(dir: &Path) -> Result<Checkpoint, InputError> {
+    let path = path(dir);
+    let bytes = std::fs::read(&path).map_err(|e| {
+        InputError::new(
+            &path,
+            format!(
+                "cannot read the checkpoint ({e}); run with analysis.checkpoint_every = N \
+                 (or --checkpoint-every N) to write one"
+            ),
+        )
+    })?;
+    if bytes.len() < 12 || &bytes[..8] != MAGIC {
+        return Err(InputError::new(&path, "not an impact checkpoint"));
+    }
+    let format = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if format != FORMAT {
+        return Err(InputError::new(
+            &path,
+            format!(
+                "checkpoint format {format}, this impact reads format {FORMAT}: rerun the scene"
+            ),
+        ));
+    }
+    postcard::from_bytes(&bytes[12..])
+        .map_err(|e| InputError::new(&path, format!("damaged checkpoint: {e}")))
+}

@@ -1,0 +1,397 @@
+//! Reliability: checkpoints and `impact resume`, Ctrl-C and SIGKILL at any moment.
+//!
+//! Each test compares a stopped-and-resumed run with an uninterrupted one of the same scene
+//! (same `analysis.checkpoint_every`): history.csv, the .pvd and every frame must be equal
+//! byte for byte.
+
+mod common;
+
+use impact::analysis::{self, RunError, RunOptions, Status};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A J2 block (E = 200, sigma_y = 0.5, H = 10) dropped at 1.0 onto a rigid floor with
+/// Coulomb friction 0.2: it yields at the impact, bounces and slides.
+const PLASTIC_BLOCK: &str = r#"
+[[material]]
+name = "metal"
+young = 200.0
+poisson = 0.3
+density = 1.0
+yield_stress = 0.5
+hardening_modulus = 10.0
+
+[[body]]
+name = "block"
+material = "metal"
+formulation = "plane_strain"
+velocity = [0.3, -1.0]
+mesh = { type = "rectangle", origin = [0.0, 0.02], width = 1.0, height = 0.5, nx = 6, ny = 3 }
+
+[[obstacle]]
+name = "floor"
+points = [[10.0, 0.0], [-10.0, 0.0]]
+
+[[contact]]
+name = "floor"
+slave = { set = "bottom" }
+obstacle = "floor"
+friction = 0.2
+
+[analysis]
+type = "dynamic"
+integrator = "average"
+dt = 0.002
+end_time = 0.24
+checkpoint_every = 50
+
+[output]
+frame_every = 7
+
+[[output.probe]]
+quantity = "eq_plastic_strain"
+set = "all"
+
+[[output.probe]]
+quantity = "v_y"
+set = "all"
+"#;
+
+fn run_full(name: &str, text: &str, overrides: &[&str]) -> PathBuf {
+    let model = common::model(name, text, overrides);
+    let dir = common::out_dir(&format!("{name}_full"));
+    let summary = analysis::run(&model, &dir, RunOptions::default())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(summary.status, Status::Ok);
+    dir
+}
+
+/// Runs until `halt` steps (as if killed then: rows and frames after the last checkpoint
+/// are left on disk), then resumes from the checkpoint in the same folder.
+fn run_killed_and_resumed(name: &str, text: &str, overrides: &[&str], halt: usize) -> PathBuf {
+    let model = common::model(name, text, overrides);
+    let dir = common::out_dir(&format!("{name}_resumed"));
+    let options = RunOptions {
+        halt_after_steps: Some(halt),
+        ..Default::default()
+    };
+    match analysis::run(&model, &dir, options) {
+        Err(RunError::Interrupted { .. }) => {}
+        other => panic!(
+            "{name}: expected the halt, got {:?}",
+            other.map(|s| s.status)
+        ),
+    }
+    let summary = analysis::resume(&dir, RunOptions::default())
+        .unwrap_or_else(|e| panic!("{name}: resume: {e}"));
+    assert_eq!(summary.status, Status::Ok);
+    dir
+}
+
+/// history.csv, the .pvd and every listed frame, byte-equal.
+fn assert_same_output(a: &Path, b: &Path, name: &str) {
+    let read = |p: PathBuf| std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    let history = read(a.join("history.csv"));
+    assert!(
+        history == read(b.join("history.csv")),
+        "{name}: history.csv differs"
+    );
+    let pvd = format!("{name}.pvd");
+    assert_eq!(
+        read(a.join(&pvd)),
+        read(b.join(&pvd)),
+        "{name}: the .pvd differs"
+    );
+    let frames = impact::output::vtk::read_pvd(&a.join(&pvd)).unwrap();
+    assert!(frames.len() > 3, "{name}: {} frames", frames.len());
+    for (time, frame) in &frames {
+        let other = b.join(frame.strip_prefix(a).unwrap());
+        assert!(
+            read(frame.clone()) == read(other),
+            "{name}: frame at t = {time} differs"
+        );
+    }
+}
+
+/// Goal: a run checkpointed at step 50, killed at step 73 and resumed ends bit-identical to
+/// the uninterrupted run. Setup: PLASTIC_BLOCK (implicit average acceleration, J2 plasticity,
+/// contact with Coulomb friction, event-split steps), checkpoints every 50 steps.
+#[test]
+fn implicit_plastic_contact_resume_is_bit_identical() {
+    let name = "plastic_block";
+    let full = run_full(name, PLASTIC_BLOCK, &[]);
+    let rows = common::column(&full, "time").len();
+    assert!(rows > 120, "{rows} rows");
+    let plastic = common::column(&full, "eq_plastic_strain[all]");
+    assert!(*plastic.last().unwrap() > 0.0, "the block yields");
+    let resumed = run_killed_and_resumed(name, PLASTIC_BLOCK, &[], 73);
+    assert_same_output(&full, &resumed, name);
+}
+
+/// Goal: Houbolt's past displacements and modified Newton with a reused factorization
+/// survive a checkpoint. Setup: PLASTIC_BLOCK with Houbolt and refactor_every = 4.
+#[test]
+fn houbolt_modified_newton_resume_is_bit_identical() {
+    let name = "plastic_block_houbolt";
+    let set = [
+        "analysis.integrator=houbolt",
+        "analysis.newton.refactor_every=4",
+        "analysis.checkpoint_every=30",
+    ];
+    let full = run_full(name, PLASTIC_BLOCK, &set);
+    let resumed = run_killed_and_resumed(name, PLASTIC_BLOCK, &set, 100);
+    assert_same_output(&full, &resumed, name);
+}
+
+/// PLASTIC_BLOCK without friction (explicit contact is frictionless).
+fn frictionless() -> String {
+    PLASTIC_BLOCK.replace("friction = 0.2\n", "")
+}
+
+/// Goal: the explicit driver resumes bit-identically. Setup: PLASTIC_BLOCK, frictionless, with central
+/// difference (lumped mass, dt below the stability limit), checkpoint at 50, killed at 77.
+#[test]
+fn explicit_plastic_contact_resume_is_bit_identical() {
+    let name = "plastic_block_explicit";
+    let set = [
+        "analysis.integrator=central_difference",
+        "analysis.dt=0.0005",
+        "analysis.end_time=0.1",
+    ];
+    let text = frictionless();
+    let full = run_full(name, &text, &set);
+    let resumed = run_killed_and_resumed(name, &text, &set, 77);
+    assert_same_output(&full, &resumed, name);
+}
+
+/// Goal: static load stepping resumes bit-identically (modified Newton every 3 increments).
+#[test]
+fn static_plastic_resume_is_bit_identical() {
+    let name = "plastic_static";
+    let text = r#"
+[[material]]
+name = "metal"
+young = 200.0
+poisson = 0.3
+yield_stress = 0.5
+hardening_modulus = 10.0
+
+[[body]]
+name = "strip"
+material = "metal"
+formulation = "plane_strain"
+mesh = { type = "rectangle", width = 2.0, height = 1.0, nx = 6, ny = 3 }
+
+[[support]]
+set = "left"
+fix = ["x", "y"]
+
+[[load]]
+type = "displacement"
+set = "right"
+x = 0.02
+y = -0.05
+
+[analysis]
+type = "static"
+steps = 60
+checkpoint_every = 20
+newton = { refactor_every = 3 }
+
+[[output.probe]]
+quantity = "eq_plastic_strain"
+set = "all"
+"#;
+    let full = run_full(name, text, &[]);
+    let resumed = run_killed_and_resumed(name, text, &[], 33);
+    assert_same_output(&full, &resumed, name);
+}
+
+/// Goal: `impact resume` refuses a folder without a checkpoint with exit 2, naming the file.
+#[test]
+fn resume_without_checkpoint_is_bad_input() {
+    let dir = common::out_dir("resume_nothing");
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["resume", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("checkpoint.bin"), "{stderr}");
+    assert!(stderr.contains("checkpoint_every"), "{stderr}");
+    std::fs::write(dir.join("checkpoint.bin"), b"IMPACTCP\x01\0\0\0garbage").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["resume", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("damaged checkpoint"), "{stderr}");
+}
+
+/// A small deterministic generator (SplitMix64) for kill moments.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The long explicit scene of the signal tests: PLASTIC_BLOCK, central difference, finer.
+const LONG: [&str; 7] = [
+    "analysis.integrator=central_difference",
+    "body.block.mesh.nx=30",
+    "body.block.mesh.ny=15",
+    "analysis.dt=0.00025",
+    "analysis.end_time=0.5",
+    "analysis.checkpoint_every=100",
+    "output.frame_every=20",
+];
+
+fn spawn_run(scene: &Path, out: &Path) -> std::process::Child {
+    let mut args = vec![
+        "run".to_string(),
+        scene.display().to_string(),
+        "--out".into(),
+        out.display().to_string(),
+        "--quiet".into(),
+    ];
+    for s in LONG {
+        args.push("--set".into());
+        args.push(s.into());
+    }
+    Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(&args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn signal(child: &std::process::Child, sig: i32) {
+    let rc = unsafe { libc::kill(child.id() as i32, sig) };
+    assert_eq!(rc, 0, "kill failed");
+}
+
+fn resume_cli(dir: &Path) -> (i32, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["resume", dir.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// Every frame the .pvd lists loads with vtkio and has the grid's points.
+fn assert_frames_load(dir: &Path, name: &str) -> usize {
+    let pvd = dir.join(format!("{name}.pvd"));
+    let frames = impact::output::vtk::read_pvd(&pvd)
+        .unwrap_or_else(|e| panic!("the .pvd does not parse: {e}"));
+    for (time, path) in &frames {
+        vtkio::Vtk::import(path).unwrap_or_else(|e| {
+            panic!(
+                "frame at t = {time} ({}) does not load: {e}",
+                path.display()
+            )
+        });
+    }
+    frames.len()
+}
+
+/// Goal: SIGKILL at a random moment (4 times, seeded) leaves every frame the .pvd lists
+/// loadable, and `impact resume` then completes the run with history.csv and the frames
+/// equal byte for byte to an uninterrupted run's.
+#[test]
+fn sigkill_at_random_moments_then_resume_completes_identically() {
+    let root = common::out_dir("sigkill");
+    let scene = root.join("block.toml");
+    std::fs::write(&scene, frictionless()).unwrap();
+    let reference = root.join("reference");
+    let started = Instant::now();
+    let status = spawn_run(&scene, &reference).wait().unwrap();
+    assert!(status.success());
+    let duration = started.elapsed().as_secs_f64();
+    let mut rng = SplitMix(20240610);
+    let mut resumed = 0;
+    for k in 0..4 {
+        let out = root.join(format!("killed_{k}"));
+        let mut child = spawn_run(&scene, &out);
+        let wait = 0.05 + 0.9 * duration * rng.next();
+        std::thread::sleep(Duration::from_secs_f64(wait));
+        signal(&child, libc::SIGKILL);
+        let _ = child.wait();
+        if !out.join("block.pvd").exists() {
+            continue; // killed before the output existed
+        }
+        assert_frames_load(&out, "block");
+        if !out.join("checkpoint.bin").exists() {
+            continue; // killed before the first checkpoint (step 0)
+        }
+        let (code, stderr) = resume_cli(&out);
+        assert_eq!(code, 0, "resume after a kill at {wait:.3} s: {stderr}");
+        assert_same_output(&reference, &out, "block");
+        resumed += 1;
+    }
+    assert!(resumed >= 2, "only {resumed} of 4 kills left a checkpoint");
+}
+
+/// Goal: Ctrl-C (SIGINT) finishes the step, writes a frame, a checkpoint and summary.json
+/// with status `interrupted`, exits 130; `impact resume` completes the run (the explicit
+/// method has no factorization, so history.csv equals the uninterrupted run's).
+#[test]
+fn sigint_stops_cleanly_with_130_and_resume_completes() {
+    let root = common::out_dir("sigint");
+    let scene = root.join("block.toml");
+    std::fs::write(&scene, frictionless()).unwrap();
+    let reference = root.join("reference");
+    let started = Instant::now();
+    assert!(spawn_run(&scene, &reference).wait().unwrap().success());
+    let duration = started.elapsed().as_secs_f64();
+    let out = root.join("interrupted");
+    let child = spawn_run(&scene, &out);
+    std::thread::sleep(Duration::from_secs_f64(0.5 * duration));
+    signal(&child, libc::SIGINT);
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "interrupted");
+    let steps = summary["steps"].as_u64().unwrap();
+    assert!(steps > 0 && steps < 2000, "stopped after {steps} steps");
+    // the last frame is the state at the interruption
+    let frames = assert_frames_load(&out, "block");
+    let pvd = impact::output::vtk::read_pvd(&out.join("block.pvd")).unwrap();
+    let t_stop = summary["message"]
+        .as_str()
+        .unwrap()
+        .split("t = ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse::<f64>()
+        .unwrap();
+    assert_eq!(pvd[frames - 1].0, t_stop);
+    let (code, stderr) = resume_cli(&out);
+    assert_eq!(code, 0, "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "ok");
+    assert_eq!(summary["steps"], 2000);
+    assert!(
+        std::fs::read(reference.join("history.csv")).unwrap()
+            == std::fs::read(out.join("history.csv")).unwrap(),
+        "history.csv differs"
+    );
+}
