@@ -7,6 +7,7 @@
 
 pub mod analysis;
 pub mod assembly;
+pub mod bench;
 pub mod contact;
 pub mod element;
 pub mod integrator;
@@ -14,6 +15,7 @@ pub mod kinematics;
 pub mod material;
 pub mod mesh;
 pub mod output;
+pub mod profile;
 pub mod reference;
 pub mod scene;
 pub mod solver;

@@ -99,6 +99,18 @@ enum Command {
         quiet: bool,
     },
     /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
+    /// Generated scenes of growing size (a J2 block striking a rigid wall), implicit and
+    /// explicit, one child process each: a table of DOFs, steps/s, element updates/s,
+    /// factorizations, back-substitutions, peak memory and the time per phase; bench.json and
+    /// charts in the output folder.
+    Bench {
+        /// Two small sizes only (seconds in all).
+        #[arg(long)]
+        quick: bool,
+        /// Output folder. Default: output/bench/
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     Plot {
         history: PathBuf,
         /// A column to plot (repeat for more; one series each).
@@ -163,6 +175,7 @@ fn main() -> ExitCode {
             out,
             quiet,
         ),
+        Command::Bench { quick, out } => bench(quick, out),
         Command::Plot {
             history,
             y,
@@ -198,7 +211,31 @@ fn run_options(quiet: bool) -> RunOptions {
     }
 }
 
+fn bench(quick: bool, out: Option<PathBuf>) -> Result<(), RunError> {
+    let exe = std::env::current_exe().map_err(|e| {
+        RunError::Output(OutputError::Io {
+            path: PathBuf::from("impact"),
+            action: "find the executable of",
+            source: e,
+        })
+    })?;
+    let dir = out.unwrap_or_else(impact::bench::default_dir);
+    let cases = impact::bench::plan(quick);
+    println!("impact bench: {} cases -> {}", cases.len(), dir.display());
+    let rows = impact::bench::run(&exe, &dir, &cases, |row| {
+        println!(
+            "  {}: {} DOFs, {:.3} s",
+            row.name, row.dofs, row.wall_seconds
+        )
+    })?;
+    print!("{}", impact::bench::table(&rows));
+    Ok(())
+}
+
 fn run(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result<(), RunError> {
+    if std::env::var_os("IMPACT_PROFILE_FINE").is_some() {
+        impact::profile::set_fine(true);
+    }
     let model = scene::load(path, set)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
     let summary = analysis::run(&model, &dir, run_options(quiet))?;

@@ -241,6 +241,7 @@ impl ContactState {
                 ]
             };
             let start = |n: usize| reference[n];
+            let search = std::time::Instant::now();
             let mut penetrating = Vec::new();
             let mut alpha = 1.0f64;
             for (p, pair) in pairs.iter().enumerate() {
@@ -263,6 +264,7 @@ impl ContactState {
                     }
                 }
             }
+            crate::profile::add(crate::profile::Phase::Contact, search);
             if penetrating.is_empty() {
                 // friction: Greco's return targets from this (frictionless) slip, once per
                 // step; Coulomb stick <-> slide switches. A cycling status is accepted after

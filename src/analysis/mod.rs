@@ -83,6 +83,10 @@ pub struct Summary {
     pub contact: ContactSummary,
     pub energy: EnergySummary,
     pub buckling: Option<BucklingSummary>,
+    /// Seconds per phase and element updates (see `profile`); process-wide counters, so
+    /// only meaningful for one run per process (as `impact run` and `impact bench` do).
+    #[serde(default)]
+    pub timing: crate::profile::Timing,
 }
 
 impl Summary {
@@ -115,6 +119,7 @@ impl Summary {
             contact: ContactSummary::default(),
             energy: EnergySummary::default(),
             buckling: None,
+            timing: Default::default(),
         }
     }
 
@@ -132,6 +137,7 @@ impl Summary {
         self.factorizations = solver.map_or(0, |s| s.factorizations);
         self.back_substitutions = solver.map_or(0, |s| s.solves);
         self.wall_seconds = start.elapsed().as_secs_f64();
+        self.timing = crate::profile::snapshot();
         self.energy.final_ = energies.kinetic + energies.internal;
         self.energy.plastic_dissipation = energies.plastic_work;
     }
@@ -476,6 +482,7 @@ fn run_from(
     options: RunOptions,
     resume: Option<checkpoint::Checkpoint>,
 ) -> Result<Outcome, RunError> {
+    crate::profile::reset();
     let imperfect = buckling::with_imperfection(model).map_err(|e| {
         InputError::new(
             &model.file,

@@ -20,6 +20,7 @@ use crate::assembly::{self, Evaluation, Mass, State, System};
 use crate::contact::ContactPair;
 use crate::element::Geometry;
 use crate::integrator::StepForm;
+use crate::profile::{self, Phase};
 use crate::scene::Model;
 use crate::scene::spec::{NewtonSpec, Strategy, Tangent};
 use crate::solver::Solver;
@@ -206,15 +207,30 @@ fn constrained_solve(
         return Ok((delta, Vec::new()));
     }
     let n = delta.len();
+    // Z = K*^-1 C^T from the unit columns K*^-1 e_i of the rows' equations, kept with the
+    // factorization (a row has 1 to 6 entries), so an iteration costs one back-substitution
+    // however many constraints are active; above the cache's budget, one per row
+    let mut equations: Vec<usize> = rows.rows.iter().flatten().map(|(eq, _)| *eq).collect();
+    equations.sort_unstable();
+    equations.dedup();
+    let cached = solver.unit_columns_fit(equations.len(), n);
     let mut z = Vec::with_capacity(m);
     for row in &rows.rows {
         let mut column = vec![0.0; n];
-        for (eq, c) in row {
-            column[*eq] += c;
+        if cached {
+            for (eq, c) in row {
+                let unit = solver.unit_column(*eq, n);
+                column.iter_mut().zip(unit).for_each(|(z, u)| *z += c * u);
+            }
+        } else {
+            for (eq, c) in row {
+                column[*eq] += c;
+            }
+            solver.solve(&mut column);
         }
-        solver.solve(&mut column);
         z.push(column);
     }
+    let schur_start = std::time::Instant::now();
     let dot =
         |row: &Vec<(usize, f64)>, v: &[f64]| row.iter().map(|(eq, c)| c * v[*eq]).sum::<f64>();
     let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&rows.rows[i], &z[j]));
@@ -227,6 +243,7 @@ fn constrained_solve(
             *d += tau[j] * zj;
         }
     }
+    profile::add(Phase::Contact, schur_start);
     Ok((delta, tau.iter().copied().collect()))
 }
 
@@ -340,7 +357,7 @@ impl Step<'_> {
             let (residual, scale) = self.residual(&d, &evaluation, system, &damping, external_norm);
             let (mut residual, scale) = (residual, scale);
             let rows = match &self.contact {
-                Some(c) => c.rows(&d, system)?,
+                Some(c) => profile::time(Phase::Contact, || c.rows(&d, system))?,
                 None => Rows::empty(),
             };
             // sliding friction: known forces from the last solve's normal multipliers

@@ -143,6 +143,7 @@ impl Recorder {
         contact: Option<&ContactState>,
         force_frame: bool,
     ) -> Result<(), OutputError> {
+        let start = std::time::Instant::now();
         let mut row = vec![
             state.time,
             energies.kinetic,
@@ -181,6 +182,7 @@ impl Recorder {
             row.push(self.negative_pivots.map_or(f64::NAN, |n| n as f64));
         }
         self.history.append(&row)?;
+        crate::profile::add(crate::profile::Phase::Output, start);
         self.steps_since_frame += 1;
         let listed = model
             .output
@@ -210,6 +212,7 @@ impl Recorder {
         if self.last_frame_time == Some(state.time) {
             return Ok(());
         }
+        let _timer = OutputTimer(std::time::Instant::now());
         let cells = cell_fields(model, state);
         let vectors =
             |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
@@ -407,4 +410,13 @@ pub struct RecorderPosition {
     pub steps_since_frame: usize,
     pub last_frame_time: Option<f64>,
     pub negative_pivots: Option<usize>,
+}
+
+/// Adds its lifetime to the output phase.
+struct OutputTimer(std::time::Instant);
+
+impl Drop for OutputTimer {
+    fn drop(&mut self) {
+        crate::profile::add(crate::profile::Phase::Output, self.0);
+    }
 }

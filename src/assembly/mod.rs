@@ -18,6 +18,7 @@ use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind, Model};
 use crate::solver::Pattern;
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// Per body, per material point (element-major: element e's points are e*ppe .. (e+1)*ppe).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -213,6 +214,15 @@ impl System {
     }
 }
 
+/// Adds its lifetime to the assembly phase (every return path of `evaluate`).
+struct Timer(Instant);
+
+impl Drop for Timer {
+    fn drop(&mut self) {
+        crate::profile::add(crate::profile::Phase::Assembly, self.0);
+    }
+}
+
 struct ElementResult {
     force: Vec8,
     matrix: Option<[f64; 64]>,
@@ -232,6 +242,8 @@ pub fn evaluate(
     mut system: Option<&mut System>,
     tangent: Tangent,
 ) -> Result<Evaluation, ElementFailure> {
+    let _timer = Timer(Instant::now());
+    crate::profile::count_elements(model.elements());
     let want_tangent = system.is_some();
     if let Some(s) = system.as_deref_mut() {
         s.values.iter_mut().for_each(|v| *v = 0.0);
@@ -325,10 +337,14 @@ fn element(
             } else {
                 StressState::General
             };
+            let fine = crate::profile::fine().then(Instant::now);
             let responses: [_; 4] = std::array::from_fn(|q| {
                 body.material
                     .update(&committed.points[4 * e + q], &strains[q], stress_state)
             });
+            if let Some(start) = fine {
+                crate::profile::add(crate::profile::Phase::Constitutive, start);
+            }
             let stress = responses.map(|r| r.stress);
             let mut work = 0.0;
             let mut plastic_work = 0.0;

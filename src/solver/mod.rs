@@ -116,7 +116,12 @@ pub struct Solver {
     factor: Option<Llt<usize, f64>>,
     pub factorizations: usize,
     pub solves: usize,
+    /// K^-1 e_i of the current factorization, by equation i (contact rows reuse them).
+    unit: std::collections::HashMap<usize, Vec<f64>>,
 }
+
+/// The most entries the unit columns may hold (256 MB of f64).
+const UNIT_CACHE_ENTRIES: usize = 32 << 20;
 
 impl Solver {
     pub fn new(pattern: &Pattern) -> Result<Solver, SolverError> {
@@ -141,12 +146,21 @@ impl Solver {
             factor: None,
             factorizations: 0,
             solves: 0,
+            unit: std::collections::HashMap::new(),
         })
     }
 
     /// Numeric factorization of the matrix with the given lower-triangle values.
     pub fn factor(&mut self, values: &[f64]) -> Result<(), SolverError> {
+        let start = std::time::Instant::now();
+        let result = self.factor_values(values);
+        crate::profile::add(crate::profile::Phase::Factorization, start);
+        result
+    }
+
+    fn factor_values(&mut self, values: &[f64]) -> Result<(), SolverError> {
         self.factor = None;
+        self.unit.clear();
         self.factorizations += 1;
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
@@ -168,6 +182,23 @@ impl Solver {
         self.factor.is_some() || (self.symbolic.is_none() && self.factorizations > 0)
     }
 
+    /// Whether `count` more unit columns of size `n` fit the cache.
+    pub fn unit_columns_fit(&self, count: usize, n: usize) -> bool {
+        (self.unit.len() + count) * n <= UNIT_CACHE_ENTRIES
+    }
+
+    /// K^-1 e_eq for the current factorization, solved once and kept until the next
+    /// factorization (`n` the system size).
+    pub fn unit_column(&mut self, eq: usize, n: usize) -> &[f64] {
+        if !self.unit.contains_key(&eq) {
+            let mut column = vec![0.0; n];
+            column[eq] = 1.0;
+            self.solve(&mut column);
+            self.unit.insert(eq, column);
+        }
+        &self.unit[&eq]
+    }
+
     /// Solves in place with the current factorization.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         self.solves += 1;
@@ -179,7 +210,9 @@ impl Solver {
             .as_ref()
             .expect("solve after a successful factor");
         let n = rhs.len();
+        let start = std::time::Instant::now();
         factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
+        crate::profile::add(crate::profile::Phase::Solve, start);
     }
 }
 

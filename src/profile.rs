@@ -1,0 +1,109 @@
+//! Where a run's time goes: wall-clock seconds per phase, summed over the run, for
+//! summary.json's `timing` block and `impact bench`.
+//!
+//! Phases are timed where they are called (one clock read per call), so the cost is nil next
+//! to the work they time; the constitutive update is timed per element and only when fine
+//! timing is switched on (`set_fine(true)`, as `impact bench` does), since a clock read per
+//! element would show in the explicit path. Counters are process-wide atomics: one run per
+//! process is what they describe (`reset` at the start of a run).
+
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Instant;
+
+/// A timed phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// Element loops and the scatter into the force vector and stiffness (includes the
+    /// constitutive update).
+    Assembly,
+    /// The constitutive update inside the element loops (fine timing only).
+    Constitutive,
+    /// Numeric factorizations.
+    Factorization,
+    /// Back-substitutions with the factor.
+    Solve,
+    /// Contact search, constraint rows, the Schur complement, the active set.
+    Contact,
+    /// history.csv rows, VTK frames, checkpoints.
+    Output,
+}
+
+const PHASES: usize = 6;
+
+static NANOS: [AtomicU64; PHASES] = [const { AtomicU64::new(0) }; PHASES];
+static ELEMENT_UPDATES: AtomicU64 = AtomicU64::new(0);
+static FINE: AtomicBool = AtomicBool::new(false);
+
+/// Clears the counters (the start of a run).
+pub fn reset() {
+    for n in &NANOS {
+        n.store(0, Ordering::Relaxed);
+    }
+    ELEMENT_UPDATES.store(0, Ordering::Relaxed);
+}
+
+/// Switches the per-element timing of the constitutive update on or off.
+pub fn set_fine(on: bool) {
+    FINE.store(on, Ordering::Relaxed);
+}
+
+pub fn fine() -> bool {
+    FINE.load(Ordering::Relaxed)
+}
+
+/// Adds the time since `start` to `phase`.
+pub fn add(phase: Phase, start: Instant) {
+    NANOS[phase as usize].fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+}
+
+/// Runs `f`, adding its time to `phase`.
+pub fn time<T>(phase: Phase, f: impl FnOnce() -> T) -> T {
+    let start = Instant::now();
+    let out = f();
+    add(phase, start);
+    out
+}
+
+/// Counts element evaluations (one element's force, with or without its stiffness).
+pub fn count_elements(n: usize) {
+    ELEMENT_UPDATES.fetch_add(n as u64, Ordering::Relaxed);
+}
+
+/// The `timing` block of summary.json: seconds per phase, and the element updates.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct Timing {
+    pub assembly: f64,
+    /// Zero unless fine timing was on.
+    pub constitutive: f64,
+    pub factorization: f64,
+    pub solve: f64,
+    pub contact: f64,
+    pub output: f64,
+    pub element_updates: u64,
+    /// Peak resident memory of the process (bytes, Linux VmHWM), null where unknown.
+    pub peak_memory_bytes: Option<u64>,
+}
+
+/// The counters now.
+pub fn snapshot() -> Timing {
+    let s = |p: Phase| NANOS[p as usize].load(Ordering::Relaxed) as f64 * 1e-9;
+    Timing {
+        assembly: s(Phase::Assembly),
+        constitutive: s(Phase::Constitutive),
+        factorization: s(Phase::Factorization),
+        solve: s(Phase::Solve),
+        contact: s(Phase::Contact),
+        output: s(Phase::Output),
+        element_updates: ELEMENT_UPDATES.load(Ordering::Relaxed),
+        peak_memory_bytes: peak_memory(),
+    }
+}
+
+/// VmHWM of /proc/self/status.
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
