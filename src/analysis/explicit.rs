@@ -376,6 +376,9 @@ pub fn run(
         }
     }
     progress.finish_and_clear();
+    if let Some(kernel) = &reduced {
+        kernel.write_points(model, &mut state);
+    }
     summary.finish(&energies, &Counters::default(), None, start);
     summary.contact = contact.summary();
     recorder.write_summary(&summary)?;
