@@ -239,3 +239,289 @@ fn free_block_conserves_energy_with_hourglass_stiffness() {
         );
     }
 }
+
+/// Goal: the reduced kernel's J2 return at finite strain.
+/// Setup: a plane-strain column 1 x 4 of 1 x 4 elements (E = 200, nu = 0.3, sigma_y = 0.3,
+/// H = 2), every node on an x-roller, the bottom fixed, the top pushed down 4 % (logarithmic
+/// strain ln 0.96) at constant speed over 20 time units (~ 550 steps), started with the
+/// matching linear velocity field so the motion is homogeneous (no wave; the inertia of the
+/// slowly changing velocity gradient is ~ rho V^2 / h ~ 1e-7 of the stress). Reference:
+/// reference::uniaxial_strain_j2 at eps = ln(0.96) (the Hughes-Winget mid-point increments
+/// d = dh / h_mid sum to the logarithmic strain to O(dh^3) per step, and the rate form keeps
+/// K and mu constant). Measured: 4e-10 relative. Tolerance 1e-6 relative on s_yy, s_xx and
+/// eps_p (the return is exact for linear hardening; what is left is the O(dh^3) per step
+/// of the mid-point strain and round-off).
+#[test]
+fn j2_uniaxial_strain_column_matches_closed_form() {
+    let mut text = r#"
+[[material]]
+name = "steel"
+young = 200.0
+poisson = 0.3
+density = 1.0
+yield_stress = 0.3
+hardening_modulus = 2.0
+
+[[body]]
+name = "column"
+material = "steel"
+formulation = "plane_strain"
+mesh = { type = "rectangle", width = 1.0, height = 4.0, nx = 1, ny = 4 }
+
+[[support]]
+set = "all"
+fix = ["x"]
+
+[[support]]
+set = "bottom"
+fix = ["y"]
+
+[[curve]]
+name = "ramp"
+points = [[0.0, 0.0], [20.0, 1.0]]
+
+[[load]]
+type = "displacement"
+set = "top"
+y = -0.16
+curve = "ramp"
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+quadrature = "reduced"
+dt = 0.036
+end_time = 20.0
+
+[output]
+frame_every = 0
+
+[[output.probe]]
+quantity = "s_yy"
+set = "all"
+
+[[output.probe]]
+quantity = "s_xx"
+set = "all"
+
+[[output.probe]]
+quantity = "eq_plastic_strain"
+set = "all"
+"#
+    .to_string();
+    for j in 0..=4 {
+        let y = j as f64;
+        text += &format!(
+            "[[node_set]]\nname = \"row{j}\"\nbox = [-0.1, {:.1}, 1.1, {:.1}]\n\n\
+             [[initial_velocity]]\nset = \"row{j}\"\nvelocity = [0.0, {:e}]\n\n",
+            y - 0.1,
+            y + 0.1,
+            -0.16 / 20.0 * y / 4.0
+        );
+    }
+    let model = common::model("j2_column", &text, &[]);
+    let dir = common::out_dir("j2_column");
+    impact::analysis::run(&model, &dir, Default::default()).unwrap();
+    let last = |name: &str| *column(&dir, name).last().unwrap();
+    let strain = (3.84f64 / 4.0).ln();
+    let (axial, lateral, eps_p) =
+        impact::reference::uniaxial_strain_j2(200.0, 0.3, 0.3, 2.0, strain);
+    println!(
+        "s_yy {} vs {axial}, s_xx {} vs {lateral}, eps_p {} vs {eps_p}",
+        last("s_yy[all]"),
+        last("s_xx[all]"),
+        last("eq_plastic_strain[all]")
+    );
+    approx::assert_relative_eq!(last("s_yy[all]"), axial, max_relative = 1e-6);
+    approx::assert_relative_eq!(last("s_xx[all]"), lateral, max_relative = 1e-6);
+    approx::assert_relative_eq!(last("eq_plastic_strain[all]"), eps_p, max_relative = 1e-6);
+}
+
+/// A coarse 8 x 4 plane-strain elastic block (8 x 4 elements) on a fixed base, one top node
+/// struck downwards at `speed` (a point impact: the worst case for hourglass modes, which
+/// a single loaded node excites directly).
+fn point_impact(speed: f64) -> String {
+    format!(
+        r#"
+[[material]]
+name = "m"
+young = 200.0
+poisson = 0.3
+density = 1.0
+
+[[body]]
+name = "block"
+material = "m"
+formulation = "plane_strain"
+mesh = {{ type = "rectangle", width = 8.0, height = 4.0, nx = 8, ny = 4 }}
+
+[[support]]
+set = "bottom"
+fix = ["x", "y"]
+
+[[node_set]]
+name = "struck"
+nearest = [4.0, 4.0]
+
+[[initial_velocity]]
+set = "struck"
+velocity = [0.0, {speed:e}]
+
+[[output.probe]]
+quantity = "u_y"
+set = "struck"
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+quadrature = "reduced"
+dt = 0.01
+end_time = 20.0
+
+[output]
+frame_every = 0
+"#
+    )
+}
+
+/// Goal: the hourglass control keeps the spurious modes bounded under a point impact.
+/// Setup: `point_impact` (V = -0.05), default kappa = 0.1, dt = 0.9 dt_crit, 20 time units
+/// (~ 15 transits of the shear wave through the height). Reference: the energy bookkeeping
+/// itself. Explicit practice (e.g. LS-DYNA's user guidance) accepts hourglass energy up to
+/// ~ 10 % of the internal energy; a single struck node is the worst case, since its motion
+/// projects directly on the hourglass pattern of the two elements it belongs to (and the
+/// share grows with kappa, because a stiffer control stores more of that pattern's energy:
+/// measured mean share 6.8 % at kappa 0.1, 12 % at 0.3, 24 % at 1, where a square element's
+/// "hourglass" stiffness equals the fully integrated element's own bending stiffness).
+/// Asserted at kappa = 0.1: the mean share after the first P-wave transit (t > 0.3) below
+/// 10 %, the share at the end below 10 % (measured 8.0 %), and no growth: the hourglass
+/// energy in the second half of the run at most 1.5 times its first-half peak.
+#[test]
+fn point_impact_hourglass_energy_stays_small() {
+    let model = at_fraction_of_critical(
+        "point_impact",
+        &point_impact(-0.05),
+        0.9,
+        &["analysis.hourglass=0.1"],
+    );
+    let dir = common::out_dir("point_impact");
+    impact::analysis::run(&model, &dir, Default::default()).unwrap();
+    let t = column(&dir, "time");
+    let internal = column(&dir, "internal_energy");
+    let hourglass = column(&dir, "hourglass_energy");
+    let share: Vec<f64> = t
+        .iter()
+        .zip(internal.iter().zip(&hourglass))
+        .filter(|(t, _)| **t > 0.3)
+        .map(|(_, (i, h))| h / i)
+        .collect();
+    let half = |second: bool| {
+        t.iter()
+            .zip(&hourglass)
+            .filter(|(t, _)| (**t > 10.0) == second)
+            .map(|(_, h)| *h)
+            .fold(0.0, f64::max)
+    };
+    let (first, second) = (half(false), half(true));
+    println!(
+        "hourglass / internal: mean {:.3e}, last {:.3e}; hourglass energy peaks {first:.3e}, {second:.3e}",
+        mean(&share),
+        share.last().unwrap()
+    );
+    assert!(mean(&share) < 0.1, "mean share {}", mean(&share));
+    assert!(*share.last().unwrap() < 0.1);
+    assert!(second <= 1.5 * first, "{second} vs {first}");
+}
+
+/// Goal: the reduced kernel's results do not depend on the thread count.
+/// Setup: a 40 x 20 plane-strain J2 block (800 elements: 4 chunks of the kernel's 256),
+/// half of it started at (2, 1), 60 steps, run inside rayon pools of 1 and 2 threads.
+/// Reference: bit-for-bit equality of history.csv and the final displacements and stresses
+/// (the kernel gathers nodal forces in element order and sums the work in chunk order).
+#[test]
+fn reduced_results_do_not_depend_on_thread_count() {
+    let text = r#"
+[[material]]
+name = "steel"
+young = 200.0
+poisson = 0.3
+density = 1.0
+yield_stress = 0.3
+hardening_modulus = 2.0
+
+[[body]]
+name = "block"
+material = "steel"
+formulation = "plane_strain"
+mesh = { type = "rectangle", width = 40.0, height = 20.0, nx = 40, ny = 20 }
+
+[[node_set]]
+name = "half"
+box = [-0.1, -0.1, 20.1, 20.1]
+
+[[initial_velocity]]
+set = "half"
+velocity = [2.0, 1.0]
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+quadrature = "reduced"
+dt = 0.03
+end_time = 1.8
+
+[output]
+frame_every = 0
+
+[[output.probe]]
+quantity = "von_mises"
+set = "all"
+statistic = "max"
+"#;
+    let model = common::model("threads", text, &[]);
+    let runs: Vec<(String, impact::assembly::State)> = [1, 2]
+        .iter()
+        .map(|&threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let name = format!("threads_{threads}");
+            let (_, state) = pool.install(|| common::run(&name, &model));
+            let dir = common::out_dir(&format!("{name}_history"));
+            pool.install(|| impact::analysis::run(&model, &dir, Default::default()))
+                .unwrap();
+            (
+                std::fs::read_to_string(dir.join("history.csv")).unwrap(),
+                state,
+            )
+        })
+        .collect();
+    assert!(column_count(&runs[0].0) > 60);
+    assert_eq!(runs[0].0, runs[1].0, "history.csv differs");
+    let bits = |s: &impact::assembly::State| -> Vec<u64> {
+        s.displacement
+            .iter()
+            .copied()
+            .chain(
+                s.bodies[0]
+                    .points
+                    .iter()
+                    .flat_map(|p| p.stress.iter().copied()),
+            )
+            .map(f64::to_bits)
+            .collect()
+    };
+    assert_eq!(bits(&runs[0].1), bits(&runs[1].1));
+    assert!(
+        runs[0].1.bodies[0]
+            .points
+            .iter()
+            .any(|p| p.eq_plastic_strain > 0.0),
+        "the run is plastic"
+    );
+}
+
+fn column_count(history: &str) -> usize {
+    history.lines().count()
+}
