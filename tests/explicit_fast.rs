@@ -525,3 +525,67 @@ statistic = "max"
 fn column_count(history: &str) -> usize {
     history.lines().count()
 }
+
+/// Goal: bad uses of the reduced kernel are refused with a message naming the key (the CLI
+/// turns these into exit 2). Setup: the strip scene with one change each.
+#[test]
+fn reduced_quadrature_bad_input_names_the_key() {
+    let base = strip("reduced");
+    let cases: &[(&str, &[&str], &str)] = &[
+        (
+            "implicit",
+            &["analysis.integrator=average"],
+            "analysis.quadrature",
+        ),
+        (
+            "kappa_high",
+            &["analysis.hourglass=1.5"],
+            "analysis.hourglass",
+        ),
+        (
+            "kappa_nan",
+            &["analysis.hourglass=-0.1"],
+            "analysis.hourglass",
+        ),
+        (
+            "linear",
+            &["analysis.geometry=linear"],
+            "analysis.quadrature",
+        ),
+        (
+            "checkpoint",
+            &["analysis.checkpoint_every=5"],
+            "analysis.checkpoint_every",
+        ),
+        ("typo", &["analysis.quadrature=reduce"], "quadrature"),
+    ];
+    for (name, overrides, key) in cases {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let err = impact::scene::from_str(&base, std::path::Path::new("strip.toml"), &overrides)
+            .err()
+            .unwrap_or_else(|| panic!("{name}: accepted"));
+        assert!(err.to_string().contains(key), "{name}: {err}");
+    }
+    let full = strip("full");
+    let err = impact::scene::from_str(
+        &full,
+        std::path::Path::new("strip.toml"),
+        &["analysis.hourglass=0.1".to_string()],
+    )
+    .err()
+    .expect("hourglass without reduced");
+    assert!(err.to_string().contains("analysis.hourglass"), "{err}");
+    let axisymmetric = base.replace("plane_strain", "axisymmetric");
+    let err = impact::scene::from_str(&axisymmetric, std::path::Path::new("strip.toml"), &[])
+        .err()
+        .expect("axisymmetric refused");
+    assert!(
+        err.to_string().contains("analysis.quadrature") && err.to_string().contains("axisymmetric"),
+        "{err}"
+    );
+    let misspelled = base.replace("quadrature = ", "quadratur = ");
+    let err = impact::scene::from_str(&misspelled, std::path::Path::new("strip.toml"), &[])
+        .err()
+        .expect("misspelled key refused");
+    assert!(err.to_string().contains("quadratur"), "{err}");
+}
