@@ -66,6 +66,7 @@ const SQRT_3_2: f64 = 1.224_744_871_391_589;
 /// ||eta|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) (sigma_y0 + H_iso (eps_p + sqrt(2/3) dl)) is
 /// linear in dl and solved in closed form (the general return iterates Newton to round-off):
 /// (stress, back stress, eps_p, plastic work density), None when elastic.
+#[inline(always)]
 fn linear_return(
     j2: &LinearJ2,
     trial: &[f64; 4],
@@ -121,6 +122,7 @@ pub struct ElementStep {
 }
 
 /// Area, b_x, b_y (see the legend).
+#[inline(always)]
 fn centroid_gradient(x: &Nodes) -> (f64, [f64; 4], [f64; 4]) {
     let area = 0.5
         * ((x[2][0] - x[0][0]) * (x[3][1] - x[1][1]) - (x[3][0] - x[1][0]) * (x[2][1] - x[0][1]));
@@ -141,6 +143,7 @@ fn centroid_gradient(x: &Nodes) -> (f64, [f64; 4], [f64; 4]) {
 }
 
 /// FB's gamma vector (see the legend).
+#[inline(always)]
 fn gamma(x: &Nodes, bx: &[f64; 4], by: &[f64; 4]) -> [f64; 4] {
     let hx: f64 = (0..4).map(|a| HOURGLASS[a] * x[a][0]).sum();
     let hy: f64 = (0..4).map(|a| HOURGLASS[a] * x[a][1]).sum();
@@ -148,6 +151,7 @@ fn gamma(x: &Nodes, bx: &[f64; 4], by: &[f64; 4]) -> [f64; 4] {
 }
 
 /// Rotates the in-plane part of a symmetric tensor [xx yy zz xy] by R = [[c s] [-s c]].
+#[inline(always)]
 fn rotate(t: &[f64; 4], c: f64, s: f64) -> [f64; 4] {
     let (a, b, x) = (t[0], t[1], t[3]);
     [
@@ -159,6 +163,7 @@ fn rotate(t: &[f64; 4], c: f64, s: f64) -> [f64; 4] {
 }
 
 /// Internal force of an element on the configuration x (the stored stress and Q).
+#[inline(always)]
 fn element_force(x: &Nodes, state: &ElementState) -> Result<[f64; 8], KernelError> {
     let (area, bx, by) = centroid_gradient(x);
     if !(area > 0.0) {
@@ -180,6 +185,7 @@ fn element_force(x: &Nodes, state: &ElementState) -> Result<[f64; 8], KernelErro
 }
 
 /// One element over one step: positions x at the start, increment u (see the legend).
+#[inline(always)]
 fn element_step(
     p: &BodyParameters,
     x: &Nodes,
