@@ -650,3 +650,23 @@ set = "all"
     assert!(last("s_yy[all]").abs() < 1e-4 * expected);
     assert_eq!(last("s_zz[all]"), 0.0);
 }
+
+/// Goal: an interrupted reduced run stops cleanly and says it wrote no checkpoint.
+/// Setup: models/strip_wall.toml with the interrupt flag raised before the start (as a
+/// signal would). Reference: status interrupted after the first step, the message names
+/// `reduced`, no checkpoint.bin, and the last frame is written (2 frames: t = 0 and t = dt).
+#[test]
+fn interrupted_reduced_run_writes_its_frame_and_no_checkpoint() {
+    static FLAG: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
+    let model = common::model("strip_interrupted", &strip("reduced"), &[]);
+    let dir = common::out_dir("strip_interrupted");
+    let options = impact::analysis::RunOptions {
+        interrupt: Some(&FLAG),
+        ..Default::default()
+    };
+    let err = impact::analysis::run(&model, &dir, options).unwrap_err();
+    assert!(err.to_string().contains("reduced"), "{err}");
+    assert!(!dir.join("checkpoint.bin").exists());
+    let frames = std::fs::read_dir(dir.join("vtk")).unwrap().count();
+    assert_eq!(frames, 2);
+}

@@ -372,7 +372,15 @@ pub fn run(
             progress.abandon();
             summary.finish(&energies, &Counters::default(), None, start);
             summary.contact = contact.summary();
-            return Err(super::interrupted(&recorder, summary, state.time));
+            return Err(match reduced {
+                Some(_) => super::interrupted_saying(
+                    &recorder,
+                    summary,
+                    state.time,
+                    "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
+                ),
+                None => super::interrupted(&recorder, summary, state.time),
+            });
         }
     }
     progress.finish_and_clear();
