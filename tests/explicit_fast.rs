@@ -531,21 +531,18 @@ fn reduced_quadrature_bad_input_names_the_key() {
         std::path::Path::new("strip.toml"),
         &["analysis.hourglass=0.1".to_string()],
     )
-    .err()
-    .expect("hourglass without reduced");
+    .expect_err("hourglass without reduced");
     assert!(err.to_string().contains("analysis.hourglass"), "{err}");
     let axisymmetric = base.replace("plane_strain", "axisymmetric");
     let err = impact::scene::from_str(&axisymmetric, std::path::Path::new("strip.toml"), &[])
-        .err()
-        .expect("axisymmetric refused");
+        .expect_err("axisymmetric refused");
     assert!(
         err.to_string().contains("analysis.quadrature") && err.to_string().contains("axisymmetric"),
         "{err}"
     );
     let misspelled = base.replace("quadrature = ", "quadratur = ");
     let err = impact::scene::from_str(&misspelled, std::path::Path::new("strip.toml"), &[])
-        .err()
-        .expect("misspelled key refused");
+        .expect_err("misspelled key refused");
     assert!(err.to_string().contains("quadratur"), "{err}");
 }
 
