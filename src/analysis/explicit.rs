@@ -18,8 +18,10 @@ use super::dynamics::check_mass;
 use super::newton::Counters;
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
+use crate::assembly::reduced::{Reduced, StepWork};
 use crate::assembly::{self, Mass, MassKind, State, System};
 use crate::scene::spec::DynamicSpec;
+use crate::scene::spec::Quadrature;
 use crate::scene::{InputError, Model};
 use std::path::Path;
 use std::time::Instant;
@@ -84,15 +86,28 @@ pub fn run(
     let m = &mass.lumped;
     let a_r = spec.rayleigh[0];
 
+    // the reduced kernel keeps its element state in its own arrays (copied into `state`
+    // only when the recorder reads stresses)
+    let mut reduced = (spec.quadrature == Quadrature::Reduced)
+        .then(|| Reduced::new(model, &state, spec.hourglass));
     let zero = vec![0.0; model.dofs()];
-    let first = assembly::evaluate(
-        model,
-        &state,
-        &zero,
-        spec.geometry,
-        None,
-        spec.newton.tangent,
-    )
+    let first = match reduced.as_mut() {
+        Some(kernel) => {
+            let mut force = zero.clone();
+            kernel
+                .internal_force(&state.reference, &mut force)
+                .map(|_| force)
+        }
+        None => assembly::evaluate(
+            model,
+            &state,
+            &zero,
+            spec.geometry,
+            None,
+            spec.newton.tangent,
+        )
+        .map(|e| e.force),
+    }
     .map_err(|err| {
         super::fail(
             &recorder,
@@ -101,7 +116,7 @@ pub fn run(
             err.to_string(),
         )
     })?;
-    let mut internal = first.force;
+    let mut internal = first;
     let mut v = super::initial_velocity(model, &system, spec.dt);
     let external = loads::external_force(model, &state, &initial, 0.0);
     let mut a: Vec<f64> = (0..model.dofs())
@@ -224,15 +239,23 @@ pub fn run(
             let force = contact.nodal_forces(model, &positions);
             energies.contact_work -= force.iter().zip(&du).map(|(f, u)| f * u).sum::<f64>();
         }
-        let evaluation = match assembly::evaluate(
-            model,
-            &state,
-            &du,
-            spec.geometry,
-            None,
-            spec.newton.tangent,
-        ) {
-            Ok(e) => e,
+        let evaluation = match reduced.as_mut() {
+            Some(kernel) => kernel
+                .step(&state.reference, &du, &mut internal)
+                .map(|work| {
+                    commit_reduced(&mut state, &du, work);
+                    recorder.hourglass_energy = kernel.hourglass_energy;
+                }),
+            None => {
+                assembly::evaluate(model, &state, &du, spec.geometry, None, spec.newton.tangent)
+                    .map(|evaluation| {
+                        internal = evaluation.force.clone();
+                        assembly::commit(model, &mut state, &du, evaluation, spec.geometry);
+                    })
+            }
+        };
+        match evaluation {
+            Ok(()) => {}
             Err(err) => {
                 progress.abandon();
                 summary.finish(&energies, &Counters::default(), None, start);
@@ -248,10 +271,15 @@ pub fn run(
                     format!("at t = {time}: {err}"),
                 ));
             }
-        };
-        internal = evaluation.force.clone();
-        assembly::commit(model, &mut state, &du, evaluation, spec.geometry);
+        }
         state.time = time;
+        let synced = match &reduced {
+            Some(kernel) if recorder.reads_stresses(model, time, step == steps) => {
+                kernel.write_points(model, &mut state);
+                true
+            }
+            _ => false,
+        };
         let external = loads::external_force(model, &state, &initial, time);
         for i in 0..model.dofs() {
             if free[i] {
@@ -285,6 +313,9 @@ pub fn run(
         };
         if !energy.is_finite() || energy > 100.0 * energy_reference {
             progress.abandon();
+            if let (Some(kernel), false) = (&reduced, synced) {
+                kernel.write_points(model, &mut state);
+            }
             recorder.frame(model, &state, &motion, None).ok();
             summary.finish(&energies, &Counters::default(), None, start);
             let message = format!(
@@ -313,9 +344,16 @@ pub fn run(
         progress.set_position(step as u64);
         let interrupted = step < steps && options.interrupted();
         if interrupted {
+            if let (Some(kernel), false) = (&reduced, synced) {
+                kernel.write_points(model, &mut state);
+            }
             recorder.frame(model, &state, &motion, Some(&contact))?;
         }
-        if interrupted || (step < steps && super::checkpoint_due(model, step)) {
+        // the reduced kernel writes no checkpoint (its hourglass forces are not in `State`;
+        // the scene refuses checkpoint_every with it)
+        if reduced.is_none()
+            && (interrupted || (step < steps && super::checkpoint_due(model, step)))
+        {
             save(
                 &recorder,
                 &summary,
@@ -334,10 +372,21 @@ pub fn run(
             progress.abandon();
             summary.finish(&energies, &Counters::default(), None, start);
             summary.contact = contact.summary();
-            return Err(super::interrupted(&recorder, summary, state.time));
+            return Err(match reduced {
+                Some(_) => super::interrupted_saying(
+                    &recorder,
+                    summary,
+                    state.time,
+                    "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
+                ),
+                None => super::interrupted(&recorder, summary, state.time),
+            });
         }
     }
     progress.finish_and_clear();
+    if let Some(kernel) = &reduced {
+        kernel.write_points(model, &mut state);
+    }
     summary.finish(&energies, &Counters::default(), None, start);
     summary.contact = contact.summary();
     recorder.write_summary(&summary)?;
@@ -347,6 +396,20 @@ pub fn run(
         state,
         contact_force,
     })
+}
+
+/// Commits a step of the reduced kernel (whose element state is already updated): the
+/// configuration moves by du, the work accumulates.
+fn commit_reduced(state: &mut State, du: &[f64], work: StepWork) {
+    for (n, x) in state.reference.iter_mut().enumerate() {
+        x[0] += du[2 * n];
+        x[1] += du[2 * n + 1];
+    }
+    for (u, d) in state.displacement.iter_mut().zip(du) {
+        *u += d;
+    }
+    state.internal_work += work.internal;
+    state.plastic_work += work.plastic;
 }
 
 /// F: f_ext on the free DOFs, the reaction m a + a_R m v + f_int on the prescribed ones.
@@ -368,4 +431,121 @@ fn total_force(
             }
         })
         .collect()
+}
+
+/// The scene of `kernel_benchmark`: a unit-cell n x n plane-strain J2 block, reduced kernel.
+fn benchmark_scene(n: usize) -> String {
+    format!(
+        r#"
+[[material]]
+name = "steel"
+young = 200.0
+poisson = 0.3
+density = 1.0
+yield_stress = 0.3
+hardening_modulus = 2.0
+
+[[body]]
+name = "block"
+material = "steel"
+formulation = "plane_strain"
+mesh = {{ type = "rectangle", width = {n}.0, height = {n}.0, nx = {n}, ny = {n} }}
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+quadrature = "reduced"
+dt = 0.02
+end_time = 1.0
+
+[output]
+frame_every = 0
+"#
+    )
+}
+
+/// Element-updates per second of the reduced explicit kernel (the issue #9 target), for
+/// `impact bench`: a sqrt(elements)^2 plane-strain J2 block (unit elements, E = 200,
+/// nu = 0.3, rho = 1, sigma_y = 0.3) sheared isochorically (v = r (-x, y) about the centre,
+/// r such that it yields after ~10 steps, so most of the run is plastic) for `steps`
+/// central-difference steps at dt = 0.5 h / c_p, in a rayon pool of `threads` threads.
+/// Times the whole step (nodal updates, element kernel, gather); setup excluded.
+/// Returns 0 when `elements`, `steps` or `threads` is 0 or the pool cannot be built.
+pub fn kernel_benchmark(elements: usize, steps: usize, threads: usize) -> f64 {
+    kernel_benchmark_run(elements, steps, threads).map_or(0.0, |r| r.0)
+}
+
+/// `kernel_benchmark` with the fraction of elements that turned plastic: (element-updates/s,
+/// plastic fraction).
+pub fn kernel_benchmark_run(elements: usize, steps: usize, threads: usize) -> Option<(f64, f64)> {
+    let n = (elements as f64).sqrt().round() as usize;
+    if n == 0 || steps == 0 || threads == 0 {
+        return None;
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .ok()?;
+    let model =
+        crate::scene::from_str(&benchmark_scene(n), Path::new("kernel_benchmark.toml"), &[])
+            .expect("the benchmark scene is valid");
+    let mass = Mass::new(&model, MassKind::Lumped).ok()?;
+    let m = &mass.lumped;
+    let young: f64 = 200.0;
+    let c = (model.bodies[0].material.elastic.p_wave_modulus()).sqrt();
+    let h = 0.5 / c;
+    let rate = 0.3 / young / (10.0 * h);
+    let centre = 0.5 * n as f64;
+    pool.install(|| {
+        let mut state = State::initial(&model);
+        let mut kernel = Reduced::new(&model, &state, 0.1);
+        let dofs = model.dofs();
+        let mut v: Vec<f64> = state
+            .reference
+            .iter()
+            .flat_map(|x| [-rate * (x[0] - centre), rate * (x[1] - centre)])
+            .collect();
+        let mut a = vec![0.0; dofs];
+        let mut du = vec![0.0; dofs];
+        let mut force = vec![0.0; dofs];
+        use rayon::prelude::*;
+        let start = Instant::now();
+        for _ in 0..steps {
+            v.par_iter_mut()
+                .zip(a.par_iter())
+                .zip(du.par_iter_mut())
+                .for_each(|((v, a), du)| {
+                    *v += 0.5 * h * a;
+                    *du = h * *v;
+                });
+            if kernel.step(&state.reference, &du, &mut force).is_err() {
+                return None;
+            }
+            state
+                .reference
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(i, x)| {
+                    x[0] += du[2 * i];
+                    x[1] += du[2 * i + 1];
+                });
+            v.par_iter_mut()
+                .zip(a.par_iter_mut())
+                .zip(force.par_iter().zip(m.par_iter()))
+                .for_each(|((v, a), (f, m))| {
+                    *a = -f / m;
+                    *v += 0.5 * h * *a;
+                });
+        }
+        let seconds = start.elapsed().as_secs_f64();
+        let plastic = kernel
+            .eq_plastic_strain
+            .iter()
+            .filter(|e| **e > 0.0)
+            .count();
+        Some((
+            (kernel.elements() * steps) as f64 / seconds,
+            plastic as f64 / kernel.elements() as f64,
+        ))
+    })
 }

@@ -415,11 +415,21 @@ fn resumed_start(wall_seconds: f64) -> Instant {
 }
 
 /// An interrupted run: summary.json with status `interrupted`, exit 130.
-fn interrupted(recorder: &Recorder, mut summary: Summary, time: f64) -> RunError {
+fn interrupted(recorder: &Recorder, summary: Summary, time: f64) -> RunError {
+    let next = format!("`impact resume {}` continues", recorder.dir().display());
+    interrupted_saying(recorder, summary, time, &next)
+}
+
+/// As `interrupted`, for a run that wrote no checkpoint (`what_next` says so).
+fn interrupted_saying(
+    recorder: &Recorder,
+    mut summary: Summary,
+    time: f64,
+    what_next: &str,
+) -> RunError {
     let message = format!(
-        "interrupted by a signal at t = {time} after {} steps; `impact resume {}` continues",
-        summary.steps,
-        recorder.dir().display()
+        "interrupted by a signal at t = {time} after {} steps; {what_next}",
+        summary.steps
     );
     summary.status = Status::Interrupted;
     summary.message = Some(message.clone());

@@ -44,6 +44,10 @@ pub struct Recorder {
     pivots_column: bool,
     /// Its value for the next row (the buckling check sets it before each step is recorded).
     pub negative_pivots: Option<usize>,
+    /// Whether history.csv ends with the `hourglass_energy` column (quadrature `reduced`).
+    hourglass_column: bool,
+    /// Its value for the next row (the reduced explicit kernel sets it before each step).
+    pub hourglass_energy: f64,
 }
 
 impl Recorder {
@@ -71,6 +75,8 @@ impl Recorder {
             last_frame_time: None,
             pivots_column,
             negative_pivots: None,
+            hourglass_column: hourglass_column(model),
+            hourglass_energy: 0.0,
         })
     }
 
@@ -113,6 +119,8 @@ impl Recorder {
             last_frame_time: position.last_frame_time,
             pivots_column,
             negative_pivots: position.negative_pivots,
+            hourglass_column: hourglass_column(model),
+            hourglass_energy: 0.0,
         })
     }
 
@@ -181,21 +189,35 @@ impl Recorder {
         if self.pivots_column {
             row.push(self.negative_pivots.map_or(f64::NAN, |n| n as f64));
         }
+        if self.hourglass_column {
+            row.push(self.hourglass_energy);
+        }
         self.history.append(&row)?;
         crate::profile::add(crate::profile::Phase::Output, start);
         self.steps_since_frame += 1;
+        if self.frame_due(model, state.time, force_frame, 0) {
+            self.frame(model, state, motion, contact)?;
+        }
+        Ok(())
+    }
+
+    /// Whether recording the step that ends at `time` reads the element stresses: a stress
+    /// probe, or a frame due. Call it before `step_with_contact`.
+    pub fn reads_stresses(&self, model: &Model, time: f64, force_frame: bool) -> bool {
+        model.probes.iter().any(|p| !p.quantity.is_nodal())
+            || (self.series.is_some() && self.frame_due(model, time, force_frame, 1))
+    }
+
+    /// `pending`: steps not yet counted in `steps_since_frame`.
+    fn frame_due(&self, model: &Model, time: f64, force_frame: bool, pending: usize) -> bool {
         let listed = model
             .output
             .frame_times
             .iter()
-            .any(|t| (t - state.time).abs() <= 1e-9 * t.abs().max(1e-300));
-        if force_frame
+            .any(|t| (t - time).abs() <= 1e-9 * t.abs().max(1e-300));
+        force_frame
             || listed
-            || (self.frame_every > 0 && self.steps_since_frame >= self.frame_every)
-        {
-            self.frame(model, state, motion, contact)?;
-        }
-        Ok(())
+            || (self.frame_every > 0 && self.steps_since_frame + pending >= self.frame_every)
     }
 
     /// Writes a frame of the state unless one was written at this time already.
@@ -399,7 +421,15 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
     if pivots_column {
         columns.push("tangent_negative_pivots".to_string());
     }
+    if hourglass_column(model) {
+        columns.push("hourglass_energy".to_string());
+    }
     (columns, pivots_column)
+}
+
+fn hourglass_column(model: &Model) -> bool {
+    matches!(&model.analysis, crate::scene::model::Analysis::Dynamic(d)
+        if d.quadrature == crate::scene::spec::Quadrature::Reduced)
 }
 /// Where a run's output stands at a checkpoint: the frames listed, the bytes of
 /// history.csv (whole rows), and the frame cadence.

@@ -11,6 +11,8 @@
 //! W_int      work of the internal forces, sum_q w_q 1/2 (sigma_n + S) . dE (trapezoid)
 //! ```
 
+pub mod reduced;
+
 use crate::element::{Formulation, Geometry, KernelError, Mat4, Vec4, Vec8, Voigt, quad4, rod2};
 use crate::kinematics;
 use crate::material::{PointState, StressState};

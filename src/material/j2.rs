@@ -51,6 +51,20 @@ pub struct Return {
     pub plastic_strain: Voigt,
 }
 
+/// The state after a radial return, with what the tangent needs.
+struct Radial {
+    stress: Voigt,
+    back_stress: Voigt,
+    eq_plastic_strain: f64,
+    /// n = eta / ||eta||
+    direction: Voigt,
+    /// dl
+    multiplier: f64,
+    eta_norm: f64,
+    /// The isotropic hardening slope at the solution.
+    slope: f64,
+}
+
 const SQRT_2_3: f64 = 0.816_496_580_927_726;
 
 fn norm(x: &Voigt) -> f64 {
@@ -117,20 +131,10 @@ impl J2 {
         back: &Voigt,
         eps_p: f64,
     ) -> Option<Return> {
-        // dev of the difference: the pushed-forward back stress need not stay traceless
-        let eta = deviator(&(trial - back));
-        let eta_norm = norm(&eta);
-        let (sy, _) = self.yield_stress_at(eps_p);
-        if (1.5f64).sqrt() * eta_norm - sy <= 0.0 {
-            return None;
-        }
-        let h_kin = self.kinematic_modulus;
-        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, eps_p);
-        let n = eta / eta_norm;
-        let stress = trial - n * (2.0 * mu * dl);
-        let back_stress = back + n * (2.0 / 3.0 * h_kin * dl);
+        let r = self.radial(trial, mu, back, eps_p)?;
+        let (n, dl, eta_norm) = (r.direction, r.multiplier, r.eta_norm);
         // consistent tangent D_e - 2 mu [c1 n n^T + c2 (I_dev - n n^T)]
-        let c1 = 2.0 * mu / (2.0 * mu + 2.0 / 3.0 * (h_iso + h_kin));
+        let c1 = 2.0 * mu / (2.0 * mu + 2.0 / 3.0 * (r.slope + self.kinematic_modulus));
         let c2 = 2.0 * mu * dl / eta_norm;
         let nn = n * n.transpose();
         let mut i_dev = Moduli::zeros();
@@ -142,11 +146,51 @@ impl J2 {
         i_dev[(3, 3)] = 0.5;
         let moduli = elastic - (nn * c1 + (i_dev - nn) * c2) * (2.0 * mu);
         Some(Return {
-            stress,
-            back_stress,
-            eq_plastic_strain: eps_p + SQRT_2_3 * dl,
+            stress: r.stress,
+            back_stress: r.back_stress,
+            eq_plastic_strain: r.eq_plastic_strain,
             moduli,
             plastic_strain: n * dl,
+        })
+    }
+
+    /// The radial return without the tangent (the explicit kernels, which need none):
+    /// (stress, back stress, eps_p, plastic work density S : d eps_p), or None when elastic.
+    pub fn return_stress(
+        &self,
+        trial: &Voigt,
+        mu: f64,
+        back: &Voigt,
+        eps_p: f64,
+    ) -> Option<(Voigt, Voigt, f64, f64)> {
+        let r = self.radial(trial, mu, back, eps_p)?;
+        let e = r.direction * r.multiplier;
+        let s = &r.stress;
+        let work = s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * s[3] * e[3];
+        Some((r.stress, r.back_stress, r.eq_plastic_strain, work))
+    }
+
+    /// dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(eps_p,n + sqrt(2/3) dl)
+    /// and the returned state; None when the trial state is elastic.
+    fn radial(&self, trial: &Voigt, mu: f64, back: &Voigt, eps_p: f64) -> Option<Radial> {
+        // dev of the difference: the pushed-forward back stress need not stay traceless
+        let eta = deviator(&(trial - back));
+        let eta_norm = norm(&eta);
+        let (sy, _) = self.yield_stress_at(eps_p);
+        if (1.5f64).sqrt() * eta_norm - sy <= 0.0 {
+            return None;
+        }
+        let h_kin = self.kinematic_modulus;
+        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, eps_p);
+        let n = eta / eta_norm;
+        Some(Radial {
+            stress: trial - n * (2.0 * mu * dl),
+            back_stress: back + n * (2.0 / 3.0 * h_kin * dl),
+            eq_plastic_strain: eps_p + SQRT_2_3 * dl,
+            direction: n,
+            multiplier: dl,
+            eta_norm,
+            slope: h_iso,
         })
     }
 

@@ -277,6 +277,32 @@ pub fn uniaxial_bar_stress(
         .collect()
 }
 
+/// Uniaxial strain (plane strain, the lateral strains held at zero) of a J2 material with
+/// linear isotropic hardening H under a monotone axial (logarithmic) strain `strain`:
+/// the mean stress K eps (plastic flow is isochoric), the Mises stress q = 2 mu |eps| while
+/// elastic, then q = 2 mu |eps| - 3 mu eps_p = sigma_y + H eps_p, so
+/// eps_p = (2 mu |eps| - sigma_y) / (3 mu + H). Returns (sigma_axial, sigma_lateral, eps_p)
+/// with sigma_axial = K eps + sign(eps) 2/3 q, sigma_lateral = K eps - sign(eps) q / 3
+/// (the lateral stresses xx and zz are equal).
+pub fn uniaxial_strain_j2(
+    young: f64,
+    poisson: f64,
+    yield_stress: f64,
+    hardening: f64,
+    strain: f64,
+) -> (f64, f64, f64) {
+    let mu = young / (2.0 * (1.0 + poisson));
+    let bulk = young / (3.0 * (1.0 - 2.0 * poisson));
+    let eps_p = ((2.0 * mu * strain.abs() - yield_stress) / (3.0 * mu + hardening)).max(0.0);
+    let q = 2.0 * mu * strain.abs() - 3.0 * mu * eps_p;
+    let s = strain.signum();
+    (
+        bulk * strain + s * 2.0 / 3.0 * q,
+        bulk * strain - s * q / 3.0,
+        eps_p,
+    )
+}
+
 /// Hill's elastic-perfectly plastic thick cylinder (Mises, plane strain, incompressible),
 /// inner radius a, outer b, yield stress sigma_y, shear modulus G, plastic front at radius c:
 /// internal pressure p(c) = (2/sqrt 3) sigma_y (ln(c/a) + (1 - c^2/b^2)/2) and bore

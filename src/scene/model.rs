@@ -8,7 +8,7 @@ use super::InputError;
 use super::spec::{
     AnalysisKind, AnalysisSpec, BodySpec, BucklingSpec, Component, ContactSpec, DynamicSpec,
     FormulationSpec, IntegratorKind, LoadSpec, MaterialSpec, NewtonSpec, NodeSetSpec, OutputSpec,
-    ProbeSpec, Quantity, ReferenceKind, ReferenceSpec, Scene, StaticSpec, Statistic,
+    ProbeSpec, Quadrature, Quantity, ReferenceKind, ReferenceSpec, Scene, StaticSpec, Statistic,
 };
 use crate::assembly::MassKind;
 use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
@@ -329,6 +329,27 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         return Err(cx.err(format!(
             "contact[{k}].name: `{}` is used twice",
             contacts[k].name
+        )));
+    }
+    if let Analysis::Dynamic(d) = &analysis
+        && d.quadrature == Quadrature::Reduced
+        && let Some(body) = bodies.iter().find(|b| {
+            !matches!(
+                b.kind,
+                BodyKind::Continuum {
+                    formulation: Formulation::PlaneStrain | Formulation::PlaneStress,
+                    ..
+                }
+            )
+        })
+    {
+        return Err(cx.err(format!(
+            "analysis.quadrature: `reduced` covers plane-strain and plane-stress Quad4 bodies; body `{}` is {}: use quadrature = \"full\"",
+            body.name,
+            match body.kind {
+                BodyKind::Rod { .. } => "a rod",
+                _ => "axisymmetric",
+            }
         )));
     }
     if let Analysis::Dynamic(d) = &analysis
@@ -787,6 +808,8 @@ fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, InputError> {
                 (spec.mass.is_some(), "mass"),
                 (spec.rayleigh.is_some(), "rayleigh"),
                 (spec.allow_unstable, "allow_unstable"),
+                (spec.quadrature.is_some(), "quadrature"),
+                (spec.hourglass.is_some(), "hourglass"),
             ] {
                 given(present, key, "static")?;
             }
@@ -903,7 +926,41 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
             "analysis.rayleigh: coefficients must be >= 0, got {rayleigh:?}"
         )));
     }
+    let quadrature = spec.quadrature.unwrap_or_default();
+    if quadrature == Quadrature::Reduced {
+        if integrator != I::CentralDifference {
+            return Err(cx.err(format!(
+                "analysis.quadrature: `reduced` (one-point Quad4 with hourglass control) is the explicit fast path; \
+                 integrator {integrator:?} needs the tangent of the full 2x2 kernel: use quadrature = \"full\" or integrator = \"central_difference\""
+            )));
+        }
+        if spec.geometry == Geometry::Linear {
+            return Err(cx.err(
+                "analysis.quadrature: `reduced` runs the updated-Lagrangian (finite-strain) kernel only; use geometry = \"nonlinear\" or quadrature = \"full\"",
+            ));
+        }
+        if spec.checkpoint_every > 0 {
+            return Err(cx.err(
+                "analysis.checkpoint_every: checkpoints are not implemented for quadrature = \"reduced\" (its hourglass forces are not in the checkpoint); use quadrature = \"full\" or no checkpoints",
+            ));
+        }
+    }
+    let hourglass = match (quadrature, spec.hourglass) {
+        (Quadrature::Full, Some(_)) => {
+            return Err(cx.err(
+                "analysis.hourglass: applies to quadrature = \"reduced\" only (the full 2x2 kernel has no hourglass modes)",
+            ));
+        }
+        (_, Some(k)) if !(0.0..=1.0).contains(&k) => {
+            return Err(cx.err(format!(
+                "analysis.hourglass: the hourglass coefficient must lie in [0, 1], got {k}"
+            )));
+        }
+        (_, k) => k.unwrap_or(0.1),
+    };
     Ok(DynamicSpec {
+        quadrature,
+        hourglass,
         dt,
         end_time,
         integrator,

@@ -379,6 +379,24 @@ pub struct AnalysisSpec {
     /// steps, so `impact resume DIR` can continue the run. Default 0: no checkpoints.
     #[serde(default)]
     pub checkpoint_every: usize,
+    /// Central difference: the Quad4 kernel. `full` (default): 2x2 Gauss, exact push-forward;
+    /// `reduced`: one point with Flanagan-Belytschko hourglass control, the structure-of-arrays
+    /// fast path (plane strain and plane stress; see docs/theory.md "Reduced explicit Quad4").
+    pub quadrature: Option<Quadrature>,
+    /// `quadrature = "reduced"`: the hourglass stiffness coefficient kappa in [0, 1]: kappa = 1
+    /// gives a square element the hourglass stiffness of the fully integrated one. Default 0.1.
+    pub hourglass: Option<f64>,
+}
+
+/// Quadrature of the explicit Quad4 kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quadrature {
+    /// 2x2 Gauss (B-bar by option), the same kernel as the implicit integrators.
+    #[default]
+    Full,
+    /// One point at the centroid plus hourglass control (central difference only).
+    Reduced,
 }
 
 /// `[analysis.buckling]`: the inertia of the tangent after every converged state, the
@@ -445,6 +463,10 @@ pub struct DynamicSpec {
     pub geometry: Geometry,
     pub newton: NewtonSpec,
     pub buckling: Option<BucklingSpec>,
+    /// Central difference's Quad4 kernel (always `full` for the implicit integrators).
+    pub quadrature: Quadrature,
+    /// The hourglass coefficient kappa of the reduced kernel (0.1 unless given).
+    pub hourglass: f64,
 }
 
 /// The validated static analysis.
