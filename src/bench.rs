@@ -2,7 +2,7 @@
 //! spends per phase (summary.json's `timing`), written as bench.json and a table.
 //!
 //! The scene: a plane-strain J2 block (steel-like: E = 200 GPa, nu = 0.3, rho = 7850 kg/m^3,
-//! yield 250 MPa, hardening 1 GPa) of W x W/2 with n x n/2 quads, moving at 10 m/s onto a
+//! yield 250 MPa, hardening 1 GPa) of W x W/2 with n x n/2 quads, moving at 10 m/s (1 m/s in the elastic cases) onto a
 //! rigid wall it touches at t = 0, so its whole bottom edge (n + 1 slaves) closes in the first
 //! step. Implicit: Newmark average, modified Newton, dt = 2 h / c (Courant number 2);
 //! explicit: central difference at dt = 0.5 h / c (below its limit h / c for these squares).
@@ -25,6 +25,14 @@ pub struct Case {
     pub contact: bool,
     /// Write a VTK frame every this many steps (0: none).
     pub frame_every: usize,
+    /// Rayon threads of the run (None: rayon's default, one per core).
+    pub threads: Option<usize>,
+    /// Impact speed (m/s): 10 crushes the block's edge plastically (rho c V = 460 MPa against
+    /// a yield stress of 250 MPa); 1 stays elastic.
+    pub speed: f64,
+    /// Implicit: `analysis.newton.strategy` ("modified": factor each step; "initial": factor
+    /// once, the seed's way).
+    pub strategy: &'static str,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -32,8 +40,11 @@ pub struct Case {
 pub enum Method {
     /// Newmark average acceleration, modified Newton.
     Implicit,
-    /// Central difference.
+    /// Central difference, 2x2 Gauss Quad4 (the general path).
     Explicit,
+    /// Central difference, one-point Quad4 with hourglass control over structure-of-arrays
+    /// data (`analysis.quadrature = "reduced"`, the fast path).
+    ExplicitReduced,
 }
 
 /// A measured case: bench.json's rows.
@@ -45,9 +56,13 @@ pub struct Row {
     pub dofs: usize,
     pub contact: bool,
     pub frame_every: usize,
+    pub threads: Option<usize>,
     pub status: String,
     pub steps: usize,
     pub wall_seconds: f64,
+    /// Before the first step (model arrays, symbolic analysis, mass, first frame).
+    pub setup_seconds: f64,
+    /// Steps per second after the setup.
     pub steps_per_second: f64,
     pub element_updates_per_second: f64,
     pub newton_iterations: usize,
@@ -72,50 +87,103 @@ pub struct Shares {
     pub output: f64,
 }
 
-/// The plan: `quick` keeps the cases under a few seconds in all.
+/// The plan: `quick` keeps the cases under ten seconds in all; the full plan spans 1e3 to
+/// 1e6 DOFs (n = 32 to 1000 elements across) and has the cases of issue #9's targets: the
+/// fast explicit path at 1e5 elements on one and two threads and with frames every 10 steps,
+/// and the implicit step with and without ~100 contact pairs (n = 100: 101 slaves).
 pub fn plan(quick: bool) -> Vec<Case> {
-    let sizes: &[usize] = if quick {
-        &[20, 60]
-    } else {
-        &[20, 64, 200, 632]
+    let case = |method: Method, n: usize| Case {
+        name: format!("{}_{n}", name(method)),
+        method,
+        n,
+        steps: match method {
+            Method::Implicit => 10,
+            Method::Explicit | Method::ExplicitReduced => 100,
+        },
+        contact: true,
+        frame_every: 0,
+        threads: None,
+        speed: 10.0,
+        strategy: "modified",
+    };
+    // the cost of contact alone: an elastic impact, K* factored once, with and without the
+    // wall (n + 1 active pairs)
+    let elastic = |n: usize, contact: bool| Case {
+        name: format!("implicit_{n}_elastic{}", if contact { "" } else { "_free" }),
+        contact,
+        speed: 1.0,
+        strategy: "initial",
+        ..case(Method::Implicit, n)
     };
     let mut cases = Vec::new();
-    for &n in sizes {
-        for method in [Method::Implicit, Method::Explicit] {
-            let steps = match method {
-                Method::Implicit => 10,
-                Method::Explicit => 100,
-            };
+    if quick {
+        for n in [20, 60] {
+            for method in [Method::Implicit, Method::Explicit, Method::ExplicitReduced] {
+                cases.push(case(method, n));
+            }
+        }
+        for method in [Method::Implicit, Method::ExplicitReduced] {
             cases.push(Case {
-                name: format!("{}_{n}", name(method)),
-                method,
-                n,
-                steps,
-                contact: true,
-                frame_every: 0,
+                name: format!("{}_60_free", name(method)),
+                contact: false,
+                ..case(method, 60)
             });
         }
-    }
-    // the cost of contact (the same block in free flight) and of output (frames every 10)
-    let n = if quick { 60 } else { 200 };
-    for method in [Method::Implicit, Method::Explicit] {
-        let steps = if method == Method::Implicit { 10 } else { 100 };
+        cases.push(elastic(60, true));
+        cases.push(elastic(60, false));
         cases.push(Case {
-            name: format!("{}_{n}_free", name(method)),
-            method,
-            n,
-            steps,
+            name: "explicit_reduced_60_frames".into(),
+            frame_every: 10,
+            ..case(Method::ExplicitReduced, 60)
+        });
+        return cases;
+    }
+    for n in [32, 100, 316, 1000] {
+        // the plastic impact with modified Newton: each factorization pays one
+        // back-substitution per active pair for the Schur complement (n + 1 of them), which
+        // makes n = 1000 (1e6 DOFs) an hour; its free flight is below
+        if n <= 316 {
+            cases.push(case(Method::Implicit, n));
+        }
+        if n <= 316 {
+            cases.push(case(Method::Explicit, n));
+        }
+        cases.push(case(Method::ExplicitReduced, n));
+    }
+    for n in [32, 100, 316, 1000] {
+        cases.push(Case {
+            name: format!("implicit_{n}_free"),
             contact: false,
-            frame_every: 0,
+            ..case(Method::Implicit, n)
         });
     }
+    for n in [100, 316] {
+        cases.push(elastic(n, true));
+        cases.push(elastic(n, false));
+    }
+    // 448 x 224 = 100 352 elements
+    let fast = |name: &str| Case {
+        name: name.into(),
+        steps: 200,
+        ..case(Method::ExplicitReduced, 448)
+    };
     cases.push(Case {
-        name: format!("explicit_{n}_frames"),
-        method: Method::Explicit,
-        n,
-        steps: 100,
-        contact: true,
+        threads: Some(1),
+        ..fast("explicit_reduced_448_1thread")
+    });
+    cases.push(Case {
+        threads: Some(2),
+        ..fast("explicit_reduced_448_2threads")
+    });
+    cases.push(Case {
+        threads: Some(2),
+        contact: false,
+        ..fast("explicit_reduced_448_free")
+    });
+    cases.push(Case {
+        threads: Some(2),
         frame_every: 10,
+        ..fast("explicit_reduced_448_frames")
     });
     cases
 }
@@ -124,6 +192,7 @@ fn name(method: Method) -> &'static str {
     match method {
         Method::Implicit => "implicit",
         Method::Explicit => "explicit",
+        Method::ExplicitReduced => "explicit_reduced",
     }
 }
 
@@ -138,7 +207,11 @@ pub fn scene(case: &Case) -> String {
     let c = (modulus / rho).sqrt();
     let (integrator, dt) = match case.method {
         Method::Implicit => ("average", 2.0 * h / c),
-        Method::Explicit => ("central_difference", 0.5 * h / c),
+        Method::Explicit | Method::ExplicitReduced => ("central_difference", 0.5 * h / c),
+    };
+    let quadrature = match case.method {
+        Method::ExplicitReduced => "reduced",
+        Method::Implicit | Method::Explicit => "full",
     };
     let contact = if case.contact {
         r#"
@@ -169,15 +242,16 @@ hardening_modulus = 1e9
 name = "block"
 material = "steel"
 formulation = "plane_strain"
-velocity = [0.0, -10.0]
+velocity = [0.0, {speed:?}]
 mesh = {{ type = "rectangle", origin = [{x0}, 0.0], width = {width}, height = {height}, nx = {n}, ny = {ny} }}
 {contact}
 [analysis]
 type = "dynamic"
 integrator = "{integrator}"
+quadrature = "{quadrature}"
 dt = {dt:e}
 end_time = {end:e}
-newton = {{ strategy = "modified" }}
+newton = {{ strategy = "{strategy}" }}
 
 [output]
 frame_every = {frames}
@@ -187,6 +261,8 @@ frame_every = {frames}
         height = h * ny as f64,
         end = dt * case.steps as f64,
         frames = case.frame_every,
+        speed = -case.speed,
+        strategy = case.strategy,
     )
 }
 
@@ -204,7 +280,11 @@ pub fn run(
         let scene_path = dir.join(format!("{}.toml", case.name));
         write_atomic(&scene_path, scene(case).as_bytes())?;
         let out = dir.join(&case.name);
-        let status = Command::new(exe)
+        let mut command = Command::new(exe);
+        if let Some(threads) = case.threads {
+            command.env("RAYON_NUM_THREADS", threads.to_string());
+        }
+        let status = command
             .arg("run")
             .arg(&scene_path)
             .arg("--quiet")
@@ -233,6 +313,8 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
         })?;
     let wall = s.wall_seconds.max(1e-12);
     let t = &s.timing;
+    // the steady rate: the steps after the setup
+    let stepping = (s.wall_seconds - t.setup).max(1e-12);
     let share = Shares {
         assembly: t.assembly / wall,
         constitutive: t.constitutive / wall,
@@ -248,7 +330,7 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
             let evaluations = (t.element_updates as f64 / s.elements.max(1) as f64).max(1.0);
             let per_evaluation = t.assembly / evaluations;
             let per_solve = t.solve / s.back_substitutions.max(1) as f64;
-            let iteration = (wall - t.factorization - t.output) / s.newton_iterations as f64;
+            let iteration = (stepping - t.factorization - t.output) / s.newton_iterations as f64;
             iteration / (per_evaluation + per_solve)
         });
     Ok(Row {
@@ -258,6 +340,7 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
         dofs: s.dofs,
         contact: case.contact,
         frame_every: case.frame_every,
+        threads: case.threads,
         status: match code {
             Some(0) => "ok".into(),
             Some(c) => format!("exit {c}"),
@@ -265,8 +348,9 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
         },
         steps: s.steps,
         wall_seconds: s.wall_seconds,
-        steps_per_second: s.steps as f64 / wall,
-        element_updates_per_second: t.element_updates as f64 / wall,
+        setup_seconds: t.setup,
+        steps_per_second: s.steps as f64 / stepping,
+        element_updates_per_second: t.element_updates as f64 / stepping,
         newton_iterations: s.newton_iterations,
         factorizations: s.factorizations,
         back_substitutions: s.back_substitutions,
@@ -279,12 +363,13 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
 /// The table printed by `impact bench`.
 pub fn table(rows: &[Row]) -> String {
     let mut s = format!(
-        "{:<22} {:>8} {:>8} {:>9} {:>10} {:>6} {:>5} {:>8} {:>9} | {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}\n",
+        "{:<29} {:>8} {:>8} {:>9} {:>8} {:>7} {:>6} {:>5} {:>8} {:>9} | {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}\n",
         "case",
         "DOFs",
         "steps/s",
         "elem/s",
         "wall s",
+        "setup s",
         "iter",
         "fact",
         "backsub",
@@ -299,12 +384,13 @@ pub fn table(rows: &[Row]) -> String {
     for r in rows {
         let p = |x: f64| format!("{:>4.0}%", 100.0 * x);
         s.push_str(&format!(
-            "{:<22} {:>8} {:>8.1} {:>9.2e} {:>10.3} {:>6} {:>5} {:>8} {:>9} | {} {} {} {} {} {}{}\n",
+            "{:<29} {:>8} {:>8.1} {:>9.2e} {:>8.2} {:>7.2} {:>6} {:>5} {:>8} {:>9} | {} {} {} {} {} {}{}\n",
             r.name,
             r.dofs,
             r.steps_per_second,
             r.element_updates_per_second,
             r.wall_seconds,
+            r.setup_seconds,
             r.newton_iterations,
             r.factorizations,
             r.back_substitutions,
@@ -331,7 +417,7 @@ pub fn table(rows: &[Row]) -> String {
 fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
     let sized: Vec<&Row> = rows
         .iter()
-        .filter(|r| r.contact && r.frame_every == 0 && r.status == "ok")
+        .filter(|r| r.contact && r.frame_every == 0 && r.threads.is_none() && r.status == "ok")
         .collect();
     let series_of = |method: Method, f: &dyn Fn(&Row) -> f64, label: &str| Series {
         label: format!("{label} ({})", name(method)),
@@ -344,7 +430,7 @@ fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
         style: SeriesStyle::LineAndMarkers,
     };
     let mut throughput = Vec::new();
-    for method in [Method::Implicit, Method::Explicit] {
+    for method in [Method::Implicit, Method::Explicit, Method::ExplicitReduced] {
         throughput.push(series_of(
             method,
             &|r| r.element_updates_per_second,
@@ -367,7 +453,7 @@ fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
         )?;
     }
     let mut shares = Vec::new();
-    for method in [Method::Implicit, Method::Explicit] {
+    for method in [Method::Implicit, Method::Explicit, Method::ExplicitReduced] {
         for (label, f) in [
             ("assembly", (|r: &Row| r.share.assembly) as fn(&Row) -> f64),
             ("constitutive", |r: &Row| r.share.constitutive),

@@ -27,9 +27,12 @@ pub enum Phase {
     Contact,
     /// history.csv rows, VTK frames, checkpoints.
     Output,
+    /// From the start of the analysis to its first step: model arrays, the symbolic
+    /// analysis, the mass, the stability limit, the first frame.
+    Setup,
 }
 
-const PHASES: usize = 6;
+const PHASES: usize = 7;
 
 static NANOS: [AtomicU64; PHASES] = [const { AtomicU64::new(0) }; PHASES];
 static ELEMENT_UPDATES: AtomicU64 = AtomicU64::new(0);
@@ -80,6 +83,10 @@ pub struct Timing {
     pub solve: f64,
     pub contact: f64,
     pub output: f64,
+    /// Before the first step (included in the run's wall_seconds, not in the phases above
+    /// except output).
+    #[serde(default)]
+    pub setup: f64,
     pub element_updates: u64,
     /// Peak resident memory of the process (bytes, Linux VmHWM), null where unknown.
     pub peak_memory_bytes: Option<u64>,
@@ -95,6 +102,7 @@ pub fn snapshot() -> Timing {
         solve: s(Phase::Solve),
         contact: s(Phase::Contact),
         output: s(Phase::Output),
+        setup: s(Phase::Setup),
         element_updates: ELEMENT_UPDATES.load(Ordering::Relaxed),
         peak_memory_bytes: peak_memory(),
     }

@@ -117,6 +117,7 @@ pub fn run(
     resume: Option<Checkpoint>,
 ) -> Result<Outcome, RunError> {
     let mut start = Instant::now();
+    let setup_start = start;
     let initial = model.coordinates();
     let mut system = System::new(model, &loads::constrained_dofs(model));
     let mass =
@@ -261,6 +262,7 @@ pub fn run(
     if summary.steps == 0 && model.checkpoint_every > 0 {
         save!();
     }
+    crate::profile::add(crate::profile::Phase::Setup, setup_start);
     while state.time < spec.end_time * (1.0 - 1e-12) {
         // steps end at the listed frame times
         let next_frame = model

@@ -43,6 +43,7 @@ pub fn run(
     resume: Option<Checkpoint>,
 ) -> Result<Outcome, RunError> {
     let mut start = Instant::now();
+    let setup_start = start;
     let (dt_crit, b, e) = critical_time_step(model)?;
     if spec.dt > dt_crit && !spec.allow_unstable {
         return Err(InputError::new(
@@ -220,6 +221,7 @@ pub fn run(
     let inverse_mass: Vec<f64> = (0..model.dofs())
         .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
         .collect();
+    crate::profile::add(crate::profile::Phase::Setup, setup_start);
     for step in first_step..=steps {
         let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
         let h = super::step_length(time - state.time, spec.dt);
@@ -240,12 +242,14 @@ pub fn run(
             energies.contact_work -= force.iter().zip(&du).map(|(f, u)| f * u).sum::<f64>();
         }
         let evaluation = match reduced.as_mut() {
-            Some(kernel) => kernel
-                .step(&state.reference, &du, &mut internal)
-                .map(|work| {
-                    commit_reduced(&mut state, &du, work);
-                    recorder.hourglass_energy = kernel.hourglass_energy;
-                }),
+            Some(kernel) => crate::profile::time(crate::profile::Phase::Assembly, || {
+                crate::profile::count_elements(kernel.elements());
+                kernel.step(&state.reference, &du, &mut internal)
+            })
+            .map(|work| {
+                commit_reduced(&mut state, &du, work);
+                recorder.hourglass_energy = kernel.hourglass_energy;
+            }),
             None => {
                 assembly::evaluate(model, &state, &du, spec.geometry, None, spec.newton.tangent)
                     .map(|evaluation| {

@@ -193,8 +193,8 @@ fn add_constraint_forces(rows: &Rows, forces: &[f64], target: &mut [f64]) {
     }
 }
 
-/// The Schur complement solve on the factored K*: delta_0 = K*^-1 R, Z = K*^-1 C^T,
-/// (C Z) tau = -g - C delta_0, delta = delta_0 + Z tau. Contact never refactors K*.
+/// The Schur complement solve on the factored K*: delta_0 = K*^-1 R, S = C K*^-1 C^T,
+/// S tau = -g - C delta_0, delta = delta_0 + K*^-1 C^T tau. Contact never refactors K*.
 fn constrained_solve(
     solver: &mut Solver,
     rows: &Rows,
@@ -206,44 +206,54 @@ fn constrained_solve(
     if m == 0 {
         return Ok((delta, Vec::new()));
     }
-    let n = delta.len();
-    // Z = K*^-1 C^T from the unit columns K*^-1 e_i of the rows' equations, kept with the
-    // factorization (a row has 1 to 6 entries), so an iteration costs one back-substitution
-    // however many constraints are active; above the cache's budget, one per row
-    let mut equations: Vec<usize> = rows.rows.iter().flatten().map(|(eq, _)| *eq).collect();
-    equations.sort_unstable();
-    equations.dedup();
-    let cached = solver.unit_columns_fit(equations.len(), n);
-    let mut z = Vec::with_capacity(m);
-    for row in &rows.rows {
-        let mut column = vec![0.0; n];
-        if cached {
-            for (eq, c) in row {
-                let unit = solver.unit_column(*eq, n);
-                column.iter_mut().zip(unit).for_each(|(z, u)| *z += c * u);
-            }
-        } else {
-            for (eq, c) in row {
-                column[*eq] += c;
-            }
-            solver.solve(&mut column);
-        }
-        z.push(column);
-    }
+    // the Schur complement from K*^-1 restricted to the rows' equations (solved once per
+    // factorization), the correction delta += K*^-1 C^T tau by one more back-substitution:
+    // an iteration costs two back-substitutions however many constraints are active
+    // (entries with a zero coefficient, as the x entry of a row on a horizontal wall, are left
+    // out: they would cost a back-substitution each for nothing)
+    let equations: Vec<usize> = rows
+        .rows
+        .iter()
+        .flatten()
+        .filter(|(_, c)| *c != 0.0)
+        .map(|(eq, _)| *eq)
+        .collect();
+    solver.know_inverse(&equations);
     let schur_start = std::time::Instant::now();
+    let local: Vec<Vec<(usize, f64)>> = rows
+        .rows
+        .iter()
+        .map(|row| {
+            row.iter()
+                .filter(|(_, c)| *c != 0.0)
+                .map(|(eq, c)| (solver.inverse_local(*eq), *c))
+                .collect()
+        })
+        .collect();
+    let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| {
+        let mut s = 0.0;
+        for (a, ca) in &local[i] {
+            for (b, cb) in &local[j] {
+                s += ca * cb * solver.inverse_entry(*a, *b);
+            }
+        }
+        s
+    });
     let dot =
         |row: &Vec<(usize, f64)>, v: &[f64]| row.iter().map(|(eq, c)| c * v[*eq]).sum::<f64>();
-    let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&rows.rows[i], &z[j]));
     let rhs = nalgebra::DVector::from_fn(m, |i, _| -rows.gaps[i] - dot(&rows.rows[i], &delta));
     let tau = schur.lu().solve(&rhs).ok_or_else(|| {
         StepFailure("the contact constraints are redundant (singular Schur complement)".into())
     })?;
-    for (j, column) in z.iter().enumerate() {
-        for (d, zj) in delta.iter_mut().zip(column) {
-            *d += tau[j] * zj;
+    let mut correction = vec![0.0; delta.len()];
+    for (row, t) in rows.rows.iter().zip(tau.iter()) {
+        for (eq, c) in row {
+            correction[*eq] += c * t;
         }
     }
     profile::add(Phase::Contact, schur_start);
+    solver.solve(&mut correction);
+    delta.iter_mut().zip(&correction).for_each(|(d, c)| *d += c);
     Ok((delta, tau.iter().copied().collect()))
 }
 

@@ -225,6 +225,9 @@ impl Drop for Timer {
     }
 }
 
+/// Elements per chunk of `evaluate` (about 5 MB of results in flight).
+const CHUNK: usize = 8192;
+
 struct ElementResult {
     force: Vec8,
     matrix: Option<[f64; 64]>,
@@ -256,46 +259,53 @@ pub fn evaluate(
     let mut work = 0.0;
     let mut plastic_work = 0.0;
     for (b, body) in model.bodies.iter().enumerate() {
-        let results: Vec<ElementResult> = (0..body.elements())
-            .into_par_iter()
-            .map(|e| {
-                element(
-                    body,
-                    &state.bodies[b],
-                    &state.reference,
-                    d,
-                    e,
-                    geometry,
-                    want_tangent.then_some(tangent),
-                )
-            })
-            .collect::<Result<_, _>>()
-            .map_err(|(element, error)| ElementFailure {
-                body: body.name.clone(),
-                element,
-                error,
-            })?;
         let ppe = body.points_per_element();
-        let mut body_trial = Vec::with_capacity(results.len() * ppe);
-        let mut body_zz = Vec::with_capacity(results.len() * ppe);
-        for (e, r) in results.iter().enumerate() {
-            let dofs = element_dofs(body, e);
-            for (a, g) in dofs.iter().enumerate() {
-                force[*g] += r.force[a];
-            }
-            if let (Some(s), Some(m)) = (system.as_deref_mut(), &r.matrix) {
-                let n = dofs.len();
-                let positions = &s.scatter[b][e * n * n..(e + 1) * n * n];
-                for (k, p) in positions.iter().enumerate() {
-                    if *p != usize::MAX {
-                        s.values[*p] += m[k];
+        let mut body_trial = Vec::with_capacity(body.elements() * ppe);
+        let mut body_zz = Vec::with_capacity(body.elements() * ppe);
+        // elements in chunks, each evaluated in parallel and then scattered: the results in
+        // flight stay a few MB however large the mesh (a whole mesh's 8 x 8 matrices at once
+        // was 0.7 kB per element of transient memory)
+        let mut results = Vec::with_capacity(CHUNK.min(body.elements()));
+        for first in (0..body.elements()).step_by(CHUNK) {
+            let last = (first + CHUNK).min(body.elements());
+            (first..last)
+                .into_par_iter()
+                .map(|e| {
+                    element(
+                        body,
+                        &state.bodies[b],
+                        &state.reference,
+                        d,
+                        e,
+                        geometry,
+                        want_tangent.then_some(tangent),
+                    )
+                })
+                .collect_into_vec(&mut results);
+            for (r, e) in results.iter().zip(first..last) {
+                let r = r.as_ref().map_err(|(element, error)| ElementFailure {
+                    body: body.name.clone(),
+                    element: *element,
+                    error: error.clone(),
+                })?;
+                let dofs = element_dofs(body, e);
+                for (a, g) in dofs.iter().enumerate() {
+                    force[*g] += r.force[a];
+                }
+                if let (Some(s), Some(m)) = (system.as_deref_mut(), &r.matrix) {
+                    let n = dofs.len();
+                    let positions = &s.scatter[b][e * n * n..(e + 1) * n * n];
+                    for (k, p) in positions.iter().enumerate() {
+                        if *p != usize::MAX {
+                            s.values[*p] += m[k];
+                        }
                     }
                 }
+                body_trial.extend_from_slice(&r.trial[..ppe]);
+                body_zz.extend_from_slice(&r.strain_zz[..ppe]);
+                work += r.work;
+                plastic_work += r.plastic_work;
             }
-            body_trial.extend_from_slice(&r.trial[..ppe]);
-            body_zz.extend_from_slice(&r.strain_zz[..ppe]);
-            work += r.work;
-            plastic_work += r.plastic_work;
         }
         trial.push(body_trial);
         strain_zz.push(body_zz);

@@ -116,12 +116,25 @@ pub struct Solver {
     factor: Option<Llt<usize, f64>>,
     pub factorizations: usize,
     pub solves: usize,
-    /// K^-1 e_i of the current factorization, by equation i (contact rows reuse them).
-    unit: std::collections::HashMap<usize, Vec<f64>>,
+    /// Entries of K^-1 among the equations the contact rows have named, for the current
+    /// factorization.
+    inverse: InverseEntries,
 }
 
-/// The most entries the unit columns may hold (256 MB of f64).
-const UNIT_CACHE_ENTRIES: usize = 32 << 20;
+/// K^-1 restricted to a growing set of equations (those contact rows name): the Schur
+/// complement C K^-1 C^T needs no more. An equation's column K^-1 e_i is solved once per
+/// factorization (in blocks of right-hand sides) and only its entries at the equations known
+/// by then are kept; by symmetry they hold every pair.
+#[derive(Default)]
+struct InverseEntries {
+    local: std::collections::HashMap<usize, usize>,
+    equations: Vec<usize>,
+    /// `lower[k][j]` = (K^-1 e_{equations[k]})[equations[j]] for j <= k.
+    lower: Vec<Vec<f64>>,
+}
+
+/// Right-hand sides per block solve of unit columns.
+const UNIT_BLOCK: usize = 32;
 
 impl Solver {
     pub fn new(pattern: &Pattern) -> Result<Solver, SolverError> {
@@ -146,7 +159,7 @@ impl Solver {
             factor: None,
             factorizations: 0,
             solves: 0,
-            unit: std::collections::HashMap::new(),
+            inverse: InverseEntries::default(),
         })
     }
 
@@ -160,7 +173,7 @@ impl Solver {
 
     fn factor_values(&mut self, values: &[f64]) -> Result<(), SolverError> {
         self.factor = None;
-        self.unit.clear();
+        self.inverse = InverseEntries::default();
         self.factorizations += 1;
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
@@ -182,21 +195,66 @@ impl Solver {
         self.factor.is_some() || (self.symbolic.is_none() && self.factorizations > 0)
     }
 
-    /// Whether `count` more unit columns of size `n` fit the cache.
-    pub fn unit_columns_fit(&self, count: usize, n: usize) -> bool {
-        (self.unit.len() + count) * n <= UNIT_CACHE_ENTRIES
+    /// Makes the entries of K^-1 among `equations` (and those named before) available to
+    /// `inverse_local` / `inverse_entry`: one back-substitution per equation not seen since
+    /// the last factorization, solved as blocks of right-hand sides.
+    pub fn know_inverse(&mut self, equations: &[usize]) {
+        let mut new: Vec<usize> = equations
+            .iter()
+            .copied()
+            .filter(|eq| !self.inverse.local.contains_key(eq))
+            .collect();
+        new.sort_unstable();
+        new.dedup();
+        if new.is_empty() {
+            return;
+        }
+        let n = self.matrix.nrows();
+        for block in new.chunks(UNIT_BLOCK) {
+            let first = self.inverse.equations.len();
+            for (j, &eq) in block.iter().enumerate() {
+                self.inverse.local.insert(eq, first + j);
+                self.inverse.equations.push(eq);
+            }
+            let mut columns = vec![0.0; n * block.len()];
+            for (j, &eq) in block.iter().enumerate() {
+                columns[j * n + eq] = 1.0;
+            }
+            self.solve_block(&mut columns, block.len());
+            for j in 0..block.len() {
+                let column = &columns[j * n..(j + 1) * n];
+                let known = &self.inverse.equations[..=first + j];
+                self.inverse
+                    .lower
+                    .push(known.iter().map(|&eq| column[eq]).collect());
+            }
+        }
     }
 
-    /// K^-1 e_eq for the current factorization, solved once and kept until the next
-    /// factorization (`n` the system size).
-    pub fn unit_column(&mut self, eq: usize, n: usize) -> &[f64] {
-        if !self.unit.contains_key(&eq) {
-            let mut column = vec![0.0; n];
-            column[eq] = 1.0;
-            self.solve(&mut column);
-            self.unit.insert(eq, column);
+    /// The local index of an equation made known by `know_inverse`.
+    pub fn inverse_local(&self, equation: usize) -> usize {
+        self.inverse.local[&equation]
+    }
+
+    /// (K^-1)_{ab} for local indices a, b from `inverse_local`.
+    pub fn inverse_entry(&self, a: usize, b: usize) -> f64 {
+        if a <= b {
+            self.inverse.lower[b][a]
+        } else {
+            self.inverse.lower[a][b]
         }
-        &self.unit[&eq]
+    }
+
+    /// Solves in place for `count` right-hand sides stored column after column.
+    fn solve_block(&mut self, columns: &mut [f64], count: usize) {
+        self.solves += count;
+        let Some(factor) = &self.factor else {
+            return;
+        };
+        let n = columns.len() / count.max(1);
+        let start = std::time::Instant::now();
+        factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(columns, n, count));
+        crate::profile::add(crate::profile::Phase::Solve, start);
     }
 
     /// Solves in place with the current factorization.
