@@ -255,6 +255,7 @@ newton = {{ strategy = "{strategy}" }}
 
 [output]
 frame_every = {frames}
+compression = "{compression}"
 "#,
         name = case.name,
         x0 = -width / 2.0,
@@ -262,6 +263,8 @@ frame_every = {frames}
         end = dt * case.steps as f64,
         frames = case.frame_every,
         speed = -case.speed,
+        // LZ4 halves the time of a large frame (CRATES.md: 0.054 s against 0.115 s plain)
+        compression = if case.frame_every > 0 { "lz4" } else { "none" },
         strategy = case.strategy,
     )
 }

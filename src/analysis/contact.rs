@@ -582,22 +582,7 @@ impl ContactState {
                 .zip(&gaps)
                 .map(|((p, k), g)| g.row(model.contacts[*p].slaves[*k]))
                 .collect();
-            let m = rows.len();
-            let w = |i: usize, j: usize| -> f64 {
-                rows[i]
-                    .iter()
-                    .map(|(a, ca)| {
-                        rows[j]
-                            .iter()
-                            .filter(|(b, _)| b == a)
-                            .map(|(_, cb)| ca * cb * inverse_mass[*a])
-                            .sum::<f64>()
-                    })
-                    .sum()
-            };
-            let matrix = nalgebra::DMatrix::from_fn(m, m, w);
-            let rhs = nalgebra::DVector::from_fn(m, |i, _| -gaps[i].gap);
-            let Some(mu) = matrix.lu().solve(&rhs) else {
+            let Some(mu) = lumped_multipliers(&rows, &gaps, inverse_mass) else {
                 break;
             };
             for (i, row) in rows.iter().enumerate() {
@@ -764,6 +749,70 @@ fn extent(model: &Model, active: &[(usize, usize)], coords: &[[f64; 2]]) -> f64 
     best
 }
 
+/// The multipliers mu of (C M^-1 C^T) mu = -g for the rows C of the explicit contact step
+/// (lumped M). C M^-1 C^T couples two rows only through a shared DOF, so it is solved per
+/// group of rows linked by shared DOFs (one row each on a rigid wall; a run of slaves on a
+/// shared master segment otherwise): dense LU of the groups instead of the whole m x m
+/// matrix. None when a group is singular (redundant rows).
+fn lumped_multipliers(
+    rows: &[Vec<(usize, f64)>],
+    gaps: &[Gap],
+    inverse_mass: &[f64],
+) -> Option<Vec<f64>> {
+    let m = rows.len();
+    // union-find of the rows over their DOFs
+    let mut parent: Vec<usize> = (0..m).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut owner: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for (i, row) in rows.iter().enumerate() {
+        for (dof, c) in row {
+            if *c == 0.0 {
+                continue;
+            }
+            if let Some(&j) = owner.get(dof) {
+                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                parent[a] = b;
+            } else {
+                owner.insert(*dof, i);
+            }
+        }
+    }
+    let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for i in 0..m {
+        let r = root(&mut parent, i);
+        groups.entry(r).or_default().push(i);
+    }
+    let mut mu = vec![0.0; m];
+    for members in groups.values() {
+        let w = |i: usize, j: usize| -> f64 {
+            rows[i]
+                .iter()
+                .map(|(a, ca)| {
+                    rows[j]
+                        .iter()
+                        .filter(|(b, _)| b == a)
+                        .map(|(_, cb)| ca * cb * inverse_mass[*a])
+                        .sum::<f64>()
+                })
+                .sum()
+        };
+        let k = members.len();
+        let matrix = nalgebra::DMatrix::from_fn(k, k, |a, b| w(members[a], members[b]));
+        let rhs = nalgebra::DVector::from_fn(k, |a, _| -gaps[members[a]].gap);
+        let solution = matrix.lu().solve(&rhs)?;
+        for (a, &i) in members.iter().enumerate() {
+            mu[i] = solution[a];
+        }
+    }
+    Some(mu)
+}
+
 /// The impedance rho c A of node `node` of body `body` (A: its tributary contact area).
 fn impedance(model: &Model, body: usize, node: usize, coords: &[[f64; 2]]) -> f64 {
     let b = &model.bodies[body];
@@ -778,11 +827,8 @@ fn impedance(model: &Model, body: usize, node: usize, coords: &[[f64; 2]]) -> f6
             ..
         } => {
             let local = node - b.node_offset;
-            let half_edges: f64 = b
-                .mesh
-                .boundary_edges()
+            let half_edges: f64 = b.boundary_at_node[local]
                 .iter()
-                .filter(|e| e.contains(&local))
                 .map(|[p, q]| {
                     let (a, c) = (coords[b.global(*p)], coords[b.global(*q)]);
                     0.5 * ((a[0] - c[0]).powi(2) + (a[1] - c[1]).powi(2)).sqrt()

@@ -233,7 +233,9 @@ pub fn run(
         let mut v_half = v_half;
         if !model.contacts.is_empty() {
             let positions = state.positions(spec.geometry);
-            let correction = contact.explicit_step(model, &positions, &du, &inverse_mass, h, time);
+            let correction = crate::profile::time(crate::profile::Phase::Contact, || {
+                contact.explicit_step(model, &positions, &du, &inverse_mass, h, time)
+            });
             for i in 0..model.dofs() {
                 du[i] += correction[i];
                 v_half[i] += correction[i] / h;

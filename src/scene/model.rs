@@ -39,6 +39,9 @@ pub struct Body {
     pub node_offset: usize,
     pub initial_stress: Voigt,
     pub velocity: [f64; 2],
+    /// The boundary edges of the mesh touching each node (local numbers; empty for rods):
+    /// the contact impedance's tributary length, found once.
+    pub boundary_at_node: Vec<Vec<[usize; 2]>>,
 }
 
 impl Body {
@@ -733,8 +736,15 @@ fn body(
     };
     check_cells(cx, &key, &mesh, &kind)?;
     let initial_stress = Voigt::from(spec.initial_stress.unwrap_or([0.0; 4]));
+    let mut boundary_at_node = vec![Vec::new(); mesh.nodes.len()];
+    for edge in mesh.boundary_edges() {
+        for node in edge {
+            boundary_at_node[node].push(edge);
+        }
+    }
     Ok(Body {
         name: spec.name.clone(),
+        boundary_at_node,
         mesh,
         kind,
         material,

@@ -1,0 +1,62 @@
+//! `impact bench --quick` (issue #9): every case runs, and the solver counters obey the rules
+//! of DESIGN section 4 (contact through the Schur complement on a K* factored once). No
+//! timing is asserted: speed is measured by `impact bench` itself (docs/performance.md).
+
+use impact::bench::Row;
+use std::process::Command;
+
+/// Goal: the quick bench runs end to end and its counters show the factor-once contact.
+/// Setup: `impact bench --quick` (2 sizes, implicit / explicit / fast explicit, free flight,
+/// frames, the elastic contact pair with K* factored once), about a second of runs.
+/// Reference: the design rule, counted independently of the run: with `strategy = "initial"`
+/// and a constant dt, one factorization for the whole run however the contact status
+/// changes; the Schur complement costs one back-substitution per constrained equation once
+/// per factorization (the 61 bottom nodes of the 60 x 30 block, y only on the horizontal
+/// wall) plus two per iteration (delta_0 and K*^-1 C^T tau); without contact, one per iteration.
+/// Tolerance: exact counts.
+#[test]
+fn quick_bench_runs_and_contact_never_refactors() {
+    let dir = std::env::temp_dir().join(format!("impact_bench_test_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["bench", "--quick", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows: Vec<Row> =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    assert_eq!(rows.len(), impact::bench::plan(true).len());
+    for r in &rows {
+        assert_eq!(r.status, "ok", "{}", r.name);
+        assert!(r.element_updates_per_second > 0.0, "{}", r.name);
+        let shares = [
+            r.share.assembly,
+            r.share.factorization,
+            r.share.solve,
+            r.share.contact,
+            r.share.output,
+        ];
+        // phases are disjoint parts of the wall time (the constitutive update is inside
+        // assembly)
+        assert!(
+            shares.iter().sum::<f64>() <= 1.0 + 1e-9,
+            "{}: {shares:?}",
+            r.name
+        );
+    }
+    let row = |name: &str| rows.iter().find(|r| r.name == name).unwrap();
+    let contact = row("implicit_60_elastic");
+    let free = row("implicit_60_elastic_free");
+    assert_eq!(contact.factorizations, 1);
+    assert_eq!(free.factorizations, 1);
+    assert_eq!(
+        contact.back_substitutions,
+        61 + 2 * contact.newton_iterations
+    );
+    assert_eq!(free.back_substitutions, free.newton_iterations);
+    for chart in ["bench_throughput.svg", "bench_time_breakdown.svg"] {
+        assert!(dir.join(chart).is_file(), "{chart}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
