@@ -98,7 +98,6 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
-    /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
     /// Generated scenes of growing size (a J2 block striking a rigid wall), implicit and
     /// explicit, one child process each: a table of DOFs, steps/s, element updates/s,
     /// factorizations, back-substitutions, peak memory and the time per phase; bench.json and
@@ -111,6 +110,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
     Plot {
         history: PathBuf,
         /// A column to plot (repeat for more; one series each).

@@ -17,13 +17,17 @@ pub enum Phase {
     /// Element loops and the scatter into the force vector and stiffness (includes the
     /// constitutive update).
     Assembly,
-    /// The constitutive update inside the element loops (fine timing only).
+    /// The constitutive update inside the element loops (fine timing only): CPU seconds
+    /// summed over the threads, so on several threads it can exceed the assembly's wall time.
     Constitutive,
     /// Numeric factorizations.
     Factorization,
-    /// Back-substitutions with the factor.
+    /// Back-substitutions with the factor (including the unit columns of the contact Schur
+    /// complement).
     Solve,
-    /// Contact search, constraint rows, the Schur complement, the active set.
+    /// Contact: the penetration search, the constraint rows, forming and solving the Schur
+    /// complement, the explicit multipliers (the impact and release conditions and the
+    /// active-set bookkeeping are not timed: they are per slave node, not per DOF).
     Contact,
     /// history.csv rows, VTK frames, checkpoints.
     Output,
@@ -60,6 +64,21 @@ pub fn add(phase: Phase, start: Instant) {
     NANOS[phase as usize].fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
 }
 
+/// Adds the time from its creation to its drop to a phase (for functions with early returns).
+pub struct Timer(Phase, Instant);
+
+impl Timer {
+    pub fn new(phase: Phase) -> Timer {
+        Timer(phase, Instant::now())
+    }
+}
+
+impl Drop for Timer {
+    fn drop(&mut self) {
+        add(self.0, self.1);
+    }
+}
+
 /// Runs `f`, adding its time to `phase`.
 pub fn time<T>(phase: Phase, f: impl FnOnce() -> T) -> T {
     let start = Instant::now();
@@ -77,14 +96,15 @@ pub fn count_elements(n: usize) {
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 pub struct Timing {
     pub assembly: f64,
-    /// Zero unless fine timing was on.
+    /// Zero unless fine timing was on; CPU seconds summed over threads.
     pub constitutive: f64,
     pub factorization: f64,
     pub solve: f64,
     pub contact: f64,
     pub output: f64,
-    /// Before the first step (included in the run's wall_seconds, not in the phases above
-    /// except output).
+    /// Before the first step (included in the run's wall_seconds). It overlaps the phases
+    /// above: the first frame (output), the initial acceleration's evaluation (assembly,
+    /// counted in element_updates) and, with loads, its factorization and solve.
     #[serde(default)]
     pub setup: f64,
     pub element_updates: u64,

@@ -582,9 +582,7 @@ impl ContactState {
                 .zip(&gaps)
                 .map(|((p, k), g)| g.row(model.contacts[*p].slaves[*k]))
                 .collect();
-            let Some(mu) = lumped_multipliers(&rows, &gaps, inverse_mass) else {
-                break;
-            };
+            let mu = lumped_multipliers(&rows, &gaps, inverse_mass);
             for (i, row) in rows.iter().enumerate() {
                 for (dof, c) in row {
                     delta[*dof] += inverse_mass[*dof] * c * mu[i];
@@ -752,13 +750,12 @@ fn extent(model: &Model, active: &[(usize, usize)], coords: &[[f64; 2]]) -> f64 
 /// The multipliers mu of (C M^-1 C^T) mu = -g for the rows C of the explicit contact step
 /// (lumped M). C M^-1 C^T couples two rows only through a shared DOF, so it is solved per
 /// group of rows linked by shared DOFs (one row each on a rigid wall; a run of slaves on a
-/// shared master segment otherwise): dense LU of the groups instead of the whole m x m
-/// matrix. None when a group is singular (redundant rows).
-fn lumped_multipliers(
-    rows: &[Vec<(usize, f64)>],
-    gaps: &[Gap],
-    inverse_mass: &[f64],
-) -> Option<Vec<f64>> {
+/// shared master segment otherwise; on a deformable master a continuous contact zone is one
+/// group, so the gain is on rigid obstacles): dense LU of the groups instead of the whole
+/// m x m matrix. A singular group (redundant rows, or rows on prescribed DOFs only, which no
+/// multiplier can move) gets mu = 0 and is left to the penetration check; the others are
+/// solved.
+fn lumped_multipliers(rows: &[Vec<(usize, f64)>], gaps: &[Gap], inverse_mass: &[f64]) -> Vec<f64> {
     let m = rows.len();
     // union-find of the rows over their DOFs
     let mut parent: Vec<usize> = (0..m).collect();
@@ -805,12 +802,14 @@ fn lumped_multipliers(
         let k = members.len();
         let matrix = nalgebra::DMatrix::from_fn(k, k, |a, b| w(members[a], members[b]));
         let rhs = nalgebra::DVector::from_fn(k, |a, _| -gaps[members[a]].gap);
-        let solution = matrix.lu().solve(&rhs)?;
+        let Some(solution) = matrix.lu().solve(&rhs) else {
+            continue;
+        };
         for (a, &i) in members.iter().enumerate() {
             mu[i] = solution[a];
         }
     }
-    Some(mu)
+    mu
 }
 
 /// The impedance rho c A of node `node` of body `body` (A: its tributary contact area).

@@ -372,6 +372,7 @@ struct Bookkeeping<'a> {
 
 impl Bookkeeping<'_> {
     fn save(&self, carry: checkpoint::Carry) -> Result<(), RunError> {
+        let _timer = crate::profile::Timer::new(crate::profile::Phase::Output);
         let checkpoint = checkpoint::Checkpoint {
             // absolute when the file exists, so `impact resume` works from any folder (mesh
             // files are found next to the scene)

@@ -230,6 +230,12 @@ fn constrained_solve(
                 .collect()
         })
         .collect();
+    if local.iter().any(|row| row.is_empty()) {
+        return Err(StepFailure(
+            "a contact constraint acts on prescribed DOFs only (a supported slave node against its obstacle): it cannot be enforced"
+                .into(),
+        ));
+    }
     let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| {
         let mut s = 0.0;
         for (a, ca) in &local[i] {

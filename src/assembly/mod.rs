@@ -286,7 +286,7 @@ pub fn evaluate(
                 let r = r.as_ref().map_err(|(element, error)| ElementFailure {
                     body: body.name.clone(),
                     element: *element,
-                    error: error.clone(),
+                    error: *error,
                 })?;
                 let dofs = element_dofs(body, e);
                 for (a, g) in dofs.iter().enumerate() {

@@ -133,8 +133,10 @@ struct InverseEntries {
     lower: Vec<Vec<f64>>,
 }
 
-/// Right-hand sides per block solve of unit columns.
+/// Right-hand sides per block solve of unit columns, and the most entries such a block may
+/// hold (32 MB of f64: at 1e6 equations a block is 4 columns).
 const UNIT_BLOCK: usize = 32;
+const UNIT_BLOCK_ENTRIES: usize = 4 << 20;
 
 impl Solver {
     pub fn new(pattern: &Pattern) -> Result<Solver, SolverError> {
@@ -210,17 +212,21 @@ impl Solver {
             return;
         }
         let n = self.matrix.nrows();
-        for block in new.chunks(UNIT_BLOCK) {
+        // blocks of at most UNIT_BLOCK columns and UNIT_BLOCK_ENTRIES entries, in one buffer
+        let width = UNIT_BLOCK.min(UNIT_BLOCK_ENTRIES / n.max(1)).max(1);
+        let mut buffer = vec![0.0; n * width.min(new.len())];
+        for block in new.chunks(width) {
             let first = self.inverse.equations.len();
             for (j, &eq) in block.iter().enumerate() {
                 self.inverse.local.insert(eq, first + j);
                 self.inverse.equations.push(eq);
             }
-            let mut columns = vec![0.0; n * block.len()];
+            let columns = &mut buffer[..n * block.len()];
+            columns.fill(0.0);
             for (j, &eq) in block.iter().enumerate() {
                 columns[j * n + eq] = 1.0;
             }
-            self.solve_block(&mut columns, block.len());
+            self.solve_block(columns, block.len());
             for j in 0..block.len() {
                 let column = &columns[j * n..(j + 1) * n];
                 let known = &self.inverse.equations[..=first + j];
@@ -248,9 +254,13 @@ impl Solver {
     /// Solves in place for `count` right-hand sides stored column after column.
     fn solve_block(&mut self, columns: &mut [f64], count: usize) {
         self.solves += count;
-        let Some(factor) = &self.factor else {
+        if self.symbolic.is_none() {
             return;
-        };
+        }
+        let factor = self
+            .factor
+            .as_ref()
+            .expect("solve after a successful factor");
         let n = columns.len() / count.max(1);
         let start = std::time::Instant::now();
         factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(columns, n, count));
