@@ -135,7 +135,10 @@ fn two_bars_on_the_seeds_mesh_keep_energy_within_two_percent() {
     let lost = (kinetic[0] - kinetic.last().unwrap() - internal.last().unwrap()) / kinetic[0];
     assert!((0.0..0.02).contains(&lost), "energy lost {lost}");
     let release = r.summary.contact.last_release_time.expect("release");
-    assert!((release - 0.2).abs() <= 0.005 + 1e-12, "release at {release}");
+    assert!(
+        (release - 0.2).abs() <= 0.005 + 1e-12,
+        "release at {release}"
+    );
 }
 
 /// Goal: the impact and release conditions matter (Hughes Figs I-16..I-18): without them the

@@ -59,7 +59,10 @@ impl Recorder {
             source,
         })?;
         let series = if model.output.frame_every > 0 || !model.output.frame_times.is_empty() {
-            Some(Series::create(dir, &model.name, model.output.compression)?)
+            let mut series = Series::create(dir, &model.name, model.output.compression)?;
+            // frames are encoded and written off the stepping thread
+            series.set_background(true);
+            Some(series)
         } else {
             None
         };
@@ -82,6 +85,10 @@ impl Recorder {
 
     /// Where the output stands, for a checkpoint.
     pub fn position(&self) -> Result<RecorderPosition, OutputError> {
+        // the frames the checkpoint lists are on disk before it is written
+        if let Some(series) = &self.series {
+            series.flush()?;
+        }
         Ok(RecorderPosition {
             series: self.series.as_ref().map(Series::position),
             history_bytes: self.history.byte_len()?,
@@ -99,12 +106,11 @@ impl Recorder {
         position: RecorderPosition,
     ) -> Result<Recorder, OutputError> {
         let series = match position.series {
-            Some(p) if model.output.frame_every > 0 => Some(Series::resume(
-                dir,
-                &model.name,
-                model.output.compression,
-                p,
-            )?),
+            Some(p) => {
+                let mut series = Series::resume(dir, &model.name, model.output.compression, p)?;
+                series.set_background(true);
+                Some(series)
+            }
             _ => None,
         };
         let (columns, pivots_column) = columns(model);
@@ -266,6 +272,10 @@ impl Recorder {
     }
 
     pub fn write_summary(&self, summary: &Summary) -> Result<(), OutputError> {
+        // every frame on disk and listed before the summary says how the run ended
+        if let Some(series) = &self.series {
+            series.flush()?;
+        }
         let path = self.dir.join("summary.json");
         let text = serde_json::to_string_pretty(summary).expect("the summary serializes");
         write_atomic(&path, text.as_bytes())

@@ -15,6 +15,12 @@
 //! Each frame is encoded by vtkio (XML, inline base64, optionally LZ4/ZLib) into memory, written
 //! to a temporary name and renamed; the .pvd is then rewritten the same way. A crash therefore
 //! never leaves a truncated frame or a listed frame that is missing.
+//!
+//! With `Series::set_background(true)` (as runs do) the encoding and both writes happen on a
+//! thread of the series' own, one frame in flight, so a large frame costs the stepping only
+//! its gathering; `flush` (called before a checkpoint and the summary, and on drop) waits for
+//! it and returns its error, if any. The order of the writes, and so the guarantee above, is
+//! the same.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -84,9 +90,64 @@ pub struct Series {
     dir: PathBuf,
     name: String,
     compression: Compression,
-    /// The .pvd's `<DataSet .../>` lines, one per frame written.
+    /// The .pvd's `<DataSet .../>` lines, one per frame written (or handed to the writer).
     entries: Vec<String>,
     last_time: Option<f64>,
+    background: bool,
+    writer: std::cell::RefCell<Option<Writer>>,
+}
+
+/// A frame for the writer thread: the .vtu to encode and write, then the .pvd text.
+struct Job {
+    path: PathBuf,
+    vtk: Vtk,
+    compression: Compression,
+    pvd_path: PathBuf,
+    pvd_text: String,
+}
+
+/// The writer thread: jobs in order, one waiting at most; it stops at its first error and
+/// returns it.
+#[derive(Debug)]
+struct Writer {
+    jobs: std::sync::mpsc::SyncSender<Job>,
+    handle: std::thread::JoinHandle<Result<(), OutputError>>,
+}
+
+impl std::fmt::Debug for Job {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Job({})", self.path.display())
+    }
+}
+
+impl Writer {
+    fn start() -> Writer {
+        let (jobs, queue) = std::sync::mpsc::sync_channel::<Job>(1);
+        let handle = std::thread::spawn(move || {
+            for job in queue {
+                write_atomic(&job.path, &encode(&job.path, job.vtk, job.compression)?)?;
+                write_atomic(&job.pvd_path, job.pvd_text.as_bytes())?;
+            }
+            Ok(())
+        });
+        Writer { jobs, handle }
+    }
+
+    /// Waits for the frames handed over and returns the first error.
+    fn finish(self, pvd: &Path) -> Result<(), OutputError> {
+        drop(self.jobs);
+        self.handle
+            .join()
+            .unwrap_or_else(|_| Err(OutputError::invalid(pvd, "the frame writer panicked")))
+    }
+}
+
+impl Drop for Series {
+    fn drop(&mut self) {
+        // frames handed over are written before the series goes (an error here was, or will
+        // never be, reported by `flush`)
+        let _ = self.flush();
+    }
 }
 
 impl Series {
@@ -105,6 +166,8 @@ impl Series {
             compression,
             entries: Vec::new(),
             last_time: None,
+            background: false,
+            writer: std::cell::RefCell::new(None),
         };
         series.write_pvd()?;
         Ok(series)
@@ -125,12 +188,53 @@ impl Series {
         let path = self.dir.join("vtk").join(&file_name);
         self.check_time(&path, time)?;
         let vtk = unstructured_grid(&path, grid, fields)?;
-        write_atomic(&path, &encode(&path, vtk, self.compression)?)?;
+        if !self.background {
+            write_atomic(&path, &encode(&path, vtk, self.compression)?)?;
+            self.entries
+                .push(pvd_entry(time, &format!("vtk/{file_name}")));
+            self.last_time = Some(time);
+            self.write_pvd()?;
+            return Ok(path);
+        }
         self.entries
             .push(pvd_entry(time, &format!("vtk/{file_name}")));
         self.last_time = Some(time);
-        self.write_pvd()?;
+        let job = Job {
+            path: path.clone(),
+            vtk,
+            compression: self.compression,
+            pvd_path: self.pvd_path(),
+            pvd_text: self.pvd_text(),
+        };
+        let sent = self
+            .writer
+            .borrow_mut()
+            .get_or_insert_with(Writer::start)
+            .jobs
+            .send(job);
+        if sent.is_err() {
+            // the writer stopped at an error: report it
+            self.flush()?;
+            return Err(OutputError::invalid(&path, "the frame writer stopped"));
+        }
         Ok(path)
+    }
+
+    /// Writes frames on a thread of their own from now on (`flush` waits for them).
+    pub fn set_background(&mut self, on: bool) {
+        if !on {
+            let _ = self.flush();
+        }
+        self.background = on;
+    }
+
+    /// Waits until every frame handed over is on disk (and listed by the .pvd); returns the
+    /// writer's error, if it met one.
+    pub fn flush(&self) -> Result<(), OutputError> {
+        match self.writer.borrow_mut().take() {
+            Some(writer) => writer.finish(&self.pvd_path()),
+            None => Ok(()),
+        }
     }
 
     pub fn frames(&self) -> usize {
@@ -188,6 +292,8 @@ impl Series {
             compression,
             entries: position.entries,
             last_time: position.last_time,
+            background: false,
+            writer: std::cell::RefCell::new(None),
         };
         series.write_pvd()?;
         Ok(series)
@@ -215,6 +321,10 @@ impl Series {
     }
 
     fn write_pvd(&self) -> Result<(), OutputError> {
+        write_atomic(&self.pvd_path(), self.pvd_text().as_bytes())
+    }
+
+    fn pvd_text(&self) -> String {
         let mut text = String::from(concat!(
             "<?xml version=\"1.0\"?>\n",
             "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n",
@@ -222,7 +332,7 @@ impl Series {
         ));
         self.entries.iter().for_each(|entry| text.push_str(entry));
         text.push_str("  </Collection>\n</VTKFile>\n");
-        write_atomic(&self.pvd_path(), text.as_bytes())
+        text
     }
 }
 
