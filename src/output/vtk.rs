@@ -17,10 +17,11 @@
 //! never leaves a truncated frame or a listed frame that is missing.
 //!
 //! With `Series::set_background(true)` (as runs do) the encoding and both writes happen on a
-//! thread of the series' own, one frame in flight, so a large frame costs the stepping only
+//! thread of the series' own: one frame is encoded and written there while the next is
+//! gathered (the hand-over waits for the writer), so a large frame costs the stepping only
 //! its gathering; `flush` (called before a checkpoint and the summary, and on drop) waits for
 //! it and returns its error, if any. The order of the writes, and so the guarantee above, is
-//! the same.
+//! the same. After a writer error the series refuses every further frame and flush with it.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -95,6 +96,9 @@ pub struct Series {
     last_time: Option<f64>,
     background: bool,
     writer: std::cell::RefCell<Option<Writer>>,
+    /// The writer's error (the file and the message), kept: once a frame failed, the series
+    /// is unusable and says so at every call.
+    failure: std::cell::RefCell<Option<(PathBuf, String)>>,
 }
 
 /// A frame for the writer thread: the .vtu to encode and write, then the .pvd text.
@@ -106,8 +110,8 @@ struct Job {
     pvd_text: String,
 }
 
-/// The writer thread: jobs in order, one waiting at most; it stops at its first error and
-/// returns it.
+/// The writer thread: jobs in order, handed over one at a time (a rendezvous channel); it
+/// stops at its first error and returns it.
 #[derive(Debug)]
 struct Writer {
     jobs: std::sync::mpsc::SyncSender<Job>,
@@ -121,16 +125,19 @@ impl std::fmt::Debug for Job {
 }
 
 impl Writer {
-    fn start() -> Writer {
-        let (jobs, queue) = std::sync::mpsc::sync_channel::<Job>(1);
-        let handle = std::thread::spawn(move || {
-            for job in queue {
-                write_atomic(&job.path, &encode(&job.path, job.vtk, job.compression)?)?;
-                write_atomic(&job.pvd_path, job.pvd_text.as_bytes())?;
-            }
-            Ok(())
-        });
-        Writer { jobs, handle }
+    fn start(pvd: &Path) -> Result<Writer, OutputError> {
+        let (jobs, queue) = std::sync::mpsc::sync_channel::<Job>(0);
+        let handle = std::thread::Builder::new()
+            .name("vtk-writer".into())
+            .spawn(move || {
+                for job in queue {
+                    write_atomic(&job.path, &encode(&job.path, job.vtk, job.compression)?)?;
+                    write_atomic(&job.pvd_path, job.pvd_text.as_bytes())?;
+                }
+                Ok(())
+            })
+            .map_err(|e| OutputError::io(pvd, "start the frame writer thread", e))?;
+        Ok(Writer { jobs, handle })
     }
 
     /// Waits for the frames handed over and returns the first error.
@@ -168,6 +175,7 @@ impl Series {
             last_time: None,
             background: false,
             writer: std::cell::RefCell::new(None),
+            failure: std::cell::RefCell::new(None),
         };
         series.write_pvd()?;
         Ok(series)
@@ -196,6 +204,8 @@ impl Series {
             self.write_pvd()?;
             return Ok(path);
         }
+        self.failed()?;
+        let previous_time = self.last_time;
         self.entries
             .push(pvd_entry(time, &format!("vtk/{file_name}")));
         self.last_time = Some(time);
@@ -206,14 +216,17 @@ impl Series {
             pvd_path: self.pvd_path(),
             pvd_text: self.pvd_text(),
         };
-        let sent = self
-            .writer
-            .borrow_mut()
-            .get_or_insert_with(Writer::start)
-            .jobs
-            .send(job);
+        let mut writer = self.writer.borrow_mut();
+        if writer.is_none() {
+            *writer = Some(Writer::start(&self.pvd_path())?);
+        }
+        let sent = writer.as_ref().expect("started above").jobs.send(job);
+        drop(writer);
         if sent.is_err() {
-            // the writer stopped at an error: report it
+            // the writer stopped at an error: this frame is not written, and the error is
+            // the one to report
+            self.entries.pop();
+            self.last_time = previous_time;
             self.flush()?;
             return Err(OutputError::invalid(&path, "the frame writer stopped"));
         }
@@ -231,8 +244,23 @@ impl Series {
     /// Waits until every frame handed over is on disk (and listed by the .pvd); returns the
     /// writer's error, if it met one.
     pub fn flush(&self) -> Result<(), OutputError> {
-        match self.writer.borrow_mut().take() {
-            Some(writer) => writer.finish(&self.pvd_path()),
+        let writer = self.writer.borrow_mut().take();
+        if let Some(writer) = writer
+            && let Err(e) = writer.finish(&self.pvd_path())
+        {
+            *self.failure.borrow_mut() = Some((self.pvd_path(), e.to_string()));
+            return Err(e);
+        }
+        self.failed()
+    }
+
+    /// The kept writer error, if any.
+    fn failed(&self) -> Result<(), OutputError> {
+        match &*self.failure.borrow() {
+            Some((path, message)) => Err(OutputError::invalid(
+                path,
+                format!("an earlier frame could not be written: {message}"),
+            )),
             None => Ok(()),
         }
     }
@@ -294,6 +322,7 @@ impl Series {
             last_time: position.last_time,
             background: false,
             writer: std::cell::RefCell::new(None),
+            failure: std::cell::RefCell::new(None),
         };
         series.write_pvd()?;
         Ok(series)
@@ -762,6 +791,51 @@ mod tests {
             assert!(!temporary_path(path).exists());
             assert_frame(path, &grid, frame);
         }
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Goal: frames written by the writer thread are the synchronous ones: in order, each
+    /// listed once complete, all on disk after `flush`; a writer error is reported by the
+    /// next call and by every call after it, and the .pvd keeps listing only the frames
+    /// that were written. Reference: the frames' own data (read back with vtkio).
+    #[test]
+    fn background_writer_keeps_order_and_reports_its_error() {
+        let dir = test_dir("background");
+        let grid = two_quads_and_a_rod();
+        let frames: Vec<Frame> = (0..3).map(|k| Frame::new(&grid, k)).collect();
+        let mut series = Series::create(&dir, "run", Compression::Lz4).unwrap();
+        series.set_background(true);
+        for (k, frame) in frames.iter().enumerate() {
+            series
+                .write_frame(TIMES[k], &grid, &frame.fields())
+                .unwrap();
+        }
+        series.flush().unwrap();
+        let listed = read_pvd(&dir.join("run.pvd")).unwrap();
+        assert_eq!(listed.len(), 3);
+        for ((time, path), (k, frame)) in listed.iter().zip(frames.iter().enumerate()) {
+            assert_eq!(time.to_bits(), TIMES[k].to_bits());
+            assert_frame(path, &grid, frame);
+        }
+        // the frames folder turns into a file: the next frame cannot be written
+        fs::remove_dir_all(dir.join("vtk")).unwrap();
+        fs::write(dir.join("vtk"), b"not a folder").unwrap();
+        let next = Frame::new(&grid, 3);
+        let handed = series.write_frame(3.0, &grid, &next.fields());
+        let first = match handed {
+            Err(e) => e,
+            Ok(_) => series.flush().expect_err("the writer met an error"),
+        };
+        assert!(first.to_string().contains("vtk"), "{first}");
+        let again = series.flush().expect_err("the error is kept");
+        assert!(
+            again.to_string().contains("could not be written"),
+            "{again}"
+        );
+        assert!(series.write_frame(4.0, &grid, &next.fields()).is_err());
+        // the .pvd still lists the three frames written
+        assert_eq!(read_pvd(&dir.join("run.pvd")).unwrap().len(), 3);
+        drop(series);
         fs::remove_dir_all(&dir).unwrap();
     }
 
