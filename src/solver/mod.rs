@@ -269,18 +269,7 @@ impl Solver {
 
     /// Solves in place with the current factorization.
     pub fn solve(&mut self, rhs: &mut [f64]) {
-        self.solves += 1;
-        if self.symbolic.is_none() {
-            return;
-        }
-        let factor = self
-            .factor
-            .as_ref()
-            .expect("solve after a successful factor");
-        let n = rhs.len();
-        let start = std::time::Instant::now();
-        factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
-        crate::profile::add(crate::profile::Phase::Solve, start);
+        self.solve_block(rhs, 1);
     }
 }
 
