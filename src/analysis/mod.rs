@@ -228,11 +228,23 @@ impl StepControl {
     }
 
     /// A step of length `attempted` failed: halve it, or say why the run must stop.
+    ///
+    /// Besides `max_cuts` cuts in a row, the length may not fall below the nominal step over
+    /// 2^max_cuts and a tenth (the shortest event split of such a step): cuts and successes
+    /// that alternate would otherwise shrink it without end (to 1e-17 and then 0, which
+    /// Wilson-theta met on a crushed contact tip).
     fn reject(&mut self, attempted: f64, counters: &mut Counters) -> Result<(), String> {
         if self.cuts_in_a_row >= self.max_cuts {
             return Err(format!(
                 "did not converge after {} cuts (dt = {attempted:e})",
                 self.cuts_in_a_row
+            ));
+        }
+        let floor = self.nominal * 0.5f64.powi(self.max_cuts as i32) * 0.1;
+        if 0.5 * attempted < floor {
+            return Err(format!(
+                "did not converge: repeated cuts brought the step to {attempted:e}, and halving it would go below dt / 2^{} / 10 = {floor:e}",
+                self.max_cuts
             ));
         }
         self.length = 0.5 * attempted;
@@ -512,5 +524,36 @@ fn run_from(
                 dynamics::run(model, spec, out_dir, options, resume)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Goal: cuts that alternate with successes cannot shrink the step without end (the
+    /// cuts-in-a-row limit never trips then). Reference: the floor dt / 2^max_cuts / 10.
+    #[test]
+    fn alternating_cuts_stop_at_the_floor() {
+        let mut control = StepControl::new(1e-3, 6);
+        let mut counters = Counters::default();
+        let floor = 1e-3 / 64.0 / 10.0;
+        let mut error = None;
+        // two cuts, one success (which doubles back once): the length halves per round
+        for _ in 0..100 {
+            let mut round = || -> Result<(), String> {
+                control.reject(control.length, &mut counters)?;
+                control.reject(control.length, &mut counters)?;
+                control.accept(true);
+                Ok(())
+            };
+            if let Err(e) = round() {
+                error = Some(e);
+                break;
+            }
+            assert!(control.length >= floor, "length {}", control.length);
+        }
+        let error = error.expect("the floor stops the run");
+        assert!(error.contains("below dt / 2^6 / 10"), "{error}");
     }
 }
