@@ -355,7 +355,7 @@ fn element(
                     .update(&committed.points[4 * e + q], &strains[q], stress_state)
             });
             if let Some(start) = fine {
-                crate::profile::add(crate::profile::Phase::Constitutive, start);
+                crate::profile::add_constitutive(start);
             }
             let stress = responses.map(|r| r.stress);
             let mut work = 0.0;
