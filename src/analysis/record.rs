@@ -240,7 +240,7 @@ impl Recorder {
         if self.last_frame_time == Some(state.time) {
             return Ok(());
         }
-        let _timer = OutputTimer(std::time::Instant::now());
+        let _timer = crate::profile::Timer::new(crate::profile::Phase::Output);
         let cells = cell_fields(model, state);
         let vectors =
             |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
@@ -450,13 +450,4 @@ pub struct RecorderPosition {
     pub steps_since_frame: usize,
     pub last_frame_time: Option<f64>,
     pub negative_pivots: Option<usize>,
-}
-
-/// Adds its lifetime to the output phase.
-struct OutputTimer(std::time::Instant);
-
-impl Drop for OutputTimer {
-    fn drop(&mut self) {
-        crate::profile::add(crate::profile::Phase::Output, self.0);
-    }
 }

@@ -216,15 +216,6 @@ impl System {
     }
 }
 
-/// Adds its lifetime to the assembly phase (every return path of `evaluate`).
-struct Timer(Instant);
-
-impl Drop for Timer {
-    fn drop(&mut self) {
-        crate::profile::add(crate::profile::Phase::Assembly, self.0);
-    }
-}
-
 /// Elements per chunk of `evaluate` (about 5 MB of results in flight).
 const CHUNK: usize = 8192;
 
@@ -247,7 +238,7 @@ pub fn evaluate(
     mut system: Option<&mut System>,
     tangent: Tangent,
 ) -> Result<Evaluation, ElementFailure> {
-    let _timer = Timer(Instant::now());
+    let _timer = crate::profile::Timer::new(crate::profile::Phase::Assembly);
     crate::profile::count_elements(model.elements());
     let want_tangent = system.is_some();
     if let Some(s) = system.as_deref_mut() {
