@@ -533,6 +533,12 @@ impl ContactState {
         let n = du.len();
         let mut delta = vec![0.0; n];
         let mut active: Vec<(usize, usize)> = Vec::new();
+        // whether (p, k) is in `active`: keeps the bookkeeping linear in the slaves
+        let mut in_active: Vec<Vec<bool>> = model
+            .contacts
+            .iter()
+            .map(|pair| vec![false; pair.slaves.len()])
+            .collect();
         let mut mu_total: Vec<f64> = Vec::new();
         let position = |delta: &[f64], node: usize| {
             [
@@ -546,7 +552,7 @@ impl ContactState {
             let mut changed = false;
             for (p, pair) in model.contacts.iter().enumerate() {
                 for (k, s) in pair.slaves.iter().enumerate() {
-                    if active.contains(&(p, k)) {
+                    if in_active[p][k] {
                         continue;
                     }
                     if pair
@@ -554,6 +560,7 @@ impl ContactState {
                         .is_some_and(|g| g.gap < -pair.options.tolerance)
                     {
                         active.push((p, k));
+                        in_active[p][k] = true;
                         mu_total.push(0.0);
                         changed = true;
                     }
@@ -590,32 +597,25 @@ impl ContactState {
                 mu_total[i] += mu[i];
             }
             // entries pulled (total multiplier negative) leave and give back their correction
-            let mut i = 0;
-            while i < active.len() {
+            for (i, row) in rows.iter().enumerate() {
                 if mu_total[i] < 0.0 {
-                    for (dof, c) in &rows[i] {
+                    for (dof, c) in row {
                         delta[*dof] -= inverse_mass[*dof] * c * mu_total[i];
                     }
-                    active.remove(i);
-                    mu_total.remove(i);
-                } else {
-                    i += 1;
+                    let (p, k) = active[i];
+                    in_active[p][k] = false;
                 }
             }
+            let mut kept = mu_total.iter().map(|mu| *mu >= 0.0);
+            active.retain(|_| kept.next().expect("one flag per entry"));
+            mu_total.retain(|mu| *mu >= 0.0);
         }
         let forces: Vec<f64> = mu_total.iter().map(|mu| mu / (h * h)).collect();
-        let was_active: Vec<(usize, usize)> = self
+        let released = self
             .active
             .iter()
-            .enumerate()
-            .flat_map(|(p, f)| {
-                f.iter()
-                    .enumerate()
-                    .filter(|(_, a)| **a)
-                    .map(move |(k, _)| (p, k))
-            })
-            .collect();
-        let released = was_active.iter().any(|e| !active.contains(e));
+            .zip(&in_active)
+            .any(|(was, is)| was.iter().zip(is).any(|(was, is)| *was && !*is));
         let end: Vec<[f64; 2]> = (0..start.len())
             .map(|node| position(&delta, node))
             .collect();

@@ -23,6 +23,7 @@ use crate::assembly::{self, Mass, MassKind, State, System};
 use crate::scene::spec::DynamicSpec;
 use crate::scene::spec::Quadrature;
 use crate::scene::{InputError, Model};
+use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
 
@@ -221,27 +222,37 @@ pub fn run(
     let inverse_mass: Vec<f64> = (0..model.dofs())
         .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
         .collect();
+    // the step's vectors, allocated once; without force loads the external force stays zero
+    let dofs = model.dofs();
+    let (mut v_half, mut du) = (vec![0.0; dofs], vec![0.0; dofs]);
+    let mut external = vec![0.0; dofs];
+    let mut total = vec![0.0; dofs];
+    let forces_applied = loads::has_external_force(model);
     crate::profile::add(crate::profile::Phase::Setup, setup_start);
     for step in first_step..=steps {
         let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
         let h = super::step_length(time - state.time, spec.dt);
-        let v_half: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v + 0.5 * h * a).collect();
-        let mut du: Vec<f64> = v_half.iter().map(|v| h * v).collect();
+        predict(&v, &a, h, &mut v_half, &mut du);
         for (dof, value) in loads::prescribed(model, &initial, time) {
             du[dof] = value - state.displacement[dof];
         }
-        let mut v_half = v_half;
         if !model.contacts.is_empty() {
-            let positions = state.positions(spec.geometry);
-            let correction = crate::profile::time(crate::profile::Phase::Contact, || {
-                contact.explicit_step(model, &positions, &du, &inverse_mass, h, time)
+            crate::profile::time(crate::profile::Phase::Contact, || {
+                let positions = state.positions(spec.geometry);
+                let correction =
+                    contact.explicit_step(model, &positions, &du, &inverse_mass, h, time);
+                (du.par_chunks_mut(DOF_CHUNK), v_half.par_chunks_mut(DOF_CHUNK))
+                    .into_par_iter()
+                    .zip(correction.par_chunks(DOF_CHUNK))
+                    .for_each(|((du, v_half), correction)| {
+                        for ((du, v), c) in du.iter_mut().zip(v_half).zip(correction) {
+                            *du += c;
+                            *v += c / h;
+                        }
+                    });
+                let force = contact.nodal_forces(model, &positions);
+                energies.contact_work -= chunked_sum(&force, &du, |f, u| f * u);
             });
-            for i in 0..model.dofs() {
-                du[i] += correction[i];
-                v_half[i] += correction[i] / h;
-            }
-            let force = contact.nodal_forces(model, &positions);
-            energies.contact_work -= force.iter().zip(&du).map(|(f, u)| f * u).sum::<f64>();
         }
         let evaluation = match reduced.as_mut() {
             Some(kernel) => crate::profile::time(crate::profile::Phase::Assembly, || {
@@ -286,20 +297,25 @@ pub fn run(
             }
             _ => false,
         };
-        let external = loads::external_force(model, &state, &initial, time);
-        for i in 0..model.dofs() {
-            if free[i] {
-                a[i] = (external[i] - internal[i] - a_r * m[i] * v_half[i]) / m[i];
-                v[i] = v_half[i] + 0.5 * h * a[i];
-            } else {
-                a[i] = (du[i] / h - v[i]) * 2.0 / h;
-                v[i] = du[i] / h;
-            }
+        if forces_applied {
+            external.fill(0.0);
+            loads::add_external_force(model, &state, &initial, time, &mut external);
         }
-        let total = total_force(&free, &external, &internal, m, &a, &v, a_r);
-        energies.external_work += super::trapezoid_work(&du, &total, &last_total);
-        last_total = total;
-        energies.kinetic = kinetic(&v);
+        let (work, kinetic_energy) = StepEnd {
+            free: &free,
+            external: &external,
+            internal: &internal,
+            m,
+            v_half: &v_half,
+            du: &du,
+            last_total: &last_total,
+            h,
+            a_r,
+        }
+        .apply(&mut a, &mut v, &mut total);
+        energies.external_work += work;
+        std::mem::swap(&mut last_total, &mut total);
+        energies.kinetic = kinetic_energy;
         energies.internal = state.internal_work - state.plastic_work;
         energies.plastic_work = state.plastic_work;
         summary.steps += 1;
@@ -338,9 +354,10 @@ pub fn run(
             Some(&contact),
             step == steps,
         )?;
-        if let Some(message) =
+        let runaway = crate::profile::time(crate::profile::Phase::Contact, || {
             contact.runaway_penetration(model, &state.positions(spec.geometry), &penetration_limits)
-        {
+        });
+        if let Some(message) = runaway {
             progress.abandon();
             summary.finish(&energies, &Counters::default(), None, start);
             summary.contact = contact.summary();
@@ -407,15 +424,109 @@ pub fn run(
 /// Commits a step of the reduced kernel (whose element state is already updated): the
 /// configuration moves by du, the work accumulates.
 fn commit_reduced(state: &mut State, du: &[f64], work: StepWork) {
-    for (n, x) in state.reference.iter_mut().enumerate() {
-        x[0] += du[2 * n];
-        x[1] += du[2 * n + 1];
-    }
-    for (u, d) in state.displacement.iter_mut().zip(du) {
-        *u += d;
-    }
+    state
+        .reference
+        .par_chunks_mut(DOF_CHUNK / 2)
+        .zip(du.par_chunks(DOF_CHUNK))
+        .for_each(|(x, du)| {
+            for (x, d) in x.iter_mut().zip(du.chunks_exact(2)) {
+                x[0] += d[0];
+                x[1] += d[1];
+            }
+        });
+    state
+        .displacement
+        .par_chunks_mut(DOF_CHUNK)
+        .zip(du.par_chunks(DOF_CHUNK))
+        .for_each(|(u, du)| {
+            for (u, d) in u.iter_mut().zip(du) {
+                *u += d;
+            }
+        });
     state.internal_work += work.internal;
     state.plastic_work += work.plastic;
+}
+
+/// DOFs per chunk of the driver's vector loops: they run in parallel over fixed chunks and
+/// their sums add the chunks' partial sums in chunk order, so the results are the same bits
+/// for any number of threads.
+const DOF_CHUNK: usize = 4096;
+
+/// The predictor: v_{n+1/2} = v_n + h/2 a_n, du = h v_{n+1/2}.
+fn predict(v: &[f64], a: &[f64], h: f64, v_half: &mut [f64], du: &mut [f64]) {
+    (v_half.par_chunks_mut(DOF_CHUNK), du.par_chunks_mut(DOF_CHUNK))
+        .into_par_iter()
+        .zip((v.par_chunks(DOF_CHUNK), a.par_chunks(DOF_CHUNK)))
+        .for_each(|((v_half, du), (v, a))| {
+            for (((vh, d), v), a) in v_half.iter_mut().zip(du).zip(v).zip(a) {
+                *vh = v + 0.5 * h * a;
+                *d = h * *vh;
+            }
+        });
+}
+
+/// sum_i term(x_i, y_i), deterministic for any number of threads (see `DOF_CHUNK`).
+fn chunked_sum(x: &[f64], y: &[f64], term: impl Fn(f64, f64) -> f64 + Sync) -> f64 {
+    x.par_chunks(DOF_CHUNK)
+        .zip(y.par_chunks(DOF_CHUNK))
+        .map(|(x, y)| x.iter().zip(y).map(|(x, y)| term(*x, *y)).sum::<f64>())
+        .collect::<Vec<f64>>()
+        .into_iter()
+        .sum()
+}
+
+/// The end of a step, once the internal force at u_{n+1} is known.
+struct StepEnd<'a> {
+    free: &'a [bool],
+    external: &'a [f64],
+    internal: &'a [f64],
+    m: &'a [f64],
+    v_half: &'a [f64],
+    du: &'a [f64],
+    /// F of the step before (see `total_force`).
+    last_total: &'a [f64],
+    h: f64,
+    a_r: f64,
+}
+
+impl StepEnd<'_> {
+    /// a_{n+1} and v_{n+1} (prescribed DOFs: from their increment), F_{n+1} into `total`;
+    /// returns the external work of the step by the trapezoidal rule,
+    /// du . (F_{n+1} + F_n) / 2, and the kinetic energy 1/2 v.M v.
+    fn apply(&self, a: &mut [f64], v: &mut [f64], total: &mut [f64]) -> (f64, f64) {
+        let (h, a_r) = (self.h, self.a_r);
+        let sums: Vec<(f64, f64)> = (
+            a.par_chunks_mut(DOF_CHUNK),
+            v.par_chunks_mut(DOF_CHUNK),
+            total.par_chunks_mut(DOF_CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, (a, v, total))| {
+                let (mut work, mut kinetic) = (0.0, 0.0);
+                for (j, ((a, v), total)) in a.iter_mut().zip(v).zip(total).enumerate() {
+                    let i = k * DOF_CHUNK + j;
+                    let m = self.m[i];
+                    if self.free[i] {
+                        *a = (self.external[i] - self.internal[i] - a_r * m * self.v_half[i]) / m;
+                        *v = self.v_half[i] + 0.5 * h * *a;
+                        *total = self.external[i];
+                    } else {
+                        *a = (self.du[i] / h - *v) * 2.0 / h;
+                        *v = self.du[i] / h;
+                        *total = m * *a + a_r * m * *v + self.internal[i];
+                    }
+                    work += self.du[i] * (*total + self.last_total[i]);
+                    kinetic += m * *v * *v;
+                }
+                (work, kinetic)
+            })
+            .collect();
+        let (work, kinetic) = sums
+            .into_iter()
+            .fold((0.0, 0.0), |(w, k), (dw, dk)| (w + dw, k + dk));
+        (0.5 * work, 0.5 * kinetic)
+    }
 }
 
 /// F: f_ext on the free DOFs, the reaction m a + a_R m v + f_int on the prescribed ones.

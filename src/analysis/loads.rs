@@ -83,6 +83,29 @@ pub fn prescribed(model: &Model, initial: &[[f64; 2]], t: f64) -> Vec<(usize, f6
 /// pressures on the edges of the reference (last converged) configuration.
 pub fn external_force(model: &Model, state: &State, initial: &[[f64; 2]], t: f64) -> Vec<f64> {
     let mut f = vec![0.0; model.dofs()];
+    add_external_force(model, state, initial, t, &mut f);
+    f
+}
+
+/// Whether the scene has loads that give an external force (nodal forces, tractions,
+/// pressures): without them the external force is zero at all times.
+pub fn has_external_force(model: &Model) -> bool {
+    model.loads.iter().any(|load| {
+        !matches!(
+            load,
+            Load::Displacement { .. } | Load::Rotation { .. } | Load::Affine { .. }
+        )
+    })
+}
+
+/// Adds the external force at time t to `f` (as `external_force`, into a buffer of the caller's).
+pub fn add_external_force(
+    model: &Model,
+    state: &State,
+    initial: &[[f64; 2]],
+    t: f64,
+    f: &mut [f64],
+) {
     for load in &model.loads {
         match load {
             Load::NodalForce {
@@ -104,7 +127,7 @@ pub fn external_force(model: &Model, state: &State, initial: &[[f64; 2]], t: f64
             } => {
                 let s = curve.value(t);
                 let t = [traction[0] * s, traction[1] * s];
-                add_edge_forces(model, *body, edges, initial, |_, _| t, &mut f);
+                add_edge_forces(model, *body, edges, initial, |_, _| t, f);
             }
             Load::Pressure {
                 body,
@@ -122,13 +145,12 @@ pub fn external_force(model: &Model, state: &State, initial: &[[f64; 2]], t: f64
                         let n = quad4::outward_normal(a, b);
                         [-p * n[0], -p * n[1]]
                     },
-                    &mut f,
+                    f,
                 );
             }
             Load::Displacement { .. } | Load::Rotation { .. } | Load::Affine { .. } => {}
         }
     }
-    f
 }
 
 fn add_edge_forces(

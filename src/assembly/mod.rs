@@ -48,9 +48,9 @@ pub struct State {
 impl State {
     /// Current node positions: the reference configuration in finite strain; the initial
     /// one plus the displacement in small strain (whose reference never moves).
-    pub fn positions(&self, geometry: Geometry) -> Vec<[f64; 2]> {
+    pub fn positions(&self, geometry: Geometry) -> std::borrow::Cow<'_, [[f64; 2]]> {
         match geometry {
-            Geometry::Nonlinear => self.reference.clone(),
+            Geometry::Nonlinear => std::borrow::Cow::Borrowed(&self.reference),
             Geometry::Linear => self
                 .reference
                 .iter()
