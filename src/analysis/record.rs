@@ -2,6 +2,7 @@
 //! row per converged step, summary.json at the end (also after a failure).
 
 use super::Summary;
+use rayon::prelude::*;
 use super::contact::ContactState;
 use crate::assembly::State;
 use crate::contact::Friction;
@@ -306,14 +307,9 @@ struct CellFields {
     pressure: Vec<f64>,
 }
 
-/// Per cell, the mean over its points; quads first, then rods (as in `grid`).
+/// Per cell, the mean over its points; quads first, then rods (as in `grid`). Parallel over
+/// the cells, each written in its own slot.
 fn cell_fields(model: &Model, state: &State) -> CellFields {
-    let mut out = CellFields {
-        stress: Vec::new(),
-        von_mises: Vec::new(),
-        eq_plastic_strain: Vec::new(),
-        pressure: Vec::new(),
-    };
     let quads_first = model
         .bodies
         .iter()
@@ -326,18 +322,36 @@ fn cell_fields(model: &Model, state: &State) -> CellFields {
                 .enumerate()
                 .filter(|(_, b)| b.points_per_element() == 1),
         );
+    let cells: usize = model.bodies.iter().map(|b| b.elements()).sum();
+    let mut out = CellFields {
+        stress: vec![[0.0; 6]; cells],
+        von_mises: vec![0.0; cells],
+        eq_plastic_strain: vec![0.0; cells],
+        pressure: vec![0.0; cells],
+    };
+    let mut first = 0;
     for (b, body) in quads_first {
         let ppe = body.points_per_element();
-        for points in state.bodies[b].points.chunks_exact(ppe) {
-            let mean = |f: &dyn Fn(&crate::material::PointState) -> f64| {
-                points.iter().map(f).sum::<f64>() / ppe as f64
-            };
-            let s: [f64; 4] = std::array::from_fn(|k| mean(&|p| p.stress[k]));
-            out.stress.push([s[0], s[1], s[2], s[3], 0.0, 0.0]);
-            out.von_mises.push(mean(&|p| von_mises(&p.stress)));
-            out.eq_plastic_strain.push(mean(&|p| p.eq_plastic_strain));
-            out.pressure.push(mean(&|p| pressure(&p.stress)));
-        }
+        let last = first + body.elements();
+        (
+            &mut out.stress[first..last],
+            &mut out.von_mises[first..last],
+            &mut out.eq_plastic_strain[first..last],
+            &mut out.pressure[first..last],
+        )
+            .into_par_iter()
+            .zip(state.bodies[b].points.par_chunks_exact(ppe))
+            .for_each(|((stress, mises, eps_p, p), points)| {
+                let mean = |f: &dyn Fn(&crate::material::PointState) -> f64| {
+                    points.iter().map(f).sum::<f64>() / ppe as f64
+                };
+                let s: [f64; 4] = std::array::from_fn(|k| mean(&|p| p.stress[k]));
+                *stress = [s[0], s[1], s[2], s[3], 0.0, 0.0];
+                *mises = mean(&|p| von_mises(&p.stress));
+                *eps_p = mean(&|p| p.eq_plastic_strain);
+                *p = mean(&|p| pressure(&p.stress));
+            });
+        first = last;
     }
     out
 }

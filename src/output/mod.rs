@@ -9,6 +9,7 @@
 pub mod history;
 pub mod plot;
 pub mod vtk;
+pub mod vtu;
 
 use std::fs;
 use std::io;
@@ -24,13 +25,6 @@ pub enum OutputError {
         action: &'static str,
         #[source]
         source: io::Error,
-    },
-    /// vtkio could not encode a frame.
-    #[error("{}: cannot encode the VTK file: {source}", .path.display())]
-    Vtk {
-        path: PathBuf,
-        #[source]
-        source: vtkio::Error,
     },
     /// An array (a field, a history row) has the wrong number of entries.
     #[error("{}: {what} has {found} entries, expected {expected}", .path.display())]
@@ -85,6 +79,23 @@ impl OutputError {
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     let tmp = temporary_path(path);
     fs::write(&tmp, bytes).map_err(|e| OutputError::io(&tmp, "write", e))?;
+    fs::rename(&tmp, path).map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        OutputError::io(path, "rename the temporary file onto", e)
+    })
+}
+
+/// As `write_atomic`, for a file given as consecutive parts (no copy into one buffer).
+pub fn write_atomic_parts(path: &Path, parts: &[Vec<u8>]) -> Result<(), OutputError> {
+    use std::io::Write;
+    let tmp = temporary_path(path);
+    let written = fs::File::create(&tmp).and_then(|mut file| {
+        parts.iter().try_for_each(|part| file.write_all(part))
+    });
+    written.map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        OutputError::io(&tmp, "write", e)
+    })?;
     fs::rename(&tmp, path).map_err(|e| {
         let _ = fs::remove_file(&tmp);
         OutputError::io(path, "rename the temporary file onto", e)

@@ -12,27 +12,24 @@
 //! The points never move: show the deformed mesh in ParaView with Warp By Vector on
 //! `displacement` (the active vectors, so the filter picks it by default), scale factor 1.
 //!
-//! Each frame is encoded by vtkio (XML, inline base64, optionally LZ4/ZLib) into memory, written
-//! to a temporary name and renamed; the .pvd is then rewritten the same way. A crash therefore
-//! never leaves a truncated frame or a listed frame that is missing.
+//! Each frame is a VTK XML file with its arrays appended as raw binary, optionally LZ4/ZLib
+//! compressed (src/output/vtu.rs), written to a temporary name and renamed; the .pvd is then
+//! rewritten the same way. A crash therefore never leaves a truncated frame or a listed frame
+//! that is missing.
 //!
-//! With `Series::set_background(true)` (as runs do) the encoding and both writes happen on a
-//! thread of the series' own: one frame is encoded and written there while the next is
-//! gathered (the hand-over waits for the writer), so a large frame costs the stepping only
-//! its gathering; `flush` (called before a checkpoint and the summary, and on drop) waits for
+//! With `Series::set_background(true)` (as runs do) the compression and both writes happen
+//! on a thread of the series' own: one frame is written there while the next is gathered
+//! (the hand-over waits for the writer), so a large frame costs the stepping only its
+//! gathering and layout; `flush` (called before a checkpoint and the summary, and on drop) waits for
 //! it and returns its error, if any. The order of the writes, and so the guarantee above, is
 //! the same. After a writer error the series refuses every further frame and flush with it.
 
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use vtkio::model::{
-    Attribute, Attributes, ByteOrder, CellType, Cells, DataArray, DataSet, ElementType,
-    UnstructuredGridPiece, Version, VertexNumbers, Vtk,
-};
-use vtkio::xml::Compressor;
-
-use super::{OutputError, format_f64, write_atomic};
+pub use super::vtu::Compression;
+use super::vtu::{Field, Payload, Section, Source};
+use super::{OutputError, format_f64, write_atomic, write_atomic_parts};
 
 /// All bodies merged into one grid with global node numbering; cells are the quads first, then the lines.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -64,27 +61,6 @@ pub struct Fields<'a> {
     pub pressure: &'a [f64],
 }
 
-/// Compression of the binary arrays inside each .vtu (ParaView reads all three).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Compression {
-    #[default]
-    None,
-    Lz4,
-    Zlib,
-}
-
-impl Compression {
-    /// vtkio's compressor and level (level 0 would switch compression off; LZ4 ignores it).
-    fn vtkio(self) -> (Compressor, u32) {
-        match self {
-            Compression::None => (Compressor::None, 0),
-            Compression::Lz4 => (Compressor::LZ4, 1),
-            Compression::Zlib => (Compressor::ZLib, 6),
-        }
-    }
-}
-
 /// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
 #[derive(Debug)]
 pub struct Series {
@@ -101,10 +77,10 @@ pub struct Series {
     failure: std::cell::RefCell<Option<(PathBuf, String)>>,
 }
 
-/// A frame for the writer thread: the .vtu to encode and write, then the .pvd text.
+/// A frame for the writer thread: the .vtu to compress and write, then the .pvd text.
 struct Job {
     path: PathBuf,
-    vtk: Vtk,
+    payload: Payload,
     compression: Compression,
     pvd_path: PathBuf,
     pvd_text: String,
@@ -131,7 +107,7 @@ impl Writer {
             .name("vtk-writer".into())
             .spawn(move || {
                 for job in queue {
-                    write_atomic(&job.path, &encode(&job.path, job.vtk, job.compression)?)?;
+                    write_atomic_parts(&job.path, &job.payload.into_parts(job.compression))?;
                     write_atomic(&job.pvd_path, job.pvd_text.as_bytes())?;
                 }
                 Ok(())
@@ -195,9 +171,9 @@ impl Series {
         let file_name = format!("{}_{:05}.vtu", self.name, self.frames());
         let path = self.dir.join("vtk").join(&file_name);
         self.check_time(&path, time)?;
-        let vtk = unstructured_grid(&path, grid, fields)?;
+        let payload = payload(&path, grid, fields)?;
         if !self.background {
-            write_atomic(&path, &encode(&path, vtk, self.compression)?)?;
+            write_atomic_parts(&path, &payload.into_parts(self.compression))?;
             self.entries
                 .push(pvd_entry(time, &format!("vtk/{file_name}")));
             self.last_time = Some(time);
@@ -211,7 +187,7 @@ impl Series {
         self.last_time = Some(time);
         let job = Job {
             path: path.clone(),
-            vtk,
+            payload,
             compression: self.compression,
             pvd_path: self.pvd_path(),
             pvd_text: self.pvd_text(),
@@ -401,7 +377,7 @@ pub fn read_pvd(path: &Path) -> Result<Vec<(f64, PathBuf)>, OutputError> {
 }
 
 /// The `name="value"` pairs of a tag's text (after the element name, before `>`).
-fn attributes(mut tag: &str) -> impl Iterator<Item = (&str, &str)> {
+pub(crate) fn attributes(mut tag: &str) -> impl Iterator<Item = (&str, &str)> {
     std::iter::from_fn(move || {
         let (name, rest) = tag.split_once('=')?;
         let rest = rest.trim_start();
@@ -461,168 +437,36 @@ fn is_frame_file(file_name: &str, name: &str) -> bool {
         .is_some_and(|digits| digits.len() >= 5 && digits.bytes().all(|b| b.is_ascii_digit()))
 }
 
-/// Checks the grid and the fields and builds vtkio's model of one frame.
-fn unstructured_grid(path: &Path, grid: &Grid, fields: &Fields) -> Result<Vtk, OutputError> {
-    use ElementType::{Generic, Vectors};
-    let (n, m) = (grid.points.len(), grid.cells());
-    let point = vec![
-        array(path, "displacement", Vectors, rows(fields.displacement), n)?,
-        array(path, "velocity", Generic(3), rows(fields.velocity), n)?,
-        array(
-            path,
-            "acceleration",
-            Generic(3),
-            rows(fields.acceleration),
-            n,
-        )?,
-        array(
-            path,
-            "contact_force",
-            Generic(3),
-            rows(fields.contact_force),
-            n,
-        )?,
-        array(path, "gap", Generic(1), singles(fields.gap), n)?,
-        array(
-            path,
-            "contact_status",
-            Generic(1),
-            singles(fields.contact_status),
-            n,
-        )?,
-    ];
-    let cell = vec![
-        array(path, "stress", Generic(6), rows(fields.stress), m)?,
-        array(path, "von_mises", Generic(1), singles(fields.von_mises), m)?,
-        array(
-            path,
-            "eq_plastic_strain",
-            Generic(1),
-            singles(fields.eq_plastic_strain),
-            m,
-        )?,
-        array(path, "pressure", Generic(1), singles(fields.pressure), m)?,
-    ];
-    let piece = UnstructuredGridPiece {
-        points: flatten(path, "points", rows(&grid.points), n, 3)?.into(),
-        cells: vtk_cells(path, grid)?,
-        data: Attributes { point, cell },
+/// Checks the grid and the fields and lays out one frame's arrays.
+fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputError> {
+    let field = |section, name, source, width| Field {
+        section,
+        name,
+        source,
+        width,
     };
-    Ok(Vtk {
-        version: Version::new_xml(1, 0),
-        title: String::new(),
-        byte_order: ByteOrder::LittleEndian,
-        data: DataSet::inline(piece),
-        file_path: None,
-    })
-}
-
-/// A named point or cell array of `count` checked entries, zero-padded to `elem`'s width.
-fn array<'v>(
-    path: &Path,
-    name: &'static str,
-    elem: ElementType,
-    entries: impl ExactSizeIterator<Item = &'v [f64]>,
-    count: usize,
-) -> Result<Attribute, OutputError> {
-    let data = flatten(path, name, entries, count, elem.num_comp() as usize)?;
-    Ok(Attribute::DataArray(DataArray {
-        name: name.to_string(),
-        elem,
-        data: data.into(),
-    }))
-}
-
-fn rows<const N: usize>(values: &[[f64; N]]) -> impl ExactSizeIterator<Item = &[f64]> {
-    values.iter().map(|v| v.as_slice())
-}
-
-fn singles(values: &[f64]) -> impl ExactSizeIterator<Item = &[f64]> {
-    values.iter().map(std::slice::from_ref)
-}
-
-/// Checks a field's length and values and flattens it, padding each entry with zeros to `width`.
-fn flatten<'v>(
-    path: &Path,
-    field: &'static str,
-    entries: impl ExactSizeIterator<Item = &'v [f64]>,
-    expected: usize,
-    width: usize,
-) -> Result<Vec<f64>, OutputError> {
-    if entries.len() != expected {
-        return Err(OutputError::Length {
-            path: path.to_path_buf(),
-            what: format!("field `{field}`"),
-            expected,
-            found: entries.len(),
-        });
-    }
-    let mut flat = Vec::with_capacity(expected * width);
-    for (index, entry) in entries.enumerate() {
-        if let Some(component) = entry.iter().position(|x| !x.is_finite()) {
-            let value = entry[component];
-            return Err(OutputError::NonFinite {
-                path: path.to_path_buf(),
-                field,
-                index,
-                component,
-                value,
-            });
-        }
-        flat.extend_from_slice(entry);
-        flat.resize(flat.len() + width - entry.len(), 0.0);
-    }
-    Ok(flat)
-}
-
-/// Quads then lines, as XML connectivity and end offsets; every node must be a point of the grid.
-fn vtk_cells(path: &Path, grid: &Grid) -> Result<Cells, OutputError> {
-    let quads = grid.quads.iter().map(|q| &q[..]);
-    let lines = grid.lines.iter().map(|l| &l[..]);
-    let mut connectivity = Vec::with_capacity(4 * grid.quads.len() + 2 * grid.lines.len());
-    let mut offsets = Vec::with_capacity(grid.cells());
-    for (cell, nodes) in quads.chain(lines).enumerate() {
-        if let Some(&node) = nodes.iter().find(|&&n| n >= grid.points.len()) {
-            let reason = format!(
-                "cell {cell} refers to node {node}, but the grid has {} points",
-                grid.points.len()
-            );
-            return Err(OutputError::invalid(path, reason));
-        }
-        connectivity.extend(nodes.iter().map(|&n| n as u64));
-        offsets.push(connectivity.len() as u64);
-    }
-    let mut types = vec![CellType::Quad; grid.quads.len()];
-    types.resize(grid.cells(), CellType::Line);
-    Ok(Cells {
-        cell_verts: VertexNumbers::XML {
-            connectivity,
-            offsets,
-        },
-        types,
-    })
-}
-
-/// Encodes the frame into XML bytes in memory (vtkio's own file writer ignores short writes).
-fn encode(path: &Path, vtk: Vtk, compression: Compression) -> Result<Vec<u8>, OutputError> {
-    let vtk_error = |source: vtkio::xml::Error| OutputError::Vtk {
-        path: path.to_path_buf(),
-        source: source.into(),
-    };
-    let (compressor, level) = compression.vtkio();
-    let file = vtk
-        .try_into_xml_format(compressor, level)
-        .map_err(vtk_error)?;
-    let mut bytes = Vec::new();
-    file.write(&mut bytes).map_err(vtk_error)?;
-    Ok(bytes)
+    use Section::{CellData, PointData};
+    use Source::{Pairs, Singles, Sixes};
+    let list = [
+        field(PointData, "displacement", Pairs(fields.displacement), 3),
+        field(PointData, "velocity", Pairs(fields.velocity), 3),
+        field(PointData, "acceleration", Pairs(fields.acceleration), 3),
+        field(PointData, "contact_force", Pairs(fields.contact_force), 3),
+        field(PointData, "gap", Singles(fields.gap), 1),
+        field(PointData, "contact_status", Singles(fields.contact_status), 1),
+        field(CellData, "stress", Sixes(fields.stress), 6),
+        field(CellData, "von_mises", Singles(fields.von_mises), 1),
+        field(CellData, "eq_plastic_strain", Singles(fields.eq_plastic_strain), 1),
+        field(CellData, "pressure", Singles(fields.pressure), 1),
+    ];
+    Payload::new(path, grid, &list, Some("displacement"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::output::{temporary_path, test_dir};
-    use vtkio::model::{Attribute, IOBuffer};
+    use crate::output::vtu::{FrameData, read_frame};
 
     /// Owned fields of one frame, with values that differ per entry, component and frame.
     struct Frame {
@@ -705,63 +549,64 @@ mod tests {
         }
     }
 
-    fn import(path: &Path) -> UnstructuredGridPiece {
-        let vtk = Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let DataSet::UnstructuredGrid { mut pieces, .. } = vtk.data else {
-            panic!("{} is not an unstructured grid", path.display())
-        };
-        assert_eq!(pieces.len(), 1);
-        pieces.remove(0).into_loaded_piece_data(None).unwrap()
-    }
-
-    fn floats(buffer: &IOBuffer) -> Vec<f64> {
-        buffer.cast_into::<f64>().expect("a Float64 array")
+    fn import(path: &Path) -> FrameData {
+        read_frame(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
     }
 
     fn bits(values: &[f64]) -> Vec<u64> {
         values.iter().map(|x| x.to_bits()).collect()
     }
 
-    /// Checks that `attributes` hold exactly the `expected` arrays, bit for bit.
-    fn assert_arrays(path: &Path, attributes: &[Attribute], expected: &[(&str, usize, Vec<f64>)]) {
-        assert_eq!(attributes.len(), expected.len(), "{}", path.display());
+    /// Checks that `section` holds exactly the `expected` arrays, bit for bit.
+    fn assert_arrays(
+        path: &Path,
+        frame: &FrameData,
+        section: Section,
+        expected: &[(&str, usize, Vec<f64>)],
+    ) {
+        let names: Vec<&str> = expected.iter().map(|(name, ..)| *name).collect();
+        assert_eq!(frame.names(section), names, "{}", path.display());
         for (name, components, values) in expected {
-            let array = attributes
-                .iter()
-                .find_map(|a| match a {
-                    Attribute::DataArray(array) if array.name == *name => Some(array),
-                    _ => None,
-                })
-                .unwrap_or_else(|| panic!("{}: no array {name}", path.display()));
-            assert_eq!(array.num_comp(), *components, "{name}");
-            assert_eq!(bits(&floats(&array.data)), bits(values), "{name}");
+            let (found, read) = frame
+                .floats(section, name)
+                .unwrap_or_else(|| panic!("{}: no Float64 array {name}", path.display()));
+            assert_eq!(found, *components, "{name}");
+            assert_eq!(bits(read), bits(values), "{name}");
         }
     }
 
     /// Checks one written frame against the grid and the fields it was written from.
     fn assert_frame(path: &Path, grid: &Grid, frame: &Frame) {
-        let piece = import(path);
+        let read = import(path);
+        assert_eq!((read.points, read.cells), (grid.points.len(), grid.cells()));
+        assert_eq!(read.vectors.as_deref(), Some("displacement"));
         let points: Vec<f64> = grid.points.iter().flat_map(|p| [p[0], p[1], 0.0]).collect();
-        assert_eq!(bits(&floats(&piece.points)), bits(&points));
-        let mut types = vec![CellType::Quad; grid.quads.len()];
-        types.resize(grid.cells(), CellType::Line);
-        assert_eq!(piece.cells.types, types);
-        let (connectivity, offsets) = piece.cells.cell_verts.into_xml();
+        assert_arrays(path, &read, Section::Points, &[("Points", 3, points)]);
+        let mut types = vec![9u8; grid.quads.len()];
+        types.resize(grid.cells(), 3);
+        assert_eq!(read.types().unwrap(), types);
         let nodes = grid
             .quads
             .iter()
             .map(|q| &q[..])
             .chain(grid.lines.iter().map(|l| &l[..]));
-        let expected: Vec<u64> = nodes.flatten().map(|&n| n as u64).collect();
-        assert_eq!(connectivity, expected);
-        assert_eq!(offsets.len(), grid.cells());
-        assert_arrays(path, &piece.data.point, &frame.point_arrays());
-        assert_arrays(path, &piece.data.cell, &frame.cell_arrays());
+        let offsets: Vec<i64> = nodes
+            .clone()
+            .scan(0, |end, cell| {
+                *end += cell.len() as i64;
+                Some(*end)
+            })
+            .collect();
+        let expected: Vec<i64> = nodes.flatten().map(|&n| n as i64).collect();
+        assert_eq!(read.integers("connectivity").unwrap(), expected);
+        assert_eq!(read.integers("offsets").unwrap(), offsets);
+        assert_arrays(path, &read, Section::PointData, &frame.point_arrays());
+        assert_arrays(path, &read, Section::CellData, &frame.cell_arrays());
     }
 
     const TIMES: [f64; 3] = [0.0, 1e-5, 1.0 / 3.0];
 
-    /// Goal: a 3-frame series reads back through the .pvd and vtkio exactly as written.
+    /// Goal: a 3-frame series reads back through the .pvd and `read_frame` exactly as written.
     /// Setup: 2 quads + 1 rod, all fields distinct per entry, times 0, 1e-5, 1/3.
     /// Reference: the written values themselves (binary arrays must be bit-exact).
     fn assert_series_round_trips(compression: Compression) {
@@ -797,7 +642,7 @@ mod tests {
     /// Goal: frames written by the writer thread are the synchronous ones: in order, each
     /// listed once complete, all on disk after `flush`; a writer error is reported by the
     /// next call and by every call after it, and the .pvd keeps listing only the frames
-    /// that were written. Reference: the frames' own data (read back with vtkio).
+    /// that were written. Reference: the frames' own data (read back).
     #[test]
     fn background_writer_keeps_order_and_reports_its_error() {
         let dir = test_dir("background");
@@ -840,22 +685,22 @@ mod tests {
     }
 
     #[test]
-    fn series_round_trips_through_pvd_and_vtkio_uncompressed() {
+    fn series_round_trips_through_pvd_uncompressed() {
         assert_series_round_trips(Compression::None);
     }
 
     #[test]
-    fn series_round_trips_through_pvd_and_vtkio_lz4() {
+    fn series_round_trips_through_pvd_lz4() {
         assert_series_round_trips(Compression::Lz4);
     }
 
     #[test]
-    fn series_round_trips_through_pvd_and_vtkio_zlib() {
+    fn series_round_trips_through_pvd_zlib() {
         assert_series_round_trips(Compression::Zlib);
     }
 
     /// A 64 x 64 node grid with 63 x 63 quads and 127 rods: 4096 points and 4096 cells, so
-    /// every array is a whole number of vtkio's 32768-byte compression blocks.
+    /// every array is a whole number of the 32768-byte compression blocks.
     fn block_sized_grid() -> Grid {
         let n = 64;
         let points = (0..n * n)
@@ -873,8 +718,8 @@ mod tests {
         }
     }
 
-    /// Goal: compressed arrays whose size is an exact multiple of the 32768-byte block
-    /// (vtkio then writes an empty last block) still read back exactly.
+    /// Goal: compressed arrays whose size is an exact multiple of the 32768-byte block (the
+    /// last block size in the header is then 0: a full block) still read back exactly.
     #[test]
     fn compressed_arrays_of_whole_blocks_round_trip() {
         let grid = block_sized_grid();
@@ -887,6 +732,51 @@ mod tests {
             assert_frame(&path, &grid, &frame);
             fs::remove_dir_all(&dir).unwrap();
         }
+    }
+
+    /// Writes the series that tests/vtk/check_with_vtk.py reads with VTK's own reader (the
+    /// independent check of the file layout, docs/validation.md): for each compression,
+    /// output/vtk_reader_check/COMPRESSION/{small,blocks}.pvd with the frames of `Frame::new`.
+    /// Run: cargo test --release --lib vtk_reader_check -- --ignored, then the script.
+    #[test]
+    #[ignore = "writes files for tests/vtk/check_with_vtk.py"]
+    fn vtk_reader_check_frames() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("output/vtk_reader_check");
+        for compression in [Compression::None, Compression::Lz4, Compression::Zlib] {
+            let dir = root.join(serde_json::to_string(&compression).unwrap().trim_matches('"'));
+            for (name, grid) in [("small", two_quads_and_a_rod()), ("blocks", block_sized_grid())] {
+                let mut series = Series::create(&dir, name, compression).unwrap();
+                for (k, time) in TIMES.iter().enumerate() {
+                    let frame = Frame::new(&grid, k);
+                    series.write_frame(*time, &grid, &frame.fields()).unwrap();
+                }
+            }
+        }
+    }
+
+    /// Goal: a frame file cut short, or with a header this code does not write, is an error
+    /// naming the file, not a panic or wrong values.
+    #[test]
+    fn damaged_frames_are_read_as_errors() {
+        let dir = test_dir("damaged");
+        let grid = block_sized_grid();
+        let frame = Frame::new(&grid, 0);
+        for compression in [Compression::None, Compression::Lz4, Compression::Zlib] {
+            let mut series = Series::create(&dir, "run", compression).unwrap();
+            let path = series.write_frame(0.0, &grid, &frame.fields()).unwrap();
+            let bytes = fs::read(&path).unwrap();
+            for cut in [bytes.len() / 3, bytes.len() - 40] {
+                fs::write(&path, &bytes[..cut]).unwrap();
+                let err = read_frame(&path).expect_err("a cut file");
+                assert!(err.to_string().contains("run_00000.vtu"), "{err}");
+            }
+            let text = String::from_utf8_lossy(&bytes[..200]).replace("UInt64", "UInt32");
+            let mut other = text.into_bytes();
+            other.extend_from_slice(&bytes[200..]);
+            fs::write(&path, &other).unwrap();
+            assert!(read_frame(&path).unwrap_err().to_string().contains("header_type"));
+        }
+        fs::remove_dir_all(&dir).unwrap();
     }
 
     /// Goal: a bad frame is an error naming the problem, and the frames and .pvd already
