@@ -264,7 +264,12 @@ fn run_writes_a_loadable_series_and_check_reports_size() {
         ] {
             let found = frame.floats(section, name).map(|(c, v)| (c, v.len()));
             let entries = if section == PointData { 27 } else { 16 };
-            assert_eq!(found, Some((components, components * entries)), "{name} in {}", path.display());
+            assert_eq!(
+                found,
+                Some((components, components * entries)),
+                "{name} in {}",
+                path.display()
+            );
         }
     }
     let check = impact(&["check", scene.to_str().unwrap()]);

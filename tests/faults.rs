@@ -88,7 +88,8 @@ fn assert_fault(out: &Path, name: &str, status: &str, needles: &[&str]) -> serde
     let frames = impact::output::vtk::read_pvd(&out.join(format!("{name}.pvd"))).unwrap();
     assert!(!frames.is_empty());
     for (time, path) in &frames {
-        impact::output::vtu::read_frame(path).unwrap_or_else(|e| panic!("frame at t = {time}: {e}"));
+        impact::output::vtu::read_frame(path)
+            .unwrap_or_else(|e| panic!("frame at t = {time}: {e}"));
     }
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     assert!(history.ends_with('\n'), "whole rows only");

@@ -241,7 +241,10 @@ pub fn run(
                 let positions = state.positions(spec.geometry);
                 let correction =
                     contact.explicit_step(model, &positions, &du, &inverse_mass, h, time);
-                (du.par_chunks_mut(DOF_CHUNK), v_half.par_chunks_mut(DOF_CHUNK))
+                (
+                    du.par_chunks_mut(DOF_CHUNK),
+                    v_half.par_chunks_mut(DOF_CHUNK),
+                )
                     .into_par_iter()
                     .zip(correction.par_chunks(DOF_CHUNK))
                     .for_each(|((du, v_half), correction)| {
@@ -454,7 +457,10 @@ const DOF_CHUNK: usize = 4096;
 
 /// The predictor: v_{n+1/2} = v_n + h/2 a_n, du = h v_{n+1/2}.
 fn predict(v: &[f64], a: &[f64], h: f64, v_half: &mut [f64], du: &mut [f64]) {
-    (v_half.par_chunks_mut(DOF_CHUNK), du.par_chunks_mut(DOF_CHUNK))
+    (
+        v_half.par_chunks_mut(DOF_CHUNK),
+        du.par_chunks_mut(DOF_CHUNK),
+    )
         .into_par_iter()
         .zip((v.par_chunks(DOF_CHUNK), a.par_chunks(DOF_CHUNK)))
         .for_each(|((v_half, du), (v, a))| {

@@ -2,7 +2,6 @@
 //! row per converged step, summary.json at the end (also after a failure).
 
 use super::Summary;
-use rayon::prelude::*;
 use super::contact::ContactState;
 use crate::assembly::State;
 use crate::contact::Friction;
@@ -13,6 +12,7 @@ use crate::output::vtk::{Fields, Grid, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
 use crate::scene::spec::{Quantity, Statistic};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Energies of one step (history.csv columns 2-6).

@@ -89,9 +89,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 pub fn write_atomic_parts(path: &Path, parts: &[Vec<u8>]) -> Result<(), OutputError> {
     use std::io::Write;
     let tmp = temporary_path(path);
-    let written = fs::File::create(&tmp).and_then(|mut file| {
-        parts.iter().try_for_each(|part| file.write_all(part))
-    });
+    let written = fs::File::create(&tmp)
+        .and_then(|mut file| parts.iter().try_for_each(|part| file.write_all(part)));
     written.map_err(|e| {
         let _ = fs::remove_file(&tmp);
         OutputError::io(&tmp, "write", e)

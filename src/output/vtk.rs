@@ -453,10 +453,20 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
         field(PointData, "acceleration", Pairs(fields.acceleration), 3),
         field(PointData, "contact_force", Pairs(fields.contact_force), 3),
         field(PointData, "gap", Singles(fields.gap), 1),
-        field(PointData, "contact_status", Singles(fields.contact_status), 1),
+        field(
+            PointData,
+            "contact_status",
+            Singles(fields.contact_status),
+            1,
+        ),
         field(CellData, "stress", Sixes(fields.stress), 6),
         field(CellData, "von_mises", Singles(fields.von_mises), 1),
-        field(CellData, "eq_plastic_strain", Singles(fields.eq_plastic_strain), 1),
+        field(
+            CellData,
+            "eq_plastic_strain",
+            Singles(fields.eq_plastic_strain),
+            1,
+        ),
         field(CellData, "pressure", Singles(fields.pressure), 1),
     ];
     Payload::new(path, grid, &list, Some("displacement"))
@@ -465,8 +475,8 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::{temporary_path, test_dir};
     use crate::output::vtu::{FrameData, read_frame};
+    use crate::output::{temporary_path, test_dir};
 
     /// Owned fields of one frame, with values that differ per entry, component and frame.
     struct Frame {
@@ -743,8 +753,15 @@ mod tests {
     fn vtk_reader_check_frames() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("output/vtk_reader_check");
         for compression in [Compression::None, Compression::Lz4, Compression::Zlib] {
-            let dir = root.join(serde_json::to_string(&compression).unwrap().trim_matches('"'));
-            for (name, grid) in [("small", two_quads_and_a_rod()), ("blocks", block_sized_grid())] {
+            let dir = root.join(
+                serde_json::to_string(&compression)
+                    .unwrap()
+                    .trim_matches('"'),
+            );
+            for (name, grid) in [
+                ("small", two_quads_and_a_rod()),
+                ("blocks", block_sized_grid()),
+            ] {
                 let mut series = Series::create(&dir, name, compression).unwrap();
                 for (k, time) in TIMES.iter().enumerate() {
                     let frame = Frame::new(&grid, k);
@@ -774,7 +791,12 @@ mod tests {
             let mut other = text.into_bytes();
             other.extend_from_slice(&bytes[200..]);
             fs::write(&path, &other).unwrap();
-            assert!(read_frame(&path).unwrap_err().to_string().contains("header_type"));
+            assert!(
+                read_frame(&path)
+                    .unwrap_err()
+                    .to_string()
+                    .contains("header_type")
+            );
         }
         fs::remove_dir_all(&dir).unwrap();
     }

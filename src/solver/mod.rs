@@ -305,3 +305,98 @@ mod tests {
         }
     }
 }
+
+/// The fill of the Cholesky factor of the bench block (docs/performance.md, implicit memory).
+#[cfg(test)]
+mod fill {
+    use faer::Side;
+    use faer::sparse::SymbolicSparseColMat;
+    use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
+
+    /// Nodes of an nx x ny grid in geometric nested-dissection order: each half first, the
+    /// separating grid line last, down to blocks of 16 nodes.
+    fn dissect(x: (usize, usize), y: (usize, usize), nx: usize, out: &mut Vec<usize>) {
+        let (w, h) = (x.1 - x.0, y.1 - y.0);
+        if w * h <= 16 {
+            out.extend((y.0..y.1).flat_map(|j| (x.0..x.1).map(move |i| j * nx + i)));
+        } else if w >= h {
+            let m = x.0 + w / 2;
+            dissect((x.0, m), y, nx, out);
+            dissect((m + 1, x.1), y, nx, out);
+            out.extend((y.0..y.1).map(|j| j * nx + m));
+        } else {
+            let m = y.0 + h / 2;
+            dissect(x, (y.0, m), nx, out);
+            dissect(x, (m + 1, y.1), nx, out);
+            out.extend((x.0..x.1).map(|i| m * nx + i));
+        }
+    }
+
+    /// Goal: how many entries the factor of the bench's implicit block holds per DOF, with
+    /// faer's AMD and with a geometric nested dissection (the asymptotically optimal order on
+    /// a 2D grid, George 1973), to see what a better order could save of issue #9's memory
+    /// target (1 kB/DOF at 1e6 DOFs). Prints; asserts only that the two orders agree within
+    /// 20 % at 1e6 DOFs, the conclusion docs/performance.md draws.
+    /// Run: cargo test --release --lib cholesky_fill -- --ignored --nocapture (about 10 s).
+    #[test]
+    #[ignore = "a measurement for docs/performance.md"]
+    fn cholesky_fill_of_the_bench_block_amd_against_nested_dissection() {
+        for n in [100usize, 316, 1000] {
+            let text = crate::bench::scene(&crate::bench::Case {
+                name: "fill".into(),
+                method: crate::bench::Method::Implicit,
+                n,
+                steps: 1,
+                contact: false,
+                frame_every: 0,
+                threads: None,
+                speed: 10.0,
+                strategy: "modified",
+            });
+            let model =
+                crate::scene::from_str(&text, std::path::Path::new("fill.toml"), &[]).unwrap();
+            let p = crate::assembly::System::new(&model, &[]).pattern;
+            let matrix = SymbolicSparseColMat::new_checked(
+                p.size,
+                p.size,
+                p.col_ptr.clone(),
+                None,
+                p.row_idx.clone(),
+            );
+            let factor = |ordering| {
+                factorize_symbolic_cholesky(
+                    matrix.as_ref(),
+                    Side::Lower,
+                    ordering,
+                    Default::default(),
+                )
+                .unwrap()
+                .len_val()
+            };
+            let amd = factor(SymmetricOrdering::Amd);
+            let (nx, ny) = (n + 1, n / 2 + 1);
+            let mut nodes = Vec::with_capacity(nx * ny);
+            dissect((0, nx), (0, ny), nx, &mut nodes);
+            let forward: Vec<usize> = nodes.iter().flat_map(|v| [2 * v, 2 * v + 1]).collect();
+            let mut inverse = vec![0; p.size];
+            for (i, f) in forward.iter().enumerate() {
+                inverse[*f] = i;
+            }
+            let order = faer::perm::PermRef::new_checked(&forward, &inverse, p.size);
+            let nd = factor(SymmetricOrdering::Custom(order));
+            let per_dof = |entries: usize| entries as f64 / p.size as f64;
+            eprintln!(
+                "{} DOFs: K lower {:.1} entries/DOF; factor AMD {:.1} entries/DOF ({:.3} kB/DOF in f64), nested dissection {:.1} ({:.3} kB/DOF)",
+                p.size,
+                per_dof(p.row_idx.len()),
+                per_dof(amd),
+                per_dof(amd) * 8e-3,
+                per_dof(nd),
+                per_dof(nd) * 8e-3
+            );
+            if n == 1000 {
+                assert!((nd as f64 / amd as f64 - 1.0).abs() < 0.2);
+            }
+        }
+    }
+}
