@@ -23,6 +23,10 @@ pub struct Case {
     pub n: usize,
     pub steps: usize,
     pub contact: bool,
+    /// The bottom edge held at y = 0 by supports instead of the wall: the same deformation as
+    /// the closed wall (no release within the run) without the contact machinery, the
+    /// baseline of the cost of contact.
+    pub supported: bool,
     /// Write a VTK frame every this many steps (0: none).
     pub frame_every: usize,
     /// Rayon threads of the run (None: rayon's default, one per core).
@@ -55,6 +59,9 @@ pub struct Row {
     pub elements: usize,
     pub dofs: usize,
     pub contact: bool,
+    /// See `Case::supported`.
+    #[serde(default)]
+    pub supported: bool,
     pub frame_every: usize,
     pub threads: Option<usize>,
     pub status: String,
@@ -101,16 +108,19 @@ pub fn plan(quick: bool) -> Vec<Case> {
             Method::Explicit | Method::ExplicitReduced => 100,
         },
         contact: true,
+        supported: false,
         frame_every: 0,
         threads: None,
         speed: 10.0,
         strategy: "modified",
     };
-    // the cost of contact alone: an elastic impact, K* factored once, with and without the
-    // wall (n + 1 active pairs)
-    let elastic = |n: usize, contact: bool| Case {
-        name: format!("implicit_{n}_elastic{}", if contact { "" } else { "_free" }),
-        contact,
+    // the cost of contact alone: an elastic impact, K* factored once, with the wall (n + 1
+    // active pairs), with supports in its place (the same deformation, no contact) and in
+    // free flight (a rigid motion)
+    let elastic = |n: usize, bottom: &str| Case {
+        name: format!("implicit_{n}_elastic{bottom}"),
+        contact: bottom.is_empty(),
+        supported: bottom == "_supported",
         speed: 1.0,
         strategy: "initial",
         ..case(Method::Implicit, n)
@@ -129,8 +139,9 @@ pub fn plan(quick: bool) -> Vec<Case> {
                 ..case(method, 60)
             });
         }
-        cases.push(elastic(60, true));
-        cases.push(elastic(60, false));
+        for bottom in ["", "_supported", "_free"] {
+            cases.push(elastic(60, bottom));
+        }
         cases.push(Case {
             name: "explicit_reduced_60_frames".into(),
             frame_every: 10,
@@ -158,8 +169,9 @@ pub fn plan(quick: bool) -> Vec<Case> {
         });
     }
     for n in [100, 316] {
-        cases.push(elastic(n, true));
-        cases.push(elastic(n, false));
+        for bottom in ["", "_supported", "_free"] {
+            cases.push(elastic(n, bottom));
+        }
     }
     // 448 x 224 = 100 352 elements
     let fast = |name: &str| Case {
@@ -223,6 +235,12 @@ points = [[1.0, 0.0], [-1.0, 0.0]]
 name = "wall"
 slave = { set = "bottom" }
 obstacle = "wall"
+"#
+    } else if case.supported {
+        r#"
+[[support]]
+set = "bottom"
+fix = ["y"]
 "#
     } else {
         ""
@@ -337,6 +355,7 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
         elements: s.elements,
         dofs: s.dofs,
         contact: case.contact,
+        supported: case.supported,
         frame_every: case.frame_every,
         threads: case.threads,
         status: match code {

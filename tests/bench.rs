@@ -15,7 +15,8 @@ use std::process::Command;
 /// per factorization (the 61 bottom nodes of the 60 x 30 block, all closed from the first
 /// step, y only on the horizontal wall) plus two per iteration (delta_0 and K*^-1 C^T tau)
 /// while a constraint is active, which holds for all 10 steps here (the block does not
-/// rebound within them); without contact, one per iteration. Tolerance: exact counts.
+/// rebound within them); without contact (free flight, or supports in place of the wall),
+/// one per iteration. Tolerance: exact counts.
 #[test]
 fn quick_bench_runs_and_contact_never_refactors() {
     let dir = std::env::temp_dir().join(format!("impact_bench_test_{}", std::process::id()));
@@ -57,6 +58,9 @@ fn quick_bench_runs_and_contact_never_refactors() {
         61 + 2 * contact.newton_iterations
     );
     assert_eq!(free.back_substitutions, free.newton_iterations);
+    let supported = row("implicit_60_elastic_supported");
+    assert_eq!(supported.factorizations, 1);
+    assert_eq!(supported.back_substitutions, supported.newton_iterations);
     for chart in ["bench_throughput.svg", "bench_time_breakdown.svg"] {
         assert!(dir.join(chart).is_file(), "{chart}");
     }

@@ -348,6 +348,7 @@ mod fill {
                 n,
                 steps: 1,
                 contact: false,
+                supported: false,
                 frame_every: 0,
                 threads: None,
                 speed: 10.0,
