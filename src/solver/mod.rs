@@ -5,9 +5,16 @@
 //! assembly writes into `values` through precomputed positions.
 
 use faer::Side;
-use faer::prelude::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltError as LltFactorError;
+use faer::sparse::linalg::cholesky::simplicial::SymbolicSimplicialCholesky;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use rayon::prelude::*;
 
 /// Lower-triangular CSC pattern of the free-DOF matrix.
 #[derive(Debug, Clone)]
@@ -109,11 +116,15 @@ pub enum SolverError {
 }
 
 /// Sparse Cholesky with the symbolic analysis reused and counters for the summary.
+///
+/// faer's LL^T: the symbolic analysis (AMD ordering, supernodes) once per pattern, the
+/// numeric factor in `values` once per K*.
 pub struct Solver {
     matrix: SymbolicSparseColMat<usize>,
     /// None for an empty system (every DOF prescribed): factor and solve do nothing.
-    symbolic: Option<SymbolicLlt<usize>>,
-    factor: Option<Llt<usize, f64>>,
+    symbolic: Option<Symbolic>,
+    /// The values of L of the last successful factorization (empty: none).
+    values: Vec<f64>,
     pub factorizations: usize,
     pub solves: usize,
     /// Entries of K^-1 among the equations the contact rows have named, for the current
@@ -121,22 +132,57 @@ pub struct Solver {
     inverse: InverseEntries,
 }
 
+/// The symbolic factorization and what the partial forward solves need of it.
+struct Symbolic {
+    cholesky: SymbolicCholesky<usize>,
+    /// The supernode of each (permuted) column (supernodal factors).
+    supernode_of: Vec<usize>,
+}
+
+/// The numeric factor seen as the blocks of the elimination tree: supernodes, or single
+/// columns of a simplicial factor (faer picks one when supernodes would not pay: diagonal
+/// matrices here).
+#[derive(Clone, Copy)]
+enum TreeFactor<'a> {
+    Supernodal(SupernodalLltRef<'a, usize, f64>, &'a [usize]),
+    Simplicial(&'a SymbolicSimplicialCholesky<usize>, &'a [f64]),
+}
+
 /// K^-1 restricted to a growing set of equations (those contact rows name): the Schur
-/// complement C K^-1 C^T needs no more. An equation's column K^-1 e_i is solved once per
-/// factorization (in blocks of right-hand sides) and only its entries at the equations known
-/// by then are kept; by symmetry they hold every pair.
+/// complement C K^-1 C^T needs no more. With K = P^T L L^T P,
+/// ```text
+/// (K^-1)_ab = y_a . y_b,   y_a = L^-1 P e_a
+/// ```
+/// and y_a is non-zero only on the supernodes on the path from a's supernode to the root
+/// of the supernodal elimination tree: a forward solve along that path (a few per cent of
+/// the factor on the bench's grids) instead of a whole back-substitution. The y's are kept
+/// per factorization, so an equation named later costs its own path and its dot products.
 #[derive(Default)]
 struct InverseEntries {
     local: std::collections::HashMap<usize, usize>,
     equations: Vec<usize>,
-    /// `lower[k][j]` = (K^-1 e_{equations[k]})[equations[j]] for j <= k.
+    /// y_{equations[k]}: (supernode, its segment of y), supernodes ascending (the path).
+    paths: Vec<Vec<(usize, Vec<f64>)>>,
+    /// `lower[k][j]` = (K^-1)_{equations[k], equations[j]} for j <= k.
     lower: Vec<Vec<f64>>,
 }
 
-/// Right-hand sides per block solve of unit columns, and the most entries such a block may
-/// hold (32 MB of f64: at 1e6 equations a block is 4 columns).
-const UNIT_BLOCK: usize = 32;
-const UNIT_BLOCK_ENTRIES: usize = 4 << 20;
+/// y_a . y_b over the supernodes both paths hold (their common ancestors).
+fn path_dot(a: &[(usize, Vec<f64>)], b: &[(usize, Vec<f64>)]) -> f64 {
+    let (mut i, mut j, mut sum) = (0, 0, 0.0);
+    while i < a.len() && j < b.len() {
+        match a[i].0.cmp(&b[j].0) {
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+            std::cmp::Ordering::Equal => {
+                sum += a[i].1.iter().zip(&b[j].1).map(|(x, y)| x * y).sum::<f64>();
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    sum
+}
 
 impl Solver {
     pub fn new(pattern: &Pattern) -> Result<Solver, SolverError> {
@@ -150,15 +196,33 @@ impl Solver {
         let symbolic = if pattern.size == 0 {
             None
         } else {
-            Some(
-                SymbolicLlt::try_new(matrix.as_ref(), Side::Lower)
-                    .map_err(|e| SolverError::Factorization(format!("{e:?}")))?,
+            let cholesky = factorize_symbolic_cholesky(
+                matrix.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                CholeskySymbolicParams::default(),
             )
+            .map_err(|e| SolverError::Factorization(format!("{e:?}")))?;
+            let mut supernode_of = Vec::new();
+            if let SymbolicCholeskyRaw::Supernodal(supernodal) = cholesky.raw() {
+                supernode_of = vec![0; pattern.size];
+                for s in 0..supernodal.n_supernodes() {
+                    let (begin, end) = (
+                        supernodal.supernode_begin()[s],
+                        supernodal.supernode_end()[s],
+                    );
+                    supernode_of[begin..end].fill(s);
+                }
+            }
+            Some(Symbolic {
+                cholesky,
+                supernode_of,
+            })
         };
         Ok(Solver {
             matrix,
             symbolic,
-            factor: None,
+            values: Vec::new(),
             factorizations: 0,
             solves: 0,
             inverse: InverseEntries::default(),
@@ -174,32 +238,48 @@ impl Solver {
     }
 
     fn factor_values(&mut self, values: &[f64]) -> Result<(), SolverError> {
-        self.factor = None;
+        self.values.clear();
         self.inverse = InverseEntries::default();
         self.factorizations += 1;
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
         };
+        let cholesky = &symbolic.cholesky;
+        let mut factor = Vec::new();
+        factor
+            .try_reserve_exact(cholesky.len_val())
+            .map_err(|_| SolverError::Factorization("out of memory for the factor".into()))?;
+        factor.resize(cholesky.len_val(), 0.0);
+        let par = faer::get_global_parallelism();
+        let scratch = cholesky.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        let mut buffer = MemBuffer::try_new(scratch)
+            .map_err(|_| SolverError::Factorization("out of memory for the workspace".into()))?;
         let a = SparseColMatRef::new(self.matrix.as_ref(), values);
-        let llt =
-            Llt::try_new_with_symbolic(symbolic.clone(), a, Side::Lower).map_err(|e| match e {
-                faer::sparse::linalg::LltError::Numeric(
-                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
-                ) => SolverError::NotPositiveDefinite { index },
-                other => SolverError::Factorization(format!("{other:?}")),
-            });
-        self.factor = Some(llt?);
+        cholesky
+            .factorize_numeric_llt::<f64>(
+                &mut factor,
+                a,
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|LltFactorError::NonPositivePivot { index }| {
+                SolverError::NotPositiveDefinite { index }
+            })?;
+        self.values = factor;
         Ok(())
     }
 
     /// Whether a factorization is at hand (an empty system counts as factored once factored).
     pub fn is_factored(&self) -> bool {
-        self.factor.is_some() || (self.symbolic.is_none() && self.factorizations > 0)
+        !self.values.is_empty() || (self.symbolic.is_none() && self.factorizations > 0)
     }
 
     /// Makes the entries of K^-1 among `equations` (and those named before) available to
-    /// `inverse_local` / `inverse_entry`: one back-substitution per equation not seen since
-    /// the last factorization, solved as blocks of right-hand sides.
+    /// `inverse_local` / `inverse_entry`: a forward solve along its elimination-tree path per
+    /// equation not seen since the last factorization, and its dot products with the others.
     pub fn know_inverse(&mut self, equations: &[usize]) {
         let mut new: Vec<usize> = equations
             .iter()
@@ -211,30 +291,53 @@ impl Solver {
         if new.is_empty() {
             return;
         }
-        let n = self.matrix.nrows();
-        // blocks of at most UNIT_BLOCK columns and UNIT_BLOCK_ENTRIES entries, in one buffer
-        let width = UNIT_BLOCK.min(UNIT_BLOCK_ENTRIES / n.max(1)).max(1);
-        let mut buffer = vec![0.0; n * width.min(new.len())];
-        for block in new.chunks(width) {
-            let first = self.inverse.equations.len();
-            for (j, &eq) in block.iter().enumerate() {
-                self.inverse.local.insert(eq, first + j);
-                self.inverse.equations.push(eq);
+        let Some(symbolic) = &self.symbolic else {
+            return;
+        };
+        assert!(
+            !self.values.is_empty(),
+            "know_inverse after a successful factor"
+        );
+        let start = std::time::Instant::now();
+        let factor = match symbolic.cholesky.raw() {
+            SymbolicCholeskyRaw::Supernodal(supernodal) => TreeFactor::Supernodal(
+                SupernodalLltRef::new(supernodal, &self.values),
+                &symbolic.supernode_of,
+            ),
+            SymbolicCholeskyRaw::Simplicial(simplicial) => {
+                TreeFactor::Simplicial(simplicial, &self.values)
             }
-            let columns = &mut buffer[..n * block.len()];
-            columns.fill(0.0);
-            for (j, &eq) in block.iter().enumerate() {
-                columns[j * n + eq] = 1.0;
-            }
-            self.solve_block(columns, block.len());
-            for j in 0..block.len() {
-                let column = &columns[j * n..(j + 1) * n];
-                let known = &self.inverse.equations[..=first + j];
-                self.inverse
-                    .lower
-                    .push(known.iter().map(|&eq| column[eq]).collect());
-            }
+        };
+        let inverse_perm = symbolic.cholesky.perm().map(|p| p.arrays().1.to_vec());
+        let paths: Vec<Vec<(usize, Vec<f64>)>> = new
+            .par_iter()
+            .map_init(
+                || vec![0.0; self.matrix.nrows()],
+                |work, &eq| {
+                    let row = inverse_perm.as_ref().map_or(eq, |inv| inv[eq]);
+                    forward_path(factor, row, work)
+                },
+            )
+            .collect();
+        for (eq, path) in new.into_iter().zip(paths) {
+            let k = self.inverse.equations.len();
+            self.inverse.local.insert(eq, k);
+            self.inverse.equations.push(eq);
+            self.inverse.paths.push(path);
         }
+        // the rows of the new equations: dot products with every equation known
+        let first = self.lower_rows();
+        let paths = &self.inverse.paths;
+        let rows: Vec<Vec<f64>> = (first..paths.len())
+            .into_par_iter()
+            .map(|k| (0..=k).map(|j| path_dot(&paths[k], &paths[j])).collect())
+            .collect();
+        self.inverse.lower.extend(rows);
+        crate::profile::add(crate::profile::Phase::Solve, start);
+    }
+
+    fn lower_rows(&self) -> usize {
+        self.inverse.lower.len()
     }
 
     /// The local index of an equation made known by `know_inverse`.
@@ -251,26 +354,87 @@ impl Solver {
         }
     }
 
-    /// Solves in place for `count` right-hand sides stored column after column.
-    fn solve_block(&mut self, columns: &mut [f64], count: usize) {
-        self.solves += count;
-        if self.symbolic.is_none() {
+    /// Solves in place with the current factorization (a back-substitution).
+    pub fn solve(&mut self, rhs: &mut [f64]) {
+        self.solves += 1;
+        let Some(symbolic) = &self.symbolic else {
             return;
-        }
-        let factor = self
-            .factor
-            .as_ref()
-            .expect("solve after a successful factor");
-        let n = columns.len() / count.max(1);
+        };
+        assert!(!self.values.is_empty(), "solve after a successful factor");
         let start = std::time::Instant::now();
-        factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(columns, n, count));
+        let par = faer::get_global_parallelism();
+        let mut buffer = MemBuffer::new(symbolic.cholesky.solve_in_place_scratch::<f64>(1, par));
+        LltRef::new(&symbolic.cholesky, &self.values).solve_in_place_with_conj(
+            faer::Conj::No,
+            faer::MatMut::from_column_major_slice_mut(rhs, rhs.len(), 1),
+            par,
+            MemStack::new(&mut buffer),
+        );
         crate::profile::add(crate::profile::Phase::Solve, start);
     }
+}
 
-    /// Solves in place with the current factorization.
-    pub fn solve(&mut self, rhs: &mut [f64]) {
-        self.solve_block(rhs, 1);
+/// y = L^-1 e_row along the elimination-tree path from `row`'s block (supernode, or column
+/// of a simplicial factor) to the root, as (block, its segment of y) in path order; `work`
+/// is zero on entry and on return.
+fn forward_path(factor: TreeFactor<'_>, row: usize, work: &mut [f64]) -> Vec<(usize, Vec<f64>)> {
+    let mut path = Vec::new();
+    work[row] = 1.0;
+    match factor {
+        TreeFactor::Simplicial(symbolic, values) => {
+            // column j: x_j /= L_jj, then the rows below; the parent is the first row below
+            let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+            let mut j = row;
+            loop {
+                let (first, end) = (col_ptr[j], col_ptr[j + 1]);
+                let xj = work[j] / values[first];
+                work[j] = 0.0;
+                for k in first + 1..end {
+                    work[row_idx[k]] -= values[k] * xj;
+                }
+                path.push((j, vec![xj]));
+                if first + 1 == end {
+                    break;
+                }
+                j = row_idx[first + 1];
+            }
+        }
+        TreeFactor::Supernodal(factor, supernode_of) => {
+            let mut s = supernode_of[row];
+            loop {
+                let node = factor.supernode(s);
+                let l = node.val();
+                let (begin, size) = (node.start(), l.ncols());
+                let pattern = node.pattern();
+                // the diagonal block: x_top = L_top^-1 x_top (lower triangular, non-unit)
+                let mut x: Vec<f64> = work[begin..begin + size].to_vec();
+                work[begin..begin + size].fill(0.0);
+                for j in 0..size {
+                    x[j] /= l[(j, j)];
+                    let xj = x[j];
+                    if xj != 0.0 {
+                        for i in j + 1..size {
+                            x[i] -= l[(i, j)] * xj;
+                        }
+                    }
+                }
+                // the rows below (all in ancestors): work[pattern] -= L_bottom x_top
+                for (j, xj) in x.iter().enumerate() {
+                    if *xj != 0.0 {
+                        for (k, r) in pattern.iter().enumerate() {
+                            work[*r] -= l[(size + k, j)] * xj;
+                        }
+                    }
+                }
+                path.push((s, x));
+                match pattern.first() {
+                    Some(r) => s = supernode_of[*r],
+                    None => break,
+                }
+            }
+        }
     }
+    path
 }
 
 #[cfg(test)]
@@ -304,100 +468,104 @@ mod tests {
             approx::assert_abs_diff_eq!(xi, bi, epsilon = 1e-12);
         }
     }
-}
 
-/// The fill of the Cholesky factor of the bench block (docs/performance.md, implicit memory).
-#[cfg(test)]
-mod fill {
-    use faer::Side;
-    use faer::sparse::SymbolicSparseColMat;
-    use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
-
-    /// Nodes of an nx x ny grid in geometric nested-dissection order: each half first, the
-    /// separating grid line last, down to blocks of 16 nodes.
-    fn dissect(x: (usize, usize), y: (usize, usize), nx: usize, out: &mut Vec<usize>) {
-        let (w, h) = (x.1 - x.0, y.1 - y.0);
-        if w * h <= 16 {
-            out.extend((y.0..y.1).flat_map(|j| (x.0..x.1).map(move |i| j * nx + i)));
-        } else if w >= h {
-            let m = x.0 + w / 2;
-            dissect((x.0, m), y, nx, out);
-            dissect((m + 1, x.1), y, nx, out);
-            out.extend((y.0..y.1).map(|j| j * nx + m));
-        } else {
-            let m = y.0 + h / 2;
-            dissect(x, (y.0, m), nx, out);
-            dissect(x, (m + 1, y.1), nx, out);
-            out.extend((x.0..x.1).map(|i| m * nx + i));
+    /// The largest error of `know_inverse`'s entries among `named` (in two groups, as
+    /// contact rows grow) against whole solves K^-1 e_a, and the largest entry.
+    fn inverse_errors(solver: &mut Solver, size: usize, named: &[usize]) -> (f64, f64) {
+        let (first, second) = named.split_at(named.len() / 2);
+        solver.know_inverse(first);
+        solver.know_inverse(second);
+        solver.know_inverse(&first[..1]);
+        let (mut largest, mut worst): (f64, f64) = (0.0, 0.0);
+        for &a in named {
+            let mut column = vec![0.0; size];
+            column[a] = 1.0;
+            solver.solve(&mut column);
+            for &b in named {
+                let entry = solver.inverse_entry(solver.inverse_local(a), solver.inverse_local(b));
+                largest = largest.max(column[b].abs());
+                worst = worst.max((entry - column[b]).abs());
+            }
         }
+        (worst, largest)
     }
 
-    /// Goal: how many entries the factor of the bench's implicit block holds per DOF, with
-    /// faer's AMD and with a geometric nested dissection (the asymptotically optimal order on
-    /// a 2D grid, George 1973), to see what a better order could save of issue #9's memory
-    /// target (1 kB/DOF at 1e6 DOFs). Prints; asserts only that the two orders agree within
-    /// 20 % at 1e6 DOFs, the conclusion docs/performance.md draws.
-    /// Run: cargo test --release --lib cholesky_fill -- --ignored --nocapture (about 10 s).
-    #[test]
-    #[ignore = "a measurement for docs/performance.md"]
-    fn cholesky_fill_of_the_bench_block_amd_against_nested_dissection() {
-        for n in [100usize, 316, 1000] {
-            let text = crate::bench::scene(&crate::bench::Case {
-                name: "fill".into(),
-                method: crate::bench::Method::Implicit,
-                n,
-                steps: 1,
-                contact: false,
-                supported: false,
-                frame_every: 0,
-                threads: None,
-                speed: 10.0,
-                strategy: "modified",
-            });
-            let model =
-                crate::scene::from_str(&text, std::path::Path::new("fill.toml"), &[]).unwrap();
-            let p = crate::assembly::System::new(&model, &[]).pattern;
-            let matrix = SymbolicSparseColMat::new_checked(
-                p.size,
-                p.size,
-                p.col_ptr.clone(),
-                None,
-                p.row_idx.clone(),
-            );
-            let factor = |ordering| {
-                factorize_symbolic_cholesky(
-                    matrix.as_ref(),
-                    Side::Lower,
-                    ordering,
-                    Default::default(),
-                )
-                .unwrap()
-                .len_val()
-            };
-            let amd = factor(SymmetricOrdering::Amd);
-            let (nx, ny) = (n + 1, n / 2 + 1);
-            let mut nodes = Vec::with_capacity(nx * ny);
-            dissect((0, nx), (0, ny), nx, &mut nodes);
-            let forward: Vec<usize> = nodes.iter().flat_map(|v| [2 * v, 2 * v + 1]).collect();
-            let mut inverse = vec![0; p.size];
-            for (i, f) in forward.iter().enumerate() {
-                inverse[*f] = i;
-            }
-            let order = faer::perm::PermRef::new_checked(&forward, &inverse, p.size);
-            let nd = factor(SymmetricOrdering::Custom(order));
-            let per_dof = |entries: usize| entries as f64 / p.size as f64;
-            eprintln!(
-                "{} DOFs: K lower {:.1} entries/DOF; factor AMD {:.1} entries/DOF ({:.3} kB/DOF in f64), nested dissection {:.1} ({:.3} kB/DOF)",
-                p.size,
-                per_dof(p.row_idx.len()),
-                per_dof(amd),
-                per_dof(amd) * 8e-3,
-                per_dof(nd),
-                per_dof(nd) * 8e-3
-            );
-            if n == 1000 {
-                assert!((nd as f64 / amd as f64 - 1.0).abs() < 0.2);
+    fn is_supernodal(solver: &Solver) -> bool {
+        let symbolic = solver.symbolic.as_ref().unwrap();
+        matches!(symbolic.cholesky.raw(), SymbolicCholeskyRaw::Supernodal(_))
+    }
+
+    /// A 2-DOF-per-node nx x ny node grid with the Quad4 pattern, SPD by diagonal dominance
+    /// with varying off-diagonals.
+    fn grid(nx: usize, ny: usize) -> (Pattern, Vec<f64>) {
+        let node = |i: usize, j: usize| j * nx + i;
+        let elements: Vec<Vec<Option<usize>>> = (0..ny - 1)
+            .flat_map(|j| (0..nx - 1).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                [
+                    node(i, j),
+                    node(i + 1, j),
+                    node(i + 1, j + 1),
+                    node(i, j + 1),
+                ]
+                .iter()
+                .flat_map(|n| [Some(2 * n), Some(2 * n + 1)])
+                .collect()
+            })
+            .collect();
+        let size = 2 * nx * ny;
+        let pattern = Pattern::from_elements(size, elements.iter().map(|e| e.as_slice()));
+        let mut values = vec![0.0; pattern.nonzeros()];
+        for j in 0..size {
+            for k in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                let i = pattern.row_idx[k];
+                values[k] = if i == j {
+                    20.0 + (j % 7) as f64
+                } else {
+                    -0.5 - 0.4 * ((i * 31 + j * 17) % 5) as f64 / 5.0
+                };
             }
         }
+        (pattern, values)
+    }
+
+    /// Goal: the entries of K^-1 from the partial forward solves along the elimination tree
+    /// (`know_inverse`) are those of whole back-substitutions K^-1 e_a, for supernodal and
+    /// for simplicial factors (faer picks by the flop count).
+    /// Setup: Quad4-pattern grids of 31 x 13 and 201 x 101 nodes (2 DOFs each) and a diagonal
+    /// matrix; 40 equations (6 for the diagonal) named in two groups, one again.
+    /// Reference: solve(e_a) read at every named b. Tolerance: 1e-12 relative to the
+    /// largest entry (two orders of summation).
+    #[test]
+    fn inverse_entries_from_tree_paths_match_whole_solves() {
+        let mut kinds = Vec::new();
+        for (nx, ny) in [(31, 13), (201, 101)] {
+            let (pattern, values) = grid(nx, ny);
+            let size = pattern.size;
+            let mut solver = Solver::new(&pattern).unwrap();
+            solver.factor(&values).unwrap();
+            kinds.push(is_supernodal(&solver));
+            let named: Vec<usize> = (0..20)
+                .map(|k| (k * 37) % size)
+                .chain((0..20).map(|k| (k * 53 + 11) % size))
+                .collect();
+            let (worst, largest) = inverse_errors(&mut solver, size, &named);
+            assert!(largest > 0.01, "{largest}");
+            assert!(
+                worst <= 1e-12 * largest,
+                "{nx} x {ny}: {worst} against {largest}"
+            );
+        }
+        let n = 12;
+        let singles: Vec<[Option<usize>; 1]> = (0..n).map(|i| [Some(i)]).collect();
+        let diagonal = Pattern::from_elements(n, singles.iter().map(|e| e.as_slice()));
+        let values: Vec<f64> = (0..n).map(|i| 1.0 + i as f64).collect();
+        let mut solver = Solver::new(&diagonal).unwrap();
+        solver.factor(&values).unwrap();
+        kinds.push(is_supernodal(&solver));
+        let (worst, largest) = inverse_errors(&mut solver, n, &[0, 3, 7, 11, 5, 2]);
+        assert_eq!(largest, 1.0);
+        assert!(worst <= 1e-15, "{worst}");
+        assert!(kinds.contains(&true) && kinds.contains(&false), "{kinds:?}");
     }
 }
