@@ -193,40 +193,45 @@ fn add_constraint_forces(rows: &Rows, forces: &[f64], target: &mut [f64]) {
     }
 }
 
-/// The Schur complement solve on the factored K*: delta_0 = K*^-1 R, S = C K*^-1 C^T,
-/// S tau = -g - C delta_0, delta = delta_0 + K*^-1 C^T tau. Contact never refactors K*.
+/// The Schur complement solve on the factored K* = P^T L L^T P, in one back-substitution:
+/// ```text
+/// w = L^-1 P R,  (delta_0)_a = y_a . w,  S = C K*^-1 C^T,  S tau = -g - C delta_0,
+/// delta = P^T L^-T (w + sum_rows tau_i sum_a c_ia y_a)      (y_a = L^-1 P e_a)
+/// ```
+/// (= delta_0 + K*^-1 C^T tau). Contact never refactors K*; the y_a come with the entries of
+/// K*^-1 among the constrained equations (`Solver::know_inverse`, once per factorization).
 fn constrained_solve(
     solver: &mut Solver,
     rows: &Rows,
     residual: Vec<f64>,
 ) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
-    let mut delta = residual;
-    solver.solve(&mut delta);
     let m = rows.rows.len();
     if m == 0 {
+        let mut delta = residual;
+        solver.solve(&mut delta);
         return Ok((delta, Vec::new()));
     }
-    // the Schur complement from K*^-1 restricted to the rows' equations (solved once per
-    // factorization), the correction delta += K*^-1 C^T tau by one more back-substitution:
-    // an iteration costs two back-substitutions however many constraints are active
-    // (entries with a zero coefficient, as the x entry of a row on a horizontal wall, are left
-    // out: they would cost a back-substitution each for nothing)
+    // entries with a zero coefficient, as the x entry of a row on a horizontal wall, are
+    // left out: they would cost a path each for nothing
+    let nonzero = |row: &Vec<(usize, f64)>| -> Vec<(usize, f64)> {
+        row.iter().filter(|(_, c)| *c != 0.0).copied().collect()
+    };
     let equations: Vec<usize> = rows
         .rows
         .iter()
-        .flatten()
-        .filter(|(_, c)| *c != 0.0)
-        .map(|(eq, _)| *eq)
+        .flat_map(nonzero)
+        .map(|(eq, _)| eq)
         .collect();
     solver.know_inverse(&equations);
+    let mut w = solver.forward(&residual);
     let schur_start = std::time::Instant::now();
     let local: Vec<Vec<(usize, f64)>> = rows
         .rows
         .iter()
         .map(|row| {
-            row.iter()
-                .filter(|(_, c)| *c != 0.0)
-                .map(|(eq, c)| (solver.inverse_local(*eq), *c))
+            nonzero(row)
+                .into_iter()
+                .map(|(eq, c)| (solver.inverse_local(eq), c))
                 .collect()
         })
         .collect();
@@ -245,21 +250,23 @@ fn constrained_solve(
         }
         s
     });
-    let dot =
-        |row: &Vec<(usize, f64)>, v: &[f64]| row.iter().map(|(eq, c)| c * v[*eq]).sum::<f64>();
-    let rhs = nalgebra::DVector::from_fn(m, |i, _| -rows.gaps[i] - dot(&rows.rows[i], &delta));
+    let rhs = nalgebra::DVector::from_fn(m, |i, _| {
+        -rows.gaps[i]
+            - nonzero(&rows.rows[i])
+                .iter()
+                .map(|(eq, c)| c * solver.solution_entry(&w, *eq))
+                .sum::<f64>()
+    });
     let tau = schur.lu().solve(&rhs).ok_or_else(|| {
         StepFailure("the contact constraints are redundant (singular Schur complement)".into())
     })?;
-    let mut correction = vec![0.0; delta.len()];
     for (row, t) in rows.rows.iter().zip(tau.iter()) {
-        for (eq, c) in row {
-            correction[*eq] += c * t;
+        for (eq, c) in nonzero(row) {
+            solver.add_unit(&mut w, eq, c * t);
         }
     }
     profile::add(Phase::Contact, schur_start);
-    solver.solve(&mut correction);
-    delta.iter_mut().zip(&correction).for_each(|(d, c)| *d += c);
+    let delta = solver.backward(w);
     Ok((delta, tau.iter().copied().collect()))
 }
 
