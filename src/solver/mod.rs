@@ -559,31 +559,34 @@ fn forward_path(factor: TreeFactor<'_>, row: usize, work: &mut [f64]) -> Vec<(us
             }
         }
         TreeFactor::Supernodal(factor, supernode_of) => {
+            let mut below = Vec::new();
             let mut s = supernode_of[row];
             loop {
                 let node = factor.supernode(s);
                 let l = node.val();
                 let (begin, size) = (node.start(), l.ncols());
                 let pattern = node.pattern();
-                // the diagonal block: x_top = L_top^-1 x_top (lower triangular, non-unit)
+                // the diagonal block: x_top = L_top^-1 x_top; the rows below (all in
+                // ancestors): work[pattern] -= L_bottom x_top
+                let (l_top, l_bottom) = l.split_at_row(size);
                 let mut x: Vec<f64> = work[begin..begin + size].to_vec();
                 work[begin..begin + size].fill(0.0);
-                for j in 0..size {
-                    x[j] /= l[(j, j)];
-                    let xj = x[j];
-                    if xj != 0.0 {
-                        for i in j + 1..size {
-                            x[i] -= l[(i, j)] * xj;
-                        }
-                    }
-                }
-                // the rows below (all in ancestors): work[pattern] -= L_bottom x_top
-                for (j, xj) in x.iter().enumerate() {
-                    if *xj != 0.0 {
-                        for (k, r) in pattern.iter().enumerate() {
-                            work[*r] -= l[(size + k, j)] * xj;
-                        }
-                    }
+                let mut x_top = faer::MatMut::from_column_major_slice_mut(&mut x, size, 1);
+                solve_lower_triangular_in_place(l_top, x_top.rb_mut(), Par::Seq);
+                below.clear();
+                below.resize(pattern.len(), 0.0);
+                let mut product =
+                    faer::MatMut::from_column_major_slice_mut(&mut below, pattern.len(), 1);
+                matmul(
+                    product.rb_mut(),
+                    Accum::Replace,
+                    l_bottom,
+                    x_top.rb(),
+                    1.0,
+                    Par::Seq,
+                );
+                for (r, b) in pattern.iter().zip(&below) {
+                    work[*r] -= b;
                 }
                 path.push((s, x));
                 match pattern.first() {
