@@ -244,14 +244,16 @@ impl Solver {
     }
 
     fn factor_values(&mut self, values: &[f64]) -> Result<(), SolverError> {
-        self.values.clear();
+        // the last factor's buffer is reused (one factor in memory at a time); it is left
+        // empty, i.e. not factored, until the new factorization succeeds
+        let mut factor = std::mem::take(&mut self.values);
         self.inverse = InverseEntries::default();
         self.factorizations += 1;
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
         };
         let cholesky = &symbolic.cholesky;
-        let mut factor = Vec::new();
+        factor.clear();
         factor
             .try_reserve_exact(cholesky.len_val())
             .map_err(|_| SolverError::Factorization("out of memory for the factor".into()))?;
