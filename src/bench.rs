@@ -197,6 +197,12 @@ pub fn plan(quick: bool) -> Vec<Case> {
         frame_every: 10,
         ..fast("explicit_reduced_448_frames")
     });
+    // one stepping thread: the frame writer has the other core to itself
+    cases.push(Case {
+        threads: Some(1),
+        frame_every: 10,
+        ..fast("explicit_reduced_448_frames_1thread")
+    });
     cases
 }
 
@@ -379,7 +385,7 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
 /// The table printed by `impact bench`.
 pub fn table(rows: &[Row]) -> String {
     let mut s = format!(
-        "{:<29} {:>8} {:>8} {:>9} {:>8} {:>7} {:>6} {:>5} {:>8} {:>9} | {:>5} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}\n",
+        "{:<36} {:>8} {:>8} {:>9} {:>8} {:>7} {:>6} {:>5} {:>8} {:>9} | {:>5} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}\n",
         "case",
         "DOFs",
         "steps/s",
@@ -401,7 +407,7 @@ pub fn table(rows: &[Row]) -> String {
     for r in rows {
         let p = |x: f64| format!("{:>4.0}%", 100.0 * x);
         s.push_str(&format!(
-            "{:<29} {:>8} {:>8.1} {:>9.2e} {:>8.2} {:>7.2} {:>6} {:>5} {:>8} {:>9} | {} {} {} {} {} {} {}{}\n",
+            "{:<36} {:>8} {:>8.1} {:>9.2e} {:>8.2} {:>7.2} {:>6} {:>5} {:>8} {:>9} | {} {} {} {} {} {} {}{}\n",
             r.name,
             r.dofs,
             r.steps_per_second,

@@ -106,6 +106,10 @@ enum Command {
         /// Two small sizes only (seconds in all).
         #[arg(long)]
         quick: bool,
+        /// Only the cases whose name contains this text (repeatable), e.g.
+        /// `--case 448 --case elastic`.
+        #[arg(long = "case", value_name = "TEXT")]
+        cases: Vec<String>,
         /// Output folder. Default: output/bench/
         #[arg(long)]
         out: Option<PathBuf>,
@@ -175,7 +179,7 @@ fn main() -> ExitCode {
             out,
             quiet,
         ),
-        Command::Bench { quick, out } => bench(quick, out),
+        Command::Bench { quick, cases, out } => bench(quick, &cases, out),
         Command::Plot {
             history,
             y,
@@ -211,7 +215,7 @@ fn run_options(quiet: bool) -> RunOptions {
     }
 }
 
-fn bench(quick: bool, out: Option<PathBuf>) -> Result<(), RunError> {
+fn bench(quick: bool, only: &[String], out: Option<PathBuf>) -> Result<(), RunError> {
     let exe = std::env::current_exe().map_err(|e| {
         RunError::Output(OutputError::Io {
             path: PathBuf::from("impact"),
@@ -220,7 +224,19 @@ fn bench(quick: bool, out: Option<PathBuf>) -> Result<(), RunError> {
         })
     })?;
     let dir = out.unwrap_or_else(impact::bench::default_dir);
-    let cases = impact::bench::plan(quick);
+    let cases: Vec<_> = impact::bench::plan(quick)
+        .into_iter()
+        .filter(|c| only.is_empty() || only.iter().any(|text| c.name.contains(text.as_str())))
+        .collect();
+    if cases.is_empty() {
+        return Err(RunError::Input(impact::scene::InputError::new(
+            Path::new("impact bench"),
+            format!(
+                "no case of the plan matches --case {}",
+                only.join(", --case ")
+            ),
+        )));
+    }
     println!("impact bench: {} cases -> {}", cases.len(), dir.display());
     let rows = impact::bench::run(&exe, &dir, &cases, |row| {
         println!(

@@ -63,3 +63,29 @@ fn quick_bench_runs_and_contact_never_refactors() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Goal: `--case` keeps the matching cases only, and a filter that matches none is bad input
+/// (exit 2 naming it), not an empty bench. Reference: the plan's own names.
+#[test]
+fn bench_case_filter_runs_matching_cases_and_rejects_an_empty_selection() {
+    let dir = std::env::temp_dir().join(format!("impact_bench_case_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["bench", "--quick", "--case", "implicit_20", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows: Vec<Row> =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(names, ["implicit_20"]);
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["bench", "--quick", "--case", "no_such_case", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no_such_case"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
