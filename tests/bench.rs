@@ -3,7 +3,22 @@
 //! timing is asserted: speed is measured by `impact bench` itself (docs/performance.md).
 
 use impact::bench::Row;
+use std::path::Path;
 use std::process::Command;
+
+/// Runs `impact bench --quick ARGS --out DIR` (DIR emptied first) and reads its bench.json.
+fn quick_bench(dir: &Path, args: &[&str]) -> Vec<Row> {
+    let _ = std::fs::remove_dir_all(dir);
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["bench", "--quick"])
+        .args(args)
+        .arg("--out")
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap()
+}
 
 /// Goal: the quick bench runs end to end and its counters show the factor-once contact.
 /// Setup: `impact bench --quick` (2 sizes, implicit / explicit / fast explicit, free flight,
@@ -20,15 +35,7 @@ use std::process::Command;
 #[test]
 fn quick_bench_runs_and_contact_never_refactors() {
     let dir = std::env::temp_dir().join(format!("impact_bench_test_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(["bench", "--quick", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let rows: Vec<Row> =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    let rows = quick_bench(&dir, &[]);
     assert_eq!(rows.len(), impact::bench::plan(true).len());
     for r in &rows {
         assert_eq!(r.status, "ok", "{}", r.name);
@@ -69,15 +76,7 @@ fn quick_bench_runs_and_contact_never_refactors() {
 #[test]
 fn bench_case_filter_runs_matching_cases_and_rejects_an_empty_selection() {
     let dir = std::env::temp_dir().join(format!("impact_bench_case_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(["bench", "--quick", "--case", "implicit_20", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let rows: Vec<Row> =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    let rows = quick_bench(&dir, &["--case", "implicit_20"]);
     let names: Vec<&str> = rows.iter().map(|r| r.name.as_str()).collect();
     assert_eq!(names, ["implicit_20"]);
     let o = Command::new(env!("CARGO_BIN_EXE_impact"))

@@ -414,25 +414,7 @@ impl Solver {
                     let node = factor.supernode(s);
                     let (l, pattern) = (node.val(), node.pattern());
                     let (begin, size) = (node.start(), l.ncols());
-                    let (l_top, l_bottom) = l.split_at_row(size);
-                    let mut x_top = faer::MatMut::from_column_major_slice_mut(
-                        &mut x[begin..begin + size],
-                        size,
-                        1,
-                    );
-                    solve_lower_triangular_in_place(l_top, x_top.rb_mut(), Par::Seq);
-                    below.clear();
-                    below.resize(pattern.len(), 0.0);
-                    let mut product =
-                        faer::MatMut::from_column_major_slice_mut(&mut below, pattern.len(), 1);
-                    matmul(
-                        product.rb_mut(),
-                        Accum::Replace,
-                        l_bottom,
-                        x_top.rb(),
-                        1.0,
-                        Par::Seq,
-                    );
+                    supernode_forward(l, &mut x[begin..begin + size], &mut below);
                     for (r, b) in pattern.iter().zip(&below) {
                         x[*r] -= b;
                     }
@@ -532,6 +514,20 @@ impl Solver {
     }
 }
 
+/// One supernode of a forward solve: x_top = L_top^-1 x_top in place (lower triangular,
+/// non-unit), and `below` = L_bottom x_top, to be subtracted from the rows of its pattern.
+fn supernode_forward(l: faer::MatRef<'_, f64>, x_top: &mut [f64], below: &mut Vec<f64>) {
+    let size = x_top.len();
+    let (l_top, l_bottom) = l.split_at_row(size);
+    let mut x_top = faer::MatMut::from_column_major_slice_mut(x_top, size, 1);
+    solve_lower_triangular_in_place(l_top, x_top.rb_mut(), Par::Seq);
+    below.clear();
+    below.resize(l_bottom.nrows(), 0.0);
+    let rows = below.len();
+    let product = faer::MatMut::from_column_major_slice_mut(below, rows, 1);
+    matmul(product, Accum::Replace, l_bottom, x_top.rb(), 1.0, Par::Seq);
+}
+
 /// w = L^-1 P r of `Solver::forward`, in the factor's (permuted) order.
 pub struct Forward(Vec<f64>);
 
@@ -568,25 +564,10 @@ fn forward_path(factor: TreeFactor<'_>, row: usize, work: &mut [f64]) -> Vec<(us
                 let l = node.val();
                 let (begin, size) = (node.start(), l.ncols());
                 let pattern = node.pattern();
-                // the diagonal block: x_top = L_top^-1 x_top; the rows below (all in
-                // ancestors): work[pattern] -= L_bottom x_top
-                let (l_top, l_bottom) = l.split_at_row(size);
+                // the rows below are all in ancestors
                 let mut x: Vec<f64> = work[begin..begin + size].to_vec();
                 work[begin..begin + size].fill(0.0);
-                let mut x_top = faer::MatMut::from_column_major_slice_mut(&mut x, size, 1);
-                solve_lower_triangular_in_place(l_top, x_top.rb_mut(), Par::Seq);
-                below.clear();
-                below.resize(pattern.len(), 0.0);
-                let mut product =
-                    faer::MatMut::from_column_major_slice_mut(&mut below, pattern.len(), 1);
-                matmul(
-                    product.rb_mut(),
-                    Accum::Replace,
-                    l_bottom,
-                    x_top.rb(),
-                    1.0,
-                    Par::Seq,
-                );
+                supernode_forward(l, &mut x, &mut below);
                 for (r, b) in pattern.iter().zip(&below) {
                     work[*r] -= b;
                 }
