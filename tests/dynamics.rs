@@ -572,3 +572,47 @@ set = "left"
     let first_slope = 0.05 * (2.0 * std::f64::consts::PI * 0.01 / 0.4).sin() / 0.01;
     approx::assert_relative_eq!(v[0], first_slope, max_relative = 1e-9);
 }
+
+/// Goal: an end time a hair past a whole number of steps (as an end_time written with a few
+/// digits gives) ends the run in the last whole step, lengthened by the hair, instead of a
+/// step of 1e-8 dt of its own (found with the bench block: such a step did not converge,
+/// `diverged` after six cuts, with end_time = 5.1226381e-06). Setup: the bench's 20 x 10 J2 steel block in free flight at 10 m/s, Newmark average,
+/// modified Newton, end_time = 3 dt + 1e-13 s (6e-8 dt) and 3 dt + 3.6e-10 s (2e-4 dt, under
+/// the shortest step the control takes, dt / 2^6 / 10). Reference: a rigid motion keeps its
+/// kinetic energy (1/2 m V^2 = 1962.5 J/m), and the run ends at end_time in 3 steps.
+#[test]
+fn a_remainder_shorter_than_the_shortest_step_joins_the_last_step() {
+    let text = impact::bench::scene(&impact::bench::Case {
+        name: "remainder".into(),
+        method: impact::bench::Method::Implicit,
+        n: 20,
+        steps: 3,
+        contact: false,
+        supported: false,
+        frame_every: 0,
+        threads: None,
+        speed: 10.0,
+        strategy: "modified",
+    });
+    let model = common::model("remainder", &text, &[]);
+    let impact::scene::model::Analysis::Dynamic(spec) = &model.analysis else {
+        panic!("a dynamic scene")
+    };
+    let dt = spec.dt;
+    for extra in [1e-13, 3.6e-10] {
+        let end = 3.0 * dt + extra;
+        let set = format!("analysis.end_time={end:e}");
+        let model = common::model("remainder", &text, &[set.as_str()]);
+        let dir = common::out_dir("remainder");
+        let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
+        assert_eq!(summary.steps, 3, "extra {extra:e}");
+        let time = column(&dir, "time");
+        assert_eq!(*time.last().unwrap(), end);
+        // rho W H V^2 / 2 = 7850 * 0.1 * 0.05 * 100 / 2; round-off of 3 steps
+        approx::assert_relative_eq!(
+            *column(&dir, "kinetic_energy").last().unwrap(),
+            1962.5,
+            max_relative = 1e-12
+        );
+    }
+}

@@ -272,12 +272,14 @@ pub fn run(
             .copied()
             .find(|t| *t > state.time * (1.0 + 1e-9) + 1e-12 * spec.dt)
             .unwrap_or(f64::INFINITY);
-        let target = super::snap(
-            (state.time + control.length)
-                .min(spec.end_time)
-                .min(next_frame),
-            spec.dt,
-        );
+        // a remainder shorter than the shortest step the control takes joins this step: a
+        // step of 1e-7 dt (end_time written with a few digits) does not converge
+        let stop = spec.end_time.min(next_frame);
+        let mut end = (state.time + control.length).min(stop);
+        if stop - end < control.shortest() {
+            end = stop;
+        }
+        let target = super::snap(end, spec.dt);
         let nominal = super::step_length(target - state.time, spec.dt);
         let positions = state.positions(spec.geometry);
         let kinetic_before_impact = mass.kinetic_energy(model, &kin.velocity);

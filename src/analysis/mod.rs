@@ -240,7 +240,7 @@ impl StepControl {
                 self.cuts_in_a_row
             ));
         }
-        let floor = self.nominal * 0.5f64.powi(self.max_cuts as i32) * 0.1;
+        let floor = self.shortest();
         if 0.5 * attempted < floor {
             return Err(format!(
                 "did not converge: repeated cuts brought the step to {attempted:e}, and halving it would go below dt / 2^{} / 10 = {floor:e}",
@@ -251,6 +251,11 @@ impl StepControl {
         self.cuts_in_a_row += 1;
         counters.cuts += 1;
         Ok(())
+    }
+
+    /// The shortest step the control takes: the nominal over 2^max_cuts and a tenth.
+    fn shortest(&self) -> f64 {
+        self.nominal * 0.5f64.powi(self.max_cuts as i32) * 0.1
     }
 
     fn after_cut(&self) -> bool {
