@@ -1,5 +1,7 @@
 //! Sparse symmetric solves with faer: the symbolic Cholesky analysis once per topology, a
-//! numeric factorization only when K* changes, back-substitutions as often as needed.
+//! numeric factorization only when K* changes, back-substitutions as often as needed, and the
+//! entries of K*^-1 among the contact equations from paths of the elimination tree
+//! (docs/theory.md 8.6).
 //!
 //! The matrix is stored as its lower triangle in compressed sparse columns (`Pattern`); the
 //! assembly writes into `values` through precomputed positions.
@@ -146,8 +148,9 @@ struct Symbolic {
 }
 
 /// The numeric factor seen as the blocks of the elimination tree: supernodes, or single
-/// columns of a simplicial factor (faer picks one when supernodes would not pay: diagonal
-/// matrices here).
+/// columns of a simplicial factor (faer's choice when supernodes would not pay: small or
+/// very sparse factors, e.g. the 1e4-DOF bench block). A block's parent has a larger index,
+/// so a path runs in ascending order.
 #[derive(Clone, Copy)]
 enum TreeFactor<'a> {
     Supernodal(SupernodalLltRef<'a, usize, f64>, &'a [usize]),
@@ -159,21 +162,22 @@ enum TreeFactor<'a> {
 /// ```text
 /// (K^-1)_ab = y_a . y_b,   y_a = L^-1 P e_a
 /// ```
-/// and y_a is non-zero only on the supernodes on the path from a's supernode to the root
-/// of the supernodal elimination tree: a forward solve along that path (a few per cent of
-/// the factor on the bench's grids) instead of a whole back-substitution. The y's are kept
-/// per factorization, so an equation named later costs its own path and its dot products.
+/// and y_a is non-zero only on the blocks (supernodes, or columns) on the path from a's block
+/// to the root of the elimination tree: a forward solve along that path (~1 900 of 1e5
+/// entries on the bench block) instead of a whole back-substitution. The y's are kept per
+/// factorization, so an equation named later costs its own path and its dot products.
 #[derive(Default)]
 struct InverseEntries {
     local: std::collections::HashMap<usize, usize>,
     equations: Vec<usize>,
-    /// y_{equations[k]}: (supernode, its segment of y), supernodes ascending (the path).
+    /// y_{equations[k]}: (block, its segment of y), blocks ascending (the path).
     paths: Vec<Vec<(usize, Vec<f64>)>>,
     /// `lower[k][j]` = (K^-1)_{equations[k], equations[j]} for j <= k.
     lower: Vec<Vec<f64>>,
 }
 
-/// y_a . y_b over the supernodes both paths hold (their common ancestors).
+/// y_a . y_b over the blocks both paths hold (their common ancestors): a merge of the two
+/// ascending paths.
 fn path_dot(a: &[(usize, Vec<f64>)], b: &[(usize, Vec<f64>)]) -> f64 {
     let (mut i, mut j, mut sum) = (0, 0, 0.0);
     while i < a.len() && j < b.len() {
