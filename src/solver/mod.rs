@@ -153,8 +153,73 @@ struct Symbolic {
 /// so a path runs in ascending order.
 #[derive(Clone, Copy)]
 enum TreeFactor<'a> {
+    /// The factor and the supernode of each column.
     Supernodal(SupernodalLltRef<'a, usize, f64>, &'a [usize]),
     Simplicial(&'a SymbolicSimplicialCholesky<usize>, &'a [f64]),
+}
+
+impl TreeFactor<'_> {
+    fn blocks(self) -> usize {
+        match self {
+            TreeFactor::Supernodal(factor, _) => factor.symbolic().n_supernodes(),
+            TreeFactor::Simplicial(symbolic, _) => symbolic.nrows(),
+        }
+    }
+
+    /// The block holding (permuted) column `column`.
+    fn block_of(self, column: usize) -> usize {
+        match self {
+            TreeFactor::Supernodal(_, supernode_of) => supernode_of[column],
+            TreeFactor::Simplicial(..) => column,
+        }
+    }
+
+    /// The columns of a block.
+    fn columns(self, block: usize) -> std::ops::Range<usize> {
+        match self {
+            TreeFactor::Supernodal(factor, _) => {
+                let symbolic = factor.symbolic();
+                symbolic.supernode_begin()[block]..symbolic.supernode_end()[block]
+            }
+            TreeFactor::Simplicial(..) => block..block + 1,
+        }
+    }
+
+    /// One block of the forward solve L x = b in place: x_block = L_block^-1 x_block, then
+    /// x[rows below] -= L_below x_block (rows all in the block's ancestors). Returns the
+    /// parent block (None at a root). `below` is scratch.
+    fn forward_block(self, block: usize, x: &mut [f64], below: &mut Vec<f64>) -> Option<usize> {
+        match self {
+            TreeFactor::Simplicial(symbolic, values) => {
+                let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+                let (first, end) = (col_ptr[block], col_ptr[block + 1]);
+                let xj = x[block] / values[first];
+                x[block] = xj;
+                for k in first + 1..end {
+                    x[row_idx[k]] -= values[k] * xj;
+                }
+                // the parent is the first row below the diagonal
+                (first + 1 < end).then(|| row_idx[first + 1])
+            }
+            TreeFactor::Supernodal(factor, supernode_of) => {
+                let node = factor.supernode(block);
+                let (l, pattern) = (node.val(), node.pattern());
+                let (begin, size) = (node.start(), l.ncols());
+                let (l_top, l_bottom) = l.split_at_row(size);
+                let mut x_top =
+                    faer::MatMut::from_column_major_slice_mut(&mut x[begin..begin + size], size, 1);
+                solve_lower_triangular_in_place(l_top, x_top.rb_mut(), Par::Seq);
+                below.clear();
+                below.resize(pattern.len(), 0.0);
+                let product = faer::MatMut::from_column_major_slice_mut(below, pattern.len(), 1);
+                matmul(product, Accum::Replace, l_bottom, x_top.rb(), 1.0, Par::Seq);
+                for (r, b) in pattern.iter().zip(below.iter()) {
+                    x[*r] -= b;
+                }
+                pattern.first().map(|r| supernode_of[*r])
+            }
+        }
+    }
 }
 
 /// K^-1 restricted to a growing set of equations (those contact rows name): the Schur
@@ -303,31 +368,18 @@ impl Solver {
         if new.is_empty() {
             return;
         }
-        let Some(symbolic) = &self.symbolic else {
+        let Some(factor) = self.tree() else {
             return;
         };
-        assert!(
-            !self.values.is_empty(),
-            "know_inverse after a successful factor"
-        );
         let start = std::time::Instant::now();
-        let factor = match symbolic.cholesky.raw() {
-            SymbolicCholeskyRaw::Supernodal(supernodal) => TreeFactor::Supernodal(
-                SupernodalLltRef::new(supernodal, &self.values),
-                &symbolic.supernode_of,
-            ),
-            SymbolicCholeskyRaw::Simplicial(simplicial) => {
-                TreeFactor::Simplicial(simplicial, &self.values)
-            }
-        };
-        let inverse_perm = symbolic.cholesky.perm().map(|p| p.arrays().1.to_vec());
+        let inverse_perm = self.permutation().map(|p| p.arrays().1);
         let paths: Vec<Vec<(usize, Vec<f64>)>> = new
             .par_iter()
             .map_init(
-                || vec![0.0; self.matrix.nrows()],
-                |work, &eq| {
-                    let row = inverse_perm.as_ref().map_or(eq, |inv| inv[eq]);
-                    forward_path(factor, row, work)
+                || (vec![0.0; self.matrix.nrows()], Vec::new()),
+                |(work, below), &eq| {
+                    let row = inverse_perm.map_or(eq, |inv| inv[eq]);
+                    forward_path(factor, row, work, below)
                 },
             )
             .collect();
@@ -338,7 +390,7 @@ impl Solver {
             self.inverse.paths.push(path);
         }
         // the rows of the new equations: dot products with every equation known
-        let first = self.lower_rows();
+        let first = self.inverse.lower.len();
         let paths = &self.inverse.paths;
         let rows: Vec<Vec<f64>> = (first..paths.len())
             .into_par_iter()
@@ -346,10 +398,6 @@ impl Solver {
             .collect();
         self.inverse.lower.extend(rows);
         crate::profile::add(crate::profile::Phase::Solve, start);
-    }
-
-    fn lower_rows(&self) -> usize {
-        self.inverse.lower.len()
     }
 
     /// The local index of an equation made known by `know_inverse`.
@@ -372,6 +420,11 @@ impl Solver {
         let w = self.forward(rhs);
         let x = self.backward(w);
         rhs.copy_from_slice(&x);
+    }
+
+    /// The fill-reducing permutation P (None: the identity, or an empty system).
+    fn permutation(&self) -> Option<faer::perm::PermRef<'_, usize>> {
+        self.symbolic.as_ref().and_then(|s| s.cholesky.perm())
     }
 
     /// The tree view of the current factor (None: an empty system).
@@ -397,34 +450,15 @@ impl Solver {
     /// ```
     pub fn forward(&self, rhs: &[f64]) -> Forward {
         let start = std::time::Instant::now();
-        let mut x = match self.symbolic.as_ref().and_then(|s| s.cholesky.perm()) {
+        let mut x = match self.permutation() {
             Some(perm) => perm.arrays().0.iter().map(|&i| rhs[i]).collect(),
             None => rhs.to_vec(),
         };
-        match self.tree() {
-            Some(TreeFactor::Simplicial(symbolic, values)) => {
-                let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
-                for j in 0..x.len() {
-                    let xj = x[j] / values[col_ptr[j]];
-                    x[j] = xj;
-                    for k in col_ptr[j] + 1..col_ptr[j + 1] {
-                        x[row_idx[k]] -= values[k] * xj;
-                    }
-                }
+        if let Some(factor) = self.tree() {
+            let mut below = Vec::new();
+            for block in 0..factor.blocks() {
+                factor.forward_block(block, &mut x, &mut below);
             }
-            Some(TreeFactor::Supernodal(factor, _)) => {
-                let mut below = Vec::new();
-                for s in 0..factor.symbolic().n_supernodes() {
-                    let node = factor.supernode(s);
-                    let (l, pattern) = (node.val(), node.pattern());
-                    let (begin, size) = (node.start(), l.ncols());
-                    supernode_forward(l, &mut x[begin..begin + size], &mut below);
-                    for (r, b) in pattern.iter().zip(&below) {
-                        x[*r] -= b;
-                    }
-                }
-            }
-            None => {}
         }
         crate::profile::add(crate::profile::Phase::Solve, start);
         Forward(x)
@@ -433,14 +467,11 @@ impl Solver {
     /// (K^-1 r)_eq for the w of r and an equation made known by `know_inverse`.
     pub fn solution_entry(&self, w: &Forward, equation: usize) -> f64 {
         let path = &self.inverse.paths[self.inverse.local[&equation]];
-        let blocks = self.blocks();
+        let factor = self.tree().expect("equations known: a factor at hand");
         path.iter()
             .map(|(block, y)| {
-                let begin = blocks(*block);
-                y.iter()
-                    .zip(&w.0[begin..begin + y.len()])
-                    .map(|(a, b)| a * b)
-                    .sum::<f64>()
+                let w = &w.0[factor.columns(*block)];
+                y.iter().zip(w).map(|(a, b)| a * b).sum::<f64>()
             })
             .sum()
     }
@@ -448,20 +479,11 @@ impl Solver {
     /// w += value y_eq: the backward solve then adds value K^-1 e_eq.
     pub fn add_unit(&self, w: &mut Forward, equation: usize, value: f64) {
         let path = &self.inverse.paths[self.inverse.local[&equation]];
-        let blocks = self.blocks();
+        let factor = self.tree().expect("equations known: a factor at hand");
         for (block, y) in path {
-            let begin = blocks(*block);
-            for (x, y) in w.0[begin..begin + y.len()].iter_mut().zip(y) {
+            for (x, y) in w.0[factor.columns(*block)].iter_mut().zip(y) {
                 *x += value * y;
             }
-        }
-    }
-
-    /// The first column of each block of the tree (supernode, or column).
-    fn blocks(&self) -> impl Fn(usize) -> usize + '_ {
-        move |block| match self.tree() {
-            Some(TreeFactor::Supernodal(factor, _)) => factor.symbolic().supernode_begin()[block],
-            _ => block,
         }
     }
 
@@ -509,7 +531,7 @@ impl Solver {
             }
             None => {}
         }
-        let out = match self.symbolic.as_ref().and_then(|s| s.cholesky.perm()) {
+        let out = match self.permutation() {
             Some(perm) => perm.arrays().1.iter().map(|&i| x[i]).collect(),
             None => x,
         };
@@ -518,70 +540,27 @@ impl Solver {
     }
 }
 
-/// One supernode of a forward solve: x_top = L_top^-1 x_top in place (lower triangular,
-/// non-unit), and `below` = L_bottom x_top, to be subtracted from the rows of its pattern.
-fn supernode_forward(l: faer::MatRef<'_, f64>, x_top: &mut [f64], below: &mut Vec<f64>) {
-    let size = x_top.len();
-    let (l_top, l_bottom) = l.split_at_row(size);
-    let mut x_top = faer::MatMut::from_column_major_slice_mut(x_top, size, 1);
-    solve_lower_triangular_in_place(l_top, x_top.rb_mut(), Par::Seq);
-    below.clear();
-    below.resize(l_bottom.nrows(), 0.0);
-    let rows = below.len();
-    let product = faer::MatMut::from_column_major_slice_mut(below, rows, 1);
-    matmul(product, Accum::Replace, l_bottom, x_top.rb(), 1.0, Par::Seq);
-}
-
 /// w = L^-1 P r of `Solver::forward`, in the factor's (permuted) order.
 pub struct Forward(Vec<f64>);
 
 /// y = L^-1 e_row along the elimination-tree path from `row`'s block (supernode, or column
-/// of a simplicial factor) to the root, as (block, its segment of y) in path order; `work`
-/// is zero on entry and on return.
-fn forward_path(factor: TreeFactor<'_>, row: usize, work: &mut [f64]) -> Vec<(usize, Vec<f64>)> {
+/// of a simplicial factor) to the root, as (block, its segment of y) in path order: the
+/// forward solve's block steps on that path only (e_row is zero before it). `work` is zero
+/// on entry and on return; `below` is scratch.
+fn forward_path(
+    factor: TreeFactor<'_>,
+    row: usize,
+    work: &mut [f64],
+    below: &mut Vec<f64>,
+) -> Vec<(usize, Vec<f64>)> {
     let mut path = Vec::new();
     work[row] = 1.0;
-    match factor {
-        TreeFactor::Simplicial(symbolic, values) => {
-            // column j: x_j /= L_jj, then the rows below; the parent is the first row below
-            let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
-            let mut j = row;
-            loop {
-                let (first, end) = (col_ptr[j], col_ptr[j + 1]);
-                let xj = work[j] / values[first];
-                work[j] = 0.0;
-                for k in first + 1..end {
-                    work[row_idx[k]] -= values[k] * xj;
-                }
-                path.push((j, vec![xj]));
-                if first + 1 == end {
-                    break;
-                }
-                j = row_idx[first + 1];
-            }
-        }
-        TreeFactor::Supernodal(factor, supernode_of) => {
-            let mut below = Vec::new();
-            let mut s = supernode_of[row];
-            loop {
-                let node = factor.supernode(s);
-                let l = node.val();
-                let (begin, size) = (node.start(), l.ncols());
-                let pattern = node.pattern();
-                // the rows below are all in ancestors
-                let mut x: Vec<f64> = work[begin..begin + size].to_vec();
-                work[begin..begin + size].fill(0.0);
-                supernode_forward(l, &mut x, &mut below);
-                for (r, b) in pattern.iter().zip(&below) {
-                    work[*r] -= b;
-                }
-                path.push((s, x));
-                match pattern.first() {
-                    Some(r) => s = supernode_of[*r],
-                    None => break,
-                }
-            }
-        }
+    let mut block = Some(factor.block_of(row));
+    while let Some(b) = block {
+        block = factor.forward_block(b, work, below);
+        let segment = &mut work[factor.columns(b)];
+        path.push((b, segment.to_vec()));
+        segment.fill(0.0);
     }
     path
 }
