@@ -22,11 +22,7 @@ pub struct Case {
     /// Elements across the block (n); the block has n x n/2 quads.
     pub n: usize,
     pub steps: usize,
-    pub contact: bool,
-    /// The bottom edge held at y = 0 by supports instead of the wall: the same deformation as
-    /// the closed wall (no release within the run) without the contact machinery, the
-    /// baseline of the cost of contact.
-    pub supported: bool,
+    pub bottom: Bottom,
     /// Write a VTK frame every this many steps (0: none).
     pub frame_every: usize,
     /// Rayon threads of the run (None: rayon's default, one per core).
@@ -37,6 +33,19 @@ pub struct Case {
     /// Implicit: `analysis.newton.strategy` ("modified": factor each step; "initial": factor
     /// once, the seed's way).
     pub strategy: &'static str,
+}
+
+/// What holds the block's bottom edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bottom {
+    /// The rigid wall it strikes (n + 1 contact slaves).
+    Wall,
+    /// Supports at y = 0 in the wall's place: the same deformation as the closed wall (no
+    /// release within the run) without the contact machinery, the baseline of the cost of
+    /// contact.
+    Supported,
+    /// Nothing: free flight, a rigid motion.
+    Free,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -58,8 +67,9 @@ pub struct Row {
     pub method: Method,
     pub elements: usize,
     pub dofs: usize,
+    /// The bottom edge against the wall (`Bottom::Wall`).
     pub contact: bool,
-    /// See `Case::supported`.
+    /// The bottom edge held by supports (`Bottom::Supported`).
     #[serde(default)]
     pub supported: bool,
     pub frame_every: usize,
@@ -107,8 +117,7 @@ pub fn plan(quick: bool) -> Vec<Case> {
             Method::Implicit => 10,
             Method::Explicit | Method::ExplicitReduced => 100,
         },
-        contact: true,
-        supported: false,
+        bottom: Bottom::Wall,
         frame_every: 0,
         threads: None,
         speed: 10.0,
@@ -117,10 +126,16 @@ pub fn plan(quick: bool) -> Vec<Case> {
     // the cost of contact alone: an elastic impact, K* factored once, with the wall (n + 1
     // active pairs), with supports in its place (the same deformation, no contact) and in
     // free flight (a rigid motion)
-    let elastic = |n: usize, bottom: &str| Case {
-        name: format!("implicit_{n}_elastic{bottom}"),
-        contact: bottom.is_empty(),
-        supported: bottom == "_supported",
+    let elastic = |n: usize, bottom: Bottom| Case {
+        name: format!(
+            "implicit_{n}_elastic{}",
+            match bottom {
+                Bottom::Wall => "",
+                Bottom::Supported => "_supported",
+                Bottom::Free => "_free",
+            }
+        ),
+        bottom,
         speed: 1.0,
         strategy: "initial",
         ..case(Method::Implicit, n)
@@ -135,11 +150,11 @@ pub fn plan(quick: bool) -> Vec<Case> {
         for method in [Method::Implicit, Method::ExplicitReduced] {
             cases.push(Case {
                 name: format!("{}_60_free", name(method)),
-                contact: false,
+                bottom: Bottom::Free,
                 ..case(method, 60)
             });
         }
-        for bottom in ["", "_supported", "_free"] {
+        for bottom in [Bottom::Wall, Bottom::Supported, Bottom::Free] {
             cases.push(elastic(60, bottom));
         }
         cases.push(Case {
@@ -164,12 +179,12 @@ pub fn plan(quick: bool) -> Vec<Case> {
     for n in [32, 100, 316, 1000] {
         cases.push(Case {
             name: format!("implicit_{n}_free"),
-            contact: false,
+            bottom: Bottom::Free,
             ..case(Method::Implicit, n)
         });
     }
     for n in [100, 316] {
-        for bottom in ["", "_supported", "_free"] {
+        for bottom in [Bottom::Wall, Bottom::Supported, Bottom::Free] {
             cases.push(elastic(n, bottom));
         }
     }
@@ -189,7 +204,7 @@ pub fn plan(quick: bool) -> Vec<Case> {
     });
     cases.push(Case {
         threads: Some(2),
-        contact: false,
+        bottom: Bottom::Free,
         ..fast("explicit_reduced_448_free")
     });
     cases.push(Case {
@@ -231,8 +246,9 @@ pub fn scene(case: &Case) -> String {
         Method::ExplicitReduced => "reduced",
         Method::Implicit | Method::Explicit => "full",
     };
-    let contact = if case.contact {
-        r#"
+    let contact = match case.bottom {
+        Bottom::Wall => {
+            r#"
 [[obstacle]]
 name = "wall"
 points = [[1.0, 0.0], [-1.0, 0.0]]
@@ -242,14 +258,15 @@ name = "wall"
 slave = { set = "bottom" }
 obstacle = "wall"
 "#
-    } else if case.supported {
-        r#"
+        }
+        Bottom::Supported => {
+            r#"
 [[support]]
 set = "bottom"
 fix = ["y"]
 "#
-    } else {
-        ""
+        }
+        Bottom::Free => "",
     };
     format!(
         r#"title = "bench {name}: J2 block striking a rigid wall"
@@ -360,8 +377,8 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
         method: case.method,
         elements: s.elements,
         dofs: s.dofs,
-        contact: case.contact,
-        supported: case.supported,
+        contact: case.bottom == Bottom::Wall,
+        supported: case.bottom == Bottom::Supported,
         frame_every: case.frame_every,
         threads: case.threads,
         status: match code {

@@ -516,12 +516,12 @@ impl StepEnd<'_> {
                     if self.free[i] {
                         *a = (self.external[i] - self.internal[i] - a_r * m * self.v_half[i]) / m;
                         *v = self.v_half[i] + 0.5 * h * *a;
-                        *total = self.external[i];
                     } else {
                         *a = (self.du[i] / h - *v) * 2.0 / h;
                         *v = self.du[i] / h;
-                        *total = m * *a + a_r * m * *v + self.internal[i];
                     }
+                    let (external, internal) = (self.external[i], self.internal[i]);
+                    *total = total_at(self.free[i], external, internal, m, *a, *v, a_r);
                     work += self.du[i] * (*total + self.last_total[i]);
                     kinetic += m * *v * *v;
                 }
@@ -546,14 +546,17 @@ fn total_force(
     a_r: f64,
 ) -> Vec<f64> {
     (0..free.len())
-        .map(|i| {
-            if free[i] {
-                external[i]
-            } else {
-                m[i] * a[i] + a_r * m[i] * v[i] + internal[i]
-            }
-        })
+        .map(|i| total_at(free[i], external[i], internal[i], m[i], a[i], v[i], a_r))
         .collect()
+}
+
+/// F at one DOF (see `total_force`).
+fn total_at(free: bool, external: f64, internal: f64, m: f64, a: f64, v: f64, a_r: f64) -> f64 {
+    if free {
+        external
+    } else {
+        m * a + a_r * m * v + internal
+    }
 }
 
 /// The scene of `kernel_benchmark`: a unit-cell n x n plane-strain J2 block, reduced kernel.

@@ -213,25 +213,20 @@ fn constrained_solve(
     }
     // entries with a zero coefficient, as the x entry of a row on a horizontal wall, are
     // left out: they would cost a path each for nothing
-    let nonzero = |row: &Vec<(usize, f64)>| -> Vec<(usize, f64)> {
-        row.iter().filter(|(_, c)| *c != 0.0).copied().collect()
-    };
-    let equations: Vec<usize> = rows
+    let nonzero: Vec<Vec<(usize, f64)>> = rows
         .rows
         .iter()
-        .flat_map(nonzero)
-        .map(|(eq, _)| eq)
+        .map(|row| row.iter().filter(|(_, c)| *c != 0.0).copied().collect())
         .collect();
+    let equations: Vec<usize> = nonzero.iter().flatten().map(|(eq, _)| *eq).collect();
     solver.know_inverse(&equations);
     let mut w = solver.forward(&residual);
     let schur_start = std::time::Instant::now();
-    let local: Vec<Vec<(usize, f64)>> = rows
-        .rows
+    let local: Vec<Vec<(usize, f64)>> = nonzero
         .iter()
         .map(|row| {
-            nonzero(row)
-                .into_iter()
-                .map(|(eq, c)| (solver.inverse_local(eq), c))
+            row.iter()
+                .map(|(eq, c)| (solver.inverse_local(*eq), *c))
                 .collect()
         })
         .collect();
@@ -252,7 +247,7 @@ fn constrained_solve(
     });
     let rhs = nalgebra::DVector::from_fn(m, |i, _| {
         -rows.gaps[i]
-            - nonzero(&rows.rows[i])
+            - nonzero[i]
                 .iter()
                 .map(|(eq, c)| c * solver.solution_entry(&w, *eq))
                 .sum::<f64>()
@@ -260,9 +255,9 @@ fn constrained_solve(
     let tau = schur.lu().solve(&rhs).ok_or_else(|| {
         StepFailure("the contact constraints are redundant (singular Schur complement)".into())
     })?;
-    for (row, t) in rows.rows.iter().zip(tau.iter()) {
-        for (eq, c) in nonzero(row) {
-            solver.add_unit(&mut w, eq, c * t);
+    for (row, t) in nonzero.iter().zip(tau.iter()) {
+        for (eq, c) in row {
+            solver.add_unit(&mut w, *eq, c * t);
         }
     }
     profile::add(Phase::Contact, schur_start);
