@@ -77,20 +77,18 @@ impl OutputError {
 /// The temporary file is `path` with `.tmp` appended. A crash leaves the old `path` (or none)
 /// and possibly a stale `.tmp`, never a truncated `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    let tmp = temporary_path(path);
-    fs::write(&tmp, bytes).map_err(|e| OutputError::io(&tmp, "write", e))?;
-    fs::rename(&tmp, path).map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        OutputError::io(path, "rename the temporary file onto", e)
-    })
+    write_atomic_parts(path, &[bytes])
 }
 
 /// As `write_atomic`, for a file given as consecutive parts (no copy into one buffer).
-pub fn write_atomic_parts(path: &Path, parts: &[Vec<u8>]) -> Result<(), OutputError> {
+pub fn write_atomic_parts(path: &Path, parts: &[impl AsRef<[u8]>]) -> Result<(), OutputError> {
     use std::io::Write;
     let tmp = temporary_path(path);
-    let written = fs::File::create(&tmp)
-        .and_then(|mut file| parts.iter().try_for_each(|part| file.write_all(part)));
+    let written = fs::File::create(&tmp).and_then(|mut file| {
+        parts
+            .iter()
+            .try_for_each(|part| file.write_all(part.as_ref()))
+    });
     written.map_err(|e| {
         let _ = fs::remove_file(&tmp);
         OutputError::io(&tmp, "write", e)

@@ -182,16 +182,19 @@ impl Payload {
 
     /// The file as consecutive parts (XML header, the arrays' blocks, the closing tags),
     /// compressed as asked.
-    pub fn into_parts(self, compression: Compression) -> Vec<Vec<u8>> {
-        let blocks: Vec<(Vec<u8>, Vec<u8>)> = self
+    pub fn into_parts(mut self, compression: Compression) -> Vec<Vec<u8>> {
+        // each array's block in the appended data: its header, then its (compressed) bytes
+        let blocks: Vec<[Vec<u8>; 2]> = self
             .arrays
-            .iter()
-            .map(|a| match compression {
-                Compression::None => ((a.bytes.len() as u64).to_le_bytes().to_vec(), Vec::new()),
-                Compression::Lz4 | Compression::Zlib => compress(&a.bytes, compression),
+            .iter_mut()
+            .map(|a| {
+                let bytes = std::mem::take(&mut a.bytes);
+                match compression {
+                    Compression::None => [(bytes.len() as u64).to_le_bytes().to_vec(), bytes],
+                    Compression::Lz4 | Compression::Zlib => compress(&bytes, compression),
+                }
             })
             .collect();
-        let mut offset = 0;
         let mut header = String::new();
         header.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"");
         if let Some(compressor) = compression.compressor() {
@@ -202,15 +205,14 @@ impl Payload {
             "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
             self.points, self.cells
         ));
-        let mut offsets = Vec::with_capacity(self.arrays.len());
-        for ((lead, body), array) in blocks.iter().zip(&self.arrays) {
-            offsets.push(offset);
-            offset += lead.len()
-                + match compression {
-                    Compression::None => array.bytes.len(),
-                    _ => body.len(),
-                };
-        }
+        let offsets: Vec<usize> = blocks
+            .iter()
+            .scan(0, |end, [lead, body]| {
+                let start = *end;
+                *end += lead.len() + body.len();
+                Some(start)
+            })
+            .collect();
         for section in [
             Section::PointData,
             Section::CellData,
@@ -242,15 +244,8 @@ impl Payload {
         header.push_str(
             "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _",
         );
-        let mut parts = Vec::with_capacity(2 * self.arrays.len() + 2);
-        parts.push(header.into_bytes());
-        for ((lead, body), array) in blocks.into_iter().zip(self.arrays) {
-            parts.push(lead);
-            parts.push(match compression {
-                Compression::None => array.bytes,
-                _ => body,
-            });
-        }
+        let mut parts = vec![header.into_bytes()];
+        parts.extend(blocks.into_iter().flatten());
         parts.push(b"\n  </AppendedData>\n</VTKFile>\n".to_vec());
         parts
     }
@@ -341,8 +336,8 @@ fn float_array(path: &Path, field: &Field, expected: usize) -> Result<Array, Out
     })
 }
 
-/// VTK's compressed layout of one array: (the header, the compressed blocks).
-fn compress(bytes: &[u8], compression: Compression) -> (Vec<u8>, Vec<u8>) {
+/// VTK's compressed layout of one array: [the header, the compressed blocks].
+fn compress(bytes: &[u8], compression: Compression) -> [Vec<u8>; 2] {
     let blocks: Vec<Vec<u8>> = bytes
         .chunks(BLOCK)
         .map(|block| match compression {
@@ -364,7 +359,7 @@ fn compress(bytes: &[u8], compression: Compression) -> (Vec<u8>, Vec<u8>) {
     {
         header.extend_from_slice(&(n as u64).to_le_bytes());
     }
-    (header, blocks.concat())
+    [header, blocks.concat()]
 }
 
 /// A frame read back by [`read_frame`].
