@@ -38,8 +38,8 @@ fn quick_bench_runs_and_contact_never_refactors() {
     let rows = quick_bench(&dir, &[]);
     assert_eq!(rows.len(), impact::bench::plan(true).len());
     for r in &rows {
+        // speeds are measured by `impact bench`, not asserted here
         assert_eq!(r.status, "ok", "{}", r.name);
-        assert!(r.element_updates_per_second > 0.0, "{}", r.name);
         let shares = [
             r.share.assembly,
             r.share.factorization,

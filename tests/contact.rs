@@ -418,6 +418,11 @@ fn coulomb_block_sticks_then_slides_at_mu_n() {
 
 /// Reflection angle from the wall normal after separation, from the final momentum, and the
 /// momentum change (the impulses of the wall) of a ring_wall run.
+/// TOL of Hughes II-7 on ring_wall, rounded up: 1e-9 of the model's size (the diagonal of
+/// the bodies' bounding box, 2 sqrt 2 for the ring). Lagrange multipliers close every active
+/// gap, so no slave may end a step deeper than that.
+const RING_WALL_TOL: f64 = 1e-9 * 3.0;
+
 fn ring_wall(name: &str, overrides: &[&str]) -> (Run, f64, [f64; 2]) {
     let r = run(name, "ring_wall", overrides);
     let (px, py) = (column(&r.dir, "p_x[all]"), column(&r.dir, "p_y[all]"));
@@ -453,7 +458,7 @@ fn ring_wall_frictionless_keeps_tangential_momentum_and_energy() {
         max_relative = 0.01
     );
     assert!(angle > 45.0 && angle < 60.0, "reflection angle {angle}");
-    assert!(r.summary.contact.min_gap.unwrap() > -1e-6);
+    assert!(r.summary.contact.min_gap.unwrap() > -RING_WALL_TOL);
 }
 
 /// Goal: Coulomb friction in an oblique impact. Setup: ring_wall with mu = 0.3. Reference
@@ -479,7 +484,7 @@ fn ring_wall_coulomb_friction_obeys_the_impulse_bound() {
         assert!(t.abs() <= mu * n * (1.0 + 1e-9) + 1e-12, "{t} > mu {n}");
     }
     assert!(angle < 45.0, "reflection angle {angle}");
-    assert!(r.summary.contact.min_gap.unwrap() > -1e-6);
+    assert!(r.summary.contact.min_gap.unwrap() > -RING_WALL_TOL);
 }
 
 /// Goal: Greco's return coefficient (eq 36). Reference (the rule's limits): R = 0 is

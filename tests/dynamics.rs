@@ -94,7 +94,8 @@ fn elongation_and_decay(rho: f64, phase: f64, omega_h: f64) -> (f64, f64) {
 
 /// Goal: each implicit method reproduces its own numerical dispersion and dissipation.
 /// Setup: the undamped unit oscillator at dt/T = 0.05, 0.1, 0.2 (as in Bathe & Wilson's
-/// charts), 30 cycles. Reference: the principal root of the method's amplification matrix
+/// charts), 12 cycles (3 for Hu above dt/T = 0.05, whose decay leaves little signal).
+/// Reference: the principal root of the method's amplification matrix
 /// (reference::amplification, written from the textbook recurrences). The measured root
 /// comes from a least-squares fit of the two-term recurrence to u_n. Tolerance: 5 % of the
 /// predicted value (the issue's), or 1e-6 absolute where the prediction is zero.
@@ -436,23 +437,44 @@ frame_every = 0
 /// Goal: a step load travels at c and doubles on reflection at a fixed end.
 /// Setup: rod L = 10, E = 100, rho = 0.01 (c = 100, L/c = 0.1), 100 elements, fixed at x = 0,
 /// a compressive step force F = 1 at x = L from t = 0; central difference at Courant number
-/// 0.999 (nearly exact for lumped rods). Reference (d'Alembert): the stress at the fixed end
-/// is 0 before L/c and -2 F / A after it, until 3 L/c. Tolerance: one element transit
-/// (h/c = 0.001) in time, checked two transits before and after; 5 % on the doubled stress.
+/// 0.999 (nearly exact for lumped rods); the fixed-end element's stress in every history row
+/// up to 3 L/c. Reference (d'Alembert): the stress at the fixed end is 0 before L/c and
+/// -2 F / A after it, until 3 L/c. Tolerance: one element transit (h/c = 0.001) in time,
+/// checked from two transits before and after the arrivals; 5 % of F on the doubled stress
+/// and before the arrival (the front's dispersion at Courant 0.999).
 #[test]
 fn rod_wave_arrives_at_l_over_c_and_doubles_on_reflection() {
-    let fixed_end_stress = |t: f64| {
-        let model = common::model("wave", &wave(), &[&format!("analysis.end_time={t}")]);
-        let (_, state) = common::run(&format!("wave_{t}"), &model);
-        state.bodies[0].points[0].stress[0]
-    };
-    let (f, c, l) = (1.0, 100.0, 10.0);
-    let before = fixed_end_stress(l / c - 0.002);
-    assert!(before.abs() < 0.05 * f, "stress before arrival: {before}");
-    for t in [l / c + 0.002, 0.2, 3.0 * l / c - 0.002] {
-        let after = fixed_end_stress(t);
-        approx::assert_relative_eq!(after, -2.0 * f, max_relative = 0.05);
+    let (f, c, l, transit) = (1.0, 100.0, 10.0, 0.001);
+    let text = format!(
+        "{}\n[[output.probe]]\nquantity = \"s_xx\"\nset = \"start\"\n",
+        wave()
+    );
+    let model = common::model(
+        "wave",
+        &text,
+        &[&format!("analysis.end_time={}", 3.0 * l / c)],
+    );
+    let dir = common::out_dir("wave");
+    impact::analysis::run(&model, &dir, Default::default()).unwrap();
+    let time = column(&dir, "time");
+    let stress = column(&dir, "s_xx[start]");
+    let (mut before, mut after) = (0, 0);
+    for (t, s) in time.iter().zip(&stress) {
+        if *t <= l / c - 2.0 * transit {
+            assert!(s.abs() < 0.05 * f, "stress before arrival at t = {t}: {s}");
+            before += 1;
+        } else if *t >= l / c + 2.0 * transit && *t <= 3.0 * l / c - 2.0 * transit {
+            assert!(
+                (s + 2.0 * f).abs() < 0.05 * f,
+                "doubled stress at t = {t}: {s}"
+            );
+            after += 1;
+        }
     }
+    assert!(
+        before > 90 && after > 190,
+        "rows checked: {before} before, {after} after"
+    );
 }
 
 /// Goal: Rayleigh damping C = a M + b K damps the oscillator at zeta = a / (2 omega) + b omega / 2.

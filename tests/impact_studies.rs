@@ -133,8 +133,13 @@ fn central_difference_at_the_seeds_dt_is_refused() {
 /// symmetric, so the half model must give the same contact force (the half's doubled), plastic
 /// work (doubled), tip stress and tip displacement: within 5 % (measured 0.7 %, 0.9 %, 1.3 %,
 /// 3.3 %: the full model's round-off asymmetry grows in the crushed tip). The rigid wall
-/// removes the block's compliance and plastic work: its peak force and tip stress differ by
-/// more than 10 % (measured -25 % and +16 %), which is the point of reporting it.
+/// run is checked against the impulse-momentum balance: the bar's momentum change equals
+/// the time integral of the wall's force (trapezoid over the history rows) within 3 % (the
+/// impact conditions give each closing tip node the wall's velocity without a force, a
+/// fraction of a percent of the bar's momentum per node: measured 1.6 %). Its difference from the full model
+/// is the finding reported, not a verification: the rigid wall removes the block's compliance
+/// and plastic work, and the peak force and tip stress differ by more than 10 % (measured
+/// -25 % and +16 %; asserted only so that the report stays true).
 #[test]
 fn half_model_matches_the_full_one_and_the_rigid_wall_does_not() {
     let full = study_run("round_bar", false, "average").unwrap();
@@ -159,6 +164,15 @@ fn half_model_matches_the_full_one_and_the_rigid_wall_does_not() {
         .iter()
         .copied()
         .fold(f64::INFINITY, f64::min);
+    let (t, f, p) = (
+        column(&wall.dir, "time"),
+        column(&wall.dir, "contact_force[tip]"),
+        column(&wall.dir, "p_y[all]"),
+    );
+    let impulse: f64 = (1..t.len())
+        .map(|k| 0.5 * (f[k] + f[k - 1]) * (t[k] - t[k - 1]))
+        .sum();
+    approx::assert_relative_eq!(p[p.len() - 1] - p[0], impulse, max_relative = 0.03);
     assert!(force_change.abs() > 0.1, "{force_change}");
     assert!((stress / pf[2] - 1.0).abs() > 0.1);
 }

@@ -187,14 +187,16 @@ fn hill_cylinder_limit_pressure() {
 
 const PLATE: &str = include_str!("../models/plate_with_hole.toml");
 
-/// Goal: the plane-stress return converges under refinement and keeps sigma_zz = 0.
+/// Goal: the plane-stress J2 solution converges under refinement.
 /// Setup: quarter of a square plate (half width 5) with a hole (radius 1), plane stress, J2
 /// with linear hardening, uniform tension on the top edge to 0.75 sigma_y (net-section yield
 /// at 0.8), meshes n = 4, 8, 16 (elements per half arc and radially). Reference: convergence
 /// itself (the differences between successive meshes fall by more than 1.5 at every load
-/// level past first yield) and the plane-stress condition sigma_zz = 0 exactly at every point.
+/// level past first yield). The plane-stress condition is checked where it can fail: the
+/// material's unit tests replay the 3D update at the returned out-of-plane strain, and
+/// tests/explicit_fast.rs compares the thickness strain with the width strain of a strip.
 #[test]
-fn plate_with_hole_plane_stress_converges_and_keeps_szz_zero() {
+fn plate_with_hole_plane_stress_converges() {
     let mut curves = Vec::new();
     for n in [4, 8, 16] {
         let set_n = format!("body.plate.mesh.n={n}");
@@ -207,7 +209,6 @@ fn plate_with_hole_plane_stress_converges_and_keeps_szz_zero() {
             summary.energy.plastic_dissipation > 0.0,
             "the plate must yield"
         );
-        assert!(state.bodies[0].points.iter().all(|p| p.stress[2] == 0.0));
         assert!(
             state.bodies[0]
                 .points

@@ -124,6 +124,8 @@ mod tests {
             true,
         )
         .unwrap();
+        // central differences: truncation O(h^2) ~ 1e-12 and round-off eps |f| / h ~ 1e-10
+        // against entries ~ EA / L ~ 2; 1e-8 bounds both with a margin of 100
         let h = 1e-6;
         for j in 0..4 {
             let (mut dp, mut dm) = (d, d);
