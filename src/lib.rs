@@ -1,9 +1,22 @@
 //! impact: finite-strain elastoplastic contact-impact in 2D (plane strain, plane stress,
-//! axisymmetric) and 1D rods, after Hughes et al. (1975), Erklig et al. (2010) and
-//! Greco & Coda (2003). See docs/theory.md for the equations and their sources.
+//! axisymmetric) and 1D rods, after Hughes, Taylor & Sackman (1975), Erklig, Guzelbey &
+//! Cevik (2010) and Greco & Coda (2003) (the three source documents; docs/theory.md gives the
+//! equations with their numbers).
 //!
-//! Dependencies flow one way: scene -> mesh -> element / material / kinematics -> assembly
-//! -> solver -> analysis -> output.
+//! Dependencies flow one way, from the ground up: a module uses only modules of lower
+//! layers (tests/architecture.rs checks it on the source).
+//! ```text
+//! 1  profile, reference, mesh, output   timing, closed forms, meshes, writers on plain arrays
+//! 2  element                            pure kernels and the small fixed-size types
+//! 3  material, kinematics               constitutive update, objective push-forward
+//! 4  contact, solver, integrator        contact on plain arrays, faer, step coefficients
+//! 5  scene                              TOML -> validated Model (owns every enum a scene names)
+//! 6  assembly                           element dispatch, scatter, parallel loops
+//! 7  stability                          inertia of K_T, linearized buckling
+//! 8  analysis                           the run scaffold and its steppers
+//! 9  sweep, bench                       studies and speed
+//! ```
+//! The binary (src/main.rs) sits on top and calls analysis, sweep, bench and output.
 
 pub mod analysis;
 pub mod assembly;

@@ -16,7 +16,7 @@ pub mod reduced;
 use crate::element::{Formulation, Geometry, KernelError, Mat4, Vec4, Vec8, Voigt, quad4, rod2};
 use crate::kinematics;
 use crate::material::{PointState, StressState};
-use crate::scene::spec::Tangent;
+use crate::scene::spec::{MassKind, Tangent};
 use crate::scene::{Body, BodyKind, Model};
 use crate::solver::Pattern;
 use rayon::prelude::*;
@@ -528,15 +528,6 @@ fn push_forward_body(
             }
         }
     }
-}
-
-/// Consistent (sum rho N^T N over the initial configuration) or lumped (row sums) mass.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MassKind {
-    #[default]
-    Consistent,
-    Lumped,
 }
 
 /// The mass matrix. In the updated-Lagrangian description rho dV is invariant, so the mass

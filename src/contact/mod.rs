@@ -19,6 +19,7 @@
 //! tau            Lagrange multiplier: the compressive normal force, +tau n on the slave
 //! ```
 
+use crate::mesh::plane::{dot, sub};
 use std::f64::consts::PI;
 
 /// A rigid obstacle: a fixed polyline, solid on its left (a closed counter-clockwise polygon
@@ -154,14 +155,7 @@ impl Gap {
     }
 }
 
-fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
-    a[0] * b[0] + a[1] * b[1]
-}
-
+/// |a| as sqrt(a . a) (the gaps' own rounding; `plane::norm` uses hypot).
 fn length(a: [f64; 2]) -> f64 {
     dot(a, a).sqrt()
 }

@@ -24,9 +24,8 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use super::plane::{Point, cross, norm, quad_area, sub};
 use super::{Cells, Mesh, MeshError};
-
-type Point = [f64; 2];
 
 /// Size of a disc's O-grid core as a fraction of the radius.
 const DISC_CORE: f64 = 0.5;
@@ -888,23 +887,6 @@ fn lerp(a: Point, b: Point, t: f64) -> Point {
 
 fn along(a: Point, b: Point, ts: &[f64]) -> Vec<Point> {
     ts.iter().map(|&t| lerp(a, b, t)).collect()
-}
-
-fn sub(a: Point, b: Point) -> Point {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-fn cross(a: Point, b: Point) -> f64 {
-    a[0] * b[1] - a[1] * b[0]
-}
-
-fn norm(a: Point) -> f64 {
-    a[0].hypot(a[1])
-}
-
-/// Signed area of a quadrilateral (> 0 when counter-clockwise).
-pub(super) fn quad_area(q: [Point; 4]) -> f64 {
-    0.5 * (0..4).map(|k| cross(q[k], q[(k + 1) % 4])).sum::<f64>()
 }
 
 /// Where the rays from `center` through `points` cut the chord from the first to the last

@@ -21,7 +21,7 @@ use std::path::Path;
 
 use mshio::{ElementType, MshFile, MshParserError};
 
-use super::generate::quad_area;
+use super::plane::quad_area;
 use super::{Cells, Mesh, MeshError};
 
 /// (dimension, physical tag) of a physical group.

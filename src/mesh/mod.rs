@@ -14,6 +14,7 @@
 
 pub mod generate;
 pub mod gmsh;
+pub mod plane;
 
 use std::collections::BTreeMap;
 

@@ -27,23 +27,9 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-pub use super::vtu::Compression;
-use super::vtu::{Field, Payload, Section, Source};
+pub use super::vtu::{Compression, Grid};
+use super::vtu::{Field, Payload, Section, Source, attributes};
 use super::{OutputError, format_f64, write_atomic, write_atomic_parts};
-
-/// All bodies merged into one grid with global node numbering; cells are the quads first, then the lines.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Grid {
-    pub points: Vec<[f64; 2]>,
-    pub quads: Vec<[usize; 4]>,
-    pub lines: Vec<[usize; 2]>,
-}
-
-impl Grid {
-    pub fn cells(&self) -> usize {
-        self.quads.len() + self.lines.len()
-    }
-}
 
 /// One frame's fields. Point fields have one entry per grid point, cell fields one per cell (quads then lines).
 #[derive(Clone, Copy, Debug)]
@@ -374,18 +360,6 @@ pub fn read_pvd(path: &Path) -> Result<Vec<(f64, PathBuf)>, OutputError> {
         listed.push((time, folder.join(file)));
     }
     Ok(listed)
-}
-
-/// The `name="value"` pairs of a tag's text (after the element name, before `>`).
-pub(crate) fn attributes(mut tag: &str) -> impl Iterator<Item = (&str, &str)> {
-    std::iter::from_fn(move || {
-        let (name, rest) = tag.split_once('=')?;
-        let rest = rest.trim_start();
-        let quote = rest.chars().next().filter(|c| *c == '"' || *c == '\'')?;
-        let (value, rest) = rest[1..].split_once(quote)?;
-        tag = rest;
-        Some((name.trim(), value))
-    })
 }
 
 fn check_name(dir: &Path, name: &str) -> Result<(), OutputError> {

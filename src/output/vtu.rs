@@ -23,7 +23,32 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use super::OutputError;
-use super::vtk::Grid;
+
+/// All bodies merged into one grid with global node numbering; cells are the quads first, then the lines.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Grid {
+    pub points: Vec<[f64; 2]>,
+    pub quads: Vec<[usize; 4]>,
+    pub lines: Vec<[usize; 2]>,
+}
+
+impl Grid {
+    pub fn cells(&self) -> usize {
+        self.quads.len() + self.lines.len()
+    }
+}
+
+/// The `name="value"` pairs of a tag's text (after the element name, before `>`).
+pub(crate) fn attributes(mut tag: &str) -> impl Iterator<Item = (&str, &str)> {
+    std::iter::from_fn(move || {
+        let (name, rest) = tag.split_once('=')?;
+        let rest = rest.trim_start();
+        let quote = rest.chars().next().filter(|c| *c == '"' || *c == '\'')?;
+        let (value, rest) = rest[1..].split_once(quote)?;
+        tag = rest;
+        Some((name.trim(), value))
+    })
+}
 
 /// Raw bytes per compression block (VTK's default).
 const BLOCK: usize = 32768;
@@ -454,11 +479,7 @@ pub fn read_frame(path: &Path) -> Result<FrameData, OutputError> {
         let tag = tag.split('>').next().unwrap_or_default();
         let (element, rest) = tag.split_once(char::is_whitespace).unwrap_or((tag, ""));
         let element = element.trim_end_matches('/');
-        let attribute = |key: &str| {
-            super::vtk::attributes(rest)
-                .find(|(k, _)| *k == key)
-                .map(|(_, v)| v)
-        };
+        let attribute = |key: &str| attributes(rest).find(|(k, _)| *k == key).map(|(_, v)| v);
         let number = |key: &str| -> Result<usize, OutputError> {
             attribute(key)
                 .ok_or_else(|| bad(format!("<{element}> has no {key}")))?

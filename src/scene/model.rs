@@ -7,10 +7,10 @@
 use super::InputError;
 use super::spec::{
     AnalysisKind, AnalysisSpec, BodySpec, BucklingSpec, Component, ContactSpec, DynamicSpec,
-    FormulationSpec, IntegratorKind, LoadSpec, MaterialSpec, NewtonSpec, NodeSetSpec, OutputSpec,
-    ProbeSpec, Quadrature, Quantity, ReferenceKind, ReferenceSpec, Scene, StaticSpec, Statistic,
+    FormulationSpec, IntegratorKind, LoadSpec, MassKind, MaterialSpec, NewtonSpec, NodeSetSpec,
+    OutputSpec, ProbeSpec, Quadrature, Quantity, ReferenceKind, ReferenceSpec, Scene, StaticSpec,
+    Statistic,
 };
-use crate::assembly::MassKind;
 use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
 use crate::element::{Formulation, Geometry, Voigt, quad4, rod2};
 use crate::material::{Elastic, Hardening, J2, Material};

@@ -1,7 +1,6 @@
 //! The scene file's schema. Each struct denies unknown fields; each enum variant wraps its own
 //! struct so unknown keys are caught inside internally tagged enums too (serde #2123, #2294).
 
-use crate::assembly::MassKind;
 use crate::element::Geometry;
 use crate::mesh::MeshSpec;
 use crate::output::vtk::Compression;
@@ -333,6 +332,15 @@ pub enum IntegratorKind {
     GeneralizedAlpha,
     /// Explicit central difference with lumped mass.
     CentralDifference,
+}
+
+/// Consistent (sum rho N^T N over the initial configuration) or lumped (row sums) mass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MassKind {
+    #[default]
+    Consistent,
+    Lumped,
 }
 
 /// The analysis block. One flat table (so every message points at its key's line); keys

@@ -1,0 +1,191 @@
+//! The module order stated in src/lib.rs, checked on the source: a `crate::` path to a module
+//! of the same or a higher layer fails, and so does a file-level cycle inside a module (two
+//! files that import each other).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// The layers of src/lib.rs, from the ground up: a module may use only lower layers.
+const LAYERS: [&[&str]; 9] = [
+    &["profile", "reference", "mesh", "output"],
+    &["element"],
+    &["material", "kinematics"],
+    &["contact", "solver", "integrator"],
+    &["scene"],
+    &["assembly"],
+    &["stability"],
+    &["analysis"],
+    &["sweep", "bench"],
+];
+
+fn layer(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|l| l.contains(&module))
+}
+
+fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            sources(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The code of a file without its `#[cfg(test)]` part and its comments.
+fn code(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = match text.find("#[cfg(test)]") {
+        Some(cut) => &text[..cut],
+        None => &text,
+    };
+    text.lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The top-level module of a file under src/ (`analysis` for src/analysis/run.rs).
+fn module_of(path: &Path) -> String {
+    let rel = path.strip_prefix("src").unwrap();
+    let first = rel
+        .components()
+        .next()
+        .unwrap()
+        .as_os_str()
+        .to_string_lossy();
+    first.trim_end_matches(".rs").to_string()
+}
+
+/// The modules a file names through `crate::NAME` paths (in `use` lines and in paths).
+fn crate_paths(code: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for (i, _) in code.match_indices("crate::") {
+        let rest = &code[i + "crate::".len()..];
+        let name: String = rest
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        if !name.is_empty() {
+            out.insert(name);
+        }
+        // `use crate::{a, b}` names several
+        if rest.starts_with('{') {
+            let inner = &rest[1..rest.find('}').unwrap_or(rest.len())];
+            for part in inner.split(',') {
+                let name: String = part
+                    .trim()
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if !name.is_empty() {
+                    out.insert(name);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Goal: dependencies flow one way, as src/lib.rs states. Setup: every file under src/
+/// except lib.rs and main.rs (the binary sits above every layer). Reference: the layer list
+/// above, which mirrors lib.rs; a module may name only modules of lower layers.
+#[test]
+fn modules_use_only_lower_layers() {
+    let mut files = Vec::new();
+    sources(Path::new("src"), &mut files);
+    let mut violations = Vec::new();
+    for path in &files {
+        let module = module_of(path);
+        if module == "lib" || module == "main" {
+            continue;
+        }
+        let own = layer(&module).unwrap_or_else(|| panic!("{module} is in no layer of lib.rs"));
+        for used in crate_paths(&code(path)) {
+            if used == module {
+                continue;
+            }
+            let theirs = layer(&used).unwrap_or_else(|| panic!("{used} is in no layer"));
+            if theirs >= own {
+                violations.push(format!(
+                    "{} (layer {own}) uses {used} (layer {theirs})",
+                    path.display()
+                ));
+            }
+        }
+    }
+    assert!(violations.is_empty(), "{violations:#?}");
+    // lib.rs states the same order
+    let lib = std::fs::read_to_string("src/lib.rs").unwrap();
+    for (k, modules) in LAYERS.iter().enumerate() {
+        for m in *modules {
+            assert!(lib.contains(m), "lib.rs does not name {m} (layer {k})");
+        }
+    }
+}
+
+/// Goal: no two sibling files of one module import each other (a module's mod.rs and its
+/// files are parent and children, not siblings). Setup: `super::NAME` and
+/// `crate::MODULE::NAME` paths between the files of each module. Reference: a file-level
+/// import graph without 2-cycles.
+#[test]
+fn no_file_imports_a_file_that_imports_it() {
+    let mut files = Vec::new();
+    sources(Path::new("src"), &mut files);
+    let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for path in &files {
+        let rel = path.strip_prefix("src").unwrap();
+        let parts: Vec<String> = rel
+            .components()
+            .map(|c| {
+                c.as_os_str()
+                    .to_string_lossy()
+                    .trim_end_matches(".rs")
+                    .to_string()
+            })
+            .collect();
+        if parts.len() != 2 {
+            continue;
+        }
+        let (module, file) = (&parts[0], &parts[1]);
+        let code = code(path);
+        let mut siblings = BTreeSet::new();
+        for prefix in ["super::".to_string(), format!("crate::{module}::")] {
+            for (i, _) in code.match_indices(prefix.as_str()) {
+                let name: String = code[i + prefix.len()..]
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                let target = if Path::new("src")
+                    .join(module)
+                    .join(format!("{name}.rs"))
+                    .exists()
+                {
+                    name
+                } else {
+                    "mod".to_string()
+                };
+                if &target != file && target != "mod" && file != "mod" {
+                    siblings.insert(target);
+                }
+            }
+        }
+        edges.insert(
+            format!("{module}/{file}"),
+            siblings
+                .into_iter()
+                .map(|s| format!("{module}/{s}"))
+                .collect(),
+        );
+    }
+    let mut cycles = Vec::new();
+    for (a, targets) in &edges {
+        for b in targets {
+            if a < b && edges.get(b).is_some_and(|t| t.contains(a)) {
+                cycles.push(format!("{a} <-> {b}"));
+            }
+        }
+    }
+    assert!(cycles.is_empty(), "{cycles:#?}");
+}
