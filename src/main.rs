@@ -303,7 +303,11 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
         model.dofs()
     );
     if model.bodies.iter().all(|b| b.material.density > 0.0) {
-        let (dt_crit, b, e) = analysis::explicit::critical_time_step(&model)?;
+        let analysis::explicit::StableStep {
+            dt: dt_crit,
+            body: b,
+            element: e,
+        } = analysis::explicit::critical_time_step(&model)?;
         println!(
             "  central-difference stability limit: dt_crit = {dt_crit:.6e} (element eigenvalue bound; body `{}`, element {e})",
             model.bodies[b].name

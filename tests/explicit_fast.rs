@@ -140,7 +140,9 @@ fn at_fraction_of_critical(
     overrides: &[&str],
 ) -> impact::scene::Model {
     let model = common::model(name, text, overrides);
-    let (dt_crit, _, _) = impact::analysis::explicit::critical_time_step(&model).unwrap();
+    let dt_crit = impact::analysis::explicit::critical_time_step(&model)
+        .unwrap()
+        .dt;
     let mut all: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     all.push(format!("analysis.dt={:e}", factor * dt_crit));
     let refs: Vec<&str> = all.iter().map(String::as_str).collect();

@@ -4,8 +4,8 @@
 //! stiffness of a moved element is the rotated stiffness).
 
 use impact::element::quad4::{self, Coords};
-use impact::element::{Formulation, Geometry, Mat8, Moduli, Vec8};
-use impact::material::{Elastic, StressState};
+use impact::element::{Formulation, GeometricStiffness, Mat8, Moduli, Strain, Vec8};
+use impact::material::{Elastic, StressCondition};
 use proptest::prelude::*;
 
 fn moduli() -> Moduli {
@@ -13,7 +13,7 @@ fn moduli() -> Moduli {
         young: 210.0,
         poisson: 0.3,
     }
-    .moduli(StressState::General)
+    .moduli(StressCondition::General)
 }
 
 /// A convex counter-clockwise quad: the unit square's corners moved by up to 0.3, scaled,
@@ -38,17 +38,23 @@ fn shape(offsets: [f64; 8], scale: f64, angle: f64, shift: [f64; 2]) -> Option<C
     convex.then_some(x)
 }
 
+fn op(bbar: bool) -> quad4::Operator {
+    quad4::Operator {
+        strain: Strain::Finite,
+        bbar,
+    }
+}
+
 fn stiffness(x: &Coords, bbar: bool, stress: [f64; 4]) -> Mat8 {
-    let geom = quad4::geometry(x, Formulation::PlaneStrain, &[1.0; 4]).expect("valid shape");
+    let geom = quad4::values(x, Formulation::PlaneStrain, &[1.0; 4]).expect("valid shape");
     let s = impact::element::Voigt::new(stress[0], stress[1], stress[2], stress[3]);
     quad4::tangent(
         &geom,
         &Vec8::zeros(),
         &[s; 4],
         &[moduli(); 4],
-        Geometry::Nonlinear,
-        bbar,
-        true,
+        op(bbar),
+        GeometricStiffness::Included,
     )
 }
 
@@ -102,7 +108,7 @@ proptest! {
         bbar: bool,
         stress in prop::array::uniform4(-5.0f64..5.0),
     ) {
-        let geom = quad4::geometry(&x, Formulation::PlaneStrain, &[1.0; 4]).unwrap();
+        let geom = quad4::values(&x, Formulation::PlaneStrain, &[1.0; 4]).unwrap();
         let (s, c) = angle.sin_cos();
         let mut d = Vec8::zeros();
         let mut moved = x;
@@ -114,17 +120,17 @@ proptest! {
             moved[i] = r;
         }
         let size = x.iter().flatten().fold(1.0f64, |m, v| m.max(v.abs()));
-        for strain in quad4::strains(&geom, &d, Geometry::Nonlinear, bbar) {
+        for strain in quad4::strains(&geom, &d, op(bbar)) {
             prop_assert!(strain.abs().max() <= 1e-11 * size * size, "strain {:?}", strain);
         }
         let s0 = impact::element::Voigt::new(stress[0], stress[1], stress[2], stress[3]);
         let r = stress_rotated(stress, angle);
         let s_moved = impact::element::Voigt::new(r[0], r[1], r[2], r[3]);
-        let geom_moved = quad4::geometry(&moved, Formulation::PlaneStrain, &[1.0; 4]).unwrap();
-        let f0 = quad4::internal_force(&geom, &Vec8::zeros(), &[s0; 4], Geometry::Nonlinear, bbar);
-        let f_rigid = quad4::internal_force(&geom, &d, &[s0; 4], Geometry::Nonlinear, bbar);
+        let geom_moved = quad4::values(&moved, Formulation::PlaneStrain, &[1.0; 4]).unwrap();
+        let f0 = quad4::internal_force(&geom, &Vec8::zeros(), &[s0; 4], op(bbar));
+        let f_rigid = quad4::internal_force(&geom, &d, &[s0; 4], op(bbar));
         let f_moved =
-            quad4::internal_force(&geom_moved, &Vec8::zeros(), &[s_moved; 4], Geometry::Nonlinear, bbar);
+            quad4::internal_force(&geom_moved, &Vec8::zeros(), &[s_moved; 4], op(bbar));
         let k = stiffness(&x, bbar, stress);
         let k_moved = stiffness(&moved, bbar, stress_rotated(stress, angle));
         let mut t = Mat8::zeros();

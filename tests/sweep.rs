@@ -93,7 +93,7 @@ fn stability_map_central_difference_fails_just_above_dt_crit() {
             &impact::scene::load(Path::new("models/bar_wall.toml"), &[]).unwrap()
         )
         .unwrap()
-        .0,
+        .dt,
         dt_crit,
         max_relative = 1e-9
     );

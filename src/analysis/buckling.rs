@@ -15,7 +15,7 @@
 use super::loads;
 use super::record;
 use crate::assembly::{self, State, System};
-use crate::element::Geometry;
+use crate::element::Strain;
 use crate::output::OutputError;
 use crate::output::vtk::{Fields, Series};
 use crate::scene::Model;
@@ -40,7 +40,7 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
         d[dof] = value;
     }
     let linear = |d: &[f64], system: Option<&mut System>| {
-        assembly::evaluate(model, &state, d, Geometry::Linear, system, Tangent::Elastic)
+        assembly::evaluate(model, &state, d, Strain::Small, system, Tangent::Elastic)
     };
     let evaluation = linear(&d, Some(&mut system))?;
     let mut solver = Solver::new(&system.pattern)?;
@@ -56,7 +56,7 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
     solver.solve(&mut residual);
     system.scatter_add(&residual, &mut d);
     let evaluation = linear(&d, None)?;
-    assembly::commit(model, &mut state, &d, evaluation, Geometry::Linear);
+    assembly::commit(model, &mut state, &d, evaluation, Strain::Small);
     state.time = end;
     Ok(state)
 }

@@ -18,7 +18,7 @@ use super::newton::Counters;
 use super::record::{Energies, RecorderPosition};
 use super::{StepControl, Summary};
 use crate::assembly::State;
-use crate::integrator::{Kinematics, MethodHistory};
+use crate::integrator::{MethodHistory, MotionState};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::{InputError, SceneSource};
 use serde::{Deserialize, Serialize};
@@ -68,7 +68,7 @@ pub struct StaticCarry {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct DynamicCarry {
     pub state: State,
-    pub kinematics: Kinematics,
+    pub kinematics: MotionState,
     pub method: MethodHistory,
     pub energies: Energies,
     pub initial_kinetic: f64,

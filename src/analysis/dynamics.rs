@@ -18,7 +18,7 @@ use super::newton::{ContactStep, Counters, Inertia, Step, StepFailure, Tangentia
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, Mass, State, System};
-use crate::integrator::{GeneralizedAlpha, Houbolt, Integrator, Kinematics, Wilson};
+use crate::integrator::{GeneralizedAlpha, Houbolt, Integrator, MotionState, Wilson};
 use crate::scene::spec::{DynamicSpec, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
@@ -156,7 +156,7 @@ pub fn run(
             return Err(super::fail(&recorder, summary, Status::Diverged, message));
         }
     };
-    let mut kin = Kinematics {
+    let mut kin = MotionState {
         displacement: vec![0.0; model.dofs()],
         velocity,
         acceleration,
@@ -520,7 +520,7 @@ fn total_force(
     system: &System,
     mass: &Mass,
     spec: &DynamicSpec,
-    kin: &Kinematics,
+    kin: &MotionState,
     internal: &[f64],
     state: &State,
     initial: &[[f64; 2]],

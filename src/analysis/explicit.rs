@@ -27,13 +27,26 @@ use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
 
+/// A central-difference stability limit and the element that sets it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableStep {
+    /// dt_crit = 2 / omega_max.
+    pub dt: f64,
+    pub body: usize,
+    pub element: usize,
+}
+
 /// The central-difference stability limit of the model in its initial state, with the
 /// element that sets it.
-pub fn critical_time_step(model: &Model) -> Result<(f64, usize, usize), InputError> {
+pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
     let state = State::initial(model);
-    let (omega2, b, e) = assembly::max_frequency_squared(model, &state, model.analysis.geometry())
+    let bound = assembly::max_frequency_squared(model, &state, model.analysis.geometry())
         .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    Ok((2.0 / omega2.sqrt(), b, e))
+    Ok(StableStep {
+        dt: 2.0 / bound.omega_squared.sqrt(),
+        body: bound.body,
+        element: bound.element,
+    })
 }
 
 pub fn run(
@@ -45,7 +58,11 @@ pub fn run(
 ) -> Result<Outcome, RunError> {
     let mut start = Instant::now();
     let setup_start = start;
-    let (dt_crit, b, e) = critical_time_step(model)?;
+    let StableStep {
+        dt: dt_crit,
+        body: b,
+        element: e,
+    } = critical_time_step(model)?;
     if spec.dt > dt_crit && !spec.allow_unstable {
         return Err(InputError::new(
             &model.file,
@@ -97,7 +114,7 @@ pub fn run(
         Some(kernel) => {
             let mut force = zero.clone();
             kernel
-                .internal_force(&state.reference, &mut force)
+                .internal_force(&state.coordinates, &mut force)
                 .map(|_| force)
         }
         None => assembly::evaluate(
@@ -260,7 +277,7 @@ pub fn run(
         let evaluation = match reduced.as_mut() {
             Some(kernel) => crate::profile::time(crate::profile::Phase::Assembly, || {
                 crate::profile::count_elements(kernel.elements());
-                kernel.step(&state.reference, &du, &mut internal)
+                kernel.step(&state.coordinates, &du, &mut internal)
             })
             .map(|work| {
                 commit_reduced(&mut state, &du, work);
@@ -428,7 +445,7 @@ pub fn run(
 /// configuration moves by du, the work accumulates.
 fn commit_reduced(state: &mut State, du: &[f64], work: StepWork) {
     state
-        .reference
+        .coordinates
         .par_chunks_mut(DOF_CHUNK / 2)
         .zip(du.par_chunks(DOF_CHUNK))
         .for_each(|(x, du)| {
@@ -627,7 +644,7 @@ pub fn kernel_benchmark_run(elements: usize, steps: usize, threads: usize) -> Op
         let mut kernel = Reduced::new(&model, &state, 0.1);
         let dofs = model.dofs();
         let mut v: Vec<f64> = state
-            .reference
+            .coordinates
             .iter()
             .flat_map(|x| [-rate * (x[0] - centre), rate * (x[1] - centre)])
             .collect();
@@ -644,11 +661,11 @@ pub fn kernel_benchmark_run(elements: usize, steps: usize, threads: usize) -> Op
                     *v += 0.5 * h * a;
                     *du = h * *v;
                 });
-            if kernel.step(&state.reference, &du, &mut force).is_err() {
+            if kernel.step(&state.coordinates, &du, &mut force).is_err() {
                 return None;
             }
             state
-                .reference
+                .coordinates
                 .par_iter_mut()
                 .enumerate()
                 .for_each(|(i, x)| {

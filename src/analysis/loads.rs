@@ -140,7 +140,7 @@ pub fn add_external_force(
                     model,
                     *body,
                     edges,
-                    &state.reference,
+                    &state.coordinates,
                     |a, b| {
                         let n = quad4::outward_normal(a, b);
                         [-p * n[0], -p * n[1]]

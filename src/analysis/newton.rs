@@ -18,7 +18,7 @@
 
 use crate::assembly::{self, Evaluation, Mass, State, System};
 use crate::contact::ContactPair;
-use crate::element::Geometry;
+use crate::element::Strain;
 use crate::integrator::StepForm;
 use crate::profile::{self, Phase};
 use crate::scene::Model;
@@ -44,7 +44,7 @@ pub struct Inertia<'a> {
 
 pub struct Step<'a> {
     pub model: &'a Model,
-    pub geometry: Geometry,
+    pub geometry: Strain,
     pub newton: &'a NewtonSpec,
     pub inertia: Option<Inertia<'a>>,
     pub form: &'a StepForm,
@@ -423,7 +423,7 @@ impl Step<'_> {
             // (refactoring cannot help where the factorized matrix would not change: an
             // elastic tangent on linear kinematics)
             let refactor_helps =
-                newton.tangent == Tangent::Consistent || self.geometry == Geometry::Nonlinear;
+                newton.tangent == Tangent::Consistent || self.geometry == Strain::Finite;
             let stalled = iteration > 0
                 && refactor_helps
                 && (ratio > newton.contraction || needed > 0.5 * left);

@@ -245,7 +245,7 @@ impl Recorder {
         let cells = cell_fields(model, state);
         let vectors =
             |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
-        let n = state.reference.len();
+        let n = state.coordinates.len();
         let (contact_force, gap, status) = match contact {
             Some(c) => {
                 let positions = state.positions(model.analysis.geometry());

@@ -13,9 +13,11 @@
 
 pub mod reduced;
 
-use crate::element::{Formulation, Geometry, KernelError, Mat4, Vec4, Vec8, Voigt, quad4, rod2};
+use crate::element::{
+    Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
+};
 use crate::kinematics;
-use crate::material::{PointState, StressState};
+use crate::material::{PointState, StressCondition};
 use crate::scene::spec::{MassKind, Tangent};
 use crate::scene::{Body, BodyKind, Model};
 use crate::solver::Pattern;
@@ -34,8 +36,9 @@ pub struct BodyState {
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct State {
     pub time: f64,
-    /// Coordinates of the reference (last converged) configuration, global nodes.
-    pub reference: Vec<[f64; 2]>,
+    /// Node coordinates of the last converged configuration: the reference configuration of
+    /// the next increment in finite strain, the initial one in small strain. Global nodes.
+    pub coordinates: Vec<[f64; 2]>,
     /// Total displacement since the initial configuration, 2 per node.
     pub displacement: Vec<f64>,
     pub bodies: Vec<BodyState>,
@@ -48,11 +51,11 @@ pub struct State {
 impl State {
     /// Current node positions: the reference configuration in finite strain; the initial
     /// one plus the displacement in small strain (whose reference never moves).
-    pub fn positions(&self, geometry: Geometry) -> std::borrow::Cow<'_, [[f64; 2]]> {
+    pub fn positions(&self, geometry: Strain) -> std::borrow::Cow<'_, [[f64; 2]]> {
         match geometry {
-            Geometry::Nonlinear => std::borrow::Cow::Borrowed(&self.reference),
-            Geometry::Linear => self
-                .reference
+            Strain::Finite => std::borrow::Cow::Borrowed(&self.coordinates),
+            Strain::Small => self
+                .coordinates
                 .iter()
                 .enumerate()
                 .map(|(n, x)| {
@@ -93,7 +96,7 @@ impl State {
             .collect();
         State {
             time: 0.0,
-            reference: model.coordinates(),
+            coordinates: model.coordinates(),
             displacement: vec![0.0; model.dofs()],
             bodies,
             internal_work: 0.0,
@@ -234,7 +237,7 @@ pub fn evaluate(
     model: &Model,
     state: &State,
     d: &[f64],
-    geometry: Geometry,
+    geometry: Strain,
     mut system: Option<&mut System>,
     tangent: Tangent,
 ) -> Result<Evaluation, ElementFailure> {
@@ -265,7 +268,7 @@ pub fn evaluate(
                     element(
                         body,
                         &state.bodies[b],
-                        &state.reference,
+                        &state.coordinates,
                         d,
                         e,
                         geometry,
@@ -316,12 +319,16 @@ fn element(
     reference: &[[f64; 2]],
     d: &[f64],
     e: usize,
-    geometry: Geometry,
+    geometry: Strain,
     tangent: Option<Tangent>,
 ) -> Result<ElementResult, (usize, KernelError)> {
     // the material's tangent, or D_e (Erklig's modified Newton); K_sigma unless `elastic`
     let elastic_moduli = tangent.is_some_and(|t| t != Tangent::Consistent);
-    let geometric = tangent != Some(Tangent::Elastic);
+    let geometric = if tangent == Some(Tangent::Elastic) {
+        GeometricStiffness::Omitted
+    } else {
+        GeometricStiffness::Included
+    };
     let nodes = body.mesh.cells.nodes_of(e);
     match body.kind {
         BodyKind::Continuum {
@@ -329,16 +336,20 @@ fn element(
         } => {
             let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
             let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
-            let geom = quad4::geometry(&x, formulation, &thickness).map_err(|err| (e, err))?;
+            let geom = quad4::values(&x, formulation, &thickness).map_err(|err| (e, err))?;
             let de = Vec8::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
-            if geometry == Geometry::Nonlinear {
+            if geometry == Strain::Finite {
                 check_orientation(&geom, &de).map_err(|err| (e, err))?;
             }
-            let strains = quad4::strains(&geom, &de, geometry, bbar);
+            let op = quad4::Operator {
+                strain: geometry,
+                bbar,
+            };
+            let strains = quad4::strains(&geom, &de, op);
             let stress_state = if formulation == Formulation::PlaneStress {
-                StressState::PlaneStress
+                StressCondition::PlaneStress
             } else {
-                StressState::General
+                StressCondition::General
             };
             let fine = crate::profile::fine().then(Instant::now);
             let responses: [_; 4] = std::array::from_fn(|q| {
@@ -359,14 +370,14 @@ fn element(
                     * 0.5
                     * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
             }
-            let force = quad4::internal_force(&geom, &de, &stress, geometry, bbar);
+            let force = quad4::internal_force(&geom, &de, &stress, op);
             let matrix = tangent.map(|_| {
                 let moduli = if elastic_moduli {
                     [body.material.elastic.moduli(stress_state); 4]
                 } else {
                     responses.map(|r| r.moduli)
                 };
-                let k = quad4::tangent(&geom, &de, &stress, &moduli, geometry, bbar, geometric);
+                let k = quad4::tangent(&geom, &de, &stress, &moduli, op, geometric);
                 let mut m = [0.0; 64];
                 m.copy_from_slice(k.transpose().as_slice()); // row-major
                 m
@@ -387,8 +398,13 @@ fn element(
             ];
             let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
             let strain = rod2::strain(&x, &de, geometry).map_err(|err| (e, err))?;
-            let (stress, modulus, state, plastic_density) =
-                body.material.update_uniaxial(&committed.points[e], strain);
+            let response = body.material.update_uniaxial(&committed.points[e], strain);
+            let (stress, modulus, state, plastic_density) = (
+                response.stress,
+                response.tangent,
+                response.state,
+                response.plastic_work,
+            );
             let length = rod2::length(&x).map_err(|err| (e, err))?;
             let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
             let plastic_work = area * length * plastic_density;
@@ -423,7 +439,7 @@ fn element(
 }
 
 /// det F > 0 at every Gauss point of the increment (the element does not turn inside out).
-fn check_orientation(geom: &quad4::QuadGeometry, d: &Vec8) -> Result<(), KernelError> {
+fn check_orientation(geom: &quad4::QuadValues, d: &Vec8) -> Result<(), KernelError> {
     for (point, (f, f_zz)) in quad4::deformation(geom, d).iter().enumerate() {
         let det = f.determinant() * f_zz;
         if !(det > 0.0) {
@@ -440,7 +456,7 @@ pub fn commit(
     state: &mut State,
     d: &[f64],
     evaluation: Evaluation,
-    geometry: Geometry,
+    geometry: Strain,
 ) {
     let Evaluation {
         trial,
@@ -451,11 +467,11 @@ pub fn commit(
     } = evaluation;
     for (b, body) in model.bodies.iter().enumerate() {
         let mut points = trial[b].clone();
-        if geometry == Geometry::Nonlinear {
+        if geometry == Strain::Finite {
             push_forward_body(
                 body,
                 &state.bodies[b],
-                &state.reference,
+                &state.coordinates,
                 d,
                 &strain_zz[b],
                 &mut points,
@@ -473,8 +489,8 @@ pub fn commit(
         }
         state.bodies[b].points = points;
     }
-    if geometry == Geometry::Nonlinear {
-        for (n, x) in state.reference.iter_mut().enumerate() {
+    if geometry == Strain::Finite {
+        for (n, x) in state.coordinates.iter_mut().enumerate() {
             x[0] += d[2 * n];
             x[1] += d[2 * n + 1];
         }
@@ -500,7 +516,7 @@ fn push_forward_body(
             BodyKind::Continuum { formulation, .. } => {
                 let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
                 let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
-                let geom = quad4::geometry(&x, formulation, &thickness)
+                let geom = quad4::values(&x, formulation, &thickness)
                     .expect("checked during the evaluation");
                 let de = Vec8::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
                 for (q, (f, hoop)) in quad4::deformation(&geom, &de).iter().enumerate() {
@@ -565,7 +581,7 @@ impl Mass {
                         let x: quad4::Coords =
                             std::array::from_fn(|i| coords[body.global(nodes[i])]);
                         let geom =
-                            quad4::geometry(&x, formulation, &[thickness; 4]).map_err(failure)?;
+                            quad4::values(&x, formulation, &[thickness; 4]).map_err(failure)?;
                         let m = quad4::mass(&geom) * rho;
                         m.transpose().as_slice().to_vec()
                     }
@@ -656,18 +672,30 @@ impl Mass {
     }
 }
 
+/// The highest element frequency squared and the element that has it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrequencyBound {
+    /// max_e lambda_max(M_e^-1 K_e).
+    pub omega_squared: f64,
+    pub body: usize,
+    pub element: usize,
+}
+
 /// The largest element eigenvalue max_e lambda_max(M_e^-1 K_e) with the lumped element mass:
 /// an upper bound of the highest natural frequency squared of the assembled model (Irons'
-/// element eigenvalue theorem), so 2 / sqrt(it) is a safe central-difference step. Returns
-/// the bound and the (body, element) that sets it.
+/// element eigenvalue theorem), so 2 / sqrt(it) is a safe central-difference step.
 pub fn max_frequency_squared(
     model: &Model,
     state: &State,
-    geometry: Geometry,
-) -> Result<(f64, usize, usize), ElementFailure> {
+    geometry: Strain,
+) -> Result<FrequencyBound, ElementFailure> {
     let zero = vec![0.0; model.dofs()];
     let coords = model.coordinates();
-    let mut best = (0.0, 0, 0);
+    let mut best = FrequencyBound {
+        omega_squared: 0.0,
+        body: 0,
+        element: 0,
+    };
     for (b, body) in model.bodies.iter().enumerate() {
         let rho = body.material.density;
         for e in 0..body.elements() {
@@ -679,7 +707,7 @@ pub fn max_frequency_squared(
             let r = element(
                 body,
                 &state.bodies[b],
-                &state.reference,
+                &state.coordinates,
                 &zero,
                 e,
                 geometry,
@@ -695,8 +723,7 @@ pub fn max_frequency_squared(
                     ..
                 } => {
                     let x: quad4::Coords = std::array::from_fn(|i| coords[body.global(nodes[i])]);
-                    let geom =
-                        quad4::geometry(&x, formulation, &[thickness; 4]).map_err(failure)?;
+                    let geom = quad4::values(&x, formulation, &[thickness; 4]).map_err(failure)?;
                     let m = quad4::mass(&geom);
                     (0..4).map(|i| rho * m.row(i).sum()).collect()
                 }
@@ -711,8 +738,12 @@ pub fn max_frequency_squared(
             let a = nalgebra::DMatrix::from_fn(n, n, |i, j| k[i * n + j] * scale[i] * scale[j]);
             let a = (&a + a.transpose()) * 0.5;
             let lambda = a.symmetric_eigenvalues().max();
-            if lambda > best.0 {
-                best = (lambda, b, e);
+            if lambda > best.omega_squared {
+                best = FrequencyBound {
+                    omega_squared: lambda,
+                    body: b,
+                    element: e,
+                };
             }
         }
     }

@@ -26,7 +26,7 @@
 
 use super::{ElementFailure, State};
 use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{Hardening, Material, PointState, StressState};
+use crate::material::{Hardening, Material, PointState, StressCondition};
 use crate::scene::{BodyKind, Model};
 use rayon::prelude::*;
 
@@ -223,7 +223,7 @@ fn element_step(
                 back_stress: Voigt::from(back_n),
             },
             &Voigt::from(strain),
-            StressState::PlaneStress,
+            StressCondition::PlaneStress,
         );
         strain[2] = r.strain_zz;
         (
@@ -385,17 +385,17 @@ impl Reduced {
             }
         }
         let count = body.len();
-        let mut node_start = vec![0usize; state.reference.len() + 1];
+        let mut node_start = vec![0usize; state.coordinates.len() + 1];
         for element in &nodes {
             for n in element {
                 node_start[*n as usize + 1] += 1;
             }
         }
-        for n in 0..state.reference.len() {
+        for n in 0..state.coordinates.len() {
             node_start[n + 1] += node_start[n];
         }
         let mut fill = node_start.clone();
-        let mut node_entries = vec![0u32; node_start[state.reference.len()]];
+        let mut node_entries = vec![0u32; node_start[state.coordinates.len()]];
         for (e, element) in nodes.iter().enumerate() {
             for (a, n) in element.iter().enumerate() {
                 node_entries[fill[*n as usize]] = (8 * e + 2 * a) as u32;

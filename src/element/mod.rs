@@ -33,15 +33,25 @@ pub enum Formulation {
     Axisymmetric,
 }
 
-/// Small-strain (linear) or updated-Lagrangian finite-strain kinematics.
+/// Small or finite strain: the scene's `analysis.geometry = "linear" | "nonlinear"`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Geometry {
-    /// B = B_s, no geometric stiffness, the reference configuration is never updated.
-    Linear,
-    /// B = B_s + B_L(theta), K_T = K_0 + K_sigma, reference = last converged configuration.
+pub enum Strain {
+    /// Linear geometry: B = B_s, no geometric stiffness, the reference configuration is
+    /// never updated.
+    #[serde(rename = "linear")]
+    Small,
+    /// Updated Lagrangian: B = B_s + B_L(theta), K_T = K_0 + K_sigma, reference = the last
+    /// converged configuration.
     #[default]
-    Nonlinear,
+    #[serde(rename = "nonlinear")]
+    Finite,
+}
+
+/// Whether a tangent includes the geometric (initial-stress) stiffness K_sigma.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GeometricStiffness {
+    Included,
+    Omitted,
 }
 
 /// A failure inside an element kernel: the caller knows the element id and adds it.

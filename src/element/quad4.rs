@@ -19,7 +19,9 @@
 //! linearization adds (tr S / 3)(avg(M) - M) to K_sigma, M = d^2 tr(dE) / dd^2, so the
 //! tangent stays the exact derivative of the internal force (checked by finite differences).
 
-use super::{Formulation, Geometry, KernelError, Mat4, Mat8, Moduli, Vec8, Voigt};
+use super::{
+    Formulation, GeometricStiffness, KernelError, Mat4, Mat8, Moduli, Strain, Vec8, Voigt,
+};
 use nalgebra::{Matrix2, SMatrix};
 use std::f64::consts::PI;
 
@@ -39,7 +41,7 @@ const NODE_SIGNS: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0,
 
 /// Shape functions and their reference derivatives at one Gauss point.
 #[derive(Debug, Clone, Copy)]
-pub struct PointGeometry {
+pub struct PointValues {
     pub shape: [f64; 4],
     /// dN_i/dX, dN_i/dY
     pub dndx: [[f64; 2]; 4],
@@ -50,12 +52,12 @@ pub struct PointGeometry {
 }
 
 #[derive(Debug, Clone, Copy)]
-pub struct QuadGeometry {
-    pub points: [PointGeometry; 4],
+pub struct QuadValues {
+    pub points: [PointValues; 4],
     pub formulation: Formulation,
 }
 
-impl QuadGeometry {
+impl QuadValues {
     pub fn volume(&self) -> f64 {
         self.points.iter().map(|p| p.weight).sum()
     }
@@ -73,12 +75,12 @@ fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
 
 /// Shape-function derivatives, radii and point volumes on the reference configuration `x`.
 /// `thickness` is per Gauss point and used only in plane stress.
-pub fn geometry(
+pub fn values(
     x: &Coords,
     formulation: Formulation,
     thickness: &[f64; 4],
-) -> Result<QuadGeometry, KernelError> {
-    let mut points = [PointGeometry {
+) -> Result<QuadValues, KernelError> {
+    let mut points = [PointValues {
         shape: [0.0; 4],
         dndx: [[0.0; 2]; 4],
         radius: 0.0,
@@ -117,21 +119,21 @@ pub fn geometry(
                 det * 2.0 * PI * radius
             }
         };
-        points[q] = PointGeometry {
+        points[q] = PointValues {
             shape: n,
             dndx,
             radius,
             weight,
         };
     }
-    Ok(QuadGeometry {
+    Ok(QuadValues {
         points,
         formulation,
     })
 }
 
 /// Kinematics of one point for a given increment d.
-struct PointKinematics {
+struct PointStrain {
     /// [u,x u,y v,x v,y]
     theta: [f64; 4],
     /// u_r / r (zero unless axisymmetric)
@@ -140,12 +142,12 @@ struct PointKinematics {
     b: BMatrix,
 }
 
-fn point_kinematics(
-    p: &PointGeometry,
+fn point_strain(
+    p: &PointValues,
     d: &Vec8,
     formulation: Formulation,
-    geometry: Geometry,
-) -> PointKinematics {
+    geometry: Strain,
+) -> PointStrain {
     let mut theta = [0.0; 4];
     for i in 0..4 {
         let [nx, ny] = p.dndx[i];
@@ -161,11 +163,7 @@ fn point_kinematics(
         0.0
     };
     // Nonlinear parts switched off by a zero factor in linear kinematics.
-    let nl = if geometry == Geometry::Nonlinear {
-        1.0
-    } else {
-        0.0
-    };
+    let nl = if geometry == Strain::Finite { 1.0 } else { 0.0 };
     let [ux, uy, vx, vy] = theta;
     let strain = Voigt::new(
         ux + 0.5 * nl * (ux * ux + vx * vx),
@@ -187,7 +185,7 @@ fn point_kinematics(
         b[(3, cu)] = ny * (1.0 + nl * ux) + nx * nl * uy;
         b[(3, cv)] = nx * (1.0 + nl * vy) + ny * nl * vx;
     }
-    PointKinematics {
+    PointStrain {
         theta,
         hoop,
         strain,
@@ -195,17 +193,20 @@ fn point_kinematics(
     }
 }
 
-/// The four points' kinematics with the B-bar modification applied when asked.
-fn kinematics(
-    geom: &QuadGeometry,
-    d: &Vec8,
-    geometry: Geometry,
-    bbar: bool,
-) -> [PointKinematics; 4] {
+/// How a Quad4 body forms its strains: small or finite strain, and the volumetric part
+/// standard or averaged over the element (B-bar, mean dilatation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Operator {
+    pub strain: Strain,
+    pub bbar: bool,
+}
+
+/// The four points' strain operators with the B-bar modification applied when asked.
+fn point_strains(geom: &QuadValues, d: &Vec8, op: Operator) -> [PointStrain; 4] {
     let mut k = geom
         .points
-        .map(|p| point_kinematics(&p, d, geom.formulation, geometry));
-    if bbar {
+        .map(|p| point_strain(&p, d, geom.formulation, op.strain));
+    if op.bbar {
         let volume = geom.volume();
         let mut mean_trace = 0.0;
         let mut mean_b = SMatrix::<f64, 1, 8>::zeros();
@@ -232,29 +233,23 @@ fn trace(v: &Voigt) -> f64 {
 
 /// Green-Lagrange strain increments at the four Gauss points (zz = 0 in plane stress: the
 /// material decides it).
-pub fn strains(geom: &QuadGeometry, d: &Vec8, geometry: Geometry, bbar: bool) -> [Voigt; 4] {
-    kinematics(geom, d, geometry, bbar).map(|k| k.strain)
+pub fn strains(geom: &QuadValues, d: &Vec8, op: Operator) -> [Voigt; 4] {
+    point_strains(geom, d, op).map(|k| k.strain)
 }
 
 /// In-plane deformation gradient F = I + [[u,x u,y] [v,x v,y]] and the hoop stretch 1 + u/r
 /// (1 unless axisymmetric) at the four Gauss points.
-pub fn deformation(geom: &QuadGeometry, d: &Vec8) -> [(Matrix2<f64>, f64); 4] {
+pub fn deformation(geom: &QuadValues, d: &Vec8) -> [(Matrix2<f64>, f64); 4] {
     geom.points.map(|p| {
-        let k = point_kinematics(&p, d, geom.formulation, Geometry::Nonlinear);
+        let k = point_strain(&p, d, geom.formulation, Strain::Finite);
         let [ux, uy, vx, vy] = k.theta;
         (Matrix2::new(1.0 + ux, uy, vx, 1.0 + vy), 1.0 + k.hoop)
     })
 }
 
 /// Internal force f = sum_q w_q B_q^T S_q (Erklig eq 25).
-pub fn internal_force(
-    geom: &QuadGeometry,
-    d: &Vec8,
-    stress: &[Voigt; 4],
-    geometry: Geometry,
-    bbar: bool,
-) -> Vec8 {
-    let k = kinematics(geom, d, geometry, bbar);
+pub fn internal_force(geom: &QuadValues, d: &Vec8, stress: &[Voigt; 4], op: Operator) -> Vec8 {
+    let k = point_strains(geom, d, op);
     let mut f = Vec8::zeros();
     for q in 0..4 {
         f += k[q].b.transpose() * stress[q] * geom.points[q].weight;
@@ -263,23 +258,22 @@ pub fn internal_force(
 }
 
 /// Tangent K_T = K_0 + K_sigma (Erklig eqs 32-34), the exact derivative of `internal_force`
-/// for the given material moduli dS/dE; without K_sigma when `geometric` is false.
+/// for the given material moduli dS/dE; K_sigma only when `geometric` includes it.
 pub fn tangent(
-    geom: &QuadGeometry,
+    geom: &QuadValues,
     d: &Vec8,
     stress: &[Voigt; 4],
     moduli: &[Moduli; 4],
-    geometry: Geometry,
-    bbar: bool,
-    geometric: bool,
+    op: Operator,
+    geometric: GeometricStiffness,
 ) -> Mat8 {
-    let k = kinematics(geom, d, geometry, bbar);
+    let k = point_strains(geom, d, op);
     let mut kt = Mat8::zeros();
     for q in 0..4 {
         let w = geom.points[q].weight;
         kt += k[q].b.transpose() * (moduli[q] * k[q].b) * w;
     }
-    if geometry == Geometry::Linear || !geometric {
+    if op.strain == Strain::Small || geometric == GeometricStiffness::Omitted {
         return kt;
     }
     let axisymmetric = geom.formulation == Formulation::Axisymmetric;
@@ -309,7 +303,7 @@ pub fn tangent(
         }
         mean_m += ms[q] * (p.weight / geom.volume());
     }
-    if bbar {
+    if op.bbar {
         for q in 0..4 {
             let w = geom.points[q].weight;
             kt += (mean_m - ms[q]) * (w * trace(&stress[q]) / 3.0);
@@ -319,7 +313,7 @@ pub fn tangent(
 }
 
 /// Consistent mass per unit density, the same for both directions: M_ij = sum w N_i N_j.
-pub fn mass(geom: &QuadGeometry) -> Mat4 {
+pub fn mass(geom: &QuadValues) -> Mat4 {
     let mut m = Mat4::zeros();
     for p in &geom.points {
         for i in 0..4 {
@@ -400,26 +394,23 @@ mod tests {
             Formulation::Axisymmetric,
         ] {
             for bbar in [false, true] {
-                let geom = geometry(&distorted(), form, &[0.7; 4]).unwrap();
-                let force = |d: &Vec8| {
-                    let e = strains(&geom, d, Geometry::Nonlinear, bbar);
-                    internal_force(
-                        &geom,
-                        d,
-                        &e.map(|e| stress_of(&e, &s0)),
-                        Geometry::Nonlinear,
-                        bbar,
-                    )
+                let op = Operator {
+                    strain: Strain::Finite,
+                    bbar,
                 };
-                let e = strains(&geom, &d, Geometry::Nonlinear, bbar);
+                let geom = values(&distorted(), form, &[0.7; 4]).unwrap();
+                let force = |d: &Vec8| {
+                    let e = strains(&geom, d, op);
+                    internal_force(&geom, d, &e.map(|e| stress_of(&e, &s0)), op)
+                };
+                let e = strains(&geom, &d, op);
                 let kt = tangent(
                     &geom,
                     &d,
                     &e.map(|e| stress_of(&e, &s0)),
                     &[moduli(); 4],
-                    Geometry::Nonlinear,
-                    bbar,
-                    true,
+                    op,
+                    GeometricStiffness::Included,
                 );
                 let h = 1e-6;
                 for j in 0..8 {
@@ -447,9 +438,13 @@ mod tests {
     /// A rigid translation gives no strain, no force; volume of the reference element is its area.
     #[test]
     fn rigid_translation_is_strain_free() {
-        let geom = geometry(&distorted(), Formulation::PlaneStrain, &[1.0; 4]).unwrap();
+        let geom = values(&distorted(), Formulation::PlaneStrain, &[1.0; 4]).unwrap();
         let d = Vec8::from_fn(|i, _| if i % 2 == 0 { 0.3 } else { -0.7 });
-        for e in strains(&geom, &d, Geometry::Nonlinear, true) {
+        let op = Operator {
+            strain: Strain::Finite,
+            bbar: true,
+        };
+        for e in strains(&geom, &d, op) {
             assert!(e.norm() < 1e-14);
         }
         // shoelace area of the quad
@@ -466,7 +461,7 @@ mod tests {
         let mut x = distorted();
         x.swap(1, 3);
         assert!(matches!(
-            geometry(&x, Formulation::PlaneStrain, &[1.0; 4]),
+            values(&x, Formulation::PlaneStrain, &[1.0; 4]),
             Err(KernelError::NegativeJacobian { .. })
         ));
     }

@@ -11,7 +11,7 @@
 //! ```
 //! Linear kinematics keeps B = [-e, e] / L with e the reference direction and no K_sigma.
 
-use super::{Geometry, KernelError, Mat4, Vec4};
+use super::{GeometricStiffness, KernelError, Mat4, Strain, Vec4};
 
 /// Reference length and unit direction of the rod X1 -> X2.
 pub fn length(x: &[[f64; 2]; 2]) -> Result<f64, KernelError> {
@@ -23,9 +23,9 @@ pub fn length(x: &[[f64; 2]; 2]) -> Result<f64, KernelError> {
     }
 }
 
-fn b_vector(x: &[[f64; 2]; 2], d: &Vec4, length: f64, geometry: Geometry) -> Vec4 {
+fn b_vector(x: &[[f64; 2]; 2], d: &Vec4, length: f64, geometry: Strain) -> Vec4 {
     let mut dx = [x[1][0] - x[0][0], x[1][1] - x[0][1]];
-    if geometry == Geometry::Nonlinear {
+    if geometry == Strain::Finite {
         dx[0] += d[2] - d[0];
         dx[1] += d[3] - d[1];
     }
@@ -34,14 +34,14 @@ fn b_vector(x: &[[f64; 2]; 2], d: &Vec4, length: f64, geometry: Geometry) -> Vec
 }
 
 /// Axial Green-Lagrange strain increment.
-pub fn strain(x: &[[f64; 2]; 2], d: &Vec4, geometry: Geometry) -> Result<f64, KernelError> {
+pub fn strain(x: &[[f64; 2]; 2], d: &Vec4, geometry: Strain) -> Result<f64, KernelError> {
     let l = length(x)?;
     let e = [(x[1][0] - x[0][0]) / l, (x[1][1] - x[0][1]) / l];
     let du = [d[2] - d[0], d[3] - d[1]];
     let linear = (e[0] * du[0] + e[1] * du[1]) / l;
     Ok(match geometry {
-        Geometry::Linear => linear,
-        Geometry::Nonlinear => linear + 0.5 * (du[0] * du[0] + du[1] * du[1]) / (l * l),
+        Strain::Small => linear,
+        Strain::Finite => linear + 0.5 * (du[0] * du[0] + du[1] * du[1]) / (l * l),
     })
 }
 
@@ -61,27 +61,27 @@ pub fn internal_force(
     d: &Vec4,
     stress: f64,
     area: f64,
-    geometry: Geometry,
+    geometry: Strain,
 ) -> Result<Vec4, KernelError> {
     let l = length(x)?;
     Ok(b_vector(x, d, l, geometry) * (area * l * stress))
 }
 
-/// Tangent: the exact derivative of `internal_force` for dS/dE = `modulus`; without the
-/// geometric term when `geometric` is false.
+/// Tangent: the exact derivative of `internal_force` for dS/dE = `modulus`; the geometric
+/// term only when `geometric` includes it.
 pub fn tangent(
     x: &[[f64; 2]; 2],
     d: &Vec4,
     stress: f64,
     modulus: f64,
     area: f64,
-    geometry: Geometry,
-    geometric: bool,
+    geometry: Strain,
+    geometric: GeometricStiffness,
 ) -> Result<Mat4, KernelError> {
     let l = length(x)?;
     let b = b_vector(x, d, l, geometry);
     let mut k = b * b.transpose() * (area * l * modulus);
-    if geometry == Geometry::Nonlinear && geometric {
+    if geometry == Strain::Finite && geometric == GeometricStiffness::Included {
         let g = area * stress / l;
         for a in 0..2 {
             k[(a, a)] += g;
@@ -110,18 +110,18 @@ mod tests {
         let d = Vec4::new(0.01, -0.03, 0.08, 0.05);
         let (s0, modulus, area) = (0.4, 3.0, 0.7);
         let force = |d: &Vec4| {
-            let e = strain(&x, d, Geometry::Nonlinear).unwrap();
-            internal_force(&x, d, s0 + modulus * e, area, Geometry::Nonlinear).unwrap()
+            let e = strain(&x, d, Strain::Finite).unwrap();
+            internal_force(&x, d, s0 + modulus * e, area, Strain::Finite).unwrap()
         };
-        let e = strain(&x, &d, Geometry::Nonlinear).unwrap();
+        let e = strain(&x, &d, Strain::Finite).unwrap();
         let k = tangent(
             &x,
             &d,
             s0 + modulus * e,
             modulus,
             area,
-            Geometry::Nonlinear,
-            true,
+            Strain::Finite,
+            GeometricStiffness::Included,
         )
         .unwrap();
         // central differences: truncation O(h^2) ~ 1e-12 and round-off eps |f| / h ~ 1e-10
@@ -145,7 +145,7 @@ mod tests {
         let d = Vec4::new(0.0, 0.0, 0.5, 1.0);
         let l2: f64 = 2.5f64.powi(2) + 1.0;
         approx::assert_relative_eq!(
-            strain(&x, &d, Geometry::Nonlinear).unwrap(),
+            strain(&x, &d, Strain::Finite).unwrap(),
             (l2 - 4.0) / 8.0,
             max_relative = 1e-14
         );

@@ -16,7 +16,7 @@ use serde::Serialize;
 
 /// The committed kinematics at the start of a step.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
-pub struct Kinematics {
+pub struct MotionState {
     pub displacement: Vec<f64>,
     pub velocity: Vec<f64>,
     pub acceleration: Vec<f64>,
@@ -63,9 +63,9 @@ pub struct Advance {
 pub trait Integrator: Send {
     /// A name for summaries and charts (with its parameters).
     fn name(&self) -> String;
-    fn form(&self, dt: f64, k: &Kinematics) -> StepForm;
+    fn form(&self, dt: f64, k: &MotionState) -> StepForm;
     /// The end-of-step kinematics; the method may keep history (Houbolt).
-    fn advance(&mut self, dt: f64, k: &Kinematics, solved: &[f64]) -> Advance;
+    fn advance(&mut self, dt: f64, k: &MotionState, solved: &[f64]) -> Advance;
     /// Called when a step is abandoned (cut): history stays as before the step.
     fn reject(&mut self) {}
     /// What the method carries from step to step besides u, v, a (for checkpoints).
@@ -150,7 +150,7 @@ impl GeneralizedAlpha {
         }
     }
 
-    fn newmark_acceleration(&self, dt: f64, k: &Kinematics) -> (f64, Vec<f64>) {
+    fn newmark_acceleration(&self, dt: f64, k: &MotionState) -> (f64, Vec<f64>) {
         // a_{n+1} = D / (beta dt^2) - v_n / (beta dt) - (1/(2 beta) - 1) a_n
         let b = self.beta;
         affine(
@@ -176,7 +176,7 @@ impl Integrator for GeneralizedAlpha {
         }
     }
 
-    fn form(&self, dt: f64, k: &Kinematics) -> StepForm {
+    fn form(&self, dt: f64, k: &MotionState) -> StepForm {
         let n = k.velocity.len();
         let (ca, a_hat) = self.newmark_acceleration(dt, k);
         let (b, g) = (self.beta, self.gamma);
@@ -211,7 +211,7 @@ impl Integrator for GeneralizedAlpha {
         }
     }
 
-    fn advance(&mut self, dt: f64, k: &Kinematics, solved: &[f64]) -> Advance {
+    fn advance(&mut self, dt: f64, k: &MotionState, solved: &[f64]) -> Advance {
         let (ca, a_hat) = self.newmark_acceleration(dt, k);
         let acceleration: Vec<f64> = solved.iter().zip(&a_hat).map(|(d, h)| ca * d + h).collect();
         let g = self.gamma;
@@ -248,7 +248,7 @@ impl Integrator for Wilson {
         format!("wilson(theta={})", self.theta)
     }
 
-    fn form(&self, dt: f64, k: &Kinematics) -> StepForm {
+    fn form(&self, dt: f64, k: &MotionState) -> StepForm {
         let n = k.velocity.len();
         let h = self.theta * dt;
         let (ca, acceleration_offset) = affine(
@@ -272,7 +272,7 @@ impl Integrator for Wilson {
         }
     }
 
-    fn advance(&mut self, dt: f64, k: &Kinematics, solved: &[f64]) -> Advance {
+    fn advance(&mut self, dt: f64, k: &MotionState, solved: &[f64]) -> Advance {
         let h = self.theta * dt;
         let mut increment = Vec::with_capacity(solved.len());
         let mut velocity = Vec::with_capacity(solved.len());
@@ -322,7 +322,7 @@ impl Integrator for Houbolt {
         "houbolt".into()
     }
 
-    fn form(&self, dt: f64, k: &Kinematics) -> StepForm {
+    fn form(&self, dt: f64, k: &MotionState) -> StepForm {
         if !self.ready(dt) {
             return Houbolt::starter().form(dt, k);
         }
@@ -358,7 +358,7 @@ impl Integrator for Houbolt {
         }
     }
 
-    fn advance(&mut self, dt: f64, k: &Kinematics, solved: &[f64]) -> Advance {
+    fn advance(&mut self, dt: f64, k: &MotionState, solved: &[f64]) -> Advance {
         let advance = if self.ready(dt) {
             let (acceleration, velocity) = self.form(dt, k).motion(solved);
             Advance {
@@ -403,7 +403,7 @@ mod tests {
         let omega: f64 = 2.0;
         let dt = 0.3;
         let mut m = GeneralizedAlpha::newmark("average", 0.25, 0.5);
-        let mut k = Kinematics {
+        let mut k = MotionState {
             displacement: vec![1.0],
             velocity: vec![0.0],
             acceleration: vec![-omega * omega],
@@ -415,7 +415,7 @@ mod tests {
             let d = -(f.acceleration_offset[0] + omega * omega * k.displacement[0])
                 / (f.mass_coefficient + omega * omega);
             let adv = m.advance(dt, &k, &[d]);
-            k = Kinematics {
+            k = MotionState {
                 displacement: vec![k.displacement[0] + adv.increment[0]],
                 velocity: adv.velocity,
                 acceleration: adv.acceleration,

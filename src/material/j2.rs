@@ -194,14 +194,14 @@ impl J2 {
         })
     }
 
-    /// One-dimensional return for rods: (stress, back stress, eps_p, tangent, plastic strain).
+    /// One-dimensional return for rods, None when the trial stress is elastic.
     pub fn uniaxial(
         &self,
         trial: f64,
         young: f64,
         back: f64,
         eps_p: f64,
-    ) -> Option<(f64, f64, f64, f64, f64)> {
+    ) -> Option<UniaxialReturn> {
         let xi = trial - back;
         let (sy, _) = self.yield_stress_at(eps_p);
         if xi.abs() - sy <= 0.0 {
@@ -214,15 +214,25 @@ impl J2 {
         let (dl, h_iso) =
             self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), eps_p);
         let dep = SQRT_2_3 * dl;
-        let stress = trial - sign * young * dep;
-        let back_stress = back + sign * h_kin * dep;
         let h = h_iso + h_kin;
-        Some((
-            stress,
-            back_stress,
-            eps_p + dep,
-            young * h / (young + h),
-            sign * dep,
-        ))
+        Some(UniaxialReturn {
+            stress: trial - sign * young * dep,
+            back_stress: back + sign * h_kin * dep,
+            eq_plastic_strain: eps_p + dep,
+            tangent: young * h / (young + h),
+            plastic_strain: sign * dep,
+        })
     }
+}
+
+/// The result of a one-dimensional (rod) return.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UniaxialReturn {
+    pub stress: f64,
+    pub back_stress: f64,
+    pub eq_plastic_strain: f64,
+    /// The algorithmic tangent E H / (E + H), H = H_iso + H_kin.
+    pub tangent: f64,
+    /// The plastic strain increment (signed).
+    pub plastic_strain: f64,
 }

@@ -19,7 +19,7 @@ pub use j2::{Hardening, J2};
 
 /// How many stress components the body carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StressState {
+pub enum StressCondition {
     /// Plane strain and axisymmetric: all four components.
     General,
     /// sigma_zz = 0; the material decides the out-of-plane strain.
@@ -71,14 +71,18 @@ impl Elastic {
 
     /// Elastic moduli; in plane stress the condensed in-plane moduli with the zz row and
     /// column zero.
-    pub fn moduli(&self, state: StressState) -> Moduli {
+    pub fn moduli(&self, state: StressCondition) -> Moduli {
         let (lambda, mu) = self.lame();
         let lambda = match state {
-            StressState::General => lambda,
-            StressState::PlaneStress => 2.0 * lambda * mu / (lambda + 2.0 * mu),
+            StressCondition::General => lambda,
+            StressCondition::PlaneStress => 2.0 * lambda * mu / (lambda + 2.0 * mu),
         };
         let mut d = Moduli::zeros();
-        let normal = if state == StressState::General { 3 } else { 2 };
+        let normal = if state == StressCondition::General {
+            3
+        } else {
+            2
+        };
         for a in 0..normal {
             for b in 0..normal {
                 d[(a, b)] = lambda;
@@ -114,15 +118,20 @@ fn work(stress: &Voigt, plastic_strain: &Voigt) -> f64 {
 impl Material {
     /// Response of a continuum point (Quad4): elastic predictor, then the return to the yield
     /// surface when the material is plastic.
-    pub fn update(&self, committed: &PointState, strain: &Voigt, state: StressState) -> Response {
+    pub fn update(
+        &self,
+        committed: &PointState,
+        strain: &Voigt,
+        state: StressCondition,
+    ) -> Response {
         match state {
-            StressState::General => self.update_general(committed, strain),
-            StressState::PlaneStress => self.update_plane_stress(committed, strain),
+            StressCondition::General => self.update_general(committed, strain),
+            StressCondition::PlaneStress => self.update_plane_stress(committed, strain),
         }
     }
 
     fn update_general(&self, committed: &PointState, strain: &Voigt) -> Response {
-        let moduli = self.elastic.moduli(StressState::General);
+        let moduli = self.elastic.moduli(StressCondition::General);
         let trial = committed.stress + moduli * strain;
         let (_, mu) = self.elastic.lame();
         let plastic = self.plasticity.as_ref().and_then(|j2| {
@@ -214,12 +223,8 @@ impl Material {
         response
     }
 
-    /// Response of a rod: axial stress, tangent modulus, new state, plastic work density.
-    pub fn update_uniaxial(
-        &self,
-        committed: &PointState,
-        strain: f64,
-    ) -> (f64, f64, PointState, f64) {
+    /// Response of a rod to an axial strain increment.
+    pub fn update_uniaxial(&self, committed: &PointState, strain: f64) -> UniaxialResponse {
         let young = self.elastic.young;
         let trial = committed.stress[0] + young * strain;
         let plastic = self.plasticity.as_ref().and_then(|j2| {
@@ -234,16 +239,38 @@ impl Material {
         match plastic {
             None => {
                 state.stress[0] = trial;
-                (trial, young, state, 0.0)
+                UniaxialResponse {
+                    stress: trial,
+                    tangent: young,
+                    state,
+                    plastic_work: 0.0,
+                }
             }
-            Some((stress, back, eps_p, tangent, dep)) => {
-                state.stress[0] = stress;
-                state.back_stress[0] = back;
-                state.eq_plastic_strain = eps_p;
-                (stress, tangent, state, stress * dep)
+            Some(r) => {
+                state.stress[0] = r.stress;
+                state.back_stress[0] = r.back_stress;
+                state.eq_plastic_strain = r.eq_plastic_strain;
+                UniaxialResponse {
+                    stress: r.stress,
+                    tangent: r.tangent,
+                    state,
+                    plastic_work: r.stress * r.plastic_strain,
+                }
             }
         }
     }
+}
+
+/// The response of a rod point.
+#[derive(Debug, Clone, Copy)]
+pub struct UniaxialResponse {
+    /// Axial second Piola-Kirchhoff stress relative to the reference configuration.
+    pub stress: f64,
+    /// dS/dE.
+    pub tangent: f64,
+    pub state: PointState,
+    /// Plastic work per unit reference volume of the increment.
+    pub plastic_work: f64,
 }
 
 /// Von Mises equivalent stress of [xx yy zz xy].
@@ -280,7 +307,7 @@ mod tests {
         let r = m.update(
             &PointState::default(),
             &Voigt::new(1e-3, 0.0, 0.0, 0.0),
-            StressState::PlaneStress,
+            StressCondition::PlaneStress,
         );
         approx::assert_relative_eq!(
             r.stress[0],
@@ -291,7 +318,7 @@ mod tests {
         let replay = m.update(
             &PointState::default(),
             &Voigt::new(1e-3, 0.0, r.strain_zz, 0.0),
-            StressState::General,
+            StressCondition::General,
         );
         assert!(replay.stress[2].abs() <= 1e-12 * replay.stress.norm());
     }
@@ -345,9 +372,9 @@ mod plasticity_tests {
         ];
         for (law, kinematic) in laws {
             let m = steel(law, kinematic);
-            for state in [StressState::General, StressState::PlaneStress] {
+            for state in [StressCondition::General, StressCondition::PlaneStress] {
                 let mut c = committed();
-                if state == StressState::PlaneStress {
+                if state == StressCondition::PlaneStress {
                     c.stress[2] = 0.0;
                     c.back_stress[2] = 0.0;
                 }
@@ -355,7 +382,7 @@ mod plasticity_tests {
                 let r = m.update(&c, &strain, state);
                 assert!(r.plastic_work > 0.0, "the step must be plastic");
                 let h = 1e-8;
-                let columns: &[usize] = if state == StressState::General {
+                let columns: &[usize] = if state == StressCondition::General {
                     &[0, 1, 2, 3]
                 } else {
                     &[0, 1, 3]
@@ -386,9 +413,9 @@ mod plasticity_tests {
     #[test]
     fn plastic_state_lies_on_the_yield_surface() {
         let m = steel(Hardening::Linear { modulus: 10.0 }, 5.0);
-        for state in [StressState::General, StressState::PlaneStress] {
+        for state in [StressCondition::General, StressCondition::PlaneStress] {
             let mut c = committed();
-            if state == StressState::PlaneStress {
+            if state == StressCondition::PlaneStress {
                 c.stress[2] = 0.0;
             }
             let strain = Voigt::new(0.004, -0.001, 0.0005, 0.003);
@@ -407,10 +434,10 @@ mod plasticity_tests {
             .sqrt();
             let sy = 0.5 + 10.0 * r.state.eq_plastic_strain;
             approx::assert_relative_eq!(mises, sy, max_relative = 1e-12);
-            if state == StressState::PlaneStress {
+            if state == StressCondition::PlaneStress {
                 let mut strain_3d = strain;
                 strain_3d[2] = r.strain_zz;
-                let replay = m.update(&c, &strain_3d, StressState::General);
+                let replay = m.update(&c, &strain_3d, StressCondition::General);
                 let scale = replay.stress.norm();
                 assert!(
                     replay.stress[2].abs() <= 1e-12 * scale,

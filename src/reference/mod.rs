@@ -60,11 +60,10 @@ pub fn elastica_midspan_deflection(load_ratio: f64) -> f64 {
 
 /// Tip of an inextensible elastic cantilever (the elastica) of length 1, clamped at s = 0
 /// along x, under a dead tip load perpendicular to the initial axis with k = P L^2 / (E I).
-/// Returns (shortening u / L, deflection w / L, tip rotation).
 ///
 /// theta'' = -k cos(theta), theta(0) = 0, theta'(1) = 0, solved by shooting on theta'(0)
 /// with RK4 (4000 steps) and bisection; x' = cos(theta), y' = sin(theta).
-pub fn elastica_tip(k: f64) -> (f64, f64, f64) {
+pub fn elastica_tip(k: f64) -> ElasticaTip {
     let end_curvature = |kappa0: f64| integrate_elastica(k, kappa0).3;
     // theta'(0) = k x_tip lies in (0, k]
     let (mut lo, mut hi) = (0.0, k);
@@ -77,7 +76,22 @@ pub fn elastica_tip(k: f64) -> (f64, f64, f64) {
         }
     }
     let (x, y, theta, _) = integrate_elastica(k, 0.5 * (lo + hi));
-    (1.0 - x, y, theta)
+    ElasticaTip {
+        shortening: 1.0 - x,
+        deflection: y,
+        rotation: theta,
+    }
+}
+
+/// The tip of the cantilever elastica of length 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElasticaTip {
+    /// u / L along the initial axis.
+    pub shortening: f64,
+    /// w / L across it.
+    pub deflection: f64,
+    /// The tip rotation (radians).
+    pub rotation: f64,
 }
 
 /// Integrates the elastica from s = 0 to 1; returns (x, y, theta, theta') at s = 1.
@@ -108,7 +122,8 @@ mod tests {
     #[test]
     fn elastica_matches_mattiasson_table() {
         for (k, u, w) in [(1.0, 0.05643, 0.30172), (2.0, 0.16064, 0.49346)] {
-            let (du, dw, _) = elastica_tip(k);
+            let tip = elastica_tip(k);
+            let (du, dw) = (tip.shortening, tip.deflection);
             approx::assert_abs_diff_eq!(du, u, epsilon = 1e-5);
             approx::assert_abs_diff_eq!(dw, w, epsilon = 1e-5);
         }
@@ -166,7 +181,8 @@ mod tests {
     /// Small loads: the linear beam's w = k/3, and u = 1/2 int w'^2 ds = k^2 / 15.
     #[test]
     fn elastica_reduces_to_linear_beam() {
-        let (u, w, _) = elastica_tip(1e-4);
+        let tip = elastica_tip(1e-4);
+        let (u, w) = (tip.shortening, tip.deflection);
         approx::assert_relative_eq!(w, 1e-4 / 3.0, max_relative = 1e-6);
         approx::assert_relative_eq!(u, 1e-8 / 15.0, max_relative = 1e-3);
     }

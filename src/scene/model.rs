@@ -12,7 +12,7 @@ use super::spec::{
     Statistic,
 };
 use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
-use crate::element::{Formulation, Geometry, Voigt, quad4, rod2};
+use crate::element::{Formulation, Strain, Voigt, quad4, rod2};
 use crate::material::{Elastic, Hardening, J2, Material};
 use crate::mesh::{Cells, Mesh};
 use std::collections::BTreeMap;
@@ -146,7 +146,7 @@ pub enum Analysis {
 }
 
 impl Analysis {
-    pub fn geometry(&self) -> Geometry {
+    pub fn geometry(&self) -> Strain {
         match self {
             Analysis::Static(s) => s.geometry,
             Analysis::Dynamic(s) => s.geometry,
@@ -764,7 +764,7 @@ fn check_cells(cx: &Context, key: &str, mesh: &Mesh, kind: &BodyKind) -> Result<
         (Cells::Quad4(quads), BodyKind::Continuum { formulation, .. }) => {
             for (e, q) in quads.iter().enumerate() {
                 let x = q.map(|n| mesh.nodes[n]);
-                quad4::geometry(&x, *formulation, &[1.0; 4]).map_err(|err| {
+                quad4::values(&x, *formulation, &[1.0; 4]).map_err(|err| {
                     cx.err(format!(
                         "{key}: element {e} (nodes {q:?}) is invalid: {err}"
                     ))
@@ -944,7 +944,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
                  integrator {integrator:?} needs the tangent of the full 2x2 kernel: use quadrature = \"full\" or integrator = \"central_difference\""
             )));
         }
-        if spec.geometry == Geometry::Linear {
+        if spec.geometry == Strain::Small {
             return Err(cx.err(
                 "analysis.quadrature: `reduced` runs the updated-Lagrangian (finite-strain) kernel only; use geometry = \"nonlinear\" or quadrature = \"full\"",
             ));

@@ -1,7 +1,7 @@
 //! The scene file's schema. Each struct denies unknown fields; each enum variant wraps its own
 //! struct so unknown keys are caught inside internally tagged enums too (serde #2123, #2294).
 
-use crate::element::Geometry;
+use crate::element::Strain;
 use crate::mesh::MeshSpec;
 use crate::output::vtk::Compression;
 use serde::Deserialize;
@@ -358,7 +358,7 @@ pub struct AnalysisSpec {
     pub end_time: Option<f64>,
     /// `nonlinear` (default, updated Lagrangian) or `linear` (small strain).
     #[serde(default)]
-    pub geometry: Geometry,
+    pub geometry: Strain,
     #[serde(default)]
     pub newton: NewtonSpec,
     /// Dynamic: the integrator (default `average`).
@@ -468,7 +468,7 @@ pub struct DynamicSpec {
     pub mass: MassKind,
     pub rayleigh: [f64; 2],
     pub allow_unstable: bool,
-    pub geometry: Geometry,
+    pub geometry: Strain,
     pub newton: NewtonSpec,
     pub buckling: Option<BucklingSpec>,
     /// Central difference's Quad4 kernel (always `full` for the implicit integrators).
@@ -482,7 +482,7 @@ pub struct DynamicSpec {
 pub struct StaticSpec {
     pub steps: usize,
     pub end_time: f64,
-    pub geometry: Geometry,
+    pub geometry: Strain,
     pub newton: NewtonSpec,
     pub buckling: Option<BucklingSpec>,
 }

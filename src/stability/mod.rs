@@ -22,7 +22,7 @@
 //! estimate beta_m |s_m,i| is below 1e-10 mu_i.
 
 use crate::assembly::{self, ElementFailure, State, System};
-use crate::element::Geometry;
+use crate::element::Strain;
 use crate::scene::Model;
 use crate::scene::spec::Tangent;
 use crate::solver::{Pattern, Solver, SolverError};
@@ -138,7 +138,7 @@ pub fn assemble_tangent(
         model,
         state,
         &zero,
-        Geometry::Nonlinear,
+        Strain::Finite,
         Some(system),
         Tangent::Consistent,
     )?;
@@ -157,7 +157,7 @@ pub fn stiffness_parts(
             model,
             state,
             &zero,
-            Geometry::Nonlinear,
+            Strain::Finite,
             Some(&mut *system),
             tangent,
         )

@@ -137,7 +137,7 @@ pub fn tabulate(
             .and_then(|f| read_json(&f.join("case.json")));
         let files = folder.as_ref().and_then(|f| load(f, column.as_deref()));
         let dt_crit = if model.bodies.iter().all(|b| b.material.density > 0.0) {
-            Some(critical_time_step(model)?.0)
+            Some(critical_time_step(model)?.dt)
         } else {
             None
         };
