@@ -225,15 +225,15 @@ dt = 0.01
 end_time = 0.1
 "#;
     let model = common::model("penetration", text, &[]);
-    let limits = impact::analysis::contact::penetration_limits(&model);
-    approx::assert_relative_eq!(limits[0], 0.5 / 6.0, max_relative = 1e-12);
-    let state = impact::analysis::contact::ContactState::new(&model);
+    use impact::contact::{penetration_limits, runaway_penetration};
     let mut x = model.coordinates();
-    assert!(state.runaway_penetration(&model, &x, &limits).is_none());
+    let limits = penetration_limits(&model.contacts, &x);
+    approx::assert_relative_eq!(limits[0], 0.5 / 6.0, max_relative = 1e-12);
+    assert!(runaway_penetration(&model.contacts, &x, &limits).is_none());
     x[3][1] -= 0.05;
-    assert!(state.runaway_penetration(&model, &x, &limits).is_none());
+    assert!(runaway_penetration(&model.contacts, &x, &limits).is_none());
     x[2][1] -= 0.2;
-    let message = state.runaway_penetration(&model, &x, &limits).unwrap();
+    let message = runaway_penetration(&model.contacts, &x, &limits).unwrap();
     for n in ["contact `floor`", "node 2", "gap = -2e-1", "beyond -8.3"] {
         assert!(message.contains(n), "`{n}` missing in {message}");
     }

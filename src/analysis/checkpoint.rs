@@ -13,11 +13,11 @@
 //! not stored: the step after a checkpoint refactors K* in the run that wrote it and in the
 //! resumed one alike, so both take the same path (one extra factorization per checkpoint).
 
-use super::contact::ContactState;
 use super::newton::Counters;
 use super::record::{Energies, RecorderPosition};
 use super::{StepControl, Summary};
 use crate::assembly::State;
+use crate::contact::ContactState;
 use crate::integrator::{MethodHistory, MotionState};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::{InputError, SceneSource};

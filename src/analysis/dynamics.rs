@@ -13,11 +13,11 @@
 //! integrator formulas as the free ones.
 
 use super::checkpoint::{Carry, Checkpoint, DynamicCarry};
-use super::contact::ContactState;
-use super::newton::{ContactStep, Counters, Inertia, Step, StepFailure, Tangential};
+use super::newton::{Constraints, Counters, Inertia, Step, StepFailure};
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, Mass, State, System};
+use crate::contact::{ContactState, Tangential};
 use crate::integrator::{GeneralizedAlpha, Houbolt, Integrator, MotionState, Wilson};
 use crate::scene::spec::{DynamicSpec, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
@@ -185,8 +185,9 @@ pub fn run(
     // step after a checkpoint factors afresh: a resumed run has no factorization)
     let mut factored_for: Option<[f64; 3]> = None;
     let mut increments = 0usize;
-    let mut contact = ContactState::new(model);
-    let penetration_limits = super::contact::penetration_limits(model);
+    let interfaces = super::interfaces(model);
+    let mut contact = ContactState::new(&model.contacts);
+    let penetration_limits = crate::contact::penetration_limits(&model.contacts, &initial);
     let mut last_contact = vec![0.0; model.dofs()];
     match resume {
         Some((checkpoint, carry)) => {
@@ -284,7 +285,7 @@ pub fn run(
         let positions = state.positions(spec.geometry);
         let kinetic_before_impact = mass.kinetic_energy(model, &kin.velocity);
         contact.close_touching(
-            model,
+            &interfaces,
             &positions,
             &mass.lumped,
             &mut kin.velocity,
@@ -331,10 +332,10 @@ pub fn run(
                 external: &external,
                 internal_start: &last_internal,
                 factor_first,
-                contact: Some(ContactStep {
+                contact: Some(Constraints {
                     pairs: &model.contacts,
                     active,
-                    reference: &positions,
+                    start: &positions,
                     forces,
                     tangential,
                 }),
@@ -348,7 +349,7 @@ pub fn run(
             result
         };
         let outcome = contact
-            .step(model, &positions, nominal, attempt)
+            .step(&model.contacts, &positions, nominal, attempt)
             .and_then(|mut step| {
                 let h = step.length;
                 let form = method.form(h, &kin);
@@ -387,8 +388,8 @@ pub fn run(
                 }
                 let kinetic_before = mass.kinetic_energy(model, &kin.velocity);
                 let positions = state.positions(spec.geometry);
-                super::contact::apply_conditions(
-                    model,
+                crate::contact::apply_conditions(
+                    &interfaces,
                     &mut step,
                     &positions,
                     &mass.lumped,
@@ -396,8 +397,8 @@ pub fn run(
                     &mut kin.velocity,
                     &mut kin.acceleration,
                 );
-                contact.commit(model, &step, state.time, &positions);
-                let contact_force = contact.nodal_forces(model, &positions);
+                contact.commit(&interfaces, &step, state.time, &positions);
+                let contact_force = contact.nodal_forces(&model.contacts, &positions);
                 let total = total_force(
                     model, &system, &mass, spec, &kin, &internal, &state, &initial,
                 );
@@ -449,8 +450,8 @@ pub fn run(
                     Some(&contact),
                     last,
                 )?;
-                if let Some(message) = contact.runaway_penetration(
-                    model,
+                if let Some(message) = crate::contact::runaway_penetration(
+                    &model.contacts,
                     &state.positions(spec.geometry),
                     &penetration_limits,
                 ) {
@@ -505,7 +506,7 @@ pub fn run(
     summary.finish(&energies, &counters, Some(&solver), start);
     summary.buckling = monitor.map(|m| m.summary);
     recorder.write_summary(&summary)?;
-    let contact_force = contact.nodal_forces(model, &state.positions(spec.geometry));
+    let contact_force = contact.nodal_forces(&model.contacts, &state.positions(spec.geometry));
     Ok(Outcome {
         summary,
         state,

@@ -13,13 +13,13 @@
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
 use super::checkpoint::{Carry, Checkpoint, ExplicitCarry};
-use super::contact::ContactState;
 use super::dynamics::check_mass;
 use super::newton::Counters;
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::reduced::{Reduced, StepWork};
 use crate::assembly::{self, Mass, State, System};
+use crate::contact::ContactState;
 use crate::scene::spec::Quadrature;
 use crate::scene::spec::{DynamicSpec, MassKind};
 use crate::scene::{InputError, Model};
@@ -156,8 +156,9 @@ pub fn run(
     summary.energy.initial = initial_kinetic;
     let mut last_total = total_force(&free, &external, &internal, m, &a, &v, a_r);
     let mut energy_reference = initial_kinetic;
-    let mut contact = ContactState::new(model);
-    let penetration_limits = super::contact::penetration_limits(model);
+    let interfaces = super::interfaces(model);
+    let mut contact = ContactState::new(&model.contacts);
+    let penetration_limits = crate::contact::penetration_limits(&model.contacts, &initial);
     let mut first_step = 1;
     match resume {
         Some((checkpoint, carry)) => {
@@ -257,7 +258,7 @@ pub fn run(
             crate::profile::time(crate::profile::Phase::Contact, || {
                 let positions = state.positions(spec.geometry);
                 let correction =
-                    contact.explicit_step(model, &positions, &du, &inverse_mass, h, time);
+                    contact.explicit_step(&interfaces, &positions, &du, &inverse_mass, h, time);
                 (
                     du.par_chunks_mut(DOF_CHUNK),
                     v_half.par_chunks_mut(DOF_CHUNK),
@@ -270,7 +271,7 @@ pub fn run(
                             *v += c / h;
                         }
                     });
-                let force = contact.nodal_forces(model, &positions);
+                let force = contact.nodal_forces(&model.contacts, &positions);
                 energies.contact_work -= chunked_sum(&force, &du, |f, u| f * u);
             });
         }
@@ -375,7 +376,11 @@ pub fn run(
             step == steps,
         )?;
         let runaway = crate::profile::time(crate::profile::Phase::Contact, || {
-            contact.runaway_penetration(model, &state.positions(spec.geometry), &penetration_limits)
+            crate::contact::runaway_penetration(
+                &model.contacts,
+                &state.positions(spec.geometry),
+                &penetration_limits,
+            )
         });
         if let Some(message) = runaway {
             progress.abandon();

@@ -3,7 +3,6 @@
 
 pub mod buckling;
 pub mod checkpoint;
-pub mod contact;
 pub mod dynamics;
 pub mod explicit;
 pub mod loads;
@@ -34,14 +33,53 @@ pub enum Status {
     Interrupted,
 }
 
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
-pub struct ContactSummary {
-    pub first_contact_time: Option<f64>,
-    pub last_release_time: Option<f64>,
-    pub peak_force: f64,
-    pub peak_contact_radius: f64,
-    /// The most negative slave gap after any step (penetration if < 0), null without contact.
-    pub min_gap: Option<f64>,
+pub use crate::contact::ContactSummary;
+
+/// The contact problem of `model` as contact sees it: the pairs, and per body its section
+/// and plane-wave impedance for the impact and release conditions.
+pub fn interfaces(model: &Model) -> crate::contact::Interfaces {
+    use crate::contact::{BodySurface, Section};
+    use crate::element::Formulation;
+    use crate::scene::BodyKind;
+    let bodies = model
+        .bodies
+        .iter()
+        .map(|b| {
+            let e = &b.material.elastic;
+            let (lambda, mu) = e.lame();
+            let (modulus, section) = match b.kind {
+                BodyKind::Rod { area } => (e.young, Section::Rod { area }),
+                BodyKind::Continuum {
+                    formulation,
+                    thickness,
+                    ..
+                } => match formulation {
+                    Formulation::PlaneStrain => {
+                        (lambda + 2.0 * mu, Section::Plane { thickness: 1.0 })
+                    }
+                    Formulation::PlaneStress => (
+                        e.young / (1.0 - e.poisson * e.poisson),
+                        Section::Plane { thickness },
+                    ),
+                    Formulation::Axisymmetric => (lambda + 2.0 * mu, Section::Axisymmetric),
+                },
+            };
+            BodySurface {
+                section,
+                impedance_per_area: (modulus * b.material.density).sqrt(),
+                boundary_at_node: b
+                    .boundary_at_node
+                    .iter()
+                    .map(|edges| edges.iter().map(|e| e.map(|n| b.global(n))).collect())
+                    .collect(),
+                node_offset: b.node_offset,
+            }
+        })
+        .collect();
+    crate::contact::Interfaces {
+        pairs: model.contacts.clone(),
+        bodies,
+    }
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]

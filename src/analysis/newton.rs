@@ -17,7 +17,7 @@
 //! more than half of the iterations left to reach the force tolerance.
 
 use crate::assembly::{self, Evaluation, Mass, State, System};
-use crate::contact::ContactPair;
+use crate::contact::{ConstrainedSolution, ContactPair, Tangential, Unsettled};
 use crate::element::Strain;
 use crate::integrator::StepForm;
 use crate::profile::{self, Phase};
@@ -35,6 +35,12 @@ pub struct Counters {
 /// The step failed to converge: why (reported after the last cut).
 #[derive(Debug, Clone)]
 pub struct StepFailure(pub String);
+
+impl From<Unsettled> for StepFailure {
+    fn from(e: Unsettled) -> StepFailure {
+        StepFailure(e.to_string())
+    }
+}
 
 /// Inertia and damping of a dynamic problem.
 pub struct Inertia<'a> {
@@ -55,31 +61,18 @@ pub struct Step<'a> {
     /// Factor at the first iteration (else the solver's factorization is reused).
     pub factor_first: bool,
     /// Active contact constraints, enforced by Lagrange multipliers.
-    pub contact: Option<ContactStep<'a>>,
+    pub contact: Option<Constraints<'a>>,
 }
 
-/// The contact constraints a step enforces: (pair, slave node) entries, gaps measured at
-/// reference + d. Their multipliers start from `forces` (the last step's).
-pub struct ContactStep<'a> {
+/// The contact constraints a step enforces (its input): (pair, slave node) entries, gaps
+/// measured at start + d. Their multipliers start from `forces` (the last step's).
+pub struct Constraints<'a> {
     pub pairs: &'a [ContactPair],
     pub active: &'a [(usize, usize)],
-    pub reference: &'a [[f64; 2]],
+    pub start: &'a [[f64; 2]],
     pub forces: Vec<f64>,
     /// Friction on some of the active entries.
     pub tangential: &'a [Tangential],
-}
-
-/// A tangential condition on active entry `entry` (an index into `active`). The slip s of a
-/// step is t . (d_s - sum w_m d_m), t = (-n_y, n_x); a tangential force f acts as f t on
-/// the slave and -w_m f t on the master nodes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Tangential {
-    /// s = target, by a Lagrange multiplier (Coulomb stick: 0; Greco's return: (1 - R) times
-    /// the frictionless slip).
-    Fixed { entry: usize, target: f64 },
-    /// f = coefficient x tau of the entry (Coulomb slide: +-mu), a known force in each
-    /// iteration (tau of the last solve).
-    Sliding { entry: usize, coefficient: f64 },
 }
 
 /// A converged step: the increment, its evaluation, the contact multipliers (tau, the
@@ -90,6 +83,18 @@ pub struct Solution {
     pub evaluation: Evaluation,
     pub forces: Vec<f64>,
     pub tangential: Vec<f64>,
+}
+
+impl ConstrainedSolution for Solution {
+    fn increment(&self) -> &[f64] {
+        &self.d
+    }
+    fn normal_forces(&self) -> &[f64] {
+        &self.forces
+    }
+    fn tangential_forces(&self) -> &[f64] {
+        &self.tangential
+    }
 }
 
 /// Active constraint rows restricted to the free DOFs, and their gaps (normal rows first,
@@ -122,7 +127,7 @@ impl Rows {
         }
     }
 
-    /// The tangential forces in the order of `ContactStep::tangential`, from the multipliers
+    /// The tangential forces in the order of `Constraints::tangential`, from the multipliers
     /// of a solve (normal rows, then fixed tangential rows).
     fn tangential_forces(&self, tangential: &[Tangential], multipliers: &[f64]) -> Vec<f64> {
         let mut fixed = self.normal;
@@ -139,14 +144,9 @@ impl Rows {
     }
 }
 
-impl ContactStep<'_> {
+impl Constraints<'_> {
     fn rows(&self, d: &[f64], system: &System) -> Result<Rows, StepFailure> {
-        let x = |n: usize| {
-            [
-                self.reference[n][0] + d[2 * n],
-                self.reference[n][1] + d[2 * n + 1],
-            ]
-        };
+        let x = |n: usize| [self.start[n][0] + d[2 * n], self.start[n][1] + d[2 * n + 1]];
         let free = |row: Vec<(usize, f64)>| -> Vec<(usize, f64)> {
             row.into_iter()
                 .filter_map(|(dof, c)| system.equation[dof].map(|eq| (eq, c)))

@@ -2,8 +2,8 @@
 //! row per converged step, summary.json at the end (also after a failure).
 
 use super::Summary;
-use super::contact::ContactState;
 use crate::assembly::State;
+use crate::contact::ContactState;
 use crate::contact::Friction;
 use crate::material::{pressure, von_mises};
 use crate::mesh::Cells;
@@ -249,8 +249,12 @@ impl Recorder {
         let (contact_force, gap, status) = match contact {
             Some(c) => {
                 let positions = state.positions(model.analysis.geometry());
-                let (gap, status) = c.nodal_status(model, &positions);
-                (c.nodal_forces(model, &positions), gap, status)
+                let nodal = c.nodal_status(&model.contacts, &positions);
+                (
+                    c.nodal_forces(&model.contacts, &positions),
+                    nodal.gap,
+                    nodal.status,
+                )
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };

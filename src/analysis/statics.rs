@@ -10,11 +10,11 @@
 //! the run stops `diverged` with its output so far kept. After a cut the step grows back.
 
 use super::checkpoint::{Carry, Checkpoint, StaticCarry};
-use super::contact::ContactState;
-use super::newton::{ContactStep, Counters, Step, StepFailure, Tangential};
+use super::newton::{Constraints, Counters, Step, StepFailure};
 use super::record::{Energies, Motion, Recorder};
 use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
 use crate::assembly::{self, State, System};
+use crate::contact::{ContactState, Tangential};
 use crate::integrator::StepForm;
 use crate::scene::Model;
 use crate::scene::spec::{StaticSpec, Strategy};
@@ -76,8 +76,9 @@ pub fn run(
     let mut counters = Counters::default();
     let mut control = super::StepControl::new(dt, spec.newton.max_cuts);
     let mut increments = 0usize;
-    let mut contact = ContactState::new(model);
-    let penetration_limits = super::contact::penetration_limits(model);
+    let interfaces = super::interfaces(model);
+    let mut contact = ContactState::new(&model.contacts);
+    let penetration_limits = crate::contact::penetration_limits(&model.contacts, &initial);
     match resume {
         Some((checkpoint, carry)) => {
             state = carry.state;
@@ -170,10 +171,10 @@ pub fn run(
                     external: &external,
                     internal_start: &last_force,
                     factor_first,
-                    contact: Some(ContactStep {
+                    contact: Some(Constraints {
                         pairs: &model.contacts,
                         active,
-                        reference: &positions,
+                        start: &positions,
                         forces,
                         tangential,
                     }),
@@ -182,7 +183,7 @@ pub fn run(
             };
         // an event inside the increment ends it early (Erklig 2.1.4: alpha brings the next
         // node exactly into contact before the boundary conditions change)
-        match contact.step(model, &positions, target - state.time, attempt) {
+        match contact.step(&model.contacts, &positions, target - state.time, attempt) {
             Ok(mut step) => {
                 let end = if state.time + step.length >= target {
                     target
@@ -194,7 +195,12 @@ pub fn run(
                 let force = evaluation.force.clone();
                 assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
                 state.time = end;
-                contact.commit(model, &step, state.time, &state.positions(spec.geometry));
+                contact.commit(
+                    &interfaces,
+                    &step,
+                    state.time,
+                    &state.positions(spec.geometry),
+                );
                 // the work of all nodal forces (loads, reactions and contact forces)
                 energies.external_work += super::trapezoid_work(&d, &force, &last_force);
                 energies.internal = state.internal_work - state.plastic_work;
@@ -231,8 +237,8 @@ pub fn run(
                     Some(&contact),
                     last,
                 )?;
-                if let Some(message) = contact.runaway_penetration(
-                    model,
+                if let Some(message) = crate::contact::runaway_penetration(
+                    &model.contacts,
                     &state.positions(spec.geometry),
                     &penetration_limits,
                 ) {
@@ -290,7 +296,7 @@ pub fn run(
     summary.contact = contact.summary();
     summary.buckling = monitor.map(|m| m.summary);
     recorder.write_summary(&summary)?;
-    let contact_force = contact.nodal_forces(model, &state.positions(spec.geometry));
+    let contact_force = contact.nodal_forces(&model.contacts, &state.positions(spec.geometry));
     Ok(Outcome {
         summary,
         state,

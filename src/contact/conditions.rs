@@ -1,0 +1,217 @@
+//! Hughes' impact conditions (II-8) for the entries that close and release conditions
+//! (II-11, II-12) for those released by the fraction rule, with their tangential
+//! counterparts under friction.
+//!
+//! Legend (per entry: a slave node of a pair)
+//! ```text
+//! tau          compressive normal force (Lagrange multiplier)
+//! Z            rho c A: the normal impedance of a node (c the dilatational wave speed,
+//!              A its tributary contact area)
+//! M            the node's lumped mass
+//! v_n, a_n     normal components of velocity and acceleration, n out of the master
+//! V+ = (Z_s v_s,n-1 + Z_m v_m,n-1) / (Z_s + Z_m)       velocities of the previous step
+//! a+ = (M_s a_s + M_m a_m) / (M_s + M_m),  tau+ = tau + M_s (a+ - a_s)
+//! v_s,n += tau / Z_s,  v_m,n -= tau / Z_m,  a_s,n -= tau / M_s,  a_m,n += tau / M_m
+//! ```
+//! A rigid obstacle is a master of infinite mass and impedance at rest.
+
+use super::Interfaces;
+use super::geometry::{ContactPair, Friction, Gap, Master};
+
+pub(super) fn normal_component(v: &[f64], node: usize, n: [f64; 2]) -> f64 {
+    v[2 * node] * n[0] + v[2 * node + 1] * n[1]
+}
+
+pub(super) fn add_normal(v: &mut [f64], node: usize, n: [f64; 2], amount: f64) {
+    v[2 * node] += amount * n[0];
+    v[2 * node + 1] += amount * n[1];
+}
+
+/// The master side of an entry: nodes with weights, their interpolated mass, impedance, and
+/// normal velocity/acceleration; a rigid obstacle has none (infinite mass, at rest).
+pub(super) struct MasterSide {
+    pub nodes: Vec<(usize, f64)>,
+    pub mass: f64,
+    pub impedance: f64,
+}
+
+pub(super) fn master_side(
+    interfaces: &Interfaces,
+    pair: &ContactPair,
+    gap: &Gap,
+    lumped: &[f64],
+    coords: &[[f64; 2]],
+) -> Option<MasterSide> {
+    let body = match &pair.master {
+        Master::Obstacle(_) => return None,
+        Master::Segments { body, .. } | Master::Nodes { body, .. } => *body,
+    };
+    let mass = gap.masters.iter().map(|(m, w)| w * lumped[2 * m]).sum();
+    let impedance = gap
+        .masters
+        .iter()
+        .map(|(m, w)| w * interfaces.impedance(body, *m, coords))
+        .sum();
+    Some(MasterSide {
+        nodes: gap.masters.clone(),
+        mass,
+        impedance,
+    })
+}
+
+/// Whether a touching slave approaches its master: the normal velocity relative to the
+/// master's interpolated one is negative.
+pub(super) fn approaching(
+    interfaces: &Interfaces,
+    pair: &ContactPair,
+    s: usize,
+    gap: &Gap,
+    coords: &[[f64; 2]],
+    lumped: &[f64],
+    velocity: &[f64],
+) -> bool {
+    let n = gap.normal;
+    let master = master_side(interfaces, pair, gap, lumped, coords);
+    let vm = master
+        .as_ref()
+        .map_or(0.0, |m| interpolated(velocity, m, n));
+    normal_component(velocity, s, n) - vm < 0.0
+}
+
+/// Spreads a change of the interpolated normal component over the master nodes so that the
+/// interpolation sum w_i x_i changes by exactly `change`.
+pub(super) fn spread(v: &mut [f64], side: &MasterSide, n: [f64; 2], change: f64) {
+    let w2: f64 = side.nodes.iter().map(|(_, w)| w * w).sum();
+    if w2 > 0.0 {
+        for (m, w) in &side.nodes {
+            add_normal(v, *m, n, change * w / w2);
+        }
+    }
+}
+
+pub(super) fn interpolated(v: &[f64], side: &MasterSide, n: [f64; 2]) -> f64 {
+    side.nodes
+        .iter()
+        .map(|(m, w)| w * normal_component(v, *m, n))
+        .sum()
+}
+
+/// The tangential counterpart of II-8 with friction: a change dv_n of the normal velocity
+/// (positive: a push out of the master) comes with a change of the relative tangential
+/// velocity v_t by -sign(v_t) mu dv_n, at most down to v_t = 0 (Coulomb: the impulse of the
+/// condition obeys the friction law; a pull, which takes back part of the step's normal
+/// impulse, gives back the friction that came with it), or by -R v_t (Greco's return: R = 0
+/// keeps the tangential motion, R = 1 stops it). The give-back turns v_t towards its value
+/// before the step and stops there. Momentum is shared by the lumped masses.
+fn tangential_impact(
+    pair: &ContactPair,
+    s: usize,
+    gap: &Gap,
+    master: Option<&MasterSide>,
+    lumped: &[f64],
+    previous_velocity: &[f64],
+    velocity: &mut [f64],
+    normal_change: f64,
+) {
+    let t = gap.tangent();
+    let vm = master.map_or(0.0, |m| interpolated(velocity, m, t));
+    let relative = normal_component(velocity, s, t) - vm;
+    let change = match pair.options.friction {
+        Friction::None => return,
+        Friction::Coulomb { mu } if normal_change > 0.0 => {
+            -relative.signum() * relative.abs().min(mu * normal_change)
+        }
+        Friction::Coulomb { mu } => {
+            // towards the tangential velocity before the step, and no further
+            let before = normal_component(previous_velocity, s, t)
+                - master.map_or(0.0, |m| interpolated(previous_velocity, m, t));
+            let limit = -mu * normal_change;
+            (before - relative).clamp(-limit, limit)
+        }
+        Friction::Return { r } => -r * relative,
+    };
+    let ms = lumped[2 * s];
+    let share = master.map_or(1.0, |side| side.mass / (ms + side.mass));
+    add_normal(velocity, s, t, share * change);
+    if let Some(side) = master {
+        spread(velocity, side, t, -(1.0 - share) * change);
+    }
+}
+
+/// Hughes II-8 for one slave: the common normal velocity from the impedances and the
+/// previous velocities, the common acceleration from the masses, and the force that keeps
+/// the equations of motion.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn impact(
+    interfaces: &Interfaces,
+    pair: &ContactPair,
+    s: usize,
+    gap: &Gap,
+    coords: &[[f64; 2]],
+    lumped: &[f64],
+    previous_velocity: &[f64],
+    velocity: &mut [f64],
+    acceleration: &mut [f64],
+    force: &mut f64,
+) {
+    let n = gap.normal;
+    let (ms, zs) = (
+        lumped[2 * s],
+        interfaces.impedance(pair.slave_body, s, coords),
+    );
+    let (vs_prev, as_now) = (
+        normal_component(previous_velocity, s, n),
+        normal_component(acceleration, s, n),
+    );
+    let master = master_side(interfaces, pair, gap, lumped, coords);
+    let (v_plus, a_plus) = match &master {
+        None => (0.0, 0.0),
+        Some(side) => {
+            let vm_prev = interpolated(previous_velocity, side, n);
+            let am_now = interpolated(acceleration, side, n);
+            (
+                (zs * vs_prev + side.impedance * vm_prev) / (zs + side.impedance),
+                (ms * as_now + side.mass * am_now) / (ms + side.mass),
+            )
+        }
+    };
+    // II-8's force; were it a pull, the pair's accelerations only lose the present force
+    // (the multiplier stays compressive and the equations of motion hold with it)
+    let tau_plus = *force + ms * (a_plus - as_now);
+    let (a_plus, master_acceleration) = if tau_plus >= 0.0 {
+        (a_plus, None)
+    } else {
+        let released = *force;
+        (
+            as_now - released / ms,
+            master.as_ref().map(|side| {
+                interpolated(acceleration, side, n) + released / side.mass.max(f64::MIN_POSITIVE)
+            }),
+        )
+    };
+    *force = tau_plus.max(0.0);
+    let normal_change = v_plus - normal_component(velocity, s, n);
+    tangential_impact(
+        pair,
+        s,
+        gap,
+        master.as_ref(),
+        lumped,
+        previous_velocity,
+        velocity,
+        normal_change,
+    );
+    add_normal(velocity, s, n, v_plus - normal_component(velocity, s, n));
+    add_normal(acceleration, s, n, a_plus - as_now);
+    if let Some(side) = &master {
+        let vm = interpolated(velocity, side, n);
+        let am = interpolated(acceleration, side, n);
+        spread(velocity, side, n, v_plus - vm);
+        spread(
+            acceleration,
+            side,
+            n,
+            master_acceleration.unwrap_or(a_plus) - am,
+        );
+    }
+}

@@ -1,0 +1,519 @@
+//! Surfaces, detection and the constraint rows of a slave (Hughes et al. 1975, section II;
+//! Greco & Coda 2003, section 2). The solver owns the system; this file only says where the
+//! slaves are, how far from their masters, and along which direction (legend in `contact`).
+
+use crate::mesh::plane::{dot, sub};
+use std::f64::consts::PI;
+
+/// A rigid obstacle: a fixed polyline, solid on its left (a closed counter-clockwise polygon
+/// is a finite obstacle, a clockwise one a cavity, an open polyline a half-space boundary).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Obstacle {
+    pub name: String,
+    pub points: Vec<[f64; 2]>,
+    pub closed: bool,
+}
+
+impl Obstacle {
+    /// Whether a closed polygon runs clockwise (a cavity: its solid lies outside the loop).
+    pub fn is_cavity(&self) -> bool {
+        let n = self.points.len();
+        let area: f64 = (0..n)
+            .map(|i| {
+                let (a, b) = (self.points[i], self.points[(i + 1) % n]);
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum();
+        self.closed && area < 0.0
+    }
+
+    pub fn segments(&self) -> Vec<[[f64; 2]; 2]> {
+        let n = self.points.len();
+        let count = if self.closed { n } else { n - 1 };
+        (0..count)
+            .map(|i| [self.points[i], self.points[(i + 1) % n]])
+            .collect()
+    }
+}
+
+/// What the slaves of a pair meet.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Master {
+    /// Boundary edges of a deformable body (global node ids), and the body's whole boundary
+    /// for the inside test.
+    Segments {
+        body: usize,
+        edges: Vec<[usize; 2]>,
+        boundary: Vec<[usize; 2]>,
+    },
+    /// Node-to-node: each slave meets its nearest master node along a fixed master normal.
+    Nodes {
+        body: usize,
+        nodes: Vec<usize>,
+        normal: [f64; 2],
+    },
+    /// A rigid obstacle.
+    Obstacle(Obstacle),
+}
+
+/// How a pair behaves; every switch of the seeds is here so its effect can be shown.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairOptions {
+    /// Hughes II-8 when a pair closes (dynamics).
+    pub impact_conditions: bool,
+    /// Hughes II-11, II-12 when a pair opens (dynamics).
+    pub release_conditions: bool,
+    /// Release when tau falls below this fraction of the last step's value (Hughes: 0.02).
+    pub release_fraction: f64,
+    /// TOL of Hughes II-7 (length).
+    pub tolerance: f64,
+    /// Slaves farther than this from the master are not candidates (length).
+    pub search_distance: f64,
+    /// Split a step (or load increment) at the first contact event inside it.
+    pub split_at_events: bool,
+    /// The tangential law of the interface.
+    pub friction: Friction,
+}
+
+/// The tangential law of a contact pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Friction {
+    /// No tangential force.
+    None,
+    /// Coulomb: stick (a tangential Lagrange multiplier) while |t| <= mu tau, else slide with
+    /// |t| = mu tau against the slip.
+    Coulomb { mu: f64 },
+    /// Greco's geometric return (eq 36): the slide of each step is (1 - R) times the slide
+    /// the step would have without friction (R = 0 frictionless, R = 1 adherence).
+    Return { r: f64 },
+}
+
+/// A validated contact pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactPair {
+    pub name: String,
+    pub slave_body: usize,
+    /// Global node ids.
+    pub slaves: Vec<usize>,
+    pub master: Master,
+    pub options: PairOptions,
+}
+
+/// A slave node's relation to its master at a given configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gap {
+    pub gap: f64,
+    pub normal: [f64; 2],
+    /// Master nodes and their weights (empty for a rigid obstacle).
+    pub masters: Vec<(usize, f64)>,
+}
+
+impl Gap {
+    /// The constraint row as (DOF, coefficient) pairs for slave node `slave`.
+    pub fn row(&self, slave: usize) -> Vec<(usize, f64)> {
+        let n = self.normal;
+        let mut row = vec![(2 * slave, n[0]), (2 * slave + 1, n[1])];
+        for (m, w) in &self.masters {
+            row.push((2 * m, -w * n[0]));
+            row.push((2 * m + 1, -w * n[1]));
+        }
+        row
+    }
+
+    /// The tangent t = (-n_y, n_x): the direction of positive slip.
+    pub fn tangent(&self) -> [f64; 2] {
+        [-self.normal[1], self.normal[0]]
+    }
+
+    /// The tangential row t . (x_s - sum w_m x_m) as (DOF, coefficient) pairs: applied to an
+    /// increment it gives the relative slip of the slave along the master.
+    pub fn tangent_row(&self, slave: usize) -> Vec<(usize, f64)> {
+        let t = self.tangent();
+        let mut row = vec![(2 * slave, t[0]), (2 * slave + 1, t[1])];
+        for (m, w) in &self.masters {
+            row.push((2 * m, -w * t[0]));
+            row.push((2 * m + 1, -w * t[1]));
+        }
+        row
+    }
+}
+
+/// |a| as sqrt(a . a) (the gaps' own rounding; `plane::norm` uses hypot).
+fn length(a: [f64; 2]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Greco eq 17: c(S) = -1/(2 pi) sum over the segments [A, B] of the angle increment
+/// phi_B - phi_A seen from S (wrapped into (-pi, pi]); segments run with the solid on their
+/// left, so a point inside a counter-clockwise boundary gets 1. A point on a segment gets
+/// 1/2 and a point on a corner alpha / (2 pi).
+pub fn winding_number(s: [f64; 2], segments: &[[[f64; 2]; 2]]) -> f64 {
+    let mut total = 0.0;
+    for [a, b] in segments {
+        let (ra, rb) = (sub(*a, s), sub(*b, s));
+        if length(ra) == 0.0 || length(rb) == 0.0 {
+            continue; // S on a node: the two adjacent segments give the corner angle
+        }
+        let mut delta = rb[1].atan2(rb[0]) - ra[1].atan2(ra[0]);
+        if delta > PI {
+            delta -= 2.0 * PI;
+        } else if delta <= -PI {
+            delta += 2.0 * PI;
+        }
+        // S on the segment itself sees it under +-pi: it contributes nothing, the rest of the
+        // boundary sums to the half turn
+        if (delta.abs() - PI).abs() < 1e-12 {
+            continue;
+        }
+        total += delta;
+    }
+    // counter-clockwise boundaries sum to +2 pi around interior points
+    total / (2.0 * PI)
+}
+
+/// Nearest point of segment [a, b] to x: (xi, distance).
+fn project(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
+    let ab = sub(b, a);
+    let l2 = dot(ab, ab);
+    let xi = if l2 > 0.0 {
+        (dot(sub(x, a), ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let p = [a[0] + xi * ab[0], a[1] + xi * ab[1]];
+    (xi, length(sub(x, p)))
+}
+
+/// Outward unit normal of a -> b (solid on the left).
+fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    let d = sub(b, a);
+    let l = length(d);
+    [d[1] / l, -d[0] / l]
+}
+
+/// The gap of a point to a polyline of (possibly degenerate) segments with the solid on the
+/// left; `inside` decides the sign where the nearest point is a corner.
+fn gap_to_segments(
+    x: [f64; 2],
+    segments: &[[[f64; 2]; 2]],
+    inside: impl Fn() -> bool,
+) -> Option<(usize, f64, f64, [f64; 2])> {
+    let mut best: Option<(usize, f64, f64)> = None;
+    for (k, [a, b]) in segments.iter().enumerate() {
+        let (xi, d) = project(x, *a, *b);
+        let interior = xi > 0.0 && xi < 1.0;
+        let better = match best {
+            None => true,
+            Some((kb, _, db)) => {
+                let (xib, _) = project(x, segments[kb][0], segments[kb][1]);
+                d < db - 1e-12 * db.max(1e-300)
+                    || ((d - db).abs() <= 1e-12 * db.max(1e-300)
+                        && interior
+                        && !(xib > 0.0 && xib < 1.0))
+            }
+        };
+        if better {
+            best = Some((k, xi, d));
+        }
+    }
+    let (k, xi, d) = best?;
+    let [a, b] = segments[k];
+    let n = outward(a, b);
+    let p = [a[0] + xi * (b[0] - a[0]), a[1] + xi * (b[1] - a[1])];
+    let along_normal = dot(sub(x, p), n);
+    let (gap, normal) = if xi > 0.0 && xi < 1.0 || d == 0.0 {
+        (along_normal, n)
+    } else if inside() {
+        // penetrated near a vertex: the segment's own normal. The direction to the vertex
+        // would turn with every small tangential offset (at a vertex between collinear
+        // segments it flips from side to side) and Newton could not settle.
+        (along_normal, n)
+    } else {
+        // outside a convex corner: the normal points from the corner to the slave
+        let dir = sub(x, p);
+        (d, [dir[0] / d, dir[1] / d])
+    };
+    Some((k, xi, gap, normal))
+}
+
+impl ContactPair {
+    /// The gap of slave node `slave` at positions `x` (global node -> position), or None
+    /// when there is no master within the search distance.
+    pub fn gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
+        let xs = x(slave);
+        let result = match &self.master {
+            Master::Nodes { nodes, normal, .. } => {
+                let m = *nodes
+                    .iter()
+                    .min_by(|a, b| length(sub(x(**a), xs)).total_cmp(&length(sub(x(**b), xs))))?;
+                Gap {
+                    gap: dot(sub(xs, x(m)), *normal),
+                    normal: *normal,
+                    masters: vec![(m, 1.0)],
+                }
+            }
+            Master::Segments {
+                edges, boundary, ..
+            } => {
+                let segments: Vec<[[f64; 2]; 2]> =
+                    edges.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
+                let inside = || {
+                    let closed: Vec<[[f64; 2]; 2]> =
+                        boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
+                    winding_number(xs, &closed) > 0.5
+                };
+                let (k, xi, _, _) = gap_to_segments(xs, &segments, inside)?;
+                let [a, b] = edges[k];
+                // the normal interpolated between the master nodes' averaged normals: it
+                // turns continuously across a vertex, where a dented deformable surface would
+                // otherwise flip the slave's row between its two segments
+                let nodal = |node: usize| -> [f64; 2] {
+                    let mut sum = [0.0; 2];
+                    for [p, q] in edges.iter().filter(|e| e.contains(&node)) {
+                        let n = outward(x(*p), x(*q));
+                        sum = [sum[0] + n[0], sum[1] + n[1]];
+                    }
+                    sum
+                };
+                let (na, nb) = (nodal(a), nodal(b));
+                let raw = [
+                    (1.0 - xi) * na[0] + xi * nb[0],
+                    (1.0 - xi) * na[1] + xi * nb[1],
+                ];
+                let l = length(raw);
+                let normal = if l > 0.0 {
+                    [raw[0] / l, raw[1] / l]
+                } else {
+                    outward(x(a), x(b))
+                };
+                let p = [
+                    (1.0 - xi) * x(a)[0] + xi * x(b)[0],
+                    (1.0 - xi) * x(a)[1] + xi * x(b)[1],
+                ];
+                let gap = dot(sub(xs, p), normal);
+                Gap {
+                    gap,
+                    normal,
+                    masters: vec![(a, 1.0 - xi), (b, xi)],
+                }
+            }
+            Master::Obstacle(o) => {
+                let segments = o.segments();
+                let inside = || {
+                    if o.closed {
+                        // a cavity's loop winds -1 around its void: the solid is where the
+                        // winding number plus the boundary at infinity (1) exceeds 1/2
+                        let infinity = if o.is_cavity() { 1.0 } else { 0.0 };
+                        winding_number(xs, &segments) + infinity > 0.5
+                    } else {
+                        // a half-space boundary: the side of the nearest segment
+                        let (k, _, _) = segments
+                            .iter()
+                            .enumerate()
+                            .map(|(k, [a, b])| (k, project(xs, *a, *b)))
+                            .map(|(k, (xi, d))| (k, xi, d))
+                            .min_by(|a, b| a.2.total_cmp(&b.2))
+                            .expect("segments");
+                        let [a, b] = segments[k];
+                        dot(sub(xs, a), outward(a, b)) < 0.0
+                    }
+                };
+                let (_, _, gap, normal) = gap_to_segments(xs, &segments, inside)?;
+                Gap {
+                    gap,
+                    normal,
+                    masters: Vec::new(),
+                }
+            }
+        };
+        (result.gap <= self.options.search_distance).then_some(result)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Vec<[[f64; 2]; 2]> {
+        let p = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        (0..4).map(|i| [p[i], p[(i + 1) % 4]]).collect()
+    }
+
+    /// Greco eq 17 on a convex square: 1 inside, 0 outside, 1/2 on an edge, 1/4 at a corner
+    /// (alpha = pi/2).
+    #[test]
+    fn winding_number_of_convex_polygon() {
+        let s = square();
+        approx::assert_abs_diff_eq!(winding_number([0.3, 0.6], &s), 1.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([1.3, 0.6], &s), 0.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([0.5, 0.0], &s), 0.5, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([1.0, 1.0], &s), 0.25, epsilon = 1e-12);
+    }
+
+    /// A concave L-shape: points in the notch are outside; the reflex corner (alpha = 3 pi/2)
+    /// gives 3/4. A clockwise square (a cavity) gives -1 inside: its solid is outside.
+    #[test]
+    fn winding_number_of_concave_polygon_and_cavity() {
+        let p = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ];
+        let l: Vec<[[f64; 2]; 2]> = (0..6).map(|i| [p[i], p[(i + 1) % 6]]).collect();
+        approx::assert_abs_diff_eq!(winding_number([1.5, 1.5], &l), 0.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([0.5, 1.5], &l), 1.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([1.0, 1.0], &l), 0.75, epsilon = 1e-12);
+        let cavity: Vec<[[f64; 2]; 2]> = square().iter().rev().map(|[a, b]| [*b, *a]).collect();
+        approx::assert_abs_diff_eq!(winding_number([0.5, 0.5], &cavity), -1.0, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(winding_number([3.0, 0.5], &cavity), 0.0, epsilon = 1e-12);
+    }
+
+    /// A rigid cavity (clockwise square): a slave pushed out through a corner is inside the
+    /// solid and gets a negative gap; one in the void near the corner a positive gap.
+    #[test]
+    fn cavity_corner_signs() {
+        let cavity = Obstacle {
+            name: "box".into(),
+            points: vec![[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]],
+            closed: true,
+        };
+        assert!(cavity.is_cavity());
+        let pair = slave_node_0(Master::Obstacle(cavity));
+        let outside = pair.gap(0, &|_| [1.1, 1.2]).unwrap();
+        assert!(outside.gap < 0.0, "{outside:?}");
+        let inside = pair.gap(0, &|_| [0.9, 0.95]).unwrap();
+        approx::assert_abs_diff_eq!(inside.gap, 0.05, epsilon = 1e-12);
+    }
+
+    /// A slave pressed in just below a vertex between two collinear master segments keeps
+    /// the surface normal and the gap -depth whichever side of the vertex it drifts to
+    /// (the direction to the vertex would swing through 180 degrees).
+    #[test]
+    fn penetration_below_a_flat_vertex_keeps_the_surface_normal() {
+        let coords = [
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [0.0, 0.0],
+            [-1.0, 0.0],
+            [-1.0, -1.0],
+            [1.0, -1.0],
+        ];
+        let pair = slave_node_0(Master::Segments {
+            body: 1,
+            edges: vec![[1, 2], [2, 3]],
+            boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
+        });
+        for dx in [-1e-9, 0.0, 1e-9] {
+            let x = |n: usize| if n == 0 { [dx, -1e-6] } else { coords[n] };
+            let g = pair.gap(0, &x).unwrap();
+            approx::assert_abs_diff_eq!(g.gap, -1e-6, epsilon = 1e-15);
+            approx::assert_abs_diff_eq!(g.normal[1], 1.0, epsilon = 1e-12);
+        }
+    }
+
+    /// On a dented deformable master (a V at a vertex) the interpolated normal is continuous
+    /// across the vertex: slaves just left and right of it (at 0.001 above, projecting at
+    /// xi = 1e-4 from the vertex) get the averaged vertex normal to within 1e-4, where the
+    /// segments' own normals differ by 0.2 in their x component.
+    #[test]
+    fn smoothed_normal_is_continuous_across_a_dented_vertex() {
+        let coords = [
+            [0.0, 0.0],
+            [1.0, 0.1],
+            [0.0, 0.0],
+            [-1.0, 0.1],
+            [-1.0, -1.0],
+            [1.0, -1.0],
+        ];
+        let pair = slave_node_0(Master::Segments {
+            body: 1,
+            edges: vec![[1, 2], [2, 3]],
+            boundary: vec![[1, 2], [2, 3], [3, 4], [4, 5], [5, 1]],
+        });
+        let normal_at = |dx: f64| {
+            pair.gap(0, &|n: usize| if n == 0 { [dx, 0.001] } else { coords[n] })
+                .unwrap()
+                .normal
+        };
+        let (left, right) = (normal_at(-1e-7), normal_at(1e-7));
+        approx::assert_abs_diff_eq!(left[0], right[0], epsilon = 1e-4);
+        approx::assert_abs_diff_eq!(left[1], 1.0, epsilon = 1e-6);
+        approx::assert_abs_diff_eq!(right[1], 1.0, epsilon = 1e-6);
+    }
+
+    /// A pair whose only slave is node 0.
+    fn slave_node_0(master: Master) -> ContactPair {
+        ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master,
+            options: options(),
+        }
+    }
+
+    fn options() -> PairOptions {
+        PairOptions {
+            impact_conditions: true,
+            release_conditions: true,
+            release_fraction: 0.02,
+            tolerance: 1e-10,
+            search_distance: f64::INFINITY,
+            split_at_events: true,
+            friction: Friction::None,
+        }
+    }
+
+    /// Gap and weights to a wall (open polyline, solid below y = 0): signed distance, the
+    /// normal +y, no master nodes; the row is the normal on the slave DOFs.
+    #[test]
+    fn gap_to_a_rigid_wall_and_its_row() {
+        let wall = Obstacle {
+            name: "w".into(),
+            points: vec![[2.0, 0.0], [-2.0, 0.0]],
+            closed: false,
+        };
+        let pair = slave_node_0(Master::Obstacle(wall));
+        for (y, expected) in [(0.3, 0.3), (-0.2, -0.2)] {
+            let g = pair.gap(0, &|_| [0.5, y]).unwrap();
+            approx::assert_abs_diff_eq!(g.gap, expected, epsilon = 1e-15);
+            approx::assert_abs_diff_eq!(g.normal[1], 1.0, epsilon = 1e-15);
+            assert_eq!(g.row(0), vec![(0, 0.0), (1, 1.0)]);
+        }
+    }
+
+    /// Node-to-segment weights (Hughes II-13..16): the projection parameter splits the
+    /// constraint between the two master nodes; with the slave over a master node the row
+    /// reduces to node-to-node (II-4).
+    #[test]
+    fn segment_weights_reduce_to_node_to_node() {
+        let coords = [
+            [0.25, 0.1],
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, -1.0],
+            [0.0, -1.0],
+        ];
+        let pair = slave_node_0(Master::Segments {
+            body: 1,
+            edges: vec![[2, 1]],
+            boundary: vec![[1, 4], [4, 3], [3, 2], [2, 1]],
+        });
+        let g = pair.gap(0, &|n| coords[n]).unwrap();
+        approx::assert_abs_diff_eq!(g.gap, 0.1, epsilon = 1e-15);
+        assert_eq!(g.masters, vec![(2, 0.25), (1, 0.75)]);
+        let over_node = [
+            [1.0, -0.05],
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, -1.0],
+            [0.0, -1.0],
+        ];
+        let g = pair.gap(0, &|n| over_node[n]).unwrap();
+        approx::assert_abs_diff_eq!(g.gap, -0.05, epsilon = 1e-15);
+        assert_eq!(g.masters, vec![(2, 1.0), (1, 0.0)]);
+    }
+}

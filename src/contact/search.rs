@@ -1,0 +1,100 @@
+//! The one search over the slaves: where each slave of each pair lies against its master.
+//! Every question contact asks of the configuration (who penetrates, who touches, how deep,
+//! the gaps written to the frames) walks the slaves through [`slave_gaps`].
+
+use super::geometry::{ContactPair, Gap};
+
+/// A slave node's gap at a configuration.
+#[derive(Debug, Clone)]
+pub struct SlaveGap {
+    /// The pair and the slave's index in it.
+    pub pair: usize,
+    pub index: usize,
+    /// The global node.
+    pub node: usize,
+    pub gap: Gap,
+}
+
+/// The gaps of the slaves of `pairs` at positions `x`, pair by pair in slave order; entries
+/// for which `skip(pair, index)` holds are passed over before their gap is computed, and
+/// slaves with no master within the search distance are left out.
+pub fn slave_gaps<'a>(
+    pairs: &'a [ContactPair],
+    x: &'a dyn Fn(usize) -> [f64; 2],
+    skip: &'a dyn Fn(usize, usize) -> bool,
+) -> impl Iterator<Item = SlaveGap> + 'a {
+    pairs.iter().enumerate().flat_map(move |(p, pair)| {
+        pair.slaves
+            .iter()
+            .enumerate()
+            .filter(move |(k, _)| !skip(p, *k))
+            .filter_map(move |(k, s)| {
+                pair.gap(*s, x).map(|gap| SlaveGap {
+                    pair: p,
+                    index: k,
+                    node: *s,
+                    gap,
+                })
+            })
+    })
+}
+
+/// The slaves (not skipped) that penetrate their master beyond the pair's TOL (Hughes II-7).
+pub fn penetrating<'a>(
+    pairs: &'a [ContactPair],
+    x: &'a dyn Fn(usize) -> [f64; 2],
+    skip: &'a dyn Fn(usize, usize) -> bool,
+) -> impl Iterator<Item = SlaveGap> + 'a {
+    slave_gaps(pairs, x, skip).filter(|s| s.gap.gap < -pairs[s.pair].options.tolerance)
+}
+
+/// Per pair, the penetration beyond which a run stops: half the smallest distance between
+/// two of its slave nodes in the configuration `x` (infinite with one slave).
+pub fn penetration_limits(pairs: &[ContactPair], x: &[[f64; 2]]) -> Vec<f64> {
+    pairs
+        .iter()
+        .map(|pair| {
+            let mut nodes: Vec<[f64; 2]> = pair.slaves.iter().map(|s| x[*s]).collect();
+            nodes.sort_by(|a, b| a[0].total_cmp(&b[0]));
+            let mut h = f64::INFINITY;
+            for i in 0..nodes.len() {
+                for j in i + 1..nodes.len() {
+                    let dx = nodes[j][0] - nodes[i][0];
+                    if dx >= h {
+                        break;
+                    }
+                    let d = dx.hypot(nodes[j][1] - nodes[i][1]);
+                    if d > 0.0 {
+                        h = h.min(d);
+                    }
+                }
+            }
+            0.5 * h
+        })
+        .collect()
+}
+
+/// The deepest slave penetration beyond its pair's limit (see [`penetration_limits`]), as a
+/// message naming the pair, the node, the gap and the limit: a node that deep has passed
+/// its neighbours' master segments, and the contact no longer holds.
+pub fn runaway_penetration(
+    pairs: &[ContactPair],
+    coords: &[[f64; 2]],
+    limits: &[f64],
+) -> Option<String> {
+    let x = |n: usize| coords[n];
+    let mut worst: Option<(f64, usize, usize, f64)> = None;
+    for s in slave_gaps(pairs, &x, &|_, _| false) {
+        let (g, p) = (s.gap.gap, s.pair);
+        if (g < -limits[p] || !g.is_finite()) && worst.is_none_or(|w| g / limits[p] < w.0 / w.3) {
+            worst = Some((g, p, s.node, limits[p]));
+        }
+    }
+    worst.map(|(gap, p, node, limit)| {
+        format!(
+            "runaway penetration: contact `{}`, node {node}: gap = {gap:e} beyond -{limit:e} \
+             (half the slave node spacing)",
+            pairs[p].name
+        )
+    })
+}
