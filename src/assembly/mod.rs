@@ -11,18 +11,18 @@
 //! W_int      work of the internal forces, sum_q w_q 1/2 (sigma_n + S) . dE (trapezoid)
 //! ```
 
+mod kernel;
 pub mod reduced;
 
-use crate::element::{
-    Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
-};
+pub use kernel::Kernel;
+
+use crate::element::{KernelError, Strain};
 use crate::kinematics;
-use crate::material::{PointState, StressCondition};
+use crate::material::PointState;
 use crate::scene::spec::{MassKind, Tangent};
-use crate::scene::{Body, BodyKind, Model};
+use crate::scene::{Body, Model};
 use crate::solver::Pattern;
 use rayon::prelude::*;
-use std::time::Instant;
 
 /// Per body, per material point (element-major: element e's points are e*ppe .. (e+1)*ppe).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -74,14 +74,8 @@ impl State {
             .iter()
             .map(|b| {
                 let n = b.elements() * b.points_per_element();
-                let thickness = match b.kind {
-                    BodyKind::Continuum { thickness, .. } => thickness,
-                    BodyKind::Rod { .. } => 1.0,
-                };
-                let stress = match b.kind {
-                    BodyKind::Continuum { .. } => b.initial_stress,
-                    BodyKind::Rod { .. } => Voigt::new(b.initial_stress[0], 0.0, 0.0, 0.0),
-                };
+                let kernel = Kernel::of(b);
+                let (thickness, stress) = (kernel.thickness(), kernel.stress(b.initial_stress));
                 BodyState {
                     points: vec![
                         PointState {
@@ -222,15 +216,6 @@ impl System {
 /// Elements per chunk of `evaluate` (about 5 MB of results in flight).
 const CHUNK: usize = 8192;
 
-struct ElementResult {
-    force: Vec8,
-    matrix: Option<[f64; 64]>,
-    trial: [PointState; 4],
-    strain_zz: [f64; 4],
-    work: f64,
-    plastic_work: f64,
-}
-
 /// Internal force (and, when `system` is given, the tangent into `system.values`) at the
 /// increment `d` from the committed `state`.
 pub fn evaluate(
@@ -253,6 +238,7 @@ pub fn evaluate(
     let mut work = 0.0;
     let mut plastic_work = 0.0;
     for (b, body) in model.bodies.iter().enumerate() {
+        let kernel = Kernel::of(body);
         let ppe = body.points_per_element();
         let mut body_trial = Vec::with_capacity(body.elements() * ppe);
         let mut body_zz = Vec::with_capacity(body.elements() * ppe);
@@ -265,7 +251,7 @@ pub fn evaluate(
             (first..last)
                 .into_par_iter()
                 .map(|e| {
-                    element(
+                    kernel.evaluate(
                         body,
                         &state.bodies[b],
                         &state.coordinates,
@@ -277,9 +263,9 @@ pub fn evaluate(
                 })
                 .collect_into_vec(&mut results);
             for (r, e) in results.iter().zip(first..last) {
-                let r = r.as_ref().map_err(|(element, error)| ElementFailure {
+                let r = r.as_ref().map_err(|error| ElementFailure {
                     body: body.name.clone(),
-                    element: *element,
+                    element: e,
                     error: *error,
                 })?;
                 let dofs = element_dofs(body, e);
@@ -313,142 +299,6 @@ pub fn evaluate(
     })
 }
 
-fn element(
-    body: &Body,
-    committed: &BodyState,
-    reference: &[[f64; 2]],
-    d: &[f64],
-    e: usize,
-    geometry: Strain,
-    tangent: Option<Tangent>,
-) -> Result<ElementResult, (usize, KernelError)> {
-    // the material's tangent, or D_e (Erklig's modified Newton); K_sigma unless `elastic`
-    let elastic_moduli = tangent.is_some_and(|t| t != Tangent::Consistent);
-    let geometric = if tangent == Some(Tangent::Elastic) {
-        GeometricStiffness::Omitted
-    } else {
-        GeometricStiffness::Included
-    };
-    let nodes = body.mesh.cells.nodes_of(e);
-    match body.kind {
-        BodyKind::Continuum {
-            formulation, bbar, ..
-        } => {
-            let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
-            let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
-            let geom = quad4::values(&x, formulation, &thickness).map_err(|err| (e, err))?;
-            let de = Vec8::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
-            if geometry == Strain::Finite {
-                check_orientation(&geom, &de).map_err(|err| (e, err))?;
-            }
-            let op = quad4::Operator {
-                strain: geometry,
-                bbar,
-            };
-            let strains = quad4::strains(&geom, &de, op);
-            let stress_state = if formulation == Formulation::PlaneStress {
-                StressCondition::PlaneStress
-            } else {
-                StressCondition::General
-            };
-            let fine = crate::profile::fine().then(Instant::now);
-            let responses: [_; 4] = std::array::from_fn(|q| {
-                body.material
-                    .update(&committed.points[4 * e + q], &strains[q], stress_state)
-            });
-            if let Some(start) = fine {
-                crate::profile::add_constitutive(start);
-            }
-            let stress = responses.map(|r| r.stress);
-            let mut work = 0.0;
-            let mut plastic_work = 0.0;
-            for q in 0..4 {
-                plastic_work += geom.points[q].weight * responses[q].plastic_work;
-                let mut strain = strains[q];
-                strain[2] = responses[q].strain_zz;
-                work += geom.points[q].weight
-                    * 0.5
-                    * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
-            }
-            let force = quad4::internal_force(&geom, &de, &stress, op);
-            let matrix = tangent.map(|_| {
-                let moduli = if elastic_moduli {
-                    [body.material.elastic.moduli(stress_state); 4]
-                } else {
-                    responses.map(|r| r.moduli)
-                };
-                let k = quad4::tangent(&geom, &de, &stress, &moduli, op, geometric);
-                let mut m = [0.0; 64];
-                m.copy_from_slice(k.transpose().as_slice()); // row-major
-                m
-            });
-            Ok(ElementResult {
-                force,
-                matrix,
-                trial: responses.map(|r| r.state),
-                strain_zz: responses.map(|r| r.strain_zz),
-                work,
-                plastic_work,
-            })
-        }
-        BodyKind::Rod { area } => {
-            let x = [
-                reference[body.global(nodes[0])],
-                reference[body.global(nodes[1])],
-            ];
-            let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
-            let strain = rod2::strain(&x, &de, geometry).map_err(|err| (e, err))?;
-            let response = body.material.update_uniaxial(&committed.points[e], strain);
-            let (stress, modulus, state, plastic_density) = (
-                response.stress,
-                response.tangent,
-                response.state,
-                response.plastic_work,
-            );
-            let length = rod2::length(&x).map_err(|err| (e, err))?;
-            let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
-            let plastic_work = area * length * plastic_density;
-            let f4 =
-                rod2::internal_force(&x, &de, stress, area, geometry).map_err(|err| (e, err))?;
-            let matrix = if tangent.is_some() {
-                let modulus = if elastic_moduli {
-                    body.material.elastic.young
-                } else {
-                    modulus
-                };
-                let k: Mat4 = rod2::tangent(&x, &de, stress, modulus, area, geometry, geometric)
-                    .map_err(|err| (e, err))?;
-                let mut m = [0.0; 64];
-                m[..16].copy_from_slice(k.transpose().as_slice());
-                Some(m)
-            } else {
-                None
-            };
-            let mut force = Vec8::zeros();
-            force.fixed_rows_mut::<4>(0).copy_from(&f4);
-            Ok(ElementResult {
-                force,
-                matrix,
-                trial: [state; 4],
-                strain_zz: [0.0; 4],
-                work,
-                plastic_work,
-            })
-        }
-    }
-}
-
-/// det F > 0 at every Gauss point of the increment (the element does not turn inside out).
-fn check_orientation(geom: &quad4::QuadValues, d: &Vec8) -> Result<(), KernelError> {
-    for (point, (f, f_zz)) in quad4::deformation(geom, d).iter().enumerate() {
-        let det = f.determinant() * f_zz;
-        if !(det > 0.0) {
-            return Err(KernelError::NegativeJacobian { point, det });
-        }
-    }
-    Ok(())
-}
-
 /// Commits an evaluation: pushes the stresses forward to the new configuration (nonlinear
 /// geometry), updates the reference coordinates, thickness and the accumulated work.
 pub fn commit(
@@ -468,20 +318,20 @@ pub fn commit(
     for (b, body) in model.bodies.iter().enumerate() {
         let mut points = trial[b].clone();
         if geometry == Strain::Finite {
-            push_forward_body(
-                body,
-                &state.bodies[b],
-                &state.coordinates,
-                d,
-                &strain_zz[b],
-                &mut points,
-            );
-            let bs = &mut state.bodies[b];
-            if let BodyKind::Continuum {
-                formulation: Formulation::PlaneStress,
-                ..
-            } = body.kind
-            {
+            let kernel = Kernel::of(body);
+            for e in 0..body.elements() {
+                kernel.push_forward(
+                    body,
+                    &state.bodies[b],
+                    &state.coordinates,
+                    d,
+                    &strain_zz[b],
+                    e,
+                    &mut points,
+                );
+            }
+            if kernel.thins() {
+                let bs = &mut state.bodies[b];
                 for (t, ezz) in bs.thickness.iter_mut().zip(&strain_zz[b]) {
                     *t *= kinematics::plane_stress_stretch(*ezz);
                 }
@@ -502,50 +352,6 @@ pub fn commit(
     state.plastic_work += evaluation_plastic_work;
 }
 
-fn push_forward_body(
-    body: &Body,
-    committed: &BodyState,
-    reference: &[[f64; 2]],
-    d: &[f64],
-    strain_zz: &[f64],
-    points: &mut [PointState],
-) {
-    for e in 0..body.elements() {
-        let nodes = body.mesh.cells.nodes_of(e);
-        match body.kind {
-            BodyKind::Continuum { formulation, .. } => {
-                let x: quad4::Coords = std::array::from_fn(|i| reference[body.global(nodes[i])]);
-                let thickness: [f64; 4] = std::array::from_fn(|q| committed.thickness[4 * e + q]);
-                let geom = quad4::values(&x, formulation, &thickness)
-                    .expect("checked during the evaluation");
-                let de = Vec8::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
-                for (q, (f, hoop)) in quad4::deformation(&geom, &de).iter().enumerate() {
-                    let f_zz = match formulation {
-                        Formulation::PlaneStress => {
-                            kinematics::plane_stress_stretch(strain_zz[4 * e + q])
-                        }
-                        Formulation::Axisymmetric => *hoop,
-                        Formulation::PlaneStrain => 1.0,
-                    };
-                    let p = &mut points[4 * e + q];
-                    p.stress = kinematics::push_forward(&p.stress, f, f_zz);
-                    p.back_stress = kinematics::push_forward(&p.back_stress, f, f_zz);
-                }
-            }
-            BodyKind::Rod { .. } => {
-                let x = [
-                    reference[body.global(nodes[0])],
-                    reference[body.global(nodes[1])],
-                ];
-                let de = Vec4::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2]);
-                let stretch = rod2::stretch(&x, &de).expect("checked during the evaluation");
-                points[e].stress[0] *= stretch;
-                points[e].back_stress[0] *= stretch;
-            }
-        }
-    }
-}
-
 /// The mass matrix. In the updated-Lagrangian description rho dV is invariant, so the mass
 /// is computed once on the initial configuration and never changes.
 pub struct Mass {
@@ -562,7 +368,7 @@ impl Mass {
         let mut lumped = vec![0.0; model.dofs()];
         let mut elements = Vec::with_capacity(model.bodies.len());
         for body in &model.bodies {
-            let rho = body.material.density;
+            let kernel = Kernel::of(body);
             let nn = body.mesh.cells.nodes_of(0).len();
             let mut body_m = Vec::with_capacity(body.elements() * nn * nn);
             for e in 0..body.elements() {
@@ -572,25 +378,7 @@ impl Mass {
                     element: e,
                     error,
                 };
-                let m: Vec<f64> = match body.kind {
-                    BodyKind::Continuum {
-                        formulation,
-                        thickness,
-                        ..
-                    } => {
-                        let x: quad4::Coords =
-                            std::array::from_fn(|i| coords[body.global(nodes[i])]);
-                        let geom =
-                            quad4::values(&x, formulation, &[thickness; 4]).map_err(failure)?;
-                        let m = quad4::mass(&geom) * rho;
-                        m.transpose().as_slice().to_vec()
-                    }
-                    BodyKind::Rod { area } => {
-                        let x = [coords[body.global(nodes[0])], coords[body.global(nodes[1])]];
-                        let m = rod2::mass(&x).map_err(failure)?;
-                        m.iter().flatten().map(|v| v * rho * area).collect()
-                    }
-                };
+                let m = kernel.mass(body, &coords, e).map_err(failure)?;
                 for (i, n) in nodes.iter().enumerate() {
                     let row: f64 = m[i * nn..(i + 1) * nn].iter().sum();
                     lumped[2 * body.global(*n)] += row;
@@ -697,47 +485,24 @@ pub fn max_frequency_squared(
         element: 0,
     };
     for (b, body) in model.bodies.iter().enumerate() {
-        let rho = body.material.density;
+        let kernel = Kernel::of(body);
         for e in 0..body.elements() {
             let failure = |error| ElementFailure {
                 body: body.name.clone(),
                 element: e,
                 error,
             };
-            let r = element(
-                body,
-                &state.bodies[b],
-                &state.coordinates,
-                &zero,
-                e,
-                geometry,
-                Some(Tangent::Consistent),
-            )
-            .map_err(|(_, err)| failure(err))?;
-            let k = r.matrix.expect("tangent requested");
-            let nodes = body.mesh.cells.nodes_of(e);
-            let lumped: Vec<f64> = match body.kind {
-                BodyKind::Continuum {
-                    formulation,
-                    thickness,
-                    ..
-                } => {
-                    let x: quad4::Coords = std::array::from_fn(|i| coords[body.global(nodes[i])]);
-                    let geom = quad4::values(&x, formulation, &[thickness; 4]).map_err(failure)?;
-                    let m = quad4::mass(&geom);
-                    (0..4).map(|i| rho * m.row(i).sum()).collect()
-                }
-                BodyKind::Rod { area } => {
-                    let x = [coords[body.global(nodes[0])], coords[body.global(nodes[1])]];
-                    let l = rod2::length(&x).map_err(failure)?;
-                    vec![rho * area * l / 2.0; 2]
-                }
-            };
-            let n = 2 * lumped.len();
-            let scale: Vec<f64> = (0..n).map(|i| 1.0 / lumped[i / 2].sqrt()).collect();
-            let a = nalgebra::DMatrix::from_fn(n, n, |i, j| k[i * n + j] * scale[i] * scale[j]);
-            let a = (&a + a.transpose()) * 0.5;
-            let lambda = a.symmetric_eigenvalues().max();
+            let lambda = kernel
+                .max_frequency_squared(
+                    body,
+                    &state.bodies[b],
+                    &state.coordinates,
+                    &coords,
+                    &zero,
+                    e,
+                    geometry,
+                )
+                .map_err(failure)?;
             if lambda > best.omega_squared {
                 best = FrequencyBound {
                     omega_squared: lambda,

@@ -1,22 +1,11 @@
-//! The explicit fast path: one-point Quad4 with Flanagan-Belytschko (1981) hourglass control,
-//! element data as structure of arrays, internal forces in parallel (docs/theory.md,
-//! "Reduced explicit Quad4").
+//! The explicit fast path: the one-point Quad4 of `element::quad4_one_point` over element
+//! data as structure of arrays, internal forces in parallel (docs/theory.md, "Reduced
+//! explicit Quad4"). The element's kinematics, hourglass control and forces are the
+//! kernel's; here the material updates the rotated stress between them.
 //!
-//! Legend (one element; x_a node positions, u_a the increment of the step, a = 1..4)
+//! Legend (one element; see `element::quad4_one_point` for the kinematics)
 //! ```text
-//! b_a        dN_a/dx at the centroid = the element mean, FB eq 13:
-//!            b_x = [y2-y4, y3-y1, y4-y2, y1-y3] / 2A,  b_y = [x4-x2, x1-x3, x2-x4, x3-x1] / 2A
-//! A          area, A = 1/2 ((x3-x1)(y4-y2) - (x4-x2)(y3-y1))
-//! G          sum_a u_a (x) b_a(x_mid): the increment gradient on x_mid = x_n + u / 2
-//! d, w       sym G (strain increment [xx yy zz xy], engineering shear), w = (G_xy - G_yx) / 2
-//! R          Hughes-Winget rotation (I - W/2)^-1 (I + W/2), W = w [[0 1] [-1 0]]
 //! sigma      sigma_{n+1} = material(R sigma_n R^T, d)   (back stress rotated alike)
-//! h          [1 -1 1 -1], the hourglass base vector
-//! gamma_a    h_a - (h . x) b_xa - (h . y) b_ya           (FB eq 25: orthogonal to linear fields)
-//! q_i        sum_a gamma_a u_ia, the hourglass-mode increment (i = x, y)
-//! Q_i        Q_{n+1} = R Q_n + k q,  k = kappa (lambda + 3 mu) t A (b . b) / 24
-//!            (kappa = 1: a square element gets the hourglass stiffness of the 2x2 Gauss one)
-//! f_a        t A sigma b_a + Q gamma_a, on the end configuration x_{n+1}
 //! W_int      t A_mid 1/2 (R sigma_n R^T + sigma_{n+1}) . d;  W_hg = 1/2 (R Q_n + Q_{n+1}) . q
 //! ```
 //! Parallel and deterministic: elements are processed in fixed chunks (rayon), each writes
@@ -25,6 +14,7 @@
 //! count.
 
 use super::{ElementFailure, State};
+use crate::element::quad4_one_point::{self as one_point, Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
 use crate::material::{Hardening, Material, PointState, StressCondition};
 use crate::scene::{BodyKind, Model};
@@ -32,9 +22,6 @@ use rayon::prelude::*;
 
 /// Elements per parallel task (fixed, so the work sums do not depend on the thread count).
 const CHUNK: usize = 256;
-const HOURGLASS: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
-
-type Nodes = [[f64; 2]; 4];
 
 /// What the kernel needs of a body.
 #[derive(Debug, Clone)]
@@ -121,69 +108,6 @@ pub struct ElementStep {
     pub hourglass_work: f64,
 }
 
-/// Area, b_x, b_y (see the legend).
-#[inline(always)]
-fn centroid_gradient(x: &Nodes) -> (f64, [f64; 4], [f64; 4]) {
-    let area = 0.5
-        * ((x[2][0] - x[0][0]) * (x[3][1] - x[1][1]) - (x[3][0] - x[1][0]) * (x[2][1] - x[0][1]));
-    let s = 0.5 / area;
-    let bx = [
-        s * (x[1][1] - x[3][1]),
-        s * (x[2][1] - x[0][1]),
-        s * (x[3][1] - x[1][1]),
-        s * (x[0][1] - x[2][1]),
-    ];
-    let by = [
-        s * (x[3][0] - x[1][0]),
-        s * (x[0][0] - x[2][0]),
-        s * (x[1][0] - x[3][0]),
-        s * (x[2][0] - x[0][0]),
-    ];
-    (area, bx, by)
-}
-
-/// FB's gamma vector (see the legend).
-#[inline(always)]
-fn gamma(x: &Nodes, bx: &[f64; 4], by: &[f64; 4]) -> [f64; 4] {
-    let hx: f64 = (0..4).map(|a| HOURGLASS[a] * x[a][0]).sum();
-    let hy: f64 = (0..4).map(|a| HOURGLASS[a] * x[a][1]).sum();
-    std::array::from_fn(|a| HOURGLASS[a] - hx * bx[a] - hy * by[a])
-}
-
-/// Rotates the in-plane part of a symmetric tensor [xx yy zz xy] by R = [[c s] [-s c]].
-#[inline(always)]
-fn rotate(t: &[f64; 4], c: f64, s: f64) -> [f64; 4] {
-    let (a, b, x) = (t[0], t[1], t[3]);
-    [
-        c * c * a + 2.0 * c * s * x + s * s * b,
-        s * s * a - 2.0 * c * s * x + c * c * b,
-        t[2],
-        c * s * (b - a) + (c * c - s * s) * x,
-    ]
-}
-
-/// Internal force of an element on the configuration x (the stored stress and Q).
-#[inline(always)]
-fn element_force(x: &Nodes, state: &ElementState) -> Result<[f64; 8], KernelError> {
-    let (area, bx, by) = centroid_gradient(x);
-    if !(area > 0.0) {
-        return Err(KernelError::NegativeJacobian {
-            point: 0,
-            det: area,
-        });
-    }
-    let g = gamma(x, &bx, &by);
-    let v = area * state.thickness;
-    let s = &state.stress;
-    let q = &state.hourglass;
-    let mut f = [0.0; 8];
-    for a in 0..4 {
-        f[2 * a] = v * (s[0] * bx[a] + s[3] * by[a]) + q[0] * g[a];
-        f[2 * a + 1] = v * (s[3] * bx[a] + s[1] * by[a]) + q[1] * g[a];
-    }
-    Ok(f)
-}
-
 /// One element over one step: positions x at the start, increment u (see the legend).
 #[inline(always)]
 fn element_step(
@@ -192,28 +116,11 @@ fn element_step(
     u: &Nodes,
     committed: &ElementState,
 ) -> Result<ElementStep, KernelError> {
-    let mid: Nodes = std::array::from_fn(|a| [x[a][0] + 0.5 * u[a][0], x[a][1] + 0.5 * u[a][1]]);
-    let end: Nodes = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);
-    let (area, bx, by) = centroid_gradient(&mid);
-    if !(area > 0.0) {
-        return Err(KernelError::NegativeJacobian {
-            point: 0,
-            det: area,
-        });
-    }
-    let (mut gxx, mut gxy, mut gyx, mut gyy) = (0.0, 0.0, 0.0, 0.0);
-    for a in 0..4 {
-        gxx += u[a][0] * bx[a];
-        gxy += u[a][0] * by[a];
-        gyx += u[a][1] * bx[a];
-        gyy += u[a][1] * by[a];
-    }
-    let w = 0.5 * (gxy - gyx);
-    let scale = 1.0 / (1.0 + 0.25 * w * w);
-    let (c, s) = ((1.0 - 0.25 * w * w) * scale, w * scale);
+    let step = one_point::increment(x, u)?;
+    let (c, s) = (step.cos, step.sin);
     let stress_n = rotate(&committed.stress, c, s);
     let back_n = rotate(&committed.back_stress, c, s);
-    let mut strain = [gxx, gyy, 0.0, gxy + gyx];
+    let mut strain = step.strain;
     let t = committed.thickness;
     let (stress, back_stress, eq_plastic_strain, plastic_density, thickness) = if p.plane_stress {
         let r = p.material.update(
@@ -259,39 +166,27 @@ fn element_step(
             Some((stress, back, eps_p, work)) => (stress, back, eps_p, work, t),
         }
     };
-    let volume = area * t;
+    let volume = step.gradient.area * t;
     let work = volume
         * 0.5
         * (0..4)
             .map(|k| (stress_n[k] + stress[k]) * strain[k])
             .sum::<f64>();
-    // hourglass: stiffness form on the mid-step configuration
-    let g = gamma(&mid, &bx, &by);
-    let bb: f64 = (0..4).map(|a| bx[a] * bx[a] + by[a] * by[a]).sum();
-    let k = p.hourglass_modulus * t * area * bb;
-    let q = [
-        (0..4).map(|a| g[a] * u[a][0]).sum::<f64>(),
-        (0..4).map(|a| g[a] * u[a][1]).sum::<f64>(),
-    ];
-    let hq = &committed.hourglass;
-    let rotated = [c * hq[0] + s * hq[1], -s * hq[0] + c * hq[1]];
-    let hourglass = [rotated[0] + k * q[0], rotated[1] + k * q[1]];
-    let hourglass_work =
-        0.5 * ((rotated[0] + hourglass[0]) * q[0] + (rotated[1] + hourglass[1]) * q[1]);
+    let hourglass = one_point::hourglass(&step, u, &committed.hourglass, p.hourglass_modulus, t);
     let state = ElementState {
         stress,
         back_stress,
         eq_plastic_strain,
         thickness,
-        hourglass,
+        hourglass: hourglass.forces,
     };
-    let force = element_force(&end, &state)?;
+    let force = one_point::force(&step.end, &state.stress, state.thickness, &state.hourglass)?;
     Ok(ElementStep {
         state,
         force,
         work,
         plastic_work: volume * plastic_density,
-        hourglass_work,
+        hourglass_work: hourglass.work,
     })
 }
 
@@ -477,7 +372,8 @@ impl Reduced {
                 for (i, f) in chunk.chunks_exact_mut(8).enumerate() {
                     let e = k * CHUNK + i;
                     let xe: Nodes = this.nodes[e].map(|n| x[n as usize]);
-                    match element_force(&xe, &this.state_of(e)) {
+                    let state = this.state_of(e);
+                    match one_point::force(&xe, &state.stress, state.thickness, &state.hourglass) {
                         Ok(v) => f.copy_from_slice(&v),
                         Err(err) => return Some((e, err)),
                     }
@@ -648,26 +544,6 @@ mod tests {
     }
 
     const SQUARE: Nodes = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.5], [0.0, 1.5]];
-
-    /// b_a is the gradient of N_a at the centroid: sum_a b_a = 0, sum_a x_a b_a = I; gamma is
-    /// orthogonal to the linear fields (FB eq 25) on a distorted element.
-    #[test]
-    fn centroid_gradient_and_gamma_identities() {
-        let x: Nodes = [[0.1, -0.2], [2.3, 0.1], [1.9, 1.7], [-0.3, 1.2]];
-        let (_, bx, by) = centroid_gradient(&x);
-        let g = gamma(&x, &bx, &by);
-        for (i, b) in [bx, by].iter().enumerate() {
-            assert!(b.iter().sum::<f64>().abs() < 1e-14);
-            for j in 0..2 {
-                let v: f64 = (0..4).map(|a| x[a][j] * b[a]).sum();
-                assert!((v - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14);
-            }
-        }
-        assert!(g.iter().sum::<f64>().abs() < 1e-14);
-        for j in 0..2 {
-            assert!((0..4).map(|a| x[a][j] * g[a]).sum::<f64>().abs() < 1e-14);
-        }
-    }
 
     /// A rigid rotation by 0.3 rad in 100 increments leaves a stressed element's stress
     /// invariants unchanged (Hughes-Winget is exactly orthogonal) and its forces in

@@ -9,6 +9,7 @@
 //! bodies x = r, y = z and zz is the hoop (theta theta) component.
 
 pub mod quad4;
+pub mod quad4_one_point;
 pub mod rod2;
 
 use nalgebra::{Matrix4, SMatrix, SVector, Vector4};

@@ -1,0 +1,383 @@
+//! The element dispatch: the one place where a body's kind picks the kernel that integrates
+//! its elements (Quad4 with 2x2 Gauss, Rod2; the one-point Quad4 of the explicit fast path
+//! has its structure-of-arrays loop in `reduced`), and where an element's nodes, thickness
+//! and increment are gathered for that kernel. Each kernel gives, for one element: the
+//! internal force with the material's response (and the tangent when asked), the
+//! push-forward of its stresses at commit, its consistent and lumped mass, and its element
+//! frequency bound for the central-difference stable step.
+
+use super::BodyState;
+use crate::element::{
+    Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
+};
+use crate::kinematics;
+use crate::material::{PointState, StressCondition};
+use crate::scene::spec::Tangent;
+use crate::scene::{Body, BodyKind};
+use std::time::Instant;
+
+/// What a kernel gives for one element at an increment.
+pub struct ElementResult {
+    /// Internal force (the first 2 nn entries).
+    pub force: Vec8,
+    /// The tangent, row-major in the first (2 nn)^2 entries, when asked.
+    pub matrix: Option<[f64; 64]>,
+    /// Trial point states (rods: the first).
+    pub trial: [PointState; 4],
+    /// Out-of-plane Green-Lagrange strain per point (plane stress).
+    pub strain_zz: [f64; 4],
+    /// Increments of the internal and plastic work.
+    pub work: f64,
+    pub plastic_work: f64,
+}
+
+/// How the elements of a body are integrated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Kernel {
+    /// Four-node quadrilateral, 2x2 Gauss points.
+    Quad4 {
+        formulation: Formulation,
+        bbar: bool,
+        /// The initial thickness (plane stress; 1 otherwise), for the mass.
+        thickness: f64,
+    },
+    /// Two-node rod of the given cross-section area.
+    Rod2 { area: f64 },
+}
+
+/// The node coordinates of element `e` of `body` from the global `coordinates`.
+fn quad_nodes(body: &Body, e: usize, coordinates: &[[f64; 2]]) -> quad4::Coords {
+    let nodes = body.mesh.cells.nodes_of(e);
+    std::array::from_fn(|i| coordinates[body.global(nodes[i])])
+}
+
+fn rod_nodes(body: &Body, e: usize, coordinates: &[[f64; 2]]) -> [[f64; 2]; 2] {
+    let nodes = body.mesh.cells.nodes_of(e);
+    [
+        coordinates[body.global(nodes[0])],
+        coordinates[body.global(nodes[1])],
+    ]
+}
+
+/// The increment of element `e` of `body` from the global increment `d` (2 DOFs a node).
+fn increment<const N: usize>(body: &Body, e: usize, d: &[f64]) -> nalgebra::SVector<f64, N> {
+    let nodes = body.mesh.cells.nodes_of(e);
+    nalgebra::SVector::from_fn(|k, _| d[2 * body.global(nodes[k / 2]) + k % 2])
+}
+
+/// The committed thickness at the four points of element `e`.
+fn point_thickness(committed: &BodyState, e: usize) -> [f64; 4] {
+    std::array::from_fn(|q| committed.thickness[4 * e + q])
+}
+
+impl Kernel {
+    /// The kernel of a body.
+    pub fn of(body: &Body) -> Kernel {
+        match body.kind {
+            BodyKind::Continuum {
+                formulation,
+                bbar,
+                thickness,
+            } => Kernel::Quad4 {
+                formulation,
+                bbar,
+                thickness,
+            },
+            BodyKind::Rod { area } => Kernel::Rod2 { area },
+        }
+    }
+
+    /// Internal force, trial point states and work of element `e` at the increment `d` from
+    /// the committed state; with `tangent`, its matrix (row-major, 2 nn x 2 nn in the first
+    /// entries of 64).
+    #[allow(clippy::too_many_arguments)]
+    pub fn evaluate(
+        &self,
+        body: &Body,
+        committed: &BodyState,
+        coordinates: &[[f64; 2]],
+        d: &[f64],
+        e: usize,
+        geometry: Strain,
+        tangent: Option<Tangent>,
+    ) -> Result<ElementResult, KernelError> {
+        // the material's tangent, or D_e (Erklig's modified Newton); K_sigma unless `elastic`
+        let elastic_moduli = tangent.is_some_and(|t| t != Tangent::Consistent);
+        let geometric = if tangent == Some(Tangent::Elastic) {
+            GeometricStiffness::Omitted
+        } else {
+            GeometricStiffness::Included
+        };
+        match *self {
+            Kernel::Quad4 {
+                formulation, bbar, ..
+            } => {
+                let x = quad_nodes(body, e, coordinates);
+                let thickness = point_thickness(committed, e);
+                let geom = quad4::values(&x, formulation, &thickness)?;
+                let de: Vec8 = increment(body, e, d);
+                if geometry == Strain::Finite {
+                    check_orientation(&geom, &de)?;
+                }
+                let op = quad4::Operator {
+                    strain: geometry,
+                    bbar,
+                };
+                let strains = quad4::strains(&geom, &de, op);
+                let condition = stress_condition(formulation);
+                let fine = crate::profile::fine().then(Instant::now);
+                let responses: [_; 4] = std::array::from_fn(|q| {
+                    body.material
+                        .update(&committed.points[4 * e + q], &strains[q], condition)
+                });
+                if let Some(start) = fine {
+                    crate::profile::add_constitutive(start);
+                }
+                let stress = responses.map(|r| r.stress);
+                let mut work = 0.0;
+                let mut plastic_work = 0.0;
+                for q in 0..4 {
+                    plastic_work += geom.points[q].weight * responses[q].plastic_work;
+                    let mut strain = strains[q];
+                    strain[2] = responses[q].strain_zz;
+                    work += geom.points[q].weight
+                        * 0.5
+                        * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
+                }
+                let force = quad4::internal_force(&geom, &de, &stress, op);
+                let matrix = tangent.map(|_| {
+                    let moduli = if elastic_moduli {
+                        [body.material.elastic.moduli(condition); 4]
+                    } else {
+                        responses.map(|r| r.moduli)
+                    };
+                    let k = quad4::tangent(&geom, &de, &stress, &moduli, op, geometric);
+                    let mut m = [0.0; 64];
+                    m.copy_from_slice(k.transpose().as_slice()); // row-major
+                    m
+                });
+                Ok(ElementResult {
+                    force,
+                    matrix,
+                    trial: responses.map(|r| r.state),
+                    strain_zz: responses.map(|r| r.strain_zz),
+                    work,
+                    plastic_work,
+                })
+            }
+            Kernel::Rod2 { area } => {
+                let x = rod_nodes(body, e, coordinates);
+                let de: Vec4 = increment(body, e, d);
+                let strain = rod2::strain(&x, &de, geometry)?;
+                let response = body.material.update_uniaxial(&committed.points[e], strain);
+                let stress = response.stress;
+                let length = rod2::length(&x)?;
+                let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
+                let plastic_work = area * length * response.plastic_work;
+                let f4 = rod2::internal_force(&x, &de, stress, area, geometry)?;
+                let matrix = match tangent {
+                    Some(_) => {
+                        let modulus = if elastic_moduli {
+                            body.material.elastic.young
+                        } else {
+                            response.tangent
+                        };
+                        let k: Mat4 =
+                            rod2::tangent(&x, &de, stress, modulus, area, geometry, geometric)?;
+                        let mut m = [0.0; 64];
+                        m[..16].copy_from_slice(k.transpose().as_slice());
+                        Some(m)
+                    }
+                    None => None,
+                };
+                let mut force = Vec8::zeros();
+                force.fixed_rows_mut::<4>(0).copy_from(&f4);
+                Ok(ElementResult {
+                    force,
+                    matrix,
+                    trial: [response.state; 4],
+                    strain_zz: [0.0; 4],
+                    work,
+                    plastic_work,
+                })
+            }
+        }
+    }
+
+    /// Pushes the trial stresses of element `e` (second Piola-Kirchhoff of the increment `d`)
+    /// forward to Cauchy stresses on the new configuration (finite strain).
+    #[allow(clippy::too_many_arguments)]
+    pub fn push_forward(
+        &self,
+        body: &Body,
+        committed: &BodyState,
+        coordinates: &[[f64; 2]],
+        d: &[f64],
+        strain_zz: &[f64],
+        e: usize,
+        points: &mut [PointState],
+    ) {
+        match *self {
+            Kernel::Quad4 { formulation, .. } => {
+                let x = quad_nodes(body, e, coordinates);
+                let thickness = point_thickness(committed, e);
+                let geom = quad4::values(&x, formulation, &thickness)
+                    .expect("checked during the evaluation");
+                let de: Vec8 = increment(body, e, d);
+                for (q, (f, hoop)) in quad4::deformation(&geom, &de).iter().enumerate() {
+                    let f_zz = match formulation {
+                        Formulation::PlaneStress => {
+                            kinematics::plane_stress_stretch(strain_zz[4 * e + q])
+                        }
+                        Formulation::Axisymmetric => *hoop,
+                        Formulation::PlaneStrain => 1.0,
+                    };
+                    let p = &mut points[4 * e + q];
+                    p.stress = kinematics::push_forward(&p.stress, f, f_zz);
+                    p.back_stress = kinematics::push_forward(&p.back_stress, f, f_zz);
+                }
+            }
+            Kernel::Rod2 { .. } => {
+                let x = rod_nodes(body, e, coordinates);
+                let de: Vec4 = increment(body, e, d);
+                let stretch = rod2::stretch(&x, &de).expect("checked during the evaluation");
+                points[e].stress[0] *= stretch;
+                points[e].back_stress[0] *= stretch;
+            }
+        }
+    }
+
+    /// The initial thickness of the points (1 for rods: their area is their own).
+    pub fn thickness(&self) -> f64 {
+        match *self {
+            Kernel::Quad4 { thickness, .. } => thickness,
+            Kernel::Rod2 { .. } => 1.0,
+        }
+    }
+
+    /// The stress a point of this kernel carries of a body's `initial` stress (rods: the
+    /// axial component only).
+    pub fn stress(&self, initial: Voigt) -> Voigt {
+        match self {
+            Kernel::Quad4 { .. } => initial,
+            Kernel::Rod2 { .. } => Voigt::new(initial[0], 0.0, 0.0, 0.0),
+        }
+    }
+
+    /// Whether the body's thickness follows the out-of-plane stretch (plane stress).
+    pub fn thins(&self) -> bool {
+        matches!(
+            self,
+            Kernel::Quad4 {
+                formulation: Formulation::PlaneStress,
+                ..
+            }
+        )
+    }
+
+    /// The consistent mass of element `e` on the `initial` coordinates, rho N^T N, the same
+    /// for x and y: nn x nn, row-major.
+    pub fn mass(
+        &self,
+        body: &Body,
+        initial: &[[f64; 2]],
+        e: usize,
+    ) -> Result<Vec<f64>, KernelError> {
+        let rho = body.material.density;
+        match *self {
+            Kernel::Quad4 {
+                formulation,
+                thickness,
+                ..
+            } => {
+                let x = quad_nodes(body, e, initial);
+                let geom = quad4::values(&x, formulation, &[thickness; 4])?;
+                let m = quad4::mass(&geom) * rho;
+                Ok(m.transpose().as_slice().to_vec())
+            }
+            Kernel::Rod2 { area } => {
+                let x = rod_nodes(body, e, initial);
+                let m = rod2::mass(&x)?;
+                Ok(m.iter().flatten().map(|v| v * rho * area).collect())
+            }
+        }
+    }
+
+    /// The lumped mass per node of element `e` on the `initial` coordinates (its row sums).
+    pub fn lumped_mass(
+        &self,
+        body: &Body,
+        initial: &[[f64; 2]],
+        e: usize,
+    ) -> Result<Vec<f64>, KernelError> {
+        let rho = body.material.density;
+        match *self {
+            Kernel::Quad4 {
+                formulation,
+                thickness,
+                ..
+            } => {
+                let x = quad_nodes(body, e, initial);
+                let geom = quad4::values(&x, formulation, &[thickness; 4])?;
+                let m = quad4::mass(&geom);
+                Ok((0..4).map(|i| rho * m.row(i).sum()).collect())
+            }
+            Kernel::Rod2 { area } => {
+                let x = rod_nodes(body, e, initial);
+                let l = rod2::length(&x)?;
+                Ok(vec![rho * area * l / 2.0; 2])
+            }
+        }
+    }
+
+    /// The largest eigenvalue of M_e^-1 K_e of element `e` (lumped M_e) at the committed
+    /// state, its frequency squared; `zero` is a zero increment over all DOFs.
+    #[allow(clippy::too_many_arguments)]
+    pub fn max_frequency_squared(
+        &self,
+        body: &Body,
+        committed: &BodyState,
+        coordinates: &[[f64; 2]],
+        initial: &[[f64; 2]],
+        zero: &[f64],
+        e: usize,
+        geometry: Strain,
+    ) -> Result<f64, KernelError> {
+        let r = self.evaluate(
+            body,
+            committed,
+            coordinates,
+            zero,
+            e,
+            geometry,
+            Some(Tangent::Consistent),
+        )?;
+        let k = r.matrix.expect("tangent requested");
+        let lumped = self.lumped_mass(body, initial, e)?;
+        let n = 2 * lumped.len();
+        let scale: Vec<f64> = (0..n).map(|i| 1.0 / lumped[i / 2].sqrt()).collect();
+        let a = nalgebra::DMatrix::from_fn(n, n, |i, j| k[i * n + j] * scale[i] * scale[j]);
+        let a = (&a + a.transpose()) * 0.5;
+        Ok(a.symmetric_eigenvalues().max())
+    }
+}
+
+/// The stress condition of a Quad4 formulation.
+fn stress_condition(formulation: Formulation) -> StressCondition {
+    if formulation == Formulation::PlaneStress {
+        StressCondition::PlaneStress
+    } else {
+        StressCondition::General
+    }
+}
+
+/// det F > 0 at every Gauss point of the increment (the element does not turn inside out).
+fn check_orientation(geom: &quad4::QuadValues, d: &Vec8) -> Result<(), KernelError> {
+    for (point, (f, f_zz)) in quad4::deformation(geom, d).iter().enumerate() {
+        let det = f.determinant() * f_zz;
+        if !(det > 0.0) {
+            return Err(KernelError::NegativeJacobian { point, det });
+        }
+    }
+    Ok(())
+}
