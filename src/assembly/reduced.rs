@@ -16,7 +16,7 @@
 use super::{ElementFailure, State};
 use crate::element::quad4_one_point::{self as one_point, Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{Hardening, Material, PointState, StressCondition};
+use crate::material::{Material, PointState, StressCondition};
 use crate::scene::{BodyKind, Model};
 use rayon::prelude::*;
 
@@ -33,54 +33,7 @@ struct BodyParameters {
     mu: f64,
     /// kappa (lambda + 3 mu) / 24
     hourglass_modulus: f64,
-    /// J2 with linear hardening: its closed-form return (`linear_return`).
-    linear: Option<LinearJ2>,
     first_element: usize,
-}
-
-/// J2 with linear isotropic and kinematic hardening: sigma_y = yield_stress + h_iso eps_p.
-#[derive(Debug, Clone, Copy)]
-struct LinearJ2 {
-    yield_stress: f64,
-    h_iso: f64,
-    h_kin: f64,
-}
-
-const SQRT_2_3: f64 = 0.816_496_580_927_726;
-const SQRT_3_2: f64 = 1.224_744_871_391_589;
-
-/// The radial return of `J2::general` for linear hardening, where the consistency condition
-/// ||eta|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) (sigma_y0 + H_iso (eps_p + sqrt(2/3) dl)) is
-/// linear in dl and solved in closed form (the general return iterates Newton to round-off):
-/// (stress, back stress, eps_p, plastic work density), None when elastic.
-#[inline(always)]
-fn linear_return(
-    j2: &LinearJ2,
-    trial: &[f64; 4],
-    back: &[f64; 4],
-    eps_p: f64,
-    mu: f64,
-) -> Option<([f64; 4], [f64; 4], f64, f64)> {
-    let r = [
-        trial[0] - back[0],
-        trial[1] - back[1],
-        trial[2] - back[2],
-        trial[3] - back[3],
-    ];
-    let p = (r[0] + r[1] + r[2]) / 3.0;
-    let eta = [r[0] - p, r[1] - p, r[2] - p, r[3]];
-    let norm = (eta[0] * eta[0] + eta[1] * eta[1] + eta[2] * eta[2] + 2.0 * eta[3] * eta[3]).sqrt();
-    let yield_stress = j2.yield_stress + j2.h_iso * eps_p;
-    if SQRT_3_2 * norm - yield_stress <= 0.0 {
-        return None;
-    }
-    let dl = (norm - SQRT_2_3 * yield_stress) / (2.0 * mu + 2.0 / 3.0 * (j2.h_iso + j2.h_kin));
-    let scale = dl / norm;
-    let n: [f64; 4] = std::array::from_fn(|k| eta[k] * scale); // dl n = d eps_p
-    let stress: [f64; 4] = std::array::from_fn(|k| trial[k] - 2.0 * mu * n[k]);
-    let back: [f64; 4] = std::array::from_fn(|k| back[k] + 2.0 / 3.0 * j2.h_kin * n[k]);
-    let work = stress[0] * n[0] + stress[1] * n[1] + stress[2] * n[2] + 2.0 * stress[3] * n[3];
-    Some((stress, back, eps_p + SQRT_2_3 * dl, work))
 }
 
 /// The committed state of one element as the kernel reads it.
@@ -149,18 +102,23 @@ fn element_step(
             stress_n[2] + volumetric,
             stress_n[3] + mu * strain[3],
         ];
-        let plastic = match (&p.linear, &p.material.plasticity) {
-            (Some(j2), _) => linear_return(j2, &trial, &back_n, committed.eq_plastic_strain, mu),
-            (None, Some(j2)) => j2
-                .return_stress(
-                    &Voigt::from(trial),
-                    mu,
-                    &Voigt::from(back_n),
-                    committed.eq_plastic_strain,
+        let plastic = p.material.plasticity.as_ref().and_then(|j2| {
+            j2.radial(
+                &Voigt::from(trial),
+                mu,
+                &Voigt::from(back_n),
+                committed.eq_plastic_strain,
+            )
+            .map(|r| {
+                let work = r.plastic_work();
+                (
+                    r.stress.into(),
+                    r.back_stress.into(),
+                    r.eq_plastic_strain,
+                    work,
                 )
-                .map(|(s, b, e, w)| (s.into(), b.into(), e, w)),
-            (None, None) => None,
-        };
+            })
+        });
         match plastic {
             None => (trial, back_n, committed.eq_plastic_strain, 0.0, t),
             Some((stress, back, eps_p, work)) => (stress, back, eps_p, work, t),
@@ -252,18 +210,6 @@ impl Reduced {
                 lambda: spec.material.elastic.lame().0,
                 mu,
                 hourglass_modulus: kappa * (lambda + 3.0 * mu) / 24.0,
-                linear: spec
-                    .material
-                    .plasticity
-                    .as_ref()
-                    .and_then(|j2| match j2.hardening {
-                        Hardening::Linear { modulus } => Some(LinearJ2 {
-                            yield_stress: j2.yield_stress,
-                            h_iso: modulus,
-                            h_kin: j2.kinematic_modulus,
-                        }),
-                        Hardening::Table { .. } => None,
-                    }),
                 first_element: body.len(),
             });
             let index = (bodies.len() - 1) as u32;
@@ -510,37 +456,8 @@ mod tests {
             lambda,
             mu,
             hourglass_modulus: 0.1 * (lambda + 3.0 * mu) / 24.0,
-            linear: None,
             first_element: 0,
         }
-    }
-
-    /// The closed-form linear return equals the general (Newton) return of J2 to round-off,
-    /// isotropic plus kinematic hardening.
-    #[test]
-    fn linear_return_matches_the_general_return() {
-        let j2 = crate::material::J2 {
-            yield_stress: 0.5,
-            hardening: Hardening::Linear { modulus: 10.0 },
-            kinematic_modulus: 5.0,
-        };
-        let linear = LinearJ2 {
-            yield_stress: 0.5,
-            h_iso: 10.0,
-            h_kin: 5.0,
-        };
-        let mu = 200.0 / 2.6;
-        let trial = [1.4, -0.3, 0.2, 0.6];
-        let back = [0.02, -0.01, -0.01, 0.01];
-        let (s, b, e, w) = linear_return(&linear, &trial, &back, 0.01, mu).unwrap();
-        let (s2, b2, e2, w2) = j2
-            .return_stress(&Voigt::from(trial), mu, &Voigt::from(back), 0.01)
-            .unwrap();
-        for k in 0..4 {
-            assert!((s[k] - s2[k]).abs() < 1e-13 && (b[k] - b2[k]).abs() < 1e-13);
-        }
-        assert!((e - e2).abs() < 1e-15 && (w - w2).abs() < 1e-13);
-        assert!(linear_return(&linear, &[0.1, 0.0, 0.0, 0.0], &[0.0; 4], 0.0, mu).is_none());
     }
 
     const SQUARE: Nodes = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.5], [0.0, 1.5]];

@@ -13,12 +13,14 @@
 //! alpha     += 2/3 H_kin dl n                           linear kinematic hardening
 //! sigma_y    sigma_y0 + H_iso eps_p, or a piecewise-linear table eps_p -> sigma_y
 //! ```
-//! General (plane strain, axisymmetric): radial return, dl from
-//! ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(eps_p,n + sqrt(2/3) dl).
-//! Plane stress: the same three-dimensional return with the out-of-plane strain found by
-//! Newton so that sigma_zz = 0 (see `Material::update`), which keeps the model identical to
-//! the 3D one (kinematic hardening included) and its tangent exact by static condensation.
-//! Rods: the one-dimensional return.
+//! One radial return, [`J2::radial`], serves every continuum path (plane strain and
+//! axisymmetric 2x2 points, the 3D update inside plane stress, the one-point explicit
+//! kernel): dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(eps_p,n +
+//! sqrt(2/3) dl), in closed form for linear hardening and by Newton for a table; the
+//! implicit paths add its consistent tangent ([`J2::tangent`]). Plane stress finds the
+//! out-of-plane strain by Newton so that sigma_zz = 0 (see `Material::update`), which keeps
+//! the model identical to the 3D one (kinematic hardening included) and its tangent exact by
+//! static condensation. Rods: the one-dimensional form of the same multiplier equation.
 
 use crate::element::{Moduli, Voigt};
 
@@ -40,29 +42,27 @@ pub struct J2 {
     pub kinematic_modulus: f64,
 }
 
-/// Result of a return.
+/// The state after a radial return, with what the consistent tangent needs.
 #[derive(Debug, Clone, Copy)]
-pub struct Return {
+pub struct Radial {
     pub stress: Voigt,
     pub back_stress: Voigt,
     pub eq_plastic_strain: f64,
-    pub moduli: Moduli,
-    /// Plastic strain increment (tensor components; zz included) for the plastic work.
-    pub plastic_strain: Voigt,
+    /// n = eta / ||eta||
+    pub direction: Voigt,
+    /// dl: the plastic strain increment is dl n (tensor components, zz included).
+    pub multiplier: f64,
+    pub eta_norm: f64,
+    /// The isotropic hardening slope at the solution.
+    pub slope: f64,
 }
 
-/// The state after a radial return, with what the tangent needs.
-struct Radial {
-    stress: Voigt,
-    back_stress: Voigt,
-    eq_plastic_strain: f64,
-    /// n = eta / ||eta||
-    direction: Voigt,
-    /// dl
-    multiplier: f64,
-    eta_norm: f64,
-    /// The isotropic hardening slope at the solution.
-    slope: f64,
+impl Radial {
+    /// Plastic work per unit volume of the increment, S_{n+1} : d eps_p.
+    pub fn plastic_work(&self) -> f64 {
+        let (s, e) = (&self.stress, self.direction * self.multiplier);
+        s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * s[3] * e[3]
+    }
 }
 
 const SQRT_2_3: f64 = 0.816_496_580_927_726;
@@ -102,10 +102,15 @@ impl J2 {
         }
     }
 
-    /// Solves g(dl) = a - b dl - sqrt(2/3) sigma_y(eps_p + sqrt(2/3) dl) = 0 for dl >= 0
-    /// (Newton; exact in one step for linear hardening). Returns dl and the hardening slope
-    /// at the solution.
+    /// Solves g(dl) = a - b dl - sqrt(2/3) sigma_y(eps_p + sqrt(2/3) dl) = 0 for dl >= 0:
+    /// in closed form for linear hardening (g is linear in dl), else by Newton to round-off.
+    /// Returns dl and the hardening slope at the solution.
     fn plastic_multiplier(&self, a: f64, b: f64, eps_p: f64) -> (f64, f64) {
+        if let Hardening::Linear { modulus } = self.hardening {
+            let yield_stress = self.yield_stress + modulus * eps_p;
+            let dl = (a - SQRT_2_3 * yield_stress) / (b + 2.0 / 3.0 * modulus);
+            return (dl.max(0.0), modulus);
+        }
         let mut dl = 0.0;
         let mut slope = 0.0;
         for _ in 0..50 {
@@ -122,18 +127,11 @@ impl J2 {
         (dl, slope)
     }
 
-    /// Radial return for plane strain and axisymmetric points.
-    pub fn general(
-        &self,
-        trial: &Voigt,
-        elastic: &Moduli,
-        mu: f64,
-        back: &Voigt,
-        eps_p: f64,
-    ) -> Option<Return> {
-        let r = self.radial(trial, mu, back, eps_p)?;
+    /// The consistent tangent of a radial return from the elastic moduli:
+    /// D_e - 2 mu [c1 n n^T + c2 (I_dev - n n^T)], c1 = 2 mu / (2 mu + 2/3 (H_iso + H_kin)),
+    /// c2 = 2 mu dl / ||eta_tr||.
+    pub fn tangent(&self, r: &Radial, elastic: &Moduli, mu: f64) -> Moduli {
         let (n, dl, eta_norm) = (r.direction, r.multiplier, r.eta_norm);
-        // consistent tangent D_e - 2 mu [c1 n n^T + c2 (I_dev - n n^T)]
         let c1 = 2.0 * mu / (2.0 * mu + 2.0 / 3.0 * (r.slope + self.kinematic_modulus));
         let c2 = 2.0 * mu * dl / eta_norm;
         let nn = n * n.transpose();
@@ -144,35 +142,14 @@ impl J2 {
             }
         }
         i_dev[(3, 3)] = 0.5;
-        let moduli = elastic - (nn * c1 + (i_dev - nn) * c2) * (2.0 * mu);
-        Some(Return {
-            stress: r.stress,
-            back_stress: r.back_stress,
-            eq_plastic_strain: r.eq_plastic_strain,
-            moduli,
-            plastic_strain: n * dl,
-        })
+        elastic - (nn * c1 + (i_dev - nn) * c2) * (2.0 * mu)
     }
 
-    /// The radial return without the tangent (the explicit kernels, which need none):
-    /// (stress, back stress, eps_p, plastic work density S : d eps_p), or None when elastic.
-    pub fn return_stress(
-        &self,
-        trial: &Voigt,
-        mu: f64,
-        back: &Voigt,
-        eps_p: f64,
-    ) -> Option<(Voigt, Voigt, f64, f64)> {
-        let r = self.radial(trial, mu, back, eps_p)?;
-        let e = r.direction * r.multiplier;
-        let s = &r.stress;
-        let work = s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * s[3] * e[3];
-        Some((r.stress, r.back_stress, r.eq_plastic_strain, work))
-    }
-
-    /// dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(eps_p,n + sqrt(2/3) dl)
-    /// and the returned state; None when the trial state is elastic.
-    fn radial(&self, trial: &Voigt, mu: f64, back: &Voigt, eps_p: f64) -> Option<Radial> {
+    /// The radial return of a trial stress (plane strain, axisymmetric, the 3D update inside
+    /// plane stress, and the one-point explicit kernel: the one return of every continuum
+    /// path): dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(eps_p,n +
+    /// sqrt(2/3) dl) and the returned state; None when the trial state is elastic.
+    pub fn radial(&self, trial: &Voigt, mu: f64, back: &Voigt, eps_p: f64) -> Option<Radial> {
         // dev of the difference: the pushed-forward back stress need not stay traceless
         let eta = deviator(&(trial - back));
         let eta_norm = norm(&eta);
@@ -235,4 +212,41 @@ pub struct UniaxialReturn {
     pub tangent: f64,
     /// The plastic strain increment (signed).
     pub plastic_strain: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed-form multiplier of linear hardening equals Newton's on the same law given as
+    /// a table (one point on the line: the table's slope continues beyond it), isotropic plus
+    /// kinematic hardening; an elastic trial returns None. Newton stops at 1e-15 relative.
+    #[test]
+    fn linear_multiplier_matches_newton_on_the_same_law() {
+        let linear = J2 {
+            yield_stress: 0.5,
+            hardening: Hardening::Linear { modulus: 10.0 },
+            kinematic_modulus: 5.0,
+        };
+        let table = J2 {
+            hardening: Hardening::Table {
+                points: vec![[1.0, 10.5]],
+            },
+            ..linear.clone()
+        };
+        let mu = 200.0 / 2.6;
+        let trial = Voigt::new(1.4, -0.3, 0.2, 0.6);
+        let back = Voigt::new(0.02, -0.01, -0.01, 0.01);
+        let a = linear.radial(&trial, mu, &back, 0.01).unwrap();
+        let b = table.radial(&trial, mu, &back, 0.01).unwrap();
+        assert!((a.stress - b.stress).norm() < 1e-13);
+        assert!((a.back_stress - b.back_stress).norm() < 1e-13);
+        assert!((a.eq_plastic_strain - b.eq_plastic_strain).abs() < 1e-15);
+        assert!((a.plastic_work() - b.plastic_work()).abs() < 1e-13);
+        assert!(
+            linear
+                .radial(&Voigt::new(0.1, 0.0, 0.0, 0.0), mu, &Voigt::zeros(), 0.0)
+                .is_none()
+        );
+    }
 }

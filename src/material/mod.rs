@@ -110,11 +110,6 @@ pub struct Material {
     pub plasticity: Option<J2>,
 }
 
-fn work(stress: &Voigt, plastic_strain: &Voigt) -> f64 {
-    let (s, e) = (stress, plastic_strain);
-    s[0] * e[0] + s[1] * e[1] + s[2] * e[2] + 2.0 * s[3] * e[3]
-}
-
 impl Material {
     /// Response of a continuum point (Quad4): elastic predictor, then the return to the yield
     /// surface when the material is plastic.
@@ -135,13 +130,13 @@ impl Material {
         let trial = committed.stress + moduli * strain;
         let (_, mu) = self.elastic.lame();
         let plastic = self.plasticity.as_ref().and_then(|j2| {
-            j2.general(
+            j2.radial(
                 &trial,
-                &moduli,
                 mu,
                 &committed.back_stress,
                 committed.eq_plastic_strain,
             )
+            .map(|r| (j2.tangent(&r, &moduli, mu), r))
         });
         match plastic {
             None => Response {
@@ -154,16 +149,16 @@ impl Material {
                 },
                 plastic_work: 0.0,
             },
-            Some(r) => Response {
+            Some((tangent, r)) => Response {
                 stress: r.stress,
-                moduli: r.moduli,
+                moduli: tangent,
                 strain_zz: strain[2],
                 state: PointState {
                     stress: r.stress,
                     eq_plastic_strain: r.eq_plastic_strain,
                     back_stress: r.back_stress,
                 },
-                plastic_work: work(&r.stress, &r.plastic_strain),
+                plastic_work: r.plastic_work(),
             },
         }
     }
