@@ -14,12 +14,12 @@ use common::column;
 #[ignore]
 fn kernel_benchmark_element_updates_per_second() {
     for threads in [1, 2] {
-        let (rate, plastic) =
+        let run =
             impact::analysis::explicit::kernel_benchmark_run(316 * 316, 200, threads).unwrap();
         println!(
             "threads {threads}: {:.3e} element-updates/s ({:.1} % of the elements plastic)",
-            rate,
-            100.0 * plastic
+            run.element_updates_per_second,
+            100.0 * run.plastic_fraction
         );
     }
 }
@@ -681,4 +681,29 @@ fn interrupted_reduced_run_writes_its_frame_and_no_checkpoint() {
     assert!(!dir.join("checkpoint.bin").exists());
     let frames = std::fs::read_dir(dir.join("vtk")).unwrap().count();
     assert_eq!(frames, 2);
+}
+
+/// Goal: the explicit run's outcome carries its nodal contact forces, as the implicit one
+/// does. Setup: models/strip_wall.toml (one-point kernel) stopped at t = 0.1, halfway through
+/// the contact (0 < t < 0.2). Reference: the run's own last history row: the nodal forces sum
+/// to the pair's normal force (the wall pushes along -x), and they act on the slave set only.
+#[test]
+fn explicit_outcome_carries_the_contact_forces() {
+    let model = common::model(
+        "strip_outcome",
+        &strip("reduced"),
+        &["analysis.end_time=0.1"],
+    );
+    let dir = common::out_dir("strip_outcome");
+    let outcome = impact::analysis::run_outcome(&model, &dir, Default::default()).unwrap();
+    let pair = *column(&dir, "contact_force[wall]").last().unwrap();
+    assert!(pair > 0.1, "in contact at the end: {pair}");
+    let fx: f64 = outcome.contact_force.iter().step_by(2).sum();
+    let fy: f64 = outcome.contact_force.iter().skip(1).step_by(2).sum();
+    approx::assert_relative_eq!(-fx, pair, max_relative = 1e-12);
+    assert!(fy.abs() <= 1e-12 * pair);
+    let slaves = &model.contacts[0].slaves;
+    for (dof, f) in outcome.contact_force.iter().enumerate() {
+        assert!(*f == 0.0 || slaves.contains(&(dof / 2)), "dof {dof}: {f}");
+    }
 }

@@ -238,3 +238,39 @@ end_time = 0.1
         assert!(message.contains(n), "`{n}` missing in {message}");
     }
 }
+
+/// Goal: a failing explicit contact run reports its contact: the summary's contact block is
+/// filled in the same place whatever the stepper and however the run ends. Setup:
+/// models/round_bar_wall.toml with central difference at dt = 4e-4 (below the initial
+/// stability limit, 5.1e-4): the crushed tip inverts an element at t = 0.0476, long after
+/// the first contact. Reference: the run's own history.csv, written row by row before the
+/// failure: the summary's first contact time is the first row with a contact force, and its
+/// peak force is the largest force in the column.
+#[test]
+fn failing_explicit_contact_run_reports_its_contact() {
+    let model = impact::scene::load(
+        Path::new("models/round_bar_wall.toml"),
+        &[
+            "analysis.integrator=central_difference".to_string(),
+            "analysis.dt=0.0004".to_string(),
+        ],
+    )
+    .unwrap();
+    let dir = common::out_dir("explicit_contact_failure");
+    let err = impact::analysis::run(&model, &dir, Default::default()).unwrap_err();
+    assert_eq!(err.exit_code(), 3, "{err}");
+    let summary: impact::analysis::Summary =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary.status, impact::analysis::Status::Diverged);
+    let time = common::column(&dir, "time");
+    let force = common::column(&dir, "contact_force[tip]");
+    let first = time
+        .iter()
+        .zip(&force)
+        .find(|(_, f)| **f > 0.0)
+        .map(|(t, _)| *t)
+        .expect("the bar reaches the wall before it fails");
+    assert_eq!(summary.contact.first_contact_time, Some(first));
+    let peak = force.iter().copied().fold(0.0, f64::max);
+    assert_eq!(summary.contact.peak_force, peak);
+}

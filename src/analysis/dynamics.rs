@@ -10,20 +10,22 @@
 //!              prescribed ones (so W_ext includes the work of supports and prescribed motion)
 //! ```
 //! Prescribed DOFs follow their curves; their velocity and acceleration come from the same
-//! integrator formulas as the free ones.
+//! integrator formulas as the free ones. A step that fails is halved (at most `max_cuts`
+//! times in a row); a slave that touches its master at the start of a step closes with the
+//! impact conditions, and the step is split at the first contact event inside it.
 
 use super::checkpoint::{Carry, Checkpoint, DynamicCarry};
-use super::newton::{Constraints, Counters, Inertia, Step, StepFailure};
-use super::record::{Energies, Motion, Recorder};
-use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
+use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
+use super::record::{Energies, Motion};
+use super::run::{StepError, Stepper};
+use super::{StepControl, loads};
 use crate::assembly::{self, Mass, State, System};
-use crate::contact::{ContactState, Tangential};
-use crate::integrator::{GeneralizedAlpha, Houbolt, Integrator, MotionState, Wilson};
+use crate::contact::{ContactResult, ContactState, Interfaces, Tangential};
+use crate::integrator::{Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, Wilson};
 use crate::scene::spec::{DynamicSpec, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
-use std::time::Instant;
 
 /// The integrator a scene asks for (implicit ones).
 pub fn integrator(spec: &DynamicSpec) -> Box<dyn Integrator> {
@@ -41,7 +43,7 @@ pub fn integrator(spec: &DynamicSpec) -> Box<dyn Integrator> {
             Box::new(GeneralizedAlpha::chung_hulbert(spec.rho_infinity))
         }
         IntegratorKind::CentralDifference => {
-            unreachable!("the explicit driver runs central difference")
+            unreachable!("the explicit stepper runs central difference")
         }
     }
 }
@@ -69,470 +71,478 @@ pub fn check_mass(model: &Model, mass: &Mass, system: &System) -> Result<(), Inp
     Ok(())
 }
 
-/// The initial acceleration M a_0 = f_ext(0) - f_int(0) - C v_0 on the free DOFs (zero on
-/// prescribed DOFs); solved with the mass matrix only when the right side is not zero.
-fn initial_acceleration(
-    model: &Model,
-    state: &State,
-    mass: &Mass,
-    system: &mut System,
-    solver: &mut Solver,
-    velocity: &[f64],
-    spec: &DynamicSpec,
-) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let initial = model.coordinates();
-    let external = loads::external_force(model, state, &initial, 0.0);
-    let evaluation = assembly::evaluate(
-        model,
-        state,
-        &vec![0.0; model.dofs()],
-        spec.geometry,
-        None,
-        spec.newton.tangent,
-    )
-    .map_err(|e| e.to_string())?;
-    let damping = mass.product(model, velocity);
-    let rhs: Vec<f64> = external
-        .iter()
-        .zip(evaluation.force.iter().zip(&damping))
-        .map(|(f, (fi, c))| f - fi - spec.rayleigh[0] * c)
-        .collect();
-    let mut free = system.gather(&rhs);
-    let mut a = vec![0.0; model.dofs()];
-    if free.iter().any(|v| *v != 0.0) {
-        system.values.iter_mut().for_each(|v| *v = 0.0);
-        mass.add_to(model, system, 1.0);
-        solver.factor(&system.values).map_err(|e| e.to_string())?;
-        solver.solve(&mut free);
-        system.scatter_add(&free, &mut a);
-    }
-    Ok((a, evaluation.force))
+/// Implicit time stepping: the state, the motion, the solver and what the loop carries.
+pub struct Dynamics<'a> {
+    model: &'a Model,
+    spec: &'a DynamicSpec,
+    interfaces: Interfaces,
+    initial: Vec<[f64; 2]>,
+    system: System,
+    solver: Solver,
+    mass: Mass,
+    method: Box<dyn Integrator>,
+    state: State,
+    kin: MotionState,
+    energies: Energies,
+    initial_kinetic: f64,
+    last_total: Vec<f64>,
+    last_internal: Vec<f64>,
+    last_contact: Vec<f64>,
+    control: StepControl,
+    /// K* = ca M + cv C + w K_T: a factorization serves while these coefficients stay (the
+    /// step after a checkpoint factors afresh: a resumed run has no factorization).
+    factored_for: Option<[f64; 3]>,
+    increments: usize,
+    contact: ContactState,
 }
 
-pub fn run(
-    model: &Model,
-    spec: &DynamicSpec,
-    dir: &Path,
-    options: RunOptions,
-    resume: Option<Checkpoint>,
-) -> Result<Outcome, RunError> {
-    let mut start = Instant::now();
-    let setup_start = start;
-    let initial = model.coordinates();
-    let mut system = System::new(model, &loads::constrained_dofs(model));
-    let mass =
-        Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
-    check_mass(model, &mass, &system)?;
-    let mut solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
-    let (mut recorder, resume) = match resume {
-        Some(c) => {
-            let Carry::Dynamic(carry) = c.carry.clone() else {
-                return Err(super::wrong_carry(dir, "implicit dynamic"));
-            };
-            (
-                Recorder::resume(model, dir, c.recorder.clone())?,
-                Some((c, carry)),
-            )
-        }
-        None => (Recorder::create(model, dir)?, None),
-    };
-    let mut state = State::initial(model);
-    let mut method = integrator(spec);
-    let steps = (spec.end_time / spec.dt).round().max(1.0) as usize;
-    let mut summary = Summary::new(model, &method.name(), spec.dt, spec.end_time, system.free);
-    let velocity = super::initial_velocity(model, &system, spec.dt);
-    let (acceleration, mut last_internal) = match initial_acceleration(
-        model,
-        &state,
-        &mass,
-        &mut system,
-        &mut solver,
-        &velocity,
-        spec,
-    ) {
-        Ok(x) => x,
-        Err(reason) => {
-            let message = format!("initial acceleration: {reason}");
-            return Err(super::fail(&recorder, summary, Status::Diverged, message));
-        }
-    };
-    let mut kin = MotionState {
-        displacement: vec![0.0; model.dofs()],
-        velocity,
-        acceleration,
-    };
-    let mut energies = Energies {
-        kinetic: mass.kinetic_energy(model, &kin.velocity),
-        ..Default::default()
-    };
-    let mut initial_kinetic = energies.kinetic;
-    summary.energy.initial = initial_kinetic;
-    let mut monitor =
-        super::buckling::Monitor::new(model, dir).map_err(|e| super::monitor_error(model, e))?;
-    let mut last_total = total_force(
-        model,
-        &system,
-        &mass,
-        spec,
-        &kin,
-        &last_internal,
-        &state,
-        &initial,
-    );
-    let mut counters = Counters::default();
-    let mut control = super::StepControl::new(spec.dt, spec.newton.max_cuts);
-    // K* = ca M + cv C + w K_T: a factorization serves while these coefficients stay (the
-    // step after a checkpoint factors afresh: a resumed run has no factorization)
-    let mut factored_for: Option<[f64; 3]> = None;
-    let mut increments = 0usize;
-    let interfaces = super::interfaces(model);
-    let mut contact = ContactState::new(&model.contacts);
-    let penetration_limits = crate::contact::penetration_limits(&model.contacts, &initial);
-    let mut last_contact = vec![0.0; model.dofs()];
-    match resume {
-        Some((checkpoint, carry)) => {
-            state = carry.state;
-            kin = carry.kinematics;
-            method.restore(carry.method);
-            energies = carry.energies;
-            initial_kinetic = carry.initial_kinetic;
-            last_total = carry.last_total;
-            last_internal = carry.last_internal;
-            last_contact = carry.last_contact;
-            control = carry.control;
-            increments = carry.increments;
-            contact = carry.contact;
-            summary = checkpoint.summary;
-            counters = checkpoint.counters;
-            solver.factorizations = checkpoint.factorizations;
-            solver.solves = checkpoint.back_substitutions;
-            start = super::resumed_start(checkpoint.wall_seconds);
-            if let (Some(m), Some(b)) = (&mut monitor, checkpoint.buckling) {
-                m.summary = b;
-            }
-        }
-        None => {
-            if let Some(m) = &mut monitor {
-                recorder.negative_pivots = m
-                    .observe(model, &state)
-                    .map_err(|e| super::monitor_error(model, e.into()))?
-                    .0;
-            }
-            recorder.step(
-                model,
-                &state,
-                &Motion {
-                    velocity: &kin.velocity,
-                    acceleration: &kin.acceleration,
-                    mass: &mass.lumped,
-                },
-                &energies,
-                true,
-            )?;
-        }
+impl<'a> Dynamics<'a> {
+    pub fn new(
+        model: &'a Model,
+        spec: &'a DynamicSpec,
+        dir: &Path,
+    ) -> Result<Dynamics<'a>, super::RunError> {
+        let system = System::new(model, &loads::constrained_dofs(model));
+        let mass =
+            Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
+        check_mass(model, &mass, &system)?;
+        let solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
+        let n = model.dofs();
+        Ok(Dynamics {
+            model,
+            spec,
+            interfaces: super::interfaces(model),
+            initial: model.coordinates(),
+            method: integrator(spec),
+            state: State::initial(model),
+            kin: MotionState {
+                displacement: vec![0.0; n],
+                velocity: vec![0.0; n],
+                acceleration: vec![0.0; n],
+            },
+            energies: Energies::default(),
+            initial_kinetic: 0.0,
+            last_total: vec![0.0; n],
+            last_internal: vec![0.0; n],
+            last_contact: vec![0.0; n],
+            control: StepControl::new(spec.dt, spec.newton.max_cuts),
+            factored_for: None,
+            increments: 0,
+            contact: ContactState::new(&model.contacts),
+            system,
+            solver,
+            mass,
+        })
     }
-    let progress = super::progress_bar(options.progress, steps);
-    macro_rules! save {
-        () => {{
-            let carry = DynamicCarry {
-                state: state.clone(),
-                kinematics: kin.clone(),
-                method: method.history(),
-                energies,
-                initial_kinetic,
-                last_total: last_total.clone(),
-                last_internal: last_internal.clone(),
-                last_contact: last_contact.clone(),
-                control: control.clone(),
-                increments,
-                contact: contact.clone(),
-            };
-            super::Bookkeeping {
-                model,
-                recorder: &recorder,
-                summary: &summary,
-                counters: &counters,
-                solver: Some(&solver),
-                start,
-                buckling: monitor.as_ref().map(|m| &m.summary),
-            }
-            .save(Carry::Dynamic(carry))?;
-            factored_for = None;
-        }};
+
+    /// The initial acceleration M a_0 = f_ext(0) - f_int(0) - C v_0 on the free DOFs (zero
+    /// on prescribed DOFs); solved with the mass matrix only when the right side is not zero.
+    fn initial_acceleration(&mut self, velocity: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let (model, spec) = (self.model, self.spec);
+        let external = loads::external_force(model, &self.state, &self.initial, 0.0);
+        let evaluation = assembly::evaluate(
+            model,
+            &self.state,
+            &vec![0.0; model.dofs()],
+            spec.geometry,
+            None,
+            spec.newton.tangent,
+        )
+        .map_err(|e| e.to_string())?;
+        let damping = self.mass.product(model, velocity);
+        let rhs: Vec<f64> = external
+            .iter()
+            .zip(evaluation.force.iter().zip(&damping))
+            .map(|(f, (fi, c))| f - fi - spec.rayleigh[0] * c)
+            .collect();
+        let mut free = self.system.gather(&rhs);
+        let mut a = vec![0.0; model.dofs()];
+        if free.iter().any(|v| *v != 0.0) {
+            self.system.values.iter_mut().for_each(|v| *v = 0.0);
+            self.mass.add_to(model, &mut self.system, 1.0);
+            self.solver
+                .factor(&self.system.values)
+                .map_err(|e| e.to_string())?;
+            self.solver.solve(&mut free);
+            self.system.scatter_add(&free, &mut a);
+        }
+        Ok((a, evaluation.force))
     }
-    if summary.steps == 0 && model.checkpoint_every > 0 {
-        save!();
-    }
-    crate::profile::add(crate::profile::Phase::Setup, setup_start);
-    while state.time < spec.end_time * (1.0 - 1e-12) {
+
+    /// The end of the step this step attempt aims at, and its nominal length.
+    fn target(&self) -> (f64, f64) {
+        let (spec, time) = (self.spec, self.state.time);
         // steps end at the listed frame times
-        let next_frame = model
+        let next_frame = self
+            .model
             .output
             .frame_times
             .iter()
             .copied()
-            .find(|t| *t > state.time * (1.0 + 1e-9) + 1e-12 * spec.dt)
+            .find(|t| *t > time * (1.0 + 1e-9) + 1e-12 * spec.dt)
             .unwrap_or(f64::INFINITY);
         // a remainder shorter than the shortest step the control takes joins this step: a
         // step of 1e-7 dt (end_time written with a few digits) does not converge
         let stop = spec.end_time.min(next_frame);
-        let mut end = (state.time + control.length).min(stop);
-        if stop - end < control.shortest() {
+        let mut end = (time + self.control.length).min(stop);
+        if stop - end < self.control.shortest() {
             end = stop;
         }
         let target = super::snap(end, spec.dt);
-        let nominal = super::step_length(target - state.time, spec.dt);
-        let positions = state.positions(spec.geometry);
-        let kinetic_before_impact = mass.kinetic_energy(model, &kin.velocity);
-        contact.close_touching(
-            &interfaces,
+        (target, super::step_length(target - time, spec.dt))
+    }
+
+    /// One attempt at the step of nominal length `nominal` (shortened at a contact event).
+    fn attempt(
+        &mut self,
+        nominal: f64,
+        positions: &[[f64; 2]],
+        counters: &mut Counters,
+    ) -> Result<(ContactResult<Solution>, Advance), StepFailure> {
+        let attempt = Attempt {
+            model: self.model,
+            spec: self.spec,
+            method: self.method.as_ref(),
+            kin: &self.kin,
+            state: &self.state,
+            initial: &self.initial,
+            mass: &self.mass,
+            last_internal: &self.last_internal,
+            positions,
+            increments: self.increments,
+        };
+        let (system, solver, factored_for) =
+            (&mut self.system, &mut self.solver, &mut self.factored_for);
+        let mut step = self.contact.step(
+            &self.model.contacts,
+            positions,
+            nominal,
+            |h, active, forces, tangential| {
+                let constraints = (h, active, forces, tangential);
+                attempt.solve(constraints, system, solver, factored_for, counters)
+            },
+        )?;
+        let h = step.length;
+        let form = self.method.form(h, &self.kin);
+        let advance = self.method.advance(h, &self.kin, &step.solution.d);
+        if form.solve_fraction != 1.0 {
+            // Wilson: the state at t_{n+1} from the interpolated increment
+            let mut du = advance.increment.clone();
+            for (dof, value) in loads::prescribed(self.model, &self.initial, self.state.time + h) {
+                du[dof] = value - self.kin.displacement[dof];
+            }
+            step.solution.evaluation = assembly::evaluate(
+                self.model,
+                &self.state,
+                &du,
+                self.spec.geometry,
+                None,
+                self.spec.newton.tangent,
+            )
+            .map_err(|e| StepFailure(e.to_string()))?;
+            step.solution.d = du;
+        }
+        Ok((step, advance))
+    }
+
+    /// Takes a converged step: the state, the motion, the contact status and the energies.
+    fn commit(
+        &mut self,
+        mut step: ContactResult<Solution>,
+        advance: Advance,
+        target: f64,
+        nominal: f64,
+    ) {
+        let (model, spec) = (self.model, self.spec);
+        let h = step.length;
+        let d = std::mem::take(&mut step.solution.d);
+        let evaluation = std::mem::take(&mut step.solution.evaluation);
+        let internal = evaluation.force.clone();
+        assembly::commit(model, &mut self.state, &d, evaluation, spec.geometry);
+        self.state.time = if h == nominal {
+            target
+        } else {
+            self.state.time + h
+        };
+        let kin = &mut self.kin;
+        let previous_velocity = std::mem::replace(&mut kin.velocity, advance.velocity);
+        kin.acceleration = advance.acceleration;
+        for (u, du) in kin.displacement.iter_mut().zip(&d) {
+            *u += du;
+        }
+        let kinetic_before = self.mass.kinetic_energy(model, &kin.velocity);
+        let positions = self.state.positions(spec.geometry);
+        crate::contact::apply_conditions(
+            &self.interfaces,
+            &mut step,
             &positions,
-            &mass.lumped,
+            &self.mass.lumped,
+            &previous_velocity,
             &mut kin.velocity,
             &mut kin.acceleration,
         );
-        energies.contact_work += kinetic_before_impact - mass.kinetic_energy(model, &kin.velocity);
-        // one attempt of the step with a given length and active contact set
-        let attempt = |h: f64,
-                       active: &[(usize, usize)],
-                       forces: Vec<f64>,
-                       tangential: &[Tangential]| {
-            let form = method.form(h, &kin);
-            let solve_time = state.time + form.solve_fraction * h;
-            let mut d: Vec<f64> = kin
-                .velocity
-                .iter()
-                .map(|v| form.solve_fraction * h * v)
-                .collect();
-            for (dof, value) in loads::prescribed(model, &initial, solve_time) {
-                d[dof] = value - kin.displacement[dof];
-            }
-            let external =
-                loads::external_force(model, &state, &initial, state.time + form.load_fraction * h);
-            let coefficients = [
-                form.mass_coefficient,
-                form.damping_coefficient,
-                form.internal_weight,
-            ];
-            let factor_first = factored_for != Some(coefficients)
-                || match spec.newton.strategy {
-                    Strategy::Full => true,
-                    Strategy::Modified => increments.is_multiple_of(spec.newton.refactor_every),
-                    Strategy::Initial => !solver.is_factored(),
-                };
-            let step = Step {
-                model,
-                geometry: spec.geometry,
-                newton: &spec.newton,
-                inertia: Some(Inertia {
-                    mass: &mass,
-                    rayleigh: spec.rayleigh,
-                }),
-                form: &form,
-                external: &external,
-                internal_start: &last_internal,
-                factor_first,
-                contact: Some(Constraints {
-                    pairs: &model.contacts,
-                    active,
-                    start: &positions,
-                    forces,
-                    tangential,
-                }),
+        self.contact
+            .commit(&self.interfaces, &step, self.state.time, &positions);
+        let contact_force = self.contact.nodal_forces(&model.contacts, &positions);
+        let total = self.total_force(&internal);
+        let energies = &mut self.energies;
+        energies.external_work += super::trapezoid_work(&d, &total, &self.last_total);
+        energies.kinetic = self.mass.kinetic_energy(model, &self.kin.velocity);
+        // energy taken up by the interface: minus the work of the contact forces on the
+        // bodies, plus what the impact/release conditions removed
+        energies.contact_work += -super::trapezoid_work(&d, &contact_force, &self.last_contact)
+            + kinetic_before
+            - energies.kinetic;
+        energies.internal = self.state.internal_work - self.state.plastic_work;
+        energies.plastic_work = self.state.plastic_work;
+        self.last_total = total;
+        self.last_internal = internal;
+        self.last_contact = contact_force;
+        self.increments += 1;
+        self.control.accept(true);
+    }
+
+    /// F: f_ext on the free DOFs, the reaction M a + a_R M v + f_int on the prescribed ones.
+    fn total_force(&self, internal: &[f64]) -> Vec<f64> {
+        let model = self.model;
+        let external = loads::external_force(model, &self.state, &self.initial, self.state.time);
+        let ma = self.mass.product(model, &self.kin.acceleration);
+        let mv = self.mass.product(model, &self.kin.velocity);
+        (0..model.dofs())
+            .map(|i| match self.system.equation[i] {
+                Some(_) => external[i],
+                None => ma[i] + self.spec.rayleigh[0] * mv[i] + internal[i],
+            })
+            .collect()
+    }
+}
+
+/// What the attempts of one step share.
+struct Attempt<'s> {
+    model: &'s Model,
+    spec: &'s DynamicSpec,
+    method: &'s dyn Integrator,
+    kin: &'s MotionState,
+    state: &'s State,
+    initial: &'s [[f64; 2]],
+    mass: &'s Mass,
+    last_internal: &'s [f64],
+    positions: &'s [[f64; 2]],
+    increments: usize,
+}
+
+impl Attempt<'_> {
+    /// Solves the step with a given length and active contact set; K* is factored again
+    /// when its coefficients changed or the strategy asks.
+    fn solve(
+        &self,
+        constraints: (f64, &[(usize, usize)], Vec<f64>, &[Tangential]),
+        system: &mut System,
+        solver: &mut Solver,
+        factored_for: &mut Option<[f64; 3]>,
+        counters: &mut Counters,
+    ) -> Result<Solution, StepFailure> {
+        let (h, active, forces, tangential) = constraints;
+        let (model, spec, state) = (self.model, self.spec, self.state);
+        let form = self.method.form(h, self.kin);
+        let solve_time = state.time + form.solve_fraction * h;
+        let mut d: Vec<f64> = self
+            .kin
+            .velocity
+            .iter()
+            .map(|v| form.solve_fraction * h * v)
+            .collect();
+        for (dof, value) in loads::prescribed(model, self.initial, solve_time) {
+            d[dof] = value - self.kin.displacement[dof];
+        }
+        let external = loads::external_force(
+            model,
+            state,
+            self.initial,
+            state.time + form.load_fraction * h,
+        );
+        let coefficients = [
+            form.mass_coefficient,
+            form.damping_coefficient,
+            form.internal_weight,
+        ];
+        let factor_first = *factored_for != Some(coefficients)
+            || match spec.newton.strategy {
+                Strategy::Full => true,
+                Strategy::Modified => self.increments.is_multiple_of(spec.newton.refactor_every),
+                Strategy::Initial => !solver.is_factored(),
             };
-            let result = step.solve(&state, d, &mut system, &mut solver, &mut counters);
-            factored_for = if solver.is_factored() {
-                Some(coefficients)
-            } else {
-                None
-            };
-            result
+        let step = Step {
+            model,
+            geometry: spec.geometry,
+            newton: &spec.newton,
+            inertia: Some(Inertia {
+                mass: self.mass,
+                rayleigh: spec.rayleigh,
+            }),
+            form: &form,
+            external: &external,
+            internal_start: self.last_internal,
+            factor_first,
+            contact: Some(Constraints {
+                pairs: &model.contacts,
+                active,
+                start: self.positions,
+                forces,
+                tangential,
+            }),
         };
-        let outcome = contact
-            .step(&model.contacts, &positions, nominal, attempt)
-            .and_then(|mut step| {
-                let h = step.length;
-                let form = method.form(h, &kin);
-                let advance = method.advance(h, &kin, &step.solution.d);
-                if form.solve_fraction != 1.0 {
-                    // Wilson: the state at t_{n+1} from the interpolated increment
-                    let mut du = advance.increment.clone();
-                    for (dof, value) in loads::prescribed(model, &initial, state.time + h) {
-                        du[dof] = value - kin.displacement[dof];
+        let result = step.solve(state, d, system, solver, counters);
+        *factored_for = if solver.is_factored() {
+            Some(coefficients)
+        } else {
+            None
+        };
+        result
+    }
+}
+
+impl Stepper for Dynamics<'_> {
+    fn integrator(&self) -> String {
+        self.method.name()
+    }
+    fn dt(&self) -> f64 {
+        self.spec.dt
+    }
+    fn end_time(&self) -> f64 {
+        self.spec.end_time
+    }
+    fn free_dofs(&self) -> usize {
+        self.system.free
+    }
+    fn checks_buckling(&self) -> bool {
+        true
+    }
+    fn kind(&self) -> &'static str {
+        "implicit dynamic"
+    }
+
+    fn start(&mut self) -> Result<(), String> {
+        let free: Vec<bool> = self.system.equation.iter().map(Option::is_some).collect();
+        let velocity = super::initial_velocity(self.model, &free, self.spec.dt);
+        let (acceleration, internal) = self
+            .initial_acceleration(&velocity)
+            .map_err(|reason| format!("initial acceleration: {reason}"))?;
+        self.kin.velocity = velocity;
+        self.kin.acceleration = acceleration;
+        self.last_internal = internal;
+        self.energies.kinetic = self.mass.kinetic_energy(self.model, &self.kin.velocity);
+        self.initial_kinetic = self.energies.kinetic;
+        self.last_total = self.total_force(&self.last_internal.clone());
+        Ok(())
+    }
+
+    fn restore(&mut self, carry: Carry, _: &Checkpoint) -> bool {
+        let Carry::Dynamic(carry) = carry else {
+            return false;
+        };
+        self.state = carry.state;
+        self.kin = carry.kinematics;
+        self.method.restore(carry.method);
+        self.energies = carry.energies;
+        self.initial_kinetic = carry.initial_kinetic;
+        self.last_total = carry.last_total;
+        self.last_internal = carry.last_internal;
+        self.last_contact = carry.last_contact;
+        self.control = carry.control;
+        self.increments = carry.increments;
+        self.contact = carry.contact;
+        true
+    }
+
+    fn carry(&self) -> Result<Carry, &'static str> {
+        Ok(Carry::Dynamic(DynamicCarry {
+            state: self.state.clone(),
+            kinematics: self.kin.clone(),
+            method: self.method.history(),
+            energies: self.energies,
+            initial_kinetic: self.initial_kinetic,
+            last_total: self.last_total.clone(),
+            last_internal: self.last_internal.clone(),
+            last_contact: self.last_contact.clone(),
+            control: self.control.clone(),
+            increments: self.increments,
+            contact: self.contact.clone(),
+        }))
+    }
+
+    fn after_checkpoint(&mut self) {
+        self.factored_for = None;
+    }
+
+    fn done(&self) -> bool {
+        self.state.time >= self.spec.end_time * (1.0 - 1e-12)
+    }
+
+    fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError> {
+        loop {
+            let (target, nominal) = self.target();
+            let positions = self.state.positions(self.spec.geometry).into_owned();
+            let kinetic_before_impact = self.mass.kinetic_energy(self.model, &self.kin.velocity);
+            self.contact.close_touching(
+                &self.interfaces,
+                &positions,
+                &self.mass.lumped,
+                &mut self.kin.velocity,
+                &mut self.kin.acceleration,
+            );
+            self.energies.contact_work +=
+                kinetic_before_impact - self.mass.kinetic_energy(self.model, &self.kin.velocity);
+            match self.attempt(nominal, &positions, counters) {
+                Ok((step, advance)) => {
+                    self.commit(step, advance, target, nominal);
+                    return Ok(());
+                }
+                Err(StepFailure(reason)) => {
+                    self.method.reject();
+                    if let Err(why) = self.control.reject(nominal, counters) {
+                        let message = format!("step to t = {target} {why}: {reason}");
+                        return Err(StepError::diverged(message));
                     }
-                    step.solution.evaluation = assembly::evaluate(
-                        model,
-                        &state,
-                        &du,
-                        spec.geometry,
-                        None,
-                        spec.newton.tangent,
-                    )
-                    .map_err(|e| StepFailure(e.to_string()))?;
-                    step.solution.d = du;
-                }
-                Ok((step, advance))
-            });
-        match outcome {
-            Ok((mut step, advance)) => {
-                let h = step.length;
-                let d = std::mem::take(&mut step.solution.d);
-                let evaluation = std::mem::take(&mut step.solution.evaluation);
-                let internal = evaluation.force.clone();
-                assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
-                state.time = if h == nominal { target } else { state.time + h };
-                let previous_velocity = std::mem::replace(&mut kin.velocity, advance.velocity);
-                kin.acceleration = advance.acceleration;
-                for (u, du) in kin.displacement.iter_mut().zip(&d) {
-                    *u += du;
-                }
-                let kinetic_before = mass.kinetic_energy(model, &kin.velocity);
-                let positions = state.positions(spec.geometry);
-                crate::contact::apply_conditions(
-                    &interfaces,
-                    &mut step,
-                    &positions,
-                    &mass.lumped,
-                    &previous_velocity,
-                    &mut kin.velocity,
-                    &mut kin.acceleration,
-                );
-                contact.commit(&interfaces, &step, state.time, &positions);
-                let contact_force = contact.nodal_forces(&model.contacts, &positions);
-                let total = total_force(
-                    model, &system, &mass, spec, &kin, &internal, &state, &initial,
-                );
-                energies.external_work += super::trapezoid_work(&d, &total, &last_total);
-                energies.kinetic = mass.kinetic_energy(model, &kin.velocity);
-                // energy taken up by the interface: minus the work of the contact forces on
-                // the bodies, plus what the impact/release conditions removed
-                energies.contact_work += -super::trapezoid_work(&d, &contact_force, &last_contact)
-                    + kinetic_before
-                    - energies.kinetic;
-                energies.internal = state.internal_work - state.plastic_work;
-                energies.plastic_work = state.plastic_work;
-                summary.energy.max_relative_drift = summary
-                    .energy
-                    .max_relative_drift
-                    .max(super::balance_error(&energies, initial_kinetic));
-                last_total = total;
-                last_internal = internal;
-                last_contact = contact_force;
-                summary.steps += 1;
-                increments += 1;
-                let mut stop = false;
-                if let Some(m) = &mut monitor {
-                    match m.observe(model, &state) {
-                        Ok((count, halt)) => {
-                            recorder.negative_pivots = count;
-                            stop = halt;
-                        }
-                        Err(e) => {
-                            progress.abandon();
-                            summary.finish(&energies, &counters, Some(&solver), start);
-                            summary.buckling = Some(m.summary.clone());
-                            let message = format!("buckling check at t = {}: {e}", state.time);
-                            return Err(super::fail(&recorder, summary, Status::Diverged, message));
-                        }
-                    }
-                }
-                let last = stop || state.time >= spec.end_time * (1.0 - 1e-12);
-                let motion = Motion {
-                    velocity: &kin.velocity,
-                    acceleration: &kin.acceleration,
-                    mass: &mass.lumped,
-                };
-                recorder.step_with_contact(
-                    model,
-                    &state,
-                    &motion,
-                    &energies,
-                    Some(&contact),
-                    last,
-                )?;
-                if let Some(message) = crate::contact::runaway_penetration(
-                    &model.contacts,
-                    &state.positions(spec.geometry),
-                    &penetration_limits,
-                ) {
-                    progress.abandon();
-                    summary.finish(&energies, &counters, Some(&solver), start);
-                    summary.contact = contact.summary();
-                    let message = format!("at t = {}: {message}", state.time);
-                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
-                }
-                progress.set_position((state.time / spec.dt).round() as u64);
-                control.accept(true);
-                if stop {
-                    summary.message = Some(super::statics::stop_message(&state, &recorder));
-                    break;
-                }
-                let interrupted = !last && options.interrupted();
-                if interrupted {
-                    let motion = Motion {
-                        velocity: &kin.velocity,
-                        acceleration: &kin.acceleration,
-                        mass: &mass.lumped,
-                    };
-                    recorder.frame(model, &state, &motion, Some(&contact))?;
-                }
-                if interrupted || (!last && super::checkpoint_due(model, summary.steps)) {
-                    save!();
-                }
-                options.halt(&summary)?;
-                if interrupted {
-                    progress.abandon();
-                    summary.finish(&energies, &counters, Some(&solver), start);
-                    summary.contact = contact.summary();
-                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
-                    return Err(super::interrupted(&recorder, summary, state.time));
-                }
-            }
-            Err(StepFailure(reason)) => {
-                method.reject();
-                if let Err(why) = control.reject(nominal, &mut counters) {
-                    progress.abandon();
-                    let message = format!("step to t = {target} {why}: {reason}");
-                    summary.finish(&energies, &counters, Some(&solver), start);
-                    summary.contact = contact.summary();
-                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
-                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
                 }
             }
         }
     }
-    summary.contact = contact.summary();
-    progress.finish_and_clear();
-    summary.finish(&energies, &counters, Some(&solver), start);
-    summary.buckling = monitor.map(|m| m.summary);
-    recorder.write_summary(&summary)?;
-    let contact_force = contact.nodal_forces(&model.contacts, &state.positions(spec.geometry));
-    Ok(Outcome {
-        summary,
-        state,
-        contact_force,
-    })
-}
 
-/// F: f_ext on the free DOFs, the reaction M a + a_R M v + f_int on the prescribed ones.
-#[allow(clippy::too_many_arguments)]
-fn total_force(
-    model: &Model,
-    system: &System,
-    mass: &Mass,
-    spec: &DynamicSpec,
-    kin: &MotionState,
-    internal: &[f64],
-    state: &State,
-    initial: &[[f64; 2]],
-) -> Vec<f64> {
-    let external = loads::external_force(model, state, initial, state.time);
-    let ma = mass.product(model, &kin.acceleration);
-    let mv = mass.product(model, &kin.velocity);
-    (0..model.dofs())
-        .map(|i| match system.equation[i] {
-            Some(_) => external[i],
-            None => ma[i] + spec.rayleigh[0] * mv[i] + internal[i],
-        })
-        .collect()
+    fn state(&self) -> &State {
+        &self.state
+    }
+    fn motion(&self) -> Motion<'_> {
+        Motion {
+            velocity: &self.kin.velocity,
+            acceleration: &self.kin.acceleration,
+            mass: &self.mass.lumped,
+        }
+    }
+    fn energies(&self) -> &Energies {
+        &self.energies
+    }
+    fn initial_kinetic(&self) -> f64 {
+        self.initial_kinetic
+    }
+    fn contact(&self) -> &ContactState {
+        &self.contact
+    }
+    fn contact_forces(&self) -> Vec<f64> {
+        let positions = self.state.positions(self.spec.geometry);
+        self.contact.nodal_forces(&self.model.contacts, &positions)
+    }
+    fn solver(&self) -> Option<&Solver> {
+        Some(&self.solver)
+    }
+    fn solver_mut(&mut self) -> Option<&mut Solver> {
+        Some(&mut self.solver)
+    }
+    fn progress(&self) -> (u64, u64) {
+        let spec = self.spec;
+        (
+            (self.state.time / spec.dt).round() as u64,
+            (spec.end_time / spec.dt).round().max(1.0) as u64,
+        )
+    }
 }

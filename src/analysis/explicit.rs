@@ -15,14 +15,15 @@
 use super::checkpoint::{Carry, Checkpoint, ExplicitCarry};
 use super::dynamics::check_mass;
 use super::newton::Counters;
-use super::record::{Energies, Motion, Recorder};
-use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
+use super::record::{Energies, Motion};
+use super::run::{StepError, Stepper};
+use super::{RunError, Status, loads};
 use crate::assembly::reduced::{Reduced, StepWork};
 use crate::assembly::{self, Mass, State, System};
-use crate::contact::ContactState;
-use crate::scene::spec::Quadrature;
-use crate::scene::spec::{DynamicSpec, MassKind};
+use crate::contact::{ContactState, Interfaces};
+use crate::scene::spec::{DynamicSpec, MassKind, Quadrature};
 use crate::scene::{InputError, Model};
+use crate::solver::Solver;
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
@@ -49,401 +50,393 @@ pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
     })
 }
 
-pub fn run(
-    model: &Model,
-    spec: &DynamicSpec,
-    dir: &Path,
-    options: RunOptions,
-    resume: Option<Checkpoint>,
-) -> Result<Outcome, RunError> {
-    let mut start = Instant::now();
-    let setup_start = start;
-    let StableStep {
-        dt: dt_crit,
-        body: b,
-        element: e,
-    } = critical_time_step(model)?;
-    if spec.dt > dt_crit && !spec.allow_unstable {
-        return Err(InputError::new(
-            &model.file,
-            format!(
-                "analysis.dt = {} exceeds the central-difference stability limit {dt_crit:.6e} (set by body `{}`, element {e}); \
-                 lower dt or set analysis.allow_unstable = true to watch it blow up",
-                spec.dt, model.bodies[b].name
-            ),
-        )
-        .into());
-    }
-    let initial = model.coordinates();
-    let system = System::new(model, &loads::constrained_dofs(model));
-    let mass = Mass::new(model, MassKind::Lumped)
-        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    check_mass(model, &mass, &system)?;
-    let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
-    let (mut recorder, resume) = match resume {
-        Some(c) => {
-            let Carry::Explicit(carry) = c.carry.clone() else {
-                return Err(super::wrong_carry(dir, "explicit"));
-            };
-            (
-                Recorder::resume(model, dir, c.recorder.clone())?,
-                Some((c, carry)),
+/// Central difference: the state, the motion, the one-point kernel when asked, and what the
+/// loop carries.
+pub struct Explicit<'a> {
+    model: &'a Model,
+    spec: &'a DynamicSpec,
+    interfaces: Interfaces,
+    initial: Vec<[f64; 2]>,
+    free: Vec<bool>,
+    /// The lumped mass per DOF, and its inverse (zero on prescribed DOFs: contact
+    /// corrections never move them).
+    mass: Vec<f64>,
+    inverse_mass: Vec<f64>,
+    dt_crit: f64,
+    /// The one-point kernel keeps its element state in its own arrays (copied into `state`
+    /// only when output reads stresses).
+    reduced: Option<Reduced>,
+    synced: bool,
+    state: State,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    internal: Vec<f64>,
+    energies: Energies,
+    initial_kinetic: f64,
+    last_total: Vec<f64>,
+    energy_reference: f64,
+    /// Steps taken (the last one's index); `steps` in all.
+    step: usize,
+    steps: usize,
+    contact: ContactState,
+    forces_applied: bool,
+    // the step's vectors, allocated once
+    v_half: Vec<f64>,
+    du: Vec<f64>,
+    external: Vec<f64>,
+    total: Vec<f64>,
+}
+
+impl<'a> Explicit<'a> {
+    /// Refuses a dt above the stability limit (unless the scene asks to watch it blow up).
+    pub fn new(model: &'a Model, spec: &'a DynamicSpec) -> Result<Explicit<'a>, RunError> {
+        let StableStep {
+            dt: dt_crit,
+            body: b,
+            element: e,
+        } = critical_time_step(model)?;
+        if spec.dt > dt_crit && !spec.allow_unstable {
+            return Err(InputError::new(
+                &model.file,
+                format!(
+                    "analysis.dt = {} exceeds the central-difference stability limit {dt_crit:.6e} (set by body `{}`, element {e}); \
+                     lower dt or set analysis.allow_unstable = true to watch it blow up",
+                    spec.dt, model.bodies[b].name
+                ),
             )
+            .into());
         }
-        None => (Recorder::create(model, dir)?, None),
-    };
-    let mut state = State::initial(model);
-    let mut summary = Summary::new(
-        model,
-        "central_difference",
-        spec.dt,
-        spec.end_time,
-        system.free,
-    );
-    // whole steps, and a shorter last one that ends exactly at end_time
-    let steps = ((spec.end_time / spec.dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-    let m = &mass.lumped;
-    let a_r = spec.rayleigh[0];
-
-    // the reduced kernel keeps its element state in its own arrays (copied into `state`
-    // only when the recorder reads stresses)
-    let mut reduced = (spec.quadrature == Quadrature::Reduced)
-        .then(|| Reduced::new(model, &state, spec.hourglass));
-    let zero = vec![0.0; model.dofs()];
-    let first = match reduced.as_mut() {
-        Some(kernel) => {
-            let mut force = zero.clone();
-            kernel
-                .internal_force(&state.coordinates, &mut force)
-                .map(|_| force)
-        }
-        None => assembly::evaluate(
+        let system = System::new(model, &loads::constrained_dofs(model));
+        let mass = Mass::new(model, MassKind::Lumped)
+            .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+        check_mass(model, &mass, &system)?;
+        let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
+        let m = mass.lumped;
+        let inverse_mass = (0..model.dofs())
+            .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
+            .collect();
+        let state = State::initial(model);
+        // whole steps, and a shorter last one that ends exactly at end_time
+        let steps = ((spec.end_time / spec.dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+        let reduced = (spec.quadrature == Quadrature::Reduced)
+            .then(|| Reduced::new(model, &state, spec.hourglass));
+        let dofs = model.dofs();
+        Ok(Explicit {
             model,
-            &state,
-            &zero,
-            spec.geometry,
-            None,
-            spec.newton.tangent,
-        )
-        .map(|e| e.force),
-    }
-    .map_err(|err| {
-        super::fail(
-            &recorder,
-            summary.clone(),
-            Status::Diverged,
-            err.to_string(),
-        )
-    })?;
-    let mut internal = first;
-    let mut v = super::initial_velocity(model, &system, spec.dt);
-    let external = loads::external_force(model, &state, &initial, 0.0);
-    let mut a: Vec<f64> = (0..model.dofs())
-        .map(|i| {
-            if free[i] {
-                (external[i] - internal[i] - a_r * m[i] * v[i]) / m[i]
-            } else {
-                0.0
-            }
+            spec,
+            interfaces: super::interfaces(model),
+            initial: model.coordinates(),
+            free,
+            mass: m,
+            inverse_mass,
+            dt_crit,
+            reduced,
+            synced: false,
+            state,
+            v: vec![0.0; dofs],
+            a: vec![0.0; dofs],
+            internal: vec![0.0; dofs],
+            energies: Energies::default(),
+            initial_kinetic: 0.0,
+            last_total: vec![0.0; dofs],
+            energy_reference: 0.0,
+            step: 0,
+            steps,
+            contact: ContactState::new(&model.contacts),
+            forces_applied: loads::has_external_force(model),
+            v_half: vec![0.0; dofs],
+            du: vec![0.0; dofs],
+            external: vec![0.0; dofs],
+            total: vec![0.0; dofs],
         })
-        .collect();
-    let kinetic = |v: &[f64]| 0.5 * v.iter().zip(m).map(|(v, m)| m * v * v).sum::<f64>();
-    let mut energies = Energies {
-        kinetic: kinetic(&v),
-        ..Default::default()
-    };
-    let mut initial_kinetic = energies.kinetic;
-    summary.energy.initial = initial_kinetic;
-    let mut last_total = total_force(&free, &external, &internal, m, &a, &v, a_r);
-    let mut energy_reference = initial_kinetic;
-    let interfaces = super::interfaces(model);
-    let mut contact = ContactState::new(&model.contacts);
-    let penetration_limits = crate::contact::penetration_limits(&model.contacts, &initial);
-    let mut first_step = 1;
-    match resume {
-        Some((checkpoint, carry)) => {
-            state = carry.state;
-            v = carry.velocity;
-            a = carry.acceleration;
-            energies = carry.energies;
-            initial_kinetic = carry.initial_kinetic;
-            last_total = carry.last_total;
-            energy_reference = carry.energy_reference;
-            contact = carry.contact;
-            first_step = carry.step + 1;
-            summary = checkpoint.summary;
-            start = super::resumed_start(checkpoint.wall_seconds);
-        }
-        None => {
-            recorder.step(
-                model,
-                &state,
-                &Motion {
-                    velocity: &v,
-                    acceleration: &a,
-                    mass: m,
-                },
-                &energies,
-                true,
-            )?;
-        }
-    }
-    let save = |recorder: &Recorder,
-                summary: &Summary,
-                step: usize,
-                state: &State,
-                v: &[f64],
-                a: &[f64],
-                energies: &Energies,
-                last_total: &[f64],
-                energy_reference: f64,
-                contact: &ContactState| {
-        let carry = ExplicitCarry {
-            state: state.clone(),
-            velocity: v.to_vec(),
-            acceleration: a.to_vec(),
-            energies: *energies,
-            initial_kinetic,
-            last_total: last_total.to_vec(),
-            energy_reference,
-            step,
-            contact: contact.clone(),
-        };
-        super::Bookkeeping {
-            model,
-            recorder,
-            summary,
-            counters: &Counters::default(),
-            solver: None,
-            start,
-            buckling: None,
-        }
-        .save(Carry::Explicit(carry))
-    };
-    if first_step == 1 && model.checkpoint_every > 0 {
-        save(
-            &recorder,
-            &summary,
-            0,
-            &state,
-            &v,
-            &a,
-            &energies,
-            &last_total,
-            energy_reference,
-            &contact,
-        )?;
     }
 
-    let progress = super::progress_bar(options.progress, steps);
-    // zero on prescribed DOFs: contact corrections never move them
-    let inverse_mass: Vec<f64> = (0..model.dofs())
-        .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
-        .collect();
-    // the step's vectors, allocated once; without force loads the external force stays zero
-    let dofs = model.dofs();
-    let (mut v_half, mut du) = (vec![0.0; dofs], vec![0.0; dofs]);
-    let mut external = vec![0.0; dofs];
-    let mut total = vec![0.0; dofs];
-    let forces_applied = loads::has_external_force(model);
-    crate::profile::add(crate::profile::Phase::Setup, setup_start);
-    for step in first_step..=steps {
+    /// The contact correction of the predicted increment (forward-increment multipliers).
+    fn contact_correction(&mut self, h: f64, time: f64) {
+        let positions = self.state.positions(self.spec.geometry);
+        let correction = self.contact.explicit_step(
+            &self.interfaces,
+            &positions,
+            &self.du,
+            &self.inverse_mass,
+            h,
+            time,
+        );
+        (
+            self.du.par_chunks_mut(DOF_CHUNK),
+            self.v_half.par_chunks_mut(DOF_CHUNK),
+        )
+            .into_par_iter()
+            .zip(correction.par_chunks(DOF_CHUNK))
+            .for_each(|((du, v_half), correction)| {
+                for ((du, v), c) in du.iter_mut().zip(v_half).zip(correction) {
+                    *du += c;
+                    *v += c / h;
+                }
+            });
+        let force = self.contact.nodal_forces(&self.model.contacts, &positions);
+        self.energies.contact_work -= chunked_sum(&force, &self.du, |f, u| f * u);
+    }
+
+    /// The internal force at u_{n+1} and the committed element state; the message of an
+    /// element that failed.
+    fn internal_force(&mut self) -> Result<(), String> {
+        let du = &self.du;
+        match self.reduced.as_mut() {
+            Some(kernel) => {
+                let work = crate::profile::time(crate::profile::Phase::Assembly, || {
+                    crate::profile::count_elements(kernel.elements());
+                    kernel.step(&self.state.coordinates, du, &mut self.internal)
+                })
+                .map_err(|e| e.to_string())?;
+                commit_reduced(&mut self.state, du, work);
+            }
+            None => {
+                let spec = self.spec;
+                let evaluation = assembly::evaluate(
+                    self.model,
+                    &self.state,
+                    du,
+                    spec.geometry,
+                    None,
+                    spec.newton.tangent,
+                )
+                .map_err(|e| e.to_string())?;
+                self.internal = evaluation.force.clone();
+                assembly::commit(self.model, &mut self.state, du, evaluation, spec.geometry);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Stepper for Explicit<'_> {
+    fn integrator(&self) -> String {
+        "central_difference".into()
+    }
+    fn dt(&self) -> f64 {
+        self.spec.dt
+    }
+    fn end_time(&self) -> f64 {
+        self.spec.end_time
+    }
+    fn free_dofs(&self) -> usize {
+        self.free.iter().filter(|f| **f).count()
+    }
+    fn checks_buckling(&self) -> bool {
+        false
+    }
+    fn kind(&self) -> &'static str {
+        "explicit"
+    }
+
+    fn start(&mut self) -> Result<(), String> {
+        let model = self.model;
+        let zero = vec![0.0; model.dofs()];
+        let first = match self.reduced.as_mut() {
+            Some(kernel) => {
+                let mut force = zero.clone();
+                kernel
+                    .internal_force(&self.state.coordinates, &mut force)
+                    .map(|_| force)
+            }
+            None => assembly::evaluate(
+                model,
+                &self.state,
+                &zero,
+                self.spec.geometry,
+                None,
+                self.spec.newton.tangent,
+            )
+            .map(|e| e.force),
+        }
+        .map_err(|err| err.to_string())?;
+        self.internal = first;
+        let system_free = &self.free;
+        let (m, a_r) = (&self.mass, self.spec.rayleigh[0]);
+        let v = super::initial_velocity(model, system_free, self.spec.dt);
+        let external = loads::external_force(model, &self.state, &self.initial, 0.0);
+        self.a = (0..model.dofs())
+            .map(|i| {
+                if system_free[i] {
+                    (external[i] - self.internal[i] - a_r * m[i] * v[i]) / m[i]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        self.v = v;
+        self.energies.kinetic = 0.5 * self.v.iter().zip(m).map(|(v, m)| m * v * v).sum::<f64>();
+        self.initial_kinetic = self.energies.kinetic;
+        self.last_total = total_force(
+            &self.free,
+            &external,
+            &self.internal,
+            m,
+            &self.a,
+            &self.v,
+            a_r,
+        );
+        self.energy_reference = self.initial_kinetic;
+        Ok(())
+    }
+
+    fn restore(&mut self, carry: Carry, _: &Checkpoint) -> bool {
+        let Carry::Explicit(carry) = carry else {
+            return false;
+        };
+        self.state = carry.state;
+        self.v = carry.velocity;
+        self.a = carry.acceleration;
+        self.energies = carry.energies;
+        self.initial_kinetic = carry.initial_kinetic;
+        self.last_total = carry.last_total;
+        self.energy_reference = carry.energy_reference;
+        self.contact = carry.contact;
+        self.step = carry.step;
+        true
+    }
+
+    fn carry(&self) -> Result<Carry, &'static str> {
+        if self.reduced.is_some() {
+            // its hourglass forces are not in `State`; the scene refuses checkpoint_every
+            return Err(
+                "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
+            );
+        }
+        Ok(Carry::Explicit(ExplicitCarry {
+            state: self.state.clone(),
+            velocity: self.v.clone(),
+            acceleration: self.a.clone(),
+            energies: self.energies,
+            initial_kinetic: self.initial_kinetic,
+            last_total: self.last_total.clone(),
+            energy_reference: self.energy_reference,
+            step: self.step,
+            contact: self.contact.clone(),
+        }))
+    }
+
+    fn done(&self) -> bool {
+        self.step >= self.steps
+    }
+
+    fn advance(&mut self, _: &mut Counters) -> Result<(), StepError> {
+        let (model, spec) = (self.model, self.spec);
+        let step = self.step + 1;
         let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
-        let h = super::step_length(time - state.time, spec.dt);
-        predict(&v, &a, h, &mut v_half, &mut du);
-        for (dof, value) in loads::prescribed(model, &initial, time) {
-            du[dof] = value - state.displacement[dof];
+        let h = super::step_length(time - self.state.time, spec.dt);
+        predict(&self.v, &self.a, h, &mut self.v_half, &mut self.du);
+        for (dof, value) in loads::prescribed(model, &self.initial, time) {
+            self.du[dof] = value - self.state.displacement[dof];
         }
         if !model.contacts.is_empty() {
-            crate::profile::time(crate::profile::Phase::Contact, || {
-                let positions = state.positions(spec.geometry);
-                let correction =
-                    contact.explicit_step(&interfaces, &positions, &du, &inverse_mass, h, time);
-                (
-                    du.par_chunks_mut(DOF_CHUNK),
-                    v_half.par_chunks_mut(DOF_CHUNK),
-                )
-                    .into_par_iter()
-                    .zip(correction.par_chunks(DOF_CHUNK))
-                    .for_each(|((du, v_half), correction)| {
-                        for ((du, v), c) in du.iter_mut().zip(v_half).zip(correction) {
-                            *du += c;
-                            *v += c / h;
-                        }
-                    });
-                let force = contact.nodal_forces(&model.contacts, &positions);
-                energies.contact_work -= chunked_sum(&force, &du, |f, u| f * u);
+            let start = Instant::now();
+            self.contact_correction(h, time);
+            crate::profile::add(crate::profile::Phase::Contact, start);
+        }
+        if let Err(err) = self.internal_force() {
+            let status = if spec.dt > self.dt_crit {
+                Status::Unstable
+            } else {
+                Status::Diverged
+            };
+            return Err(StepError {
+                status,
+                message: format!("at t = {time}: {err}"),
+                frame: false,
             });
         }
-        let evaluation = match reduced.as_mut() {
-            Some(kernel) => crate::profile::time(crate::profile::Phase::Assembly, || {
-                crate::profile::count_elements(kernel.elements());
-                kernel.step(&state.coordinates, &du, &mut internal)
-            })
-            .map(|work| {
-                commit_reduced(&mut state, &du, work);
-                recorder.hourglass_energy = kernel.hourglass_energy;
-            }),
-            None => {
-                assembly::evaluate(model, &state, &du, spec.geometry, None, spec.newton.tangent)
-                    .map(|evaluation| {
-                        internal = evaluation.force.clone();
-                        assembly::commit(model, &mut state, &du, evaluation, spec.geometry);
-                    })
-            }
-        };
-        match evaluation {
-            Ok(()) => {}
-            Err(err) => {
-                progress.abandon();
-                summary.finish(&energies, &Counters::default(), None, start);
-                let status = if spec.dt > dt_crit {
-                    Status::Unstable
-                } else {
-                    Status::Diverged
-                };
-                return Err(super::fail(
-                    &recorder,
-                    summary,
-                    status,
-                    format!("at t = {time}: {err}"),
-                ));
-            }
-        }
-        state.time = time;
-        let synced = match &reduced {
-            Some(kernel) if recorder.reads_stresses(model, time, step == steps) => {
-                kernel.write_points(model, &mut state);
-                true
-            }
-            _ => false,
-        };
-        if forces_applied {
-            external.fill(0.0);
-            loads::add_external_force(model, &state, &initial, time, &mut external);
+        self.state.time = time;
+        self.synced = false;
+        if self.forces_applied {
+            self.external.fill(0.0);
+            loads::add_external_force(model, &self.state, &self.initial, time, &mut self.external);
         }
         let (work, kinetic_energy) = StepEnd {
-            free: &free,
-            external: &external,
-            internal: &internal,
-            m,
-            v_half: &v_half,
-            du: &du,
-            last_total: &last_total,
+            free: &self.free,
+            external: &self.external,
+            internal: &self.internal,
+            m: &self.mass,
+            v_half: &self.v_half,
+            du: &self.du,
+            last_total: &self.last_total,
             h,
-            a_r,
+            a_r: spec.rayleigh[0],
         }
-        .apply(&mut a, &mut v, &mut total);
+        .apply(&mut self.a, &mut self.v, &mut self.total);
+        let energies = &mut self.energies;
         energies.external_work += work;
-        std::mem::swap(&mut last_total, &mut total);
+        std::mem::swap(&mut self.last_total, &mut self.total);
         energies.kinetic = kinetic_energy;
-        energies.internal = state.internal_work - state.plastic_work;
-        energies.plastic_work = state.plastic_work;
-        summary.steps += 1;
-        summary.energy.max_relative_drift = summary
-            .energy
-            .max_relative_drift
-            .max(super::balance_error(&energies, initial_kinetic));
+        energies.internal = self.state.internal_work - self.state.plastic_work;
+        energies.plastic_work = self.state.plastic_work;
         if step == 1 {
-            energy_reference = energy_reference.max(energies.internal.abs());
+            self.energy_reference = self.energy_reference.max(energies.internal.abs());
         }
-        energy_reference = energy_reference.max(energies.external_work.abs());
-        let energy = energies.kinetic + energies.internal;
-        let motion = Motion {
-            velocity: &v,
-            acceleration: &a,
-            mass: m,
-        };
-        if !energy.is_finite() || energy > 100.0 * energy_reference {
-            progress.abandon();
-            if let (Some(kernel), false) = (&reduced, synced) {
-                kernel.write_points(model, &mut state);
-            }
-            recorder.frame(model, &state, &motion, None).ok();
-            summary.finish(&energies, &Counters::default(), None, start);
-            let message = format!(
-                "the energy grew to {energy:.3e} (reference {energy_reference:.3e}) at t = {time}: dt = {} is above the stability limit {dt_crit:.6e}",
-                spec.dt
-            );
-            return Err(super::fail(&recorder, summary, Status::Unstable, message));
-        }
-        recorder.step_with_contact(
-            model,
-            &state,
-            &motion,
-            &energies,
-            Some(&contact),
-            step == steps,
-        )?;
-        let runaway = crate::profile::time(crate::profile::Phase::Contact, || {
-            crate::contact::runaway_penetration(
-                &model.contacts,
-                &state.positions(spec.geometry),
-                &penetration_limits,
-            )
-        });
-        if let Some(message) = runaway {
-            progress.abandon();
-            summary.finish(&energies, &Counters::default(), None, start);
-            summary.contact = contact.summary();
-            let message = format!("at t = {}: {message}", state.time);
-            return Err(super::fail(&recorder, summary, Status::Diverged, message));
-        }
-        progress.set_position(step as u64);
-        let interrupted = step < steps && options.interrupted();
-        if interrupted {
-            if let (Some(kernel), false) = (&reduced, synced) {
-                kernel.write_points(model, &mut state);
-            }
-            recorder.frame(model, &state, &motion, Some(&contact))?;
-        }
-        // the reduced kernel writes no checkpoint (its hourglass forces are not in `State`;
-        // the scene refuses checkpoint_every with it)
-        if reduced.is_none()
-            && (interrupted || (step < steps && super::checkpoint_due(model, step)))
-        {
-            save(
-                &recorder,
-                &summary,
-                step,
-                &state,
-                &v,
-                &a,
-                &energies,
-                &last_total,
-                energy_reference,
-                &contact,
-            )?;
-        }
-        options.halt(&summary)?;
-        if interrupted {
-            progress.abandon();
-            summary.finish(&energies, &Counters::default(), None, start);
-            summary.contact = contact.summary();
-            return Err(match reduced {
-                Some(_) => super::interrupted_saying(
-                    &recorder,
-                    summary,
-                    state.time,
-                    "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
+        self.energy_reference = self.energy_reference.max(energies.external_work.abs());
+        self.step = step;
+        Ok(())
+    }
+
+    fn verdict(&self) -> Result<(), StepError> {
+        let energy = self.energies.kinetic + self.energies.internal;
+        if !energy.is_finite() || energy > 100.0 * self.energy_reference {
+            return Err(StepError {
+                status: Status::Unstable,
+                message: format!(
+                    "the energy grew to {energy:.3e} (reference {:.3e}) at t = {}: dt = {} is above the stability limit {:.6e}",
+                    self.energy_reference, self.state.time, self.spec.dt, self.dt_crit
                 ),
-                None => super::interrupted(&recorder, summary, state.time),
+                frame: true,
             });
         }
+        Ok(())
     }
-    progress.finish_and_clear();
-    if let Some(kernel) = &reduced {
-        kernel.write_points(model, &mut state);
+
+    fn state(&self) -> &State {
+        &self.state
     }
-    summary.finish(&energies, &Counters::default(), None, start);
-    summary.contact = contact.summary();
-    recorder.write_summary(&summary)?;
-    let contact_force = vec![0.0; model.dofs()];
-    Ok(Outcome {
-        summary,
-        state,
-        contact_force,
-    })
+    fn motion(&self) -> Motion<'_> {
+        Motion {
+            velocity: &self.v,
+            acceleration: &self.a,
+            mass: &self.mass,
+        }
+    }
+    fn energies(&self) -> &Energies {
+        &self.energies
+    }
+    fn initial_kinetic(&self) -> f64 {
+        self.initial_kinetic
+    }
+    fn contact(&self) -> &ContactState {
+        &self.contact
+    }
+    fn contact_forces(&self) -> Vec<f64> {
+        let positions = self.state.positions(self.spec.geometry);
+        self.contact.nodal_forces(&self.model.contacts, &positions)
+    }
+    fn solver(&self) -> Option<&Solver> {
+        None
+    }
+    fn solver_mut(&mut self) -> Option<&mut Solver> {
+        None
+    }
+    fn sync_points(&mut self) {
+        if let Some(kernel) = &self.reduced
+            && !self.synced
+        {
+            kernel.write_points(self.model, &mut self.state);
+            self.synced = true;
+        }
+    }
+    fn hourglass_energy(&self) -> Option<f64> {
+        self.reduced.as_ref().map(|k| k.hourglass_energy)
+    }
+    fn progress(&self) -> (u64, u64) {
+        (self.step as u64, self.steps as u64)
+    }
 }
 
 /// Commits a step of the reduced kernel (whose element state is already updated): the
@@ -612,20 +605,18 @@ frame_every = 0
     )
 }
 
-/// Element-updates per second of the reduced explicit kernel (the issue #9 target), for
+/// Element-updates per second of the explicit driver with the one-point kernel, for
 /// `impact bench`: a sqrt(elements)^2 plane-strain J2 block (unit elements, E = 200,
 /// nu = 0.3, rho = 1, sigma_y = 0.3) sheared isochorically (v = r (-x, y) about the centre,
 /// r such that it yields after ~10 steps, so most of the run is plastic) for `steps`
 /// central-difference steps at dt = 0.5 h / c_p, in a rayon pool of `threads` threads.
-/// Times the whole step (nodal updates, element kernel, gather); setup excluded.
-/// Returns 0 when `elements`, `steps` or `threads` is 0 or the pool cannot be built.
-pub fn kernel_benchmark(elements: usize, steps: usize, threads: usize) -> f64 {
-    kernel_benchmark_run(elements, steps, threads).map_or(0.0, |r| r.0)
-}
-
-/// `kernel_benchmark` with the fraction of elements that turned plastic: (element-updates/s,
-/// plastic fraction).
-pub fn kernel_benchmark_run(elements: usize, steps: usize, threads: usize) -> Option<(f64, f64)> {
+/// Times the driver's steps (nodal updates, element kernel, gather, energies); setup
+/// excluded. None when `elements`, `steps` or `threads` is 0 or the pool cannot be built.
+pub fn kernel_benchmark_run(
+    elements: usize,
+    steps: usize,
+    threads: usize,
+) -> Option<KernelBenchmark> {
     let n = (elements as f64).sqrt().round() as usize;
     if n == 0 || steps == 0 || threads == 0 {
         return None;
@@ -634,66 +625,53 @@ pub fn kernel_benchmark_run(elements: usize, steps: usize, threads: usize) -> Op
         .num_threads(threads)
         .build()
         .ok()?;
-    let model =
+    let mut model =
         crate::scene::from_str(&benchmark_scene(n), Path::new("kernel_benchmark.toml"), &[])
             .expect("the benchmark scene is valid");
-    let mass = Mass::new(&model, MassKind::Lumped).ok()?;
-    let m = &mass.lumped;
     let young: f64 = 200.0;
     let c = (model.bodies[0].material.elastic.p_wave_modulus()).sqrt();
     let h = 0.5 / c;
     let rate = 0.3 / young / (10.0 * h);
     let centre = 0.5 * n as f64;
+    model.initial_velocity = model
+        .coordinates()
+        .iter()
+        .flat_map(|x| [-rate * (x[0] - centre), rate * (x[1] - centre)])
+        .collect();
+    let crate::scene::model::Analysis::Dynamic(spec) = &model.analysis else {
+        unreachable!("the benchmark scene is dynamic")
+    };
+    let spec = DynamicSpec {
+        dt: h,
+        end_time: h * steps as f64,
+        ..spec.clone()
+    };
     pool.install(|| {
-        let mut state = State::initial(&model);
-        let mut kernel = Reduced::new(&model, &state, 0.1);
-        let dofs = model.dofs();
-        let mut v: Vec<f64> = state
-            .coordinates
-            .iter()
-            .flat_map(|x| [-rate * (x[0] - centre), rate * (x[1] - centre)])
-            .collect();
-        let mut a = vec![0.0; dofs];
-        let mut du = vec![0.0; dofs];
-        let mut force = vec![0.0; dofs];
-        use rayon::prelude::*;
+        let mut stepper = Explicit::new(&model, &spec).ok()?;
+        stepper.start().ok()?;
+        let mut counters = Counters::default();
         let start = Instant::now();
         for _ in 0..steps {
-            v.par_iter_mut()
-                .zip(a.par_iter())
-                .zip(du.par_iter_mut())
-                .for_each(|((v, a), du)| {
-                    *v += 0.5 * h * a;
-                    *du = h * *v;
-                });
-            if kernel.step(&state.coordinates, &du, &mut force).is_err() {
-                return None;
-            }
-            state
-                .coordinates
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(i, x)| {
-                    x[0] += du[2 * i];
-                    x[1] += du[2 * i + 1];
-                });
-            v.par_iter_mut()
-                .zip(a.par_iter_mut())
-                .zip(force.par_iter().zip(m.par_iter()))
-                .for_each(|((v, a), (f, m))| {
-                    *a = -f / m;
-                    *v += 0.5 * h * *a;
-                });
+            stepper.advance(&mut counters).ok()?;
         }
         let seconds = start.elapsed().as_secs_f64();
+        let kernel = stepper.reduced.as_ref()?;
         let plastic = kernel
             .eq_plastic_strain
             .iter()
             .filter(|e| **e > 0.0)
             .count();
-        Some((
-            (kernel.elements() * steps) as f64 / seconds,
-            plastic as f64 / kernel.elements() as f64,
-        ))
+        Some(KernelBenchmark {
+            element_updates_per_second: (kernel.elements() * steps) as f64 / seconds,
+            plastic_fraction: plastic as f64 / kernel.elements() as f64,
+        })
     })
+}
+
+/// What `kernel_benchmark_run` measures.
+#[derive(Debug, Clone, Copy)]
+pub struct KernelBenchmark {
+    pub element_updates_per_second: f64,
+    /// The fraction of the elements that turned plastic.
+    pub plastic_fraction: f64,
 }

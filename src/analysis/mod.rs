@@ -1,5 +1,7 @@
-//! The drivers: static load stepping (dynamic time stepping plugs in beside it), with the
-//! run's bookkeeping and its output (VTK frames, history.csv, summary.json).
+//! The analyses: one run scaffold (`run`: recording, summary, checkpoints, resume,
+//! interruption, failure) around the steppers that advance the state: static load stepping
+//! (`statics`), implicit time stepping (`dynamics`) and explicit central difference
+//! (`explicit`); their output is VTK frames, history.csv and summary.json (`record`).
 
 pub mod buckling;
 pub mod checkpoint;
@@ -8,19 +10,17 @@ pub mod explicit;
 pub mod loads;
 pub mod newton;
 pub mod record;
+pub mod run;
 pub mod statics;
 
 use crate::assembly::State;
 use crate::output::OutputError;
 use crate::scene::{InputError, Model};
-use crate::solver::Solver;
-use indicatif::{ProgressBar, ProgressStyle};
 use newton::Counters;
-use record::{Energies, Recorder};
+use record::Energies;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 
 /// How a run ended (summary.json `status`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -160,70 +160,6 @@ impl Summary {
             timing: Default::default(),
         }
     }
-
-    /// Fills the counters, the wall time and the final energies.
-    /// `solver` is None for the explicit method (no factorization at all).
-    pub fn finish(
-        &mut self,
-        energies: &Energies,
-        counters: &Counters,
-        solver: Option<&Solver>,
-        start: Instant,
-    ) {
-        self.newton_iterations = counters.iterations;
-        self.step_cuts = counters.cuts;
-        self.factorizations = solver.map_or(0, |s| s.factorizations);
-        self.back_substitutions = solver.map_or(0, |s| s.solves);
-        self.wall_seconds = start.elapsed().as_secs_f64();
-        self.timing = crate::profile::snapshot();
-        self.energy.final_ = energies.kinetic + energies.internal;
-        self.energy.plastic_dissipation = energies.plastic_work;
-    }
-}
-
-/// A failed run: the summary is written with its status and message, then returned in the error.
-fn fail(recorder: &Recorder, mut summary: Summary, status: Status, message: String) -> RunError {
-    summary.status = status;
-    summary.message = Some(message.clone());
-    match recorder.write_summary(&summary) {
-        Ok(()) => RunError::Numerical {
-            message,
-            summary: Box::new(summary),
-        },
-        Err(e) => RunError::Output(e),
-    }
-}
-
-/// The buckling check could not be set up: its modes (bad input: nothing to buckle, missing
-/// supports) or its frames.
-fn monitor_error(model: &Model, e: buckling::MonitorError) -> RunError {
-    match e {
-        buckling::MonitorError::Stability(e) => RunError::Input(InputError::new(
-            &model.file,
-            format!("analysis.buckling: {e}"),
-        )),
-        buckling::MonitorError::Output(e) => RunError::Output(e),
-    }
-}
-
-fn setup_error(dir: &Path, e: impl std::fmt::Display) -> RunError {
-    RunError::Output(OutputError::Invalid {
-        path: dir.to_path_buf(),
-        reason: e.to_string(),
-    })
-}
-
-fn progress_bar(show: bool, steps: usize) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(steps as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps {msg}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    bar
 }
 
 /// Rounds a time that is a whole number of nominal steps up to round-off onto that multiple,
@@ -307,10 +243,11 @@ fn step_length(h: f64, dt: f64) -> f64 {
     if (h - dt).abs() <= 1e-9 * dt { dt } else { h }
 }
 
-/// The scene's initial velocity, with the constrained DOFs moving as their prescriptions do
-/// at t = 0 (the slope of the first curve segment; supports at rest): a prescribed motion
-/// then starts without a velocity jump the trapezoidal rule would carry as an oscillation.
-fn initial_velocity(model: &Model, system: &crate::assembly::System, dt: f64) -> Vec<f64> {
+/// The scene's initial velocity, with the constrained DOFs (`free` false) moving as their
+/// prescriptions do at t = 0 (the slope of the first curve segment; supports at rest): a
+/// prescribed motion then starts without a velocity jump the trapezoidal rule would carry as
+/// an oscillation.
+fn initial_velocity(model: &Model, free: &[bool], dt: f64) -> Vec<f64> {
     let mut v = model.initial_velocity.clone();
     let initial = model.coordinates();
     let eps = 1e-6 * dt;
@@ -322,8 +259,8 @@ fn initial_velocity(model: &Model, system: &crate::assembly::System, dt: f64) ->
         u
     };
     let (u0, u1) = (at(0.0), at(eps));
-    for (dof, eq) in system.equation.iter().enumerate() {
-        if eq.is_none() {
+    for (dof, free) in free.iter().enumerate() {
+        if !free {
             v[dof] = (u1[dof] - u0[dof]) / eps;
         }
     }
@@ -414,90 +351,6 @@ impl RunOptions {
     }
 }
 
-/// What every driver stores in a checkpoint besides its own carry.
-struct Bookkeeping<'a> {
-    model: &'a Model,
-    recorder: &'a Recorder,
-    summary: &'a Summary,
-    counters: &'a Counters,
-    solver: Option<&'a Solver>,
-    start: Instant,
-    buckling: Option<&'a BucklingSummary>,
-}
-
-impl Bookkeeping<'_> {
-    fn save(&self, carry: checkpoint::Carry) -> Result<(), RunError> {
-        let _timer = crate::profile::Timer::new(crate::profile::Phase::Output);
-        let checkpoint = checkpoint::Checkpoint {
-            // absolute when the file exists, so `impact resume` works from any folder (mesh
-            // files are found next to the scene)
-            scene_path: std::fs::canonicalize(&self.model.file)
-                .unwrap_or_else(|_| self.model.file.clone())
-                .display()
-                .to_string(),
-            source: self.model.source.clone(),
-            summary: self.summary.clone(),
-            counters: *self.counters,
-            factorizations: self.solver.map_or(0, |s| s.factorizations),
-            back_substitutions: self.solver.map_or(0, |s| s.solves),
-            wall_seconds: self.start.elapsed().as_secs_f64(),
-            recorder: self.recorder.position()?,
-            buckling: self.buckling.cloned(),
-            carry,
-        };
-        checkpoint::write(self.recorder.dir(), &checkpoint)?;
-        Ok(())
-    }
-}
-
-/// Whether a checkpoint is due after `steps` converged steps.
-fn checkpoint_due(model: &Model, steps: usize) -> bool {
-    model.checkpoint_every > 0 && steps.is_multiple_of(model.checkpoint_every)
-}
-
-/// A checkpoint whose carry is not the scene's driver's: damaged or hand-edited.
-fn wrong_carry(dir: &Path, driver: &str) -> RunError {
-    RunError::Input(InputError::new(
-        &checkpoint::path(dir),
-        format!("the checkpoint does not hold the state of the scene's {driver} analysis"),
-    ))
-}
-
-/// The start instant of a resumed run: as if it had been running for `wall_seconds`.
-fn resumed_start(wall_seconds: f64) -> Instant {
-    let now = Instant::now();
-    now.checked_sub(std::time::Duration::from_secs_f64(wall_seconds.max(0.0)))
-        .unwrap_or(now)
-}
-
-/// An interrupted run: summary.json with status `interrupted`, exit 130.
-fn interrupted(recorder: &Recorder, summary: Summary, time: f64) -> RunError {
-    let next = format!("`impact resume {}` continues", recorder.dir().display());
-    interrupted_saying(recorder, summary, time, &next)
-}
-
-/// As `interrupted`, for a run that wrote no checkpoint (`what_next` says so).
-fn interrupted_saying(
-    recorder: &Recorder,
-    mut summary: Summary,
-    time: f64,
-    what_next: &str,
-) -> RunError {
-    let message = format!(
-        "interrupted by a signal at t = {time} after {} steps; {what_next}",
-        summary.steps
-    );
-    summary.status = Status::Interrupted;
-    summary.message = Some(message.clone());
-    match recorder.write_summary(&summary) {
-        Ok(()) => RunError::Interrupted {
-            message,
-            summary: Box::new(summary),
-        },
-        Err(e) => RunError::Output(e),
-    }
-}
-
 /// Continues the run checkpointed in `dir` (DIR/checkpoint.bin), writing into `dir`.
 pub fn resume(dir: &Path, options: RunOptions) -> Result<Summary, RunError> {
     let checkpoint = checkpoint::read(dir)?;
@@ -558,16 +411,28 @@ fn run_from(
     let model = imperfect.as_ref().unwrap_or(model);
     match &model.analysis {
         crate::scene::model::Analysis::Static(spec) => {
-            statics::run(model, spec, out_dir, options, resume)
+            let stepper =
+                statics::Statics::new(model, spec).map_err(|e| setup_error(out_dir, e))?;
+            run::execute(model, out_dir, options, resume, stepper)
         }
         crate::scene::model::Analysis::Dynamic(spec) => {
             if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference {
-                explicit::run(model, spec, out_dir, options, resume)
+                let stepper = explicit::Explicit::new(model, spec)?;
+                run::execute(model, out_dir, options, resume, stepper)
             } else {
-                dynamics::run(model, spec, out_dir, options, resume)
+                let stepper = dynamics::Dynamics::new(model, spec, out_dir)?;
+                run::execute(model, out_dir, options, resume, stepper)
             }
         }
     }
+}
+
+/// The linear solver could not be set up for the model's pattern.
+fn setup_error(dir: &Path, e: impl std::fmt::Display) -> RunError {
+    RunError::Output(OutputError::Invalid {
+        path: dir.to_path_buf(),
+        reason: e.to_string(),
+    })
 }
 
 #[cfg(test)]

@@ -7,20 +7,21 @@
 //! ```
 //! An increment that does not converge in `max_iterations` (or meets an inverted element or a
 //! tangent that is not positive definite) is halved, at most `max_cuts` times in a row; then
-//! the run stops `diverged` with its output so far kept. After a cut the step grows back.
+//! the run stops `diverged` with its output so far kept. After a cut the step grows back. An
+//! event inside an increment ends it early (Erklig 2.1.4: alpha brings the next node exactly
+//! into contact before the boundary conditions change).
 
 use super::checkpoint::{Carry, Checkpoint, StaticCarry};
 use super::newton::{Constraints, Counters, Step, StepFailure};
-use super::record::{Energies, Motion, Recorder};
-use super::{Outcome, RunError, RunOptions, Status, Summary, loads};
+use super::record::{Energies, Motion};
+use super::run::{StepError, Stepper};
+use super::{StepControl, loads};
 use crate::assembly::{self, State, System};
-use crate::contact::{ContactState, Tangential};
+use crate::contact::{ContactState, Interfaces, Tangential};
 use crate::integrator::StepForm;
 use crate::scene::Model;
 use crate::scene::spec::{StaticSpec, Strategy};
 use crate::solver::Solver;
-use std::path::Path;
-use std::time::Instant;
 
 /// The step form of statics: no inertia, equilibrium at the end of the increment.
 fn static_form(n: usize) -> StepForm {
@@ -35,280 +36,270 @@ fn static_form(n: usize) -> StepForm {
     }
 }
 
-/// Runs a static analysis and writes its output into `dir`.
-pub fn run(
-    model: &Model,
-    spec: &StaticSpec,
-    dir: &Path,
-    options: RunOptions,
-    resume: Option<Checkpoint>,
-) -> Result<Outcome, RunError> {
-    let mut start = Instant::now();
-    let (mut recorder, resume) = match resume {
-        Some(c) => {
-            let Carry::Static(carry) = c.carry.clone() else {
-                return Err(super::wrong_carry(dir, "static"));
-            };
-            (
-                Recorder::resume(model, dir, c.recorder.clone())?,
-                Some((c, carry)),
-            )
-        }
-        None => (Recorder::create(model, dir)?, None),
-    };
-    let initial = model.coordinates();
-    let mut system = System::new(model, &loads::constrained_dofs(model));
-    let mut solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
-    let mut state = State::initial(model);
-    let zeros = vec![0.0; model.dofs()];
-    let motion = Motion {
-        velocity: &zeros,
-        acceleration: &zeros,
-        mass: &[],
-    };
-    let mut energies = Energies::default();
-    let mut last_force = vec![0.0; model.dofs()];
-    let mut monitor =
-        super::buckling::Monitor::new(model, dir).map_err(|e| super::monitor_error(model, e))?;
-    let dt = spec.end_time / spec.steps as f64;
-    let mut summary = Summary::new(model, "static", dt, spec.end_time, system.free);
-    let form = static_form(model.dofs());
-    let mut counters = Counters::default();
-    let mut control = super::StepControl::new(dt, spec.newton.max_cuts);
-    let mut increments = 0usize;
-    let interfaces = super::interfaces(model);
-    let mut contact = ContactState::new(&model.contacts);
-    let penetration_limits = crate::contact::penetration_limits(&model.contacts, &initial);
-    match resume {
-        Some((checkpoint, carry)) => {
-            state = carry.state;
-            energies = carry.energies;
-            last_force = carry.last_force;
-            control = carry.control;
-            increments = carry.increments;
-            contact = carry.contact;
-            summary = checkpoint.summary;
-            counters = checkpoint.counters;
-            solver.factorizations = checkpoint.factorizations;
-            solver.solves = checkpoint.back_substitutions;
-            start = super::resumed_start(checkpoint.wall_seconds);
-            if let (Some(m), Some(b)) = (&mut monitor, checkpoint.buckling) {
-                m.summary = b;
-            }
-        }
-        None => {
-            if let Some(m) = &mut monitor {
-                recorder.negative_pivots = m
-                    .observe(model, &state)
-                    .map_err(|e| super::monitor_error(model, e.into()))?
-                    .0;
-            }
-            recorder.step(model, &state, &motion, &energies, true)?;
-        }
-    }
-    let progress = super::progress_bar(options.progress, spec.steps);
-    // the step after a checkpoint factors K* afresh (a resumed run has no factorization)
-    let mut refresh = model.checkpoint_every > 0;
-    let save = |recorder: &Recorder,
-                summary: &Summary,
-                counters: &Counters,
-                solver: &Solver,
-                monitor: &Option<super::buckling::Monitor>,
-                carry: StaticCarry| {
-        super::Bookkeeping {
-            model,
-            recorder,
-            summary,
-            counters,
-            solver: Some(solver),
-            start,
-            buckling: monitor.as_ref().map(|m| &m.summary),
-        }
-        .save(Carry::Static(carry))
-    };
-    if summary.steps == 0 && model.checkpoint_every > 0 {
-        let carry = StaticCarry {
-            state: state.clone(),
-            energies,
-            last_force: last_force.clone(),
-            control: control.clone(),
-            increments,
-            contact: contact.clone(),
-        };
-        save(&recorder, &summary, &counters, &solver, &monitor, carry)?;
-    }
-    while state.time < spec.end_time * (1.0 - 1e-12) {
-        let target = super::snap((state.time + control.length).min(spec.end_time), dt);
-        let positions = state.positions(spec.geometry);
-        let refresh_now = std::mem::take(&mut refresh);
-        let factor_first = refresh_now
-            || match spec.newton.strategy {
-                Strategy::Full => true,
-                Strategy::Modified => {
-                    increments.is_multiple_of(spec.newton.refactor_every) || control.after_cut()
-                }
-                Strategy::Initial => !solver.is_factored() || control.after_cut(),
-            };
-        // one attempt of the increment with a given length and active contact set
-        let attempt =
-            |h: f64, active: &[(usize, usize)], forces: Vec<f64>, tangential: &[Tangential]| {
-                let end = if state.time + h >= target {
-                    target
-                } else {
-                    state.time + h
-                };
-                let mut d = vec![0.0; model.dofs()];
-                for (dof, value) in loads::prescribed(model, &initial, end) {
-                    d[dof] = value - state.displacement[dof];
-                }
-                let external = loads::external_force(model, &state, &initial, end);
-                let step = Step {
-                    model,
-                    geometry: spec.geometry,
-                    newton: &spec.newton,
-                    inertia: None,
-                    form: &form,
-                    external: &external,
-                    internal_start: &last_force,
-                    factor_first,
-                    contact: Some(Constraints {
-                        pairs: &model.contacts,
-                        active,
-                        start: &positions,
-                        forces,
-                        tangential,
-                    }),
-                };
-                step.solve(&state, d, &mut system, &mut solver, &mut counters)
-            };
-        // an event inside the increment ends it early (Erklig 2.1.4: alpha brings the next
-        // node exactly into contact before the boundary conditions change)
-        match contact.step(&model.contacts, &positions, target - state.time, attempt) {
-            Ok(mut step) => {
-                let end = if state.time + step.length >= target {
-                    target
-                } else {
-                    state.time + step.length
-                };
-                let d = std::mem::take(&mut step.solution.d);
-                let evaluation = std::mem::take(&mut step.solution.evaluation);
-                let force = evaluation.force.clone();
-                assembly::commit(model, &mut state, &d, evaluation, spec.geometry);
-                state.time = end;
-                contact.commit(
-                    &interfaces,
-                    &step,
-                    state.time,
-                    &state.positions(spec.geometry),
-                );
-                // the work of all nodal forces (loads, reactions and contact forces)
-                energies.external_work += super::trapezoid_work(&d, &force, &last_force);
-                energies.internal = state.internal_work - state.plastic_work;
-                energies.plastic_work = state.plastic_work;
-                summary.energy.max_relative_drift = summary
-                    .energy
-                    .max_relative_drift
-                    .max(super::balance_error(&energies, 0.0));
-                last_force = force;
-                summary.steps += 1;
-                increments += 1;
-                let mut stop = false;
-                if let Some(m) = &mut monitor {
-                    match m.observe(model, &state) {
-                        Ok((count, halt)) => {
-                            recorder.negative_pivots = count;
-                            stop = halt;
-                        }
-                        Err(e) => {
-                            progress.abandon();
-                            summary.finish(&energies, &counters, Some(&solver), start);
-                            summary.buckling = Some(m.summary.clone());
-                            let message = format!("buckling check at t = {}: {e}", state.time);
-                            return Err(super::fail(&recorder, summary, Status::Diverged, message));
-                        }
-                    }
-                }
-                let last = stop || state.time >= spec.end_time * (1.0 - 1e-12);
-                recorder.step_with_contact(
-                    model,
-                    &state,
-                    &motion,
-                    &energies,
-                    Some(&contact),
-                    last,
-                )?;
-                if let Some(message) = crate::contact::runaway_penetration(
-                    &model.contacts,
-                    &state.positions(spec.geometry),
-                    &penetration_limits,
-                ) {
-                    progress.abandon();
-                    summary.finish(&energies, &counters, Some(&solver), start);
-                    summary.contact = contact.summary();
-                    let message = format!("at t = {}: {message}", state.time);
-                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
-                }
-                progress.set_position((state.time / dt).round() as u64);
-                control.accept(end == target);
-                if stop {
-                    summary.message = Some(stop_message(&state, &recorder));
-                    break;
-                }
-                let interrupted = !last && options.interrupted();
-                if interrupted {
-                    recorder.frame(model, &state, &motion, Some(&contact))?;
-                }
-                if interrupted || (!last && super::checkpoint_due(model, summary.steps)) {
-                    let carry = StaticCarry {
-                        state: state.clone(),
-                        energies,
-                        last_force: last_force.clone(),
-                        control: control.clone(),
-                        increments,
-                        contact: contact.clone(),
-                    };
-                    save(&recorder, &summary, &counters, &solver, &monitor, carry)?;
-                    refresh = true;
-                }
-                options.halt(&summary)?;
-                if interrupted {
-                    progress.abandon();
-                    summary.finish(&energies, &counters, Some(&solver), start);
-                    summary.contact = contact.summary();
-                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
-                    return Err(super::interrupted(&recorder, summary, state.time));
-                }
-            }
-            Err(StepFailure(reason)) => {
-                if let Err(why) = control.reject(target - state.time, &mut counters) {
-                    progress.abandon();
-                    let message = format!("increment to t = {target} {why}: {reason}");
-                    summary.finish(&energies, &counters, Some(&solver), start);
-                    summary.contact = contact.summary();
-                    summary.buckling = monitor.as_ref().map(|m| m.summary.clone());
-                    return Err(super::fail(&recorder, summary, Status::Diverged, message));
-                }
-            }
-        }
-    }
-    progress.finish_and_clear();
-    summary.finish(&energies, &counters, Some(&solver), start);
-    summary.contact = contact.summary();
-    summary.buckling = monitor.map(|m| m.summary);
-    recorder.write_summary(&summary)?;
-    let contact_force = contact.nodal_forces(&model.contacts, &state.positions(spec.geometry));
-    Ok(Outcome {
-        summary,
-        state,
-        contact_force,
-    })
+/// Static load stepping: the state, the solver and what the loop carries.
+pub struct Statics<'a> {
+    model: &'a Model,
+    spec: &'a StaticSpec,
+    interfaces: Interfaces,
+    initial: Vec<[f64; 2]>,
+    system: System,
+    solver: Solver,
+    form: StepForm,
+    zeros: Vec<f64>,
+    dt: f64,
+    state: State,
+    energies: Energies,
+    /// The internal force of the committed state (all DOFs).
+    last_force: Vec<f64>,
+    control: StepControl,
+    increments: usize,
+    contact: ContactState,
+    /// The next increment factors K* afresh (after a checkpoint: a resumed run has none).
+    refresh: bool,
 }
 
-/// summary.json `message` of a run stopped by `on_critical = "stop"`.
-pub(super) fn stop_message(state: &State, recorder: &Recorder) -> String {
-    format!(
-        "stopped by analysis.buckling.on_critical at t = {}: K_T has {} negative pivot(s)",
-        state.time,
-        recorder.negative_pivots.unwrap_or(0)
-    )
+impl<'a> Statics<'a> {
+    pub fn new(model: &'a Model, spec: &'a StaticSpec) -> Result<Statics<'a>, String> {
+        let system = System::new(model, &loads::constrained_dofs(model));
+        let solver = Solver::new(&system.pattern).map_err(|e| e.to_string())?;
+        let dt = spec.end_time / spec.steps as f64;
+        Ok(Statics {
+            model,
+            spec,
+            interfaces: super::interfaces(model),
+            initial: model.coordinates(),
+            form: static_form(model.dofs()),
+            zeros: vec![0.0; model.dofs()],
+            dt,
+            state: State::initial(model),
+            energies: Energies::default(),
+            last_force: vec![0.0; model.dofs()],
+            control: StepControl::new(dt, spec.newton.max_cuts),
+            increments: 0,
+            contact: ContactState::new(&model.contacts),
+            refresh: model.checkpoint_every > 0,
+            system,
+            solver,
+        })
+    }
+}
+
+/// What an increment's attempts share: the committed state and the increment's settings.
+struct Increment<'s> {
+    model: &'s Model,
+    spec: &'s StaticSpec,
+    form: &'s StepForm,
+    initial: &'s [[f64; 2]],
+    state: &'s State,
+    last_force: &'s [f64],
+    positions: &'s [[f64; 2]],
+    target: f64,
+    factor_first: bool,
+}
+
+impl Increment<'_> {
+    /// Solves the increment with a given length and active contact set.
+    fn attempt(
+        &self,
+        constraints: (f64, &[(usize, usize)], Vec<f64>, &[Tangential]),
+        system: &mut System,
+        solver: &mut Solver,
+        counters: &mut Counters,
+    ) -> Result<super::newton::Solution, StepFailure> {
+        let (h, active, forces, tangential) = constraints;
+        let (model, state, target) = (self.model, self.state, self.target);
+        let end = if state.time + h >= target {
+            target
+        } else {
+            state.time + h
+        };
+        let mut d = vec![0.0; model.dofs()];
+        for (dof, value) in loads::prescribed(model, self.initial, end) {
+            d[dof] = value - state.displacement[dof];
+        }
+        let external = loads::external_force(model, state, self.initial, end);
+        let step = Step {
+            model,
+            geometry: self.spec.geometry,
+            newton: &self.spec.newton,
+            inertia: None,
+            form: self.form,
+            external: &external,
+            internal_start: self.last_force,
+            factor_first: self.factor_first,
+            contact: Some(Constraints {
+                pairs: &model.contacts,
+                active,
+                start: self.positions,
+                forces,
+                tangential,
+            }),
+        };
+        step.solve(state, d, system, solver, counters)
+    }
+}
+
+impl Stepper for Statics<'_> {
+    fn integrator(&self) -> String {
+        "static".into()
+    }
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+    fn end_time(&self) -> f64 {
+        self.spec.end_time
+    }
+    fn free_dofs(&self) -> usize {
+        self.system.free
+    }
+    fn checks_buckling(&self) -> bool {
+        true
+    }
+    fn start(&mut self) -> Result<(), String> {
+        Ok(())
+    }
+    fn kind(&self) -> &'static str {
+        "static"
+    }
+
+    fn restore(&mut self, carry: Carry, _: &Checkpoint) -> bool {
+        let Carry::Static(carry) = carry else {
+            return false;
+        };
+        self.state = carry.state;
+        self.energies = carry.energies;
+        self.last_force = carry.last_force;
+        self.control = carry.control;
+        self.increments = carry.increments;
+        self.contact = carry.contact;
+        true
+    }
+
+    fn carry(&self) -> Result<Carry, &'static str> {
+        Ok(Carry::Static(StaticCarry {
+            state: self.state.clone(),
+            energies: self.energies,
+            last_force: self.last_force.clone(),
+            control: self.control.clone(),
+            increments: self.increments,
+            contact: self.contact.clone(),
+        }))
+    }
+
+    fn after_checkpoint(&mut self) {
+        self.refresh = true;
+    }
+
+    fn done(&self) -> bool {
+        self.state.time >= self.spec.end_time * (1.0 - 1e-12)
+    }
+
+    fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError> {
+        loop {
+            let spec = self.spec;
+            let target = super::snap(
+                (self.state.time + self.control.length).min(spec.end_time),
+                self.dt,
+            );
+            let positions = self.state.positions(spec.geometry).into_owned();
+            let refresh_now = std::mem::take(&mut self.refresh);
+            let factor_first = refresh_now
+                || match spec.newton.strategy {
+                    Strategy::Full => true,
+                    Strategy::Modified => {
+                        self.increments.is_multiple_of(spec.newton.refactor_every)
+                            || self.control.after_cut()
+                    }
+                    Strategy::Initial => !self.solver.is_factored() || self.control.after_cut(),
+                };
+            let increment = Increment {
+                model: self.model,
+                spec,
+                form: &self.form,
+                initial: &self.initial,
+                state: &self.state,
+                last_force: &self.last_force,
+                positions: &positions,
+                target,
+                factor_first,
+            };
+            let (system, solver) = (&mut self.system, &mut self.solver);
+            let outcome = self.contact.step(
+                &self.model.contacts,
+                &positions,
+                target - self.state.time,
+                |h, active, forces, tangential| {
+                    increment.attempt((h, active, forces, tangential), system, solver, counters)
+                },
+            );
+            match outcome {
+                Ok(mut step) => {
+                    let end = if self.state.time + step.length >= target {
+                        target
+                    } else {
+                        self.state.time + step.length
+                    };
+                    let d = std::mem::take(&mut step.solution.d);
+                    let evaluation = std::mem::take(&mut step.solution.evaluation);
+                    let force = evaluation.force.clone();
+                    assembly::commit(self.model, &mut self.state, &d, evaluation, spec.geometry);
+                    self.state.time = end;
+                    let positions = self.state.positions(spec.geometry);
+                    self.contact
+                        .commit(&self.interfaces, &step, self.state.time, &positions);
+                    // the work of all nodal forces (loads, reactions and contact forces)
+                    let energies = &mut self.energies;
+                    energies.external_work += super::trapezoid_work(&d, &force, &self.last_force);
+                    energies.internal = self.state.internal_work - self.state.plastic_work;
+                    energies.plastic_work = self.state.plastic_work;
+                    self.last_force = force;
+                    self.increments += 1;
+                    self.control.accept(end == target);
+                    return Ok(());
+                }
+                Err(StepFailure(reason)) => {
+                    if let Err(why) = self.control.reject(target - self.state.time, counters) {
+                        let message = format!("increment to t = {target} {why}: {reason}");
+                        return Err(StepError::diverged(message));
+                    }
+                }
+            }
+        }
+    }
+
+    fn state(&self) -> &State {
+        &self.state
+    }
+    fn motion(&self) -> Motion<'_> {
+        Motion {
+            velocity: &self.zeros,
+            acceleration: &self.zeros,
+            mass: &[],
+        }
+    }
+    fn energies(&self) -> &Energies {
+        &self.energies
+    }
+    fn initial_kinetic(&self) -> f64 {
+        0.0
+    }
+    fn contact(&self) -> &ContactState {
+        &self.contact
+    }
+    fn contact_forces(&self) -> Vec<f64> {
+        let positions = self.state.positions(self.spec.geometry);
+        self.contact.nodal_forces(&self.model.contacts, &positions)
+    }
+    fn solver(&self) -> Option<&Solver> {
+        Some(&self.solver)
+    }
+    fn solver_mut(&mut self) -> Option<&mut Solver> {
+        Some(&mut self.solver)
+    }
+    fn progress(&self) -> (u64, u64) {
+        (
+            (self.state.time / self.dt).round() as u64,
+            self.spec.steps as u64,
+        )
+    }
 }

@@ -1,0 +1,495 @@
+//! The run scaffold: one type owns a run's bookkeeping (recorder, summary, counters,
+//! progress, the buckling monitor, checkpoints, resume, interruption and failure) around a
+//! [`Stepper`] that only advances the state. Every analysis (static load stepping, implicit
+//! and explicit time stepping) is a stepper; the summary and the [`Outcome`] are filled
+//! here, in one place, whatever the stepper.
+//!
+//! The life of a run
+//! ```text
+//! set up the stepper (bad input: exit 2, nothing written)
+//! create the output (or resume it from a checkpoint, with the stepper's carry)
+//! start the stepper at t = 0 and record that state        (not when resuming)
+//! while the stepper is not done:
+//!     advance one converged step (the stepper cuts and retries inside)
+//!     count it, update the energy drift, judge it (explicit: blow-up)
+//!     observe buckling, record a history row (and a frame when due)
+//!     stop on a runaway penetration, a critical state asked to stop, or a signal
+//!     write a checkpoint when due
+//! finish: summary.json, the outcome
+//! ```
+
+use super::buckling::{self, Monitor};
+use super::checkpoint::{self, Carry, Checkpoint};
+use super::newton::Counters;
+use super::record::{Energies, Motion, Recorder};
+use super::{Outcome, RunError, RunOptions, Status, Summary};
+use crate::assembly::State;
+use crate::contact::ContactState;
+use crate::profile::{self, Phase};
+use crate::scene::{InputError, Model};
+use crate::solver::Solver;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::Path;
+use std::time::Instant;
+
+/// A step that could not be taken: the run ends with this status and message.
+#[derive(Debug, Clone)]
+pub struct StepError {
+    pub status: Status,
+    pub message: String,
+    /// Write a frame of the state reached (the explicit blow-up shows what blew up).
+    pub frame: bool,
+}
+
+impl StepError {
+    pub fn diverged(message: String) -> StepError {
+        StepError {
+            status: Status::Diverged,
+            message,
+            frame: false,
+        }
+    }
+}
+
+/// One kind of analysis: it advances the state and says what it holds; the scaffold
+/// records, checkpoints and ends the run.
+pub trait Stepper {
+    /// The integrator's name in summary.json.
+    fn integrator(&self) -> String;
+    /// The nominal step and the end time.
+    fn dt(&self) -> f64;
+    fn end_time(&self) -> f64;
+    fn free_dofs(&self) -> usize;
+    /// Whether the run carries the buckling check of `[analysis.buckling]`.
+    fn checks_buckling(&self) -> bool;
+    /// What the stepper computes at t = 0 before the first row (a numerical failure here
+    /// ends the run `diverged` with the message).
+    fn start(&mut self) -> Result<(), String>;
+    /// Takes over the carry of a checkpoint; false when it is another analysis' carry.
+    fn restore(&mut self, carry: Carry, checkpoint: &Checkpoint) -> bool;
+    /// What a checkpoint stores of the stepper; None when it writes none, with the reason.
+    fn carry(&self) -> Result<Carry, &'static str>;
+    /// The analysis' name in the message of a wrong carry.
+    fn kind(&self) -> &'static str;
+    /// Called after a checkpoint is written (the step after it factors afresh, as the
+    /// resumed run must).
+    fn after_checkpoint(&mut self) {}
+    fn done(&self) -> bool;
+    /// One converged step, cutting and retrying inside as the analysis allows.
+    fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError>;
+    /// A judgement of the step just counted (explicit: the energy has not blown up).
+    fn verdict(&self) -> Result<(), StepError> {
+        Ok(())
+    }
+    fn state(&self) -> &State;
+    fn motion(&self) -> Motion<'_>;
+    fn energies(&self) -> &Energies;
+    /// The kinetic energy at t = 0: summary.json `energy.initial` and the drift's reference.
+    fn initial_kinetic(&self) -> f64;
+    fn contact(&self) -> &ContactState;
+    /// The nodal contact forces of the committed state (all DOFs).
+    fn contact_forces(&self) -> Vec<f64>;
+    fn solver(&self) -> Option<&Solver>;
+    fn solver_mut(&mut self) -> Option<&mut Solver>;
+    /// Makes the state's material points current before output reads them (the one-point
+    /// kernel keeps its own arrays).
+    fn sync_points(&mut self) {}
+    /// The accumulated hourglass work, for the history column of the one-point kernel.
+    fn hourglass_energy(&self) -> Option<f64> {
+        None
+    }
+    /// The progress bar's position and length, in nominal steps.
+    fn progress(&self) -> (u64, u64);
+}
+
+/// A run in progress: the stepper and its bookkeeping.
+struct Run<'a, S: Stepper> {
+    model: &'a Model,
+    options: RunOptions,
+    stepper: S,
+    recorder: Recorder,
+    summary: Summary,
+    counters: Counters,
+    monitor: Option<Monitor>,
+    start: Instant,
+    progress: ProgressBar,
+    penetration_limits: Vec<f64>,
+}
+
+/// Runs `stepper` from the start or from `resume`, writing into `dir`.
+pub fn execute<S: Stepper>(
+    model: &Model,
+    dir: &Path,
+    options: RunOptions,
+    resume: Option<Checkpoint>,
+    stepper: S,
+) -> Result<Outcome, RunError> {
+    let setup_start = Instant::now();
+    let mut run = Run::open(model, dir, options, resume, stepper)?;
+    profile::add(Phase::Setup, setup_start);
+    while !run.stepper.done() {
+        if let Some(end) = run.step()? {
+            return end;
+        }
+    }
+    run.finish()
+}
+
+impl<'a, S: Stepper> Run<'a, S> {
+    /// The output created or resumed, the stepper started or restored, the first row and
+    /// checkpoint written.
+    fn open(
+        model: &'a Model,
+        dir: &Path,
+        options: RunOptions,
+        resume: Option<Checkpoint>,
+        mut stepper: S,
+    ) -> Result<Run<'a, S>, RunError> {
+        let recorder = match &resume {
+            Some(c) => Recorder::resume(model, dir, c.recorder.clone())?,
+            None => Recorder::create(model, dir)?,
+        };
+        let summary = Summary::new(
+            model,
+            &stepper.integrator(),
+            stepper.dt(),
+            stepper.end_time(),
+            stepper.free_dofs(),
+        );
+        let coordinates = model.coordinates();
+        let penetration_limits = crate::contact::penetration_limits(&model.contacts, &coordinates);
+        let resuming = resume.is_some();
+        if !resuming && let Err(message) = stepper.start() {
+            let mut run_summary = summary;
+            run_summary.status = Status::Diverged;
+            run_summary.message = Some(message.clone());
+            recorder.write_summary(&run_summary)?;
+            return Err(RunError::Numerical {
+                message,
+                summary: Box::new(run_summary),
+            });
+        }
+        let monitor = if stepper.checks_buckling() {
+            Monitor::new(model, dir).map_err(|e| monitor_error(model, e))?
+        } else {
+            None
+        };
+        let (position, length) = stepper.progress();
+        let mut run = Run {
+            model,
+            options,
+            stepper,
+            recorder,
+            summary,
+            counters: Counters::default(),
+            monitor,
+            start: Instant::now(),
+            progress: progress_bar(options.progress, length),
+            penetration_limits,
+        };
+        run.summary.energy.initial = run.stepper.initial_kinetic();
+        match resume {
+            Some(checkpoint) => run.restore(checkpoint, dir)?,
+            None => {
+                if let Some(m) = &mut run.monitor {
+                    run.recorder.negative_pivots = m
+                        .observe(model, run.stepper.state())
+                        .map_err(|e| monitor_error(model, e.into()))?
+                        .0;
+                }
+                run.record(true)?;
+            }
+        }
+        run.progress.set_position(position);
+        if run.summary.steps == 0 && model.checkpoint_every > 0 && run.stepper.carry().is_ok() {
+            run.save()?;
+        }
+        Ok(run)
+    }
+
+    /// Takes a checkpoint's bookkeeping and the stepper's carry.
+    fn restore(&mut self, checkpoint: Checkpoint, dir: &Path) -> Result<(), RunError> {
+        if !self.stepper.restore(checkpoint.carry.clone(), &checkpoint) {
+            return Err(RunError::Input(InputError::new(
+                &checkpoint::path(dir),
+                format!(
+                    "the checkpoint does not hold the state of the scene's {} analysis",
+                    self.stepper.kind()
+                ),
+            )));
+        }
+        self.summary = checkpoint.summary;
+        self.counters = checkpoint.counters;
+        if let Some(solver) = self.stepper.solver_mut() {
+            solver.factorizations = checkpoint.factorizations;
+            solver.solves = checkpoint.back_substitutions;
+        }
+        self.start = resumed_start(checkpoint.wall_seconds);
+        if let (Some(m), Some(b)) = (&mut self.monitor, checkpoint.buckling) {
+            m.summary = b;
+        }
+        Ok(())
+    }
+
+    /// One step and its bookkeeping; Some(result) when the run ends here.
+    fn step(&mut self) -> Result<Option<Result<Outcome, RunError>>, RunError> {
+        if let Err(e) = self.stepper.advance(&mut self.counters) {
+            return Err(self.fail_step(e));
+        }
+        self.summary.steps += 1;
+        let drift = super::balance_error(self.stepper.energies(), self.stepper.initial_kinetic());
+        self.summary.energy.max_relative_drift = self.summary.energy.max_relative_drift.max(drift);
+        if let Err(e) = self.stepper.verdict() {
+            return Err(self.fail_step(e));
+        }
+        let stop = self.observe_buckling()?;
+        let last = stop || self.stepper.done();
+        self.record(last)?;
+        let time = self.stepper.state().time;
+        let runaway = profile::time(Phase::Contact, || {
+            let positions = self
+                .stepper
+                .state()
+                .positions(self.model.analysis.geometry());
+            crate::contact::runaway_penetration(
+                &self.model.contacts,
+                &positions,
+                &self.penetration_limits,
+            )
+        });
+        if let Some(message) = runaway {
+            let message = format!("at t = {time}: {message}");
+            return Err(self.fail(Status::Diverged, message));
+        }
+        self.progress.set_position(self.stepper.progress().0);
+        if stop {
+            self.summary.message = Some(stop_message(time, &self.recorder));
+            return Ok(Some(self.finish_early()));
+        }
+        let interrupted = !last && self.options.interrupted();
+        if interrupted {
+            self.stepper.sync_points();
+            let s = &self.stepper;
+            self.recorder
+                .frame(self.model, s.state(), &s.motion(), Some(s.contact()))?;
+        }
+        let due = !last
+            && self.model.checkpoint_every > 0
+            && self
+                .summary
+                .steps
+                .is_multiple_of(self.model.checkpoint_every);
+        if (interrupted || due) && self.stepper.carry().is_ok() {
+            self.save()?;
+        }
+        self.options.halt(&self.summary)?;
+        if interrupted {
+            return Err(self.interrupted(time));
+        }
+        Ok(None)
+    }
+
+    /// The buckling check of the committed state: whether the run must stop here.
+    fn observe_buckling(&mut self) -> Result<bool, RunError> {
+        let Some(m) = &mut self.monitor else {
+            return Ok(false);
+        };
+        match m.observe(self.model, self.stepper.state()) {
+            Ok((count, halt)) => {
+                self.recorder.negative_pivots = count;
+                Ok(halt)
+            }
+            Err(e) => {
+                let message = format!("buckling check at t = {}: {e}", self.stepper.state().time);
+                Err(self.fail(Status::Diverged, message))
+            }
+        }
+    }
+
+    /// A history row of the committed state (and a frame when due, or when `last`).
+    fn record(&mut self, last: bool) -> Result<(), RunError> {
+        let time = self.stepper.state().time;
+        if self.recorder.reads_stresses(self.model, time, last) {
+            self.stepper.sync_points();
+        }
+        if let Some(energy) = self.stepper.hourglass_energy() {
+            self.recorder.hourglass_energy = energy;
+        }
+        let s = &self.stepper;
+        let contact = (self.summary.steps > 0).then(|| s.contact());
+        self.recorder.step_with_contact(
+            self.model,
+            s.state(),
+            &s.motion(),
+            s.energies(),
+            contact,
+            last,
+        )?;
+        Ok(())
+    }
+
+    /// Writes a checkpoint of the run as it stands.
+    fn save(&mut self) -> Result<(), RunError> {
+        let carry = self.stepper.carry().expect("checked by the caller");
+        let _timer = profile::Timer::new(Phase::Output);
+        let solver = self.stepper.solver();
+        let checkpoint = Checkpoint {
+            // absolute when the file exists, so `impact resume` works from any folder (mesh
+            // files are found next to the scene)
+            scene_path: std::fs::canonicalize(&self.model.file)
+                .unwrap_or_else(|_| self.model.file.clone())
+                .display()
+                .to_string(),
+            source: self.model.source.clone(),
+            summary: self.summary.clone(),
+            counters: self.counters,
+            factorizations: solver.map_or(0, |s| s.factorizations),
+            back_substitutions: solver.map_or(0, |s| s.solves),
+            wall_seconds: self.start.elapsed().as_secs_f64(),
+            recorder: self.recorder.position()?,
+            buckling: self.monitor.as_ref().map(|m| m.summary.clone()),
+            carry,
+        };
+        checkpoint::write(self.recorder.dir(), &checkpoint)?;
+        self.stepper.after_checkpoint();
+        Ok(())
+    }
+
+    /// Fills the summary's counters, energies, contact and buckling blocks: the one place.
+    fn fill_summary(&mut self) {
+        let s = &self.stepper;
+        let energies = s.energies();
+        let solver = s.solver();
+        let summary = &mut self.summary;
+        summary.newton_iterations = self.counters.iterations;
+        summary.step_cuts = self.counters.cuts;
+        summary.factorizations = solver.map_or(0, |s| s.factorizations);
+        summary.back_substitutions = solver.map_or(0, |s| s.solves);
+        summary.wall_seconds = self.start.elapsed().as_secs_f64();
+        summary.timing = profile::snapshot();
+        summary.energy.final_ = energies.kinetic + energies.internal;
+        summary.energy.plastic_dissipation = energies.plastic_work;
+        summary.contact = s.contact().summary();
+        summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
+    }
+
+    /// A failed step: its frame when asked, then `fail`.
+    fn fail_step(&mut self, e: StepError) -> RunError {
+        if e.frame {
+            self.stepper.sync_points();
+            let s = &self.stepper;
+            self.recorder
+                .frame(self.model, s.state(), &s.motion(), Some(s.contact()))
+                .ok();
+        }
+        self.fail(e.status, e.message)
+    }
+
+    /// A failed run: the summary is written with its status and message, then returned in
+    /// the error.
+    fn fail(&mut self, status: Status, message: String) -> RunError {
+        self.progress.abandon();
+        self.fill_summary();
+        let mut summary = self.summary.clone();
+        summary.status = status;
+        summary.message = Some(message.clone());
+        match self.recorder.write_summary(&summary) {
+            Ok(()) => RunError::Numerical {
+                message,
+                summary: Box::new(summary),
+            },
+            Err(e) => RunError::Output(e),
+        }
+    }
+
+    /// A run stopped by a signal after a whole step: summary.json with status `interrupted`.
+    fn interrupted(&mut self, time: f64) -> RunError {
+        self.progress.abandon();
+        self.fill_summary();
+        let what_next = match self.stepper.carry() {
+            Ok(_) => format!(
+                "`impact resume {}` continues",
+                self.recorder.dir().display()
+            ),
+            Err(reason) => reason.to_string(),
+        };
+        let message = format!(
+            "interrupted by a signal at t = {time} after {} steps; {what_next}",
+            self.summary.steps
+        );
+        let mut summary = self.summary.clone();
+        summary.status = Status::Interrupted;
+        summary.message = Some(message.clone());
+        match self.recorder.write_summary(&summary) {
+            Ok(()) => RunError::Interrupted {
+                message,
+                summary: Box::new(summary),
+            },
+            Err(e) => RunError::Output(e),
+        }
+    }
+
+    /// A run stopped before its end time on purpose (the buckling check's `stop`).
+    fn finish_early(&mut self) -> Result<Outcome, RunError> {
+        self.progress.finish_and_clear();
+        self.end()
+    }
+
+    fn finish(mut self) -> Result<Outcome, RunError> {
+        self.progress.finish_and_clear();
+        self.end()
+    }
+
+    /// The summary written and the outcome of a run that reached its end.
+    fn end(&mut self) -> Result<Outcome, RunError> {
+        self.stepper.sync_points();
+        self.fill_summary();
+        self.recorder.write_summary(&self.summary)?;
+        let contact_force = self.stepper.contact_forces();
+        Ok(Outcome {
+            summary: self.summary.clone(),
+            state: self.stepper.state().clone(),
+            contact_force,
+        })
+    }
+}
+
+/// The buckling check could not be set up: its modes (bad input: nothing to buckle, missing
+/// supports) or its frames.
+fn monitor_error(model: &Model, e: buckling::MonitorError) -> RunError {
+    match e {
+        buckling::MonitorError::Stability(e) => RunError::Input(InputError::new(
+            &model.file,
+            format!("analysis.buckling: {e}"),
+        )),
+        buckling::MonitorError::Output(e) => RunError::Output(e),
+    }
+}
+
+fn progress_bar(show: bool, steps: u64) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(steps);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// The start instant of a resumed run: as if it had been running for `wall_seconds`.
+fn resumed_start(wall_seconds: f64) -> Instant {
+    let now = Instant::now();
+    now.checked_sub(std::time::Duration::from_secs_f64(wall_seconds.max(0.0)))
+        .unwrap_or(now)
+}
+
+/// summary.json `message` of a run stopped by `on_critical = "stop"`.
+fn stop_message(time: f64, recorder: &Recorder) -> String {
+    format!(
+        "stopped by analysis.buckling.on_critical at t = {time}: K_T has {} negative pivot(s)",
+        recorder.negative_pivots.unwrap_or(0)
+    )
+}
