@@ -4,9 +4,18 @@
 //! Every field's default is written next to it and collected in docs/user-guide.md.
 //! Validation never clamps: a value out of range is an [`InputError`] naming the file and key.
 
+mod analysis;
+mod bodies;
+mod contacts;
+mod context;
+mod loads;
+mod materials;
 pub mod model;
 pub mod overrides;
+mod probes;
+mod reference;
 pub mod spec;
+pub mod validate;
 
 pub use model::{Body, BodyKind, Curve, Load, Model, SceneSource};
 pub use spec::Scene;
@@ -56,7 +65,7 @@ pub fn from_str(text: &str, path: &Path, overrides: &[String]) -> Result<Model, 
         })?
     };
     let base_dir: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mut model = model::build(scene, path, &base_dir)?;
+    let mut model = validate::build(scene, path, &base_dir)?;
     model.source = SceneSource {
         text: text.to_string(),
         overrides: overrides.to_vec(),

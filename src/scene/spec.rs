@@ -1,5 +1,6 @@
 //! The scene file's schema. Each struct denies unknown fields; each enum variant wraps its own
-//! struct so unknown keys are caught inside internally tagged enums too (serde #2123, #2294).
+//! struct so unknown keys are caught inside internally tagged enums too (`deny_unknown_fields`
+//! on such an enum itself does not reach its variants' keys).
 
 use crate::element::Strain;
 use crate::mesh::MeshSpec;
@@ -239,25 +240,29 @@ pub struct ContactSpec {
     pub master: Option<SurfaceSpec>,
     /// The name of an `[[obstacle]]`.
     pub obstacle: Option<String>,
-    /// Hughes' impact conditions II-8 when a pair closes. Default true.
+    /// The impact conditions II-8 of Hughes, Taylor & Sackman (1975) when a pair closes.
+    /// Default true.
     #[serde(default = "yes")]
     pub impact_conditions: bool,
-    /// Hughes' release conditions II-11, II-12 when a pair opens. Default true.
+    /// The release conditions II-11, II-12 of Hughes, Taylor & Sackman (1975) when a pair
+    /// opens. Default true.
     #[serde(default = "yes")]
     pub release_conditions: bool,
     /// Release when the force falls below this fraction of the last step's. Default 0.02.
     #[serde(default = "default_release_fraction")]
     pub release_fraction: f64,
-    /// TOL of Hughes II-7 (length). Default 1e-9 of the model's size.
+    /// TOL of Hughes, Taylor & Sackman (1975) II-7 (length). Default 1e-9 of the model's size.
     pub tolerance: Option<f64>,
     /// Slaves farther than this from the master are skipped (length). Default: no limit.
     pub search_distance: Option<f64>,
-    /// Split a step at the first contact event inside it (Erklig 2.1.4). Default true.
+    /// Split a step at the first contact event inside it (Erklig, Guzelbey & Cevik 2010,
+    /// section 2.1.4). Default true.
     #[serde(default = "yes")]
     pub split_at_events: bool,
     /// Coulomb friction coefficient mu (stick/slip). Default: frictionless.
     pub friction: Option<f64>,
-    /// Greco's return coefficient R in [0, 1] (eq 36), instead of `friction`.
+    /// The return coefficient R in [0, 1] of Greco & Coda (2003) (eq 36), instead of
+    /// `friction`.
     pub return_coefficient: Option<f64>,
 }
 
@@ -318,7 +323,7 @@ pub enum IntegratorKind {
     Average,
     /// Newmark linear acceleration (beta 1/6, gamma 1/2): conditionally stable.
     Linear,
-    /// Hu's modified Newmark (beta 1.0, gamma 1.5), the Greco seed's choice.
+    /// Hu's modified Newmark (beta 1.0, gamma 1.5), the choice of Greco & Coda (2003).
     Hu,
     /// Newmark with the scene's `beta` and `gamma`.
     Newmark,
@@ -381,7 +386,7 @@ pub struct AnalysisSpec {
     /// as status `unstable`. Default false (refused).
     #[serde(default)]
     pub allow_unstable: bool,
-    /// The buckling check (Erklig 2.1.3). Default: none.
+    /// The buckling check (Erklig, Guzelbey & Cevik 2010, section 2.1.3). Default: none.
     pub buckling: Option<BucklingSpec>,
     /// Write DIR/checkpoint.bin (the whole run state) at the start and every N converged
     /// steps, so `impact resume DIR` can continue the run. Default 0: no checkpoints.
@@ -492,7 +497,8 @@ pub struct StaticSpec {
 #[serde(rename_all = "snake_case")]
 pub enum Strategy {
     /// Factor at the start of each increment; refactor only when the residual stops
-    /// contracting (the seed's modified Newton-Raphson).
+    /// contracting (the modified Newton-Raphson of Erklig, Guzelbey & Cevik 2010, section
+    /// 2.1.2).
     #[default]
     Modified,
     /// Factor the current tangent at every iteration.
@@ -509,7 +515,8 @@ pub enum Tangent {
     /// The algorithmic (consistent) material tangent plus K_sigma: the exact derivative.
     #[default]
     Consistent,
-    /// D_e only (Erklig 2.1.2 (c)(ii): "D_r is taken as the elastic stress-strain matrix").
+    /// D_e only (Erklig, Guzelbey & Cevik 2010, section 2.1.2 (c)(ii): "D_r is taken as the
+    /// elastic stress-strain matrix").
     Elastic,
     /// D_e plus the geometric stiffness K_sigma.
     ElasticGeometric,
@@ -527,10 +534,12 @@ pub struct NewtonSpec {
     /// Iterations per increment before it is cut. Default 30.
     #[serde(default = "default_iterations")]
     pub max_iterations: usize,
-    /// Tolerance on ||d delta|| / ||delta|| (Erklig 2.1.2 (viii)). Default 1e-8.
+    /// Tolerance on ||d delta|| / ||delta|| (Erklig, Guzelbey & Cevik 2010, section 2.1.2
+    /// (viii)). Default 1e-8.
     #[serde(default = "default_tolerance")]
     pub tol_displacement: f64,
-    /// Tolerance on ||R|| / ||F|| (Erklig 2.1.2 (viii)). Default 1e-8.
+    /// Tolerance on ||R|| / ||F|| (Erklig, Guzelbey & Cevik 2010, section 2.1.2 (viii)).
+    /// Default 1e-8.
     #[serde(default = "default_tolerance")]
     pub tol_force: f64,
     /// Modified Newton refactors when ||R_k|| > contraction ||R_k-1||. Default 0.8.

@@ -1,11 +1,12 @@
-//! The buckling check (Erklig 2.1.3; docs/theory.md section 8.4): the inertia of the tangent
-//! without mass, and the linearized eigen-buckling problem at a converged state.
+//! The buckling check (Erklig, Guzelbey & Cevik 2010, section 2.1.3; docs/theory.md section
+//! 8.4): the inertia of the tangent without mass, and the linearized eigen-buckling problem at
+//! a converged state.
 //!
 //! Legend
 //! ```text
 //! K_T        tangent stiffness at the committed state (d = 0): K_0 + K_sigma, free DOFs
-//! K_0        material part, sum w B^T D B                                  (Erklig eq 33)
-//! K_sigma    geometric part from the current stresses, sum w G^T S G        (Erklig eq 34)
+//! K_0        material part, sum w B^T D B                      (Erklig et al. 2010, eq 33)
+//! K_sigma    geometric part from the current stresses, sum w G^T S G               (eq 34)
 //! inertia    number of negative pivots of K_T = L D L^T (= negative eigenvalues, Sylvester)
 //! lambda     load factor of (K_0 + lambda K_sigma) phi = 0: the current stresses times
 //!            lambda make the tangent singular; lambda_cr = the smallest positive one
@@ -203,105 +204,14 @@ pub fn eigen_buckling(
         SolverError::NotPositiveDefinite { .. } => StabilityError::MaterialStiffness,
         other => StabilityError::Solver(other),
     })?;
-    // y = K_0^-1 (-K_sigma x)
-    let mut product = vec![0.0; n];
-    let mut apply = |x: &[f64], solver: &mut Solver| {
-        pattern.symmetric_product(&k_sigma, x, &mut product);
-        let mut y: Vec<f64> = product.iter().map(|v| -v).collect();
-        solver.solve(&mut y);
-        y
+    let mut operator = Operator {
+        pattern,
+        k_0: &k_0,
+        k_sigma: &k_sigma,
+        solver,
+        product: vec![0.0; n],
     };
-    let k0_times = |x: &[f64]| {
-        let mut y = vec![0.0; n];
-        pattern.symmetric_product(&k_0, x, &mut y);
-        y
-    };
-    // a deterministic start vector with every component (a linear congruential sequence)
-    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
-    let mut q: Vec<f64> = (0..n)
-        .map(|_| {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect();
-    // start in the range of A, where the modes live (K_0^-1 of a random vector is smooth)
-    q = apply(&q, &mut solver);
-    let mut kq = k0_times(&q);
-    let norm = dot(&q, &kq).sqrt();
-    q.iter_mut().for_each(|v| *v /= norm);
-    kq.iter_mut().for_each(|v| *v /= norm);
-    let max_steps = n.min(400);
-    let mut basis: Vec<Vec<f64>> = Vec::new();
-    let mut k_basis: Vec<Vec<f64>> = Vec::new();
-    let mut alpha: Vec<f64> = Vec::new();
-    let mut beta: Vec<f64> = Vec::new();
-    let mut converged: Vec<(f64, Vec<f64>)> = Vec::new();
-    for step in 0..max_steps {
-        let mut w = apply(&q, &mut solver);
-        alpha.push(dot(&w, &kq));
-        basis.push(q);
-        k_basis.push(kq);
-        // full K_0-orthogonalization, twice (Lanczos loses orthogonality as Ritz values converge)
-        for _ in 0..2 {
-            for (v, kv) in basis.iter().zip(&k_basis) {
-                let c = dot(&w, kv);
-                w.iter_mut().zip(v).for_each(|(wi, vi)| *wi -= c * vi);
-            }
-        }
-        let kw = k0_times(&w);
-        let b = dot(&w, &kw).max(0.0).sqrt();
-        let m = alpha.len();
-        let check = m >= (2 * count + 10).min(max_steps) && (m % 5 == 0 || b == 0.0)
-            || step + 1 == max_steps;
-        if check {
-            let t = nalgebra::DMatrix::from_fn(m, m, |i, j| {
-                if i == j {
-                    alpha[i]
-                } else if i == j + 1 {
-                    beta[j]
-                } else if j == i + 1 {
-                    beta[i]
-                } else {
-                    0.0
-                }
-            });
-            let eigen = t.symmetric_eigen();
-            // mu below 1e-8 of the spectrum's largest |mu| is round-off of a zero (a mode
-            // the stresses leave alone), not a buckling load
-            let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let mut order: Vec<usize> = (0..m)
-                .filter(|&i| eigen.eigenvalues[i] > 1e-8 * largest)
-                .collect();
-            order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
-            let wanted: Vec<usize> = order.into_iter().take(count).collect();
-            let residual =
-                |i: usize| b * eigen.eigenvectors[(m - 1, i)].abs() / eigen.eigenvalues[i];
-            let done = b == 0.0 || step + 1 == max_steps || m == n;
-            if wanted.len() == count && wanted.iter().all(|&i| residual(i) < 1e-10) || done {
-                converged = wanted
-                    .iter()
-                    .filter(|&&i| residual(i) < 1e-6)
-                    .map(|&i| {
-                        let mut shape = vec![0.0; n];
-                        for (k, v) in basis.iter().enumerate() {
-                            let s = eigen.eigenvectors[(k, i)];
-                            shape.iter_mut().zip(v).for_each(|(x, vk)| *x += s * vk);
-                        }
-                        (eigen.eigenvalues[i], shape)
-                    })
-                    .collect();
-                break;
-            }
-        }
-        if b == 0.0 {
-            break;
-        }
-        beta.push(b);
-        q = w.iter().map(|v| v / b).collect();
-        kq = kw.iter().map(|v| v / b).collect();
-    }
+    let converged = lanczos(&mut operator, count);
     if converged.is_empty() {
         return Err(StabilityError::NoMode);
     }
@@ -317,6 +227,148 @@ pub fn eigen_buckling(
             }
         })
         .collect())
+}
+
+/// A = K_0^-1 (-K_sigma) on the free DOFs, K_0 factored, and K_0 for the inner product.
+struct Operator<'a> {
+    pattern: &'a Pattern,
+    k_0: &'a [f64],
+    k_sigma: &'a [f64],
+    solver: Solver,
+    product: Vec<f64>,
+}
+
+impl Operator<'_> {
+    /// y = K_0^-1 (-K_sigma x)
+    fn apply(&mut self, x: &[f64]) -> Vec<f64> {
+        self.pattern
+            .symmetric_product(self.k_sigma, x, &mut self.product);
+        let mut y: Vec<f64> = self.product.iter().map(|v| -v).collect();
+        self.solver.solve(&mut y);
+        y
+    }
+
+    /// y = K_0 x
+    fn k0_times(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; self.pattern.size];
+        self.pattern.symmetric_product(self.k_0, x, &mut y);
+        y
+    }
+}
+
+/// A deterministic start vector with every component (a linear congruential sequence).
+fn start_vector(n: usize) -> Vec<f64> {
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    (0..n)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect()
+}
+
+/// Lanczos on A in the K_0 inner product, the basis fully K_0-orthogonalized: the converged
+/// Ritz pairs (mu, shape on the free DOFs) of the `count` largest positive mu, checked every
+/// 5 steps once the basis has 2 count + 10 vectors (at most 400 steps).
+fn lanczos(operator: &mut Operator, count: usize) -> Vec<(f64, Vec<f64>)> {
+    let n = operator.pattern.size;
+    // start in the range of A, where the modes live (K_0^-1 of a random vector is smooth)
+    let mut q = operator.apply(&start_vector(n));
+    let mut kq = operator.k0_times(&q);
+    let norm = dot(&q, &kq).sqrt();
+    q.iter_mut().for_each(|v| *v /= norm);
+    kq.iter_mut().for_each(|v| *v /= norm);
+    let max_steps = n.min(400);
+    let mut basis: Vec<Vec<f64>> = Vec::new();
+    let mut k_basis: Vec<Vec<f64>> = Vec::new();
+    let mut alpha: Vec<f64> = Vec::new();
+    let mut beta: Vec<f64> = Vec::new();
+    for step in 0..max_steps {
+        let mut w = operator.apply(&q);
+        alpha.push(dot(&w, &kq));
+        basis.push(q);
+        k_basis.push(kq);
+        // full K_0-orthogonalization, twice (Lanczos loses orthogonality as Ritz values converge)
+        for _ in 0..2 {
+            for (v, kv) in basis.iter().zip(&k_basis) {
+                let c = dot(&w, kv);
+                w.iter_mut().zip(v).for_each(|(wi, vi)| *wi -= c * vi);
+            }
+        }
+        let kw = operator.k0_times(&w);
+        let b = dot(&w, &kw).max(0.0).sqrt();
+        let m = alpha.len();
+        let check = m >= (2 * count + 10).min(max_steps) && (m.is_multiple_of(5) || b == 0.0)
+            || step + 1 == max_steps;
+        if check {
+            let done = b == 0.0 || step + 1 == max_steps || m == n;
+            if let Some(converged) = ritz_pairs(&alpha, &beta, b, &basis, count, done) {
+                return converged;
+            }
+        }
+        if b == 0.0 {
+            break;
+        }
+        beta.push(b);
+        q = w.iter().map(|v| v / b).collect();
+        kq = kw.iter().map(|v| v / b).collect();
+    }
+    Vec::new()
+}
+
+/// The Ritz pairs of the tridiagonal T = tridiag(beta, alpha, beta) whose next off-diagonal
+/// would be `b`: once the `count` largest positive mu have residual estimates b |s_m,i| below
+/// 1e-10 mu (or `done`), those below 1e-6 mu with their shapes; None to go on.
+fn ritz_pairs(
+    alpha: &[f64],
+    beta: &[f64],
+    b: f64,
+    basis: &[Vec<f64>],
+    count: usize,
+    done: bool,
+) -> Option<Vec<(f64, Vec<f64>)>> {
+    let m = alpha.len();
+    let n = basis[0].len();
+    let t = nalgebra::DMatrix::from_fn(m, m, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i == j + 1 {
+            beta[j]
+        } else if j == i + 1 {
+            beta[i]
+        } else {
+            0.0
+        }
+    });
+    let eigen = t.symmetric_eigen();
+    // mu below 1e-8 of the spectrum's largest |mu| is round-off of a zero (a mode
+    // the stresses leave alone), not a buckling load
+    let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut order: Vec<usize> = (0..m)
+        .filter(|&i| eigen.eigenvalues[i] > 1e-8 * largest)
+        .collect();
+    order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
+    let wanted: Vec<usize> = order.into_iter().take(count).collect();
+    let residual = |i: usize| b * eigen.eigenvectors[(m - 1, i)].abs() / eigen.eigenvalues[i];
+    if !(wanted.len() == count && wanted.iter().all(|&i| residual(i) < 1e-10) || done) {
+        return None;
+    }
+    Some(
+        wanted
+            .iter()
+            .filter(|&&i| residual(i) < 1e-6)
+            .map(|&i| {
+                let mut shape = vec![0.0; n];
+                for (k, v) in basis.iter().enumerate() {
+                    let s = eigen.eigenvectors[(k, i)];
+                    shape.iter_mut().zip(v).for_each(|(x, vk)| *x += s * vk);
+                }
+                (eigen.eigenvalues[i], shape)
+            })
+            .collect(),
+    )
 }
 
 /// Scales a nodal vector so that its largest nodal displacement is 1, with the sign that

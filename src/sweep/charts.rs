@@ -84,6 +84,9 @@ fn grouped<'a>(plan: &Plan, rows: &'a [Row]) -> Vec<(String, Vec<&'a Row>)> {
     groups
 }
 
+/// The series of the charts: each label with its rows.
+type Groups<'a> = [(String, Vec<&'a Row>)];
+
 /// Writes the charts that the rows support; returns their paths.
 pub fn write_all(
     plan: &Plan,
@@ -93,19 +96,35 @@ pub fn write_all(
 ) -> Result<Vec<PathBuf>, RunError> {
     let mut written = Vec::new();
     let groups = grouped(plan, rows);
-    let ok = |r: &&&Row| r.status == "ok";
     let primary_name = if rows.iter().any(|r| r.measures.force_l2.is_some()) {
         "contact force L2 error (relative)"
     } else {
         "|peak force error| (relative)"
     };
-    // speed against accuracy
+    written.extend(error_vs_wall(&groups, title, primary_name, out)?);
+    written.extend(convergence(rows, &groups, title, primary_name, out)?);
+    written.extend(stability_map(rows, &groups, title, out)?);
+    Ok(written)
+}
+
+/// Whether a case finished with status `ok` (the charts of errors plot only those).
+fn finished(r: &&&Row) -> bool {
+    r.status == "ok"
+}
+
+/// Speed against accuracy: error_vs_wall, the primary error against wall time.
+fn error_vs_wall(
+    groups: &Groups,
+    title: &str,
+    primary_name: &str,
+    out: &Path,
+) -> Result<Vec<PathBuf>, RunError> {
     let series: Vec<Series> = groups
         .iter()
         .filter_map(|(label, members)| {
             let mut points: Vec<(f64, f64)> = members
                 .iter()
-                .filter(ok)
+                .filter(finished)
                 .filter_map(|r| Some((r.wall_seconds?, r.primary_error()?)))
                 .filter(|(x, y)| *x > 0.0 && *y > 0.0)
                 .collect();
@@ -117,18 +136,29 @@ pub fn write_all(
             })
         })
         .collect();
-    if !series.is_empty() {
-        let chart = Chart {
-            title: format!("{title}: error against wall time"),
-            x_label: "wall time [s]".into(),
-            y_label: primary_name.into(),
-            series,
-            log_x: true,
-            log_y: true,
-        };
-        written.extend(both(&chart, out, "error_vs_wall")?);
+    if series.is_empty() {
+        return Ok(Vec::new());
     }
-    // convergence against dt and h
+    let chart = Chart {
+        title: format!("{title}: error against wall time"),
+        x_label: "wall time [s]".into(),
+        y_label: primary_name.into(),
+        series,
+        log_x: true,
+        log_y: true,
+    };
+    both(&chart, out, "error_vs_wall")
+}
+
+/// Convergence: error_vs_dt and error_vs_h, each series with its fitted slope.
+fn convergence(
+    rows: &[Row],
+    groups: &Groups,
+    title: &str,
+    primary_name: &str,
+    out: &Path,
+) -> Result<Vec<PathBuf>, RunError> {
+    let mut written = Vec::new();
     type Measure = fn(&Row) -> Option<f64>;
     let mut measures: Vec<(&str, Measure)> = vec![("", |r: &Row| r.primary_error())];
     if rows.iter().any(|r| r.measures.force_l2_smooth.is_some()) {
@@ -141,11 +171,11 @@ pub fn write_all(
     ];
     for (name, x_label, x_of) in axes {
         let mut series = Vec::new();
-        for (label, members) in &groups {
+        for (label, members) in groups {
             for (suffix, measure) in &measures {
                 let mut points: Vec<(f64, f64)> = members
                     .iter()
-                    .filter(ok)
+                    .filter(finished)
                     .filter_map(|r| Some((x_of(r)?, measure(r)?)))
                     .filter(|(x, y)| *x > 0.0 && *y > 0.0)
                     .collect();
@@ -179,7 +209,17 @@ pub fn write_all(
             written.extend(both(&chart, out, &format!("error_vs_{name}"))?);
         }
     }
-    // stability map
+    Ok(written)
+}
+
+/// stability_map: one column per dt / dt_crit, one row per series.
+fn stability_map(
+    rows: &[Row],
+    groups: &Groups,
+    title: &str,
+    out: &Path,
+) -> Result<Vec<PathBuf>, RunError> {
+    let mut written = Vec::new();
     let mut columns: BTreeMap<i64, String> = BTreeMap::new();
     let key = |ratio: f64| (ratio * 1e3).round() as i64;
     for row in rows {
@@ -192,37 +232,38 @@ pub fn write_all(
             });
         }
     }
-    if !columns.is_empty() && rows.iter().any(|r| r.status != "missing") {
-        let column_keys: Vec<i64> = columns.keys().copied().collect();
-        let mut cells = Vec::new();
-        for (_, members) in &groups {
-            let mut line = vec![None; column_keys.len()];
-            for row in members {
-                let Some(ratio) = row.dt_over_dt_crit() else {
-                    continue;
-                };
-                let j = column_keys
-                    .binary_search(&key(ratio))
-                    .expect("listed above");
-                line[j] = Some(cell(row));
-            }
-            cells.push(line);
+    if columns.is_empty() || rows.iter().all(|r| r.status == "missing") {
+        return Ok(written);
+    }
+    let column_keys: Vec<i64> = columns.keys().copied().collect();
+    let mut cells = Vec::new();
+    for (_, members) in groups {
+        let mut line = vec![None; column_keys.len()];
+        for row in members {
+            let Some(ratio) = row.dt_over_dt_crit() else {
+                continue;
+            };
+            let j = column_keys
+                .binary_search(&key(ratio))
+                .expect("listed above");
+            line[j] = Some(cell(row));
         }
-        let map = Map {
-            title: format!(
-                "{title}: stability (energy drift limit {:.0} %)",
-                100.0 * DRIFT_LIMIT
-            ),
-            x_label: "dt / dt_crit (central difference, lumped mass)".into(),
-            columns: columns.into_values().collect(),
-            rows: groups.iter().map(|(l, _)| l.clone()).collect(),
-            cells,
-        };
-        for extension in ["png", "svg"] {
-            let path = out.join(format!("stability_map.{extension}"));
-            plot::write_map(&map, &path)?;
-            written.push(path);
-        }
+        cells.push(line);
+    }
+    let map = Map {
+        title: format!(
+            "{title}: stability (energy drift limit {:.0} %)",
+            100.0 * DRIFT_LIMIT
+        ),
+        x_label: "dt / dt_crit (central difference, lumped mass)".into(),
+        columns: columns.into_values().collect(),
+        rows: groups.iter().map(|(l, _)| l.clone()).collect(),
+        cells,
+    };
+    for extension in ["png", "svg"] {
+        let path = out.join(format!("stability_map.{extension}"));
+        plot::write_map(&map, &path)?;
+        written.push(path);
     }
     Ok(written)
 }

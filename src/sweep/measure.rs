@@ -22,6 +22,7 @@ use super::plan::{Case, Plan};
 use crate::analysis::explicit::critical_time_step;
 use crate::mesh::Cells;
 use crate::scene::model::{Analysis, Reference};
+use crate::scene::spec::ReferenceKind;
 use crate::scene::{InputError, Model};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -136,55 +137,7 @@ pub fn tabulate(
             .as_ref()
             .and_then(|f| read_json(&f.join("case.json")));
         let files = folder.as_ref().and_then(|f| load(f, column.as_deref()));
-        let dt_crit = if model.bodies.iter().all(|b| b.material.density > 0.0) {
-            Some(critical_time_step(model)?.dt)
-        } else {
-            None
-        };
-        let (integrator, dt) = match &model.analysis {
-            Analysis::Dynamic(d) => (
-                serde_json::to_value(d.integrator)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default(),
-                Some(d.dt),
-            ),
-            Analysis::Static(_) => ("static".to_string(), None),
-        };
-        let mut measures = Measures::default();
-        if let Some(files) = &files {
-            let s = &files.summary;
-            let num = |path: &[&str]| {
-                path.iter()
-                    .try_fold(s, |v, k| v.get(k))
-                    .and_then(serde_json::Value::as_f64)
-            };
-            measures.release_time = num(&["contact", "last_release_time"]);
-            measures.peak_force = num(&["contact", "peak_force"]);
-            measures.energy_drift = num(&["energy", "max_relative_drift"]);
-            if let (Some(initial), Some(last)) =
-                (num(&["energy", "initial"]), num(&["energy", "final"]))
-                && initial > 0.0
-            {
-                measures.energy_change = Some(last / initial - 1.0);
-            }
-            measures.steps = num(&["steps"]);
-            measures.newton_iterations = num(&["newton_iterations"]);
-            measures.factorizations = num(&["factorizations"]);
-        }
-        rows.push(Row {
-            case: case.clone(),
-            folder: plan.folder(case),
-            status: record
-                .as_ref()
-                .map_or("missing".to_string(), |r| r.status.clone()),
-            integrator,
-            dt,
-            h: shortest_edge(model),
-            dt_crit,
-            wall_seconds: record.as_ref().map(|r| r.wall_seconds),
-            measures,
-        });
+        rows.push(row(plan, case, model, record.as_ref(), files.as_ref())?);
         loaded.push((files, record));
     }
     let used = match &reference {
@@ -193,77 +146,157 @@ pub fn tabulate(
             pair,
             force,
             duration,
-        }) => {
-            for (row, (files, _)) in rows.iter_mut().zip(&loaded) {
-                let m = &mut row.measures;
-                if let Some(Loaded {
-                    time,
-                    force: Some(f),
-                    ..
-                }) = files
-                {
-                    let pulse = |t: f64| pulse(t, *force, *duration);
-                    m.force_l2 = relative_l2(time, f, &pulse, |_| true);
-                    let margin = duration / 8.0;
-                    m.force_l2_smooth = relative_l2(time, f, &pulse, |t| {
-                        t.abs() >= margin && (t - duration).abs() >= margin
-                    });
-                }
-                m.release_error = m.release_time.map(|t| t - duration);
-                m.peak_force_error = m.peak_force.map(|p| p / force - 1.0);
-                m.duration_error = m.release_time.map(|t| t / duration - 1.0);
-            }
-            ReferenceUsed {
-                kind: serde_json::to_value(kind)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default(),
-                pair: Some(pair.clone()),
-                force: Some(*force),
-                release_time: Some(*duration),
-                peak_force: Some(*force),
-                radius: None,
-                duration: Some(*duration),
-                finest: None,
-                richardson_order: None,
-            }
-        }
+        }) => pulse_reference(&mut rows, &loaded, kind, pair, *force, *duration),
         Some(Reference::Hertz {
             pair,
             peak_force,
             radius,
             duration,
-        }) => {
-            for (row, (files, _)) in rows.iter_mut().zip(&loaded) {
-                let m = &mut row.measures;
-                m.peak_force_error = m.peak_force.map(|p| p / peak_force - 1.0);
-                m.release_error = m.release_time.map(|t| t - duration);
-                if let Some(files) = files {
-                    let s = &files.summary["contact"];
-                    if let (Some(first), Some(last)) = (
-                        s["first_contact_time"].as_f64(),
-                        s["last_release_time"].as_f64(),
-                    ) {
-                        m.duration_error = Some((last - first) / duration - 1.0);
-                    }
-                    m.radius_error = s["peak_contact_radius"].as_f64().map(|a| a / radius - 1.0);
-                }
-            }
-            ReferenceUsed {
-                kind: "hertz_impact".into(),
-                pair: Some(pair.clone()),
-                force: None,
-                release_time: Some(*duration),
-                peak_force: Some(*peak_force),
-                radius: Some(*radius),
-                duration: Some(*duration),
-                finest: None,
-                richardson_order: None,
-            }
-        }
+        }) => hertz_reference(&mut rows, &loaded, pair, *peak_force, *radius, *duration),
         None => finest_reference(&mut rows, &loaded, pair),
     };
     Ok((rows, used))
+}
+
+/// A case's row with what it measured on its own (summary.json), before the comparison
+/// with a reference.
+fn row(
+    plan: &Plan,
+    case: &Case,
+    model: &Model,
+    record: Option<&CaseRecord>,
+    files: Option<&Loaded>,
+) -> Result<Row, InputError> {
+    let dt_crit = if model.bodies.iter().all(|b| b.material.density > 0.0) {
+        Some(critical_time_step(model)?.dt)
+    } else {
+        None
+    };
+    let (integrator, dt) = match &model.analysis {
+        Analysis::Dynamic(d) => (
+            serde_json::to_value(d.integrator)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_default(),
+            Some(d.dt),
+        ),
+        Analysis::Static(_) => ("static".to_string(), None),
+    };
+    let mut measures = Measures::default();
+    if let Some(files) = files {
+        let s = &files.summary;
+        let num = |path: &[&str]| {
+            path.iter()
+                .try_fold(s, |v, k| v.get(k))
+                .and_then(serde_json::Value::as_f64)
+        };
+        measures.release_time = num(&["contact", "last_release_time"]);
+        measures.peak_force = num(&["contact", "peak_force"]);
+        measures.energy_drift = num(&["energy", "max_relative_drift"]);
+        if let (Some(initial), Some(last)) =
+            (num(&["energy", "initial"]), num(&["energy", "final"]))
+            && initial > 0.0
+        {
+            measures.energy_change = Some(last / initial - 1.0);
+        }
+        measures.steps = num(&["steps"]);
+        measures.newton_iterations = num(&["newton_iterations"]);
+        measures.factorizations = num(&["factorizations"]);
+    }
+    Ok(Row {
+        case: case.clone(),
+        folder: plan.folder(case),
+        status: record.map_or("missing".to_string(), |r| r.status.clone()),
+        integrator,
+        dt,
+        h: shortest_edge(model),
+        dt_crit,
+        wall_seconds: record.map(|r| r.wall_seconds),
+        measures,
+    })
+}
+
+/// Against a force pulse F_0 on 0 < t < T (rod impacts): the force history's L2 errors, the
+/// release time against T and the peak force against F_0.
+fn pulse_reference(
+    rows: &mut [Row],
+    loaded: &[(Option<Loaded>, Option<CaseRecord>)],
+    kind: &ReferenceKind,
+    pair: &str,
+    force: f64,
+    duration: f64,
+) -> ReferenceUsed {
+    for (row, (files, _)) in rows.iter_mut().zip(loaded) {
+        let m = &mut row.measures;
+        if let Some(Loaded {
+            time,
+            force: Some(f),
+            ..
+        }) = files
+        {
+            let pulse = |t: f64| pulse(t, force, duration);
+            m.force_l2 = relative_l2(time, f, &pulse, |_| true);
+            let margin = duration / 8.0;
+            m.force_l2_smooth = relative_l2(time, f, &pulse, |t| {
+                t.abs() >= margin && (t - duration).abs() >= margin
+            });
+        }
+        m.release_error = m.release_time.map(|t| t - duration);
+        m.peak_force_error = m.peak_force.map(|p| p / force - 1.0);
+        m.duration_error = m.release_time.map(|t| t / duration - 1.0);
+    }
+    ReferenceUsed {
+        kind: serde_json::to_value(kind)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default(),
+        pair: Some(pair.to_string()),
+        force: Some(force),
+        release_time: Some(duration),
+        peak_force: Some(force),
+        radius: None,
+        duration: Some(duration),
+        finest: None,
+        richardson_order: None,
+    }
+}
+
+/// Against the Hertz impact: peak force, contact duration (first contact to last release)
+/// and largest contact radius.
+fn hertz_reference(
+    rows: &mut [Row],
+    loaded: &[(Option<Loaded>, Option<CaseRecord>)],
+    pair: &str,
+    peak_force: f64,
+    radius: f64,
+    duration: f64,
+) -> ReferenceUsed {
+    for (row, (files, _)) in rows.iter_mut().zip(loaded) {
+        let m = &mut row.measures;
+        m.peak_force_error = m.peak_force.map(|p| p / peak_force - 1.0);
+        m.release_error = m.release_time.map(|t| t - duration);
+        if let Some(files) = files {
+            let s = &files.summary["contact"];
+            if let (Some(first), Some(last)) = (
+                s["first_contact_time"].as_f64(),
+                s["last_release_time"].as_f64(),
+            ) {
+                m.duration_error = Some((last - first) / duration - 1.0);
+            }
+            m.radius_error = s["peak_contact_radius"].as_f64().map(|a| a / radius - 1.0);
+        }
+    }
+    ReferenceUsed {
+        kind: "hertz_impact".into(),
+        pair: Some(pair.to_string()),
+        force: None,
+        release_time: Some(duration),
+        peak_force: Some(peak_force),
+        radius: Some(radius),
+        duration: Some(duration),
+        finest: None,
+        richardson_order: None,
+    }
 }
 
 /// Without a declared reference: the finest ok case (smallest dt, then the most elements

@@ -1,0 +1,73 @@
+//! Naming a generated mesh's boundary: edge sets by a rule on each boundary edge, chained head
+//! to tail, and one-node sets at given points.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::blocks::min_edge;
+use crate::mesh::plane::{Point, norm, sub};
+use crate::mesh::{Cells, Mesh};
+
+/// Distance below which a node counts as lying on a line: far below any element size.
+pub(super) fn feature_tol(mesh: &Mesh) -> f64 {
+    let Cells::Quad4(quads) = &mesh.cells else {
+        return 0.0;
+    };
+    1e-6 * min_edge(&mesh.nodes, quads)
+}
+
+/// Both ends on the line coordinate[axis] = value.
+pub(super) fn on_line(p: Point, q: Point, axis: usize, value: f64, tol: f64) -> bool {
+    (p[axis] - value).abs() <= tol && (q[axis] - value).abs() <= tol
+}
+
+/// Puts every boundary edge a -> b into the edge set `name_of(x_a, x_b)`.
+pub(super) fn name_boundary(mesh: &mut Mesh, name_of: impl Fn(Point, Point) -> &'static str) {
+    let mut sets: BTreeMap<&str, Vec<[usize; 2]>> = BTreeMap::new();
+    for e in mesh.boundary_edges() {
+        sets.entry(name_of(mesh.nodes[e[0]], mesh.nodes[e[1]]))
+            .or_default()
+            .push(e);
+    }
+    for (name, edges) in sets {
+        mesh.add_edge_set(name, chain_order(edges));
+    }
+}
+
+/// Edges head to tail: open chains first (by first node), then closed loops.
+fn chain_order(edges: Vec<[usize; 2]>) -> Vec<[usize; 2]> {
+    let mut leaving: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (k, e) in edges.iter().enumerate() {
+        leaving.entry(e[0]).or_default().push(k);
+    }
+    let ends: BTreeSet<usize> = edges.iter().map(|e| e[1]).collect();
+    let mut heads: Vec<usize> = edges
+        .iter()
+        .map(|e| e[0])
+        .filter(|n| !ends.contains(n))
+        .collect();
+    heads.sort_unstable();
+    heads.extend(edges.iter().map(|e| e[0]));
+
+    let mut used = vec![false; edges.len()];
+    let mut ordered = Vec::with_capacity(edges.len());
+    for head in heads {
+        let mut node = head;
+        while let Some(&k) = leaving
+            .get(&node)
+            .and_then(|ks| ks.iter().find(|&&k| !used[k]))
+        {
+            used[k] = true;
+            ordered.push(edges[k]);
+            node = edges[k][1];
+        }
+    }
+    ordered
+}
+
+/// The node nearest to `p`.
+pub(super) fn node_at(mesh: &Mesh, p: Point) -> usize {
+    let distance = |n: &usize| norm(sub(mesh.nodes[*n], p));
+    (0..mesh.nodes.len())
+        .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+        .expect("a generated mesh has nodes")
+}

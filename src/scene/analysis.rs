@@ -1,0 +1,301 @@
+//! `[analysis]`: the kind of run (static or dynamic), the integrator and its parameters, the
+//! mass, damping and quadrature, the Newton iteration and the buckling check.
+
+use super::InputError;
+use super::context::{Context, positive};
+use super::model::Analysis;
+use super::spec::{
+    AnalysisKind, AnalysisSpec, BucklingSpec, DynamicSpec, IntegratorKind, MassKind, NewtonSpec,
+    Quadrature, StaticSpec,
+};
+use crate::element::Strain;
+
+/// `[analysis]`: a static analysis (load steps) or a dynamic one (time steps), checked
+/// against the keys that apply to it.
+pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, InputError> {
+    let given = |present: bool, key: &str, kind: &str| {
+        if present {
+            Err(cx.err(format!(
+                "analysis.{key}: does not apply to a {kind} analysis"
+            )))
+        } else {
+            Ok(())
+        }
+    };
+    newton(cx, &spec.newton)?;
+    match spec.kind {
+        AnalysisKind::Static => {
+            given(spec.dt.is_some(), "dt", "static")?;
+            given(spec.integrator.is_some(), "integrator", "static")?;
+            for (present, key) in [
+                (spec.beta.is_some(), "beta"),
+                (spec.gamma.is_some(), "gamma"),
+                (spec.theta.is_some(), "theta"),
+                (spec.alpha.is_some(), "alpha"),
+                (spec.rho_infinity.is_some(), "rho_infinity"),
+                (spec.mass.is_some(), "mass"),
+                (spec.rayleigh.is_some(), "rayleigh"),
+                (spec.allow_unstable, "allow_unstable"),
+                (spec.quadrature.is_some(), "quadrature"),
+                (spec.hourglass.is_some(), "hourglass"),
+            ] {
+                given(present, key, "static")?;
+            }
+            let steps = spec.steps.ok_or_else(|| {
+                cx.err("analysis.steps: a static analysis needs its number of load steps")
+            })?;
+            if steps == 0 {
+                return Err(cx.err("analysis.steps: must be at least 1"));
+            }
+            let end_time = positive(cx, "analysis.end_time", spec.end_time.unwrap_or(1.0))?;
+            Ok(Analysis::Static(StaticSpec {
+                steps,
+                end_time,
+                geometry: spec.geometry,
+                newton: spec.newton.clone(),
+                buckling: buckling(cx, spec)?,
+            }))
+        }
+        AnalysisKind::Dynamic => dynamic(cx, spec).map(Analysis::Dynamic),
+    }
+}
+
+/// A dynamic analysis: its time step, end time and integrator with that integrator's
+/// parameters, mass, damping and quadrature.
+fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError> {
+    if spec.steps.is_some() {
+        return Err(cx.err("analysis.steps: a dynamic analysis takes `dt` and `end_time`"));
+    }
+    let dt = positive(
+        cx,
+        "analysis.dt",
+        spec.dt
+            .ok_or_else(|| cx.err("analysis.dt: a dynamic analysis needs its time step"))?,
+    )?;
+    let end_time = positive(
+        cx,
+        "analysis.end_time",
+        spec.end_time
+            .ok_or_else(|| cx.err("analysis.end_time: a dynamic analysis needs its end time"))?,
+    )?;
+    let integrator = spec.integrator.unwrap_or(IntegratorKind::Average);
+    check_integrator_keys(cx, spec, integrator)?;
+    let (beta, gamma) = newmark_coefficients(cx, spec, integrator)?;
+    let (theta, alpha, rho_infinity) = integrator_parameters(cx, spec)?;
+    let (mass, rayleigh) = mass_and_damping(cx, spec, integrator)?;
+    let (quadrature, hourglass) = quadrature(cx, spec, integrator)?;
+    Ok(DynamicSpec {
+        quadrature,
+        hourglass,
+        dt,
+        end_time,
+        integrator,
+        beta,
+        gamma,
+        theta,
+        alpha,
+        rho_infinity,
+        mass,
+        rayleigh,
+        allow_unstable: spec.allow_unstable,
+        geometry: spec.geometry,
+        newton: spec.newton.clone(),
+        buckling: buckling(cx, spec)?,
+    })
+}
+
+/// The keys that belong to one integrator only are absent for the others.
+fn check_integrator_keys(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<(), InputError> {
+    let only_for = |present: bool, key: &str, kinds: &[IntegratorKind]| {
+        if present && !kinds.contains(&integrator) {
+            Err(cx.err(format!(
+                "analysis.{key}: does not apply to integrator {integrator:?}"
+            )))
+        } else {
+            Ok(())
+        }
+    };
+    use IntegratorKind as I;
+    only_for(spec.beta.is_some(), "beta", &[I::Newmark])?;
+    only_for(spec.gamma.is_some(), "gamma", &[I::Newmark])?;
+    only_for(spec.theta.is_some(), "theta", &[I::Wilson])?;
+    only_for(spec.alpha.is_some(), "alpha", &[I::Hht])?;
+    only_for(
+        spec.rho_infinity.is_some(),
+        "rho_infinity",
+        &[I::GeneralizedAlpha],
+    )?;
+    only_for(
+        spec.allow_unstable,
+        "allow_unstable",
+        &[I::CentralDifference],
+    )
+}
+
+/// Newmark's (beta, gamma): fixed by the named members of the family, given for `newmark`.
+fn newmark_coefficients(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<(f64, f64), InputError> {
+    use IntegratorKind as I;
+    let (beta, gamma) = match integrator {
+        I::Average => (0.25, 0.5),
+        I::Linear => (1.0 / 6.0, 0.5),
+        I::Hu => (1.0, 1.5),
+        I::Newmark => (
+            spec.beta
+                .ok_or_else(|| cx.err("analysis.beta: integrator newmark needs beta"))?,
+            spec.gamma
+                .ok_or_else(|| cx.err("analysis.gamma: integrator newmark needs gamma"))?,
+        ),
+        _ => (0.25, 0.5),
+    };
+    if integrator == I::Newmark && !(beta > 0.0 && gamma >= 0.0) {
+        return Err(cx.err(format!(
+            "analysis.beta, gamma: need beta > 0 and gamma >= 0, got {beta}, {gamma}"
+        )));
+    }
+    Ok((beta, gamma))
+}
+
+/// (theta, alpha, rho_infinity): Wilson's theta, HHT's alpha and the generalized-alpha
+/// spectral radius, each with its default and range.
+fn integrator_parameters(cx: &Context, spec: &AnalysisSpec) -> Result<(f64, f64, f64), InputError> {
+    let theta = spec.theta.unwrap_or(1.4);
+    if !(theta >= 1.0) {
+        return Err(cx.err(format!(
+            "analysis.theta: Wilson's theta must be >= 1, got {theta}"
+        )));
+    }
+    let alpha = spec.alpha.unwrap_or(-0.05);
+    if !(-1.0 / 3.0..=0.0).contains(&alpha) {
+        return Err(cx.err(format!(
+            "analysis.alpha: HHT's alpha must lie in [-1/3, 0], got {alpha}"
+        )));
+    }
+    let rho_infinity = spec.rho_infinity.unwrap_or(0.8);
+    if !(0.0..=1.0).contains(&rho_infinity) {
+        return Err(cx.err(format!(
+            "analysis.rho_infinity: must lie in [0, 1], got {rho_infinity}"
+        )));
+    }
+    Ok((theta, alpha, rho_infinity))
+}
+
+/// The mass matrix (lumped for central difference) and the Rayleigh coefficients [a, b].
+fn mass_and_damping(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<(MassKind, [f64; 2]), InputError> {
+    use IntegratorKind as I;
+    let mass = match (integrator, spec.mass) {
+        (I::CentralDifference, Some(MassKind::Consistent)) => {
+            return Err(cx.err("analysis.mass: central difference uses the lumped mass"));
+        }
+        (I::CentralDifference, _) => MassKind::Lumped,
+        (_, m) => m.unwrap_or_default(),
+    };
+    let rayleigh = spec.rayleigh.unwrap_or([0.0, 0.0]);
+    if integrator == I::CentralDifference && rayleigh[1] != 0.0 {
+        return Err(cx.err(
+            "analysis.rayleigh: central difference takes mass-proportional damping only (b = 0)",
+        ));
+    }
+    if rayleigh.iter().any(|c| !(*c >= 0.0 && c.is_finite())) {
+        return Err(cx.err(format!(
+            "analysis.rayleigh: coefficients must be >= 0, got {rayleigh:?}"
+        )));
+    }
+    Ok((mass, rayleigh))
+}
+
+/// The Quad4 quadrature and its hourglass coefficient: `reduced` is the explicit,
+/// finite-strain fast path without checkpoints; the coefficient belongs to it alone.
+fn quadrature(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<(Quadrature, f64), InputError> {
+    let quadrature = spec.quadrature.unwrap_or_default();
+    if quadrature == Quadrature::Reduced {
+        if integrator != IntegratorKind::CentralDifference {
+            return Err(cx.err(format!(
+                "analysis.quadrature: `reduced` (one-point Quad4 with hourglass control) is the explicit fast path; \
+                 integrator {integrator:?} needs the tangent of the full 2x2 kernel: use quadrature = \"full\" or integrator = \"central_difference\""
+            )));
+        }
+        if spec.geometry == Strain::Small {
+            return Err(cx.err(
+                "analysis.quadrature: `reduced` runs the updated-Lagrangian (finite-strain) kernel only; use geometry = \"nonlinear\" or quadrature = \"full\"",
+            ));
+        }
+        if spec.checkpoint_every > 0 {
+            return Err(cx.err(
+                "analysis.checkpoint_every: checkpoints are not implemented for quadrature = \"reduced\" (its hourglass forces are not in the checkpoint); use quadrature = \"full\" or no checkpoints",
+            ));
+        }
+    }
+    let hourglass = match (quadrature, spec.hourglass) {
+        (Quadrature::Full, Some(_)) => {
+            return Err(cx.err(
+                "analysis.hourglass: applies to quadrature = \"reduced\" only (the full 2x2 kernel has no hourglass modes)",
+            ));
+        }
+        (_, Some(k)) if !(0.0..=1.0).contains(&k) => {
+            return Err(cx.err(format!(
+                "analysis.hourglass: the hourglass coefficient must lie in [0, 1], got {k}"
+            )));
+        }
+        (_, k) => k.unwrap_or(0.1),
+    };
+    Ok((quadrature, hourglass))
+}
+
+/// `[analysis.buckling]`, which needs an implicit tangent.
+fn buckling(cx: &Context, spec: &AnalysisSpec) -> Result<Option<BucklingSpec>, InputError> {
+    let Some(b) = &spec.buckling else {
+        return Ok(None);
+    };
+    if spec.integrator == Some(IntegratorKind::CentralDifference) {
+        return Err(cx.err(
+            "analysis.buckling: the explicit method assembles no tangent; use an implicit integrator",
+        ));
+    }
+    if let Some(imperfection) = &b.imperfection {
+        if imperfection.mode == 0 {
+            return Err(cx.err("analysis.buckling.imperfection.mode: modes count from 1"));
+        }
+        if !(imperfection.amplitude.is_finite() && imperfection.amplitude != 0.0) {
+            return Err(cx.err(format!(
+                "analysis.buckling.imperfection.amplitude: a finite, non-zero length, got {}",
+                imperfection.amplitude
+            )));
+        }
+    }
+    Ok(Some(b.clone()))
+}
+
+/// `[analysis.newton]`: counts at least 1, tolerances positive, contraction in (0, 1].
+fn newton(cx: &Context, n: &NewtonSpec) -> Result<(), InputError> {
+    if n.refactor_every == 0 {
+        return Err(cx.err("analysis.newton.refactor_every: must be at least 1"));
+    }
+    if n.max_iterations == 0 {
+        return Err(cx.err("analysis.newton.max_iterations: must be at least 1"));
+    }
+    positive(cx, "analysis.newton.tol_displacement", n.tol_displacement)?;
+    positive(cx, "analysis.newton.tol_force", n.tol_force)?;
+    if !(n.contraction > 0.0 && n.contraction <= 1.0) {
+        return Err(cx.err(format!(
+            "analysis.newton.contraction: must lie in (0, 1], got {}",
+            n.contraction
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,226 @@
+//! `[[obstacle]]` and `[[contact]]`: the rigid obstacles and the contact pairs, each pair a
+//! slave node set against a master (another body's edges or nodes, or an obstacle) with its
+//! options and friction.
+
+use super::InputError;
+use super::context::{Context, body_index, edge_set, finite, node_set, positive};
+use super::model::Body;
+use super::spec::{ContactSpec, Scene, SurfaceSpec};
+use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
+
+/// The scene's contact pairs in order, their names unique.
+pub(super) fn contacts(
+    cx: &Context,
+    scene: &Scene,
+    bodies: &[Body],
+) -> Result<Vec<ContactPair>, InputError> {
+    let obstacles = obstacles(cx, scene)?;
+    let contacts = scene
+        .contact
+        .iter()
+        .enumerate()
+        .map(|(k, c)| contact(cx, bodies, &obstacles, k, c))
+        .collect::<Result<Vec<_>, _>>()?;
+    if let Some(k) =
+        (0..contacts.len()).find(|k| contacts[..*k].iter().any(|c| c.name == contacts[*k].name))
+    {
+        return Err(cx.err(format!(
+            "contact[{k}].name: `{}` is used twice",
+            contacts[k].name
+        )));
+    }
+    Ok(contacts)
+}
+
+/// The `[[obstacle]]` polylines: unique names, at least 2 points (3 when closed), finite,
+/// no two consecutive points equal.
+fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, InputError> {
+    let mut out: Vec<Obstacle> = Vec::new();
+    for (k, o) in scene.obstacle.iter().enumerate() {
+        let key = format!("obstacle[{k}] (`{}`)", o.name);
+        if out.iter().any(|p| p.name == o.name) {
+            return Err(cx.err(format!("{key}.name: used twice")));
+        }
+        if o.points.len() < 2 || (o.closed && o.points.len() < 3) {
+            return Err(cx.err(format!(
+                "{key}.points: an obstacle needs at least 2 points (3 when closed)"
+            )));
+        }
+        finite(
+            cx,
+            &format!("{key}.points"),
+            &o.points.iter().flatten().copied().collect::<Vec<_>>(),
+        )?;
+        if o.points.windows(2).any(|w| w[0] == w[1]) {
+            return Err(cx.err(format!("{key}.points: two consecutive points coincide")));
+        }
+        out.push(Obstacle {
+            name: o.name.clone(),
+            points: o.points.clone(),
+            closed: o.closed,
+        });
+    }
+    Ok(out)
+}
+
+/// One `[[contact]]` pair: its slave nodes (global), its master and its options.
+fn contact(
+    cx: &Context,
+    bodies: &[Body],
+    obstacles: &[Obstacle],
+    k: usize,
+    spec: &ContactSpec,
+) -> Result<ContactPair, InputError> {
+    let key = format!("contact[{k}] (`{}`)", spec.name);
+    let (slave_body, slaves) = node_set(
+        cx,
+        bodies,
+        spec.slave.body.as_deref(),
+        &spec.slave.set,
+        &format!("{key}.slave"),
+    )?;
+    if spec.slave.normal.is_some() {
+        return Err(cx.err(format!(
+            "{key}.slave.normal: only a node-to-node master takes a normal"
+        )));
+    }
+    let slaves: Vec<usize> = slaves
+        .into_iter()
+        .map(|n| bodies[slave_body].global(n))
+        .collect();
+    let master = match (&spec.master, &spec.obstacle) {
+        (Some(m), None) => master_body(cx, bodies, slave_body, &key, m)?,
+        (None, Some(name)) => {
+            let o = obstacles.iter().find(|o| &o.name == name).ok_or_else(|| {
+                let known: Vec<&str> = obstacles.iter().map(|o| o.name.as_str()).collect();
+                cx.err(format!(
+                    "{key}.obstacle: no obstacle named `{name}` (obstacles: {known:?})"
+                ))
+            })?;
+            Master::Obstacle(o.clone())
+        }
+        _ => return Err(cx.err(format!("{key}: give exactly one of `master` or `obstacle`"))),
+    };
+    if !(spec.release_fraction >= 0.0 && spec.release_fraction < 1.0) {
+        return Err(cx.err(format!(
+            "{key}.release_fraction: must lie in [0, 1), got {}",
+            spec.release_fraction
+        )));
+    }
+    let friction = friction(cx, &key, spec)?;
+    let size = model_size(bodies);
+    let tolerance = spec.tolerance.unwrap_or(1e-9 * size);
+    if !(tolerance >= 0.0 && tolerance.is_finite()) {
+        return Err(cx.err(format!("{key}.tolerance: must be >= 0, got {tolerance}")));
+    }
+    let search_distance = match spec.search_distance {
+        Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
+        None => f64::INFINITY,
+    };
+    Ok(ContactPair {
+        name: spec.name.clone(),
+        slave_body,
+        slaves,
+        master,
+        options: PairOptions {
+            impact_conditions: spec.impact_conditions,
+            release_conditions: spec.release_conditions,
+            release_fraction: spec.release_fraction,
+            tolerance,
+            search_distance,
+            split_at_events: spec.split_at_events,
+            friction,
+        },
+    })
+}
+
+/// A master on another body: its edge set (node-to-segment), or a node set with the
+/// `normal` of its surface (node-to-node).
+fn master_body(
+    cx: &Context,
+    bodies: &[Body],
+    slave_body: usize,
+    key: &str,
+    m: &SurfaceSpec,
+) -> Result<Master, InputError> {
+    let mkey = format!("{key}.master");
+    let b = body_index(cx, bodies, m.body.as_deref(), &mkey)?;
+    if b == slave_body {
+        return Err(cx.err(format!(
+            "{mkey}.body: self-contact is not supported; master and slave must be different bodies"
+        )));
+    }
+    Ok(match (bodies[b].mesh.edge_sets.get(&m.set), m.normal) {
+        (Some(_), None) => {
+            let (b, edges) = edge_set(cx, bodies, m.body.as_deref(), &m.set, &mkey)?;
+            let boundary = bodies[b]
+                .mesh
+                .boundary_edges()
+                .iter()
+                .map(|e| e.map(|n| bodies[b].global(n)))
+                .collect();
+            Master::Segments {
+                body: b,
+                edges,
+                boundary,
+            }
+        }
+        (_, Some(normal)) => {
+            let l = (normal[0] * normal[0] + normal[1] * normal[1]).sqrt();
+            if !(l > 0.0 && l.is_finite()) {
+                return Err(cx.err(format!("{mkey}.normal: must be a non-zero vector")));
+            }
+            let (b, nodes) = node_set(cx, bodies, m.body.as_deref(), &m.set, &mkey)?;
+            let nodes = nodes.into_iter().map(|n| bodies[b].global(n)).collect();
+            Master::Nodes {
+                body: b,
+                nodes,
+                normal: [normal[0] / l, normal[1] / l],
+            }
+        }
+        (None, None) => {
+            return Err(cx.err(format!(
+                "{mkey}: `{}` is not an edge set of body `{}`; a node-set master (node-to-node) needs `normal`",
+                m.set, bodies[b].name
+            )));
+        }
+    })
+}
+
+/// The pair's friction: none, Coulomb's `friction` or the `return_coefficient` of Greco &
+/// Coda (2003), never both.
+fn friction(cx: &Context, key: &str, spec: &ContactSpec) -> Result<Friction, InputError> {
+    Ok(match (spec.friction, spec.return_coefficient) {
+        (None, None) => Friction::None,
+        (Some(mu), None) if mu >= 0.0 && mu.is_finite() => Friction::Coulomb { mu },
+        (Some(mu), None) => {
+            return Err(cx.err(format!(
+                "{key}.friction: the Coulomb coefficient must be finite and >= 0, got {mu}"
+            )));
+        }
+        (None, Some(r)) if (0.0..=1.0).contains(&r) => Friction::Return { r },
+        (None, Some(r)) => {
+            return Err(cx.err(format!(
+                "{key}.return_coefficient: must lie in [0, 1] (0 frictionless, 1 adherence), got {r}"
+            )));
+        }
+        (Some(_), Some(_)) => {
+            return Err(cx.err(format!(
+                "{key}: give `friction` (Coulomb) or `return_coefficient` (Greco), not both"
+            )));
+        }
+    })
+}
+
+/// The diagonal of the bounding box of all nodes.
+fn model_size(bodies: &[Body]) -> f64 {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in bodies.iter().flat_map(|b| b.mesh.nodes.iter()) {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).sqrt()
+}

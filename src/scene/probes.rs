@@ -1,0 +1,73 @@
+//! `[output]`: the probes written to history.csv and the frame times.
+
+use super::InputError;
+use super::context::{Context, body_index, node_set};
+use super::model::{Body, Probe};
+use super::spec::{ProbeSpec, Statistic};
+
+/// `output.frame_times`: finite, >= 0 and increasing.
+pub(super) fn check_frame_times(cx: &Context, times: &[f64]) -> Result<(), InputError> {
+    if times.iter().any(|t| !(t.is_finite() && *t >= 0.0)) || times.windows(2).any(|w| w[1] <= w[0])
+    {
+        return Err(cx.err(format!(
+            "output.frame_times: must be finite, >= 0 and increasing, got {times:?}"
+        )));
+    }
+    Ok(())
+}
+
+/// The `[[output.probe]]` tables: each probe's members (global nodes or elements of its body)
+/// and its history.csv column.
+pub(super) fn probes(
+    cx: &Context,
+    bodies: &[Body],
+    specs: &[ProbeSpec],
+) -> Result<Vec<Probe>, InputError> {
+    let mut out = Vec::new();
+    for (k, p) in specs.iter().enumerate() {
+        let key = format!("output.probe[{k}]");
+        let b = body_index(cx, bodies, p.body.as_deref(), &key)?;
+        let members = if p.quantity.is_nodal() {
+            node_set(cx, bodies, p.body.as_deref(), &p.set, &key)?
+                .1
+                .into_iter()
+                .map(|n| bodies[b].global(n))
+                .collect()
+        } else {
+            // an element set, or the elements around the nodes of a node set
+            let mesh = &bodies[b].mesh;
+            let sets = &mesh.element_sets;
+            match (sets.get(&p.set), mesh.node_sets.get(&p.set)) {
+                (Some(elements), _) => elements.clone(),
+                (None, Some(nodes)) => (0..mesh.cells.len())
+                    .filter(|e| mesh.cells.nodes_of(*e).iter().any(|n| nodes.contains(n)))
+                    .collect(),
+                (None, None) => {
+                    let known: Vec<&String> = sets.keys().chain(mesh.node_sets.keys()).collect();
+                    return Err(cx.err(format!(
+                        "{key}.set: body `{}` has no element or node set `{}` (sets: {known:?})",
+                        bodies[b].name, p.set
+                    )));
+                }
+            }
+        };
+        let set = if bodies.len() > 1 {
+            format!("{}.{}", bodies[b].name, p.set)
+        } else {
+            p.set.clone()
+        };
+        let column = match p.statistic {
+            Statistic::Mean => format!("{}[{set}]", p.quantity.name()),
+            Statistic::Max => format!("max_{}[{set}]", p.quantity.name()),
+            Statistic::Min => format!("min_{}[{set}]", p.quantity.name()),
+        };
+        out.push(Probe {
+            statistic: p.statistic,
+            quantity: p.quantity,
+            body: b,
+            members,
+            column,
+        });
+    }
+    Ok(out)
+}
