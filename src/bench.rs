@@ -31,7 +31,7 @@ pub struct Case {
     /// a yield stress of 250 MPa); 1 stays elastic.
     pub speed: f64,
     /// Implicit: `analysis.newton.strategy` ("modified": factor each step; "initial": factor
-    /// once, the seed's way).
+    /// once, as Hughes et al. 1975 do).
     pub strategy: &'static str,
 }
 
@@ -105,7 +105,7 @@ pub struct Shares {
 }
 
 /// The plan: `quick` keeps the cases under ten seconds in all; the full plan spans 1e3 to
-/// 1e6 DOFs (n = 32 to 1000 elements across) and has the cases of issue #9's targets: the
+/// 1e6 DOFs (n = 32 to 1000 elements across) and has the cases of the speed targets: the
 /// fast explicit path at 1e5 elements on one and two threads and with frames every 10 steps,
 /// and the implicit step with and without ~100 contact pairs (n = 100: 101 slaves).
 pub fn plan(quick: bool) -> Vec<Case> {

@@ -125,65 +125,50 @@ fn modules_use_only_lower_layers() {
     }
 }
 
-/// Goal: no two sibling files of one module import each other (a module's mod.rs and its
-/// files are parent and children, not siblings). Setup: `super::NAME` and
-/// `crate::MODULE::NAME` paths between the files of each module. Reference: a file-level
-/// import graph without 2-cycles.
+/// Goal: no two sibling files of one module import each other (a module's mod.rs, or the
+/// file that declares a folder's files, is their parent, not a sibling). Setup: `super::NAME`
+/// and `crate::PATH::NAME` paths between the files of each folder under src/, at any depth.
+/// Reference: a file-level import graph without 2-cycles.
 #[test]
 fn no_file_imports_a_file_that_imports_it() {
     let mut files = Vec::new();
     sources(Path::new("src"), &mut files);
-    let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    let mut edges: BTreeMap<PathBuf, BTreeSet<PathBuf>> = BTreeMap::new();
     for path in &files {
-        let rel = path.strip_prefix("src").unwrap();
-        let parts: Vec<String> = rel
-            .components()
-            .map(|c| {
-                c.as_os_str()
-                    .to_string_lossy()
-                    .trim_end_matches(".rs")
-                    .to_string()
-            })
-            .collect();
-        if parts.len() != 2 {
+        let dir = path.parent().unwrap();
+        if dir == Path::new("src") || path.file_stem().is_some_and(|s| s == "mod") {
             continue;
         }
-        let (module, file) = (&parts[0], &parts[1]);
+        let module_path: Vec<String> = dir
+            .strip_prefix("src")
+            .unwrap()
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().to_string())
+            .collect();
         let code = code(path);
         let mut siblings = BTreeSet::new();
-        for prefix in ["super::".to_string(), format!("crate::{module}::")] {
+        for prefix in [
+            "super::".to_string(),
+            format!("crate::{}::", module_path.join("::")),
+        ] {
             for (i, _) in code.match_indices(prefix.as_str()) {
                 let name: String = code[i + prefix.len()..]
                     .chars()
                     .take_while(|c| c.is_alphanumeric() || *c == '_')
                     .collect();
-                let target = if Path::new("src")
-                    .join(module)
-                    .join(format!("{name}.rs"))
-                    .exists()
-                {
-                    name
-                } else {
-                    "mod".to_string()
-                };
-                if &target != file && target != "mod" && file != "mod" {
+                let target = dir.join(format!("{name}.rs"));
+                if target.exists() && &target != path && name != "mod" {
                     siblings.insert(target);
                 }
             }
         }
-        edges.insert(
-            format!("{module}/{file}"),
-            siblings
-                .into_iter()
-                .map(|s| format!("{module}/{s}"))
-                .collect(),
-        );
+        edges.insert(path.clone(), siblings);
     }
     let mut cycles = Vec::new();
     for (a, targets) in &edges {
         for b in targets {
             if a < b && edges.get(b).is_some_and(|t| t.contains(a)) {
-                cycles.push(format!("{a} <-> {b}"));
+                cycles.push(format!("{} <-> {}", a.display(), b.display()));
             }
         }
     }

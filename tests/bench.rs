@@ -1,5 +1,5 @@
-//! `impact bench --quick` (issue #9): every case runs, and the solver counters obey the rules
-//! of DESIGN section 4 (contact through the Schur complement on a K* factored once). No
+//! `impact bench --quick`: every case runs, and the solver counters obey the design's rules
+//! (contact through the Schur complement on a K* factored once). No
 //! timing is asserted: speed is measured by `impact bench` itself (docs/performance.md).
 
 use impact::bench::Row;

@@ -1,4 +1,4 @@
-//! The buckling check (issue #6, Erklig 2.1.3): linearized buckling loads of plane-stress
+//! The buckling check (Erklig 2.1.3): linearized buckling loads of plane-stress
 //! Quad4 columns against Euler and the shear-corrected (Engesser) load, the inertia of the
 //! tangent along load stepping and time stepping, and the post-buckling path of an
 //! imperfect column against the elastica.
@@ -166,7 +166,7 @@ fn mesh_study_pinned_column() {
 /// Goal: lambda_cr of a slender pinned-pinned column within 1 % of Euler's load.
 /// Setup: L / h = 25 (slenderness L / r = 87), 200 x 8 elements (element length h / 8), the
 /// converged mesh of the study in docs/validation.md. Reference: P_E = pi^2 E I / L^2.
-/// Tolerance 1 % (the issue's): measured +0.23 %; the continuum column's shear flexibility
+/// Tolerance 1 % (the required accuracy): measured +0.23 %; the continuum column's shear flexibility
 /// alone puts the exact answer 0.41 % below P_E, the remaining Q4 locking above it.
 /// Also the mode: a half sine (the midspan lateral displacement is the largest), and
 /// lambda_2 within 2 % of the shear-corrected second Euler load (4 P_E, half the length).
@@ -209,7 +209,7 @@ fn pinned_column_buckles_at_euler_load() {
 
 /// Goal: lambda_cr of a slender cantilever within 1 % of Euler's load with K = 2.
 /// Setup: L / h = 12.5 (effective slenderness 2 L / r = 87), 200 x 8 elements, clamp as
-/// in CANTILEVER. Reference: P_E = pi^2 E I / (2 L)^2. Tolerance 1 % (the issue's);
+/// in CANTILEVER. Reference: P_E = pi^2 E I / (2 L)^2. Tolerance 1 % (the required accuracy);
 /// measured -0.22 % (shear: -0.41 %).
 #[test]
 fn cantilever_column_buckles_at_euler_load() {
@@ -225,8 +225,8 @@ fn cantilever_column_buckles_at_euler_load() {
 
 /// Goal: a stocky column's lambda_cr follows Euler reduced by the shear flexibility.
 /// Setup: pinned-pinned, L / h = 7.5 (slenderness 26), 112 x 16 elements. Reference:
-/// P = P_E / (1 + P_E / (kappa G A)), kappa = 5/6: 4.3 % below P_E. Tolerance 2 % (the
-/// issue's); measured -1.0 % (the 2D continuum is not a Timoshenko beam: its end faces
+/// P = P_E / (1 + P_E / (kappa G A)), kappa = 5/6: 4.3 % below P_E. Tolerance 2 % (the required
+/// accuracy); measured -1.0 % (the 2D continuum is not a Timoshenko beam: its end faces
 /// warp and the pin is one node; at L / h = 5 the difference grows to -2.2 %, see
 /// docs/validation.md). The shear reduction itself must show: more than 4 % below Euler.
 #[test]
@@ -335,7 +335,7 @@ set = "mid"
 /// Goal: load stepping a perfect column, the inertia of K_T changes (one negative pivot)
 /// within 2 % of Euler's load. Setup: STEPPED; Newton with the elastic tangent (K_0: the
 /// straight path beyond P_E is unstable, K_T indefinite, so Cholesky of K_T would fail;
-/// the check assembles and counts K_T itself). Reference: P_E. Tolerance 2 % (the issue's):
+/// the check assembles and counts K_T itself). Reference: P_E. Tolerance 2 % (the required accuracy):
 /// this mesh's lambda_1 is 0.7 % above P_E, the prebuckling shortening adds ~0.3 %, and the
 /// steps are 0.6 % of P_E.
 #[test]

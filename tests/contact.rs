@@ -44,7 +44,7 @@ fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-/// Goal: the two-bar impact of the Hughes seed (Figs I-12..I-15).
+/// Goal: the two-bar impact of Hughes et al. 1975 (Figs I-12..I-15).
 /// Setup: models/two_bars.toml (14 rods per bar, dt = 0.005, Newmark average, consistent
 /// mass, impact and release conditions). Reference (exact): force rho c A V / 2 = 0.05 on
 /// 0 < t < 0.2, release at 0.2, then bar 1 at rest and bar 2 at V = 0.1, energy kept.
@@ -118,15 +118,15 @@ fn two_bars_energy_loss_falls_with_refinement() {
     );
 }
 
-/// Goal: the energy bound on the seed's mesh. The seed's mesh is 20 rods per bar
+/// Goal: the energy bound on Hughes' own mesh, 20 rods per bar
 /// (h = 0.5: the legend of Fig. I-18 puts elements 1, 11, 19 and 32 at x = 0.25, 5.25, 9.25
 /// and 15.25; 41 degrees of freedom), Courant number 1 at dt = 0.005.
-/// Reference: no energy is lost (exact). Tolerance: the 2 %; the impact conditions'
+/// Reference: no energy is lost (exact). Tolerance: the required 2 %; the impact conditions'
 /// node-pair collision loses about h / (4 L) = 1.25 % (measured 1.6 % with consistent mass).
 #[test]
-fn two_bars_on_the_seeds_mesh_keep_energy_within_two_percent() {
+fn two_bars_on_hughes_mesh_keep_energy_within_two_percent() {
     let r = run(
-        "two_bars_seed_mesh",
+        "two_bars_hughes_mesh",
         "two_bars",
         &["body.bar1.mesh.n=20", "body.bar2.mesh.n=20"],
     );
@@ -195,8 +195,8 @@ fn bar_wall_force_duration_and_rebound() {
 /// Goal: Hertz impact of an elastic sphere on a rigid wall (Hughes Table I-1, whose program
 /// came within 11 %). Setup: models/sphere_wall.toml (axisymmetric, graded to the pole,
 /// dt = 0.01, V = 0.8). Reference: Hertz's quasi-static impact theory
-/// (reference::hertz_sphere_impact): a = 0.590, t = 0.256, P = 60.2. Tolerance 5 % (the
-/// issue's); measured +3.6 % (P), -1.9 % (a, the outermost closed node), +0.4 % (t).
+/// (reference::hertz_sphere_impact): a = 0.590, t = 0.256, P = 60.2. Tolerance 5 % (the required
+/// accuracy); measured +3.6 % (P), -1.9 % (a, the outermost closed node), +0.4 % (t).
 #[test]
 fn sphere_wall_matches_hertz_at_low_speed() {
     let r = run("sphere_wall", "sphere_wall", &[]);
@@ -218,8 +218,8 @@ fn sphere_wall_matches_hertz_at_low_speed() {
 /// sphere R = 8, E = 1000, nu = 0.3, pushed 0.4 onto a rigid plane in 8 increments, some
 /// ended early where the next node touches). Reference: Hertz for the computed total force
 /// P: a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2). The pressure is taken from the nodal
-/// contact forces over their consistent tributary areas (the seed's remark): at the pole
-/// A_0 = int_0^h (1 - r/h) 2 pi r dr = pi h^2 / 3, p = F_0 / A_0. Tolerance 5 % (the issue's),
+/// contact forces over their consistent tributary areas (Hughes et al.'s remark): at the pole
+/// A_0 = int_0^h (1 - r/h) 2 pi r dr = pi h^2 / 3, p = F_0 / A_0. Tolerance 5 % (the required accuracy),
 /// with at least 10 closed nodes inside a.
 #[test]
 fn hertz_sphere_static_radius_and_pressure() {

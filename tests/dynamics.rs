@@ -98,7 +98,7 @@ fn elongation_and_decay(rho: f64, phase: f64, omega_h: f64) -> (f64, f64) {
 /// Reference: the principal root of the method's amplification matrix
 /// (reference::amplification, written from the textbook recurrences). The measured root
 /// comes from a least-squares fit of the two-term recurrence to u_n. Tolerance: 5 % of the
-/// predicted value (the issue's), or 1e-6 absolute where the prediction is zero.
+/// predicted value (the required accuracy), or 1e-6 absolute where the prediction is zero.
 #[test]
 fn oscillator_period_elongation_and_decay_match_amplification_matrices() {
     let cases: [(&str, &[&str], Recurrence); 7] = [

@@ -1,4 +1,4 @@
-//! The explicit fast path (issue #9): one-point Quad4 with Flanagan-Belytschko hourglass
+//! The explicit fast path: one-point Quad4 with Flanagan-Belytschko hourglass
 //! control (`analysis.quadrature = "reduced"`), against closed-form references and the full
 //! kernel.
 

@@ -1,6 +1,6 @@
 //! The elastoplastic impact studies of Erklig, Guzelbey & Cevik (2010), section 3: the
 //! conical-end bar (models/conical_bar.toml) and the round-end bar (models/round_bar.toml)
-//! striking a block, elastic and elastoplastic, with the seed's four integrators and Hu's.
+//! striking a block, elastic and elastoplastic, with the four integrators compared there and Hu's.
 
 mod common;
 
@@ -30,8 +30,8 @@ fn run(scene: &str, name: &str, overrides: &[&str]) -> Result<Run, RunError> {
     impact::analysis::run(&model, &dir, Default::default()).map(|summary| Run { dir, summary })
 }
 
-/// One run of the study: `method` with the seed's dt, central difference at dt = 0.0004
-/// (below its stability limit; the seed's 0.001 is refused, see below).
+/// One run of the study: `method` with the paper's dt, central difference at dt = 0.0004
+/// (below its stability limit; the paper's 0.001 is refused, see below).
 fn study_run(scene: &str, elastic: bool, method: &str) -> Result<Run, RunError> {
     let case = if elastic { "elastic" } else { "plastic" };
     let integrator = format!("analysis.integrator={method}");
@@ -57,11 +57,11 @@ fn peaks(r: &Run) -> [f64; 3] {
     ]
 }
 
-/// Goal: the seed's study runs through, and its main finding holds. Setup: both scenes,
+/// Goal: the paper's study runs through, and its main finding holds. Setup: both scenes,
 /// elastic and elastoplastic, Newmark average, Hu, Wilson 1.4, Houbolt at dt = 0.001 and
 /// central difference at 0.0004 (19 runs: Wilson on the elastoplastic conical bar fails, see
 /// docs/validation.md, and is left out). References:
-/// - the seed's finding (and the energy argument behind it): elastoplastic peak
+/// - the paper's finding (and the energy argument behind it): elastoplastic peak
 ///   displacement, velocity and stress at the contact point below the elastic ones, for
 ///   every method; plastic work positive and below the initial kinetic energy;
 /// - energy balance (kinetic + strain + plastic work + contact work = initial kinetic, with
@@ -110,11 +110,11 @@ fn erklig_study_runs_and_plastic_peaks_stay_below_elastic() {
     }
 }
 
-/// Goal: central difference at the seed's dt = 0.001 is above its stability limit
+/// Goal: central difference at the paper's dt = 0.001 is above its stability limit
 /// (4.6e-4 s on the conical bar, from the element eigenvalue bound) and is refused with an
-/// input error (exit 2) naming the limit, as the dynamics issue designed.
+/// input error (exit 2) naming the limit.
 #[test]
-fn central_difference_at_the_seeds_dt_is_refused() {
+fn central_difference_at_the_papers_dt_is_refused() {
     let err = run(
         "conical_bar",
         "conical_bar_cd_refused",

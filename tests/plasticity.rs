@@ -88,7 +88,7 @@ curve = "cycle"
 /// pushed to -3 eps_y and back to 0 in 40 steps, small strain; isotropic (H = 10) and
 /// kinematic (H_kin = 10) hardening, E = 200, sigma_y = 0.5. Reference: the piecewise-linear
 /// closed form (reference::uniaxial_bar_stress) at each step's strain. Tolerance 1e-8
-/// relative (the issue's): the return is exact for linear hardening, Newton stops at 1e-12.
+/// relative (the required accuracy): the return is exact for linear hardening, Newton stops at 1e-12.
 #[test]
 fn uniaxial_cycle_matches_closed_form_isotropic_and_kinematic() {
     for (body, end_set) in [(ROD, "end"), (QUAD, "right")] {
@@ -237,8 +237,8 @@ fn plate_with_hole_plane_stress_converges() {
 }
 
 /// Goal: the Newton strategies and tangents reach the same answer at the same tolerance
-/// (issue #3's table). Setup: models/hill_cylinder.toml with modified, full and initial
-/// strategies on the consistent tangent, and modified with the seed's elastic tangent (the
+/// (the table of strategies and tangents). Setup: models/hill_cylinder.toml with modified, full and initial
+/// strategies on the consistent tangent, and modified with Erklig's elastic tangent (the
 /// initial-stress method proper, which needs many iterations near the limit: 400 allowed).
 /// Reference: the full-Newton bore displacement; agreement within 1e-6 relative (the
 /// convergence tolerances are 1e-8).

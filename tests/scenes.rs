@@ -1,4 +1,4 @@
-//! Every scene in models/ runs to completion and writes the output contract (DESIGN section 5):
+//! Every scene in models/ runs to completion and writes the output contract (docs/user-guide.md):
 //! summary.json with its fields, history.csv with its leading columns, a .pvd whose frames load.
 //! The physics of each scene is checked in its own test file (see models/README.md).
 

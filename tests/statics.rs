@@ -296,7 +296,7 @@ fn lame_cylinder_axisymmetric_matches_and_converges() {
 /// The elastica: tip of models/cantilever_large.toml (plane stress Quad4, L/h = 20,
 /// 200 x 4 elements, full Newton) at k = P L^2 / EI = 1 and 2 against the elastica ODE
 /// integrated independently (reference::elastica_tip, itself checked against Mattiasson's
-/// table). Tolerance 2 % (the issue's); the continuum beam also shears (~0.2 % at L/h = 20).
+/// table). Tolerance 2 % (the required accuracy); the continuum beam also shears (~0.2 % at L/h = 20).
 #[test]
 fn cantilever_large_matches_elastica() {
     let text = std::fs::read_to_string("models/cantilever_large.toml").unwrap();

@@ -1,4 +1,4 @@
-//! `impact sweep` (issue #8): convergence of the contact force on the Hughes bar problems
+//! `impact sweep`: convergence of the contact force on the Hughes bar problems
 //! against the exact (d'Alembert) solutions, the stability of the integrators against the
 //! central-difference limit, reruns that do no work, shards that merge into the whole.
 
@@ -29,7 +29,7 @@ fn observed_order(points: &[(f64, f64)]) -> f64 {
     impact::sweep::charts::fitted_slope(points).unwrap().0
 }
 
-/// Goal: issue #8 item 1: on two_bars (Newmark average, impact and release conditions),
+/// Goal: on two_bars (Newmark average, impact and release conditions),
 /// refining h and dt together (Courant number 0.7) makes the contact-force error fall.
 /// Setup: a zipped --vary over n = 14, 28, 56 rods per bar with dt = 0.005, 0.0025, 0.00125.
 /// Reference (exact, reference::equal_bars_impact): F = rho c A V / 2 = 0.05 on 0 < t < 0.2.
@@ -77,7 +77,7 @@ fn two_bars_force_error_converges_with_h_and_dt_together() {
     }
 }
 
-/// Goal: issue #8 item 2: the stability map. Setup: bar_wall (dt_crit = h / c = 1/140 for
+/// Goal: the stability map. Setup: bar_wall (dt_crit = h / c = 1/140 for
 /// the lumped rod, reference: the element bound 2 / omega_max with omega_max = 2 c / h),
 /// to t = 0.4 as in the scene (a shorter run catches Wilson's known first-steps overshoot,
 /// Hilber and Hughes 1978, as an energy gain: +43 % at t = 0.1 with 10 dt_crit, -18 % by the
@@ -152,7 +152,7 @@ fn deterministic(csv: &Path) -> Vec<String> {
         .collect()
 }
 
-/// Goal: issue #8 item 3: a rerun of a finished sweep does no work, and two shards merged
+/// Goal: a rerun of a finished sweep does no work, and two shards merged
 /// equal the unsharded sweep. Setup: two_bars to t = 0.05, 2 integrators x 2 dt (4 cases).
 /// Reference: the report's count of executed runs (0 on the rerun); the merged sweep.csv
 /// equals the unsharded one in every column but wall_seconds (each case runs on one thread:

@@ -1,4 +1,4 @@
-//! The buckling check of a run (Erklig 2.1.3, DESIGN section 3): the inertia of K_T after each
+//! The buckling check of a run (Erklig 2.1.3): the inertia of K_T after each
 //! converged state, the linearized buckling load factors of the scene's loads, and the
 //! imperfection (a buckling mode added to the coordinates). The numerics are in `stability`.
 //!

@@ -27,15 +27,15 @@ use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
 
-/// The integrator a scene asks for (implicit ones).
+/// The integrator a scene asks for (implicit ones); the Newmark family's beta and gamma are
+/// the scene's (its presets for `average`, `linear` and `hu`).
 pub fn integrator(spec: &DynamicSpec) -> Box<dyn Integrator> {
+    let newmark = |label| Box::new(GeneralizedAlpha::newmark(label, spec.beta, spec.gamma));
     match spec.integrator {
-        IntegratorKind::Average => Box::new(GeneralizedAlpha::newmark("average", 0.25, 0.5)),
-        IntegratorKind::Linear => Box::new(GeneralizedAlpha::newmark("linear", 1.0 / 6.0, 0.5)),
-        IntegratorKind::Hu => Box::new(GeneralizedAlpha::newmark("hu", 1.0, 1.5)),
-        IntegratorKind::Newmark => {
-            Box::new(GeneralizedAlpha::newmark("newmark", spec.beta, spec.gamma))
-        }
+        IntegratorKind::Average => newmark("average"),
+        IntegratorKind::Linear => newmark("linear"),
+        IntegratorKind::Hu => newmark("hu"),
+        IntegratorKind::Newmark => newmark("newmark"),
         IntegratorKind::Wilson => Box::new(Wilson { theta: spec.theta }),
         IntegratorKind::Houbolt => Box::new(Houbolt::default()),
         IntegratorKind::Hht => Box::new(GeneralizedAlpha::hht(spec.alpha)),

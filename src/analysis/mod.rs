@@ -95,7 +95,8 @@ pub struct EnergySummary {
 
 pub use buckling::BucklingSummary;
 
-/// summary.json (DESIGN section 5): other tools read it; fields are only ever added.
+/// summary.json (the output contract of docs/user-guide.md): other tools read it; fields
+/// are only ever added.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Summary {
     pub scene: String,

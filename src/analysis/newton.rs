@@ -415,18 +415,13 @@ impl Step<'_> {
             if iteration == newton.max_iterations {
                 break;
             }
-            // refactor when the residual stops contracting, or contracts too slowly to reach
-            // the tolerance within the iterations left (predicted from the last ratio)
-            let ratio = residual_norm / previous_residual;
-            let needed = (newton.tol_force * scale / residual_norm).ln() / ratio.ln();
-            let left = (newton.max_iterations - iteration) as f64;
-            // (refactoring cannot help where the factorized matrix would not change: an
-            // elastic tangent on linear kinematics)
-            let refactor_helps =
-                newton.tangent == Tangent::Consistent || self.geometry == Strain::Finite;
             let stalled = iteration > 0
-                && refactor_helps
-                && (ratio > newton.contraction || needed > 0.5 * left);
+                && self.stalled(
+                    iteration,
+                    residual_norm / previous_residual,
+                    residual_norm,
+                    scale,
+                );
             if stalled && !refactor {
                 // the same state again, now with the tangent assembled
                 self.evaluate(state, &d, Some(&mut *system))?;
@@ -459,6 +454,19 @@ impl Step<'_> {
             "no convergence in {} iterations",
             newton.max_iterations
         )))
+    }
+
+    /// Whether the iteration should refactor: the residual stops contracting (`ratio` of the
+    /// last two), or contracts too slowly to reach the tolerance within the iterations left
+    /// (predicted from that ratio). Refactoring cannot help where the factorized matrix would
+    /// not change: an elastic tangent on linear kinematics.
+    fn stalled(&self, iteration: usize, ratio: f64, residual_norm: f64, scale: f64) -> bool {
+        let newton = self.newton;
+        let needed = (newton.tol_force * scale / residual_norm).ln() / ratio.ln();
+        let left = (newton.max_iterations - iteration) as f64;
+        let refactor_helps =
+            newton.tangent == Tangent::Consistent || self.geometry == Strain::Finite;
+        refactor_helps && (ratio > newton.contraction || needed > 0.5 * left)
     }
 
     /// R on the free DOFs and the force scale of eps_2.

@@ -128,6 +128,33 @@ enum Slip {
     Return(f64),
 }
 
+/// The inactive slaves that penetrate at the end of a solve (positions `end`), and the
+/// fraction alpha = g_0 / (g_0 - g_1) of the step at which the first of them touched
+/// (Erklig 2.1.4); 0 when one was already within TOL at the start or the pair does not split.
+fn first_event(
+    pairs: &[ContactPair],
+    start: &[[f64; 2]],
+    end: &dyn Fn(usize) -> [f64; 2],
+    entries: &[(usize, usize)],
+) -> (Vec<(usize, usize)>, f64) {
+    let search = std::time::Instant::now();
+    let at_start = |n: usize| start[n];
+    let mut penetrating = Vec::new();
+    let mut alpha = 1.0f64;
+    for s in search::penetrating(pairs, end, &|p, k| entries.contains(&(p, k))) {
+        let options = &pairs[s.pair].options;
+        penetrating.push((s.pair, s.index));
+        let g0 = pairs[s.pair].gap(s.node, &at_start).map_or(0.0, |g| g.gap);
+        if options.split_at_events && g0 > options.tolerance {
+            alpha = alpha.min(g0 / (g0 - s.gap.gap));
+        } else {
+            alpha = 0.0;
+        }
+    }
+    crate::profile::add(crate::profile::Phase::Contact, search);
+    (penetrating, alpha)
+}
+
 impl ContactState {
     /// Every pair starts open: slaves touching at the start (|g| <= TOL) close in the first
     /// step they press on their master, so the impact conditions see that closure.
@@ -207,21 +234,7 @@ impl ContactState {
                 continue;
             }
             let end = |n: usize| [start[n][0] + d[2 * n], start[n][1] + d[2 * n + 1]];
-            let at_start = |n: usize| start[n];
-            let search = std::time::Instant::now();
-            let mut penetrating = Vec::new();
-            let mut alpha = 1.0f64;
-            for s in search::penetrating(pairs, &end, &|p, k| entries.contains(&(p, k))) {
-                let options = &pairs[s.pair].options;
-                penetrating.push((s.pair, s.index));
-                let g0 = pairs[s.pair].gap(s.node, &at_start).map_or(0.0, |g| g.gap);
-                if options.split_at_events && g0 > options.tolerance {
-                    alpha = alpha.min(g0 / (g0 - s.gap.gap));
-                } else {
-                    alpha = 0.0;
-                }
-            }
-            crate::profile::add(crate::profile::Phase::Contact, search);
+            let (penetrating, alpha) = first_event(pairs, start, &end, &entries);
             if penetrating.is_empty() {
                 // friction: Greco's return targets from this (frictionless) slip, once per
                 // step; Coulomb stick <-> slide switches. A cycling status is accepted after

@@ -56,7 +56,7 @@ pub enum Master {
     Obstacle(Obstacle),
 }
 
-/// How a pair behaves; every switch of the seeds is here so its effect can be shown.
+/// How a pair behaves; every switch of the source documents is here so its effect can be shown.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PairOptions {
     /// Hughes II-8 when a pair closes (dynamics).

@@ -104,7 +104,7 @@ fn affine(c: f64, terms: &[(f64, &[f64])], n: usize) -> (f64, Vec<f64>) {
 /// v_{n+1} = v_n + dt ((1 - gamma) a_n + gamma a_{n+1})
 /// ```
 /// Newmark presets: `average` (1/4, 1/2), `linear` (1/6, 1/2), and Hu's (1.0, 1.5) of the
-/// Greco seed (eqs 18-33), which is unconditionally stable and strongly dissipative.
+/// Greco & Coda 2003 (eqs 18-33), which is unconditionally stable and strongly dissipative.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeneralizedAlpha {
     pub label: &'static str,

@@ -1,4 +1,4 @@
-//! history.csv: one row of scalars per output step (DESIGN.md section 5).
+//! history.csv: one row of scalars per output step (the output contract of docs/user-guide.md).
 //!
 //! ```text
 //! time,kinetic_energy,internal_energy,...     header: column names, first is `time`

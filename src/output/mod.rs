@@ -1,4 +1,4 @@
-//! Output files read by other tools (DESIGN.md section 5): the VTK time series
+//! Output files read by other tools (the output contract of docs/user-guide.md): the VTK time series
 //! (`vtk`: DIR/NAME.pvd + DIR/vtk/NAME_NNNNN.vtu), the history table (`history`: history.csv),
 //! and charts drawn from them (`plot`: SVG and PNG with plotters).
 //!

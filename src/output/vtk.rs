@@ -1,4 +1,4 @@
-//! VTK time series for ParaView: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu (DESIGN.md section 5).
+//! VTK time series for ParaView: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu (the output contract of docs/user-guide.md).
 //!
 //! Legend
 //! ```text

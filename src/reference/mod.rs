@@ -476,7 +476,7 @@ mod hertz_tests {
     /// V = 0.8 and a = 1.00, t = 0.197, p = 294 at V = 3.0 (R = 5, rho = 0.01, E = 1000,
     /// nu = 0.3), to their printed digits.
     #[test]
-    fn hertz_impact_matches_the_seed_table() {
+    fn hertz_impact_matches_hughes_table_i_1() {
         let (a, t, p) = super::hertz_sphere_impact(5.0, 0.01, 1000.0, 0.3, 0.8);
         approx::assert_abs_diff_eq!(a, 0.59, epsilon = 0.005);
         approx::assert_abs_diff_eq!(t, 0.256, epsilon = 0.0005);
