@@ -87,8 +87,6 @@ pub trait Stepper {
     /// The kinetic energy at t = 0: summary.json `energy.initial` and the drift's reference.
     fn initial_kinetic(&self) -> f64;
     fn contact(&self) -> &ContactState;
-    /// The nodal contact forces of the committed state (all DOFs).
-    fn contact_forces(&self) -> Vec<f64>;
     fn solver(&self) -> Option<&Solver>;
     fn solver_mut(&mut self) -> Option<&mut Solver>;
     /// Makes the state's material points current before output reads them (the one-point
@@ -445,7 +443,14 @@ impl<'a, S: Stepper> Run<'a, S> {
         self.stepper.sync_points();
         self.fill_summary();
         self.recorder.write_summary(&self.summary)?;
-        let contact_force = self.stepper.contact_forces();
+        let positions = self
+            .stepper
+            .state()
+            .positions(self.model.analysis.geometry());
+        let contact_force = self
+            .stepper
+            .contact()
+            .nodal_forces(&self.model.contacts, &positions);
         Ok(Outcome {
             summary: self.summary.clone(),
             state: self.stepper.state().clone(),

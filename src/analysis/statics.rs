@@ -286,10 +286,6 @@ impl Stepper for Statics<'_> {
     fn contact(&self) -> &ContactState {
         &self.contact
     }
-    fn contact_forces(&self) -> Vec<f64> {
-        let positions = self.state.positions(self.spec.geometry);
-        self.contact.nodal_forces(&self.model.contacts, &positions)
-    }
     fn solver(&self) -> Option<&Solver> {
         Some(&self.solver)
     }

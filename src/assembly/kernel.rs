@@ -303,31 +303,17 @@ impl Kernel {
         }
     }
 
-    /// The lumped mass per node of element `e` on the `initial` coordinates (its row sums).
+    /// The lumped mass per node of element `e` on the `initial` coordinates: the row sums of
+    /// its consistent mass.
     pub fn lumped_mass(
         &self,
         body: &Body,
         initial: &[[f64; 2]],
         e: usize,
     ) -> Result<Vec<f64>, KernelError> {
-        let rho = body.material.density;
-        match *self {
-            Kernel::Quad4 {
-                formulation,
-                thickness,
-                ..
-            } => {
-                let x = quad_nodes(body, e, initial);
-                let geom = quad4::values(&x, formulation, &[thickness; 4])?;
-                let m = quad4::mass(&geom);
-                Ok((0..4).map(|i| rho * m.row(i).sum()).collect())
-            }
-            Kernel::Rod2 { area } => {
-                let x = rod_nodes(body, e, initial);
-                let l = rod2::length(&x)?;
-                Ok(vec![rho * area * l / 2.0; 2])
-            }
-        }
+        let m = self.mass(body, initial, e)?;
+        let nn = body.mesh.cells.nodes_of(e).len();
+        Ok(m.chunks_exact(nn).map(|row| row.iter().sum()).collect())
     }
 
     /// The largest eigenvalue of M_e^-1 K_e of element `e` (lumped M_e) at the committed

@@ -392,7 +392,15 @@ impl ContactState {
         } in touching
         {
             let pair = &interfaces.pairs[p];
-            if !conditions::approaching(interfaces, pair, s, &gap, coords, lumped, velocity) {
+            let entry = conditions::Entry {
+                interfaces,
+                pair,
+                slave: s,
+                gap: &gap,
+                coords,
+                lumped,
+            };
+            if !conditions::approaching(&entry, velocity) {
                 continue; // touching but not approaching
             }
             self.active[p][k] = true;
@@ -402,18 +410,7 @@ impl ContactState {
                 // the velocities before the impact are the previous step's
                 let previous = velocity.to_vec();
                 let mut force = 0.0;
-                conditions::impact(
-                    interfaces,
-                    pair,
-                    s,
-                    &gap,
-                    coords,
-                    lumped,
-                    &previous,
-                    velocity,
-                    acceleration,
-                    &mut force,
-                );
+                conditions::impact(&entry, &previous, velocity, acceleration, &mut force);
                 self.force[p][k] = force.max(0.0);
             }
         }
@@ -598,13 +595,16 @@ pub fn apply_conditions<S>(
             .iter()
             .position(|e| *e == (p, k))
             .expect("closed entries are active");
-        conditions::impact(
+        let entry = conditions::Entry {
             interfaces,
             pair,
-            s,
-            &gap,
+            slave: s,
+            gap: &gap,
             coords,
             lumped,
+        };
+        conditions::impact(
+            &entry,
             previous_velocity,
             velocity,
             acceleration,
@@ -625,7 +625,7 @@ pub fn apply_conditions<S>(
             let t = gap.tangent();
             let change = step.tangential[i] - old;
             conditions::add_normal(acceleration, s, t, change / lumped[2 * s]);
-            if let Some(side) = conditions::master_side(interfaces, pair, &gap, lumped, coords)
+            if let Some(side) = entry.master()
                 && side.mass > 0.0
             {
                 conditions::spread(acceleration, &side, t, -change / side.mass);
@@ -640,16 +640,21 @@ pub fn apply_conditions<S>(
         let s = pair.slaves[k];
         let Some(gap) = pair.gap(s, &x) else { continue };
         let n = gap.normal;
-        let (ms, zs) = (
-            lumped[2 * s],
-            interfaces.impedance(pair.slave_body, s, coords),
-        );
+        let entry = conditions::Entry {
+            interfaces,
+            pair,
+            slave: s,
+            gap: &gap,
+            coords,
+            lumped,
+        };
+        let (ms, zs) = entry.slave_mass_and_impedance();
         conditions::add_normal(velocity, s, n, tau / zs);
         conditions::add_normal(acceleration, s, n, -tau / ms);
         // the friction force goes with the normal one (its acceleration, as in II-12)
         let t = gap.tangent();
         conditions::add_normal(acceleration, s, t, -friction / ms);
-        if let Some(side) = conditions::master_side(interfaces, pair, &gap, lumped, coords) {
+        if let Some(side) = entry.master() {
             conditions::spread(velocity, &side, n, -tau / side.impedance);
             conditions::spread(acceleration, &side, n, tau / side.mass);
             conditions::spread(acceleration, &side, t, friction / side.mass);

@@ -35,47 +35,63 @@ pub(super) struct MasterSide {
     pub impedance: f64,
 }
 
-pub(super) fn master_side(
-    interfaces: &Interfaces,
-    pair: &ContactPair,
-    gap: &Gap,
-    lumped: &[f64],
-    coords: &[[f64; 2]],
-) -> Option<MasterSide> {
-    let body = match &pair.master {
-        Master::Obstacle(_) => return None,
-        Master::Segments { body, .. } | Master::Nodes { body, .. } => *body,
-    };
-    let mass = gap.masters.iter().map(|(m, w)| w * lumped[2 * m]).sum();
-    let impedance = gap
-        .masters
-        .iter()
-        .map(|(m, w)| w * interfaces.impedance(body, *m, coords))
-        .sum();
-    Some(MasterSide {
-        nodes: gap.masters.clone(),
-        mass,
-        impedance,
-    })
+/// One entry at a configuration: what its conditions read.
+pub(super) struct Entry<'a> {
+    pub interfaces: &'a Interfaces,
+    pub pair: &'a ContactPair,
+    /// The slave's global node, and its gap to the master at `coords`.
+    pub slave: usize,
+    pub gap: &'a Gap,
+    pub coords: &'a [[f64; 2]],
+    /// The lumped mass per DOF.
+    pub lumped: &'a [f64],
+}
+
+impl Entry<'_> {
+    /// The master side of the entry; None on a rigid obstacle.
+    pub fn master(&self) -> Option<MasterSide> {
+        let body = match &self.pair.master {
+            Master::Obstacle(_) => return None,
+            Master::Segments { body, .. } | Master::Nodes { body, .. } => *body,
+        };
+        let gap = self.gap;
+        let mass = gap
+            .masters
+            .iter()
+            .map(|(m, w)| w * self.lumped[2 * m])
+            .sum();
+        let impedance = gap
+            .masters
+            .iter()
+            .map(|(m, w)| w * self.interfaces.impedance(body, *m, self.coords))
+            .sum();
+        Some(MasterSide {
+            nodes: gap.masters.clone(),
+            mass,
+            impedance,
+        })
+    }
+
+    /// The slave's lumped mass and impedance.
+    pub fn slave_mass_and_impedance(&self) -> (f64, f64) {
+        let s = self.slave;
+        (
+            self.lumped[2 * s],
+            self.interfaces
+                .impedance(self.pair.slave_body, s, self.coords),
+        )
+    }
 }
 
 /// Whether a touching slave approaches its master: the normal velocity relative to the
 /// master's interpolated one is negative.
-pub(super) fn approaching(
-    interfaces: &Interfaces,
-    pair: &ContactPair,
-    s: usize,
-    gap: &Gap,
-    coords: &[[f64; 2]],
-    lumped: &[f64],
-    velocity: &[f64],
-) -> bool {
-    let n = gap.normal;
-    let master = master_side(interfaces, pair, gap, lumped, coords);
+pub(super) fn approaching(entry: &Entry, velocity: &[f64]) -> bool {
+    let n = entry.gap.normal;
+    let master = entry.master();
     let vm = master
         .as_ref()
         .map_or(0.0, |m| interpolated(velocity, m, n));
-    normal_component(velocity, s, n) - vm < 0.0
+    normal_component(velocity, entry.slave, n) - vm < 0.0
 }
 
 /// Spreads a change of the interpolated normal component over the master nodes so that the
@@ -104,16 +120,14 @@ pub(super) fn interpolated(v: &[f64], side: &MasterSide, n: [f64; 2]) -> f64 {
 /// keeps the tangential motion, R = 1 stops it). The give-back turns v_t towards its value
 /// before the step and stops there. Momentum is shared by the lumped masses.
 fn tangential_impact(
-    pair: &ContactPair,
-    s: usize,
-    gap: &Gap,
+    entry: &Entry,
     master: Option<&MasterSide>,
-    lumped: &[f64],
     previous_velocity: &[f64],
     velocity: &mut [f64],
     normal_change: f64,
 ) {
-    let t = gap.tangent();
+    let (pair, s, lumped) = (entry.pair, entry.slave, entry.lumped);
+    let t = entry.gap.tangent();
     let vm = master.map_or(0.0, |m| interpolated(velocity, m, t));
     let relative = normal_component(velocity, s, t) - vm;
     let change = match pair.options.friction {
@@ -141,29 +155,20 @@ fn tangential_impact(
 /// Hughes II-8 for one slave: the common normal velocity from the impedances and the
 /// previous velocities, the common acceleration from the masses, and the force that keeps
 /// the equations of motion.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn impact(
-    interfaces: &Interfaces,
-    pair: &ContactPair,
-    s: usize,
-    gap: &Gap,
-    coords: &[[f64; 2]],
-    lumped: &[f64],
+    entry: &Entry,
     previous_velocity: &[f64],
     velocity: &mut [f64],
     acceleration: &mut [f64],
     force: &mut f64,
 ) {
-    let n = gap.normal;
-    let (ms, zs) = (
-        lumped[2 * s],
-        interfaces.impedance(pair.slave_body, s, coords),
-    );
+    let (s, n) = (entry.slave, entry.gap.normal);
+    let (ms, zs) = entry.slave_mass_and_impedance();
     let (vs_prev, as_now) = (
         normal_component(previous_velocity, s, n),
         normal_component(acceleration, s, n),
     );
-    let master = master_side(interfaces, pair, gap, lumped, coords);
+    let master = entry.master();
     let (v_plus, a_plus) = match &master {
         None => (0.0, 0.0),
         Some(side) => {
@@ -192,11 +197,8 @@ pub(super) fn impact(
     *force = tau_plus.max(0.0);
     let normal_change = v_plus - normal_component(velocity, s, n);
     tangential_impact(
-        pair,
-        s,
-        gap,
+        entry,
         master.as_ref(),
-        lumped,
         previous_velocity,
         velocity,
         normal_change,
