@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::column;
+use common::{column, mean};
 
 use std::path::Path;
 
@@ -38,10 +38,6 @@ fn window(run: &Run, column_name: &str, from: f64, to: f64) -> Vec<f64> {
         .filter(|(t, _)| **t >= from - 1e-12 && **t <= to + 1e-12)
         .map(|(_, v)| v)
         .collect()
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
 }
 
 /// Goal: the two-bar impact of Hughes et al. 1975 (Figs I-12..I-15).

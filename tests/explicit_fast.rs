@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::column;
+use common::{column, mean};
 
 /// Goal: the micro-benchmark of the reduced kernel (run by hand, no timing assertion):
 /// `cargo test --release -j 1 --test explicit_fast -- --ignored --nocapture`.
@@ -22,10 +22,6 @@ fn kernel_benchmark_element_updates_per_second() {
             100.0 * run.plastic_fraction
         );
     }
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
 }
 
 /// The scene models/strip_wall.toml with `analysis.quadrature` set.

@@ -47,3 +47,8 @@ pub fn column(dir: &Path, name: &str) -> Vec<f64> {
         .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
         .collect()
 }
+
+/// The arithmetic mean.
+pub fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
