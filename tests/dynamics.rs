@@ -619,7 +619,7 @@ fn a_remainder_shorter_than_the_shortest_step_joins_the_last_step() {
     let impact::scene::model::Analysis::Dynamic(spec) = &model.analysis else {
         panic!("a dynamic scene")
     };
-    let dt = spec.dt;
+    let dt = spec.dt();
     for extra in [1e-13, 3.6e-10] {
         let end = 3.0 * dt + extra;
         let set = format!("analysis.end_time={end:e}");

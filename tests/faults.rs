@@ -239,15 +239,18 @@ end_time = 0.1
     }
 }
 
-/// Goal: a failing explicit contact run reports its contact: the summary's contact block is
-/// filled in the same place whatever the stepper and however the run ends. Setup:
-/// models/round_bar_wall.toml with central difference at dt = 4e-4 (below the initial
-/// stability limit, 5.1e-4): the crushed tip inverts an element at t = 0.0476, long after
-/// the first contact. Reference: the run's own history.csv, written row by row before the
-/// failure: the summary's first contact time is the first row with a contact force, and its
-/// peak force is the largest force in the column.
+/// Goal: a fixed explicit step that becomes too large stops the run `unstable`, naming the
+/// body, the element, the time, dt and the current limit, before any element inverts; and
+/// the failing run reports its contact (the summary's contact block is filled in the same
+/// place whatever the stepper and however the run ends). Setup: models/round_bar_wall.toml
+/// with central difference at dt = 4e-4 (below the initial stability limit, 5.1e-4): the tip
+/// elements crush as the bar strikes the wall, and their stable step falls below dt (this
+/// run used to go on until an element inverted at t = 0.0476). Reference: the run's own
+/// history.csv, written row by row before the stop: the summary's first contact time is the
+/// first row with a contact force and its peak force the largest in the column; the stop
+/// comes before t = 0.0476.
 #[test]
-fn failing_explicit_contact_run_reports_its_contact() {
+fn fixed_explicit_step_too_large_stops_unstable_and_reports_contact() {
     let model = impact::scene::load(
         Path::new("models/round_bar_wall.toml"),
         &[
@@ -259,17 +262,29 @@ fn failing_explicit_contact_run_reports_its_contact() {
     let dir = common::out_dir("explicit_contact_failure");
     let err = impact::analysis::run(&model, &dir, Default::default()).unwrap_err();
     assert_eq!(err.exit_code(), 3, "{err}");
+    let message = err.to_string();
+    for needle in [
+        "body `bar`",
+        "element",
+        "dt = 0.0004",
+        "stability limit",
+        "at t = ",
+    ] {
+        assert!(message.contains(needle), "`{needle}` missing: {message}");
+    }
+    assert!(!message.contains("Jacobian"), "{message}");
     let summary: impact::analysis::Summary =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(summary.status, impact::analysis::Status::Diverged);
+    assert_eq!(summary.status, impact::analysis::Status::Unstable);
     let time = common::column(&dir, "time");
+    assert!(*time.last().unwrap() < 0.0476);
     let force = common::column(&dir, "contact_force[tip]");
     let first = time
         .iter()
         .zip(&force)
         .find(|(_, f)| **f > 0.0)
         .map(|(t, _)| *t)
-        .expect("the bar reaches the wall before it fails");
+        .expect("the bar reaches the wall before it stops");
     assert_eq!(summary.contact.first_contact_time, Some(first));
     let peak = force.iter().copied().fold(0.0, f64::max);
     assert_eq!(summary.contact.peak_force, peak);

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// Bumped whenever a stored type changes: an old checkpoint is refused, not misread.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -92,6 +92,7 @@ pub struct ExplicitCarry {
     /// The last step taken (the loop goes on with step + 1).
     pub step: usize,
     pub contact: ContactState,
+    pub clock: super::clock::Clock,
 }
 
 pub fn path(dir: &Path) -> PathBuf {

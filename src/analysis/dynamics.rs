@@ -94,6 +94,8 @@ pub struct Dynamics<'a> {
     factored_for: Option<[f64; 3]>,
     increments: usize,
     contact: ContactState,
+    /// The length of the last step.
+    last_step: f64,
 }
 
 impl<'a> Dynamics<'a> {
@@ -125,10 +127,11 @@ impl<'a> Dynamics<'a> {
             last_total: vec![0.0; n],
             last_internal: vec![0.0; n],
             last_contact: vec![0.0; n],
-            control: StepControl::new(spec.dt, spec.newton.max_cuts),
+            control: StepControl::new(spec.dt(), spec.newton.max_cuts),
             factored_for: None,
             increments: 0,
             contact: ContactState::new(&model.contacts),
+            last_step: 0.0,
             system,
             solver,
             mass,
@@ -179,7 +182,7 @@ impl<'a> Dynamics<'a> {
             .frame_times
             .iter()
             .copied()
-            .find(|t| *t > time * (1.0 + 1e-9) + 1e-12 * spec.dt)
+            .find(|t| *t > time * (1.0 + 1e-9) + 1e-12 * spec.dt())
             .unwrap_or(f64::INFINITY);
         // a remainder shorter than the shortest step the control takes joins this step: a
         // step of 1e-7 dt (end_time written with a few digits) does not converge
@@ -188,8 +191,8 @@ impl<'a> Dynamics<'a> {
         if stop - end < self.control.shortest() {
             end = stop;
         }
-        let target = super::snap(end, spec.dt);
-        (target, super::step_length(target - time, spec.dt))
+        let target = super::snap(end, spec.dt());
+        (target, super::step_length(target - time, spec.dt()))
     }
 
     /// One attempt at the step of nominal length `nominal` (shortened at a contact event).
@@ -259,11 +262,13 @@ impl<'a> Dynamics<'a> {
         let evaluation = std::mem::take(&mut step.solution.evaluation);
         let internal = evaluation.force.clone();
         assembly::commit(model, &mut self.state, &d, evaluation, spec.geometry);
+        let start = self.state.time;
         self.state.time = if h == nominal {
             target
         } else {
             self.state.time + h
         };
+        self.last_step = self.state.time - start;
         let kin = &mut self.kin;
         let previous_velocity = std::mem::replace(&mut kin.velocity, advance.velocity);
         kin.acceleration = advance.acceleration;
@@ -407,7 +412,7 @@ impl Stepper for Dynamics<'_> {
         self.method.name()
     }
     fn dt(&self) -> f64 {
-        self.spec.dt
+        self.spec.dt()
     }
     fn end_time(&self) -> f64 {
         self.spec.end_time
@@ -424,7 +429,7 @@ impl Stepper for Dynamics<'_> {
 
     fn start(&mut self) -> Result<(), String> {
         let free: Vec<bool> = self.system.equation.iter().map(Option::is_some).collect();
-        let velocity = super::initial_velocity(self.model, &free, self.spec.dt);
+        let velocity = super::initial_velocity(self.model, &free, self.spec.dt());
         let (acceleration, internal) = self
             .initial_acceleration(&velocity)
             .map_err(|reason| format!("initial acceleration: {reason}"))?;
@@ -537,8 +542,11 @@ impl Stepper for Dynamics<'_> {
     fn progress(&self) -> (u64, u64) {
         let spec = self.spec;
         (
-            (self.state.time / spec.dt).round() as u64,
-            (spec.end_time / spec.dt).round().max(1.0) as u64,
+            (self.state.time / spec.dt()).round() as u64,
+            (spec.end_time / spec.dt()).round().max(1.0) as u64,
         )
+    }
+    fn last_step(&self) -> f64 {
+        self.last_step
     }
 }

@@ -13,15 +13,16 @@
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
 use super::checkpoint::{Carry, Checkpoint, ExplicitCarry};
+use super::clock::Clock;
 use super::dynamics::check_mass;
 use super::newton::Counters;
 use super::record::{Energies, Motion};
-use super::run::{StepError, Stepper};
-use super::{RunError, Status, loads};
+use super::run::{StepError, Stepper, TimeStepReport};
+use super::{DtLimit, RunError, Status, loads};
 use crate::assembly::reduced::{Reduced, StepWork};
-use crate::assembly::{self, Mass, State, System};
+use crate::assembly::{self, ElementMasses, FrequencyBound, Mass, State, System};
 use crate::contact::{ContactState, Interfaces};
-use crate::scene::spec::{DynamicSpec, MassKind, Quadrature};
+use crate::scene::spec::{DynamicSpec, MassKind, Quadrature, TimeStep};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use rayon::prelude::*;
@@ -75,9 +76,13 @@ pub struct Explicit<'a> {
     initial_kinetic: f64,
     last_total: Vec<f64>,
     energy_reference: f64,
-    /// Steps taken (the last one's index); `steps` in all.
+    /// Steps taken; with a fixed step, `steps` in all (the last one shorter to end at
+    /// end_time).
     step: usize,
     steps: usize,
+    /// The step rule and the stable step of the committed configuration.
+    clock: Clock,
+    masses: ElementMasses,
     contact: ContactState,
     forces_applied: bool,
     // the step's vectors, allocated once
@@ -88,24 +93,30 @@ pub struct Explicit<'a> {
 }
 
 impl<'a> Explicit<'a> {
-    /// Refuses a dt above the stability limit (unless the scene asks to watch it blow up).
+    /// Refuses a fixed dt above the stability limit of the initial configuration (the
+    /// element eigenvalues), unless the scene asks to watch it blow up.
     pub fn new(model: &'a Model, spec: &'a DynamicSpec) -> Result<Explicit<'a>, RunError> {
         let StableStep {
             dt: dt_crit,
             body: b,
             element: e,
         } = critical_time_step(model)?;
-        if spec.dt > dt_crit && !spec.allow_unstable {
+        if let Some(dt) = spec.fixed_dt()
+            && dt > dt_crit
+            && !spec.allow_unstable
+        {
             return Err(InputError::new(
                 &model.file,
                 format!(
-                    "analysis.dt = {} exceeds the central-difference stability limit {dt_crit:.6e} (set by body `{}`, element {e}); \
-                     lower dt or set analysis.allow_unstable = true to watch it blow up",
-                    spec.dt, model.bodies[b].name
+                    "analysis.dt = {dt} exceeds the central-difference stability limit {dt_crit:.6e} (set by body `{}`, element {e}); \
+                     lower dt, use dt = \"auto\", or set analysis.allow_unstable = true to watch it blow up",
+                    model.bodies[b].name
                 ),
             )
             .into());
         }
+        let masses = ElementMasses::new(model)
+            .map_err(|err| InputError::new(&model.file, err.to_string()))?;
         let system = System::new(model, &loads::constrained_dofs(model));
         let mass = Mass::new(model, MassKind::Lumped)
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
@@ -116,10 +127,19 @@ impl<'a> Explicit<'a> {
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
         let state = State::initial(model);
-        // whole steps, and a shorter last one that ends exactly at end_time
-        let steps = ((spec.end_time / spec.dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
         let reduced = (spec.quadrature == Quadrature::Reduced)
-            .then(|| Reduced::new(model, &state, spec.hourglass));
+            .then(|| Reduced::new(model, &state, spec.hourglass, &masses));
+        let first = match &reduced {
+            Some(kernel) => kernel.frequency_bound(&state.coordinates),
+            None => assembly::frequency_bound(model, &state, &masses),
+        }
+        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+        let clock = Clock::new(spec, dt_crit, first);
+        // fixed: whole steps, and a shorter last one that ends exactly at end_time
+        let steps = match spec.step {
+            TimeStep::Fixed(dt) => ((spec.end_time / dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize,
+            TimeStep::Auto { .. } => (spec.end_time / clock.dt0).ceil().max(1.0) as usize,
+        };
         let dofs = model.dofs();
         Ok(Explicit {
             model,
@@ -142,6 +162,8 @@ impl<'a> Explicit<'a> {
             energy_reference: 0.0,
             step: 0,
             steps,
+            clock,
+            masses,
             contact: ContactState::new(&model.contacts),
             forces_applied: loads::has_external_force(model),
             v_half: vec![0.0; dofs],
@@ -178,9 +200,9 @@ impl<'a> Explicit<'a> {
         self.energies.contact_work -= chunked_sum(&force, &self.du, |f, u| f * u);
     }
 
-    /// The internal force at u_{n+1} and the committed element state; the message of an
-    /// element that failed.
-    fn internal_force(&mut self) -> Result<(), String> {
+    /// The internal force at u_{n+1}, the committed element state and the frequency bound
+    /// of the new configuration; the message of an element that failed.
+    fn internal_force(&mut self) -> Result<FrequencyBound, String> {
         let du = &self.du;
         match self.reduced.as_mut() {
             Some(kernel) => {
@@ -190,6 +212,12 @@ impl<'a> Explicit<'a> {
                 })
                 .map_err(|e| e.to_string())?;
                 commit_reduced(&mut self.state, du, work);
+                let (body, element) = kernel.locate(work.critical_element);
+                Ok(FrequencyBound {
+                    omega_squared: work.omega_squared,
+                    body,
+                    element,
+                })
             }
             None => {
                 let spec = self.spec;
@@ -204,9 +232,10 @@ impl<'a> Explicit<'a> {
                 .map_err(|e| e.to_string())?;
                 self.internal = evaluation.force.clone();
                 assembly::commit(self.model, &mut self.state, du, evaluation, spec.geometry);
+                assembly::frequency_bound(self.model, &self.state, &self.masses)
+                    .map_err(|e| e.to_string())
             }
         }
-        Ok(())
     }
 }
 
@@ -215,7 +244,7 @@ impl Stepper for Explicit<'_> {
         "central_difference".into()
     }
     fn dt(&self) -> f64 {
-        self.spec.dt
+        self.clock.dt0
     }
     fn end_time(&self) -> f64 {
         self.spec.end_time
@@ -254,7 +283,7 @@ impl Stepper for Explicit<'_> {
         self.internal = first;
         let system_free = &self.free;
         let (m, a_r) = (&self.mass, self.spec.rayleigh[0]);
-        let v = super::initial_velocity(model, system_free, self.spec.dt);
+        let v = super::initial_velocity(model, system_free, self.clock.dt0);
         let external = loads::external_force(model, &self.state, &self.initial, 0.0);
         self.a = (0..model.dofs())
             .map(|i| {
@@ -294,6 +323,7 @@ impl Stepper for Explicit<'_> {
         self.energy_reference = carry.energy_reference;
         self.contact = carry.contact;
         self.step = carry.step;
+        self.clock = carry.clock;
         true
     }
 
@@ -314,18 +344,18 @@ impl Stepper for Explicit<'_> {
             energy_reference: self.energy_reference,
             step: self.step,
             contact: self.contact.clone(),
+            clock: self.clock.clone(),
         }))
     }
 
     fn done(&self) -> bool {
-        self.step >= self.steps
+        self.state.time >= self.spec.end_time * (1.0 - 1e-12)
     }
 
     fn advance(&mut self, _: &mut Counters) -> Result<(), StepError> {
         let (model, spec) = (self.model, self.spec);
         let step = self.step + 1;
-        let time = super::snap(step as f64 * spec.dt, spec.dt).min(spec.end_time);
-        let h = super::step_length(time - self.state.time, spec.dt);
+        let (time, h) = self.clock.next(model, spec, self.state.time, step)?;
         predict(&self.v, &self.a, h, &mut self.v_half, &mut self.du);
         for (dof, value) in loads::prescribed(model, &self.initial, time) {
             self.du[dof] = value - self.state.displacement[dof];
@@ -335,18 +365,21 @@ impl Stepper for Explicit<'_> {
             self.contact_correction(h, time);
             crate::profile::add(crate::profile::Phase::Contact, start);
         }
-        if let Err(err) = self.internal_force() {
-            let status = if spec.dt > self.dt_crit {
-                Status::Unstable
-            } else {
-                Status::Diverged
-            };
-            return Err(StepError {
-                status,
-                message: format!("at t = {time}: {err}"),
-                frame: false,
-            });
-        }
+        let bound = match self.internal_force() {
+            Ok(bound) => bound,
+            Err(err) => {
+                let status = if self.clock.fixed_above_limit() {
+                    Status::Unstable
+                } else {
+                    Status::Diverged
+                };
+                return Err(StepError {
+                    status,
+                    message: format!("at t = {time}: {err}"),
+                    frame: false,
+                });
+            }
+        };
         self.state.time = time;
         self.synced = false;
         if self.forces_applied {
@@ -376,6 +409,7 @@ impl Stepper for Explicit<'_> {
         }
         self.energy_reference = self.energy_reference.max(energies.external_work.abs());
         self.step = step;
+        self.clock.took(h, bound);
         Ok(())
     }
 
@@ -386,7 +420,7 @@ impl Stepper for Explicit<'_> {
                 status: Status::Unstable,
                 message: format!(
                     "the energy grew to {energy:.3e} (reference {:.3e}) at t = {}: dt = {} is above the stability limit {:.6e}",
-                    self.energy_reference, self.state.time, self.spec.dt, self.dt_crit
+                    self.energy_reference, self.state.time, self.clock.last, self.dt_crit
                 ),
                 frame: true,
             });
@@ -432,6 +466,21 @@ impl Stepper for Explicit<'_> {
     }
     fn progress(&self) -> (u64, u64) {
         (self.step as u64, self.steps as u64)
+    }
+    fn last_step(&self) -> f64 {
+        self.clock.last
+    }
+    fn time_step_report(&self) -> Option<TimeStepReport> {
+        let c = &self.clock;
+        (self.step > 0).then(|| TimeStepReport {
+            shortest: c.shortest,
+            longest: c.longest,
+            limit: DtLimit {
+                dt: c.limit.dt,
+                body: self.model.bodies[c.limit.body].name.clone(),
+                element: c.limit.element,
+            },
+        })
     }
 }
 
@@ -638,7 +687,7 @@ pub fn kernel_benchmark_run(
         unreachable!("the benchmark scene is dynamic")
     };
     let spec = DynamicSpec {
-        dt: h,
+        step: crate::scene::spec::TimeStep::Fixed(h),
         end_time: h * steps as f64,
         ..spec.clone()
     };

@@ -5,6 +5,7 @@
 
 pub mod buckling;
 pub mod checkpoint;
+pub mod clock;
 pub mod dynamics;
 pub mod explicit;
 pub mod loads;
@@ -95,6 +96,15 @@ pub struct EnergySummary {
 
 pub use buckling::BucklingSummary;
 
+/// The stable step of a configuration (from the element bound, before the scale) and the
+/// body and element that set it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DtLimit {
+    pub dt: f64,
+    pub body: String,
+    pub element: usize,
+}
+
 /// summary.json (the output contract of docs/user-guide.md): other tools read it; fields
 /// are only ever added.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -122,6 +132,12 @@ pub struct Summary {
     pub contact: ContactSummary,
     pub energy: EnergySummary,
     pub buckling: Option<BucklingSummary>,
+    /// Central difference: the shortest and the longest step taken.
+    pub dt_min: Option<f64>,
+    pub dt_max: Option<f64>,
+    /// Central difference: the stable step of the final configuration and the element that
+    /// sets it.
+    pub dt_limit: Option<DtLimit>,
     /// Seconds per phase and element updates (see `profile`); process-wide counters, so
     /// only meaningful for one run per process (as `impact run` and `impact bench` do).
     #[serde(default)]
@@ -158,6 +174,9 @@ impl Summary {
             contact: ContactSummary::default(),
             energy: EnergySummary::default(),
             buckling: None,
+            dt_min: None,
+            dt_max: None,
+            dt_limit: None,
             timing: Default::default(),
         }
     }
@@ -410,19 +429,20 @@ fn run_from(
         )
     })?;
     let model = imperfect.as_ref().unwrap_or(model);
+    let start = std::time::Instant::now();
     match &model.analysis {
         crate::scene::model::Analysis::Static(spec) => {
             let stepper =
                 statics::Statics::new(model, spec).map_err(|e| setup_error(out_dir, e))?;
-            run::execute(model, out_dir, options, resume, stepper)
+            run::execute(model, out_dir, options, resume, (stepper, start))
         }
         crate::scene::model::Analysis::Dynamic(spec) => {
             if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference {
                 let stepper = explicit::Explicit::new(model, spec)?;
-                run::execute(model, out_dir, options, resume, stepper)
+                run::execute(model, out_dir, options, resume, (stepper, start))
             } else {
                 let stepper = dynamics::Dynamics::new(model, spec, out_dir)?;
-                run::execute(model, out_dir, options, resume, stepper)
+                run::execute(model, out_dir, options, resume, (stepper, start))
             }
         }
     }

@@ -49,6 +49,8 @@ pub struct Recorder {
     hourglass_column: bool,
     /// Its value for the next row (the reduced explicit kernel sets it before each step).
     pub hourglass_energy: f64,
+    /// The length of the step the next row ends (column `dt`; 0 on the first row).
+    pub step_length: f64,
 }
 
 impl Recorder {
@@ -81,6 +83,7 @@ impl Recorder {
             negative_pivots: None,
             hourglass_column: hourglass_column(model),
             hourglass_energy: 0.0,
+            step_length: 0.0,
         })
     }
 
@@ -128,6 +131,7 @@ impl Recorder {
             negative_pivots: position.negative_pivots,
             hourglass_column: hourglass_column(model),
             hourglass_energy: 0.0,
+            step_length: 0.0,
         })
     }
 
@@ -166,6 +170,7 @@ impl Recorder {
             energies.plastic_work,
             energies.external_work,
             energies.contact_work,
+            self.step_length,
         ];
         let friction: Vec<bool> = model
             .contacts
@@ -427,6 +432,7 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
         "plastic_work",
         "external_work",
         "contact_work",
+        "dt",
     ]
     .iter()
     .map(|s| s.to_string())

@@ -22,7 +22,7 @@ use super::buckling::{self, Monitor};
 use super::checkpoint::{self, Carry, Checkpoint};
 use super::newton::Counters;
 use super::record::{Energies, Motion, Recorder};
-use super::{Outcome, RunError, RunOptions, Status, Summary};
+use super::{DtLimit, Outcome, RunError, RunOptions, Status, Summary};
 use crate::assembly::State;
 use crate::contact::ContactState;
 use crate::profile::{self, Phase};
@@ -49,6 +49,14 @@ impl StepError {
             frame: false,
         }
     }
+}
+
+/// The steps a central-difference run took and what limits them at the end.
+#[derive(Debug, Clone)]
+pub struct TimeStepReport {
+    pub shortest: f64,
+    pub longest: f64,
+    pub limit: DtLimit,
 }
 
 /// One kind of analysis: it advances the state and says what it holds; the scaffold
@@ -98,6 +106,13 @@ pub trait Stepper {
     }
     /// The progress bar's position and length, in nominal steps.
     fn progress(&self) -> (u64, u64);
+    /// The length of the last step (0 before the first).
+    fn last_step(&self) -> f64;
+    /// What the time step did (central difference): summary.json `dt_min`, `dt_max`,
+    /// `dt_limit`.
+    fn time_step_report(&self) -> Option<TimeStepReport> {
+        None
+    }
 }
 
 /// A run in progress: the stepper and its bookkeeping.
@@ -114,17 +129,17 @@ struct Run<'a, S: Stepper> {
     penetration_limits: Vec<f64>,
 }
 
-/// Runs `stepper` from the start or from `resume`, writing into `dir`.
+/// Runs `stepper` (set up from `start` on) from the beginning or from `resume`, writing
+/// into `dir`.
 pub fn execute<S: Stepper>(
     model: &Model,
     dir: &Path,
     options: RunOptions,
     resume: Option<Checkpoint>,
-    stepper: S,
+    (stepper, start): (S, Instant),
 ) -> Result<Outcome, RunError> {
-    let setup_start = Instant::now();
-    let mut run = Run::open(model, dir, options, resume, stepper)?;
-    profile::add(Phase::Setup, setup_start);
+    let mut run = Run::open(model, dir, options, resume, stepper, start)?;
+    profile::add(Phase::Setup, start);
     while !run.stepper.done() {
         if let Some(end) = run.step()? {
             return end;
@@ -142,6 +157,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         options: RunOptions,
         resume: Option<Checkpoint>,
         mut stepper: S,
+        start: Instant,
     ) -> Result<Run<'a, S>, RunError> {
         let recorder = match &resume {
             Some(c) => Recorder::resume(model, dir, c.recorder.clone())?,
@@ -181,7 +197,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             summary,
             counters: Counters::default(),
             monitor,
-            start: Instant::now(),
+            start,
             progress: progress_bar(options.progress, length),
             penetration_limits,
         };
@@ -313,6 +329,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Some(energy) = self.stepper.hourglass_energy() {
             self.recorder.hourglass_energy = energy;
         }
+        self.recorder.step_length = self.stepper.last_step();
         let s = &self.stepper;
         let contact = (self.summary.steps > 0).then(|| s.contact());
         self.recorder.step_with_contact(
@@ -369,6 +386,11 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.energy.plastic_dissipation = energies.plastic_work;
         summary.contact = s.contact().summary();
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
+        if let Some(report) = s.time_step_report() {
+            summary.dt_min = Some(report.shortest);
+            summary.dt_max = Some(report.longest);
+            summary.dt_limit = Some(report.limit);
+        }
     }
 
     /// A failed step: its frame when asked, then `fail`.

@@ -56,6 +56,8 @@ pub struct Statics<'a> {
     contact: ContactState,
     /// The next increment factors K* afresh (after a checkpoint: a resumed run has none).
     refresh: bool,
+    /// The length of the last increment.
+    last_step: f64,
 }
 
 impl<'a> Statics<'a> {
@@ -78,6 +80,7 @@ impl<'a> Statics<'a> {
             increments: 0,
             contact: ContactState::new(&model.contacts),
             refresh: model.checkpoint_every > 0,
+            last_step: 0.0,
             system,
             solver,
         })
@@ -243,6 +246,7 @@ impl Stepper for Statics<'_> {
                     let evaluation = std::mem::take(&mut step.solution.evaluation);
                     let force = evaluation.force.clone();
                     assembly::commit(self.model, &mut self.state, &d, evaluation, spec.geometry);
+                    self.last_step = end - self.state.time;
                     self.state.time = end;
                     let positions = self.state.positions(spec.geometry);
                     self.contact
@@ -297,5 +301,8 @@ impl Stepper for Statics<'_> {
             (self.state.time / self.dt).round() as u64,
             self.spec.steps as u64,
         )
+    }
+    fn last_step(&self) -> f64 {
+        self.last_step
     }
 }

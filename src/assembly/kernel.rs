@@ -316,6 +316,37 @@ impl Kernel {
         Ok(m.chunks_exact(nn).map(|row| row.iter().sum()).collect())
     }
 
+    /// An upper bound of the highest frequency squared of element `e` on the `coordinates`
+    /// with its lumped nodal masses `lumped` (the elastic moduli of its material): the
+    /// central-difference stable step is at least 2 / sqrt of it. Quad4: the bound of
+    /// `quad4::frequency_bound`; Rod2: exact.
+    pub fn frequency_bound(
+        &self,
+        body: &Body,
+        committed: &BodyState,
+        coordinates: &[[f64; 2]],
+        e: usize,
+        lumped: &[f64],
+    ) -> Result<f64, KernelError> {
+        let elastic = &body.material.elastic;
+        match *self {
+            Kernel::Quad4 { formulation, .. } => {
+                let x = quad_nodes(body, e, coordinates);
+                let geom = quad4::values(&x, formulation, &point_thickness(committed, e))?;
+                let (mut lambda, mu) = elastic.lame();
+                if formulation == Formulation::PlaneStress {
+                    lambda = 2.0 * lambda * mu / (lambda + 2.0 * mu);
+                }
+                let m = [lumped[0], lumped[1], lumped[2], lumped[3]];
+                Ok(quad4::frequency_bound(&geom, lambda, mu, &m))
+            }
+            Kernel::Rod2 { area } => {
+                let x = rod_nodes(body, e, coordinates);
+                rod2::frequency_squared(&x, elastic.young, area, lumped[0].min(lumped[1]))
+            }
+        }
+    }
+
     /// The largest eigenvalue of M_e^-1 K_e of element `e` (lumped M_e) at the committed
     /// state, its frequency squared; `zero` is a zero increment over all DOFs.
     #[allow(clippy::too_many_arguments)]

@@ -460,6 +460,104 @@ impl Mass {
     }
 }
 
+/// The lumped mass of every element at its nodes (per body, element-major, nodes per
+/// element each): invariant in the updated-Lagrangian description (rho dV is).
+#[derive(Debug, Clone)]
+pub struct ElementMasses {
+    bodies: Vec<Vec<f64>>,
+}
+
+impl ElementMasses {
+    pub fn new(model: &Model) -> Result<ElementMasses, ElementFailure> {
+        let initial = model.coordinates();
+        let bodies = model
+            .bodies
+            .iter()
+            .map(|body| {
+                let kernel = Kernel::of(body);
+                let mut masses = Vec::new();
+                for e in 0..body.elements() {
+                    let m =
+                        kernel
+                            .lumped_mass(body, &initial, e)
+                            .map_err(|error| ElementFailure {
+                                body: body.name.clone(),
+                                element: e,
+                                error,
+                            })?;
+                    masses.extend(m);
+                }
+                Ok(masses)
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(ElementMasses { bodies })
+    }
+
+    /// The lumped masses of element `e` of body `b`.
+    pub fn of(&self, model: &Model, b: usize, e: usize) -> &[f64] {
+        let nn = model.bodies[b].mesh.cells.nodes_of(e).len();
+        &self.bodies[b][e * nn..(e + 1) * nn]
+    }
+}
+
+/// An upper bound of the highest frequency squared of the model at the committed state,
+/// element by element (Irons' theorem: the assembled model's highest frequency is at most
+/// the elements' highest), from the closed-form bounds of the kernels (`Kernel::
+/// frequency_bound`); with the element that sets it (the lowest index among equals, so the
+/// result does not depend on the thread count).
+pub fn frequency_bound(
+    model: &Model,
+    state: &State,
+    masses: &ElementMasses,
+) -> Result<FrequencyBound, ElementFailure> {
+    let mut best = FrequencyBound {
+        omega_squared: 0.0,
+        body: 0,
+        element: 0,
+    };
+    for (b, body) in model.bodies.iter().enumerate() {
+        let kernel = Kernel::of(body);
+        let committed = &state.bodies[b];
+        let worst = (0..body.elements())
+            .into_par_iter()
+            .map(|e| {
+                kernel
+                    .frequency_bound(
+                        body,
+                        committed,
+                        &state.coordinates,
+                        e,
+                        masses.of(model, b, e),
+                    )
+                    .map(|w| (w, e))
+                    .map_err(|error| (e, error))
+            })
+            .try_reduce(
+                || (0.0, usize::MAX),
+                |a, b| {
+                    Ok(if b.0 > a.0 || (b.0 == a.0 && b.1 < a.1) {
+                        b
+                    } else {
+                        a
+                    })
+                },
+            )
+            .map_err(|(element, error)| ElementFailure {
+                body: body.name.clone(),
+                element,
+                error,
+            })?;
+        if worst.0 > best.omega_squared {
+            best = FrequencyBound {
+                omega_squared: worst.0,
+                body: b,
+                element: worst.1,
+            };
+        }
+    }
+    Ok(best)
+}
+
 /// The highest element frequency squared and the element that has it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrequencyBound {

@@ -13,7 +13,7 @@
 //! the chunk sums of the work are added in chunk order. The bits do not depend on the thread
 //! count.
 
-use super::{ElementFailure, State};
+use super::{ElementFailure, ElementMasses, State};
 use crate::element::quad4_one_point::{self as one_point, Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
 use crate::material::{Material, PointState, StressCondition};
@@ -33,6 +33,11 @@ struct BodyParameters {
     mu: f64,
     /// kappa (lambda + 3 mu) / 24
     hourglass_modulus: f64,
+    /// The plane-wave modulus of the stable-step bound: lambda + 2 mu (plane stress:
+    /// E / (1 - nu^2)).
+    wave_modulus: f64,
+    /// The body's index in the model and its first element in the kernel's numbering.
+    model_body: usize,
     first_element: usize,
 }
 
@@ -59,6 +64,8 @@ pub struct ElementStep {
     pub work: f64,
     pub plastic_work: f64,
     pub hourglass_work: f64,
+    /// The bound of the element's highest frequency squared on the end configuration.
+    pub omega_squared: f64,
 }
 
 /// One element over one step: positions x at the start, increment u (see the legend).
@@ -68,6 +75,7 @@ fn element_step(
     x: &Nodes,
     u: &Nodes,
     committed: &ElementState,
+    smallest_mass: f64,
 ) -> Result<ElementStep, KernelError> {
     let step = one_point::increment(x, u)?;
     let (c, s) = (step.cos, step.sin);
@@ -138,13 +146,23 @@ fn element_step(
         thickness,
         hourglass: hourglass.forces,
     };
-    let force = one_point::force(&step.end, &state.stress, state.thickness, &state.hourglass)?;
+    let end = one_point::force(&step.end, &state.stress, state.thickness, &state.hourglass)?;
+    let omega_squared = one_point::frequency_bound(
+        &end.gradient,
+        &end.gamma,
+        p.wave_modulus,
+        end.gradient.area * state.thickness,
+        None,
+        p.hourglass_modulus,
+        smallest_mass,
+    );
     Ok(ElementStep {
         state,
-        force,
+        force: end.force,
         work,
         plastic_work: volume * plastic_density,
         hourglass_work: hourglass.work,
+        omega_squared,
     })
 }
 
@@ -155,6 +173,22 @@ pub struct StepWork {
     pub internal: f64,
     pub plastic: f64,
     pub hourglass: f64,
+    /// The largest element frequency bound squared on the end configuration, and its
+    /// element (global index over the kernel's elements; the lowest among equals).
+    pub omega_squared: f64,
+    pub critical_element: usize,
+}
+
+impl StepWork {
+    /// Takes an element's frequency bound into the maximum.
+    fn observe(&mut self, omega_squared: f64, element: usize) {
+        if omega_squared > self.omega_squared
+            || (omega_squared == self.omega_squared && element < self.critical_element)
+        {
+            self.omega_squared = omega_squared;
+            self.critical_element = element;
+        }
+    }
 }
 
 /// Element data of all Quad4 bodies as flat arrays (element-major, global element index
@@ -166,6 +200,8 @@ pub struct Reduced {
     body: Vec<u32>,
     /// Global nodes of each element, counter-clockwise.
     nodes: Vec<[u32; 4]>,
+    /// The smallest lumped nodal mass of each element (for its stable-step bound).
+    smallest_mass: Vec<f64>,
     /// Cauchy stress, 4 per element [xx yy zz xy].
     pub stress: Vec<f64>,
     /// Back stress, 4 per element.
@@ -188,10 +224,11 @@ impl Reduced {
     /// The kernel for the Quad4 bodies of `model` (plane strain or plane stress; the scene
     /// validation refuses the rest), starting from the committed `state`; `kappa` is the
     /// hourglass coefficient.
-    pub fn new(model: &Model, state: &State, kappa: f64) -> Reduced {
+    pub fn new(model: &Model, state: &State, kappa: f64, masses: &ElementMasses) -> Reduced {
         let mut bodies = Vec::new();
         let mut body = Vec::new();
         let mut nodes = Vec::new();
+        let mut smallest_mass = Vec::new();
         let (mut stress, mut back_stress, mut eq_plastic_strain, mut thickness) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (b, spec) in model.bodies.iter().enumerate() {
@@ -210,6 +247,8 @@ impl Reduced {
                 lambda: spec.material.elastic.lame().0,
                 mu,
                 hourglass_modulus: kappa * (lambda + 3.0 * mu) / 24.0,
+                wave_modulus: lambda + 2.0 * mu,
+                model_body: b,
                 first_element: body.len(),
             });
             let index = (bodies.len() - 1) as u32;
@@ -223,6 +262,13 @@ impl Reduced {
                 back_stress.extend(p.back_stress.iter());
                 eq_plastic_strain.push(p.eq_plastic_strain);
                 thickness.push(committed.thickness[4 * e]);
+                smallest_mass.push(
+                    masses
+                        .of(model, b, e)
+                        .iter()
+                        .copied()
+                        .fold(f64::INFINITY, f64::min),
+                );
             }
         }
         let count = body.len();
@@ -247,6 +293,7 @@ impl Reduced {
             bodies,
             body,
             nodes,
+            smallest_mass,
             stress,
             back_stress,
             eq_plastic_strain,
@@ -261,6 +308,12 @@ impl Reduced {
 
     pub fn elements(&self) -> usize {
         self.body.len()
+    }
+
+    /// The model's body and the element's number in it of kernel element `element`.
+    pub fn locate(&self, element: usize) -> (usize, usize) {
+        let p = &self.bodies[self.body[element] as usize];
+        (p.model_body, element - p.first_element)
     }
 
     fn failure(&self, element: usize, error: KernelError) -> ElementFailure {
@@ -320,7 +373,7 @@ impl Reduced {
                     let xe: Nodes = this.nodes[e].map(|n| x[n as usize]);
                     let state = this.state_of(e);
                     match one_point::force(&xe, &state.stress, state.thickness, &state.hourglass) {
-                        Ok(v) => f.copy_from_slice(&v),
+                        Ok(v) => f.copy_from_slice(&v.force),
                         Err(err) => return Some((e, err)),
                     }
                 }
@@ -338,6 +391,38 @@ impl Reduced {
         Ok(())
     }
 
+    /// The largest element frequency bound on the positions `x` from the stored state, with
+    /// its element (model body and element number).
+    pub fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<super::FrequencyBound, ElementFailure> {
+        let mut worst = StepWork {
+            critical_element: usize::MAX,
+            ..StepWork::default()
+        };
+        for e in 0..self.elements() {
+            let xe: Nodes = self.nodes[e].map(|n| x[n as usize]);
+            let state = self.state_of(e);
+            let p = &self.bodies[self.body[e] as usize];
+            let end = one_point::force(&xe, &state.stress, state.thickness, &state.hourglass)
+                .map_err(|err| self.failure(e, err))?;
+            let omega_squared = one_point::frequency_bound(
+                &end.gradient,
+                &end.gamma,
+                p.wave_modulus,
+                end.gradient.area * state.thickness,
+                None,
+                p.hourglass_modulus,
+                self.smallest_mass[e],
+            );
+            worst.observe(omega_squared, e);
+        }
+        let (body, element) = self.locate(worst.critical_element);
+        Ok(super::FrequencyBound {
+            omega_squared: worst.omega_squared,
+            body,
+            element,
+        })
+    }
+
     /// One step: from positions `x` (the start of the step) by the increment `du` (2 per
     /// node); updates the element state and writes the internal force on x + du into
     /// `force`. After an error the element state is partly updated and the run must stop.
@@ -350,6 +435,7 @@ impl Reduced {
         let bodies = &self.bodies;
         let body = &self.body;
         let nodes = &self.nodes;
+        let smallest_mass = &self.smallest_mass;
         let results: Vec<(StepWork, Option<(usize, KernelError)>)> = (
             self.stress.par_chunks_mut(4 * CHUNK),
             self.back_stress.par_chunks_mut(4 * CHUNK),
@@ -361,7 +447,10 @@ impl Reduced {
             .into_par_iter()
             .enumerate()
             .map(|(k, (stress, back, eps_p, thickness, hourglass, forces))| {
-                let mut sums = StepWork::default();
+                let mut sums = StepWork {
+                    critical_element: usize::MAX,
+                    ..StepWork::default()
+                };
                 for i in 0..eps_p.len() {
                     let e = k * CHUNK + i;
                     let element = nodes[e];
@@ -374,10 +463,12 @@ impl Reduced {
                         thickness: thickness[i],
                         hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
                     };
-                    let r = match element_step(&bodies[body[e] as usize], &xe, &ue, &committed) {
+                    let p = &bodies[body[e] as usize];
+                    let r = match element_step(p, &xe, &ue, &committed, smallest_mass[e]) {
                         Ok(r) => r,
                         Err(err) => return (sums, Some((e, err))),
                     };
+                    sums.observe(r.omega_squared, e);
                     stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
                     back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
                     eps_p[i] = r.state.eq_plastic_strain;
@@ -391,7 +482,10 @@ impl Reduced {
                 (sums, None)
             })
             .collect();
-        let mut total = StepWork::default();
+        let mut total = StepWork {
+            critical_element: usize::MAX,
+            ..StepWork::default()
+        };
         for (sums, error) in results {
             if let Some((e, err)) = error {
                 return Err(self.failure(e, err));
@@ -399,6 +493,7 @@ impl Reduced {
             total.internal += sums.internal;
             total.plastic += sums.plastic;
             total.hourglass += sums.hourglass;
+            total.observe(sums.omega_squared, sums.critical_element);
         }
         self.gather(force);
         self.hourglass_energy += total.hourglass;
@@ -456,6 +551,8 @@ mod tests {
             lambda,
             mu,
             hourglass_modulus: 0.1 * (lambda + 3.0 * mu) / 24.0,
+            wave_modulus: lambda + 2.0 * mu,
+            model_body: 0,
             first_element: 0,
         }
     }
@@ -483,7 +580,7 @@ mod tests {
                 let [px, py] = x[a];
                 [c * px - s * py - px, s * px + c * py - py]
             });
-            state = element_step(&p, &x, &u, &state).unwrap().state;
+            state = element_step(&p, &x, &u, &state, 1.0).unwrap().state;
             x = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);
         }
         // round-off: E ~ 200 times strains of ~1e-16 per step

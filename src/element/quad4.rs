@@ -312,6 +312,43 @@ pub fn tangent(
     kt
 }
 
+/// An upper bound of the element's highest frequency squared: for every displacement u,
+/// u . K u <= omega^2 u . M u, with K = sum_q w_q B_q^T D B_q (standard or B-bar, small
+/// strain operators on the current configuration), D isotropic with Lame constants
+/// (`lambda`, `mu`) (plane stress: the condensed lambda 2 lambda mu / (lambda + 2 mu)) and M
+/// the lumped mass `lumped` at the four nodes. At each point, with mass-weighted sums
+/// X = sum_a N_a,x^2 / m_a, Y = sum_a N_a,y^2 / m_a, H = sum_a (N_a / r)^2 / m_a and
+/// XH = sum_a (N_a,x + N_a / r)^2 / m_a (H = 0 and XH = X off the axisymmetric case),
+/// ```text
+/// omega^2 <= sum_q w_q [lambda (XH + Y) + mu (X + Y) + 2 mu max(X + H, Y)]
+/// ```
+/// by Cauchy-Schwarz on each strain component of the energy lambda tr^2 + 2 mu e:e (and
+/// by Jensen's inequality B-bar's averaged volumetric strain stores no more energy than the
+/// points' own). docs/theory.md 8.7 gives the derivation.
+pub fn frequency_bound(values: &QuadValues, lambda: f64, mu: f64, lumped: &[f64; 4]) -> f64 {
+    let axisymmetric = values.formulation == Formulation::Axisymmetric;
+    let mut bound = 0.0;
+    for p in &values.points {
+        let (mut x, mut y, mut h, mut xh) = (0.0, 0.0, 0.0, 0.0);
+        for a in 0..4 {
+            let [nx, ny] = p.dndx[a];
+            let inv = 1.0 / lumped[a];
+            x += nx * nx * inv;
+            y += ny * ny * inv;
+            if axisymmetric {
+                let nh = p.shape[a] / p.radius;
+                h += nh * nh * inv;
+                xh += (nx + nh) * (nx + nh) * inv;
+            }
+        }
+        if !axisymmetric {
+            xh = x;
+        }
+        bound += p.weight * (lambda * (xh + y) + mu * (x + y) + 2.0 * mu * (x + h).max(y));
+    }
+    bound
+}
+
 /// Consistent mass per unit density, the same for both directions: M_ij = sum w N_i N_j.
 pub fn mass(geom: &QuadValues) -> Mat4 {
     let mut m = Mat4::zeros();

@@ -157,6 +157,15 @@ pub fn hourglass(
     Hourglass { forces, work }
 }
 
+/// An element's nodal forces on a configuration, with the gradient and gamma they used.
+#[derive(Debug, Clone, Copy)]
+pub struct Forces {
+    /// [f1x f1y ... f4x f4y]
+    pub force: [f64; 8],
+    pub gradient: Gradient,
+    pub gamma: [f64; 4],
+}
+
 /// Internal force [f1x f1y ... f4x f4y] of an element on the configuration x from its
 /// Cauchy stress, thickness and hourglass forces.
 #[inline(always)]
@@ -165,7 +174,7 @@ pub fn force(
     stress: &[f64; 4],
     thickness: f64,
     hourglass: &[f64; 2],
-) -> Result<[f64; 8], KernelError> {
+) -> Result<Forces, KernelError> {
     let grad = centroid_gradient(x);
     let (area, bx, by) = (grad.area, &grad.bx, &grad.by);
     if !(area > 0.0) {
@@ -182,7 +191,38 @@ pub fn force(
         f[2 * a] = v * (s[0] * bx[a] + s[3] * by[a]) + q[0] * g[a];
         f[2 * a + 1] = v * (s[3] * bx[a] + s[1] * by[a]) + q[1] * g[a];
     }
-    Ok(f)
+    Ok(Forces {
+        force: f,
+        gradient: grad,
+        gamma: g,
+    })
+}
+
+/// An upper bound of the element's highest frequency squared with the hourglass stiffness:
+/// the one-point stiffness (Flanagan & Belytschko 1981: lambda_max <= (lambda + 2 mu) V b.b
+/// for the centroid gradient, the hoop term V / (4 r^2) added in axisymmetry) plus the
+/// hourglass stiffness's own k |gamma|^2 (Weyl: the largest eigenvalue of a sum of positive
+/// semi-definite matrices is at most the sum of theirs: the hourglass stiffness k gamma
+/// gamma^T has the one eigenvalue k |gamma|^2 per direction), over the smallest lumped nodal
+/// mass. `modulus` is lambda + 2 mu (plane stress: E / (1 - nu^2)), `volume` the element's
+/// (thickness or 2 pi r included), `hoop_radius` the centroid radius of an axisymmetric
+/// element, `hourglass_modulus` kappa (lambda + 3 mu) / 24 (k = it V b.b).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn frequency_bound(
+    grad: &Gradient,
+    gamma: &[f64; 4],
+    modulus: f64,
+    volume: f64,
+    hoop_radius: Option<f64>,
+    hourglass_modulus: f64,
+    smallest_mass: f64,
+) -> f64 {
+    let (bx, by) = (&grad.bx, &grad.by);
+    let bb: f64 = (0..4).map(|a| bx[a] * bx[a] + by[a] * by[a]).sum();
+    let hoop = hoop_radius.map_or(0.0, |r| 0.25 / (r * r));
+    let gg: f64 = gamma.iter().map(|g| g * g).sum();
+    (modulus * volume * (bb + hoop) + hourglass_modulus * volume * bb * gg) / smallest_mass
 }
 
 #[cfg(test)]

@@ -100,6 +100,18 @@ pub fn mass(x: &[[f64; 2]; 2]) -> Result<[[f64; 2]; 2], KernelError> {
     Ok([[l / 3.0, l / 6.0], [l / 6.0, l / 3.0]])
 }
 
+/// The rod's highest frequency squared with its lumped mass, exact: 2 k / m with the axial
+/// stiffness k = E A / L on the current length and the mass m = rho A L_0 / 2 at each node.
+pub fn frequency_squared(
+    x: &[[f64; 2]; 2],
+    young: f64,
+    area: f64,
+    node_mass: f64,
+) -> Result<f64, KernelError> {
+    let l = length(x)?;
+    Ok(2.0 * young * area / (l * node_mass))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,7 +6,7 @@ use super::context::{Context, positive};
 use super::model::Analysis;
 use super::spec::{
     AnalysisKind, AnalysisSpec, BucklingSpec, DynamicSpec, IntegratorKind, MassKind, NewtonSpec,
-    Quadrature, StaticSpec,
+    Quadrature, StaticSpec, StepSpec, TimeStep,
 };
 use crate::element::Strain;
 
@@ -26,6 +26,8 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
     match spec.kind {
         AnalysisKind::Static => {
             given(spec.dt.is_some(), "dt", "static")?;
+            given(spec.time_step_scale.is_some(), "time_step_scale", "static")?;
+            given(spec.dt_min.is_some(), "dt_min", "static")?;
             given(spec.integrator.is_some(), "integrator", "static")?;
             for (present, key) in [
                 (spec.beta.is_some(), "beta"),
@@ -66,12 +68,6 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
     if spec.steps.is_some() {
         return Err(cx.err("analysis.steps: a dynamic analysis takes `dt` and `end_time`"));
     }
-    let dt = positive(
-        cx,
-        "analysis.dt",
-        spec.dt
-            .ok_or_else(|| cx.err("analysis.dt: a dynamic analysis needs its time step"))?,
-    )?;
     let end_time = positive(
         cx,
         "analysis.end_time",
@@ -80,6 +76,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
     )?;
     let integrator = spec.integrator.unwrap_or(IntegratorKind::Average);
     check_integrator_keys(cx, spec, integrator)?;
+    let step = time_step(cx, spec, integrator)?;
     let (beta, gamma) = newmark_coefficients(cx, spec, integrator)?;
     let (theta, alpha, rho_infinity) = integrator_parameters(cx, spec)?;
     let (mass, rayleigh) = mass_and_damping(cx, spec, integrator)?;
@@ -87,7 +84,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
     Ok(DynamicSpec {
         quadrature,
         hourglass,
-        dt,
+        step,
         end_time,
         integrator,
         beta,
@@ -102,6 +99,54 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
         newton: spec.newton.clone(),
         buckling: buckling(cx, spec)?,
     })
+}
+
+/// `analysis.dt` (a number, or `auto` for central difference, its default) with
+/// `time_step_scale` and `dt_min`.
+fn time_step(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<TimeStep, InputError> {
+    let explicit = integrator == IntegratorKind::CentralDifference;
+    let given = spec.dt.or(explicit.then_some(StepSpec::Auto));
+    match given {
+        None => Err(cx.err("analysis.dt: a dynamic analysis needs its time step")),
+        Some(StepSpec::Fixed(dt)) => {
+            for (present, key) in [
+                (spec.time_step_scale.is_some(), "time_step_scale"),
+                (spec.dt_min.is_some(), "dt_min"),
+            ] {
+                if present {
+                    return Err(cx.err(format!(
+                        "analysis.{key}: applies to dt = \"auto\" only (dt is {dt})"
+                    )));
+                }
+            }
+            Ok(TimeStep::Fixed(positive(cx, "analysis.dt", dt)?))
+        }
+        Some(StepSpec::Auto) if !explicit => Err(cx.err(format!(
+            "analysis.dt: \"auto\" (the stable step of central difference) does not apply to integrator {integrator:?}: give a time step"
+        ))),
+        Some(StepSpec::Auto) => {
+            let scale = spec.time_step_scale.unwrap_or(0.9);
+            if !(scale > 0.0 && scale <= 1.0) {
+                return Err(cx.err(format!(
+                    "analysis.time_step_scale: must lie in (0, 1], got {scale}"
+                )));
+            }
+            if spec.allow_unstable {
+                return Err(cx.err(
+                    "analysis.allow_unstable: applies to a fixed dt (dt = \"auto\" stays below the stability limit)",
+                ));
+            }
+            let min = spec
+                .dt_min
+                .map(|m| positive(cx, "analysis.dt_min", m))
+                .transpose()?;
+            Ok(TimeStep::Auto { scale, min })
+        }
+    }
 }
 
 /// The keys that belong to one integrator only are absent for the others.

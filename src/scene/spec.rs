@@ -357,8 +357,15 @@ pub struct AnalysisSpec {
     pub kind: AnalysisKind,
     /// Static: the number of equal load increments up to `end_time` (required).
     pub steps: Option<usize>,
-    /// Dynamic: the time step (required).
-    pub dt: Option<f64>,
+    /// Dynamic: the time step, a number or `"auto"` (central difference only: the stable
+    /// step of the current configuration times `time_step_scale`, every step). Required for
+    /// the implicit integrators; `"auto"` by default for central difference.
+    pub dt: Option<StepSpec>,
+    /// `dt = "auto"`: the fraction of the critical step taken, in (0, 1]. Default 0.9.
+    pub time_step_scale: Option<f64>,
+    /// `dt = "auto"`: the run stops (status `diverged`) when the step would fall below this
+    /// (a time). Default: no limit.
+    pub dt_min: Option<f64>,
     /// Static: default 1 (pseudo time). Dynamic: required.
     pub end_time: Option<f64>,
     /// `nonlinear` (default, updated Lagrangian) or `linear` (small strain).
@@ -399,6 +406,70 @@ pub struct AnalysisSpec {
     /// `quadrature = "reduced"`: the hourglass stiffness coefficient kappa in [0, 1]: kappa = 1
     /// gives a square element the hourglass stiffness of the fully integrated one. Default 0.1.
     pub hourglass: Option<f64>,
+}
+
+/// `analysis.dt` as written: a step length or the word `auto`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepSpec {
+    Fixed(f64),
+    Auto,
+}
+
+impl<'de> Deserialize<'de> for StepSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<StepSpec, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = StepSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "a time step (a number) or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<StepSpec, E> {
+                Ok(StepSpec::Fixed(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<StepSpec, E> {
+                Ok(StepSpec::Fixed(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<StepSpec, E> {
+                Ok(StepSpec::Fixed(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<StepSpec, E> {
+                match v {
+                    "auto" => Ok(StepSpec::Auto),
+                    _ => Err(E::custom(format!(
+                        "expected a time step (a number) or \"auto\", got \"{v}\""
+                    ))),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+/// The time step of a dynamic analysis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TimeStep {
+    /// The same step throughout (the last one shorter to end at `end_time`).
+    Fixed(f64),
+    /// `scale` times the critical step of the current configuration, every step; the run
+    /// stops when it would fall below `min`.
+    Auto { scale: f64, min: Option<f64> },
+}
+
+impl DynamicSpec {
+    /// The fixed step (every implicit analysis has one; scene validation refuses `auto`
+    /// for them).
+    pub fn fixed_dt(&self) -> Option<f64> {
+        match self.step {
+            TimeStep::Fixed(dt) => Some(dt),
+            TimeStep::Auto { .. } => None,
+        }
+    }
+
+    /// The step of an implicit analysis.
+    pub fn dt(&self) -> f64 {
+        self.fixed_dt()
+            .expect("implicit analyses have a fixed step (checked by the scene)")
+    }
 }
 
 /// Quadrature of the explicit Quad4 kernel.
@@ -462,7 +533,7 @@ fn one() -> usize {
 /// The validated dynamic analysis.
 #[derive(Debug, Clone)]
 pub struct DynamicSpec {
-    pub dt: f64,
+    pub step: TimeStep,
     pub end_time: f64,
     pub integrator: IntegratorKind,
     pub beta: f64,

@@ -178,7 +178,7 @@ fn row(
                 .ok()
                 .and_then(|v| v.as_str().map(str::to_string))
                 .unwrap_or_default(),
-            Some(d.dt),
+            d.fixed_dt(),
         ),
         Analysis::Static(_) => ("static".to_string(), None),
     };

@@ -1,0 +1,165 @@
+//! The step of central difference: fixed, or the stable step of the current configuration
+//! times a scale, re-evaluated after every step (docs/theory.md 8.7).
+//!
+//! Legend
+//! ```text
+//! omega^2_e    a bound of element e's highest frequency squared on the committed
+//!              configuration (Kernel::frequency_bound, quad4_one_point::frequency_bound)
+//! dt_bound     2 / sqrt(max_e omega^2_e): a stable step (Irons: the assembled model's
+//!              highest frequency is at most the elements')
+//! auto         h = scale dt_bound, ended early at a listed frame time or the end time
+//! fixed        h = dt; stopped (status `unstable`) when dt > c dt_bound, c the ratio of the
+//!              initial element-eigenvalue limit to the initial dt_bound (so the first check
+//!              is the exact one, and the later ones follow the elements as they deform)
+//! ```
+
+use super::Status;
+use super::run::StepError;
+use crate::assembly::FrequencyBound;
+use crate::scene::Model;
+use crate::scene::spec::{DynamicSpec, TimeStep};
+use serde::{Deserialize, Serialize};
+
+/// The stable step of a configuration and the element that sets it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Limit {
+    pub dt: f64,
+    pub body: usize,
+    pub element: usize,
+}
+
+impl Limit {
+    fn of(bound: FrequencyBound) -> Limit {
+        Limit {
+            dt: 2.0 / bound.omega_squared.sqrt(),
+            body: bound.body,
+            element: bound.element,
+        }
+    }
+}
+
+/// The step rule of a central-difference run and what it has seen.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Clock {
+    rule: Rule,
+    /// The first step (fixed: dt; auto: scale times the initial dt_bound).
+    pub dt0: f64,
+    /// Fixed: the initial element-eigenvalue limit over the initial dt_bound; auto: 1.
+    calibration: f64,
+    /// The stable step of the committed configuration (the bound's, unscaled).
+    pub limit: Limit,
+    /// The last step taken, the shortest and the longest (0 before the first).
+    pub last: f64,
+    pub shortest: f64,
+    pub longest: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+enum Rule {
+    Fixed { dt: f64, allow_unstable: bool },
+    Auto { scale: f64, min: Option<f64> },
+}
+
+impl Clock {
+    /// The clock of `spec`, with the initial element-eigenvalue limit `exact` and the initial
+    /// bound `first`.
+    pub fn new(spec: &DynamicSpec, exact: f64, first: FrequencyBound) -> Clock {
+        let limit = Limit::of(first);
+        let (rule, dt0, calibration) = match spec.step {
+            TimeStep::Fixed(dt) => (
+                Rule::Fixed {
+                    dt,
+                    allow_unstable: spec.allow_unstable,
+                },
+                dt,
+                exact / limit.dt,
+            ),
+            TimeStep::Auto { scale, min } => (Rule::Auto { scale, min }, scale * limit.dt, 1.0),
+        };
+        Clock {
+            rule,
+            dt0,
+            calibration,
+            limit,
+            last: 0.0,
+            shortest: f64::INFINITY,
+            longest: 0.0,
+        }
+    }
+
+    /// The end time and length of step number `step` from `time`, or why it cannot be taken.
+    pub fn next(
+        &self,
+        model: &Model,
+        spec: &DynamicSpec,
+        time: f64,
+        step: usize,
+    ) -> Result<(f64, f64), StepError> {
+        let limit = self.calibration * self.limit.dt;
+        let element = || {
+            format!(
+                "body `{}`, element {}",
+                model.bodies[self.limit.body].name, self.limit.element
+            )
+        };
+        match self.rule {
+            Rule::Fixed { dt, allow_unstable } => {
+                if dt > limit && !allow_unstable {
+                    return Err(StepError {
+                        status: Status::Unstable,
+                        message: format!(
+                            "at t = {time}: dt = {dt} exceeds the stability limit {limit:.6e} of the current configuration, set by {}; \
+                             lower dt or use dt = \"auto\"",
+                            element()
+                        ),
+                        frame: true,
+                    });
+                }
+                let end = super::snap(step as f64 * dt, dt).min(spec.end_time);
+                Ok((end, super::step_length(end - time, dt)))
+            }
+            Rule::Auto { scale, min } => {
+                let h = scale * limit;
+                if let Some(min) = min
+                    && h < min
+                {
+                    return Err(StepError {
+                        status: Status::Diverged,
+                        message: format!(
+                            "at t = {time}: the stable step fell to {h:.6e}, below analysis.dt_min = {min:e}, set by {}",
+                            element()
+                        ),
+                        frame: true,
+                    });
+                }
+                let next_frame = model
+                    .output
+                    .frame_times
+                    .iter()
+                    .copied()
+                    .find(|t| *t > time * (1.0 + 1e-12))
+                    .unwrap_or(f64::INFINITY);
+                let stop = spec.end_time.min(next_frame);
+                let mut end = (time + h).min(stop);
+                if stop - end <= 1e-9 * h {
+                    end = stop;
+                }
+                Ok((end, end - time))
+            }
+        }
+    }
+
+    /// A step of length `h` was taken; `bound` is that of the new configuration.
+    pub fn took(&mut self, h: f64, bound: FrequencyBound) {
+        self.last = h;
+        self.shortest = self.shortest.min(h);
+        self.longest = self.longest.max(h);
+        self.limit = Limit::of(bound);
+    }
+
+    /// A fixed step above the limit of the committed configuration (the run was allowed to
+    /// go on: an element that fails then is the instability's doing).
+    pub fn fixed_above_limit(&self) -> bool {
+        matches!(self.rule, Rule::Fixed { dt, .. } if dt > self.calibration * self.limit.dt)
+    }
+}
