@@ -160,3 +160,110 @@ fn stress_rotated(s: [f64; 4], angle: f64) -> [f64; 4] {
         sn * c * (xx - yy) + (c * c - sn * sn) * xy,
     ]
 }
+
+/// A quad that may be crushed: a random convex shape squashed along y by a factor down to
+/// 1e-3 (the foot of a Taylor bar), placed at a distance from the axis between 1e-3 and 10
+/// of its width (for axisymmetric bodies).
+fn crushed_quad() -> impl Strategy<Value = (Coords, f64)> {
+    (quad(), -3.0f64..0.0, -3.0f64..1.0).prop_map(|(x, squash, offset)| {
+        let factor = 10f64.powf(squash);
+        let min_x = x.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min);
+        let width = x.iter().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max) - min_x;
+        let shift = 10f64.powf(offset) * width - min_x;
+        (x.map(|[a, b]| [a + shift, b * factor]), factor)
+    })
+}
+
+/// The largest eigenvalue of M^-1 K for a lumped (diagonal) M given per node.
+fn max_frequency_squared(k: &Mat8, lumped: &[f64; 4]) -> f64 {
+    let scaled = Mat8::from_fn(|i, j| k[(i, j)] / (lumped[i / 2] * lumped[j / 2]).sqrt());
+    let symmetric = (scaled + scaled.transpose()) * 0.5;
+    symmetric.symmetric_eigenvalues().max()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Goal: the central-difference stable step of the 2x2 Quad4 is safe on distorted and
+    /// crushed elements. Setup: random convex quads squashed down to 1e-3, plane strain,
+    /// plane stress and axisymmetric (from near the axis to far from it), B-bar or not,
+    /// nu from 0 to 0.499. Reference: the element's exact highest frequency squared, the
+    /// largest eigenvalue of M^-1 K with K the kernel's small-strain tangent (checked against
+    /// finite differences elsewhere) and M its lumped (row-sum) mass. The bound must not be
+    /// below it (1e-9 for round-off) and is never more than 16 times it (measured: 1.2 to 8).
+    #[test]
+    fn quad4_frequency_bound_exceeds_the_element_frequency(
+        (x, _) in crushed_quad(),
+        nu in 0.0f64..0.499,
+        bbar: bool,
+        form in 0usize..3,
+    ) {
+        let formulation = [Formulation::PlaneStrain, Formulation::PlaneStress, Formulation::Axisymmetric][form];
+        let elastic = Elastic { young: 1.0, poisson: nu };
+        let condition = if formulation == Formulation::PlaneStress {
+            StressCondition::PlaneStress
+        } else {
+            StressCondition::General
+        };
+        let geom = quad4::values(&x, formulation, &[1.0; 4]).unwrap();
+        let op = quad4::Operator { strain: Strain::Small, bbar };
+        let k = quad4::tangent(&geom, &Vec8::zeros(), &[impact::element::Voigt::zeros(); 4],
+            &[elastic.moduli(condition); 4], op, GeometricStiffness::Omitted);
+        let m = quad4::mass(&geom);
+        let lumped: [f64; 4] = std::array::from_fn(|i| m.row(i).sum());
+        let exact = max_frequency_squared(&k, &lumped);
+        let (mut lambda, mu) = elastic.lame();
+        if formulation == Formulation::PlaneStress {
+            lambda = 2.0 * lambda * mu / (lambda + 2.0 * mu);
+        }
+        let bound = quad4::frequency_bound(&geom, lambda, mu, &lumped);
+        prop_assert!(bound >= exact * (1.0 - 1e-9), "bound {bound} below {exact}");
+        prop_assert!(bound <= 16.0 * exact, "bound {bound} far above {exact}");
+    }
+
+    /// Goal: the stable step of the one-point Quad4 with its hourglass stiffness is safe on
+    /// distorted and crushed elements. Setup: as above (plane strain), hourglass coefficient
+    /// kappa from 0 to 1. Reference: the largest eigenvalue of M^-1 (K_1 + K_hg) built here
+    /// from the centroid gradient b: K_1 = A B^T D B (B of the gradient, D of E and nu),
+    /// K_hg = k gamma gamma^T in each direction, k = kappa (lambda + 3 mu) A b.b / 24, with
+    /// the element's lumped mass. The bound is not below it (1e-9) and not far above.
+    #[test]
+    fn one_point_frequency_bound_exceeds_the_element_frequency(
+        (x, _) in crushed_quad(),
+        nu in 0.0f64..0.499,
+        kappa in 0.0f64..1.0,
+    ) {
+        use impact::element::quad4_one_point as one_point;
+        let (young, rho) = (1.0, 1.0);
+        let lambda = young * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let mu = young / (2.0 * (1.0 + nu));
+        let g = one_point::centroid_gradient(&x);
+        let gamma = one_point::gamma(&x, &g);
+        let mut b = nalgebra::SMatrix::<f64, 3, 8>::zeros();
+        for a in 0..4 {
+            b[(0, 2 * a)] = g.bx[a];
+            b[(1, 2 * a + 1)] = g.by[a];
+            b[(2, 2 * a)] = g.by[a];
+            b[(2, 2 * a + 1)] = g.bx[a];
+        }
+        let d = nalgebra::Matrix3::new(lambda + 2.0 * mu, lambda, 0.0, lambda, lambda + 2.0 * mu, 0.0, 0.0, 0.0, mu);
+        let mut k = b.transpose() * d * b * g.area;
+        let bb: f64 = (0..4).map(|a| g.bx[a] * g.bx[a] + g.by[a] * g.by[a]).sum();
+        let hourglass = kappa * (lambda + 3.0 * mu) / 24.0;
+        let stiffness = hourglass * g.area * bb;
+        for a in 0..4 {
+            for c in 0..4 {
+                for dir in 0..2 {
+                    k[(2 * a + dir, 2 * c + dir)] += stiffness * gamma[a] * gamma[c];
+                }
+            }
+        }
+        let m = quad4::mass(&quad4::values(&x, Formulation::PlaneStrain, &[1.0; 4]).unwrap());
+        let lumped: [f64; 4] = std::array::from_fn(|i| rho * m.row(i).sum());
+        let exact = max_frequency_squared(&k, &lumped);
+        let smallest = lumped.iter().copied().fold(f64::INFINITY, f64::min);
+        let bound = one_point::frequency_bound(&g, &gamma, lambda + 2.0 * mu, g.area, None, hourglass, smallest);
+        prop_assert!(bound >= exact * (1.0 - 1e-9), "bound {bound} below {exact}");
+        prop_assert!(bound <= 16.0 * exact, "bound {bound} far above {exact}");
+    }
+}

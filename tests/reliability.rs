@@ -220,14 +220,20 @@ fn resume_without_checkpoint_is_bad_input() {
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("checkpoint.bin"), "{stderr}");
     assert!(stderr.contains("checkpoint_every"), "{stderr}");
-    std::fs::write(dir.join("checkpoint.bin"), b"IMPACTCP\x01\0\0\0garbage").unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(["resume", dir.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("damaged checkpoint"), "{stderr}");
+    // an older format is refused as such; the current format with a damaged body as damaged
+    for (version, needle) in [(1u32, "checkpoint format 1"), (2, "damaged checkpoint")] {
+        let mut bytes = b"IMPACTCP".to_vec();
+        bytes.extend(version.to_le_bytes());
+        bytes.extend(b"garbage");
+        std::fs::write(dir.join("checkpoint.bin"), &bytes).unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+            .args(["resume", dir.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(needle), "{stderr}");
+    }
 }
 
 /// A small deterministic generator (SplitMix64) for kill moments.

@@ -14,7 +14,7 @@
 //! count.
 
 use super::{ElementFailure, ElementMasses, State};
-use crate::element::quad4_one_point::{self as one_point, Nodes, rotate};
+use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
 use crate::material::{Material, PointState, StressCondition};
 use crate::scene::{BodyKind, Model};
@@ -29,6 +29,7 @@ struct BodyParameters {
     name: String,
     material: Material,
     plane_stress: bool,
+    axisymmetric: bool,
     lambda: f64,
     mu: f64,
     /// kappa (lambda + 3 mu) / 24
@@ -77,12 +78,17 @@ fn element_step(
     committed: &ElementState,
     smallest_mass: f64,
 ) -> Result<ElementStep, KernelError> {
-    let step = one_point::increment(x, u)?;
+    let t = committed.thickness;
+    let section = if p.axisymmetric {
+        Section::Axisymmetric
+    } else {
+        Section::Plane { thickness: t }
+    };
+    let step = one_point::increment(x, u, section)?;
     let (c, s) = (step.cos, step.sin);
     let stress_n = rotate(&committed.stress, c, s);
     let back_n = rotate(&committed.back_stress, c, s);
     let mut strain = step.strain;
-    let t = committed.thickness;
     let (stress, back_stress, eq_plastic_strain, plastic_density, thickness) = if p.plane_stress {
         let r = p.material.update(
             &PointState {
@@ -103,13 +109,23 @@ fn element_step(
         )
     } else {
         let (lambda, mu) = (p.lambda, p.mu);
-        let volumetric = lambda * (strain[0] + strain[1]);
-        let trial = [
-            stress_n[0] + volumetric + 2.0 * mu * strain[0],
-            stress_n[1] + volumetric + 2.0 * mu * strain[1],
-            stress_n[2] + volumetric,
-            stress_n[3] + mu * strain[3],
-        ];
+        let trial = if p.axisymmetric {
+            let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
+            [
+                stress_n[0] + volumetric + 2.0 * mu * strain[0],
+                stress_n[1] + volumetric + 2.0 * mu * strain[1],
+                stress_n[2] + volumetric + 2.0 * mu * strain[2],
+                stress_n[3] + mu * strain[3],
+            ]
+        } else {
+            let volumetric = lambda * (strain[0] + strain[1]);
+            [
+                stress_n[0] + volumetric + 2.0 * mu * strain[0],
+                stress_n[1] + volumetric + 2.0 * mu * strain[1],
+                stress_n[2] + volumetric,
+                stress_n[3] + mu * strain[3],
+            ]
+        };
         let plastic = p.material.plasticity.as_ref().and_then(|j2| {
             j2.radial(
                 &Voigt::from(trial),
@@ -132,13 +148,19 @@ fn element_step(
             Some((stress, back, eps_p, work)) => (stress, back, eps_p, work, t),
         }
     };
-    let volume = step.gradient.area * t;
+    let volume = step.gradient.area * section.weight(&step.mid);
     let work = volume
         * 0.5
         * (0..4)
             .map(|k| (stress_n[k] + stress[k]) * strain[k])
             .sum::<f64>();
-    let hourglass = one_point::hourglass(&step, u, &committed.hourglass, p.hourglass_modulus, t);
+    let hourglass = one_point::hourglass(
+        &step,
+        u,
+        &committed.hourglass,
+        p.hourglass_modulus,
+        section.weight(&step.mid),
+    );
     let state = ElementState {
         stress,
         back_stress,
@@ -146,13 +168,20 @@ fn element_step(
         thickness,
         hourglass: hourglass.forces,
     };
-    let end = one_point::force(&step.end, &state.stress, state.thickness, &state.hourglass)?;
+    let section = match section {
+        Section::Plane { .. } => Section::Plane {
+            thickness: state.thickness,
+        },
+        axisymmetric => axisymmetric,
+    };
+    let end = one_point::force(&step.end, &state.stress, section, &state.hourglass)?;
     let omega_squared = one_point::frequency_bound(
         &end.gradient,
         &end.gamma,
         p.wave_modulus,
-        end.gradient.area * state.thickness,
-        None,
+        end.gradient.area * section.weight(&step.end),
+        p.axisymmetric
+            .then(|| one_point::centroid_radius(&step.end)),
         p.hourglass_modulus,
         smallest_mass,
     );
@@ -236,6 +265,7 @@ impl Reduced {
                 continue;
             };
             let plane_stress = formulation == Formulation::PlaneStress;
+            let axisymmetric = formulation == Formulation::Axisymmetric;
             let (mut lambda, mu) = spec.material.elastic.lame();
             if plane_stress {
                 lambda = 2.0 * lambda * mu / (lambda + 2.0 * mu);
@@ -244,6 +274,7 @@ impl Reduced {
                 name: spec.name.clone(),
                 material: spec.material.clone(),
                 plane_stress,
+                axisymmetric,
                 lambda: spec.material.elastic.lame().0,
                 mu,
                 hourglass_modulus: kappa * (lambda + 3.0 * mu) / 24.0,
@@ -325,6 +356,17 @@ impl Reduced {
         }
     }
 
+    /// The section of element `e` in the state `state`.
+    fn section(&self, e: usize, state: &ElementState) -> Section {
+        if self.bodies[self.body[e] as usize].axisymmetric {
+            Section::Axisymmetric
+        } else {
+            Section::Plane {
+                thickness: state.thickness,
+            }
+        }
+    }
+
     fn state_of(&self, e: usize) -> ElementState {
         ElementState {
             stress: std::array::from_fn(|k| self.stress[4 * e + k]),
@@ -372,7 +414,8 @@ impl Reduced {
                     let e = k * CHUNK + i;
                     let xe: Nodes = this.nodes[e].map(|n| x[n as usize]);
                     let state = this.state_of(e);
-                    match one_point::force(&xe, &state.stress, state.thickness, &state.hourglass) {
+                    let section = this.section(e, &state);
+                    match one_point::force(&xe, &state.stress, section, &state.hourglass) {
                         Ok(v) => f.copy_from_slice(&v.force),
                         Err(err) => return Some((e, err)),
                     }
@@ -402,14 +445,15 @@ impl Reduced {
             let xe: Nodes = self.nodes[e].map(|n| x[n as usize]);
             let state = self.state_of(e);
             let p = &self.bodies[self.body[e] as usize];
-            let end = one_point::force(&xe, &state.stress, state.thickness, &state.hourglass)
+            let section = self.section(e, &state);
+            let end = one_point::force(&xe, &state.stress, section, &state.hourglass)
                 .map_err(|err| self.failure(e, err))?;
             let omega_squared = one_point::frequency_bound(
                 &end.gradient,
                 &end.gamma,
                 p.wave_modulus,
-                end.gradient.area * state.thickness,
-                None,
+                end.gradient.area * section.weight(&xe),
+                p.axisymmetric.then(|| one_point::centroid_radius(&xe)),
                 p.hourglass_modulus,
                 self.smallest_mass[e],
             );
@@ -548,6 +592,7 @@ mod tests {
             name: "b".into(),
             material,
             plane_stress: false,
+            axisymmetric: false,
             lambda,
             mu,
             hourglass_modulus: 0.1 * (lambda + 3.0 * mu) / 24.0,

@@ -19,11 +19,43 @@
 //! f_a        t A sigma b_a + Q gamma_a, on the end configuration x_{n+1}
 //! W_hg       1/2 (R Q_n + Q_{n+1}) . q
 //! ```
+//! Axisymmetric (x = r, y = z, zz the hoop component): the same element with its volume
+//! weight 2 pi r_c in place of t (r_c the centroid radius, the mean of the node radii), the
+//! hoop strain increment d_tt = (sum_a u_r,a / 4) / r_c at the centroid, and the hoop
+//! stress's share of the radial forces, f_a,r += 2 pi A sigma_tt / 4 (N_a = 1/4 at the
+//! centroid): one-point integration of int (B^T sigma) 2 pi r dA, volume-weighted like the
+//! mass, so momentum is kept exactly.
 
 use super::KernelError;
 
 /// The four nodes of an element, counter-clockwise.
 pub type Nodes = [[f64; 2]; 4];
+
+/// How an element's area becomes a volume.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Section {
+    /// Plane strain or plane stress: the thickness (1 per unit depth in plane strain).
+    Plane { thickness: f64 },
+    /// 2 pi r_c, r_c the centroid radius.
+    Axisymmetric,
+}
+
+/// The centroid radius of an element (the mean of its node radii: N_a = 1/4 there).
+#[inline(always)]
+pub fn centroid_radius(x: &Nodes) -> f64 {
+    0.25 * (x[0][0] + x[1][0] + x[2][0] + x[3][0])
+}
+
+impl Section {
+    /// The volume per unit area on the configuration x: t, or 2 pi r_c.
+    #[inline(always)]
+    pub fn weight(&self, x: &Nodes) -> f64 {
+        match *self {
+            Section::Plane { thickness } => thickness,
+            Section::Axisymmetric => 2.0 * std::f64::consts::PI * centroid_radius(x),
+        }
+    }
+}
 
 const HOURGLASS: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
 
@@ -89,9 +121,10 @@ pub struct Increment {
     pub sin: f64,
 }
 
-/// The step of an element from positions `x` by the increment `u` (see the legend).
+/// The step of an element from positions `x` by the increment `u` (see the legend); the
+/// hoop strain of an axisymmetric one.
 #[inline(always)]
-pub fn increment(x: &Nodes, u: &Nodes) -> Result<Increment, KernelError> {
+pub fn increment(x: &Nodes, u: &Nodes, section: Section) -> Result<Increment, KernelError> {
     let mid: Nodes = std::array::from_fn(|a| [x[a][0] + 0.5 * u[a][0], x[a][1] + 0.5 * u[a][1]]);
     let end: Nodes = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);
     let gradient = centroid_gradient(&mid);
@@ -112,11 +145,17 @@ pub fn increment(x: &Nodes, u: &Nodes) -> Result<Increment, KernelError> {
     let w = 0.5 * (gxy - gyx);
     let scale = 1.0 / (1.0 + 0.25 * w * w);
     let (cos, sin) = ((1.0 - 0.25 * w * w) * scale, w * scale);
+    let hoop = match section {
+        Section::Axisymmetric => {
+            0.25 * (u[0][0] + u[1][0] + u[2][0] + u[3][0]) / centroid_radius(&mid)
+        }
+        Section::Plane { .. } => 0.0,
+    };
     Ok(Increment {
         mid,
         end,
         gradient,
-        strain: [gxx, gyy, 0.0, gxy + gyx],
+        strain: [gxx, gyy, hoop, gxy + gyx],
         cos,
         sin,
     })
@@ -130,19 +169,20 @@ pub struct Hourglass {
 }
 
 /// Q_{n+1} = R Q_n + k q in the stiffness form on the mid-step configuration, with
-/// `modulus` = kappa (lambda + 3 mu) / 24 and the thickness t (see the legend).
+/// `modulus` = kappa (lambda + 3 mu) / 24 and `weight` the section's volume per area there
+/// (t, or 2 pi r_c; see the legend).
 #[inline(always)]
 pub fn hourglass(
     step: &Increment,
     u: &Nodes,
     committed: &[f64; 2],
     modulus: f64,
-    thickness: f64,
+    weight: f64,
 ) -> Hourglass {
     let g = gamma(&step.mid, &step.gradient);
     let (bx, by) = (&step.gradient.bx, &step.gradient.by);
     let bb: f64 = (0..4).map(|a| bx[a] * bx[a] + by[a] * by[a]).sum();
-    let k = modulus * thickness * step.gradient.area * bb;
+    let k = modulus * weight * step.gradient.area * bb;
     let q = [
         (0..4).map(|a| g[a] * u[a][0]).sum::<f64>(),
         (0..4).map(|a| g[a] * u[a][1]).sum::<f64>(),
@@ -167,12 +207,12 @@ pub struct Forces {
 }
 
 /// Internal force [f1x f1y ... f4x f4y] of an element on the configuration x from its
-/// Cauchy stress, thickness and hourglass forces.
+/// Cauchy stress, section and hourglass forces.
 #[inline(always)]
 pub fn force(
     x: &Nodes,
     stress: &[f64; 4],
-    thickness: f64,
+    section: Section,
     hourglass: &[f64; 2],
 ) -> Result<Forces, KernelError> {
     let grad = centroid_gradient(x);
@@ -184,12 +224,18 @@ pub fn force(
         });
     }
     let g = gamma(x, &grad);
-    let v = area * thickness;
+    let v = area * section.weight(x);
     let (s, q) = (stress, hourglass);
     let mut f = [0.0; 8];
     for a in 0..4 {
         f[2 * a] = v * (s[0] * bx[a] + s[3] * by[a]) + q[0] * g[a];
         f[2 * a + 1] = v * (s[3] * bx[a] + s[1] * by[a]) + q[1] * g[a];
+    }
+    if section == Section::Axisymmetric {
+        let hoop = 2.0 * std::f64::consts::PI * area * 0.25 * s[2];
+        for a in 0..4 {
+            f[2 * a] += hoop;
+        }
     }
     Ok(Forces {
         force: f,

@@ -15,7 +15,6 @@ use super::probes::{check_frame_times, probes};
 use super::reference::reference;
 use super::spec::{IntegratorKind, Quadrature, Scene};
 use crate::contact::{ContactPair, Friction};
-use crate::element::Formulation;
 use std::path::Path;
 
 /// The model of a scene; `file` names it in messages, `base_dir` anchors relative mesh files.
@@ -72,23 +71,13 @@ fn check_reduced_quadrature(
 ) -> Result<(), InputError> {
     if let Analysis::Dynamic(d) = analysis
         && d.quadrature == Quadrature::Reduced
-        && let Some(body) = bodies.iter().find(|b| {
-            !matches!(
-                b.kind,
-                BodyKind::Continuum {
-                    formulation: Formulation::PlaneStrain | Formulation::PlaneStress,
-                    ..
-                }
-            )
-        })
+        && let Some(body) = bodies
+            .iter()
+            .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
     {
         return Err(cx.err(format!(
-            "analysis.quadrature: `reduced` covers plane-strain and plane-stress Quad4 bodies; body `{}` is {}: use quadrature = \"full\"",
-            body.name,
-            match body.kind {
-                BodyKind::Rod { .. } => "a rod",
-                _ => "axisymmetric",
-            }
+            "analysis.quadrature: `reduced` covers Quad4 bodies (plane strain, plane stress, axisymmetric); body `{}` is a rod: use quadrature = \"full\"",
+            body.name
         )));
     }
     Ok(())
