@@ -16,6 +16,13 @@ pub fn out_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// The output folder of `run(name, ..)`, as it is (not emptied).
+pub fn out_dir_of(name: &str) -> PathBuf {
+    std::env::temp_dir()
+        .join(format!("impact-tests-{}", std::process::id()))
+        .join(name)
+}
+
 /// Builds the model of a scene text as if it were the file `tests/<name>.toml` (so mesh
 /// files resolve against tests/), with `--set` overrides.
 pub fn model(name: &str, text: &str, overrides: &[&str]) -> Model {
