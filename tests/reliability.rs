@@ -165,6 +165,34 @@ fn explicit_plastic_contact_resume_is_bit_identical() {
     assert_same_output(&full, &resumed, name);
 }
 
+/// Goal: the automatic explicit step resumes bit-identically: its clock (the last step, the
+/// limit of the committed configuration, the shortest and longest steps) is in the
+/// checkpoint. Setup: PLASTIC_BLOCK, frictionless, central difference with dt = "auto",
+/// checkpoints every 15 steps, killed at 40. Reference: the uninterrupted run, byte for byte
+/// (history.csv with its dt column, the frames, summary.json's dt_min, dt_max, dt_limit).
+#[test]
+fn explicit_automatic_step_resume_is_bit_identical() {
+    let name = "plastic_block_explicit_auto";
+    let set = [
+        "analysis.integrator=central_difference",
+        "analysis.dt=auto",
+        "analysis.end_time=0.3",
+        "analysis.checkpoint_every=15",
+    ];
+    let text = frictionless();
+    let full = run_full(name, &text, &set);
+    let resumed = run_killed_and_resumed(name, &text, &set, 40);
+    assert_same_output(&full, &resumed, name);
+    let read = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (read(&full), read(&resumed));
+    for key in ["dt_min", "dt_max", "dt_limit", "steps"] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    assert!(a["dt_min"].as_f64().unwrap() > 0.0);
+}
+
 /// Goal: static load stepping resumes bit-identically (modified Newton every 3 increments).
 #[test]
 fn static_plastic_resume_is_bit_identical() {
