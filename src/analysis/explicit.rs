@@ -19,7 +19,7 @@ use super::newton::Counters;
 use super::record::{Energies, Motion};
 use super::run::{StepError, Stepper, TimeStepReport};
 use super::{DtLimit, RunError, Status, loads};
-use crate::assembly::reduced::{Reduced, StepWork};
+use crate::assembly::explicit::{ExplicitKernel, Full, Reduced, StepWork};
 use crate::assembly::{self, ElementMasses, FrequencyBound, Mass, State, System};
 use crate::contact::{ContactState, Interfaces};
 use crate::scene::spec::{DynamicSpec, MassKind, Quadrature, TimeStep};
@@ -66,7 +66,9 @@ pub struct Explicit<'a> {
     dt_crit: f64,
     /// The one-point kernel keeps its element state in its own arrays (copied into `state`
     /// only when output reads stresses).
-    reduced: Option<Reduced>,
+    kernel: Option<Box<dyn ExplicitKernel>>,
+    /// Whether the kernel keeps state that `State` does not (the one-point hourglass forces).
+    kernel_has_own_state: bool,
     synced: bool,
     state: State,
     v: Vec<f64>,
@@ -127,9 +129,8 @@ impl<'a> Explicit<'a> {
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
         let state = State::initial(model);
-        let reduced = (spec.quadrature == Quadrature::Reduced)
-            .then(|| Reduced::new(model, &state, spec.hourglass, &masses));
-        let first = match &reduced {
+        let (kernel, kernel_has_own_state) = explicit_kernel(model, spec, &state, &masses);
+        let first = match &kernel {
             Some(kernel) => kernel.frequency_bound(&state.coordinates),
             None => assembly::frequency_bound(model, &state, &masses),
         }
@@ -150,7 +151,8 @@ impl<'a> Explicit<'a> {
             mass: m,
             inverse_mass,
             dt_crit,
-            reduced,
+            kernel,
+            kernel_has_own_state,
             synced: false,
             state,
             v: vec![0.0; dofs],
@@ -204,14 +206,14 @@ impl<'a> Explicit<'a> {
     /// of the new configuration; the message of an element that failed.
     fn internal_force(&mut self) -> Result<FrequencyBound, String> {
         let du = &self.du;
-        match self.reduced.as_mut() {
+        match self.kernel.as_mut() {
             Some(kernel) => {
                 let work = crate::profile::time(crate::profile::Phase::Assembly, || {
                     crate::profile::count_elements(kernel.elements());
                     kernel.step(&self.state.coordinates, du, &mut self.internal)
                 })
                 .map_err(|e| e.to_string())?;
-                commit_reduced(&mut self.state, du, work);
+                commit_kernel_step(&mut self.state, du, work);
                 let (body, element) = kernel.locate(work.critical_element);
                 Ok(FrequencyBound {
                     omega_squared: work.omega_squared,
@@ -262,7 +264,7 @@ impl Stepper for Explicit<'_> {
     fn start(&mut self) -> Result<(), String> {
         let model = self.model;
         let zero = vec![0.0; model.dofs()];
-        let first = match self.reduced.as_mut() {
+        let first = match self.kernel.as_mut() {
             Some(kernel) => {
                 let mut force = zero.clone();
                 kernel
@@ -324,18 +326,27 @@ impl Stepper for Explicit<'_> {
         self.contact = carry.contact;
         self.step = carry.step;
         self.clock = carry.clock;
+        // a kernel with its own arrays starts again from the restored points
+        if self.kernel.is_some() {
+            (self.kernel, self.kernel_has_own_state) =
+                explicit_kernel(self.model, self.spec, &self.state, &self.masses);
+        }
         true
     }
 
     fn carry(&self) -> Result<Carry, &'static str> {
-        if self.reduced.is_some() {
+        if self.kernel_has_own_state {
             // its hourglass forces are not in `State`; the scene refuses checkpoint_every
             return Err(
                 "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
             );
         }
+        let mut state = self.state.clone();
+        if let Some(kernel) = &self.kernel {
+            kernel.write_points(self.model, &mut state);
+        }
         Ok(Carry::Explicit(ExplicitCarry {
-            state: self.state.clone(),
+            state,
             velocity: self.v.clone(),
             acceleration: self.a.clone(),
             energies: self.energies,
@@ -454,7 +465,7 @@ impl Stepper for Explicit<'_> {
         None
     }
     fn sync_points(&mut self) {
-        if let Some(kernel) = &self.reduced
+        if let Some(kernel) = &self.kernel
             && !self.synced
         {
             kernel.write_points(self.model, &mut self.state);
@@ -462,7 +473,7 @@ impl Stepper for Explicit<'_> {
         }
     }
     fn hourglass_energy(&self) -> Option<f64> {
-        self.reduced.as_ref().map(|k| k.hourglass_energy)
+        self.kernel.as_ref().and_then(|k| k.hourglass_energy())
     }
     fn progress(&self) -> (u64, u64) {
         (self.step as u64, self.steps as u64)
@@ -484,9 +495,35 @@ impl Stepper for Explicit<'_> {
     }
 }
 
-/// Commits a step of the reduced kernel (whose element state is already updated): the
+/// The element loop of a central-difference run: the one-point kernel (`reduced`), the 2x2
+/// rate-form kernel on finite-strain Quad4 models, or none (rods, small strain: the general
+/// assembly); and whether the kernel keeps state that `State` does not.
+fn explicit_kernel(
+    model: &Model,
+    spec: &DynamicSpec,
+    state: &State,
+    masses: &ElementMasses,
+) -> (Option<Box<dyn ExplicitKernel>>, bool) {
+    use crate::scene::BodyKind;
+    let quads_only = model
+        .bodies
+        .iter()
+        .all(|b| matches!(b.kind, BodyKind::Continuum { .. }));
+    match spec.quadrature {
+        Quadrature::Reduced => (
+            Some(Box::new(Reduced::new(model, state, spec.hourglass, masses))),
+            true,
+        ),
+        Quadrature::Full if quads_only && spec.geometry == crate::element::Strain::Finite => {
+            (Some(Box::new(Full::new(model, state, masses))), false)
+        }
+        Quadrature::Full => (None, false),
+    }
+}
+
+/// Commits a step of an explicit kernel (whose element state is already updated): the
 /// configuration moves by du, the work accumulates.
-fn commit_reduced(state: &mut State, du: &[f64], work: StepWork) {
+fn commit_kernel_step(state: &mut State, du: &[f64], work: StepWork) {
     state
         .coordinates
         .par_chunks_mut(DOF_CHUNK / 2)
@@ -700,9 +737,9 @@ pub fn kernel_benchmark_run(
             stepper.advance(&mut counters).ok()?;
         }
         let seconds = start.elapsed().as_secs_f64();
-        let kernel = stepper.reduced.as_ref()?;
+        let kernel = stepper.kernel.as_ref()?;
         let plastic = kernel
-            .eq_plastic_strain
+            .eq_plastic_strain()
             .iter()
             .filter(|e| **e > 0.0)
             .count();

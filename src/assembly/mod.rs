@@ -11,8 +11,8 @@
 //! W_int      work of the internal forces, sum_q w_q 1/2 (sigma_n + S) . dE (trapezoid)
 //! ```
 
+pub mod explicit;
 mod kernel;
-pub mod reduced;
 
 pub use kernel::Kernel;
 

@@ -13,34 +13,13 @@
 //! the chunk sums of the work are added in chunk order. The bits do not depend on the thread
 //! count.
 
-use super::{ElementFailure, ElementMasses, State};
+use super::{BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, bound_of};
+use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
 use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
-use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{Material, PointState, StressCondition};
-use crate::scene::{BodyKind, Model};
+use crate::element::{KernelError, Voigt};
+use crate::material::{PointState, StressCondition};
+use crate::scene::Model;
 use rayon::prelude::*;
-
-/// Elements per parallel task (fixed, so the work sums do not depend on the thread count).
-const CHUNK: usize = 256;
-
-/// What the kernel needs of a body.
-#[derive(Debug, Clone)]
-struct BodyParameters {
-    name: String,
-    material: Material,
-    plane_stress: bool,
-    axisymmetric: bool,
-    lambda: f64,
-    mu: f64,
-    /// kappa (lambda + 3 mu) / 24
-    hourglass_modulus: f64,
-    /// The plane-wave modulus of the stable-step bound: lambda + 2 mu (plane stress:
-    /// E / (1 - nu^2)).
-    wave_modulus: f64,
-    /// The body's index in the model and its first element in the kernel's numbering.
-    model_body: usize,
-    first_element: usize,
-}
 
 /// The committed state of one element as the kernel reads it.
 #[derive(Debug, Clone, Copy)]
@@ -79,7 +58,7 @@ fn element_step(
     smallest_mass: f64,
 ) -> Result<ElementStep, KernelError> {
     let t = committed.thickness;
-    let section = if p.axisymmetric {
+    let section = if p.axisymmetric() {
         Section::Axisymmetric
     } else {
         Section::Plane { thickness: t }
@@ -89,7 +68,7 @@ fn element_step(
     let stress_n = rotate(&committed.stress, c, s);
     let back_n = rotate(&committed.back_stress, c, s);
     let mut strain = step.strain;
-    let (stress, back_stress, eq_plastic_strain, plastic_density, thickness) = if p.plane_stress {
+    let (stress, back_stress, eq_plastic_strain, plastic_density, thickness) = if p.plane_stress() {
         let r = p.material.update(
             &PointState {
                 stress: Voigt::from(stress_n),
@@ -109,7 +88,7 @@ fn element_step(
         )
     } else {
         let (lambda, mu) = (p.lambda, p.mu);
-        let trial = if p.axisymmetric {
+        let trial = if p.axisymmetric() {
             let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
             [
                 stress_n[0] + volumetric + 2.0 * mu * strain[0],
@@ -180,7 +159,7 @@ fn element_step(
         &end.gamma,
         p.wave_modulus,
         end.gradient.area * section.weight(&step.end),
-        p.axisymmetric
+        p.axisymmetric()
             .then(|| one_point::centroid_radius(&step.end)),
         p.hourglass_modulus,
         smallest_mass,
@@ -195,40 +174,10 @@ fn element_step(
     })
 }
 
-/// The sums of one step.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct StepWork {
-    /// Work of the stresses and the hourglass forces (includes both below).
-    pub internal: f64,
-    pub plastic: f64,
-    pub hourglass: f64,
-    /// The largest element frequency bound squared on the end configuration, and its
-    /// element (global index over the kernel's elements; the lowest among equals).
-    pub omega_squared: f64,
-    pub critical_element: usize,
-}
-
-impl StepWork {
-    /// Takes an element's frequency bound into the maximum.
-    fn observe(&mut self, omega_squared: f64, element: usize) {
-        if omega_squared > self.omega_squared
-            || (omega_squared == self.omega_squared && element < self.critical_element)
-        {
-            self.omega_squared = omega_squared;
-            self.critical_element = element;
-        }
-    }
-}
-
-/// Element data of all Quad4 bodies as flat arrays (element-major, global element index
+/// Element data of all Quad4 bodies as flat arrays (element-major, kernel element index
 /// over the bodies in order).
-#[derive(Debug, Clone)]
 pub struct Reduced {
-    bodies: Vec<BodyParameters>,
-    /// Body of each element.
-    body: Vec<u32>,
-    /// Global nodes of each element, counter-clockwise.
-    nodes: Vec<[u32; 4]>,
+    layout: Layout,
     /// The smallest lumped nodal mass of each element (for its stable-step bound).
     smallest_mass: Vec<f64>,
     /// Cauchy stress, 4 per element [xx yy zz xy].
@@ -242,88 +191,42 @@ pub struct Reduced {
     pub hourglass: Vec<f64>,
     /// Element forces of the last evaluation, 8 per element.
     element_forces: Vec<f64>,
-    /// Node -> its entries in `element_forces` (CSR, element order).
-    node_start: Vec<usize>,
-    node_entries: Vec<u32>,
+    gather: NodeGather,
     /// Accumulated hourglass work.
     pub hourglass_energy: f64,
 }
 
 impl Reduced {
-    /// The kernel for the Quad4 bodies of `model` (plane strain or plane stress; the scene
-    /// validation refuses the rest), starting from the committed `state`; `kappa` is the
-    /// hourglass coefficient.
+    /// The kernel for the Quad4 bodies of `model` (the scene refuses rods with it),
+    /// starting from the committed `state`; `kappa` is the hourglass coefficient.
     pub fn new(model: &Model, state: &State, kappa: f64, masses: &ElementMasses) -> Reduced {
-        let mut bodies = Vec::new();
-        let mut body = Vec::new();
-        let mut nodes = Vec::new();
-        let mut smallest_mass = Vec::new();
-        let (mut stress, mut back_stress, mut eq_plastic_strain, mut thickness) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for (b, spec) in model.bodies.iter().enumerate() {
-            let BodyKind::Continuum { formulation, .. } = spec.kind else {
-                continue;
-            };
-            let plane_stress = formulation == Formulation::PlaneStress;
-            let axisymmetric = formulation == Formulation::Axisymmetric;
-            let (mut lambda, mu) = spec.material.elastic.lame();
-            if plane_stress {
-                lambda = 2.0 * lambda * mu / (lambda + 2.0 * mu);
-            }
-            bodies.push(BodyParameters {
-                name: spec.name.clone(),
-                material: spec.material.clone(),
-                plane_stress,
-                axisymmetric,
-                lambda: spec.material.elastic.lame().0,
-                mu,
-                hourglass_modulus: kappa * (lambda + 3.0 * mu) / 24.0,
-                wave_modulus: lambda + 2.0 * mu,
-                model_body: b,
-                first_element: body.len(),
-            });
-            let index = (bodies.len() - 1) as u32;
+        let layout = Layout::new(model, kappa);
+        let count = layout.body.len();
+        let (mut stress, mut back_stress) =
+            (Vec::with_capacity(4 * count), Vec::with_capacity(4 * count));
+        let (mut eq_plastic_strain, mut thickness, mut smallest_mass) = (
+            Vec::with_capacity(count),
+            Vec::with_capacity(count),
+            Vec::with_capacity(count),
+        );
+        for &(b, e) in &layout.origin {
             let committed = &state.bodies[b];
-            for e in 0..spec.elements() {
-                let n = spec.mesh.cells.nodes_of(e);
-                body.push(index);
-                nodes.push(std::array::from_fn(|a| spec.global(n[a]) as u32));
-                let p = &committed.points[4 * e];
-                stress.extend(p.stress.iter());
-                back_stress.extend(p.back_stress.iter());
-                eq_plastic_strain.push(p.eq_plastic_strain);
-                thickness.push(committed.thickness[4 * e]);
-                smallest_mass.push(
-                    masses
-                        .of(model, b, e)
-                        .iter()
-                        .copied()
-                        .fold(f64::INFINITY, f64::min),
-                );
-            }
+            let p = &committed.points[4 * e];
+            stress.extend(p.stress.iter());
+            back_stress.extend(p.back_stress.iter());
+            eq_plastic_strain.push(p.eq_plastic_strain);
+            thickness.push(committed.thickness[4 * e]);
+            smallest_mass.push(
+                masses
+                    .of(model, b, e)
+                    .iter()
+                    .copied()
+                    .fold(f64::INFINITY, f64::min),
+            );
         }
-        let count = body.len();
-        let mut node_start = vec![0usize; state.coordinates.len() + 1];
-        for element in &nodes {
-            for n in element {
-                node_start[*n as usize + 1] += 1;
-            }
-        }
-        for n in 0..state.coordinates.len() {
-            node_start[n + 1] += node_start[n];
-        }
-        let mut fill = node_start.clone();
-        let mut node_entries = vec![0u32; node_start[state.coordinates.len()]];
-        for (e, element) in nodes.iter().enumerate() {
-            for (a, n) in element.iter().enumerate() {
-                node_entries[fill[*n as usize]] = (8 * e + 2 * a) as u32;
-                fill[*n as usize] += 1;
-            }
-        }
+        let gather = NodeGather::new(&layout.nodes, state.coordinates.len());
         Reduced {
-            bodies,
-            body,
-            nodes,
+            layout,
             smallest_mass,
             stress,
             back_stress,
@@ -331,34 +234,14 @@ impl Reduced {
             thickness,
             hourglass: vec![0.0; 2 * count],
             element_forces: vec![0.0; 8 * count],
-            node_start,
-            node_entries,
+            gather,
             hourglass_energy: 0.0,
-        }
-    }
-
-    pub fn elements(&self) -> usize {
-        self.body.len()
-    }
-
-    /// The model's body and the element's number in it of kernel element `element`.
-    pub fn locate(&self, element: usize) -> (usize, usize) {
-        let p = &self.bodies[self.body[element] as usize];
-        (p.model_body, element - p.first_element)
-    }
-
-    fn failure(&self, element: usize, error: KernelError) -> ElementFailure {
-        let p = &self.bodies[self.body[element] as usize];
-        ElementFailure {
-            body: p.name.clone(),
-            element: element - p.first_element,
-            error,
         }
     }
 
     /// The section of element `e` in the state `state`.
     fn section(&self, e: usize, state: &ElementState) -> Section {
-        if self.bodies[self.body[e] as usize].axisymmetric {
+        if self.layout.bodies[self.layout.body[e] as usize].axisymmetric() {
             Section::Axisymmetric
         } else {
             Section::Plane {
@@ -376,34 +259,18 @@ impl Reduced {
             hourglass: [self.hourglass[2 * e], self.hourglass[2 * e + 1]],
         }
     }
+}
 
-    /// Sums the element forces into the nodes: `force` over all DOFs (overwritten; nodes
-    /// of no Quad4 get zero).
-    fn gather(&self, force: &mut [f64]) {
-        let ef = &self.element_forces;
-        force
-            .par_chunks_mut(2 * CHUNK)
-            .enumerate()
-            .for_each(|(k, chunk)| {
-                for (i, f) in chunk.chunks_exact_mut(2).enumerate() {
-                    let n = k * CHUNK + i;
-                    let (mut fx, mut fy) = (0.0, 0.0);
-                    for entry in &self.node_entries[self.node_start[n]..self.node_start[n + 1]] {
-                        fx += ef[*entry as usize];
-                        fy += ef[*entry as usize + 1];
-                    }
-                    f[0] = fx;
-                    f[1] = fy;
-                }
-            });
+impl ExplicitKernel for Reduced {
+    fn elements(&self) -> usize {
+        self.layout.body.len()
     }
 
-    /// The internal force on the positions `x` from the stored state (no update).
-    pub fn internal_force(
-        &mut self,
-        x: &[[f64; 2]],
-        force: &mut [f64],
-    ) -> Result<(), ElementFailure> {
+    fn locate(&self, element: usize) -> (usize, usize) {
+        self.layout.origin[element]
+    }
+
+    fn internal_force(&mut self, x: &[[f64; 2]], force: &mut [f64]) -> Result<(), ElementFailure> {
         let mut forces = std::mem::take(&mut self.element_forces);
         let this = &*self;
         let error = forces
@@ -412,7 +279,7 @@ impl Reduced {
             .map(|(k, chunk)| {
                 for (i, f) in chunk.chunks_exact_mut(8).enumerate() {
                     let e = k * CHUNK + i;
-                    let xe: Nodes = this.nodes[e].map(|n| x[n as usize]);
+                    let xe: Nodes = this.layout.nodes[e].map(|n| x[n as usize]);
                     let state = this.state_of(e);
                     let section = this.section(e, &state);
                     match one_point::force(&xe, &state.stress, section, &state.hourglass) {
@@ -428,57 +295,42 @@ impl Reduced {
             .next();
         self.element_forces = forces;
         if let Some((e, err)) = error {
-            return Err(self.failure(e, err));
+            return Err(self.layout.failure(e, err));
         }
-        self.gather(force);
+        self.gather.gather(&self.element_forces, force);
         Ok(())
     }
 
-    /// The largest element frequency bound on the positions `x` from the stored state, with
-    /// its element (model body and element number).
-    pub fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<super::FrequencyBound, ElementFailure> {
-        let mut worst = StepWork {
-            critical_element: usize::MAX,
-            ..StepWork::default()
-        };
+    fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<FrequencyBound, ElementFailure> {
+        let mut worst = StepWork::default();
         for e in 0..self.elements() {
-            let xe: Nodes = self.nodes[e].map(|n| x[n as usize]);
+            let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
             let state = self.state_of(e);
-            let p = &self.bodies[self.body[e] as usize];
+            let p = &self.layout.bodies[self.layout.body[e] as usize];
             let section = self.section(e, &state);
             let end = one_point::force(&xe, &state.stress, section, &state.hourglass)
-                .map_err(|err| self.failure(e, err))?;
+                .map_err(|err| self.layout.failure(e, err))?;
             let omega_squared = one_point::frequency_bound(
                 &end.gradient,
                 &end.gamma,
                 p.wave_modulus,
                 end.gradient.area * section.weight(&xe),
-                p.axisymmetric.then(|| one_point::centroid_radius(&xe)),
+                p.axisymmetric().then(|| one_point::centroid_radius(&xe)),
                 p.hourglass_modulus,
                 self.smallest_mass[e],
             );
             worst.observe(omega_squared, e);
         }
-        let (body, element) = self.locate(worst.critical_element);
-        Ok(super::FrequencyBound {
-            omega_squared: worst.omega_squared,
-            body,
-            element,
-        })
+        Ok(bound_of(&self.layout, &worst))
     }
 
-    /// One step: from positions `x` (the start of the step) by the increment `du` (2 per
-    /// node); updates the element state and writes the internal force on x + du into
-    /// `force`. After an error the element state is partly updated and the run must stop.
-    pub fn step(
+    fn step(
         &mut self,
         x: &[[f64; 2]],
         du: &[f64],
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
-        let bodies = &self.bodies;
-        let body = &self.body;
-        let nodes = &self.nodes;
+        let layout = &self.layout;
         let smallest_mass = &self.smallest_mass;
         let results: Vec<(StepWork, Option<(usize, KernelError)>)> = (
             self.stress.par_chunks_mut(4 * CHUNK),
@@ -491,13 +343,10 @@ impl Reduced {
             .into_par_iter()
             .enumerate()
             .map(|(k, (stress, back, eps_p, thickness, hourglass, forces))| {
-                let mut sums = StepWork {
-                    critical_element: usize::MAX,
-                    ..StepWork::default()
-                };
+                let mut sums = StepWork::default();
                 for i in 0..eps_p.len() {
                     let e = k * CHUNK + i;
-                    let element = nodes[e];
+                    let element = layout.nodes[e];
                     let xe: Nodes = element.map(|n| x[n as usize]);
                     let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
                     let committed = ElementState {
@@ -507,7 +356,7 @@ impl Reduced {
                         thickness: thickness[i],
                         hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
                     };
-                    let p = &bodies[body[e] as usize];
+                    let p = &layout.bodies[layout.body[e] as usize];
                     let r = match element_step(p, &xe, &ue, &committed, smallest_mass[e]) {
                         Ok(r) => r,
                         Err(err) => return (sums, Some((e, err))),
@@ -526,39 +375,34 @@ impl Reduced {
                 (sums, None)
             })
             .collect();
-        let mut total = StepWork {
-            critical_element: usize::MAX,
-            ..StepWork::default()
-        };
+        let mut total = StepWork::default();
         for (sums, error) in results {
             if let Some((e, err)) = error {
-                return Err(self.failure(e, err));
+                return Err(self.layout.failure(e, err));
             }
-            total.internal += sums.internal;
-            total.plastic += sums.plastic;
-            total.hourglass += sums.hourglass;
-            total.observe(sums.omega_squared, sums.critical_element);
+            total.add(&sums);
         }
-        self.gather(force);
+        self.gather.gather(&self.element_forces, force);
         self.hourglass_energy += total.hourglass;
         Ok(total)
     }
 
-    /// Copies the element state into the 4 points of each element of `state` (what the
-    /// recorder and the probes read).
-    pub fn write_points(&self, model: &Model, state: &mut State) {
-        let mut e0 = 0;
-        for (b, spec) in model.bodies.iter().enumerate() {
-            if !matches!(spec.kind, BodyKind::Continuum { .. }) {
-                continue;
-            }
+    fn write_points(&self, _model: &Model, state: &mut State) {
+        let this = self;
+        let mut start = 0;
+        while start < self.layout.origin.len() {
+            let b = self.layout.origin[start].0;
+            let count = self.layout.origin[start..]
+                .iter()
+                .take_while(|(body, _)| *body == b)
+                .count();
             let bs = &mut state.bodies[b];
             bs.points
                 .par_chunks_mut(4)
                 .zip(bs.thickness.par_chunks_mut(4))
                 .enumerate()
                 .for_each(|(e, (points, thickness))| {
-                    let s = self.state_of(e0 + e);
+                    let s = this.state_of(start + e);
                     let point = PointState {
                         stress: Voigt::from(s.stress),
                         eq_plastic_strain: s.eq_plastic_strain,
@@ -567,15 +411,24 @@ impl Reduced {
                     points.fill(point);
                     thickness.fill(s.thickness);
                 });
-            e0 += spec.elements();
+            start += count;
         }
+    }
+
+    fn hourglass_energy(&self) -> Option<f64> {
+        Some(self.hourglass_energy)
+    }
+
+    fn eq_plastic_strain(&self) -> &[f64] {
+        &self.eq_plastic_strain
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::Elastic;
+    use crate::element::Formulation;
+    use crate::material::{Elastic, Material};
 
     fn parameters() -> BodyParameters {
         let material = Material {
@@ -591,13 +444,13 @@ mod tests {
         BodyParameters {
             name: "b".into(),
             material,
-            plane_stress: false,
-            axisymmetric: false,
+            formulation: Formulation::PlaneStrain,
+            bbar: false,
             lambda,
             mu,
             hourglass_modulus: 0.1 * (lambda + 3.0 * mu) / 24.0,
             wave_modulus: lambda + 2.0 * mu,
-            model_body: 0,
+            wave_lambda: lambda,
             first_element: 0,
         }
     }

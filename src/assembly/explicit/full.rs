@@ -1,0 +1,413 @@
+//! The explicit 2x2 Quad4 in rate form: at each Gauss point of the mid-step configuration the
+//! strain increment and spin of the step (Hughes-Winget), the stress rotated by it, the
+//! material's update; the nodal forces on the end configuration; mean-dilatation (B-bar)
+//! volumetric strain by option. The same element as the implicit 2x2 kernel at small steps
+//! (where the Green-Lagrange increment and the push-forward reduce to the rate form), without
+//! its tangent: the fast path of `quadrature = "full"` on finite-strain Quad4 models.
+//!
+//! Legend (element; q = 1..4 the Gauss points, a = 1..4 the nodes)
+//! ```text
+//! N_a,q, N_a,x, N_a,y   shape values and gradients at q on the mid configuration x + u/2
+//! G_q                   sum_a u_a (x) grad N_a: the increment gradient at q
+//! d_q, w_q              sym G_q ([xx yy zz xy], zz the hoop u_r / r in axisymmetry), and
+//!                       w = (G_xy - G_yx) / 2
+//! B-bar                 d_q,ii += (tr_mean - tr d_q) / 3, tr_mean the volume mean of tr d_q
+//! sigma_q               material(R_q sigma_q,n R_q^T, d_q)
+//! f_a                   sum_q W_q (B_q^T sigma_q) on the end configuration (B-bar likewise)
+//! W_int                 sum_q W_q,mid 1/2 (R sigma_n R^T + sigma_{n+1}) . d_q
+//! ```
+
+use super::{CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, bound_of};
+use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
+use crate::element::quad4::{self, QuadValues};
+use crate::element::quad4_one_point::{Nodes, rotate};
+use crate::element::{Formulation, KernelError, Voigt};
+use crate::material::{PointState, StressCondition};
+use crate::scene::Model;
+use rayon::prelude::*;
+
+/// The committed state of the four points of one element.
+#[derive(Debug, Clone, Copy)]
+struct PointsState {
+    stress: [[f64; 4]; 4],
+    back_stress: [[f64; 4]; 4],
+    eq_plastic_strain: [f64; 4],
+    thickness: [f64; 4],
+}
+
+/// One element after a step.
+struct ElementStep {
+    state: PointsState,
+    force: [f64; 8],
+    work: f64,
+    plastic_work: f64,
+    omega_squared: f64,
+}
+
+/// The 2x2 explicit kernel over a model's Quad4 bodies.
+pub struct Full {
+    layout: Layout,
+    /// The lumped mass at the four nodes of each element (for its stable-step bound).
+    lumped: Vec<[f64; 4]>,
+    /// Per element, per point: Cauchy stress and back stress [xx yy zz xy] (16 each),
+    /// equivalent plastic strain and thickness (4 each).
+    stress: Vec<f64>,
+    back_stress: Vec<f64>,
+    eq_plastic_strain: Vec<f64>,
+    thickness: Vec<f64>,
+    element_forces: Vec<f64>,
+    gather: NodeGather,
+}
+
+/// The increment gradient, strain and spin at one point.
+fn point_increment(p: &quad4::PointValues, u: &Nodes, axisymmetric: bool) -> ([f64; 4], f64) {
+    let (mut gxx, mut gxy, mut gyx, mut gyy) = (0.0, 0.0, 0.0, 0.0);
+    for a in 0..4 {
+        let [nx, ny] = p.dndx[a];
+        gxx += u[a][0] * nx;
+        gxy += u[a][0] * ny;
+        gyx += u[a][1] * nx;
+        gyy += u[a][1] * ny;
+    }
+    let hoop = if axisymmetric {
+        (0..4).map(|a| p.shape[a] * u[a][0]).sum::<f64>() / p.radius
+    } else {
+        0.0
+    };
+    ([gxx, gyy, hoop, gxy + gyx], 0.5 * (gxy - gyx))
+}
+
+/// The nodal forces sum_q W_q B_q^T sigma_q on the configuration of `values` (B-bar: the
+/// volumetric rows averaged over the element).
+fn forces(values: &QuadValues, stress: &[[f64; 4]; 4], bbar: bool) -> [f64; 8] {
+    let axisymmetric = values.formulation == Formulation::Axisymmetric;
+    let mut f = [0.0; 8];
+    let mut mean_b = [[0.0; 2]; 4];
+    let mut volume = 0.0;
+    let mut pressure_weight = 0.0;
+    for (p, s) in values.points.iter().zip(stress) {
+        let w = p.weight;
+        let mean = (s[0] + s[1] + s[2]) / 3.0;
+        for a in 0..4 {
+            let [nx, ny] = p.dndx[a];
+            let hoop = if axisymmetric {
+                p.shape[a] / p.radius
+            } else {
+                0.0
+            };
+            f[2 * a] += w * (s[0] * nx + s[3] * ny + s[2] * hoop);
+            f[2 * a + 1] += w * (s[3] * nx + s[1] * ny);
+            if bbar {
+                // minus the point's own volumetric row times its mean stress
+                f[2 * a] -= w * mean * (nx + hoop);
+                f[2 * a + 1] -= w * mean * ny;
+                mean_b[a][0] += w * (nx + hoop);
+                mean_b[a][1] += w * ny;
+            }
+        }
+        volume += w;
+        pressure_weight += w * mean;
+    }
+    if bbar {
+        for a in 0..4 {
+            f[2 * a] += mean_b[a][0] / volume * pressure_weight;
+            f[2 * a + 1] += mean_b[a][1] / volume * pressure_weight;
+        }
+    }
+    f
+}
+
+/// One element over one step: positions x at the start, increment u (see the legend).
+fn element_step(
+    p: &super::BodyParameters,
+    x: &Nodes,
+    u: &Nodes,
+    committed: &PointsState,
+    lumped: &[f64; 4],
+) -> Result<ElementStep, KernelError> {
+    let axisymmetric = p.axisymmetric();
+    let mid: Nodes = std::array::from_fn(|a| [x[a][0] + 0.5 * u[a][0], x[a][1] + 0.5 * u[a][1]]);
+    let end: Nodes = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);
+    let at_mid = quad4::values(&mid, p.formulation, &committed.thickness)?;
+    let mut strain = [[0.0; 4]; 4];
+    let mut spin = [0.0; 4];
+    for q in 0..4 {
+        (strain[q], spin[q]) = point_increment(&at_mid.points[q], u, axisymmetric);
+    }
+    if p.bbar {
+        let volume = at_mid.volume();
+        let trace = |d: &[f64; 4]| d[0] + d[1] + d[2];
+        let mean: f64 = (0..4)
+            .map(|q| at_mid.points[q].weight * trace(&strain[q]))
+            .sum::<f64>()
+            / volume;
+        for d in &mut strain {
+            let shift = (mean - trace(d)) / 3.0;
+            for c in 0..3 {
+                d[c] += shift;
+            }
+        }
+    }
+    let mut state = *committed;
+    let (mut work, mut plastic_work) = (0.0, 0.0);
+    for q in 0..4 {
+        let w = spin[q];
+        let scale = 1.0 / (1.0 + 0.25 * w * w);
+        let (c, s) = ((1.0 - 0.25 * w * w) * scale, w * scale);
+        let stress_n = rotate(&committed.stress[q], c, s);
+        let back_n = rotate(&committed.back_stress[q], c, s);
+        let (stress, plastic) = update(
+            p,
+            &stress_n,
+            &back_n,
+            committed,
+            q,
+            &mut strain[q],
+            &mut state,
+        );
+        let weight = at_mid.points[q].weight;
+        work += weight
+            * 0.5
+            * (0..4)
+                .map(|k| (stress_n[k] + stress[k]) * strain[q][k])
+                .sum::<f64>();
+        plastic_work += weight * plastic;
+        state.stress[q] = stress;
+    }
+    let at_end = quad4::values(&end, p.formulation, &state.thickness)?;
+    Ok(ElementStep {
+        force: forces(&at_end, &state.stress, p.bbar),
+        omega_squared: quad4::frequency_bound(&at_end, p.wave_lambda, p.mu, lumped),
+        state,
+        work,
+        plastic_work,
+    })
+}
+
+/// The material update of point q from its rotated stress and back stress and the strain
+/// increment (plane stress: the material's out-of-plane strain written into it and the
+/// thickness updated); returns the new stress and the plastic work density.
+fn update(
+    p: &super::BodyParameters,
+    stress_n: &[f64; 4],
+    back_n: &[f64; 4],
+    committed: &PointsState,
+    q: usize,
+    strain: &mut [f64; 4],
+    state: &mut PointsState,
+) -> ([f64; 4], f64) {
+    if p.plane_stress() {
+        let r = p.material.update(
+            &PointState {
+                stress: Voigt::from(*stress_n),
+                eq_plastic_strain: committed.eq_plastic_strain[q],
+                back_stress: Voigt::from(*back_n),
+            },
+            &Voigt::from(*strain),
+            StressCondition::PlaneStress,
+        );
+        strain[2] = r.strain_zz;
+        state.back_stress[q] = r.state.back_stress.into();
+        state.eq_plastic_strain[q] = r.state.eq_plastic_strain;
+        state.thickness[q] = committed.thickness[q] * r.strain_zz.exp();
+        return (r.state.stress.into(), r.plastic_work);
+    }
+    let (lambda, mu) = (p.lambda, p.mu);
+    let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
+    let trial = [
+        stress_n[0] + volumetric + 2.0 * mu * strain[0],
+        stress_n[1] + volumetric + 2.0 * mu * strain[1],
+        stress_n[2] + volumetric + 2.0 * mu * strain[2],
+        stress_n[3] + mu * strain[3],
+    ];
+    let plastic = p.material.plasticity.as_ref().and_then(|j2| {
+        j2.radial(
+            &Voigt::from(trial),
+            mu,
+            &Voigt::from(*back_n),
+            committed.eq_plastic_strain[q],
+        )
+    });
+    match plastic {
+        None => {
+            state.back_stress[q] = *back_n;
+            (trial, 0.0)
+        }
+        Some(r) => {
+            state.back_stress[q] = r.back_stress.into();
+            state.eq_plastic_strain[q] = r.eq_plastic_strain;
+            (r.stress.into(), r.plastic_work())
+        }
+    }
+}
+
+impl Full {
+    /// The kernel for the Quad4 bodies of `model` from the committed `state`.
+    pub fn new(model: &Model, state: &State, masses: &ElementMasses) -> Full {
+        let layout = Layout::new(model, 0.0);
+        let count = layout.body.len();
+        let mut kernel = Full {
+            lumped: Vec::with_capacity(count),
+            stress: Vec::with_capacity(16 * count),
+            back_stress: Vec::with_capacity(16 * count),
+            eq_plastic_strain: Vec::with_capacity(4 * count),
+            thickness: Vec::with_capacity(4 * count),
+            element_forces: vec![0.0; 8 * count],
+            gather: NodeGather::new(&layout.nodes, state.coordinates.len()),
+            layout,
+        };
+        for &(b, e) in &kernel.layout.origin {
+            let committed = &state.bodies[b];
+            for p in &committed.points[4 * e..4 * e + 4] {
+                kernel.stress.extend(p.stress.iter());
+                kernel.back_stress.extend(p.back_stress.iter());
+                kernel.eq_plastic_strain.push(p.eq_plastic_strain);
+            }
+            kernel
+                .thickness
+                .extend_from_slice(&committed.thickness[4 * e..4 * e + 4]);
+            let m = masses.of(model, b, e);
+            kernel.lumped.push([m[0], m[1], m[2], m[3]]);
+        }
+        kernel
+    }
+
+    fn state_of(&self, e: usize) -> PointsState {
+        PointsState {
+            stress: std::array::from_fn(|q| {
+                std::array::from_fn(|c| self.stress[16 * e + 4 * q + c])
+            }),
+            back_stress: std::array::from_fn(|q| {
+                std::array::from_fn(|c| self.back_stress[16 * e + 4 * q + c])
+            }),
+            eq_plastic_strain: std::array::from_fn(|q| self.eq_plastic_strain[4 * e + q]),
+            thickness: std::array::from_fn(|q| self.thickness[4 * e + q]),
+        }
+    }
+
+    fn parameters(&self, e: usize) -> &super::BodyParameters {
+        &self.layout.bodies[self.layout.body[e] as usize]
+    }
+}
+
+impl ExplicitKernel for Full {
+    fn elements(&self) -> usize {
+        self.layout.body.len()
+    }
+
+    fn locate(&self, element: usize) -> (usize, usize) {
+        self.layout.origin[element]
+    }
+
+    fn internal_force(&mut self, x: &[[f64; 2]], force: &mut [f64]) -> Result<(), ElementFailure> {
+        for e in 0..self.elements() {
+            let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
+            let state = self.state_of(e);
+            let p = self.parameters(e);
+            let values = quad4::values(&xe, p.formulation, &state.thickness)
+                .map_err(|err| self.layout.failure(e, err))?;
+            let f = forces(&values, &state.stress, p.bbar);
+            self.element_forces[8 * e..8 * e + 8].copy_from_slice(&f);
+        }
+        self.gather.gather(&self.element_forces, force);
+        Ok(())
+    }
+
+    fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<FrequencyBound, ElementFailure> {
+        let mut worst = StepWork::default();
+        for e in 0..self.elements() {
+            let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
+            let p = self.parameters(e);
+            let values = quad4::values(&xe, p.formulation, &self.state_of(e).thickness)
+                .map_err(|err| self.layout.failure(e, err))?;
+            let w = quad4::frequency_bound(&values, p.wave_lambda, p.mu, &self.lumped[e]);
+            worst.observe(w, e);
+        }
+        Ok(bound_of(&self.layout, &worst))
+    }
+
+    fn step(
+        &mut self,
+        x: &[[f64; 2]],
+        du: &[f64],
+        force: &mut [f64],
+    ) -> Result<StepWork, ElementFailure> {
+        let layout = &self.layout;
+        let lumped = &self.lumped;
+        let results: Vec<(StepWork, Option<(usize, KernelError)>)> = (
+            self.stress.par_chunks_mut(16 * CHUNK),
+            self.back_stress.par_chunks_mut(16 * CHUNK),
+            self.eq_plastic_strain.par_chunks_mut(4 * CHUNK),
+            self.thickness.par_chunks_mut(4 * CHUNK),
+            self.element_forces.par_chunks_mut(8 * CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, (stress, back, eps_p, thickness, forces))| {
+                let mut sums = StepWork::default();
+                for i in 0..forces.len() / 8 {
+                    let e = k * CHUNK + i;
+                    let element = layout.nodes[e];
+                    let xe: Nodes = element.map(|n| x[n as usize]);
+                    let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+                    let committed = PointsState {
+                        stress: std::array::from_fn(|q| {
+                            std::array::from_fn(|c| stress[16 * i + 4 * q + c])
+                        }),
+                        back_stress: std::array::from_fn(|q| {
+                            std::array::from_fn(|c| back[16 * i + 4 * q + c])
+                        }),
+                        eq_plastic_strain: std::array::from_fn(|q| eps_p[4 * i + q]),
+                        thickness: std::array::from_fn(|q| thickness[4 * i + q]),
+                    };
+                    let p = &layout.bodies[layout.body[e] as usize];
+                    let r = match element_step(p, &xe, &ue, &committed, &lumped[e]) {
+                        Ok(r) => r,
+                        Err(err) => return (sums, Some((e, err))),
+                    };
+                    sums.observe(r.omega_squared, e);
+                    for q in 0..4 {
+                        stress[16 * i + 4 * q..16 * i + 4 * q + 4]
+                            .copy_from_slice(&r.state.stress[q]);
+                        back[16 * i + 4 * q..16 * i + 4 * q + 4]
+                            .copy_from_slice(&r.state.back_stress[q]);
+                    }
+                    eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
+                    thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
+                    forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
+                    sums.internal += r.work;
+                    sums.plastic += r.plastic_work;
+                }
+                (sums, None)
+            })
+            .collect();
+        let mut total = StepWork::default();
+        for (sums, error) in results {
+            if let Some((e, err)) = error {
+                return Err(self.layout.failure(e, err));
+            }
+            total.add(&sums);
+        }
+        self.gather.gather(&self.element_forces, force);
+        Ok(total)
+    }
+
+    fn write_points(&self, _model: &Model, state: &mut State) {
+        for (k, &(b, e)) in self.layout.origin.iter().enumerate() {
+            let s = self.state_of(k);
+            let bs = &mut state.bodies[b];
+            for q in 0..4 {
+                bs.points[4 * e + q] = PointState {
+                    stress: Voigt::from(s.stress[q]),
+                    eq_plastic_strain: s.eq_plastic_strain[q],
+                    back_stress: Voigt::from(s.back_stress[q]),
+                };
+                bs.thickness[4 * e + q] = s.thickness[q];
+            }
+        }
+    }
+
+    fn eq_plastic_strain(&self) -> &[f64] {
+        &self.eq_plastic_strain
+    }
+}

@@ -1,0 +1,260 @@
+//! The explicit element loops: element data as structure of arrays, the element kernels run
+//! in parallel over fixed chunks, nodal forces gathered in element order (the bits do not
+//! depend on the thread count). Two kernels: the one-point Quad4 with hourglass control
+//! (`one_point`, `quadrature = "reduced"`) and the 2x2 Quad4 in the same rate form (`full`,
+//! `quadrature = "full"` on finite-strain Quad4 models); both give the element frequency
+//! bound of the end configuration for the stable step.
+
+pub mod full;
+pub mod one_point;
+
+pub use full::Full;
+pub use one_point::Reduced;
+
+use super::{ElementFailure, FrequencyBound, State};
+use crate::element::Formulation;
+use crate::material::Material;
+use crate::scene::{BodyKind, Model};
+use rayon::prelude::*;
+
+/// Elements per parallel task (fixed, so the work sums do not depend on the thread count).
+pub(super) const CHUNK: usize = 256;
+
+/// The sums of one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepWork {
+    /// Work of the stresses and the hourglass forces (includes both below).
+    pub internal: f64,
+    pub plastic: f64,
+    pub hourglass: f64,
+    /// The largest element frequency bound squared on the end configuration, and its
+    /// element (index over the kernel's elements; the lowest among equals).
+    pub omega_squared: f64,
+    pub critical_element: usize,
+}
+
+impl Default for StepWork {
+    fn default() -> StepWork {
+        StepWork {
+            internal: 0.0,
+            plastic: 0.0,
+            hourglass: 0.0,
+            omega_squared: 0.0,
+            critical_element: usize::MAX,
+        }
+    }
+}
+
+impl StepWork {
+    /// Takes an element's frequency bound into the maximum.
+    pub(super) fn observe(&mut self, omega_squared: f64, element: usize) {
+        if omega_squared > self.omega_squared
+            || (omega_squared == self.omega_squared && element < self.critical_element)
+        {
+            self.omega_squared = omega_squared;
+            self.critical_element = element;
+        }
+    }
+
+    /// Adds a chunk's sums (in chunk order).
+    pub(super) fn add(&mut self, other: &StepWork) {
+        self.internal += other.internal;
+        self.plastic += other.plastic;
+        self.hourglass += other.hourglass;
+        self.observe(other.omega_squared, other.critical_element);
+    }
+}
+
+/// What the kernels need of a Quad4 body.
+#[derive(Debug, Clone)]
+pub(super) struct BodyParameters {
+    pub name: String,
+    pub material: Material,
+    pub formulation: Formulation,
+    pub bbar: bool,
+    /// The Lame constants (lambda of the 3D law; plane stress condenses it itself).
+    pub lambda: f64,
+    pub mu: f64,
+    /// The plane-wave modulus of the stable-step bound: lambda + 2 mu (plane stress:
+    /// E / (1 - nu^2)), and the lambda that goes with it.
+    pub wave_modulus: f64,
+    pub wave_lambda: f64,
+    /// kappa (lambda + 3 mu) / 24 with the plane-stress lambda (the one-point kernel).
+    pub hourglass_modulus: f64,
+    /// The body's first element in the kernel's numbering.
+    pub first_element: usize,
+}
+
+impl BodyParameters {
+    pub(super) fn plane_stress(&self) -> bool {
+        self.formulation == Formulation::PlaneStress
+    }
+    pub(super) fn axisymmetric(&self) -> bool {
+        self.formulation == Formulation::Axisymmetric
+    }
+}
+
+/// The Quad4 bodies of a model as the kernels see them: per body its parameters, per element
+/// its body and global nodes.
+pub(super) struct Layout {
+    pub bodies: Vec<BodyParameters>,
+    pub body: Vec<u32>,
+    pub nodes: Vec<[u32; 4]>,
+    /// (model body, element in it) of each kernel element.
+    pub origin: Vec<(usize, usize)>,
+}
+
+impl Layout {
+    pub(super) fn new(model: &Model, kappa: f64) -> Layout {
+        let mut layout = Layout {
+            bodies: Vec::new(),
+            body: Vec::new(),
+            nodes: Vec::new(),
+            origin: Vec::new(),
+        };
+        for (b, spec) in model.bodies.iter().enumerate() {
+            let BodyKind::Continuum {
+                formulation, bbar, ..
+            } = spec.kind
+            else {
+                continue;
+            };
+            let (lambda, mu) = spec.material.elastic.lame();
+            let wave_lambda = if formulation == Formulation::PlaneStress {
+                2.0 * lambda * mu / (lambda + 2.0 * mu)
+            } else {
+                lambda
+            };
+            layout.bodies.push(BodyParameters {
+                name: spec.name.clone(),
+                material: spec.material.clone(),
+                formulation,
+                bbar,
+                lambda,
+                mu,
+                wave_modulus: wave_lambda + 2.0 * mu,
+                wave_lambda,
+                hourglass_modulus: kappa * (wave_lambda + 3.0 * mu) / 24.0,
+                first_element: layout.body.len(),
+            });
+            let index = (layout.bodies.len() - 1) as u32;
+            for e in 0..spec.elements() {
+                let n = spec.mesh.cells.nodes_of(e);
+                layout.body.push(index);
+                layout
+                    .nodes
+                    .push(std::array::from_fn(|a| spec.global(n[a]) as u32));
+                layout.origin.push((b, e));
+            }
+        }
+        layout
+    }
+
+    pub(super) fn failure(
+        &self,
+        element: usize,
+        error: crate::element::KernelError,
+    ) -> ElementFailure {
+        let p = &self.bodies[self.body[element] as usize];
+        ElementFailure {
+            body: p.name.clone(),
+            element: element - p.first_element,
+            error,
+        }
+    }
+}
+
+/// Node -> its entries in the element forces (8 per element), in element order: the gather
+/// that sums the element forces into the nodes.
+#[derive(Debug, Clone)]
+pub(super) struct NodeGather {
+    start: Vec<usize>,
+    entries: Vec<u32>,
+}
+
+impl NodeGather {
+    pub(super) fn new(nodes: &[[u32; 4]], node_count: usize) -> NodeGather {
+        let mut start = vec![0usize; node_count + 1];
+        for element in nodes {
+            for n in element {
+                start[*n as usize + 1] += 1;
+            }
+        }
+        for n in 0..node_count {
+            start[n + 1] += start[n];
+        }
+        let mut fill = start.clone();
+        let mut entries = vec![0u32; start[node_count]];
+        for (e, element) in nodes.iter().enumerate() {
+            for (a, n) in element.iter().enumerate() {
+                entries[fill[*n as usize]] = (8 * e + 2 * a) as u32;
+                fill[*n as usize] += 1;
+            }
+        }
+        NodeGather { start, entries }
+    }
+
+    /// Sums the element forces `element_forces` into the nodes: `force` over all DOFs
+    /// (overwritten; nodes of no element get zero).
+    pub(super) fn gather(&self, element_forces: &[f64], force: &mut [f64]) {
+        let ef = element_forces;
+        force
+            .par_chunks_mut(2 * CHUNK)
+            .enumerate()
+            .for_each(|(k, chunk)| {
+                for (i, f) in chunk.chunks_exact_mut(2).enumerate() {
+                    let n = k * CHUNK + i;
+                    let (mut fx, mut fy) = (0.0, 0.0);
+                    for entry in &self.entries[self.start[n]..self.start[n + 1]] {
+                        fx += ef[*entry as usize];
+                        fy += ef[*entry as usize + 1];
+                    }
+                    f[0] = fx;
+                    f[1] = fy;
+                }
+            });
+    }
+}
+
+/// An explicit element loop over a model's Quad4 bodies.
+pub trait ExplicitKernel: Send {
+    fn elements(&self) -> usize;
+    /// The model's body and the element's number in it of kernel element `element`.
+    fn locate(&self, element: usize) -> (usize, usize);
+    /// The internal force on the positions `x` from the stored state (no update), written
+    /// into `force` over all DOFs.
+    fn internal_force(&mut self, x: &[[f64; 2]], force: &mut [f64]) -> Result<(), ElementFailure>;
+    /// One step from positions `x` by the increment `du` (2 per node): updates the element
+    /// state and writes the internal force on x + du into `force`. After an error the
+    /// element state is partly updated and the run must stop.
+    fn step(
+        &mut self,
+        x: &[[f64; 2]],
+        du: &[f64],
+        force: &mut [f64],
+    ) -> Result<StepWork, ElementFailure>;
+    /// The largest element frequency bound on the positions `x` from the stored state.
+    fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<FrequencyBound, ElementFailure>;
+    /// Copies the element state into the points of `state` (what output reads).
+    fn write_points(&self, model: &Model, state: &mut State);
+    /// The accumulated hourglass work (the one-point kernel).
+    fn hourglass_energy(&self) -> Option<f64> {
+        None
+    }
+    /// The equivalent plastic strain of every point the kernel keeps (for studies).
+    fn eq_plastic_strain(&self) -> &[f64];
+}
+
+/// The frequency bound of kernel element `critical` as the model names it.
+pub(super) fn bound_of(layout: &Layout, work: &StepWork) -> FrequencyBound {
+    let (body, element) = layout
+        .origin
+        .get(work.critical_element)
+        .copied()
+        .unwrap_or((0, 0));
+    FrequencyBound {
+        omega_squared: work.omega_squared,
+        body,
+        element,
+    }
+}
