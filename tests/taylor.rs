@@ -61,9 +61,15 @@ fn taylor_aluminum_converges_and_lands_with_the_bilinear_models() {
     let (full, full_r, _) = taylor(5, "full");
     assert!((fine / coarse - 1.0).abs() < 0.01, "{coarse} -> {fine}");
     assert!((full / coarse - 1.0).abs() < 0.015, "{full} vs {coarse}");
-    assert!((full_r / coarse_r - 1.0).abs() < 0.05, "{full_r} vs {coarse_r}");
+    assert!(
+        (full_r / coarse_r - 1.0).abs() < 0.05,
+        "{full_r} vs {coarse_r}"
+    );
     for length in [coarse, fine, full] {
-        assert!(length > EXPERIMENT && length < 1.10 * EXPERIMENT, "{length}");
+        assert!(
+            length > EXPERIMENT && length < 1.10 * EXPERIMENT,
+            "{length}"
+        );
         assert!(length > MANUAL[0] && length < 1.025 * MANUAL[1], "{length}");
     }
 }
