@@ -10,13 +10,16 @@
 //! element_sets   name -> element ids
 //! ```
 //! Every generator and the Gmsh reader fill `element_sets["all"]`, and every edge set also
-//! appears as a node set of the same name (the union of its edge nodes).
+//! appears as a node set of the same name (the union of its edge nodes). The Gmsh reader
+//! turns the file's tagged cells into sets in tagged.rs, where other file readers can too,
+//! and gives quad meshes the edge set `boundary`.
 
 pub mod generate;
 pub mod gmsh;
 pub mod plane;
+mod tagged;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 pub use generate::MeshSpec;
 
@@ -127,4 +130,35 @@ impl Mesh {
             .map(|(e, _)| e)
             .collect()
     }
+}
+
+/// Edges head to tail: open chains first (by first node), then closed loops.
+pub fn chain_order(edges: Vec<[usize; 2]>) -> Vec<[usize; 2]> {
+    let mut leaving: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (k, e) in edges.iter().enumerate() {
+        leaving.entry(e[0]).or_default().push(k);
+    }
+    let ends: BTreeSet<usize> = edges.iter().map(|e| e[1]).collect();
+    let mut heads: Vec<usize> = edges
+        .iter()
+        .map(|e| e[0])
+        .filter(|n| !ends.contains(n))
+        .collect();
+    heads.sort_unstable();
+    heads.extend(edges.iter().map(|e| e[0]));
+
+    let mut used = vec![false; edges.len()];
+    let mut ordered = Vec::with_capacity(edges.len());
+    for head in heads {
+        let mut node = head;
+        while let Some(&k) = leaving
+            .get(&node)
+            .and_then(|ks| ks.iter().find(|&&k| !used[k]))
+        {
+            used[k] = true;
+            ordered.push(edges[k]);
+            node = edges[k][1];
+        }
+    }
+    ordered
 }
