@@ -14,9 +14,9 @@
 //! ```
 //! Quads given clockwise are reordered counter-clockwise; one with a repeated node or zero area
 //! is an error. A quad mesh also gets the edge set `boundary` (unless a group has that name).
-//! The sets are built in src/mesh/tagged.rs. mshio discards node tags when
-//! they are dense (max - min + 1 = count); they are then taken as consecutive in file order,
-//! as Gmsh writes them.
+//! The sets are built as for VTK files (src/mesh/tagged.rs). mshio discards node tags when they
+//! are dense (max - min + 1 = count); they are then taken as consecutive in file order, as Gmsh
+//! writes them.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::Path;

@@ -9,15 +9,16 @@
 //!                of a -> b (counter-clockwise around the body)
 //! element_sets   name -> element ids
 //! ```
-//! Every generator and the Gmsh reader fill `element_sets["all"]`, and every edge set also
-//! appears as a node set of the same name (the union of its edge nodes). The Gmsh reader
-//! turns the file's tagged cells into sets in tagged.rs, where other file readers can too,
-//! and gives quad meshes the edge set `boundary`.
+//! Every generator and the file readers (Gmsh, VTK) fill `element_sets["all"]`, and every
+//! edge set also appears as a node set of the same name (the union of its edge nodes). The
+//! readers share the turning of a file's tagged cells into sets (tagged.rs) and give quad
+//! meshes the edge set `boundary`.
 
 pub mod generate;
 pub mod gmsh;
 pub mod plane;
 mod tagged;
+pub mod vtk;
 
 use std::collections::{BTreeMap, BTreeSet};
 

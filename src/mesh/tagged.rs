@@ -1,5 +1,5 @@
 //! A mesh as a file gives it (points and cells by the file's numbers, each cell in the named
-//! groups the file puts it in), turned into a [`Mesh`]: what mesh file readers share.
+//! groups the file puts it in), turned into a [`Mesh`]: what the Gmsh and VTK readers share.
 //!
 //! Legend
 //! ```text
