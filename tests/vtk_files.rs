@@ -737,6 +737,35 @@ fn bad_vtk_meshes_are_refused_naming_the_file_and_the_defect() {
     }
 }
 
+/// Goal: the scene keys of this feature are checked like every other: a misspelled mesh key
+/// and an unknown `output.points` are refused (exit 2) naming what is expected. Setup: the
+/// test mesh's scene through `impact check`, and `--set output.points=deformed`. Reference:
+/// the keys' documented spellings.
+#[test]
+fn misspelled_vtk_and_points_keys_are_refused() {
+    let dir = common::out_dir("vtk_keys");
+    let path = data("rect_binary_zlib.vtu");
+    let (code, stderr) = check_mesh(&dir, &path, "[\"side\"], set = [\"side\"]");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("`set`") && stderr.contains("sets"),
+        "{stderr}"
+    );
+    let (code, stderr) = check_mesh(&dir, &path, "[]");
+    assert_eq!(code, 0, "{stderr}");
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["check", dir.join("scene.toml").to_str().unwrap()])
+        .args(["--set", "output.points=deformed"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("deformed") && stderr.contains("`current` or `reference`"),
+        "{stderr}"
+    );
+}
+
 /// Goal: quads given only clockwise are read, reordered counter-clockwise with their first
 /// node kept. Setup: every quad of the test mesh written clockwise. Reference: the generator's
 /// cells.

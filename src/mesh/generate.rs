@@ -277,6 +277,12 @@ mod tests {
         assert!(misspelled.unwrap_err().to_string().contains("gradng_x"));
         assert!(spec("type = 'quarter_disc'\nradius = 8\nn = 8\nquadrnt = 'upper'").is_err());
         assert!(spec("type = 'gmsh'\nfile = 'a.msh'\nscale = 2").is_err());
+        let Ok(MeshSpec::Vtk(vtk)) = spec("type = 'vtk'\nfile = 'a.vtu'") else {
+            panic!("a vtk spec expected")
+        };
+        assert!(vtk.sets.is_empty());
+        let misspelled = spec("type = 'vtk'\nfile = 'a.vtu'\nset = ['region']");
+        assert!(misspelled.unwrap_err().to_string().contains("sets"));
         assert!(spec("type = 'hexagon'\nradius = 1").is_err());
     }
 
