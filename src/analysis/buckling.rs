@@ -184,8 +184,9 @@ pub enum MonitorError {
 }
 
 /// Writes the modes as the frames of DIR/NAME_buckling.pvd: frame i (its "time") is mode i,
-/// the `displacement` field the mode shape (largest nodal value 1; scale it with Warp By
-/// Vector).
+/// the points the reference configuration and the `displacement` field the mode shape
+/// (largest nodal value 1). A mode's amplitude is arbitrary, so the points do not move by
+/// it: Warp By Vector shows the shape at the scale the viewer picks.
 pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|e| OutputError::io(dir, "create folder", e))?;
     let mut series = Series::create(
@@ -209,6 +210,7 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
             contact_force: &zeros2,
             gap: &zeros,
             contact_status: &zeros,
+            reference_coordinates: &grid.points,
             stress: &stress,
             von_mises: &cell_zeros,
             eq_plastic_strain: &cell_zeros,

@@ -11,7 +11,7 @@ use crate::output::history::History;
 use crate::output::vtk::{Fields, Grid, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
-use crate::scene::spec::{Quantity, Statistic};
+use crate::scene::spec::{FramePoints, Quantity, Statistic};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -35,7 +35,10 @@ pub struct Motion<'a> {
 
 pub struct Recorder {
     dir: PathBuf,
+    /// The cells, and the points of the frame being written.
     grid: Grid,
+    /// The initial coordinates (the `reference_coordinates` array).
+    reference: Vec<[f64; 2]>,
     series: Option<Series>,
     history: History,
     frame_every: usize,
@@ -74,6 +77,7 @@ impl Recorder {
         Ok(Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
+            reference: model.coordinates(),
             series,
             history,
             frame_every: model.output.frame_every,
@@ -122,6 +126,7 @@ impl Recorder {
         Ok(Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
+            reference: model.coordinates(),
             series,
             history,
             frame_every: model.output.frame_every,
@@ -251,9 +256,9 @@ impl Recorder {
         let vectors =
             |v: &[f64]| -> Vec<[f64; 2]> { v.chunks_exact(2).map(|c| [c[0], c[1]]).collect() };
         let n = state.coordinates.len();
+        let positions = state.positions(model.analysis.geometry());
         let (contact_force, gap, status) = match contact {
             Some(c) => {
-                let positions = state.positions(model.analysis.geometry());
                 let nodal = c.nodal_status(&model.contacts, &positions);
                 (
                     c.nodal_forces(&model.contacts, &positions),
@@ -270,11 +275,18 @@ impl Recorder {
             contact_force: &vectors(&contact_force),
             gap: &gap,
             contact_status: &status,
+            reference_coordinates: &self.reference,
             stress: &cells.stress,
             von_mises: &cells.von_mises,
             eq_plastic_strain: &cells.eq_plastic_strain,
             pressure: &cells.pressure,
         };
+        let points = match model.output.points {
+            FramePoints::Current => &positions[..],
+            FramePoints::Reference => &self.reference[..],
+        };
+        self.grid.points.clear();
+        self.grid.points.extend_from_slice(points);
         series.write_frame(state.time, &self.grid, &fields)?;
         self.steps_since_frame = 0;
         self.last_frame_time = Some(state.time);

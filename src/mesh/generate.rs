@@ -57,10 +57,11 @@ pub enum MeshSpec {
     RoundBar(RoundBar),
     Line(Line),
     Gmsh(GmshFile),
+    Vtk(VtkFile),
 }
 
 impl MeshSpec {
-    /// Builds the mesh. `base_dir` (the scene file's folder) anchors a relative Gmsh path.
+    /// Builds the mesh. `base_dir` (the scene file's folder) anchors a relative file path.
     pub fn build(&self, base_dir: &Path) -> Result<Mesh, MeshError> {
         match self {
             MeshSpec::Rectangle(s) => s.build(),
@@ -72,6 +73,7 @@ impl MeshSpec {
             MeshSpec::RoundBar(s) => s.build(),
             MeshSpec::Line(s) => s.build(),
             MeshSpec::Gmsh(s) => s.build(base_dir),
+            MeshSpec::Vtk(s) => s.build(base_dir),
         }
     }
 }
@@ -87,6 +89,23 @@ pub struct GmshFile {
 impl GmshFile {
     pub fn build(&self, base_dir: &Path) -> Result<Mesh, MeshError> {
         super::gmsh::read(&base_dir.join(&self.file))
+    }
+}
+
+/// `type = "vtk"`: a legacy .vtk or XML .vtu file (what is read: [`super::vtk::read`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VtkFile {
+    /// Path of the .vtk or .vtu file; a relative path is relative to the scene file's folder.
+    pub file: String,
+    /// Integer point or cell data arrays whose values name sets (`NAME_value`). Default: none.
+    #[serde(default)]
+    pub sets: Vec<String>,
+}
+
+impl VtkFile {
+    pub fn build(&self, base_dir: &Path) -> Result<Mesh, MeshError> {
+        super::vtk::read(&base_dir.join(&self.file), &self.sets)
     }
 }
 
@@ -258,6 +277,12 @@ mod tests {
         assert!(misspelled.unwrap_err().to_string().contains("gradng_x"));
         assert!(spec("type = 'quarter_disc'\nradius = 8\nn = 8\nquadrnt = 'upper'").is_err());
         assert!(spec("type = 'gmsh'\nfile = 'a.msh'\nscale = 2").is_err());
+        let Ok(MeshSpec::Vtk(vtk)) = spec("type = 'vtk'\nfile = 'a.vtu'") else {
+            panic!("a vtk spec expected")
+        };
+        assert!(vtk.sets.is_empty());
+        let misspelled = spec("type = 'vtk'\nfile = 'a.vtu'\nset = ['region']");
+        assert!(misspelled.unwrap_err().to_string().contains("sets"));
         assert!(spec("type = 'hexagon'\nradius = 1").is_err());
     }
 

@@ -12,8 +12,10 @@
 //! 0D group       -> node set
 //! group name     from $PhysicalNames, else "physical_<tag>"
 //! ```
-//! Quads given clockwise are reordered counter-clockwise. mshio discards node tags when they are
-//! dense (max - min + 1 = count); they are then taken as consecutive in file order, as Gmsh
+//! Quads given clockwise are reordered counter-clockwise; one with a repeated node or zero area
+//! is an error. A quad mesh also gets the edge set `boundary` (unless a group has that name).
+//! The sets are built as for VTK files (src/mesh/tagged.rs). mshio discards node tags when they
+//! are dense (max - min + 1 = count); they are then taken as consecutive in file order, as Gmsh
 //! writes them.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -21,8 +23,8 @@ use std::path::Path;
 
 use mshio::{ElementType, MshFile, MshParserError};
 
-use super::plane::quad_area;
-use super::{Cells, Mesh, MeshError};
+use super::tagged::{TaggedCell, TaggedMesh, Words};
+use super::{Mesh, MeshError};
 
 /// (dimension, physical tag) of a physical group.
 type Group = (i32, i32);
@@ -37,313 +39,76 @@ pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     check_binary_sizes(&file, &bytes)?;
     let msh = mshio::parse_msh_bytes(&bytes).map_err(|e| parse_error(&file, &bytes, &e))?;
     let names = physical_names(&file, &bytes)?;
-    let raw = RawMesh::collect(&msh).map_err(|reason| MeshError::Content {
-        path: file.clone(),
-        reason,
-    })?;
-    raw.into_mesh(&names)
+    collect(&msh, &names)
+        .and_then(TaggedMesh::into_mesh)
         .map_err(|reason| MeshError::Content { path: file, reason })
 }
 
-/// One element as read: Gmsh tag, node tags, physical groups of its entity.
-struct RawElement<const N: usize> {
-    tag: u64,
-    nodes: [u64; N],
-    groups: Vec<Group>,
-}
-
-/// The file's content before renumbering.
-struct RawMesh {
-    coords: HashMap<u64, [f64; 3]>,
-    quads: Vec<RawElement<4>>,
-    lines: Vec<RawElement<2>>,
-    points: Vec<RawElement<1>>,
-}
-
-impl RawMesh {
-    fn collect(msh: &MshFile<u64, i32, f64>) -> Result<RawMesh, String> {
-        let groups = entity_groups(msh);
-        let mut raw = RawMesh {
-            coords: node_coords(msh),
-            quads: Vec::new(),
-            lines: Vec::new(),
-            points: Vec::new(),
-        };
-        let blocks = msh
-            .data
-            .elements
-            .iter()
-            .flat_map(|e| e.element_blocks.iter());
-        for block in blocks {
-            let entity = (block.entity_dim, block.entity_tag);
-            let groups: Vec<Group> = groups.get(&entity).cloned().unwrap_or_default();
-            for element in &block.elements {
-                let tag = element.element_tag;
-                let groups = groups.clone();
-                match block.element_type {
-                    ElementType::Qua4 => raw.quads.push(RawElement {
-                        tag,
-                        nodes: node_tags(element)?,
-                        groups,
-                    }),
-                    ElementType::Lin2 => raw.lines.push(RawElement {
-                        tag,
-                        nodes: node_tags(element)?,
-                        groups,
-                    }),
-                    ElementType::Pnt => raw.points.push(RawElement {
-                        tag,
-                        nodes: node_tags(element)?,
-                        groups,
-                    }),
-                    other => {
-                        return Err(format!(
-                            "element {tag} has type {other:?}; impact reads 4-node quadrangles \
-                             (type 3), 2-node lines (type 1) and points (type 15)"
-                        ));
-                    }
-                }
-            }
-        }
-        Ok(raw)
-    }
-
-    fn into_mesh(self, names: &HashMap<Group, String>) -> Result<Mesh, String> {
-        let rods = self.quads.is_empty();
-        if rods && self.lines.is_empty() {
-            return Err("no 4-node quadrangles (type 3) or 2-node lines (type 1)".to_string());
-        }
-        let used = self.used_nodes(rods);
-        let ids: BTreeMap<u64, usize> = used.iter().enumerate().map(|(k, &tag)| (tag, k)).collect();
-        let nodes = self.planar_nodes(&used)?;
-        let cells = if rods {
-            Cells::Rod2(
-                self.lines
-                    .iter()
-                    .map(|l| l.nodes.map(|t| ids[&t]))
-                    .collect(),
-            )
-        } else {
-            Cells::Quad4(self.counter_clockwise_quads(&ids, &nodes)?)
-        };
-        let mut mesh = Mesh::new(nodes, cells);
-        let mut sets = SetNames::default();
-        if rods {
-            self.add_rod_groups(&mut mesh, &mut sets, &ids, names)?;
-        } else {
-            self.add_quad_groups(&mut mesh, &mut sets, &ids, names)?;
-        }
-        self.add_point_groups(&mut mesh, &mut sets, &ids, names)?;
-        Ok(mesh)
-    }
-
-    /// Node tags used by the cells, increasing.
-    fn used_nodes(&self, rods: bool) -> Vec<u64> {
-        let tags: BTreeSet<u64> = if rods {
-            self.lines.iter().flat_map(|l| l.nodes).collect()
-        } else {
-            self.quads.iter().flat_map(|q| q.nodes).collect()
-        };
-        tags.into_iter().collect()
-    }
-
-    /// [x, y] of the used nodes; every node must exist and lie in the plane z = 0.
-    fn planar_nodes(&self, used: &[u64]) -> Result<Vec<[f64; 2]>, String> {
-        let mut points = Vec::with_capacity(used.len());
-        for tag in used {
-            let p = self
-                .coords
-                .get(tag)
-                .ok_or_else(|| format!("an element uses node {tag}, which $Nodes lacks"))?;
-            points.push(*p);
-        }
-        let extent = points
-            .iter()
-            .flat_map(|p| [p[0].abs(), p[1].abs()])
-            .fold(0.0, f64::max)
-            .max(1e-300);
-        if let Some((tag, p)) = used
-            .iter()
-            .zip(&points)
-            .find(|(_, p)| p[2].abs() > 1e-9 * extent)
-        {
-            return Err(format!(
-                "node {tag} has z = {}; impact reads 2D meshes in the plane z = 0",
-                p[2]
-            ));
-        }
-        Ok(points.iter().map(|p| [p[0], p[1]]).collect())
-    }
-
-    fn counter_clockwise_quads(
-        &self,
-        ids: &BTreeMap<u64, usize>,
-        nodes: &[[f64; 2]],
-    ) -> Result<Vec<[usize; 4]>, String> {
-        let scale = nodes
-            .iter()
-            .flat_map(|p| [p[0].abs(), p[1].abs()])
-            .fold(0.0, f64::max);
-        let mut quads = Vec::with_capacity(self.quads.len());
-        for quad in &self.quads {
-            let [a, b, c, d] = quad.nodes.map(|t| ids[&t]);
-            let area = quad_area([a, b, c, d].map(|n| nodes[n]));
-            if area.abs() <= 1e-14 * scale * scale {
-                return Err(format!("quadrangle {} has zero area", quad.tag));
-            }
-            quads.push(if area > 0.0 {
-                [a, b, c, d]
-            } else {
-                [a, d, c, b]
-            });
-        }
-        Ok(quads)
-    }
-
-    /// 2D groups -> element sets; 1D groups -> edge sets oriented by their quads (+ node sets).
-    fn add_quad_groups(
-        &self,
-        mesh: &mut Mesh,
-        sets: &mut SetNames,
-        ids: &BTreeMap<u64, usize>,
-        names: &HashMap<Group, String>,
-    ) -> Result<(), String> {
-        for (group, elements) in members(&self.quads, 2) {
-            let name = sets.claim_elements(group_name(names, group))?;
-            mesh.element_sets.insert(name, elements);
-        }
-        let owner = quad_edge_owners(mesh);
-        for (group, lines) in members(&self.lines, 1) {
-            let name = sets.claim_nodes(group_name(names, group))?;
-            let mut edges = Vec::with_capacity(lines.len());
-            for k in lines {
-                let line = &self.lines[k];
-                let [a, b] = line.nodes.map(|t| ids.get(&t).copied());
-                let edge = match (a, b) {
-                    (Some(a), Some(b)) => owner.get(&(a.min(b), a.max(b))),
-                    _ => None,
-                };
-                match edge {
-                    Some((edge, 1)) => edges.push(*edge),
-                    Some(_) => {
-                        return Err(format!(
-                            "line {} of group \"{name}\" lies inside the body",
-                            line.tag
-                        ));
-                    }
-                    None => {
-                        return Err(format!(
-                            "line {} of group \"{name}\" is not a quadrangle side",
-                            line.tag
-                        ));
-                    }
-                }
-            }
-            mesh.add_edge_set(&name, edges);
-        }
-        Ok(())
-    }
-
-    /// 1D groups of a rod mesh -> element sets + node sets.
-    fn add_rod_groups(
-        &self,
-        mesh: &mut Mesh,
-        sets: &mut SetNames,
-        ids: &BTreeMap<u64, usize>,
-        names: &HashMap<Group, String>,
-    ) -> Result<(), String> {
-        for (group, elements) in members(&self.lines, 1) {
-            let name = group_name(names, group);
-            let element_name = sets.claim_elements(name.clone())?;
-            let node_name = sets.claim_nodes(name)?;
-            let nodes = elements
-                .iter()
-                .flat_map(|&k| self.lines[k].nodes.map(|t| ids[&t]))
-                .collect();
-            mesh.element_sets.insert(element_name, elements);
-            mesh.add_node_set(&node_name, nodes);
-        }
-        Ok(())
-    }
-
-    /// 0D groups -> node sets.
-    fn add_point_groups(
-        &self,
-        mesh: &mut Mesh,
-        sets: &mut SetNames,
-        ids: &BTreeMap<u64, usize>,
-        names: &HashMap<Group, String>,
-    ) -> Result<(), String> {
-        for (group, points) in members(&self.points, 0) {
-            let name = sets.claim_nodes(group_name(names, group))?;
-            let mut nodes = Vec::with_capacity(points.len());
-            for k in points {
-                let tag = self.points[k].nodes[0];
-                let id = ids.get(&tag).ok_or_else(|| {
-                    format!("point group \"{name}\" holds node {tag}, which no cell uses")
-                })?;
-                nodes.push(*id);
-            }
-            mesh.add_node_set(&name, nodes);
-        }
-        Ok(())
-    }
-}
-
-/// Set names handed out so far; a second group with the same name would overwrite a set.
-#[derive(Default)]
-struct SetNames {
-    elements: BTreeSet<String>,
-    nodes: BTreeSet<String>,
-}
-
-impl SetNames {
-    fn claim_elements(&mut self, name: String) -> Result<String, String> {
-        if name == "all" || !self.elements.insert(name.clone()) {
-            return Err(format!(
-                "two element sets named \"{name}\" (\"all\" is reserved); rename a physical group"
-            ));
-        }
-        Ok(name)
-    }
-
-    fn claim_nodes(&mut self, name: String) -> Result<String, String> {
-        if !self.nodes.insert(name.clone()) {
-            return Err(format!(
-                "two node sets named \"{name}\"; rename a physical group"
-            ));
-        }
-        Ok(name)
-    }
-}
-
-/// Physical groups of dimension `dim` -> indices of their elements, in file order.
-fn members<const N: usize>(elements: &[RawElement<N>], dim: i32) -> BTreeMap<Group, Vec<usize>> {
-    let mut groups: BTreeMap<Group, Vec<usize>> = BTreeMap::new();
-    for (k, element) in elements.iter().enumerate() {
-        for &group in element.groups.iter().filter(|g| g.0 == dim) {
-            groups.entry(group).or_default().push(k);
-        }
-    }
-    groups
-}
-
-/// Unordered quad side -> (side as the quad runs it, number of quads sharing it).
-fn quad_edge_owners(mesh: &Mesh) -> HashMap<(usize, usize), ([usize; 2], usize)> {
-    let mut owners = HashMap::new();
-    let Cells::Quad4(quads) = &mesh.cells else {
-        return owners;
+/// The file's nodes and elements, each element in the physical groups of its entity.
+fn collect(
+    msh: &MshFile<u64, i32, f64>,
+    names: &HashMap<Group, String>,
+) -> Result<TaggedMesh, String> {
+    let entities = entity_groups(msh);
+    // every physical group an entity names, numbered in (dimension, tag) order
+    let groups: BTreeSet<Group> = entities.values().flatten().copied().collect();
+    let index: HashMap<Group, usize> = groups.iter().enumerate().map(|(k, g)| (*g, k)).collect();
+    let mut raw = TaggedMesh {
+        coords: node_coords(msh),
+        quads: Vec::new(),
+        lines: Vec::new(),
+        points: Vec::new(),
+        groups: groups.iter().map(|g| group_name(names, *g)).collect(),
+        node_groups: BTreeMap::new(),
+        words: Words {
+            quad: "quadrangle",
+            line: "line",
+            node: "node",
+            nodes_section: "$Nodes",
+            rename: "rename a physical group",
+            kinds: "4-node quadrangles (type 3) or 2-node lines (type 1)",
+        },
     };
-    for q in quads {
-        for k in 0..4 {
-            let edge = [q[k], q[(k + 1) % 4]];
-            owners
-                .entry((edge[0].min(edge[1]), edge[0].max(edge[1])))
-                .or_insert((edge, 0))
-                .1 += 1;
+    let blocks = msh
+        .data
+        .elements
+        .iter()
+        .flat_map(|e| e.element_blocks.iter());
+    for block in blocks {
+        let entity = (block.entity_dim, block.entity_tag);
+        let groups: Vec<usize> = entities
+            .get(&entity)
+            .map(|gs| gs.iter().map(|g| index[g]).collect())
+            .unwrap_or_default();
+        for element in &block.elements {
+            let tag = element.element_tag;
+            let groups = groups.clone();
+            match block.element_type {
+                ElementType::Qua4 => raw.quads.push(TaggedCell {
+                    tag,
+                    nodes: node_tags(element)?,
+                    groups,
+                }),
+                ElementType::Lin2 => raw.lines.push(TaggedCell {
+                    tag,
+                    nodes: node_tags(element)?,
+                    groups,
+                }),
+                ElementType::Pnt => raw.points.push(TaggedCell {
+                    tag,
+                    nodes: node_tags(element)?,
+                    groups,
+                }),
+                other => {
+                    return Err(format!(
+                        "element {tag} has type {other:?}; impact reads 4-node quadrangles \
+                         (type 3), 2-node lines (type 1) and points (type 15)"
+                    ));
+                }
+            }
         }
     }
-    owners
+    Ok(raw)
 }
 
 fn group_name(names: &HashMap<Group, String>, group: Group) -> String {
@@ -521,6 +286,8 @@ fn line_of(bytes: &[u8], rest: &[u8]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::Cells;
+    use crate::mesh::plane::quad_area;
 
     fn data(name: &str) -> std::path::PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -561,6 +328,31 @@ mod tests {
         for e in mesh.edge_sets.values().flatten() {
             assert!(boundary.contains(e), "{e:?} is not a ccw boundary edge");
         }
+        // no group is named `boundary`: the whole boundary, counter-clockwise, chained
+        assert_eq!(
+            mesh.edge_sets["boundary"],
+            vec![[3, 0], [0, 4], [4, 1], [1, 2], [2, 5], [5, 3]]
+        );
+        assert_eq!(mesh.node_sets["boundary"], vec![0, 1, 2, 3, 4, 5]);
+    }
+
+    /// Goal: a quadrangle that lists a node twice is refused naming it (it has an area, so
+    /// only the node check catches it). Setup: two_quads.msh with quadrangle 7's third node
+    /// replaced by its second. Reference: the edit.
+    #[test]
+    fn quadrangle_with_a_repeated_node_is_refused() {
+        let text = std::fs::read_to_string(data("two_quads.msh")).unwrap();
+        let edited = text.replace("7 5 6 3 2\n", "7 5 6 6 2\n");
+        assert_ne!(edited, text);
+        let path = std::env::temp_dir().join(format!("repeated-{}.msh", std::process::id()));
+        std::fs::write(&path, edited).unwrap();
+        let err = read(&path).unwrap_err();
+        std::fs::remove_file(&path).unwrap();
+        assert!(
+            err.to_string()
+                .contains("quadrangle 7 is degenerate: it lists node 6 twice"),
+            "{err}"
+        );
     }
 
     /// Lines only: rods; dense node tags; an unnamed 1D group and a named point.

@@ -9,14 +9,18 @@
 //!                of a -> b (counter-clockwise around the body)
 //! element_sets   name -> element ids
 //! ```
-//! Every generator and the Gmsh reader fill `element_sets["all"]`, and every edge set also
-//! appears as a node set of the same name (the union of its edge nodes).
+//! Every generator and the file readers (Gmsh, VTK) fill `element_sets["all"]`, and every
+//! edge set also appears as a node set of the same name (the union of its edge nodes). The
+//! readers share the turning of a file's tagged cells into sets (tagged.rs) and give quad
+//! meshes the edge set `boundary`.
 
 pub mod generate;
 pub mod gmsh;
 pub mod plane;
+mod tagged;
+pub mod vtk;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 pub use generate::MeshSpec;
 
@@ -127,4 +131,35 @@ impl Mesh {
             .map(|(e, _)| e)
             .collect()
     }
+}
+
+/// Edges head to tail: open chains first (by first node), then closed loops.
+pub fn chain_order(edges: Vec<[usize; 2]>) -> Vec<[usize; 2]> {
+    let mut leaving: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (k, e) in edges.iter().enumerate() {
+        leaving.entry(e[0]).or_default().push(k);
+    }
+    let ends: BTreeSet<usize> = edges.iter().map(|e| e[1]).collect();
+    let mut heads: Vec<usize> = edges
+        .iter()
+        .map(|e| e[0])
+        .filter(|n| !ends.contains(n))
+        .collect();
+    heads.sort_unstable();
+    heads.extend(edges.iter().map(|e| e[0]));
+
+    let mut used = vec![false; edges.len()];
+    let mut ordered = Vec::with_capacity(edges.len());
+    for head in heads {
+        let mut node = head;
+        while let Some(&k) = leaving
+            .get(&node)
+            .and_then(|ks| ks.iter().find(|&&k| !used[k]))
+        {
+            used[k] = true;
+            ordered.push(edges[k]);
+            node = edges[k][1];
+        }
+    }
+    ordered
 }

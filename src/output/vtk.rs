@@ -4,13 +4,16 @@
 //! ```text
 //! Grid        all bodies merged, global node numbers
 //! cells       quads (VTK_QUAD = 9) first, then rods (VTK_LINE = 3)
-//! points      reference (initial) coordinates, z = 0
-//! point data  displacement, velocity, acceleration, contact_force   3 components, z = 0
+//! points      the grid's points as the caller places them, z = 0 (runs: the current,
+//!             deformed configuration, or the reference one on request)
+//! point data  displacement, velocity, acceleration, contact_force,  3 components, z = 0
+//!             reference_coordinates
 //!             gap, contact_status                                   1 component
 //! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure
 //! ```
-//! The points never move: show the deformed mesh in ParaView with Warp By Vector on
-//! `displacement` (the active vectors, so the filter picks it by default), scale factor 1.
+//! `displacement` is the active vectors array, so ParaView's Warp By Vector picks it by
+//! default (to exaggerate the motion of a frame drawn in the reference configuration);
+//! `reference_coordinates` holds the initial coordinates whichever configuration the points are in.
 //!
 //! Each frame is a VTK XML file with its arrays appended as raw binary, optionally LZ4/ZLib
 //! compressed (src/output/vtu.rs), written to a temporary name and renamed; the .pvd is then
@@ -40,6 +43,8 @@ pub struct Fields<'a> {
     pub contact_force: &'a [[f64; 2]],
     pub gap: &'a [f64],
     pub contact_status: &'a [f64],
+    /// The initial coordinates of the points.
+    pub reference_coordinates: &'a [[f64; 2]],
     /// XX YY ZZ XY YZ XZ (ParaView's order, so it names the components).
     pub stress: &'a [[f64; 6]],
     pub von_mises: &'a [f64],
@@ -433,6 +438,12 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
             Singles(fields.contact_status),
             1,
         ),
+        field(
+            PointData,
+            "reference_coordinates",
+            Pairs(fields.reference_coordinates),
+            3,
+        ),
         field(CellData, "stress", Sixes(fields.stress), 6),
         field(CellData, "von_mises", Singles(fields.von_mises), 1),
         field(
@@ -455,6 +466,7 @@ mod tests {
     /// Owned fields of one frame, with values that differ per entry, component and frame.
     struct Frame {
         vectors: [Vec<[f64; 2]>; 4],
+        reference: Vec<[f64; 2]>,
         point_scalars: [Vec<f64>; 2],
         stress: Vec<[f64; 6]>,
         cell_scalars: [Vec<f64>; 3],
@@ -470,6 +482,7 @@ mod tests {
             let scalar = |f, n| (0..n).map(|i| value(f, i, 0)).collect();
             Frame {
                 vectors: [vector(0), vector(1), vector(2), vector(3)],
+                reference: vector(10),
                 point_scalars: [scalar(4, np), scalar(5, np)],
                 stress: (0..nc)
                     .map(|i| std::array::from_fn(|c| value(6, i, c)))
@@ -486,6 +499,7 @@ mod tests {
                 contact_force: &self.vectors[3],
                 gap: &self.point_scalars[0],
                 contact_status: &self.point_scalars[1],
+                reference_coordinates: &self.reference,
                 stress: &self.stress,
                 von_mises: &self.cell_scalars[0],
                 eq_plastic_strain: &self.cell_scalars[1],
@@ -502,6 +516,7 @@ mod tests {
                 .collect();
             arrays.push(("gap", 1, self.point_scalars[0].clone()));
             arrays.push(("contact_status", 1, self.point_scalars[1].clone()));
+            arrays.push(("reference_coordinates", 3, pad(&self.reference)));
             arrays
         }
 

@@ -667,8 +667,23 @@ pub struct OutputSpec {
     /// `none` (default), `lz4` or `zlib` for the .vtu arrays.
     #[serde(default)]
     pub compression: Compression,
+    /// Where the frames' points are: `current` (default) or `reference`.
+    #[serde(default)]
+    pub points: FramePoints,
     #[serde(default)]
     pub probe: Vec<ProbeSpec>,
+}
+
+/// The configuration a frame's points show; the `displacement` and `reference_coordinates`
+/// arrays are written either way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FramePoints {
+    /// The deformed configuration: the mesh moves as the series plays.
+    #[default]
+    Current,
+    /// The initial coordinates, for Warp By Vector on `displacement` with a scale factor.
+    Reference,
 }
 
 impl Default for OutputSpec {
@@ -677,6 +692,7 @@ impl Default for OutputSpec {
             frame_every: default_frame_every(),
             frame_times: Vec::new(),
             compression: Compression::default(),
+            points: FramePoints::default(),
             probe: Vec::new(),
         }
     }

@@ -41,6 +41,7 @@ def expected(k, points, cells):
         arrays[name] = np.array([[value(k, f, i, 0), value(k, f, i, 1), 0.0] for i in range(np_)])
     arrays["gap"] = np.array([value(k, 4, i, 0) for i in range(np_)])
     arrays["contact_status"] = np.array([value(k, 5, i, 0) for i in range(np_)])
+    arrays["reference_coordinates"] = np.array([[value(k, 10, i, 0), value(k, 10, i, 1), 0.0] for i in range(np_)])
     arrays["stress"] = np.array([[value(k, 6, i, c) for c in range(6)] for i in range(nc)])
     for f, name in zip((7, 8, 9), ("von_mises", "eq_plastic_strain", "pressure")):
         arrays[name] = np.array([value(k, f, i, 0) for i in range(nc)])

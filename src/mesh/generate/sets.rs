@@ -1,11 +1,11 @@
 //! Naming a generated mesh's boundary: edge sets by a rule on each boundary edge, chained head
 //! to tail, and one-node sets at given points.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
 use super::blocks::min_edge;
 use crate::mesh::plane::{Point, norm, sub};
-use crate::mesh::{Cells, Mesh};
+use crate::mesh::{Cells, Mesh, chain_order};
 
 /// Distance below which a node counts as lying on a line: far below any element size.
 pub(super) fn feature_tol(mesh: &Mesh) -> f64 {
@@ -31,37 +31,6 @@ pub(super) fn name_boundary(mesh: &mut Mesh, name_of: impl Fn(Point, Point) -> &
     for (name, edges) in sets {
         mesh.add_edge_set(name, chain_order(edges));
     }
-}
-
-/// Edges head to tail: open chains first (by first node), then closed loops.
-fn chain_order(edges: Vec<[usize; 2]>) -> Vec<[usize; 2]> {
-    let mut leaving: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-    for (k, e) in edges.iter().enumerate() {
-        leaving.entry(e[0]).or_default().push(k);
-    }
-    let ends: BTreeSet<usize> = edges.iter().map(|e| e[1]).collect();
-    let mut heads: Vec<usize> = edges
-        .iter()
-        .map(|e| e[0])
-        .filter(|n| !ends.contains(n))
-        .collect();
-    heads.sort_unstable();
-    heads.extend(edges.iter().map(|e| e[0]));
-
-    let mut used = vec![false; edges.len()];
-    let mut ordered = Vec::with_capacity(edges.len());
-    for head in heads {
-        let mut node = head;
-        while let Some(&k) = leaving
-            .get(&node)
-            .and_then(|ks| ks.iter().find(|&&k| !used[k]))
-        {
-            used[k] = true;
-            ordered.push(edges[k]);
-            node = edges[k][1];
-        }
-    }
-    ordered
 }
 
 /// The node nearest to `p`.
