@@ -614,6 +614,7 @@ fn a_remainder_shorter_than_the_shortest_step_joins_the_last_step() {
         threads: None,
         speed: 10.0,
         strategy: "modified",
+        scene: None,
     });
     let model = common::model("remainder", &text, &[]);
     let impact::scene::model::Analysis::Dynamic(spec) = &model.analysis else {
