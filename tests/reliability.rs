@@ -220,7 +220,7 @@ fn resume_without_checkpoint_is_bad_input() {
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("checkpoint.bin"), "{stderr}");
     assert!(stderr.contains("checkpoint_every"), "{stderr}");
-    std::fs::write(dir.join("checkpoint.bin"), b"IMPACTCP\x01\0\0\0garbage").unwrap();
+    std::fs::write(dir.join("checkpoint.bin"), b"IMPACTCP\x02\0\0\0garbage").unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_impact"))
         .args(["resume", dir.to_str().unwrap()])
         .output()

@@ -40,7 +40,16 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
         d[dof] = value;
     }
     let linear = |d: &[f64], system: Option<&mut System>| {
-        assembly::evaluate(model, &state, d, Strain::Small, system, Tangent::Elastic)
+        // the linear prebuckling state: no time step (rate-dependent laws at no rate)
+        assembly::evaluate(
+            model,
+            &state,
+            d,
+            f64::INFINITY,
+            Strain::Small,
+            system,
+            Tangent::Elastic,
+        )
     };
     let evaluation = linear(&d, Some(&mut system))?;
     let mut solver = Solver::new(&system.pattern)?;

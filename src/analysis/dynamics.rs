@@ -144,6 +144,7 @@ impl<'a> Dynamics<'a> {
             model,
             &self.state,
             &vec![0.0; model.dofs()],
+            spec.dt,
             spec.geometry,
             None,
             spec.newton.tangent,
@@ -235,6 +236,7 @@ impl<'a> Dynamics<'a> {
                 self.model,
                 &self.state,
                 &du,
+                h,
                 self.spec.geometry,
                 None,
                 self.spec.newton.tangent,
@@ -374,6 +376,7 @@ impl Attempt<'_> {
             };
         let step = Step {
             model,
+            dt: form.solve_fraction * h,
             geometry: spec.geometry,
             newton: &spec.newton,
             inertia: Some(Inertia {

@@ -178,15 +178,15 @@ impl<'a> Explicit<'a> {
         self.energies.contact_work -= chunked_sum(&force, &self.du, |f, u| f * u);
     }
 
-    /// The internal force at u_{n+1} and the committed element state; the message of an
-    /// element that failed.
-    fn internal_force(&mut self) -> Result<(), String> {
+    /// The internal force at u_{n+1} (a step of length `h`) and the committed element state;
+    /// the message of an element that failed.
+    fn internal_force(&mut self, h: f64) -> Result<(), String> {
         let du = &self.du;
         match self.reduced.as_mut() {
             Some(kernel) => {
                 let work = crate::profile::time(crate::profile::Phase::Assembly, || {
                     crate::profile::count_elements(kernel.elements());
-                    kernel.step(&self.state.coordinates, du, &mut self.internal)
+                    kernel.step(&self.state.coordinates, du, h, &mut self.internal)
                 })
                 .map_err(|e| e.to_string())?;
                 commit_reduced(&mut self.state, du, work);
@@ -197,6 +197,7 @@ impl<'a> Explicit<'a> {
                     self.model,
                     &self.state,
                     du,
+                    h,
                     spec.geometry,
                     None,
                     spec.newton.tangent,
@@ -244,6 +245,7 @@ impl Stepper for Explicit<'_> {
                 model,
                 &self.state,
                 &zero,
+                self.spec.dt,
                 self.spec.geometry,
                 None,
                 self.spec.newton.tangent,
@@ -335,7 +337,7 @@ impl Stepper for Explicit<'_> {
             self.contact_correction(h, time);
             crate::profile::add(crate::profile::Phase::Contact, start);
         }
-        if let Err(err) = self.internal_force() {
+        if let Err(err) = self.internal_force(h) {
             let status = if spec.dt > self.dt_crit {
                 Status::Unstable
             } else {

@@ -16,7 +16,7 @@
 use super::{ElementFailure, State};
 use crate::element::quad4_one_point::{self as one_point, Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{Material, PointState, StressCondition};
+use crate::material::{FlowStart, Material, PointState, StressCondition, UpdateContext};
 use crate::scene::{BodyKind, Model};
 use rayon::prelude::*;
 
@@ -43,6 +43,8 @@ pub struct ElementState {
     pub stress: [f64; 4],
     pub back_stress: [f64; 4],
     pub eq_plastic_strain: f64,
+    /// Temperature (0 for materials that carry none).
+    pub temperature: f64,
     /// Current thickness (plane stress), else 1.
     pub thickness: f64,
     /// Hourglass forces Q [x y].
@@ -61,13 +63,15 @@ pub struct ElementStep {
     pub hourglass_work: f64,
 }
 
-/// One element over one step: positions x at the start, increment u (see the legend).
+/// One element over one step of length dt: positions x at the start, increment u (see the
+/// legend).
 #[inline(always)]
 fn element_step(
     p: &BodyParameters,
     x: &Nodes,
     u: &Nodes,
     committed: &ElementState,
+    dt: f64,
 ) -> Result<ElementStep, KernelError> {
     let step = one_point::increment(x, u)?;
     let (c, s) = (step.cos, step.sin);
@@ -81,9 +85,13 @@ fn element_step(
                 stress: Voigt::from(stress_n),
                 eq_plastic_strain: committed.eq_plastic_strain,
                 back_stress: Voigt::from(back_n),
+                temperature: committed.temperature,
             },
             &Voigt::from(strain),
-            StressCondition::PlaneStress,
+            UpdateContext {
+                condition: StressCondition::PlaneStress,
+                dt,
+            },
         );
         strain[2] = r.strain_zz;
         (
@@ -107,7 +115,11 @@ fn element_step(
                 &Voigt::from(trial),
                 mu,
                 &Voigt::from(back_n),
-                committed.eq_plastic_strain,
+                FlowStart {
+                    eq_plastic_strain: committed.eq_plastic_strain,
+                    temperature: committed.temperature,
+                    dt,
+                },
             )
             .map(|r| {
                 let work = r.plastic_work();
@@ -124,6 +136,8 @@ fn element_step(
             Some((stress, back, eps_p, work)) => (stress, back, eps_p, work, t),
         }
     };
+    // adiabatic heating by the step's plastic work (Johnson-Cook; the others keep theirs)
+    let temperature = p.material.heated(committed.temperature, plastic_density);
     let volume = step.gradient.area * t;
     let work = volume
         * 0.5
@@ -135,6 +149,7 @@ fn element_step(
         stress,
         back_stress,
         eq_plastic_strain,
+        temperature,
         thickness,
         hourglass: hourglass.forces,
     };
@@ -171,6 +186,8 @@ pub struct Reduced {
     /// Back stress, 4 per element.
     pub back_stress: Vec<f64>,
     pub eq_plastic_strain: Vec<f64>,
+    /// Temperature per element (0 for materials that carry none).
+    pub temperature: Vec<f64>,
     /// Current thickness per element (plane stress), else 1.
     pub thickness: Vec<f64>,
     /// Hourglass forces Q, 2 per element.
@@ -194,6 +211,7 @@ impl Reduced {
         let mut nodes = Vec::new();
         let (mut stress, mut back_stress, mut eq_plastic_strain, mut thickness) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut temperature = Vec::new();
         for (b, spec) in model.bodies.iter().enumerate() {
             let BodyKind::Continuum { formulation, .. } = spec.kind else {
                 continue;
@@ -222,6 +240,7 @@ impl Reduced {
                 stress.extend(p.stress.iter());
                 back_stress.extend(p.back_stress.iter());
                 eq_plastic_strain.push(p.eq_plastic_strain);
+                temperature.push(p.temperature);
                 thickness.push(committed.thickness[4 * e]);
             }
         }
@@ -250,6 +269,7 @@ impl Reduced {
             stress,
             back_stress,
             eq_plastic_strain,
+            temperature,
             thickness,
             hourglass: vec![0.0; 2 * count],
             element_forces: vec![0.0; 8 * count],
@@ -277,6 +297,7 @@ impl Reduced {
             stress: std::array::from_fn(|k| self.stress[4 * e + k]),
             back_stress: std::array::from_fn(|k| self.back_stress[4 * e + k]),
             eq_plastic_strain: self.eq_plastic_strain[e],
+            temperature: self.temperature[e],
             thickness: self.thickness[e],
             hourglass: [self.hourglass[2 * e], self.hourglass[2 * e + 1]],
         }
@@ -341,10 +362,12 @@ impl Reduced {
     /// One step: from positions `x` (the start of the step) by the increment `du` (2 per
     /// node); updates the element state and writes the internal force on x + du into
     /// `force`. After an error the element state is partly updated and the run must stop.
+    /// `dt` is the step's length (the strain rate of rate-dependent materials).
     pub fn step(
         &mut self,
         x: &[[f64; 2]],
         du: &[f64],
+        dt: f64,
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
         let bodies = &self.bodies;
@@ -354,13 +377,15 @@ impl Reduced {
             self.stress.par_chunks_mut(4 * CHUNK),
             self.back_stress.par_chunks_mut(4 * CHUNK),
             self.eq_plastic_strain.par_chunks_mut(CHUNK),
+            self.temperature.par_chunks_mut(CHUNK),
             self.thickness.par_chunks_mut(CHUNK),
             self.hourglass.par_chunks_mut(2 * CHUNK),
             self.element_forces.par_chunks_mut(8 * CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (stress, back, eps_p, thickness, hourglass, forces))| {
+            .map(|(k, chunks)| {
+                let (stress, back, eps_p, temperature, thickness, hourglass, forces) = chunks;
                 let mut sums = StepWork::default();
                 for i in 0..eps_p.len() {
                     let e = k * CHUNK + i;
@@ -371,16 +396,19 @@ impl Reduced {
                         stress: std::array::from_fn(|c| stress[4 * i + c]),
                         back_stress: std::array::from_fn(|c| back[4 * i + c]),
                         eq_plastic_strain: eps_p[i],
+                        temperature: temperature[i],
                         thickness: thickness[i],
                         hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
                     };
-                    let r = match element_step(&bodies[body[e] as usize], &xe, &ue, &committed) {
+                    let p = &bodies[body[e] as usize];
+                    let r = match element_step(p, &xe, &ue, &committed, dt) {
                         Ok(r) => r,
                         Err(err) => return (sums, Some((e, err))),
                     };
                     stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
                     back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
                     eps_p[i] = r.state.eq_plastic_strain;
+                    temperature[i] = r.state.temperature;
                     thickness[i] = r.state.thickness;
                     hourglass[2 * i..2 * i + 2].copy_from_slice(&r.state.hourglass);
                     forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
@@ -424,6 +452,7 @@ impl Reduced {
                         stress: Voigt::from(s.stress),
                         eq_plastic_strain: s.eq_plastic_strain,
                         back_stress: Voigt::from(s.back_stress),
+                        temperature: s.temperature,
                     };
                     points.fill(point);
                     thickness.fill(s.thickness);
@@ -473,6 +502,7 @@ mod tests {
             stress: [1.0, -0.5, 0.2, 0.3],
             back_stress: [0.0; 4],
             eq_plastic_strain: 0.0,
+            temperature: 0.0,
             thickness: 1.0,
             hourglass: [0.0; 2],
         };
@@ -483,7 +513,7 @@ mod tests {
                 let [px, py] = x[a];
                 [c * px - s * py - px, s * px + c * py - py]
             });
-            state = element_step(&p, &x, &u, &state).unwrap().state;
+            state = element_step(&p, &x, &u, &state, 1.0).unwrap().state;
             x = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);
         }
         // round-off: E ~ 200 times strains of ~1e-16 per step
