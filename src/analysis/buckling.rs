@@ -222,6 +222,7 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
             von_mises: &cell_zeros,
             eq_plastic_strain: &cell_zeros,
             pressure: &cell_zeros,
+            temperature: None,
         };
         series.write_frame((i + 1) as f64, &grid, &fields)?;
     }

@@ -353,8 +353,12 @@ impl<'a, S: Stepper> Run<'a, S> {
         Ok(())
     }
 
-    /// Fills the summary's counters, energies, contact and buckling blocks: the one place.
+    /// Fills the summary's counters, energies, contact and buckling blocks and the highest
+    /// temperature: the one place.
     fn fill_summary(&mut self) {
+        if self.model.carries_temperature() {
+            self.stepper.sync_points();
+        }
         let s = &self.stepper;
         let energies = s.energies();
         let solver = s.solver();
@@ -369,6 +373,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.energy.plastic_dissipation = energies.plastic_work;
         summary.contact = s.contact().summary();
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
+        summary.max_temperature = super::record::max_temperature(self.model, s.state());
     }
 
     /// A failed step: its frame when asked, then `fail`.
