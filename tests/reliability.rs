@@ -129,6 +129,32 @@ fn implicit_plastic_contact_resume_is_bit_identical() {
     assert_same_output(&full, &resumed, name);
 }
 
+/// Goal: the temperature of Johnson-Cook points survives a checkpoint: the resumed run ends
+/// bit-identical and reports the same summary.json `max_temperature`. Setup: PLASTIC_BLOCK
+/// with a rate-dependent, heating Johnson-Cook material and a temperature probe, halted at
+/// step 73.
+#[test]
+fn johnson_cook_resume_is_bit_identical() {
+    let name = "johnson_cook_block";
+    let text = PLASTIC_BLOCK.replace(
+        "yield_stress = 0.5\nhardening_modulus = 10.0",
+        "johnson_cook = { a = 0.5, b = 0.5, n = 0.5, c = 0.05, reference_rate = 0.01, m = 1.0, \
+         room_temperature = 0.0, melting_temperature = 1.0, specific_heat = 0.5 }",
+    ) + "\n[[output.probe]]\nquantity = \"temperature\"\nset = \"all\"\nstatistic = \"max\"\n";
+    let full = run_full(name, &text, &[]);
+    let heated = common::column(&full, "max_temperature[all]");
+    assert!(*heated.last().unwrap() > 0.0, "the block heats");
+    let resumed = run_killed_and_resumed(name, &text, &[], 73);
+    assert_same_output(&full, &resumed, name);
+    let max = |dir: &Path| -> f64 {
+        let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        json["max_temperature"].as_f64().expect("max_temperature")
+    };
+    assert_eq!(max(&full), max(&resumed));
+    assert_eq!(max(&full), *heated.last().unwrap());
+}
+
 /// Goal: Houbolt's past displacements and modified Newton with a reused factorization
 /// survive a checkpoint. Setup: PLASTIC_BLOCK with Houbolt and refactor_every = 4.
 #[test]

@@ -40,7 +40,16 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
         d[dof] = value;
     }
     let linear = |d: &[f64], system: Option<&mut System>| {
-        assembly::evaluate(model, &state, d, Strain::Small, system, Tangent::Elastic)
+        // the linear prebuckling state: no time step (rate-dependent laws at no rate)
+        assembly::evaluate(
+            model,
+            &state,
+            d,
+            f64::INFINITY,
+            Strain::Small,
+            system,
+            Tangent::Elastic,
+        )
     };
     let evaluation = linear(&d, Some(&mut system))?;
     let mut solver = Solver::new(&system.pattern)?;
@@ -215,6 +224,7 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
             von_mises: &cell_zeros,
             eq_plastic_strain: &cell_zeros,
             pressure: &cell_zeros,
+            temperature: None,
         };
         series.write_frame((i + 1) as f64, &grid, &fields)?;
     }

@@ -147,6 +147,7 @@ impl<'a> Dynamics<'a> {
             model,
             &self.state,
             &vec![0.0; model.dofs()],
+            spec.dt(),
             spec.geometry,
             None,
             spec.newton.tangent,
@@ -238,6 +239,7 @@ impl<'a> Dynamics<'a> {
                 self.model,
                 &self.state,
                 &du,
+                h,
                 self.spec.geometry,
                 None,
                 self.spec.newton.tangent,
@@ -379,6 +381,7 @@ impl Attempt<'_> {
             };
         let step = Step {
             model,
+            dt: form.solve_fraction * h,
             geometry: spec.geometry,
             newton: &spec.newton,
             inertia: Some(Inertia {

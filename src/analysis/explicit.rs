@@ -202,15 +202,15 @@ impl<'a> Explicit<'a> {
         self.energies.contact_work -= chunked_sum(&force, &self.du, |f, u| f * u);
     }
 
-    /// The internal force at u_{n+1}, the committed element state and the frequency bound
-    /// of the new configuration; the message of an element that failed.
-    fn internal_force(&mut self) -> Result<FrequencyBound, String> {
+    /// The internal force at u_{n+1} (a step of length `h`), the committed element state and
+    /// the frequency bound of the new configuration; the message of an element that failed.
+    fn internal_force(&mut self, h: f64) -> Result<FrequencyBound, String> {
         let du = &self.du;
         match self.kernel.as_mut() {
             Some(kernel) => {
                 let work = crate::profile::time(crate::profile::Phase::Assembly, || {
                     crate::profile::count_elements(kernel.elements());
-                    kernel.step(&self.state.coordinates, du, &mut self.internal)
+                    kernel.step(&self.state.coordinates, du, h, &mut self.internal)
                 })
                 .map_err(|e| e.to_string())?;
                 commit_kernel_step(&mut self.state, du, work);
@@ -227,6 +227,7 @@ impl<'a> Explicit<'a> {
                     self.model,
                     &self.state,
                     du,
+                    h,
                     spec.geometry,
                     None,
                     spec.newton.tangent,
@@ -275,6 +276,7 @@ impl Stepper for Explicit<'_> {
                 model,
                 &self.state,
                 &zero,
+                self.clock.dt0,
                 self.spec.geometry,
                 None,
                 self.spec.newton.tangent,
@@ -376,7 +378,7 @@ impl Stepper for Explicit<'_> {
             self.contact_correction(h, time);
             crate::profile::add(crate::profile::Phase::Contact, start);
         }
-        let bound = match self.internal_force() {
+        let bound = match self.internal_force(h) {
             Ok(bound) => bound,
             Err(err) => {
                 let status = if self.clock.fixed_above_limit() {

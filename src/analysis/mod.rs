@@ -142,6 +142,12 @@ pub struct Summary {
     /// only meaningful for one run per process (as `impact run` and `impact bench` do).
     #[serde(default)]
     pub timing: crate::profile::Timing,
+    /// The highest point temperature at the end (the run's highest: adiabatic heating never
+    /// cools), when some material carries a temperature. summary.json writes it last and
+    /// only then (`record::Recorder::write_summary`); a checkpoint does not store it (the
+    /// end state gives it).
+    #[serde(skip)]
+    pub max_temperature: Option<f64>,
 }
 
 impl Summary {
@@ -178,6 +184,7 @@ impl Summary {
             dt_max: None,
             dt_limit: None,
             timing: Default::default(),
+            max_temperature: None,
         }
     }
 }

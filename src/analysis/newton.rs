@@ -50,6 +50,8 @@ pub struct Inertia<'a> {
 
 pub struct Step<'a> {
     pub model: &'a Model,
+    /// The time step the increment spans (the strain rate of rate-dependent materials).
+    pub dt: f64,
     pub geometry: Strain,
     pub newton: &'a NewtonSpec,
     pub inertia: Option<Inertia<'a>>,
@@ -309,6 +311,7 @@ impl Step<'_> {
             self.model,
             state,
             d,
+            self.dt,
             self.geometry,
             system,
             self.newton.tangent,

@@ -280,6 +280,7 @@ impl Recorder {
             von_mises: &cells.von_mises,
             eq_plastic_strain: &cells.eq_plastic_strain,
             pressure: &cells.pressure,
+            temperature: cells.temperature.as_deref(),
         };
         let points = match model.output.points {
             FramePoints::Current => &positions[..],
@@ -299,9 +300,35 @@ impl Recorder {
             series.flush()?;
         }
         let path = self.dir.join("summary.json");
-        let text = serde_json::to_string_pretty(summary).expect("the summary serializes");
+        let file = SummaryFile {
+            summary,
+            max_temperature: summary.max_temperature,
+        };
+        let text = serde_json::to_string_pretty(&file).expect("the summary serializes");
         write_atomic(&path, text.as_bytes())
     }
+}
+
+/// summary.json: the summary's fields, then `max_temperature` when there is one.
+#[derive(serde::Serialize)]
+struct SummaryFile<'a> {
+    #[serde(flatten)]
+    summary: &'a Summary,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_temperature: Option<f64>,
+}
+
+/// The highest point temperature of the state, when some material carries one.
+pub fn max_temperature(model: &Model, state: &State) -> Option<f64> {
+    model.carries_temperature().then(|| {
+        model
+            .bodies
+            .iter()
+            .zip(&state.bodies)
+            .filter(|(b, _)| b.material.carries_temperature())
+            .flat_map(|(_, s)| s.points.iter().map(|p| p.temperature))
+            .fold(f64::NEG_INFINITY, f64::max)
+    })
 }
 
 /// All bodies in one grid: initial coordinates, quads first, then rods.
@@ -326,6 +353,9 @@ struct CellFields {
     von_mises: Vec<f64>,
     eq_plastic_strain: Vec<f64>,
     pressure: Vec<f64>,
+    /// When some material carries a temperature (0 in the cells of the bodies whose
+    /// material carries none: their points keep 0).
+    temperature: Option<Vec<f64>>,
 }
 
 /// Per cell, the mean over its points; quads first, then rods (as in `grid`). Parallel over
@@ -349,11 +379,20 @@ fn cell_fields(model: &Model, state: &State) -> CellFields {
         von_mises: vec![0.0; cells],
         eq_plastic_strain: vec![0.0; cells],
         pressure: vec![0.0; cells],
+        temperature: model.carries_temperature().then(|| vec![0.0; cells]),
     };
     let mut first = 0;
     for (b, body) in quads_first {
         let ppe = body.points_per_element();
         let last = first + body.elements();
+        if let Some(temperature) = out.temperature.as_mut() {
+            temperature[first..last]
+                .par_iter_mut()
+                .zip(state.bodies[b].points.par_chunks_exact(ppe))
+                .for_each(|(t, points)| {
+                    *t = points.iter().map(|p| p.temperature).sum::<f64>() / ppe as f64;
+                });
+        }
         (
             &mut out.stress[first..last],
             &mut out.von_mises[first..last],
@@ -432,6 +471,7 @@ fn probe_value(
         Quantity::StressXY => points(&|p| p.stress[3]),
         Quantity::VonMises => points(&|p| von_mises(&p.stress)),
         Quantity::EqPlasticStrain => points(&|p| p.eq_plastic_strain),
+        Quantity::Temperature => points(&|p| p.temperature),
     }
 }
 

@@ -370,8 +370,12 @@ impl<'a, S: Stepper> Run<'a, S> {
         Ok(())
     }
 
-    /// Fills the summary's counters, energies, contact and buckling blocks: the one place.
+    /// Fills the summary's counters, energies, contact and buckling blocks and the highest
+    /// temperature: the one place.
     fn fill_summary(&mut self) {
+        if self.model.carries_temperature() {
+            self.stepper.sync_points();
+        }
         let s = &self.stepper;
         let energies = s.energies();
         let solver = s.solver();
@@ -391,6 +395,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             summary.dt_max = Some(report.longest);
             summary.dt_limit = Some(report.limit);
         }
+        summary.max_temperature = super::record::max_temperature(self.model, s.state());
     }
 
     /// A failed step: its frame when asked, then `fail`.

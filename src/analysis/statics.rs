@@ -123,6 +123,7 @@ impl Increment<'_> {
         let external = loads::external_force(model, state, self.initial, end);
         let step = Step {
             model,
+            dt: end - state.time,
             geometry: self.spec.geometry,
             newton: &self.spec.newton,
             inertia: None,

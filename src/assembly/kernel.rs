@@ -11,7 +11,7 @@ use crate::element::{
     Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
 };
 use crate::kinematics;
-use crate::material::{PointState, StressCondition};
+use crate::material::{PointState, StressCondition, UpdateContext};
 use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind};
 use std::time::Instant;
@@ -87,9 +87,9 @@ impl Kernel {
         }
     }
 
-    /// Internal force, trial point states and work of element `e` at the increment `d` from
-    /// the committed state; with `tangent`, its matrix (row-major, 2 nn x 2 nn in the first
-    /// entries of 64).
+    /// Internal force, trial point states and work of element `e` at the increment `d` over
+    /// the time step `dt` from the committed state; with `tangent`, its matrix (row-major,
+    /// 2 nn x 2 nn in the first entries of 64).
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
@@ -97,6 +97,7 @@ impl Kernel {
         committed: &BodyState,
         coordinates: &[[f64; 2]],
         d: &[f64],
+        dt: f64,
         e: usize,
         geometry: Strain,
         tangent: Option<Tangent>,
@@ -125,10 +126,11 @@ impl Kernel {
                 };
                 let strains = quad4::strains(&geom, &de, op);
                 let condition = stress_condition(formulation);
+                let context = UpdateContext { condition, dt };
                 let fine = crate::profile::fine().then(Instant::now);
                 let responses: [_; 4] = std::array::from_fn(|q| {
                     body.material
-                        .update(&committed.points[4 * e + q], &strains[q], condition)
+                        .update(&committed.points[4 * e + q], &strains[q], context)
                 });
                 if let Some(start) = fine {
                     crate::profile::add_constitutive(start);
@@ -169,7 +171,9 @@ impl Kernel {
                 let x = rod_nodes(body, e, coordinates);
                 let de: Vec4 = increment(body, e, d);
                 let strain = rod2::strain(&x, &de, geometry)?;
-                let response = body.material.update_uniaxial(&committed.points[e], strain);
+                let response = body
+                    .material
+                    .update_uniaxial(&committed.points[e], strain, dt);
                 let stress = response.stress;
                 let length = rod2::length(&x)?;
                 let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
@@ -360,11 +364,13 @@ impl Kernel {
         e: usize,
         geometry: Strain,
     ) -> Result<f64, KernelError> {
+        // a zero increment: no step, no rate
         let r = self.evaluate(
             body,
             committed,
             coordinates,
             zero,
+            f64::INFINITY,
             e,
             geometry,
             Some(Tangent::Consistent),

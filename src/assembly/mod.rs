@@ -80,6 +80,7 @@ impl State {
                     points: vec![
                         PointState {
                             stress,
+                            temperature: b.material.initial_temperature(),
                             ..Default::default()
                         };
                         n
@@ -217,11 +218,13 @@ impl System {
 const CHUNK: usize = 8192;
 
 /// Internal force (and, when `system` is given, the tangent into `system.values`) at the
-/// increment `d` from the committed `state`.
+/// increment `d` over the time step `dt` (the strain rate of rate-dependent materials;
+/// infinity: no step) from the committed `state`.
 pub fn evaluate(
     model: &Model,
     state: &State,
     d: &[f64],
+    dt: f64,
     geometry: Strain,
     mut system: Option<&mut System>,
     tangent: Tangent,
@@ -256,6 +259,7 @@ pub fn evaluate(
                         &state.bodies[b],
                         &state.coordinates,
                         d,
+                        dt,
                         e,
                         geometry,
                         want_tangent.then_some(tangent),

@@ -11,17 +11,25 @@
 //! f          sqrt(3/2) ||eta|| - sigma_y(eps_p)        yield function
 //! n          eta / ||eta||,  d eps_p = dl n,  eps_p += sqrt(2/3) dl
 //! alpha     += 2/3 H_kin dl n                           linear kinematic hardening
-//! sigma_y    sigma_y0 + H_iso eps_p, or a piecewise-linear table eps_p -> sigma_y
+//! sigma_y    sigma_y0 + H_iso eps_p, a piecewise-linear table eps_p -> sigma_y, or the
+//!            Johnson-Cook law of the increment (`johnson_cook`: sigma_y0 is its A, and
+//!            sigma_y depends on the increment's rate dep / dt and the committed temperature)
+//! H_iso      d sigma_y / d dep, dep = sqrt(2/3) dl the equivalent plastic strain increment
 //! ```
 //! One radial return, [`J2::radial`], serves every continuum path (plane strain and
 //! axisymmetric 2x2 points, the 3D update inside plane stress, the one-point explicit
-//! kernel): dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(eps_p,n +
-//! sqrt(2/3) dl), in closed form for linear hardening and by Newton for a table; the
-//! implicit paths add its consistent tangent ([`J2::tangent`]). Plane stress finds the
+//! kernel) and every hardening law: dl from g(dl) = ||eta_tr|| - (2 mu + 2/3 H_kin) dl -
+//! sqrt(2/3) sigma_y(sqrt(2/3) dl) = 0, in closed form for linear hardening and by Newton for
+//! a table or Johnson-Cook (bracketed: g(0) > 0 for a plastic trial state and g(a / b) <= 0,
+//! so a Newton iterate outside the bracket, or one from an infinite slope, is replaced by
+//! bisection); the implicit paths add its consistent tangent ([`J2::tangent`]), the same
+//! formula for every law with H_iso the total derivative of sigma_y in dep (the rate term's
+//! included). Plane stress finds the
 //! out-of-plane strain by Newton so that sigma_zz = 0 (see `Material::update`), which keeps
 //! the model identical to the 3D one (kinematic hardening included) and its tangent exact by
 //! static condensation. Rods: the one-dimensional form of the same multiplier equation.
 
+use super::johnson_cook::JohnsonCook;
 use crate::element::{Moduli, Voigt};
 
 /// The isotropic hardening law.
@@ -32,6 +40,18 @@ pub enum Hardening {
     /// Piecewise-linear sigma_y(eps_p) through (0, yield_stress) and the given points,
     /// constant slope of the last segment beyond them.
     Table { points: Vec<[f64; 2]> },
+    /// sigma_y = (yield_stress + B eps_p^n) (1 + C ln max(rate / rate_0, 1)) (1 - T*^m).
+    JohnsonCook(JohnsonCook),
+}
+
+/// What the flow stress of an increment depends on besides its plastic strain increment:
+/// the committed equivalent plastic strain and temperature, and the step length (the rate
+/// is dep / dt; dt = infinity means no rate).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlowStart {
+    pub eq_plastic_strain: f64,
+    pub temperature: f64,
+    pub dt: f64,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -53,7 +73,7 @@ pub struct Radial {
     /// dl: the plastic strain increment is dl n (tensor components, zz included).
     pub multiplier: f64,
     pub eta_norm: f64,
-    /// The isotropic hardening slope at the solution.
+    /// The isotropic hardening slope d sigma_y / d dep at the solution.
     pub slope: f64,
 }
 
@@ -76,53 +96,88 @@ fn deviator(s: &Voigt) -> Voigt {
     Voigt::new(s[0] - p, s[1] - p, s[2] - p, s[3])
 }
 
+/// The piecewise-linear sigma_y(eps_p) through (0, yield_stress) and `points`, and its slope
+/// (beyond the last point the last segment's).
+fn table_flow_stress(yield_stress: f64, points: &[[f64; 2]], eps_p: f64) -> (f64, f64) {
+    let mut prev = [0.0, yield_stress];
+    for p in points {
+        if eps_p <= p[0] {
+            let slope = (p[1] - prev[1]) / (p[0] - prev[0]);
+            return (prev[1] + slope * (eps_p - prev[0]), slope);
+        }
+        prev = *p;
+    }
+    let n = points.len();
+    let before = if n >= 2 {
+        points[n - 2]
+    } else {
+        [0.0, yield_stress]
+    };
+    let slope = (prev[1] - before[1]) / (prev[0] - before[0]);
+    (prev[1] + slope * (eps_p - prev[0]), slope)
+}
+
 impl J2 {
-    /// Yield stress and its slope at eps_p.
-    pub fn yield_stress_at(&self, eps_p: f64) -> (f64, f64) {
+    /// The flow stress of an increment from `start` with the equivalent plastic strain
+    /// increment `dep`, and its slope d sigma_y / d dep.
+    pub fn flow_stress(&self, start: &FlowStart, dep: f64) -> (f64, f64) {
+        let eps_p = start.eq_plastic_strain + dep;
         match &self.hardening {
             Hardening::Linear { modulus } => (self.yield_stress + modulus * eps_p, *modulus),
-            Hardening::Table { points } => {
-                let mut prev = [0.0, self.yield_stress];
-                for p in points {
-                    if eps_p <= p[0] {
-                        let slope = (p[1] - prev[1]) / (p[0] - prev[0]);
-                        return (prev[1] + slope * (eps_p - prev[0]), slope);
-                    }
-                    prev = *p;
-                }
-                let n = points.len();
-                let before = if n >= 2 {
-                    points[n - 2]
-                } else {
-                    [0.0, self.yield_stress]
-                };
-                let slope = (prev[1] - before[1]) / (prev[0] - before[0]);
-                (prev[1] + slope * (eps_p - prev[0]), slope)
-            }
+            Hardening::Table { points } => table_flow_stress(self.yield_stress, points, eps_p),
+            Hardening::JohnsonCook(law) => law.flow_stress(
+                self.yield_stress,
+                start.eq_plastic_strain,
+                start.temperature,
+                dep,
+                start.dt,
+            ),
         }
     }
 
-    /// Solves g(dl) = a - b dl - sqrt(2/3) sigma_y(eps_p + sqrt(2/3) dl) = 0 for dl >= 0:
-    /// in closed form for linear hardening (g is linear in dl), else by Newton to round-off.
-    /// Returns dl and the hardening slope at the solution.
-    fn plastic_multiplier(&self, a: f64, b: f64, eps_p: f64) -> (f64, f64) {
+    /// Solves g(dl) = a - b dl - sqrt(2/3) sigma_y(sqrt(2/3) dl) = 0 for dl >= 0 (a
+    /// plastic trial state: g(0) > 0): in closed form for linear hardening (g is linear in
+    /// dl), else by Newton to round-off, kept inside the bracket (lo, hi] that starts as
+    /// (0, a / b] (g(a / b) = -sqrt(2/3) sigma_y <= 0) by bisection when an iterate leaves it
+    /// or the slope is not finite. (Johnson-Cook needs it: from dl = 0 below the reference
+    /// rate Newton does not see the rate term and overshoots; from there, on the convex g of
+    /// the logarithm, it can fall back to 0.) Returns dl and the hardening slope at the
+    /// solution.
+    fn plastic_multiplier(&self, a: f64, b: f64, start: &FlowStart) -> (f64, f64) {
         if let Hardening::Linear { modulus } = self.hardening {
-            let yield_stress = self.yield_stress + modulus * eps_p;
+            let yield_stress = self.yield_stress + modulus * start.eq_plastic_strain;
             let dl = (a - SQRT_2_3 * yield_stress) / (b + 2.0 / 3.0 * modulus);
             return (dl.max(0.0), modulus);
         }
+        let (mut lo, mut hi) = (0.0, a / b);
         let mut dl = 0.0;
         let mut slope = 0.0;
-        for _ in 0..50 {
-            let (sy, h) = self.yield_stress_at(eps_p + SQRT_2_3 * dl);
+        for _ in 0..200 {
+            let (sy, h) = self.flow_stress(start, SQRT_2_3 * dl);
             slope = h;
             let g = a - b * dl - SQRT_2_3 * sy;
+            if g > 0.0 {
+                lo = dl;
+            } else {
+                hi = dl;
+            }
             let dg = -b - 2.0 / 3.0 * h;
             let step = g / dg;
-            dl = (dl - step).max(0.0);
-            if step.abs() <= 1e-15 * (1.0 + dl.abs()) {
+            let newton = (dl - step).max(0.0);
+            // |g| = |step| (b + 2/3 h): for slopes small against b the step's own test
+            // |step| <= 1e-15 (1 + dl); where the flow stress is steep (the rate term of a
+            // tiny increment) the step must be smaller, so that sigma_y, not only dl, has
+            // converged
+            if g.abs() <= 1e-15 * (1.0 + newton.abs()) * b {
+                dl = newton;
                 break;
             }
+            // a Newton iterate at or below lo would go back where g > 0 is known (a cycle)
+            dl = if h.is_finite() && newton > lo && newton <= hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
         }
         (dl, slope)
     }
@@ -147,23 +202,24 @@ impl J2 {
 
     /// The radial return of a trial stress (plane strain, axisymmetric, the 3D update inside
     /// plane stress, and the one-point explicit kernel: the one return of every continuum
-    /// path): dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(eps_p,n +
-    /// sqrt(2/3) dl) and the returned state; None when the trial state is elastic.
-    pub fn radial(&self, trial: &Voigt, mu: f64, back: &Voigt, eps_p: f64) -> Option<Radial> {
+    /// path): dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(sqrt(2/3) dl)
+    /// and the returned state; None when the trial state is elastic (at the flow stress of a
+    /// zero increment).
+    pub fn radial(&self, trial: &Voigt, mu: f64, back: &Voigt, start: FlowStart) -> Option<Radial> {
         // dev of the difference: the pushed-forward back stress need not stay traceless
         let eta = deviator(&(trial - back));
         let eta_norm = norm(&eta);
-        let (sy, _) = self.yield_stress_at(eps_p);
+        let (sy, _) = self.flow_stress(&start, 0.0);
         if (1.5f64).sqrt() * eta_norm - sy <= 0.0 {
             return None;
         }
         let h_kin = self.kinematic_modulus;
-        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, eps_p);
+        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, &start);
         let n = eta / eta_norm;
         Some(Radial {
             stress: trial - n * (2.0 * mu * dl),
             back_stress: back + n * (2.0 / 3.0 * h_kin * dl),
-            eq_plastic_strain: eps_p + SQRT_2_3 * dl,
+            eq_plastic_strain: start.eq_plastic_strain + SQRT_2_3 * dl,
             direction: n,
             multiplier: dl,
             eta_norm,
@@ -177,10 +233,10 @@ impl J2 {
         trial: f64,
         young: f64,
         back: f64,
-        eps_p: f64,
+        start: FlowStart,
     ) -> Option<UniaxialReturn> {
         let xi = trial - back;
-        let (sy, _) = self.yield_stress_at(eps_p);
+        let (sy, _) = self.flow_stress(&start, 0.0);
         if xi.abs() - sy <= 0.0 {
             return None;
         }
@@ -189,14 +245,19 @@ impl J2 {
         // dl = sqrt(3/2) de_p: a = sqrt(2/3)|xi|, b = 2/3 (E + H_kin)
         let h_kin = self.kinematic_modulus;
         let (dl, h_iso) =
-            self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), eps_p);
+            self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), &start);
         let dep = SQRT_2_3 * dl;
         let h = h_iso + h_kin;
         Some(UniaxialReturn {
             stress: trial - sign * young * dep,
             back_stress: back + sign * h_kin * dep,
-            eq_plastic_strain: eps_p + dep,
-            tangent: young * h / (young + h),
+            eq_plastic_strain: start.eq_plastic_strain + dep,
+            // E H / (E + H) -> E as H -> infinity (Johnson-Cook's slope at eps_p = 0, n < 1)
+            tangent: if h.is_finite() {
+                young * h / (young + h)
+            } else {
+                young
+            },
             plastic_strain: sign * dep,
         })
     }
@@ -208,7 +269,7 @@ pub struct UniaxialReturn {
     pub stress: f64,
     pub back_stress: f64,
     pub eq_plastic_strain: f64,
-    /// The algorithmic tangent E H / (E + H), H = H_iso + H_kin.
+    /// The algorithmic tangent E H / (E + H), H = H_iso + H_kin (E for an infinite H).
     pub tangent: f64,
     /// The plastic strain increment (signed).
     pub plastic_strain: f64,
@@ -217,6 +278,15 @@ pub struct UniaxialReturn {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::material::JohnsonCook;
+
+    fn start(eq_plastic_strain: f64) -> FlowStart {
+        FlowStart {
+            eq_plastic_strain,
+            temperature: 0.0,
+            dt: f64::INFINITY,
+        }
+    }
 
     /// The closed-form multiplier of linear hardening equals Newton's on the same law given as
     /// a table (one point on the line: the table's slope continues beyond it), isotropic plus
@@ -237,16 +307,95 @@ mod tests {
         let mu = 200.0 / 2.6;
         let trial = Voigt::new(1.4, -0.3, 0.2, 0.6);
         let back = Voigt::new(0.02, -0.01, -0.01, 0.01);
-        let a = linear.radial(&trial, mu, &back, 0.01).unwrap();
-        let b = table.radial(&trial, mu, &back, 0.01).unwrap();
+        let a = linear.radial(&trial, mu, &back, start(0.01)).unwrap();
+        let b = table.radial(&trial, mu, &back, start(0.01)).unwrap();
         assert!((a.stress - b.stress).norm() < 1e-13);
         assert!((a.back_stress - b.back_stress).norm() < 1e-13);
         assert!((a.eq_plastic_strain - b.eq_plastic_strain).abs() < 1e-15);
         assert!((a.plastic_work() - b.plastic_work()).abs() < 1e-13);
         assert!(
             linear
-                .radial(&Voigt::new(0.1, 0.0, 0.0, 0.0), mu, &Voigt::zeros(), 0.0)
+                .radial(
+                    &Voigt::new(0.1, 0.0, 0.0, 0.0),
+                    mu,
+                    &Voigt::zeros(),
+                    start(0.0)
+                )
                 .is_none()
         );
+    }
+
+    /// Goal: the Johnson-Cook return satisfies the consistency condition sqrt(3/2)
+    /// ||dev S|| = sigma_y(eps_p,n + dep, dep / dt, T_n) to round-off wherever Newton alone
+    /// would fail: steps so short that the rate term switches on at a tiny dep (Newton from
+    /// dl = 0 overshoots, then falls back towards 0), n < 1 from eps_p = 0 (infinite slope),
+    /// a melted point (sigma_y = 0: the deviator must vanish), and no step (dt = infinity).
+    /// Setup: mu = 76.9, A = 0.5, B = 0.3, n = 0.3, C = 0.02, rate_0 = 1, m = 1, T in [0, 1];
+    /// trial von Mises stresses 1.001, 1.1 and 4 times the flow stress of a zero increment
+    /// (0.1 for the melted point), eps_p,n in {0, 0.05}, T_n in {0, 0.5, 1}, dt from 1e-12
+    /// to infinity.
+    /// Reference: the law written here; 1e-12 of the trial stress.
+    #[test]
+    fn johnson_cook_return_satisfies_the_consistency_condition() {
+        let law = JohnsonCook {
+            b: 0.3,
+            n: 0.3,
+            c: 0.02,
+            reference_rate: 1.0,
+            m: 1.0,
+            room_temperature: 0.0,
+            melting_temperature: 1.0,
+            specific_heat: 1.0,
+            taylor_quinney: 0.9,
+            initial_temperature: 0.0,
+        };
+        let j2 = J2 {
+            yield_stress: 0.5,
+            hardening: Hardening::JohnsonCook(law),
+            kinematic_modulus: 0.0,
+        };
+        let flow = |eps_p: f64, rate: f64, t: f64| -> f64 {
+            (0.5 + 0.3 * eps_p.powf(0.3)) * (1.0 + 0.02 * rate.max(1.0).ln()) * (1.0 - t)
+        };
+        let mu = 200.0 / 2.6;
+        let shape = deviator(&Voigt::new(1.4, -0.3, 0.2, 0.6));
+        let shape = shape / (1.5 * norm(&shape).powi(2)).sqrt();
+        let pressure = Voigt::new(-0.3, -0.3, -0.3, 0.0);
+        for (eps_p, temperature, over) in
+            itertools(&[0.0, 0.05], &[0.0, 0.5, 1.0], &[1.001, 1.1, 4.0])
+        {
+            let trial_mises = over * flow(eps_p, 0.0, temperature).max(0.1);
+            let trial = shape * trial_mises + pressure;
+            {
+                for dt in [1e-12, 1e-9, 1e-6, 1e-3, 1.0, f64::INFINITY] {
+                    let start = FlowStart {
+                        eq_plastic_strain: eps_p,
+                        temperature,
+                        dt,
+                    };
+                    let r = j2.radial(&trial, mu, &Voigt::zeros(), start).unwrap();
+                    // from the multiplier: eps_p,n+1 - eps_p,n would lose the digits of a
+                    // tiny dep
+                    let dep = SQRT_2_3 * r.multiplier;
+                    let mises = (1.5 * norm(&deviator(&r.stress)).powi(2)).sqrt();
+                    let expected = flow(eps_p + dep, dep / dt, temperature);
+                    assert!(
+                        (mises - expected).abs() <= 1e-12 * trial_mises,
+                        "eps_p {eps_p} T {temperature} dt {dt}: {mises} vs {expected}"
+                    );
+                    assert!(dep > 0.0);
+                }
+            }
+        }
+    }
+
+    /// Every combination of the three lists.
+    fn itertools(a: &[f64], b: &[f64], c: &[f64]) -> Vec<(f64, f64, f64)> {
+        a.iter()
+            .flat_map(|x| {
+                b.iter()
+                    .flat_map(move |y| c.iter().map(move |z| (*x, *y, *z)))
+            })
+            .collect()
     }
 }

@@ -9,7 +9,8 @@
 //! point data  displacement, velocity, acceleration, contact_force,  3 components, z = 0
 //!             reference_coordinates
 //!             gap, contact_status                                   1 component
-//! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure
+//! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure,
+//!             temperature (only when given)
 //! ```
 //! `displacement` is the active vectors array, so ParaView's Warp By Vector picks it by
 //! default (to exaggerate the motion of a frame drawn in the reference configuration);
@@ -50,6 +51,8 @@ pub struct Fields<'a> {
     pub von_mises: &'a [f64],
     pub eq_plastic_strain: &'a [f64],
     pub pressure: &'a [f64],
+    /// Written only when given (materials that carry a temperature).
+    pub temperature: Option<&'a [f64]>,
 }
 
 /// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
@@ -454,6 +457,10 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
         ),
         field(CellData, "pressure", Singles(fields.pressure), 1),
     ];
+    let temperature = fields
+        .temperature
+        .map(|t| field(CellData, "temperature", Singles(t), 1));
+    let list: Vec<Field> = list.into_iter().chain(temperature).collect();
     Payload::new(path, grid, &list, Some("displacement"))
 }
 
@@ -504,6 +511,7 @@ mod tests {
                 von_mises: &self.cell_scalars[0],
                 eq_plastic_strain: &self.cell_scalars[1],
                 pressure: &self.cell_scalars[2],
+                temperature: None,
             }
         }
 

@@ -247,4 +247,9 @@ impl Model {
             .flat_map(|b| b.mesh.nodes.iter().copied())
             .collect()
     }
+
+    /// Whether some body's material carries a temperature (Johnson-Cook).
+    pub fn carries_temperature(&self) -> bool {
+        self.bodies.iter().any(|b| b.material.carries_temperature())
+    }
 }

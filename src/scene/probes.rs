@@ -3,7 +3,7 @@
 use super::InputError;
 use super::context::{Context, body_index, node_set};
 use super::model::{Body, Probe};
-use super::spec::{ProbeSpec, Statistic};
+use super::spec::{ProbeSpec, Quantity, Statistic};
 
 /// `output.frame_times`: finite, >= 0 and increasing.
 pub(super) fn check_frame_times(cx: &Context, times: &[f64]) -> Result<(), InputError> {
@@ -27,6 +27,13 @@ pub(super) fn probes(
     for (k, p) in specs.iter().enumerate() {
         let key = format!("output.probe[{k}]");
         let b = body_index(cx, bodies, p.body.as_deref(), &key)?;
+        if p.quantity == Quantity::Temperature && !bodies[b].material.carries_temperature() {
+            return Err(cx.err(format!(
+                "{key}.quantity: body `{}` has material `{}`, which carries no temperature \
+                 (only `johnson_cook` materials do)",
+                bodies[b].name, bodies[b].material.name
+            )));
+        }
         let members = if p.quantity.is_nodal() {
             node_set(cx, bodies, p.body.as_deref(), &p.set, &key)?
                 .1

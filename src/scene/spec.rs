@@ -79,6 +79,50 @@ pub struct MaterialSpec {
     pub hardening_table: Option<Vec<[f64; 2]>>,
     /// Linear kinematic (Prager) hardening modulus >= 0. Default 0.
     pub kinematic_modulus: Option<f64>,
+    /// Johnson-Cook plasticity with adiabatic heating, instead of `yield_stress` and its
+    /// hardening keys. Default: none.
+    pub johnson_cook: Option<JohnsonCookSpec>,
+}
+
+/// `johnson_cook = { ... }`: sigma_y = (a + b eps_p^n) (1 + c ln max(rate /
+/// reference_rate, 1)) (1 - T*^m), T* = (T - room_temperature) / (melting_temperature -
+/// room_temperature) clamped to [0, 1], heated by dT = taylor_quinney sigma : d eps_p /
+/// (density specific_heat).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JohnsonCookSpec {
+    /// A > 0 (stress).
+    pub a: f64,
+    /// B >= 0 (stress).
+    pub b: f64,
+    /// n > 0.
+    pub n: f64,
+    /// C >= 0. Default 0 (rate-independent).
+    #[serde(default)]
+    pub c: f64,
+    /// The reference equivalent plastic strain rate > 0 (1 / time). Default 1.
+    #[serde(default = "default_reference_rate")]
+    pub reference_rate: f64,
+    /// m > 0.
+    pub m: f64,
+    pub room_temperature: f64,
+    /// > room_temperature.
+    pub melting_temperature: f64,
+    /// c_p > 0 (energy / (mass temperature)).
+    pub specific_heat: f64,
+    /// The fraction of the plastic work that heats, in [0, 1]. Default 0.9.
+    #[serde(default = "default_taylor_quinney")]
+    pub taylor_quinney: f64,
+    /// Below melting_temperature. Default room_temperature.
+    pub initial_temperature: Option<f64>,
+}
+
+fn default_reference_rate() -> f64 {
+    1.0
+}
+
+fn default_taylor_quinney() -> f64 {
+    0.9
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -734,6 +778,9 @@ pub enum Quantity {
     VonMises,
     #[serde(rename = "eq_plastic_strain")]
     EqPlasticStrain,
+    /// Johnson-Cook materials only.
+    #[serde(rename = "temperature")]
+    Temperature,
 }
 
 impl Quantity {
@@ -754,6 +801,7 @@ impl Quantity {
             Quantity::StressZZ => "s_zz",
             Quantity::VonMises => "von_mises",
             Quantity::EqPlasticStrain => "eq_plastic_strain",
+            Quantity::Temperature => "temperature",
         }
     }
 

@@ -22,7 +22,7 @@ use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
 use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{PointState, StressCondition};
+use crate::material::{FlowStart, PointState, StressCondition, UpdateContext};
 use crate::scene::Model;
 use rayon::prelude::*;
 
@@ -32,6 +32,8 @@ struct PointsState {
     stress: [[f64; 4]; 4],
     back_stress: [[f64; 4]; 4],
     eq_plastic_strain: [f64; 4],
+    /// Temperature (0 for materials that carry none).
+    temperature: [f64; 4],
     thickness: [f64; 4],
 }
 
@@ -50,10 +52,11 @@ pub struct Full {
     /// The lumped mass at the four nodes of each element (for its stable-step bound).
     lumped: Vec<[f64; 4]>,
     /// Per element, per point: Cauchy stress and back stress [xx yy zz xy] (16 each),
-    /// equivalent plastic strain and thickness (4 each).
+    /// equivalent plastic strain, temperature and thickness (4 each).
     stress: Vec<f64>,
     back_stress: Vec<f64>,
     eq_plastic_strain: Vec<f64>,
+    temperature: Vec<f64>,
     thickness: Vec<f64>,
     element_forces: Vec<f64>,
     gather: NodeGather,
@@ -117,13 +120,15 @@ fn forces(values: &QuadValues, stress: &[[f64; 4]; 4], bbar: bool) -> [f64; 8] {
     f
 }
 
-/// One element over one step: positions x at the start, increment u (see the legend).
+/// One element over one step of length dt: positions x at the start, increment u (see the
+/// legend).
 fn element_step(
     p: &super::BodyParameters,
     x: &Nodes,
     u: &Nodes,
     committed: &PointsState,
     lumped: &[f64; 4],
+    dt: f64,
 ) -> Result<ElementStep, KernelError> {
     let axisymmetric = p.axisymmetric();
     let mid: Nodes = std::array::from_fn(|a| [x[a][0] + 0.5 * u[a][0], x[a][1] + 0.5 * u[a][1]]);
@@ -163,8 +168,11 @@ fn element_step(
             committed,
             q,
             &mut strain[q],
+            dt,
             &mut state,
         );
+        // adiabatic heating by the step's plastic work (Johnson-Cook; the others keep theirs)
+        state.temperature[q] = p.material.heated(committed.temperature[q], plastic);
         let weight = at_mid.points[q].weight;
         work += weight
             * 0.5
@@ -186,7 +194,9 @@ fn element_step(
 
 /// The material update of point q from its rotated stress and back stress and the strain
 /// increment (plane stress: the material's out-of-plane strain written into it and the
-/// thickness updated); returns the new stress and the plastic work density.
+/// thickness updated); returns the new stress and the plastic work density. `dt` is the
+/// step's length (the strain rate of rate-dependent materials).
+#[allow(clippy::too_many_arguments)]
 fn update(
     p: &super::BodyParameters,
     stress_n: &[f64; 4],
@@ -194,6 +204,7 @@ fn update(
     committed: &PointsState,
     q: usize,
     strain: &mut [f64; 4],
+    dt: f64,
     state: &mut PointsState,
 ) -> ([f64; 4], f64) {
     if p.plane_stress() {
@@ -202,9 +213,13 @@ fn update(
                 stress: Voigt::from(*stress_n),
                 eq_plastic_strain: committed.eq_plastic_strain[q],
                 back_stress: Voigt::from(*back_n),
+                temperature: committed.temperature[q],
             },
             &Voigt::from(*strain),
-            StressCondition::PlaneStress,
+            UpdateContext {
+                condition: StressCondition::PlaneStress,
+                dt,
+            },
         );
         strain[2] = r.strain_zz;
         state.back_stress[q] = r.state.back_stress.into();
@@ -225,7 +240,11 @@ fn update(
             &Voigt::from(trial),
             mu,
             &Voigt::from(*back_n),
-            committed.eq_plastic_strain[q],
+            FlowStart {
+                eq_plastic_strain: committed.eq_plastic_strain[q],
+                temperature: committed.temperature[q],
+                dt,
+            },
         )
     });
     match plastic {
@@ -251,6 +270,7 @@ impl Full {
             stress: Vec::with_capacity(16 * count),
             back_stress: Vec::with_capacity(16 * count),
             eq_plastic_strain: Vec::with_capacity(4 * count),
+            temperature: Vec::with_capacity(4 * count),
             thickness: Vec::with_capacity(4 * count),
             element_forces: vec![0.0; 8 * count],
             gather: NodeGather::new(&layout.nodes, state.coordinates.len()),
@@ -262,6 +282,7 @@ impl Full {
                 kernel.stress.extend(p.stress.iter());
                 kernel.back_stress.extend(p.back_stress.iter());
                 kernel.eq_plastic_strain.push(p.eq_plastic_strain);
+                kernel.temperature.push(p.temperature);
             }
             kernel
                 .thickness
@@ -281,6 +302,7 @@ impl Full {
                 std::array::from_fn(|c| self.back_stress[16 * e + 4 * q + c])
             }),
             eq_plastic_strain: std::array::from_fn(|q| self.eq_plastic_strain[4 * e + q]),
+            temperature: std::array::from_fn(|q| self.temperature[4 * e + q]),
             thickness: std::array::from_fn(|q| self.thickness[4 * e + q]),
         }
     }
@@ -330,6 +352,7 @@ impl ExplicitKernel for Full {
         &mut self,
         x: &[[f64; 2]],
         du: &[f64],
+        dt: f64,
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
         let layout = &self.layout;
@@ -338,48 +361,54 @@ impl ExplicitKernel for Full {
             self.stress.par_chunks_mut(16 * CHUNK),
             self.back_stress.par_chunks_mut(16 * CHUNK),
             self.eq_plastic_strain.par_chunks_mut(4 * CHUNK),
+            self.temperature.par_chunks_mut(4 * CHUNK),
             self.thickness.par_chunks_mut(4 * CHUNK),
             self.element_forces.par_chunks_mut(8 * CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (stress, back, eps_p, thickness, forces))| {
-                let mut sums = StepWork::default();
-                for i in 0..forces.len() / 8 {
-                    let e = k * CHUNK + i;
-                    let element = layout.nodes[e];
-                    let xe: Nodes = element.map(|n| x[n as usize]);
-                    let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
-                    let committed = PointsState {
-                        stress: std::array::from_fn(|q| {
-                            std::array::from_fn(|c| stress[16 * i + 4 * q + c])
-                        }),
-                        back_stress: std::array::from_fn(|q| {
-                            std::array::from_fn(|c| back[16 * i + 4 * q + c])
-                        }),
-                        eq_plastic_strain: std::array::from_fn(|q| eps_p[4 * i + q]),
-                        thickness: std::array::from_fn(|q| thickness[4 * i + q]),
-                    };
-                    let p = &layout.bodies[layout.body[e] as usize];
-                    let r = match element_step(p, &xe, &ue, &committed, &lumped[e]) {
-                        Ok(r) => r,
-                        Err(err) => return (sums, Some((e, err))),
-                    };
-                    sums.observe(r.omega_squared, e);
-                    for q in 0..4 {
-                        stress[16 * i + 4 * q..16 * i + 4 * q + 4]
-                            .copy_from_slice(&r.state.stress[q]);
-                        back[16 * i + 4 * q..16 * i + 4 * q + 4]
-                            .copy_from_slice(&r.state.back_stress[q]);
+            .map(
+                |(k, (stress, back, eps_p, temperature, thickness, forces))| {
+                    let mut sums = StepWork::default();
+                    for i in 0..forces.len() / 8 {
+                        let e = k * CHUNK + i;
+                        let element = layout.nodes[e];
+                        let xe: Nodes = element.map(|n| x[n as usize]);
+                        let ue: Nodes =
+                            element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+                        let committed = PointsState {
+                            stress: std::array::from_fn(|q| {
+                                std::array::from_fn(|c| stress[16 * i + 4 * q + c])
+                            }),
+                            back_stress: std::array::from_fn(|q| {
+                                std::array::from_fn(|c| back[16 * i + 4 * q + c])
+                            }),
+                            eq_plastic_strain: std::array::from_fn(|q| eps_p[4 * i + q]),
+                            temperature: std::array::from_fn(|q| temperature[4 * i + q]),
+                            thickness: std::array::from_fn(|q| thickness[4 * i + q]),
+                        };
+                        let p = &layout.bodies[layout.body[e] as usize];
+                        let r = match element_step(p, &xe, &ue, &committed, &lumped[e], dt) {
+                            Ok(r) => r,
+                            Err(err) => return (sums, Some((e, err))),
+                        };
+                        sums.observe(r.omega_squared, e);
+                        for q in 0..4 {
+                            stress[16 * i + 4 * q..16 * i + 4 * q + 4]
+                                .copy_from_slice(&r.state.stress[q]);
+                            back[16 * i + 4 * q..16 * i + 4 * q + 4]
+                                .copy_from_slice(&r.state.back_stress[q]);
+                        }
+                        eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
+                        temperature[4 * i..4 * i + 4].copy_from_slice(&r.state.temperature);
+                        thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
+                        forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
+                        sums.internal += r.work;
+                        sums.plastic += r.plastic_work;
                     }
-                    eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
-                    thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
-                    forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
-                    sums.internal += r.work;
-                    sums.plastic += r.plastic_work;
-                }
-                (sums, None)
-            })
+                    (sums, None)
+                },
+            )
             .collect();
         let mut total = StepWork::default();
         for (sums, error) in results {
@@ -401,6 +430,7 @@ impl ExplicitKernel for Full {
                     stress: Voigt::from(s.stress[q]),
                     eq_plastic_strain: s.eq_plastic_strain[q],
                     back_stress: Voigt::from(s.back_stress[q]),
+                    temperature: s.temperature[q],
                 };
                 bs.thickness[4 * e + q] = s.thickness[q];
             }

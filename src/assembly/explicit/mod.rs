@@ -226,11 +226,13 @@ pub trait ExplicitKernel: Send {
     fn internal_force(&mut self, x: &[[f64; 2]], force: &mut [f64]) -> Result<(), ElementFailure>;
     /// One step from positions `x` by the increment `du` (2 per node): updates the element
     /// state and writes the internal force on x + du into `force`. After an error the
-    /// element state is partly updated and the run must stop.
+    /// element state is partly updated and the run must stop. `dt` is the step's length
+    /// (the strain rate of rate-dependent materials).
     fn step(
         &mut self,
         x: &[[f64; 2]],
         du: &[f64],
+        dt: f64,
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure>;
     /// The largest element frequency bound on the positions `x` from the stored state.

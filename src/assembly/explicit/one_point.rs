@@ -17,7 +17,7 @@ use super::{BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork,
 use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
 use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
-use crate::material::{PointState, StressCondition};
+use crate::material::{FlowStart, PointState, StressCondition, UpdateContext};
 use crate::scene::Model;
 use rayon::prelude::*;
 
@@ -28,6 +28,8 @@ pub struct ElementState {
     pub stress: [f64; 4],
     pub back_stress: [f64; 4],
     pub eq_plastic_strain: f64,
+    /// Temperature (0 for materials that carry none).
+    pub temperature: f64,
     /// Current thickness (plane stress), else 1.
     pub thickness: f64,
     /// Hourglass forces Q [x y].
@@ -48,7 +50,8 @@ pub struct ElementStep {
     pub omega_squared: f64,
 }
 
-/// One element over one step: positions x at the start, increment u (see the legend).
+/// One element over one step of length dt: positions x at the start, increment u (see the
+/// legend).
 #[inline(always)]
 fn element_step(
     p: &BodyParameters,
@@ -56,6 +59,7 @@ fn element_step(
     u: &Nodes,
     committed: &ElementState,
     smallest_mass: f64,
+    dt: f64,
 ) -> Result<ElementStep, KernelError> {
     let t = committed.thickness;
     let section = if p.axisymmetric() {
@@ -74,9 +78,13 @@ fn element_step(
                 stress: Voigt::from(stress_n),
                 eq_plastic_strain: committed.eq_plastic_strain,
                 back_stress: Voigt::from(back_n),
+                temperature: committed.temperature,
             },
             &Voigt::from(strain),
-            StressCondition::PlaneStress,
+            UpdateContext {
+                condition: StressCondition::PlaneStress,
+                dt,
+            },
         );
         strain[2] = r.strain_zz;
         (
@@ -110,7 +118,11 @@ fn element_step(
                 &Voigt::from(trial),
                 mu,
                 &Voigt::from(back_n),
-                committed.eq_plastic_strain,
+                FlowStart {
+                    eq_plastic_strain: committed.eq_plastic_strain,
+                    temperature: committed.temperature,
+                    dt,
+                },
             )
             .map(|r| {
                 let work = r.plastic_work();
@@ -127,6 +139,8 @@ fn element_step(
             Some((stress, back, eps_p, work)) => (stress, back, eps_p, work, t),
         }
     };
+    // adiabatic heating by the step's plastic work (Johnson-Cook; the others keep theirs)
+    let temperature = p.material.heated(committed.temperature, plastic_density);
     let volume = step.gradient.area * section.weight(&step.mid);
     let work = volume
         * 0.5
@@ -144,6 +158,7 @@ fn element_step(
         stress,
         back_stress,
         eq_plastic_strain,
+        temperature,
         thickness,
         hourglass: hourglass.forces,
     };
@@ -185,6 +200,8 @@ pub struct Reduced {
     /// Back stress, 4 per element.
     pub back_stress: Vec<f64>,
     pub eq_plastic_strain: Vec<f64>,
+    /// Temperature per element (0 for materials that carry none).
+    pub temperature: Vec<f64>,
     /// Current thickness per element (plane stress), else 1.
     pub thickness: Vec<f64>,
     /// Hourglass forces Q, 2 per element.
@@ -204,7 +221,8 @@ impl Reduced {
         let count = layout.body.len();
         let (mut stress, mut back_stress) =
             (Vec::with_capacity(4 * count), Vec::with_capacity(4 * count));
-        let (mut eq_plastic_strain, mut thickness, mut smallest_mass) = (
+        let (mut eq_plastic_strain, mut temperature, mut thickness, mut smallest_mass) = (
+            Vec::with_capacity(count),
             Vec::with_capacity(count),
             Vec::with_capacity(count),
             Vec::with_capacity(count),
@@ -215,6 +233,7 @@ impl Reduced {
             stress.extend(p.stress.iter());
             back_stress.extend(p.back_stress.iter());
             eq_plastic_strain.push(p.eq_plastic_strain);
+            temperature.push(p.temperature);
             thickness.push(committed.thickness[4 * e]);
             smallest_mass.push(
                 masses
@@ -231,6 +250,7 @@ impl Reduced {
             stress,
             back_stress,
             eq_plastic_strain,
+            temperature,
             thickness,
             hourglass: vec![0.0; 2 * count],
             element_forces: vec![0.0; 8 * count],
@@ -255,6 +275,7 @@ impl Reduced {
             stress: std::array::from_fn(|k| self.stress[4 * e + k]),
             back_stress: std::array::from_fn(|k| self.back_stress[4 * e + k]),
             eq_plastic_strain: self.eq_plastic_strain[e],
+            temperature: self.temperature[e],
             thickness: self.thickness[e],
             hourglass: [self.hourglass[2 * e], self.hourglass[2 * e + 1]],
         }
@@ -328,6 +349,7 @@ impl ExplicitKernel for Reduced {
         &mut self,
         x: &[[f64; 2]],
         du: &[f64],
+        dt: f64,
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
         let layout = &self.layout;
@@ -336,13 +358,15 @@ impl ExplicitKernel for Reduced {
             self.stress.par_chunks_mut(4 * CHUNK),
             self.back_stress.par_chunks_mut(4 * CHUNK),
             self.eq_plastic_strain.par_chunks_mut(CHUNK),
+            self.temperature.par_chunks_mut(CHUNK),
             self.thickness.par_chunks_mut(CHUNK),
             self.hourglass.par_chunks_mut(2 * CHUNK),
             self.element_forces.par_chunks_mut(8 * CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (stress, back, eps_p, thickness, hourglass, forces))| {
+            .map(|(k, chunks)| {
+                let (stress, back, eps_p, temperature, thickness, hourglass, forces) = chunks;
                 let mut sums = StepWork::default();
                 for i in 0..eps_p.len() {
                     let e = k * CHUNK + i;
@@ -353,11 +377,12 @@ impl ExplicitKernel for Reduced {
                         stress: std::array::from_fn(|c| stress[4 * i + c]),
                         back_stress: std::array::from_fn(|c| back[4 * i + c]),
                         eq_plastic_strain: eps_p[i],
+                        temperature: temperature[i],
                         thickness: thickness[i],
                         hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
                     };
                     let p = &layout.bodies[layout.body[e] as usize];
-                    let r = match element_step(p, &xe, &ue, &committed, smallest_mass[e]) {
+                    let r = match element_step(p, &xe, &ue, &committed, smallest_mass[e], dt) {
                         Ok(r) => r,
                         Err(err) => return (sums, Some((e, err))),
                     };
@@ -365,6 +390,7 @@ impl ExplicitKernel for Reduced {
                     stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
                     back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
                     eps_p[i] = r.state.eq_plastic_strain;
+                    temperature[i] = r.state.temperature;
                     thickness[i] = r.state.thickness;
                     hourglass[2 * i..2 * i + 2].copy_from_slice(&r.state.hourglass);
                     forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
@@ -407,6 +433,7 @@ impl ExplicitKernel for Reduced {
                         stress: Voigt::from(s.stress),
                         eq_plastic_strain: s.eq_plastic_strain,
                         back_stress: Voigt::from(s.back_stress),
+                        temperature: s.temperature,
                     };
                     points.fill(point);
                     thickness.fill(s.thickness);
@@ -468,6 +495,7 @@ mod tests {
             stress: [1.0, -0.5, 0.2, 0.3],
             back_stress: [0.0; 4],
             eq_plastic_strain: 0.0,
+            temperature: 0.0,
             thickness: 1.0,
             hourglass: [0.0; 2],
         };
@@ -478,7 +506,7 @@ mod tests {
                 let [px, py] = x[a];
                 [c * px - s * py - px, s * px + c * py - py]
             });
-            state = element_step(&p, &x, &u, &state, 1.0).unwrap().state;
+            state = element_step(&p, &x, &u, &state, 1.0, 1.0).unwrap().state;
             x = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);
         }
         // round-off: E ~ 200 times strains of ~1e-16 per step
