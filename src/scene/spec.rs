@@ -445,7 +445,8 @@ pub struct AnalysisSpec {
     pub checkpoint_every: usize,
     /// Central difference: the Quad4 kernel. `full` (default): 2x2 Gauss, exact push-forward;
     /// `reduced`: one point with Flanagan-Belytschko hourglass control, the structure-of-arrays
-    /// fast path (plane strain and plane stress; see docs/theory.md "Reduced explicit Quad4").
+    /// fast path (plane strain, plane stress, axisymmetric; see docs/theory.md "Reduced
+    /// explicit Quad4").
     pub quadrature: Option<Quadrature>,
     /// `quadrature = "reduced"`: the hourglass stiffness coefficient kappa in [0, 1]: kappa = 1
     /// gives a square element the hourglass stiffness of the fully integrated one. Default 0.1.

@@ -63,7 +63,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     })
 }
 
-/// One-point quadrature in a dynamic run covers plane-strain and plane-stress bodies only.
+/// One-point quadrature in a dynamic run covers Quad4 bodies only (no rods).
 fn check_reduced_quadrature(
     cx: &Context,
     analysis: &Analysis,

@@ -8,6 +8,8 @@
 //! explicit: central difference at dt = 0.5 h / c (below its limit h / c for these squares).
 //! Each case is a child `impact run` so that its peak memory is its own.
 
+mod taylor;
+
 use crate::output::plot::{self, Chart, Series, SeriesStyle};
 use crate::output::{OutputError, write_atomic};
 use serde::{Deserialize, Serialize};
@@ -201,7 +203,7 @@ pub fn plan(quick: bool) -> Vec<Case> {
             cases.push(elastic(n, bottom));
         }
     }
-    cases.extend(taylor_cases());
+    cases.extend(taylor::cases());
     // 448 x 224 = 100 352 elements
     let fast = |name: &str| Case {
         name: name.into(),
@@ -232,40 +234,6 @@ pub fn plan(quick: bool) -> Vec<Case> {
         frame_every: 10,
         ..fast("explicit_reduced_448_frames_1thread")
     });
-    cases
-}
-
-/// models/taylor_aluminum.toml at 5 x 30, 10 x 60 and 20 x 120 quads, one-point and 2x2
-/// (`impact bench --case taylor`): speed against accuracy on a large-strain impact.
-pub fn taylor_cases() -> Vec<Case> {
-    let mut cases = Vec::new();
-    for (method, quadrature) in [
-        (Method::ExplicitReduced, "reduced"),
-        (Method::Explicit, "full"),
-    ] {
-        for nx in [5, 10, 20] {
-            cases.push(Case {
-                name: format!("taylor_aluminum_{quadrature}_{nx}x{}", 6 * nx),
-                method,
-                n: nx,
-                steps: 0,
-                bottom: Bottom::Wall,
-                frame_every: 0,
-                threads: None,
-                speed: 478.0,
-                strategy: "modified",
-                scene: Some(SceneCase {
-                    file: PathBuf::from("models/taylor_aluminum.toml"),
-                    overrides: vec![
-                        format!("body.rod.mesh.nx={nx}"),
-                        format!("body.rod.mesh.ny={}", 6 * nx),
-                        format!("analysis.quadrature={quadrature}"),
-                        "output.frame_every=0".to_string(),
-                    ],
-                }),
-            });
-        }
-    }
     cases
 }
 
@@ -402,7 +370,7 @@ pub fn run(
     let text = serde_json::to_string_pretty(&rows).expect("rows serialize");
     write_atomic(&dir.join("bench.json"), text.as_bytes())?;
     charts(dir, &rows)?;
-    taylor_charts(dir, &rows)?;
+    taylor::charts(dir, &rows)?;
     Ok(rows)
 }
 
@@ -585,91 +553,6 @@ fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                 log_y: false,
             },
             &dir.join("bench_time_breakdown.svg"),
-        )?;
-    }
-    Ok(())
-}
-
-/// taylor_aluminum_length.svg and taylor_aluminum_radius.svg: the final length and the
-/// impact-face radius of the Taylor cases against their wall time, one-point and 2x2, with
-/// the experiment and the ANSYS results.
-fn taylor_charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
-    let taylor: Vec<&Row> = rows
-        .iter()
-        .filter(|r| {
-            r.scene
-                .as_deref()
-                .is_some_and(|s| s.ends_with("taylor_aluminum.toml"))
-                && r.status == "ok"
-        })
-        .collect();
-    if taylor.is_empty() {
-        return Ok(());
-    }
-    let finals = |r: &Row| -> Result<(f64, f64), OutputError> {
-        let history = dir.join(&r.name).join("history.csv");
-        let columns = plot::history_columns(&history, &["u_y[top_axis]", "u_x[foot_edge]"])?;
-        let last = |k: usize| *columns[k].last().unwrap_or(&f64::NAN);
-        Ok(((23.47e-3 + last(0)) * 1e3, (3.81e-3 + last(1)) * 1e3))
-    };
-    let mut points: Vec<(Method, f64, f64, f64)> = Vec::new();
-    for r in &taylor {
-        let (length, radius) = finals(r)?;
-        points.push((r.method, r.wall_seconds, length, radius));
-    }
-    let (lo, hi) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
-        (lo.min(p.1), hi.max(p.1))
-    });
-    let level = |label: &str, y: f64| Series {
-        label: label.into(),
-        points: vec![(lo, y), (hi, y)],
-        style: SeriesStyle::Line,
-    };
-    for (what, column, file, references) in [
-        (
-            "final length (mm)",
-            2,
-            "taylor_aluminum_length.svg",
-            vec![
-                level("experiment (Wilkins & Guinan 1973)", 13.19),
-                level("ANSYS VMC8, lowest", 14.07),
-                level("ANSYS VMC8, highest", 14.22),
-            ],
-        ),
-        (
-            "impact-face radius (mm)",
-            3,
-            "taylor_aluminum_radius.svg",
-            vec![],
-        ),
-    ] {
-        let mut series: Vec<Series> = [
-            (Method::ExplicitReduced, "one-point"),
-            (Method::Explicit, "2x2 B-bar"),
-        ]
-        .iter()
-        .map(|(method, label)| Series {
-            label: format!("{label}: 5x30, 10x60, 20x120"),
-            points: points
-                .iter()
-                .filter(|p| p.0 == *method)
-                .map(|p| (p.1, if column == 2 { p.2 } else { p.3 }))
-                .collect(),
-            style: SeriesStyle::LineAndMarkers,
-        })
-        .filter(|s| !s.points.is_empty())
-        .collect();
-        series.extend(references);
-        plot::write(
-            &Chart {
-                title: format!("Taylor impact, aluminium at 478 m/s: {what} against wall time"),
-                x_label: "wall time (s)".into(),
-                y_label: what.into(),
-                series,
-                log_x: true,
-                log_y: false,
-            },
-            &dir.join(file),
         )?;
     }
     Ok(())

@@ -1,0 +1,307 @@
+//! The Taylor benchmarks of `impact bench --case taylor`: two rods of models/ striking a rigid
+//! wall, each on three meshes (twice as fine each time) with the one-point and the 2x2 explicit
+//! kernels, the Johnson-Cook rod also with implicit Newmark; charts of the final shape against
+//! wall time beside the published results.
+
+use super::{Bottom, Case, Method, Row, SceneCase};
+use crate::output::OutputError;
+use crate::output::plot::{self, Chart, Series, SeriesStyle};
+use std::path::{Path, PathBuf};
+
+/// A final-shape quantity of a Taylor run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Measure {
+    /// The length of the axis (mm).
+    Length,
+    /// The radius of the impact face's outer node (mm).
+    Radius,
+    /// Twice that (mm).
+    Diameter,
+    /// The equivalent plastic strain of the element on the axis at the wall.
+    PlasticStrain,
+    /// Its temperature (C).
+    Temperature,
+}
+
+impl Measure {
+    fn label(self) -> &'static str {
+        match self {
+            Measure::Length => "final length (mm)",
+            Measure::Radius => "impact-face radius (mm)",
+            Measure::Diameter => "impact-face diameter (mm)",
+            Measure::PlasticStrain => "equivalent plastic strain, axis element at the wall",
+            Measure::Temperature => "temperature, axis element at the wall (C)",
+        }
+    }
+
+    fn file(self) -> &'static str {
+        match self {
+            Measure::Length => "length",
+            Measure::Radius => "radius",
+            Measure::Diameter => "diameter",
+            Measure::PlasticStrain => "plastic_strain",
+            Measure::Temperature => "temperature",
+        }
+    }
+}
+
+/// A published value drawn as a level on a chart.
+struct Reference {
+    label: &'static str,
+    measure: Measure,
+    value: f64,
+}
+
+/// One Taylor scene of models/ and what its study measures.
+struct Benchmark {
+    /// The scene's file stem, the prefix of its cases and charts.
+    key: &'static str,
+    title: &'static str,
+    /// The mesh has nx x (aspect nx) quads.
+    aspect: usize,
+    meshes: [usize; 3],
+    /// The rod's initial length and radius (m).
+    length: f64,
+    radius: f64,
+    /// The probes of the top of the axis (u_y), the impact face's outer node (u_x) and the
+    /// element on the axis at the wall.
+    top: &'static str,
+    edge: &'static str,
+    element: Option<(&'static str, &'static str)>,
+    /// Implicit Newmark average cases: dt on the coarsest mesh (halved with each refinement)
+    /// and how many of the meshes (the finest takes many minutes).
+    implicit: Option<(f64, usize)>,
+    charts: &'static [Measure],
+    references: Vec<Reference>,
+}
+
+fn benchmarks() -> Vec<Benchmark> {
+    vec![
+        Benchmark {
+            key: "taylor_aluminum",
+            title: "Taylor impact, aluminium at 478 m/s",
+            aspect: 6,
+            meshes: [5, 10, 20],
+            length: 23.47e-3,
+            radius: 3.81e-3,
+            top: "u_y[top_axis]",
+            edge: "u_x[foot_edge]",
+            element: None,
+            implicit: None,
+            charts: &[Measure::Length, Measure::Radius],
+            references: vec![
+                Reference {
+                    label: "experiment (Wilkins & Guinan 1973)",
+                    measure: Measure::Length,
+                    value: 13.19,
+                },
+                Reference {
+                    label: "ANSYS VMC8, lowest",
+                    measure: Measure::Length,
+                    value: 14.07,
+                },
+                Reference {
+                    label: "ANSYS VMC8, highest",
+                    measure: Measure::Length,
+                    value: 14.22,
+                },
+            ],
+        },
+        Benchmark {
+            key: "taylor_jc",
+            title: "Taylor impact, 42CrMo4 Johnson-Cook at 287 m/s",
+            aspect: 10,
+            meshes: [5, 10, 20],
+            length: 32.4e-3,
+            radius: 3.2e-3,
+            top: "u_y[top_axis]",
+            edge: "u_x[face_edge]",
+            element: Some(("eq_plastic_strain[face_centre]", "temperature[face_centre]")),
+            implicit: Some((1.0e-7, 2)),
+            charts: &[
+                Measure::Length,
+                Measure::Diameter,
+                Measure::PlasticStrain,
+                Measure::Temperature,
+            ],
+            references: [
+                (Measure::Length, 26.52, 26.56),
+                (Measure::Diameter, 11.15, 11.16),
+                (Measure::PlasticStrain, 1.78, 1.81),
+                (Measure::Temperature, 582.34, 590.96),
+            ]
+            .into_iter()
+            .flat_map(|(measure, dynela, abaqus)| {
+                [
+                    Reference {
+                        label: "DynELA v4 (Pantale)",
+                        measure,
+                        value: dynela,
+                    },
+                    Reference {
+                        label: "Abaqus/Explicit (Pantale)",
+                        measure,
+                        value: abaqus,
+                    },
+                ]
+            })
+            .collect(),
+        },
+    ]
+}
+
+/// The cases of both benchmarks: explicit one-point and 2x2 on every mesh, implicit where the
+/// benchmark asks for it.
+pub fn cases() -> Vec<Case> {
+    let mut cases = Vec::new();
+    for b in benchmarks() {
+        let file = PathBuf::from(format!("models/{}.toml", b.key));
+        let case = |name: String, method: Method, nx: usize, extra: Vec<String>| {
+            let mut overrides = vec![
+                format!("body.rod.mesh.nx={nx}"),
+                format!("body.rod.mesh.ny={}", b.aspect * nx),
+                "output.frame_every=0".to_string(),
+            ];
+            overrides.extend(extra);
+            Case {
+                name,
+                method,
+                n: nx,
+                steps: 0,
+                bottom: Bottom::Wall,
+                frame_every: 0,
+                threads: None,
+                speed: 0.0,
+                strategy: "modified",
+                scene: Some(SceneCase {
+                    file: file.clone(),
+                    overrides,
+                }),
+            }
+        };
+        let mesh = |nx: usize| format!("{nx}x{}", b.aspect * nx);
+        for (method, quadrature) in [
+            (Method::ExplicitReduced, "reduced"),
+            (Method::Explicit, "full"),
+        ] {
+            for nx in b.meshes {
+                cases.push(case(
+                    format!("{}_{quadrature}_{}", b.key, mesh(nx)),
+                    method,
+                    nx,
+                    vec![format!("analysis.quadrature={quadrature}")],
+                ));
+            }
+        }
+        if let Some((dt, count)) = b.implicit {
+            for (k, nx) in b.meshes.iter().take(count).enumerate() {
+                cases.push(case(
+                    format!("{}_average_{}", b.key, mesh(*nx)),
+                    Method::Implicit,
+                    *nx,
+                    vec![
+                        "analysis.integrator=average".to_string(),
+                        format!("analysis.dt={:e}", dt / f64::powi(2.0, k as i32)),
+                    ],
+                ));
+            }
+        }
+    }
+    cases
+}
+
+/// The final value of `measure` in the run of row `r` (its history in `dir`).
+fn finals(b: &Benchmark, dir: &Path, r: &Row) -> Result<Vec<(Measure, f64)>, OutputError> {
+    let history = dir.join(&r.name).join("history.csv");
+    let mut names = vec![b.top, b.edge];
+    if let Some((strain, temperature)) = b.element {
+        names.extend([strain, temperature]);
+    }
+    let columns = plot::history_columns(&history, &names)?;
+    let last = |k: usize| *columns[k].last().unwrap_or(&f64::NAN);
+    let radius = (b.radius + last(1)) * 1e3;
+    let mut out = vec![
+        (Measure::Length, (b.length + last(0)) * 1e3),
+        (Measure::Radius, radius),
+        (Measure::Diameter, 2.0 * radius),
+    ];
+    if b.element.is_some() {
+        out.extend([
+            (Measure::PlasticStrain, last(2)),
+            (Measure::Temperature, last(3)),
+        ]);
+    }
+    Ok(out)
+}
+
+/// KEY_MEASURE.svg for each benchmark that has rows: the final shape of each case against its
+/// wall time, one series per method, the published values as levels.
+pub fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
+    for b in benchmarks() {
+        let file = format!("{}.toml", b.key);
+        let runs: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.scene.as_deref().is_some_and(|s| s.ends_with(&file)) && r.status == "ok")
+            .collect();
+        if runs.is_empty() {
+            continue;
+        }
+        let mut points: Vec<(Method, f64, Vec<(Measure, f64)>)> = Vec::new();
+        for r in &runs {
+            points.push((r.method, r.wall_seconds, finals(&b, dir, r)?));
+        }
+        let (lo, hi) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
+            (lo.min(p.1), hi.max(p.1))
+        });
+        let meshes = b
+            .meshes
+            .map(|nx| format!("{nx}x{}", b.aspect * nx))
+            .join(", ");
+        for &measure in b.charts {
+            let value = |v: &[(Measure, f64)]| {
+                v.iter()
+                    .find(|(m, _)| *m == measure)
+                    .map_or(f64::NAN, |(_, x)| *x)
+            };
+            let mut series: Vec<Series> = [
+                (Method::ExplicitReduced, "one-point"),
+                (Method::Explicit, "2x2 B-bar"),
+                (Method::Implicit, "implicit average, 2x2 B-bar"),
+            ]
+            .iter()
+            .map(|(method, label)| Series {
+                label: format!("{label}: {meshes}"),
+                points: points
+                    .iter()
+                    .filter(|p| p.0 == *method)
+                    .map(|p| (p.1, value(&p.2)))
+                    .collect(),
+                style: SeriesStyle::LineAndMarkers,
+            })
+            .filter(|s| !s.points.is_empty())
+            .collect();
+            series.extend(
+                b.references
+                    .iter()
+                    .filter(|r| r.measure == measure)
+                    .map(|r| Series {
+                        label: r.label.into(),
+                        points: vec![(lo, r.value), (hi, r.value)],
+                        style: SeriesStyle::Line,
+                    }),
+            );
+            plot::write(
+                &Chart {
+                    title: format!("{}: {} against wall time", b.title, measure.label()),
+                    x_label: "wall time (s)".into(),
+                    y_label: measure.label().into(),
+                    series,
+                    log_x: true,
+                    log_y: false,
+                },
+                &dir.join(format!("{}_{}.svg", b.key, measure.file())),
+            )?;
+        }
+    }
+    Ok(())
+}
