@@ -1,7 +1,9 @@
 //! The element dispatch: the one place where a body's kind picks the kernel that integrates
-//! its elements (Quad4 with 2x2 Gauss, Rod2; the one-point Quad4 of the explicit fast path
-//! has its structure-of-arrays loop in `reduced`), and where an element's nodes, thickness
-//! and increment are gathered for that kernel. Each kernel gives, for one element: the
+//! its elements (Quad4 with 2x2 Gauss, Rod2), and where an element's nodes, thickness and
+//! increment are gathered for that kernel. The explicit Quad4 kernels (one-point and 2x2 in
+//! rate form) are not variants here: they keep their element state as structure of arrays
+//! and step it in place, so they share the trait `explicit::ExplicitKernel` instead of this
+//! per-element interface, and their element math lives beside this one in `element`. Each kernel gives, for one element: the
 //! internal force with the material's response (and the tangent when asked), the
 //! push-forward of its stresses at commit, its consistent and lumped mass, and its element
 //! frequency bound for the central-difference stable step.

@@ -27,7 +27,9 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use vtkio::Vtk;
-use vtkio::model::{Attribute, CellType, DataSet, IOBuffer, Piece, VertexNumbers};
+use vtkio::model::{
+    Attribute, Attributes, CellType, DataSet, IOBuffer, Piece, UnstructuredGridPiece, VertexNumbers,
+};
 
 use super::tagged::{TaggedCell, TaggedMesh, Words};
 use super::{Mesh, MeshError};
@@ -150,29 +152,7 @@ fn appended_raw(text: &[u8]) -> bool {
 
 /// The grid's points, cells and sets, not yet checked or renumbered.
 fn collect(vtk: Vtk, sets: &[String]) -> Result<TaggedMesh, String> {
-    let piece = match vtk.data {
-        DataSet::UnstructuredGrid { mut pieces, .. } => match (pieces.len(), pieces.pop()) {
-            (1, Some(Piece::Inline(piece))) => piece,
-            (n, _) => {
-                return Err(format!(
-                    "the grid has {n} pieces, or pieces in other files; impact reads one inline piece"
-                ));
-            }
-        },
-        other => {
-            let kind = match other {
-                DataSet::ImageData { .. } => "image data",
-                DataSet::StructuredGrid { .. } => "a structured grid",
-                DataSet::RectilinearGrid { .. } => "a rectilinear grid",
-                DataSet::PolyData { .. } => "poly data",
-                _ => "field data",
-            };
-            return Err(format!(
-                "the file holds {kind}; impact reads an unstructured grid \
-                 (in ParaView: Filters > Clean to Grid, then save as .vtu or .vtk)"
-            ));
-        }
-    };
+    let piece = one_inline_piece(vtk)?;
     let coords: Vec<f64> = piece
         .points
         .cast_into()
@@ -185,37 +165,7 @@ fn collect(vtk: Vtk, sets: &[String]) -> Result<TaggedMesh, String> {
     }
     let points = coords.len() / 3;
     let cells = cell_nodes(piece.cells.cell_verts, piece.cells.types.len())?;
-    let mut groups = Groups::default();
-    let mut cell_groups = vec![Vec::new(); cells.len()];
-    let mut node_groups: BTreeMap<usize, Vec<u64>> = BTreeMap::new();
-    let mut seen = Vec::new();
-    for name in sets {
-        if seen.contains(&name) {
-            continue;
-        }
-        seen.push(name);
-        let on_points = integer_array(&piece.data.point, name, points, "point")?;
-        let on_cells = integer_array(&piece.data.cell, name, cells.len(), "cell")?;
-        if on_points.is_none() && on_cells.is_none() {
-            let mut known: Vec<&str> = (piece.data.point.iter())
-                .chain(&piece.data.cell)
-                .flat_map(array_names)
-                .collect();
-            known.sort_unstable();
-            known.dedup();
-            return Err(format!(
-                "`sets` names \"{name}\", but the file has no point or cell data array of that \
-                 name (arrays: {known:?})"
-            ));
-        }
-        for (k, value) in on_points.into_iter().flatten().enumerate() {
-            let group = groups.index(name, "point", value);
-            node_groups.entry(group).or_default().push(k as u64);
-        }
-        for (k, value) in on_cells.into_iter().flatten().enumerate() {
-            cell_groups[k].push(groups.index(name, "cell", value));
-        }
-    }
+    let tags = set_tags(&piece.data, sets, points, cells.len())?;
     let mut tagged = TaggedMesh {
         coords: (0..points)
             .map(|k| {
@@ -228,8 +178,8 @@ fn collect(vtk: Vtk, sets: &[String]) -> Result<TaggedMesh, String> {
         quads: Vec::new(),
         lines: Vec::new(),
         points: Vec::new(),
-        groups: groups.names,
-        node_groups,
+        groups: tags.groups.names,
+        node_groups: tags.node_groups,
         words: Words {
             quad: "cell",
             line: "cell",
@@ -239,54 +189,139 @@ fn collect(vtk: Vtk, sets: &[String]) -> Result<TaggedMesh, String> {
             kinds: "quads (VTK_QUAD, 9) or lines (VTK_LINE, 3)",
         },
     };
-    for (k, ((nodes, kind), groups)) in cells
-        .into_iter()
-        .zip(piece.cells.types)
-        .zip(cell_groups)
-        .enumerate()
-    {
-        if let Some(&node) = nodes.iter().find(|&&n| n as usize >= points) {
-            return Err(format!(
-                "cell {k} uses point {node}, but the file has {points} points"
-            ));
-        }
-        let tag = k as u64;
-        let count = |n: usize| -> Result<(), String> {
-            if nodes.len() == n {
-                Ok(())
-            } else {
-                Err(format!(
-                    "cell {k} ({kind:?}) has {} points, expected {n}",
-                    nodes.len()
-                ))
-            }
-        };
-        match kind {
-            CellType::Quad => {
-                count(4)?;
-                let nodes = [nodes[0], nodes[1], nodes[2], nodes[3]];
-                tagged.quads.push(TaggedCell { tag, nodes, groups });
-            }
-            CellType::Line => {
-                count(2)?;
-                let nodes = [nodes[0], nodes[1]];
-                tagged.lines.push(TaggedCell { tag, nodes, groups });
-            }
-            CellType::Vertex => {
-                count(1)?;
-                let nodes = [nodes[0]];
-                tagged.points.push(TaggedCell { tag, nodes, groups });
-            }
-            other => {
-                return Err(format!(
-                    "cell {k} has type {other:?} (VTK type {}); impact reads quads (VTK_QUAD, \
-                     9), lines (VTK_LINE, 3) and vertices (VTK_VERTEX, 1)",
-                    other as u8
-                ));
-            }
-        }
+    let typed = cells.into_iter().zip(piece.cells.types);
+    for (k, ((nodes, kind), groups)) in typed.zip(tags.cell_groups).enumerate() {
+        add_cell(&mut tagged, k, nodes, kind, groups, points)?;
     }
     Ok(tagged)
+}
+
+/// The one inline piece of an unstructured grid; other data sets are refused with the ParaView
+/// filter that converts them.
+fn one_inline_piece(vtk: Vtk) -> Result<UnstructuredGridPiece, String> {
+    match vtk.data {
+        DataSet::UnstructuredGrid { mut pieces, .. } => match (pieces.len(), pieces.pop()) {
+            (1, Some(Piece::Inline(piece))) => Ok(*piece),
+            (n, _) => Err(format!(
+                "the grid has {n} pieces, or pieces in other files; impact reads one inline piece"
+            )),
+        },
+        other => {
+            let kind = match other {
+                DataSet::ImageData { .. } => "image data",
+                DataSet::StructuredGrid { .. } => "a structured grid",
+                DataSet::RectilinearGrid { .. } => "a rectilinear grid",
+                DataSet::PolyData { .. } => "poly data",
+                _ => "field data",
+            };
+            Err(format!(
+                "the file holds {kind}; impact reads an unstructured grid \
+                 (in ParaView: Filters > Clean to Grid, then save as .vtu or .vtk)"
+            ))
+        }
+    }
+}
+
+/// The sets that the scene's `sets` arrays give: per cell its set indices, per set its points.
+struct SetTags {
+    groups: Groups,
+    cell_groups: Vec<Vec<usize>>,
+    node_groups: BTreeMap<usize, Vec<u64>>,
+}
+
+/// Each distinct value of each named integer point or cell array becomes a set.
+fn set_tags(
+    data: &Attributes,
+    sets: &[String],
+    points: usize,
+    cells: usize,
+) -> Result<SetTags, String> {
+    let mut tags = SetTags {
+        groups: Groups::default(),
+        cell_groups: vec![Vec::new(); cells],
+        node_groups: BTreeMap::new(),
+    };
+    let mut seen = Vec::new();
+    for name in sets {
+        if seen.contains(&name) {
+            continue;
+        }
+        seen.push(name);
+        let on_points = integer_array(&data.point, name, points, "point")?;
+        let on_cells = integer_array(&data.cell, name, cells, "cell")?;
+        if on_points.is_none() && on_cells.is_none() {
+            let mut known: Vec<&str> = (data.point.iter())
+                .chain(&data.cell)
+                .flat_map(array_names)
+                .collect();
+            known.sort_unstable();
+            known.dedup();
+            return Err(format!(
+                "`sets` names \"{name}\", but the file has no point or cell data array of that \
+                 name (arrays: {known:?})"
+            ));
+        }
+        for (k, value) in on_points.into_iter().flatten().enumerate() {
+            let group = tags.groups.index(name, "point", value);
+            tags.node_groups.entry(group).or_default().push(k as u64);
+        }
+        for (k, value) in on_cells.into_iter().flatten().enumerate() {
+            tags.cell_groups[k].push(tags.groups.index(name, "cell", value));
+        }
+    }
+    Ok(tags)
+}
+
+/// Cell `k` as a quad, line or vertex of the mesh; its points must exist and match its type.
+fn add_cell(
+    tagged: &mut TaggedMesh,
+    k: usize,
+    nodes: Vec<u64>,
+    kind: CellType,
+    groups: Vec<usize>,
+    points: usize,
+) -> Result<(), String> {
+    if let Some(&node) = nodes.iter().find(|&&n| n as usize >= points) {
+        return Err(format!(
+            "cell {k} uses point {node}, but the file has {points} points"
+        ));
+    }
+    let tag = k as u64;
+    let count = |n: usize| -> Result<(), String> {
+        if nodes.len() == n {
+            Ok(())
+        } else {
+            Err(format!(
+                "cell {k} ({kind:?}) has {} points, expected {n}",
+                nodes.len()
+            ))
+        }
+    };
+    match kind {
+        CellType::Quad => {
+            count(4)?;
+            let nodes = [nodes[0], nodes[1], nodes[2], nodes[3]];
+            tagged.quads.push(TaggedCell { tag, nodes, groups });
+        }
+        CellType::Line => {
+            count(2)?;
+            let nodes = [nodes[0], nodes[1]];
+            tagged.lines.push(TaggedCell { tag, nodes, groups });
+        }
+        CellType::Vertex => {
+            count(1)?;
+            let nodes = [nodes[0]];
+            tagged.points.push(TaggedCell { tag, nodes, groups });
+        }
+        other => {
+            return Err(format!(
+                "cell {k} has type {other:?} (VTK type {}); impact reads quads (VTK_QUAD, \
+                 9), lines (VTK_LINE, 3) and vertices (VTK_VERTEX, 1)",
+                other as u8
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The set names handed out: (array, point or cell, value) -> index.

@@ -72,73 +72,13 @@ fn element_step(
     let stress_n = rotate(&committed.stress, c, s);
     let back_n = rotate(&committed.back_stress, c, s);
     let mut strain = step.strain;
-    let (stress, back_stress, eq_plastic_strain, plastic_density, thickness) = if p.plane_stress() {
-        let r = p.material.update(
-            &PointState {
-                stress: Voigt::from(stress_n),
-                eq_plastic_strain: committed.eq_plastic_strain,
-                back_stress: Voigt::from(back_n),
-                temperature: committed.temperature,
-            },
-            &Voigt::from(strain),
-            UpdateContext {
-                condition: StressCondition::PlaneStress,
-                dt,
-            },
-        );
-        strain[2] = r.strain_zz;
-        (
-            r.state.stress.into(),
-            r.state.back_stress.into(),
-            r.state.eq_plastic_strain,
-            r.plastic_work,
-            t * r.strain_zz.exp(),
-        )
-    } else {
-        let (lambda, mu) = (p.lambda, p.mu);
-        let trial = if p.axisymmetric() {
-            let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
-            [
-                stress_n[0] + volumetric + 2.0 * mu * strain[0],
-                stress_n[1] + volumetric + 2.0 * mu * strain[1],
-                stress_n[2] + volumetric + 2.0 * mu * strain[2],
-                stress_n[3] + mu * strain[3],
-            ]
-        } else {
-            let volumetric = lambda * (strain[0] + strain[1]);
-            [
-                stress_n[0] + volumetric + 2.0 * mu * strain[0],
-                stress_n[1] + volumetric + 2.0 * mu * strain[1],
-                stress_n[2] + volumetric,
-                stress_n[3] + mu * strain[3],
-            ]
-        };
-        let plastic = p.material.plasticity.as_ref().and_then(|j2| {
-            j2.radial(
-                &Voigt::from(trial),
-                mu,
-                &Voigt::from(back_n),
-                FlowStart {
-                    eq_plastic_strain: committed.eq_plastic_strain,
-                    temperature: committed.temperature,
-                    dt,
-                },
-            )
-            .map(|r| {
-                let work = r.plastic_work();
-                (
-                    r.stress.into(),
-                    r.back_stress.into(),
-                    r.eq_plastic_strain,
-                    work,
-                )
-            })
-        });
-        match plastic {
-            None => (trial, back_n, committed.eq_plastic_strain, 0.0, t),
-            Some((stress, back, eps_p, work)) => (stress, back, eps_p, work, t),
-        }
-    };
+    let MaterialStep {
+        stress,
+        back_stress,
+        eq_plastic_strain,
+        plastic_density,
+        thickness,
+    } = material_step(p, committed, &stress_n, &back_n, &mut strain, dt);
     // adiabatic heating by the step's plastic work (Johnson-Cook; the others keep theirs)
     let temperature = p.material.heated(committed.temperature, plastic_density);
     let volume = step.gradient.area * section.weight(&step.mid);
@@ -187,6 +127,100 @@ fn element_step(
         hourglass_work: hourglass.work,
         omega_squared,
     })
+}
+
+/// The element's stress after the material update of one step, from the rotated start stress.
+struct MaterialStep {
+    stress: [f64; 4],
+    back_stress: [f64; 4],
+    eq_plastic_strain: f64,
+    /// Plastic work per unit volume.
+    plastic_density: f64,
+    /// The thickness at the end of the step (plane stress), else the committed one.
+    thickness: f64,
+}
+
+/// The material update of one element at its centroid: the general update for plane stress
+/// (which also gives the thickness strain, written into `strain[2]`), else the isotropic
+/// elastic trial and the one J2 return.
+#[inline(always)]
+fn material_step(
+    p: &BodyParameters,
+    committed: &ElementState,
+    stress_n: &[f64; 4],
+    back_n: &[f64; 4],
+    strain: &mut [f64; 4],
+    dt: f64,
+) -> MaterialStep {
+    let t = committed.thickness;
+    if p.plane_stress() {
+        let r = p.material.update(
+            &PointState {
+                stress: Voigt::from(*stress_n),
+                eq_plastic_strain: committed.eq_plastic_strain,
+                back_stress: Voigt::from(*back_n),
+                temperature: committed.temperature,
+            },
+            &Voigt::from(*strain),
+            UpdateContext {
+                condition: StressCondition::PlaneStress,
+                dt,
+            },
+        );
+        strain[2] = r.strain_zz;
+        MaterialStep {
+            stress: r.state.stress.into(),
+            back_stress: r.state.back_stress.into(),
+            eq_plastic_strain: r.state.eq_plastic_strain,
+            plastic_density: r.plastic_work,
+            thickness: t * r.strain_zz.exp(),
+        }
+    } else {
+        let (lambda, mu) = (p.lambda, p.mu);
+        let trial = if p.axisymmetric() {
+            let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
+            [
+                stress_n[0] + volumetric + 2.0 * mu * strain[0],
+                stress_n[1] + volumetric + 2.0 * mu * strain[1],
+                stress_n[2] + volumetric + 2.0 * mu * strain[2],
+                stress_n[3] + mu * strain[3],
+            ]
+        } else {
+            let volumetric = lambda * (strain[0] + strain[1]);
+            [
+                stress_n[0] + volumetric + 2.0 * mu * strain[0],
+                stress_n[1] + volumetric + 2.0 * mu * strain[1],
+                stress_n[2] + volumetric,
+                stress_n[3] + mu * strain[3],
+            ]
+        };
+        let plastic = p.material.plasticity.as_ref().and_then(|j2| {
+            j2.radial(
+                &Voigt::from(trial),
+                mu,
+                &Voigt::from(*back_n),
+                FlowStart {
+                    eq_plastic_strain: committed.eq_plastic_strain,
+                    temperature: committed.temperature,
+                    dt,
+                },
+            )
+            .map(|r| MaterialStep {
+                stress: r.stress.into(),
+                back_stress: r.back_stress.into(),
+                eq_plastic_strain: r.eq_plastic_strain,
+                plastic_density: r.plastic_work(),
+                thickness: t,
+            })
+        });
+        plastic.unwrap_or(MaterialStep {
+            stress: trial,
+            back_stress: *back_n,
+            eq_plastic_strain: committed.eq_plastic_strain,
+            plastic_density: 0.0,
+            thickness: t,
+        })
+    }
 }
 
 /// Element data of all Quad4 bodies as flat arrays (element-major, kernel element index

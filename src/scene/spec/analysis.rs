@@ -1,0 +1,356 @@
+//! The analysis block of the scene schema: the analysis type, the integrator, the time or load
+//! steps, buckling and Newton's controls.
+
+use super::yes;
+use crate::element::Strain;
+use serde::Deserialize;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AnalysisKind {
+    /// Load stepping in pseudo time.
+    Static,
+    /// Direct time integration.
+    Dynamic,
+}
+
+/// The time integrator of a dynamic analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegratorKind {
+    /// Newmark average acceleration (beta 1/4, gamma 1/2): no numerical damping.
+    Average,
+    /// Newmark linear acceleration (beta 1/6, gamma 1/2): conditionally stable.
+    Linear,
+    /// Hu's modified Newmark (beta 1.0, gamma 1.5), the choice of Greco & Coda (2003).
+    Hu,
+    /// Newmark with the scene's `beta` and `gamma`.
+    Newmark,
+    /// Wilson-theta (`theta`, default 1.4).
+    Wilson,
+    /// Houbolt, started by Newmark average steps.
+    Houbolt,
+    /// Hilber-Hughes-Taylor (`alpha` in [-1/3, 0], default -0.05).
+    Hht,
+    /// Chung-Hulbert generalized-alpha (`rho_infinity` in [0, 1], default 0.8).
+    GeneralizedAlpha,
+    /// Explicit central difference with lumped mass.
+    CentralDifference,
+}
+
+/// Consistent (sum rho N^T N over the initial configuration) or lumped (row sums) mass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MassKind {
+    #[default]
+    Consistent,
+    Lumped,
+}
+
+/// The analysis block. One flat table (so every message points at its key's line); keys
+/// that do not apply to the chosen `type` are refused during validation.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisSpec {
+    #[serde(rename = "type")]
+    pub kind: AnalysisKind,
+    /// Static: the number of equal load increments up to `end_time` (required).
+    pub steps: Option<usize>,
+    /// Dynamic: the time step, a number or `"auto"` (central difference only: the stable
+    /// step of the current configuration times `time_step_scale`, every step). Required for
+    /// the implicit integrators; `"auto"` by default for central difference.
+    pub dt: Option<StepSpec>,
+    /// `dt = "auto"`: the fraction of the critical step taken, in (0, 1]. Default 0.9.
+    pub time_step_scale: Option<f64>,
+    /// `dt = "auto"`: the run stops (status `diverged`) when the step would fall below this
+    /// (a time). Default: no limit.
+    pub dt_min: Option<f64>,
+    /// Static: default 1 (pseudo time). Dynamic: required.
+    pub end_time: Option<f64>,
+    /// `nonlinear` (default, updated Lagrangian) or `linear` (small strain).
+    #[serde(default)]
+    pub geometry: Strain,
+    #[serde(default)]
+    pub newton: NewtonSpec,
+    /// Dynamic: the integrator (default `average`).
+    pub integrator: Option<IntegratorKind>,
+    /// Newmark's beta (integrator `newmark`).
+    pub beta: Option<f64>,
+    /// Newmark's gamma (integrator `newmark`).
+    pub gamma: Option<f64>,
+    /// Wilson's theta (default 1.4).
+    pub theta: Option<f64>,
+    /// HHT's alpha (default -0.05).
+    pub alpha: Option<f64>,
+    /// Generalized-alpha's spectral radius at infinite frequency (default 0.8).
+    pub rho_infinity: Option<f64>,
+    /// `consistent` (default for implicit) or `lumped` (always for central difference).
+    pub mass: Option<MassKind>,
+    /// Rayleigh damping C = a M + b K (K: the tangent at the start of the step). Default [0, 0].
+    pub rayleigh: Option<[f64; 2]>,
+    /// Central difference: run even if dt exceeds the critical step, and report the blow-up
+    /// as status `unstable`. Default false (refused).
+    #[serde(default)]
+    pub allow_unstable: bool,
+    /// The buckling check (Erklig, Guzelbey & Cevik 2010, section 2.1.3). Default: none.
+    pub buckling: Option<BucklingSpec>,
+    /// Write DIR/checkpoint.bin (the whole run state) at the start and every N converged
+    /// steps, so `impact resume DIR` can continue the run. Default 0: no checkpoints.
+    #[serde(default)]
+    pub checkpoint_every: usize,
+    /// Central difference: the Quad4 kernel. `full` (default): 2x2 Gauss, exact push-forward;
+    /// `reduced`: one point with Flanagan-Belytschko hourglass control, the structure-of-arrays
+    /// fast path (plane strain, plane stress, axisymmetric; see docs/theory.md "Reduced
+    /// explicit Quad4").
+    pub quadrature: Option<Quadrature>,
+    /// `quadrature = "reduced"`: the hourglass stiffness coefficient kappa in [0, 1]: kappa = 1
+    /// gives a square element the hourglass stiffness of the fully integrated one. Default 0.1.
+    pub hourglass: Option<f64>,
+}
+
+/// `analysis.dt` as written: a step length or the word `auto`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepSpec {
+    Fixed(f64),
+    Auto,
+}
+
+impl<'de> Deserialize<'de> for StepSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<StepSpec, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = StepSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "a time step (a number) or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<StepSpec, E> {
+                Ok(StepSpec::Fixed(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<StepSpec, E> {
+                Ok(StepSpec::Fixed(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<StepSpec, E> {
+                Ok(StepSpec::Fixed(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<StepSpec, E> {
+                match v {
+                    "auto" => Ok(StepSpec::Auto),
+                    _ => Err(E::custom(format!(
+                        "expected a time step (a number) or \"auto\", got \"{v}\""
+                    ))),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+/// The time step of a dynamic analysis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TimeStep {
+    /// The same step throughout (the last one shorter to end at `end_time`).
+    Fixed(f64),
+    /// `scale` times the critical step of the current configuration, every step; the run
+    /// stops when it would fall below `min`.
+    Auto { scale: f64, min: Option<f64> },
+}
+
+impl DynamicSpec {
+    /// The fixed step (every implicit analysis has one; scene validation refuses `auto`
+    /// for them).
+    pub fn fixed_dt(&self) -> Option<f64> {
+        match self.step {
+            TimeStep::Fixed(dt) => Some(dt),
+            TimeStep::Auto { .. } => None,
+        }
+    }
+
+    /// The step of an implicit analysis.
+    pub fn dt(&self) -> f64 {
+        self.fixed_dt()
+            .expect("implicit analyses have a fixed step (checked by the scene)")
+    }
+}
+
+/// Quadrature of the explicit Quad4 kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quadrature {
+    /// 2x2 Gauss (B-bar by option), the same kernel as the implicit integrators.
+    #[default]
+    Full,
+    /// One point at the centroid plus hourglass control (central difference only).
+    Reduced,
+}
+
+/// `[analysis.buckling]`: the inertia of the tangent after every converged state, the
+/// linearized buckling modes of the end loads, what to do when the tangent loses positive
+/// definiteness, and an initial imperfection.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BucklingSpec {
+    /// Count the negative pivots of K_T (no mass) after every converged state: history.csv
+    /// column `tangent_negative_pivots`. Default true.
+    #[serde(default = "yes")]
+    pub check: bool,
+    /// The number of linearized buckling modes of the end loads computed before the run
+    /// (summary.json `buckling.load_factors`, frames NAME_buckling.pvd). Default 0.
+    #[serde(default)]
+    pub modes: usize,
+    /// `continue` (default) or `stop` (the run ends, status ok, when the negative-pivot
+    /// count first changes).
+    #[serde(default)]
+    pub on_critical: OnCritical,
+    /// A buckling mode added to the initial coordinates. Default: none.
+    pub imperfection: Option<ImperfectionSpec>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OnCritical {
+    #[default]
+    Continue,
+    Stop,
+}
+
+/// The initial imperfection: `amplitude` times linearized buckling mode `mode` (of the end
+/// loads), the mode scaled so its largest nodal displacement is 1: `amplitude` is the
+/// largest nodal offset (a length).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImperfectionSpec {
+    /// Mode number, >= 1. Default 1.
+    #[serde(default = "one")]
+    pub mode: usize,
+    /// The largest nodal offset (length), finite and non-zero.
+    pub amplitude: f64,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// The validated dynamic analysis.
+#[derive(Debug, Clone)]
+pub struct DynamicSpec {
+    pub step: TimeStep,
+    pub end_time: f64,
+    pub integrator: IntegratorKind,
+    pub beta: f64,
+    pub gamma: f64,
+    pub theta: f64,
+    pub alpha: f64,
+    pub rho_infinity: f64,
+    pub mass: MassKind,
+    pub rayleigh: [f64; 2],
+    pub allow_unstable: bool,
+    pub geometry: Strain,
+    pub newton: NewtonSpec,
+    pub buckling: Option<BucklingSpec>,
+    /// Central difference's Quad4 kernel (always `full` for the implicit integrators).
+    pub quadrature: Quadrature,
+    /// The hourglass coefficient kappa of the reduced kernel (0.1 unless given).
+    pub hourglass: f64,
+}
+
+/// The validated static analysis.
+#[derive(Debug, Clone)]
+pub struct StaticSpec {
+    pub steps: usize,
+    pub end_time: f64,
+    pub geometry: Strain,
+    pub newton: NewtonSpec,
+    pub buckling: Option<BucklingSpec>,
+}
+
+/// How often K_T is factored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Strategy {
+    /// Factor at the start of each increment; refactor only when the residual stops
+    /// contracting (the modified Newton-Raphson of Erklig, Guzelbey & Cevik 2010, section
+    /// 2.1.2).
+    #[default]
+    Modified,
+    /// Factor the current tangent at every iteration.
+    Full,
+    /// Factor once for the whole run (and again only when dt changes or the iteration stops
+    /// contracting).
+    Initial,
+}
+
+/// Which matrix the factorized tangent holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Tangent {
+    /// The algorithmic (consistent) material tangent plus K_sigma: the exact derivative.
+    #[default]
+    Consistent,
+    /// D_e only (Erklig, Guzelbey & Cevik 2010, section 2.1.2 (c)(ii): "D_r is taken as the
+    /// elastic stress-strain matrix").
+    Elastic,
+    /// D_e plus the geometric stiffness K_sigma.
+    ElasticGeometric,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSpec {
+    /// Default `modified`.
+    #[serde(default)]
+    pub strategy: Strategy,
+    /// Default `consistent`.
+    #[serde(default)]
+    pub tangent: Tangent,
+    /// Iterations per increment before it is cut. Default 30.
+    #[serde(default = "default_iterations")]
+    pub max_iterations: usize,
+    /// Tolerance on ||d delta|| / ||delta|| (Erklig, Guzelbey & Cevik 2010, section 2.1.2
+    /// (viii)). Default 1e-8.
+    #[serde(default = "default_tolerance")]
+    pub tol_displacement: f64,
+    /// Tolerance on ||R|| / ||F|| (Erklig, Guzelbey & Cevik 2010, section 2.1.2 (viii)).
+    /// Default 1e-8.
+    #[serde(default = "default_tolerance")]
+    pub tol_force: f64,
+    /// Modified Newton refactors when ||R_k|| > contraction ||R_k-1||. Default 0.8.
+    #[serde(default = "default_contraction")]
+    pub contraction: f64,
+    /// Halvings of an increment that does not converge before the run stops `diverged`. Default 6.
+    #[serde(default = "default_cuts")]
+    pub max_cuts: usize,
+    /// Modified Newton: factor at the start of every N-th increment. Default 1.
+    #[serde(default = "default_refactor_every")]
+    pub refactor_every: usize,
+}
+
+impl Default for NewtonSpec {
+    fn default() -> Self {
+        NewtonSpec {
+            strategy: Strategy::default(),
+            tangent: Tangent::default(),
+            max_iterations: default_iterations(),
+            tol_displacement: default_tolerance(),
+            tol_force: default_tolerance(),
+            contraction: default_contraction(),
+            max_cuts: default_cuts(),
+            refactor_every: default_refactor_every(),
+        }
+    }
+}
+
+fn default_iterations() -> usize {
+    30
+}
+fn default_tolerance() -> f64 {
+    1e-8
+}
+fn default_contraction() -> f64 {
+    0.8
+}
+fn default_cuts() -> usize {
+    6
+}
+fn default_refactor_every() -> usize {
+    1
+}

@@ -1,0 +1,150 @@
+//! The output block of the scene schema: frames and probes.
+
+use crate::output::vtk::Compression;
+use serde::Deserialize;
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Write a VTK frame every N steps (and always the first and last). 0 writes none. Default 1.
+    #[serde(default = "default_frame_every")]
+    pub frame_every: usize,
+    /// Times at which a frame is written besides (dynamic steps end exactly there).
+    #[serde(default)]
+    pub frame_times: Vec<f64>,
+    /// `none` (default), `lz4` or `zlib` for the .vtu arrays.
+    #[serde(default)]
+    pub compression: Compression,
+    /// Where the frames' points are: `current` (default) or `reference`.
+    #[serde(default)]
+    pub points: FramePoints,
+    #[serde(default)]
+    pub probe: Vec<ProbeSpec>,
+}
+
+/// The configuration a frame's points show; the `displacement` and `reference_coordinates`
+/// arrays are written either way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FramePoints {
+    /// The deformed configuration: the mesh moves as the series plays.
+    #[default]
+    Current,
+    /// The initial coordinates, for Warp By Vector on `displacement` with a scale factor.
+    Reference,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec {
+            frame_every: default_frame_every(),
+            frame_times: Vec::new(),
+            compression: Compression::default(),
+            points: FramePoints::default(),
+            probe: Vec::new(),
+        }
+    }
+}
+
+fn default_frame_every() -> usize {
+    1
+}
+
+/// A probed quantity; the name in the scene and in history.csv is the serde name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum Quantity {
+    #[serde(rename = "u_x")]
+    DisplacementX,
+    #[serde(rename = "u_y")]
+    DisplacementY,
+    #[serde(rename = "v_x")]
+    VelocityX,
+    #[serde(rename = "v_y")]
+    VelocityY,
+    #[serde(rename = "a_x")]
+    AccelerationX,
+    #[serde(rename = "a_y")]
+    AccelerationY,
+    /// Linear momentum sum m v of the set (lumped mass), not a mean.
+    #[serde(rename = "p_x")]
+    MomentumX,
+    #[serde(rename = "p_y")]
+    MomentumY,
+    #[serde(rename = "s_xx")]
+    StressXX,
+    #[serde(rename = "s_yy")]
+    StressYY,
+    #[serde(rename = "s_xy")]
+    StressXY,
+    #[serde(rename = "s_zz")]
+    StressZZ,
+    #[serde(rename = "von_mises")]
+    VonMises,
+    #[serde(rename = "eq_plastic_strain")]
+    EqPlasticStrain,
+    /// Johnson-Cook materials only.
+    #[serde(rename = "temperature")]
+    Temperature,
+}
+
+impl Quantity {
+    /// The name used in scenes and history.csv.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::DisplacementX => "u_x",
+            Quantity::DisplacementY => "u_y",
+            Quantity::VelocityX => "v_x",
+            Quantity::VelocityY => "v_y",
+            Quantity::AccelerationX => "a_x",
+            Quantity::AccelerationY => "a_y",
+            Quantity::MomentumX => "p_x",
+            Quantity::MomentumY => "p_y",
+            Quantity::StressXX => "s_xx",
+            Quantity::StressYY => "s_yy",
+            Quantity::StressXY => "s_xy",
+            Quantity::StressZZ => "s_zz",
+            Quantity::VonMises => "von_mises",
+            Quantity::EqPlasticStrain => "eq_plastic_strain",
+            Quantity::Temperature => "temperature",
+        }
+    }
+
+    /// Nodal quantities are averaged over node sets, the others over element sets.
+    pub fn is_nodal(self) -> bool {
+        matches!(
+            self,
+            Quantity::DisplacementX
+                | Quantity::DisplacementY
+                | Quantity::VelocityX
+                | Quantity::VelocityY
+                | Quantity::AccelerationX
+                | Quantity::AccelerationY
+                | Quantity::MomentumX
+                | Quantity::MomentumY
+        )
+    }
+}
+
+/// A history column: the mean of a nodal quantity over a node set, or of a stress quantity
+/// over an element set. Written as `QUANTITY[SET]` (`QUANTITY[BODY.SET]` with several bodies).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    pub quantity: Quantity,
+    pub body: Option<String>,
+    pub set: String,
+    /// How the set's values combine: `mean` (default; momentum: the sum), `max` or `min`
+    /// (over nodes, or over the elements' integration points).
+    #[serde(default)]
+    pub statistic: Statistic,
+}
+
+/// How a probe combines the values of its set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Statistic {
+    #[default]
+    Mean,
+    Max,
+    Min,
+}
