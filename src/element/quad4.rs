@@ -63,18 +63,30 @@ impl QuadValues {
     }
 }
 
-fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
+const fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
     let mut n = [0.0; 4];
     let mut dn = [[0.0; 2]; 4];
-    for (i, [si, ti]) in NODE_SIGNS.iter().enumerate() {
+    let mut i = 0;
+    while i < 4 {
+        let [si, ti] = NODE_SIGNS[i];
         n[i] = 0.25 * (1.0 + si * xi) * (1.0 + ti * eta);
         dn[i] = [0.25 * si * (1.0 + ti * eta), 0.25 * ti * (1.0 + si * xi)];
+        i += 1;
     }
     (n, dn)
 }
 
+/// The shape functions and their derivatives at the four Gauss points.
+const TABLES: [([f64; 4], [[f64; 2]; 4]); 4] = [
+    shape(POINTS[0][0], POINTS[0][1]),
+    shape(POINTS[1][0], POINTS[1][1]),
+    shape(POINTS[2][0], POINTS[2][1]),
+    shape(POINTS[3][0], POINTS[3][1]),
+];
+
 /// Shape-function derivatives, radii and point volumes on the reference configuration `x`.
 /// `thickness` is per Gauss point and used only in plane stress.
+#[inline]
 pub fn values(
     x: &Coords,
     formulation: Formulation,
@@ -86,30 +98,28 @@ pub fn values(
         radius: 0.0,
         weight: 0.0,
     }; 4];
-    for (q, [xi, eta]) in POINTS.iter().enumerate() {
-        let (n, dn) = shape(*xi, *eta);
-        let mut jac = Matrix2::zeros(); // J_ab = dX_a / dxi_b
-        for i in 0..4 {
-            for a in 0..2 {
-                for b in 0..2 {
-                    jac[(a, b)] += x[i][a] * dn[i][b];
-                }
-            }
-        }
-        let det = jac.determinant();
+    for (q, (n, dn)) in TABLES.iter().enumerate() {
+        // J_ab = dX_a / dxi_b
+        let jac = |a: usize, b: usize| {
+            x[0][a] * dn[0][b] + x[1][a] * dn[1][b] + x[2][a] * dn[2][b] + x[3][a] * dn[3][b]
+        };
+        let (j00, j01, j10, j11) = (jac(0, 0), jac(0, 1), jac(1, 0), jac(1, 1));
+        let det = j00 * j11 - j10 * j01;
         if !(det > 0.0) {
             return Err(KernelError::NegativeJacobian { point: q, det });
         }
-        let inv = Matrix2::new(jac[(1, 1)], -jac[(0, 1)], -jac[(1, 0)], jac[(0, 0)]) / det;
-        let mut dndx = [[0.0; 2]; 4];
+        // J^-1 = [[j11 -j01] [-j10 j00]] / det
+        let inv = [[j11 / det, -j01 / det], [-j10 / det, j00 / det]];
+        let p = &mut points[q];
         for i in 0..4 {
             // dN/dX_a = dN/dxi_b (J^-1)_ba
-            for a in 0..2 {
-                dndx[i][a] = dn[i][0] * inv[(0, a)] + dn[i][1] * inv[(1, a)];
-            }
+            p.dndx[i] = [
+                dn[i][0] * inv[0][0] + dn[i][1] * inv[1][0],
+                dn[i][0] * inv[0][1] + dn[i][1] * inv[1][1],
+            ];
         }
-        let radius: f64 = (0..4).map(|i| n[i] * x[i][0]).sum();
-        let weight = match formulation {
+        let radius = n[0] * x[0][0] + n[1] * x[1][0] + n[2] * x[2][0] + n[3] * x[3][0];
+        p.weight = match formulation {
             Formulation::PlaneStrain => det,
             Formulation::PlaneStress => det * thickness[q],
             Formulation::Axisymmetric => {
@@ -119,12 +129,8 @@ pub fn values(
                 det * 2.0 * PI * radius
             }
         };
-        points[q] = PointValues {
-            shape: n,
-            dndx,
-            radius,
-            weight,
-        };
+        p.shape = *n;
+        p.radius = radius;
     }
     Ok(QuadValues {
         points,
