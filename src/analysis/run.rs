@@ -256,6 +256,17 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Err(e) = self.stepper.verdict() {
             return Err(self.fail_step(e));
         }
+        let e = self.stepper.energies();
+        let energies = [e.kinetic, e.internal, e.plastic_work, e.external_work, e.contact_work];
+        if energies.iter().any(|x| !x.is_finite()) {
+            let time = self.stepper.state().time;
+            let message = format!(
+                "at t = {time}: the step left a state that is not finite (kinetic energy {}, \
+                 internal {}, contact work {}); nothing of it was recorded",
+                e.kinetic, e.internal, e.contact_work
+            );
+            return Err(self.fail(Status::Diverged, message));
+        }
         let stop = self.observe_buckling()?;
         let last = stop || self.stepper.done();
         self.record(last)?;

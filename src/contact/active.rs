@@ -649,6 +649,8 @@ pub fn apply_conditions<S>(
             lumped,
         };
         let (ms, zs) = entry.slave_mass_and_impedance();
+        // the impedance is positive for any node with a contact area (an axis node included)
+        debug_assert!(zs > 0.0, "slave {s}: impedance {zs}");
         conditions::add_normal(velocity, s, n, tau / zs);
         conditions::add_normal(acceleration, s, n, -tau / ms);
         // the friction force goes with the normal one (its acceleration, as in II-12)
