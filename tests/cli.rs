@@ -3,8 +3,9 @@
 
 mod common;
 
+use common::impact;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 const BEAM: &str = r#"
 [[material]]
@@ -37,12 +38,6 @@ quantity = "u_y"
 set = "right"
 "#;
 
-fn impact(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 fn write_scene(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(format!("{name}.toml"));

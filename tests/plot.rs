@@ -3,10 +3,11 @@
 
 mod common;
 
+use common::impact;
+
 use impact::output::plot::{self, Chart, Series, SeriesStyle};
 use std::f64::consts::PI;
 use std::path::Path;
-use std::process::{Command, Output};
 
 /// sin and cos over one period, 101 points each: a line and a line with markers.
 fn sin_cos_chart() -> Chart {
@@ -200,12 +201,6 @@ fn write_history(dir: &Path) -> std::path::PathBuf {
     path
 }
 
-fn impact(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 /// Goal: `impact plot` exits 0 and writes the chart (with a reference run overlaid); an unknown
 /// column or a missing history exits 2 with a message naming it; clap's own errors also exit 2.

@@ -73,7 +73,9 @@ fn quad() -> impl Strategy<Value = Coords> {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 2000, failure_persistence: None, ..ProptestConfig::default() })]
 
-    /// K_0 (and K_0 + K_sigma) is symmetric to round-off.
+    /// K_0 (and K_0 + K_sigma) is symmetric to round-off. Tolerance 1e-12 of the largest
+    /// entry: each entry is a sum over four Gauss points of products of O(1) shape-function
+    /// derivatives, so the two triangles differ by a few ulps (2.2e-16) times the terms summed.
     #[test]
     fn quad4_stiffness_is_symmetric(x in quad(), bbar: bool, stress in prop::array::uniform4(-5.0f64..5.0)) {
         let k = stiffness(&x, bbar, stress);
@@ -82,7 +84,11 @@ proptest! {
     }
 
     /// Exactly three zero eigenvalues (two translations, one rotation): full 2x2 Gauss
-    /// has no hourglass modes, with or without B-bar.
+    /// has no hourglass modes, with or without B-bar. Zero means below 1e-10 of the largest
+    /// eigenvalue (the symmetric eigensolver's error is ~1e-15 of it, and a rigid mode's
+    /// eigenvalue is round-off); positive means above 1e-6: the shapes are convex with aspect
+    /// and skew bounded by `quad()`, whose smallest deformation eigenvalue stays well above that
+    /// (a missed mode would show as a fourth eigenvalue near 1e-16).
     #[test]
     fn quad4_has_exactly_three_zero_energy_modes(x in quad(), bbar: bool) {
         let k = stiffness(&x, bbar, [0.0; 4]);

@@ -59,3 +59,11 @@ pub fn column(dir: &Path, name: &str) -> Vec<f64> {
 pub fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
+
+/// Runs the impact binary with `args` and returns its exit status and output.
+pub fn impact(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
