@@ -253,10 +253,14 @@ pub fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
         let (lo, hi) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
             (lo.min(p.1), hi.max(p.1))
         });
-        let meshes = b
-            .meshes
-            .map(|nx| format!("{nx}x{}", b.aspect * nx))
-            .join(", ");
+        // the meshes a series ran, coarsest first (implicit runs only the coarser ones)
+        let meshes = |count: usize| {
+            b.meshes[..count.min(3)]
+                .iter()
+                .map(|nx| format!("{nx}x{}", b.aspect * nx))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         for &measure in b.charts {
             let value = |v: &[(Measure, f64)]| {
                 v.iter()
@@ -269,14 +273,17 @@ pub fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                 (Method::Implicit, "implicit average, 2x2 B-bar"),
             ]
             .iter()
-            .map(|(method, label)| Series {
-                label: format!("{label}: {meshes}"),
-                points: points
+            .map(|(method, label)| {
+                let points: Vec<(f64, f64)> = points
                     .iter()
                     .filter(|p| p.0 == *method)
                     .map(|p| (p.1, value(&p.2)))
-                    .collect(),
-                style: SeriesStyle::LineAndMarkers,
+                    .collect();
+                Series {
+                    label: format!("{label}: {}", meshes(points.len())),
+                    points,
+                    style: SeriesStyle::LineAndMarkers,
+                }
             })
             .filter(|s| !s.points.is_empty())
             .collect();
