@@ -30,10 +30,10 @@ impact plot $out/hill_cylinder/history.csv --y 'u_x[bore]' --reference $out/hill
   --title 'Hill cylinder: bore displacement against p / (0.98 p_lim), B-bar and locking plain Q4' \
   --out $fig/hill_bore.svg
 
-# the Erklig impact study (issue #7): both bars, elastic and elastoplastic, five methods
+# the impact study of Erklig et al. (2010): both bars, elastic and elastoplastic, five methods
 bash models/impact_study.sh $out/impact_study $fig
 
-# Sweeps (issue #8): convergence, speed against accuracy, stability maps.
+# Sweeps: convergence, speed against accuracy, stability maps.
 # Each writes DIR/sweep.csv and charts; the docs' copies are taken from there.
 sweep() { impact sweep "$@" --quiet; }
 copy() { for ext in png svg; do cp "$1.$ext" "$fig/$2.$ext"; done; }
@@ -59,3 +59,9 @@ copy $out/sweep_two_bars_stability/stability_map sweep_two_bars_stability
 sweep models/sphere_wall.toml --vary 'analysis.integrator=average,hu,houbolt,wilson' \
   --vary 'analysis.dt=0.02,0.01,0.005,0.0025' --out $out/sweep_sphere_wall_methods
 copy $out/sweep_sphere_wall_methods/error_vs_wall sweep_sphere_wall_speed
+
+# The Taylor rods (aluminium, Johnson-Cook steel): three meshes, one-point and 2x2 explicit,
+# implicit Newmark on the two coarser Johnson-Cook meshes; about four minutes
+impact bench --case taylor --out $out/bench_taylor
+cp $out/bench_taylor/taylor_*.svg $fig/
+cp $out/bench_taylor/bench.json $fig/taylor_bench.json
