@@ -272,4 +272,77 @@ proptest! {
         prop_assert!(bound >= exact * (1.0 - 1e-9), "bound {bound} below {exact}");
         prop_assert!(bound <= 16.0 * exact, "bound {bound} far above {exact}");
     }
+
+    /// Goal: the stable step of the axisymmetric one-point Quad4 is safe, on the axis too.
+    /// Setup: crushed convex quads (as above) placed from the axis (two nodes at r = 0, the
+    /// elements of a Taylor rod's axis) to ten widths out, nu from 0 to 0.499, kappa from 0
+    /// to 1. Reference: the largest eigenvalue of M^-1 (K_1 + K_hg) built here: K_1 = V B^T D B
+    /// with V = 2 pi r_c A, B the centroid gradient's rows rr, zz, rz and the hoop row
+    /// N_a / r_c = 1 / (4 r_c) on the radial DOFs, D the isotropic 4x4 of lambda and mu;
+    /// K_hg = k gamma gamma^T in each direction, k = kappa (lambda + 3 mu) V b.b / 24; M the
+    /// element's lumped (row-sum) axisymmetric mass, as the kernel takes it. The bound is not
+    /// below it (1e-9 for round-off) and not more than 16 times it.
+    #[test]
+    fn axisymmetric_one_point_frequency_bound_exceeds_the_element_frequency(
+        (x, _) in crushed_quad(),
+        on_axis: bool,
+        nu in 0.0f64..0.499,
+        kappa in 0.0f64..1.0,
+    ) {
+        use impact::element::quad4_one_point as one_point;
+        let x = if on_axis {
+            // the two nodes nearest the axis onto it (a convex quad stays convex: its
+            // smallest-x edge moves left as a whole)
+            let min_x = x.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min);
+            let mut order: Vec<usize> = (0..4).collect();
+            order.sort_by(|a, b| x[*a][0].total_cmp(&x[*b][0]));
+            let mut moved = x.map(|[a, b]| [a - min_x, b]);
+            moved[order[0]][0] = 0.0;
+            moved[order[1]][0] = 0.0;
+            moved
+        } else {
+            x
+        };
+        prop_assume!(one_point::centroid_gradient(&x).area > 0.0);
+        prop_assume!(quad4::values(&x, Formulation::Axisymmetric, &[1.0; 4]).is_ok());
+        let lambda = nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let mu = 1.0 / (2.0 * (1.0 + nu));
+        let g = one_point::centroid_gradient(&x);
+        let gamma = one_point::gamma(&x, &g);
+        let r = one_point::centroid_radius(&x);
+        let volume = 2.0 * std::f64::consts::PI * r * g.area;
+        let mut b = nalgebra::SMatrix::<f64, 4, 8>::zeros();
+        for a in 0..4 {
+            b[(0, 2 * a)] = g.bx[a];
+            b[(1, 2 * a + 1)] = g.by[a];
+            b[(2, 2 * a)] = 0.25 / r;
+            b[(3, 2 * a)] = g.by[a];
+            b[(3, 2 * a + 1)] = g.bx[a];
+        }
+        let mut d = nalgebra::Matrix4::<f64>::zeros();
+        for i in 0..3 {
+            for j in 0..3 {
+                d[(i, j)] = if i == j { lambda + 2.0 * mu } else { lambda };
+            }
+        }
+        d[(3, 3)] = mu;
+        let mut k = b.transpose() * d * b * volume;
+        let bb: f64 = (0..4).map(|a| g.bx[a] * g.bx[a] + g.by[a] * g.by[a]).sum();
+        let hourglass = kappa * (lambda + 3.0 * mu) / 24.0;
+        let stiffness = hourglass * volume * bb;
+        for a in 0..4 {
+            for c in 0..4 {
+                for dir in 0..2 {
+                    k[(2 * a + dir, 2 * c + dir)] += stiffness * gamma[a] * gamma[c];
+                }
+            }
+        }
+        let m = quad4::mass(&quad4::values(&x, Formulation::Axisymmetric, &[1.0; 4]).unwrap());
+        let lumped: [f64; 4] = std::array::from_fn(|i| m.row(i).sum());
+        let exact = max_frequency_squared(&k, &lumped);
+        let smallest = lumped.iter().copied().fold(f64::INFINITY, f64::min);
+        let bound = one_point::frequency_bound(&g, &gamma, lambda + 2.0 * mu, volume, Some(r), hourglass, smallest);
+        prop_assert!(bound >= exact * (1.0 - 1e-9), "bound {bound} below {exact}");
+        prop_assert!(bound <= 16.0 * exact, "bound {bound} far above {exact}");
+    }
 }
