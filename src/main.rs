@@ -40,6 +40,9 @@ enum Command {
         /// Write DIR/checkpoint.bin every N steps (same as --set analysis.checkpoint_every=N).
         #[arg(long, value_name = "N")]
         checkpoint_every: Option<usize>,
+        /// Exit 3 when the finished run has warnings (summary.json `warnings`).
+        #[arg(long)]
+        strict: bool,
     },
     /// Continue a run from DIR/checkpoint.bin (written with analysis.checkpoint_every, or when
     /// a run is interrupted by Ctrl-C / SIGTERM). The scene is the one stored in the checkpoint.
@@ -145,12 +148,13 @@ fn main() -> ExitCode {
             set,
             quiet,
             checkpoint_every,
+            strict,
         } => {
             let mut set = set;
             if let Some(n) = checkpoint_every {
                 set.push(format!("analysis.checkpoint_every={n}"));
             }
-            run(&scene, out, &set, quiet)
+            run(&scene, out, &set, quiet, strict)
         }
         Command::Resume { dir, quiet } => resume(&dir, quiet),
         Command::Check { scene, set } => check(&scene, &set),
@@ -248,7 +252,13 @@ fn bench(quick: bool, only: &[String], out: Option<PathBuf>) -> Result<(), RunEr
     Ok(())
 }
 
-fn run(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result<(), RunError> {
+fn run(
+    path: &Path,
+    out: Option<PathBuf>,
+    set: &[String],
+    quiet: bool,
+    strict: bool,
+) -> Result<(), RunError> {
     if std::env::var_os("IMPACT_PROFILE_FINE").is_some() {
         impact::profile::set_fine(true);
     }
@@ -265,6 +275,16 @@ fn run(path: &Path, out: Option<PathBuf>, set: &[String], quiet: bool) -> Result
             summary.wall_seconds,
             dir.display()
         );
+    }
+    // warnings are printed even with --quiet: they are about the answer
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
+    if strict && !summary.warnings.is_empty() {
+        return Err(RunError::Warnings {
+            count: summary.warnings.len(),
+            summary: Box::new(summary),
+        });
     }
     Ok(())
 }

@@ -29,7 +29,7 @@ pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// Bumped whenever a stored type changes: an old checkpoint is refused, not misread.
 /// 2: material points carry a temperature, the explicit carry its clock.
-const FORMAT: u32 = 2;
+const FORMAT: u32 = 3;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

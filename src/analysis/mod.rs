@@ -10,6 +10,7 @@ pub mod dynamics;
 pub mod explicit;
 pub mod loads;
 pub mod newton;
+pub mod plausibility;
 pub mod record;
 pub mod run;
 pub mod statics;
@@ -148,6 +149,11 @@ pub struct Summary {
     /// end state gives it).
     #[serde(skip)]
     pub max_temperature: Option<f64>,
+    /// What the finished run can say about its own answer (analysis::plausibility): step
+    /// cuts, the energy balance, plastic work above the energy supplied, a step too long for
+    /// the run or the impact, a contact penetration beyond TOL. Empty when none.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl Summary {
@@ -185,6 +191,7 @@ impl Summary {
             dt_limit: None,
             timing: Default::default(),
             max_temperature: None,
+            warnings: Vec::new(),
         }
     }
 }
@@ -336,6 +343,9 @@ pub enum RunError {
         message: String,
         summary: Box<Summary>,
     },
+    /// `--strict`: the run finished (status ok, its output complete) with warnings.
+    #[error("{count} warning(s) with --strict (summary.json `warnings`)")]
+    Warnings { count: usize, summary: Box<Summary> },
 }
 
 impl RunError {
@@ -345,6 +355,7 @@ impl RunError {
             RunError::Numerical { .. } => 3,
             RunError::Output(_) => 1,
             RunError::Interrupted { .. } => 130,
+            RunError::Warnings { .. } => 3,
         }
     }
 }

@@ -209,6 +209,9 @@ impl Recorder {
         if self.hourglass_column {
             row.push(self.hourglass_energy);
         }
+        if !model.contacts.is_empty() {
+            row.push(contact.map_or(0.0, |c| c.penetration));
+        }
         self.history.append(&row)?;
         crate::profile::add(crate::profile::Phase::Output, start);
         self.steps_since_frame += 1;
@@ -509,6 +512,10 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
     }
     if hourglass_column(model) {
         columns.push("hourglass_energy".to_string());
+    }
+    if !model.contacts.is_empty() {
+        // the deepest penetration of either surface into the other body after the step
+        columns.push("penetration".to_string());
     }
     (columns, pivots_column)
 }

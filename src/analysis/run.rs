@@ -407,6 +407,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             summary.dt_limit = Some(report.limit);
         }
         summary.max_temperature = super::record::max_temperature(self.model, s.state());
+        summary.warnings = super::plausibility::warnings(self.model, summary, &energies);
     }
 
     /// A failed step: its frame when asked, then `fail`.

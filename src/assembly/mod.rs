@@ -579,13 +579,29 @@ pub fn max_frequency_squared(
     state: &State,
     geometry: Strain,
 ) -> Result<FrequencyBound, ElementFailure> {
-    let zero = vec![0.0; model.dofs()];
-    let coords = model.coordinates();
     let mut best = FrequencyBound {
         omega_squared: 0.0,
         body: 0,
         element: 0,
     };
+    for bound in frequency_bounds(model, state, geometry)? {
+        if bound.omega_squared > best.omega_squared {
+            best = bound;
+        }
+    }
+    Ok(best)
+}
+
+/// Every element's frequency bound (as `max_frequency_squared` takes the largest of them),
+/// body by body in element order.
+pub fn frequency_bounds(
+    model: &Model,
+    state: &State,
+    geometry: Strain,
+) -> Result<Vec<FrequencyBound>, ElementFailure> {
+    let zero = vec![0.0; model.dofs()];
+    let coords = model.coordinates();
+    let mut bounds = Vec::new();
     for (b, body) in model.bodies.iter().enumerate() {
         let kernel = Kernel::of(body);
         for e in 0..body.elements() {
@@ -605,14 +621,12 @@ pub fn max_frequency_squared(
                     geometry,
                 )
                 .map_err(failure)?;
-            if lambda > best.omega_squared {
-                best = FrequencyBound {
-                    omega_squared: lambda,
-                    body: b,
-                    element: e,
-                };
-            }
+            bounds.push(FrequencyBound {
+                omega_squared: lambda,
+                body: b,
+                element: e,
+            });
         }
     }
-    Ok(best)
+    Ok(bounds)
 }

@@ -33,6 +33,11 @@ pub struct ContactState {
     pub peak_extent: f64,
     /// The most negative gap of any slave after any step (penetration), or None.
     pub min_gap: Option<f64>,
+    /// The deepest penetration of either surface into the other body after any step: a
+    /// slave's negative gap, or a deformable master's node inside the slave body (>= 0).
+    pub max_penetration: f64,
+    /// The same after the last step alone.
+    pub penetration: f64,
 }
 
 /// What happened in a step, for the conditions and the bookkeeping.
@@ -172,6 +177,8 @@ impl ContactState {
             peak_force: 0.0,
             peak_extent: 0.0,
             min_gap: None,
+            max_penetration: 0.0,
+            penetration: 0.0,
         }
     }
 
@@ -474,10 +481,18 @@ impl ContactState {
         let total: f64 = forces.iter().sum();
         self.peak_force = self.peak_force.max(total);
         let x = |n: usize| coords[n];
+        let mut penetration = 0.0f64;
         for s in slave_gaps(&interfaces.pairs, &x, &|_, _| false) {
             let g = s.gap.gap;
             self.min_gap = Some(self.min_gap.map_or(g, |m| m.min(g)));
+            penetration = penetration.max(-g);
         }
+        for pair in &interfaces.pairs {
+            let boundary = interfaces.boundary(pair.slave_body);
+            penetration = penetration.max(super::setup::master_penetration(pair, coords, &boundary));
+        }
+        self.penetration = penetration;
+        self.max_penetration = self.max_penetration.max(penetration);
         self.peak_extent = self.peak_extent.max(extent(interfaces, active, coords));
     }
 }
@@ -491,6 +506,7 @@ impl ContactState {
             peak_force: self.peak_force,
             peak_contact_radius: self.peak_extent,
             min_gap: self.min_gap,
+            max_penetration: self.min_gap.map(|_| self.max_penetration),
         }
     }
 

@@ -1,6 +1,7 @@
 //! Contact, in one place: detection on the current configuration (`geometry`, `search`),
 //! the active set and the event logic of a step (`active`), Hughes' impact and release
-//! conditions (`conditions`) and the explicit forward-increment multipliers (`explicit`).
+//! conditions (`conditions`), the explicit forward-increment multipliers (`explicit`) and the
+//! set-up checks of a pair (`setup`).
 //! It works on plain arrays (positions, masses, DOF indices) and never sees the model or
 //! the assembled system: the implicit solver receives the rows of the active entries and
 //! returns their multipliers (Hughes, Taylor & Sackman 1975, section II; Greco & Coda 2003).
@@ -28,6 +29,7 @@ pub mod conditions;
 pub mod explicit;
 pub mod geometry;
 pub mod search;
+pub mod setup;
 
 pub use active::{
     ConstrainedSolution, ContactResult, ContactState, Events, NodalStatus, Tangential, Unsettled,
@@ -100,6 +102,19 @@ impl Interfaces {
         };
         b.impedance_per_area * area
     }
+
+    /// The boundary edges of body `body` (global ids), each once.
+    pub fn boundary(&self, body: usize) -> Vec<[usize; 2]> {
+        let mut edges: Vec<[usize; 2]> = self.bodies[body]
+            .boundary_at_node
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
 }
 
 /// The contact block of summary.json.
@@ -111,6 +126,11 @@ pub struct ContactSummary {
     pub peak_contact_radius: f64,
     /// The most negative slave gap after any step (penetration if < 0), null without contact.
     pub min_gap: Option<f64>,
+    /// The deepest penetration of either surface into the other body after any step (a
+    /// slave into its master, or a deformable master's node into the slave body), >= 0;
+    /// null without contact.
+    #[serde(default)]
+    pub max_penetration: Option<f64>,
 }
 
 #[cfg(test)]

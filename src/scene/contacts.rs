@@ -6,7 +6,8 @@ use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
 use super::model::Body;
 use super::spec::{ContactSpec, Scene, SurfaceSpec};
-use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions};
+use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions, setup};
+use crate::mesh::Cells;
 
 /// The scene's contact pairs in order, their names unique.
 pub(super) fn contacts(
@@ -223,4 +224,76 @@ fn model_size(bodies: &[Body]) -> f64 {
         }
     }
     ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).sqrt()
+}
+
+/// The set-up checks of every pair whose `setup_check` is on (contact::setup), on the initial
+/// configuration: the first problem is an error naming the pair and the key that accepts it.
+pub(super) fn check_contact_setup(
+    cx: &Context,
+    scene: &Scene,
+    bodies: &[Body],
+    contacts: &[ContactPair],
+) -> Result<(), InputError> {
+    let coords: Vec<[f64; 2]> = bodies.iter().flat_map(|b| b.mesh.nodes.iter().copied()).collect();
+    for (spec, pair) in scene.contact.iter().zip(contacts) {
+        if !spec.setup_check {
+            continue;
+        }
+        let slave = &bodies[pair.slave_body];
+        let master_interior = match &pair.master {
+            Master::Segments { body, .. } | Master::Nodes { body, .. } => Some(interior(&bodies[*body])),
+            Master::Obstacle(_) => None,
+        };
+        let slave_normal = |node: usize| outward_normal(slave, node - slave.node_offset);
+        let placement = setup::Bodies {
+            coords: &coords,
+            slave_interior: interior(slave),
+            master_interior,
+            slave_normal: &slave_normal,
+        };
+        if let Some(problem) = setup::setup_problem(pair, &placement) {
+            return Err(cx.err(format!(
+                "contact `{}`: {problem}. (contact.{}.setup_check = false runs it as it is)",
+                pair.name, pair.name
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A point inside a body: the mean of its element centroids (of its nodes for rods).
+fn interior(body: &Body) -> [f64; 2] {
+    let nodes = &body.mesh.nodes;
+    let mean = |points: &mut dyn Iterator<Item = [f64; 2]>| {
+        let (mut sum, mut count) = ([0.0; 2], 0.0);
+        for p in points {
+            sum = [sum[0] + p[0], sum[1] + p[1]];
+            count += 1.0;
+        }
+        [sum[0] / count, sum[1] / count]
+    };
+    match &body.mesh.cells {
+        Cells::Quad4(quads) => mean(&mut quads.iter().map(|q| {
+            let c = mean(&mut q.iter().map(|n| nodes[*n]));
+            c
+        })),
+        _ => mean(&mut nodes.iter().copied()),
+    }
+}
+
+/// The outward normal of a body's boundary at local node `node`: the normalized sum of its
+/// boundary edges' outward normals (edges run counter-clockwise around the body). None for
+/// rods and interior nodes.
+fn outward_normal(body: &Body, node: usize) -> Option<[f64; 2]> {
+    let nodes = &body.mesh.nodes;
+    let mut sum = [0.0; 2];
+    for [a, b] in body.boundary_at_node.get(node)? {
+        let d = [nodes[*b][0] - nodes[*a][0], nodes[*b][1] - nodes[*a][1]];
+        let l = d[0].hypot(d[1]);
+        if l > 0.0 {
+            sum = [sum[0] + d[1] / l, sum[1] - d[0] / l];
+        }
+    }
+    let l = sum[0].hypot(sum[1]);
+    (l > 0.0).then(|| [sum[0] / l, sum[1] / l])
 }

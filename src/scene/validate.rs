@@ -6,7 +6,7 @@
 use super::InputError;
 use super::analysis::analysis;
 use super::bodies::{add_node_set, bodies, initial_velocity};
-use super::contacts::contacts;
+use super::contacts::{check_contact_setup, contacts};
 use super::context::Context;
 use super::loads::{curves, default_curve, fixed_dofs, loads};
 use super::materials::materials;
@@ -33,6 +33,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let probes = probes(&cx, &bodies, &scene.output.probe)?;
     check_frame_times(&cx, &scene.output.frame_times)?;
     let contacts = contacts(&cx, &scene, &bodies)?;
+    check_contact_setup(&cx, &scene, &bodies, &contacts)?;
     check_reduced_quadrature(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;

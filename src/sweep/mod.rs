@@ -166,6 +166,8 @@ fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<(), R
     let wall = start.elapsed().as_secs_f64();
     let (status, message, wall_seconds) = match result {
         Ok(summary) => ("ok".to_string(), None, summary.wall_seconds),
+        // analysis::run never gives Warnings (only the CLI's --strict does)
+        Err(RunError::Warnings { summary, .. }) => ("ok".to_string(), None, summary.wall_seconds),
         Err(RunError::Numerical { message, summary }) => {
             let status = serde_json::to_value(summary.status)
                 .ok()

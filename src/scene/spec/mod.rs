@@ -307,6 +307,11 @@ pub struct ContactSpec {
     /// section 2.1.4). Default true.
     #[serde(default = "yes")]
     pub split_at_events: bool,
+    /// Refuse the pair when its set-up looks wrong at t = 0: slaves that start inside the
+    /// master, a node-to-node normal pointing into the master body, a slave body on the
+    /// solid side of an obstacle, a slave surface facing away from its master. Default true.
+    #[serde(default = "yes")]
+    pub setup_check: bool,
     /// Coulomb friction coefficient mu (stick/slip). Default: frictionless.
     pub friction: Option<f64>,
     /// The return coefficient R in [0, 1] of Greco & Coda (2003) (eq 36), instead of

@@ -1,0 +1,165 @@
+//! Set-up checks of a contact pair on the initial configuration, and the penetration of the
+//! master's nodes into the slave body during a run: the ways a pair can let two bodies pass
+//! through each other while the run ends "ok" (a node-to-node normal the wrong way, an
+//! obstacle whose solid is on the body's side, surfaces that face away from each other,
+//! slaves that start inside their master, master nodes sinking into a slave body that a
+//! one-pass search never looks at).
+
+use super::geometry::{ContactPair, Master, winding_number};
+use super::search::slave_gaps;
+use crate::mesh::plane::{dot, sub};
+
+/// What the checks need of the two bodies besides the pair's own nodes.
+pub struct Bodies<'a> {
+    /// Every node's position (global numbering).
+    pub coords: &'a [[f64; 2]],
+    /// A point inside the slave body (the mean of its element centroids) and, for a
+    /// deformable master, inside the master body.
+    pub slave_interior: [f64; 2],
+    pub master_interior: Option<[f64; 2]>,
+    /// The outward normal of the slave body's boundary at a node (the mean of its boundary
+    /// edges' normals), None for rods.
+    pub slave_normal: &'a dyn Fn(usize) -> Option<[f64; 2]>,
+}
+
+/// The first thing wrong with a pair's set-up, as a sentence naming the nodes and values.
+pub fn setup_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
+    direction_problem(pair, bodies)
+        .or_else(|| penetration_problem(pair, bodies))
+        .or_else(|| facing_problem(pair, bodies))
+}
+
+/// A node-to-node normal must point from the master body to the slave body; the slave body
+/// must not lie on the solid side of an obstacle.
+fn direction_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
+    match &pair.master {
+        Master::Nodes { normal, .. } => {
+            let master = bodies.master_interior?;
+            let side = dot(sub(bodies.slave_interior, master), *normal);
+            (side <= 0.0).then(|| {
+                format!(
+                    "the node-to-node normal [{}, {}] points from the slave body into the \
+                     master body (the gap is measured along it, so the bodies would pass \
+                     through each other unseen): give the normal pointing from the master \
+                     nodes towards the slaves",
+                    normal[0], normal[1]
+                )
+            })
+        }
+        Master::Obstacle(o) => {
+            let interior = usize::MAX;
+            let x = |n: usize| {
+                if n == interior {
+                    bodies.slave_interior
+                } else {
+                    bodies.coords[n]
+                }
+            };
+            let gap = pair.gap(interior, &x)?;
+            (gap.gap < 0.0).then(|| {
+                format!(
+                    "the slave body lies on the solid side of obstacle `{}` (an obstacle is \
+                     solid on the left of its points walked in order): reverse the order of \
+                     its points",
+                    o.name
+                )
+            })
+        }
+        Master::Segments { .. } => None,
+    }
+}
+
+/// No slave may start inside its master beyond the pair's TOL.
+fn penetration_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
+    let x = |n: usize| bodies.coords[n];
+    let tolerance = pair.options.tolerance;
+    let pairs = std::slice::from_ref(pair);
+    let inside: Vec<(usize, f64)> = slave_gaps(pairs, &x, &|_, _| false)
+        .filter(|s| s.gap.gap < -tolerance)
+        .map(|s| (s.node, s.gap.gap))
+        .collect();
+    let (node, gap) = inside
+        .iter()
+        .copied()
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some(format!(
+        "{} slave node(s) start inside the master beyond TOL = {tolerance:e}, the deepest \
+         node {node} at gap {gap:e}: move the bodies apart (or the obstacle)",
+        inside.len()
+    ))
+}
+
+/// The slave nearest its master must face it: its outward normal against the master's.
+fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
+    if matches!(pair.master, Master::Nodes { .. }) {
+        return None;
+    }
+    let x = |n: usize| bodies.coords[n];
+    let pairs = std::slice::from_ref(pair);
+    let nearest = slave_gaps(pairs, &x, &|_, _| false).min_by(|a, b| a.gap.gap.total_cmp(&b.gap.gap))?;
+    let outward = (bodies.slave_normal)(nearest.node)?;
+    let n = nearest.gap.normal;
+    (dot(outward, n) > 0.0).then(|| {
+        format!(
+            "the slave surface faces away from its master: at node {}, the slave nearest the \
+             master, the slave body's outward normal [{:.3}, {:.3}] points along the master's \
+             [{:.3}, {:.3}] (the slave set should be the surface that meets the master)",
+            nearest.node, outward[0], outward[1], n[0], n[1]
+        )
+    })
+}
+
+/// The deepest penetration of a deformable master's nodes into the slave body, whose
+/// boundary edges are `slave_boundary` (global ids): for each master node inside that
+/// boundary (winding number above 1/2), its distance to the nearest boundary edge. Zero when
+/// none is inside. Only master nodes within the slave boundary's bounding box are tested.
+pub fn master_penetration(pair: &ContactPair, coords: &[[f64; 2]], slave_boundary: &[[usize; 2]]) -> f64 {
+    let Master::Segments { edges, .. } = &pair.master else {
+        return 0.0;
+    };
+    if slave_boundary.is_empty() {
+        return 0.0;
+    }
+    let segments: Vec<[[f64; 2]; 2]> = slave_boundary
+        .iter()
+        .map(|[a, b]| [coords[*a], coords[*b]])
+        .collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in segments.iter().flatten() {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    let mut nodes: Vec<usize> = edges.iter().flatten().copied().collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let mut deepest = 0.0f64;
+    for m in nodes {
+        let p = coords[m];
+        let boxed = (0..2).all(|c| p[c] > lo[c] && p[c] < hi[c]);
+        if !boxed || winding_number(p, &segments) <= 0.5 {
+            continue;
+        }
+        let depth = segments
+            .iter()
+            .map(|[a, b]| distance_to_segment(p, *a, *b))
+            .fold(f64::INFINITY, f64::min);
+        deepest = deepest.max(depth);
+    }
+    deepest
+}
+
+/// The distance from p to the segment [a, b].
+fn distance_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let ab = sub(b, a);
+    let l2 = dot(ab, ab);
+    let t = if l2 > 0.0 {
+        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
+    let d = sub(p, q);
+    dot(d, d).sqrt()
+}
