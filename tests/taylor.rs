@@ -110,13 +110,7 @@ fn taylor_jc(name: &str, overrides: &[&str]) -> ([f64; 4], impact::analysis::Sum
     let model = impact::scene::load(Path::new("models/taylor_jc.toml"), &all).unwrap();
     let dir = common::out_dir(name);
     let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
-    let last = |c: &str| *column(&dir, c).last().unwrap();
-    let finals = [
-        (32.4e-3 + last("u_y[top_axis]")) * 1e3,
-        2.0 * (3.2e-3 + last("u_x[face_edge]")) * 1e3,
-        last("temperature[face_centre]"),
-        last("eq_plastic_strain[face_centre]"),
-    ];
+    let finals = jc_finals(&dir);
     println!(
         "{name}: L_f {:.3} mm, D_f {:.3} mm, T {:.1} C, eps_p {:.3}; {} steps, {} iterations, {:.2} s",
         finals[0],
@@ -128,6 +122,17 @@ fn taylor_jc(name: &str, overrides: &[&str]) -> ([f64; 4], impact::analysis::Sum
         summary.wall_seconds
     );
     (finals, summary)
+}
+
+/// [L_f, D_f, T, eps_p] of a Johnson-Cook rod's run in `dir` (its history's last row).
+fn jc_finals(dir: &Path) -> [f64; 4] {
+    let last = |c: &str| *column(dir, c).last().unwrap();
+    [
+        (32.4e-3 + last("u_y[top_axis]")) * 1e3,
+        2.0 * (3.2e-3 + last("u_x[face_edge]")) * 1e3,
+        last("temperature[face_centre]"),
+        last("eq_plastic_strain[face_centre]"),
+    ]
 }
 
 /// The relative deviations of `finals` from `reference`.
@@ -196,14 +201,7 @@ fn taylor_jc_on_contact_wall(name: &str, overrides: &[&str]) -> ([f64; 4], impac
     let model = common::model(name, &text.replace(held, wall), &all);
     let dir = common::out_dir(name);
     let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
-    let last = |c: &str| *column(&dir, c).last().unwrap();
-    let finals = [
-        (32.4e-3 + last("u_y[top_axis]")) * 1e3,
-        2.0 * (3.2e-3 + last("u_x[face_edge]")) * 1e3,
-        last("temperature[face_centre]"),
-        last("eq_plastic_strain[face_centre]"),
-    ];
-    (finals, summary)
+    (jc_finals(&dir), summary)
 }
 
 /// Goal: implicit Newmark survives the release of the node on the axis. The release

@@ -172,7 +172,7 @@ pub fn winding_number(s: [f64; 2], segments: &[[[f64; 2]; 2]]) -> f64 {
 }
 
 /// Nearest point of segment [a, b] to x: (xi, distance).
-fn project(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
+pub(super) fn project(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
     let ab = sub(b, a);
     let l2 = dot(ab, ab);
     let xi = if l2 > 0.0 {

@@ -5,7 +5,7 @@
 //! slaves that start inside their master, master nodes sinking into a slave body that a
 //! one-pass search never looks at).
 
-use super::geometry::{ContactPair, Master, winding_number};
+use super::geometry::{ContactPair, Master, project, winding_number};
 use super::search::slave_gaps;
 use crate::mesh::plane::{dot, sub};
 
@@ -143,23 +143,9 @@ pub fn master_penetration(pair: &ContactPair, coords: &[[f64; 2]], slave_boundar
         }
         let depth = segments
             .iter()
-            .map(|[a, b]| distance_to_segment(p, *a, *b))
+            .map(|[a, b]| project(p, *a, *b).1)
             .fold(f64::INFINITY, f64::min);
         deepest = deepest.max(depth);
     }
     deepest
-}
-
-/// The distance from p to the segment [a, b].
-fn distance_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let ab = sub(b, a);
-    let l2 = dot(ab, ab);
-    let t = if l2 > 0.0 {
-        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
-    let d = sub(p, q);
-    dot(d, d).sqrt()
 }
