@@ -89,6 +89,20 @@ fn every_scene_runs_and_writes_the_output_contract() {
             ),
             "{name}: history.csv header"
         );
+        // stored elastic energy cannot be negative (its bookkeeping telescopes to the elastic
+        // energy of the state, theory 7): allow round-off of the energies in play, 1e-12
+        let stored = common::column(&dir, "internal_energy");
+        let scale = [
+            common::column(&dir, "kinetic_energy"),
+            common::column(&dir, "external_work"),
+            stored.clone(),
+        ]
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+        for (k, w) in stored.iter().enumerate() {
+            assert!(*w >= -1e-12 * scale, "{name}: stored energy {w} < 0 at row {k}");
+        }
         let frames = impact::output::vtk::read_pvd(&dir.join(format!("{name}.pvd"))).unwrap();
         assert!(frames.len() >= 2, "{name}: frames");
         for (_, frame) in frames.iter().take(2).chain(frames.last()) {

@@ -13,7 +13,7 @@ use crate::element::{
     Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
 };
 use crate::kinematics;
-use crate::material::{PointState, StressCondition, UpdateContext};
+use crate::material::{PointState, StressCondition, UpdateContext, trapezoid_dissipation};
 use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind};
 use std::time::Instant;
@@ -141,7 +141,15 @@ impl Kernel {
                 let mut work = 0.0;
                 let mut plastic_work = 0.0;
                 for q in 0..4 {
-                    plastic_work += geom.points[q].weight * responses[q].plastic_work;
+                    let start = &committed.points[4 * e + q].stress;
+                    let end = &responses[q].state;
+                    plastic_work += geom.points[q].weight
+                        * trapezoid_dissipation(
+                            start,
+                            &end.stress,
+                            &end.back_stress,
+                            responses[q].plastic_work,
+                        );
                     let mut strain = strains[q];
                     strain[2] = responses[q].strain_zz;
                     work += geom.points[q].weight
@@ -179,7 +187,10 @@ impl Kernel {
                 let stress = response.stress;
                 let length = rod2::length(&x)?;
                 let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
-                let plastic_work = area * length * response.plastic_work;
+                // 1/2 (S_n + S_{n+1}) dep, as the work (see trapezoid_dissipation)
+                let (start, end) = (committed.points[e].stress[0], stress);
+                let share = if end != 0.0 { 0.5 * (1.0 + start / end) } else { 1.0 };
+                let plastic_work = area * length * share * response.plastic_work;
                 let f4 = rod2::internal_force(&x, &de, stress, area, geometry)?;
                 let matrix = match tangent {
                     Some(_) => {

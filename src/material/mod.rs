@@ -332,6 +332,31 @@ pub struct UniaxialResponse {
     pub plastic_work: f64,
 }
 
+/// The plastic work of an increment by the trapezoidal rule, 1/2 (S_n + S_{n+1}) : d eps_p,
+/// from the return's S_{n+1} : d eps_p (`plastic_work`) and the start stress: with
+/// d eps_p = dl n and n the direction of the returned relative stress dev(S_{n+1} - alpha),
+/// S_n : d eps_p = (s_n : n) / (s_{n+1} : n) times it. The energy bookkeeping uses this
+/// value: the element work is summed by the same rule, 1/2 (S_n + S_{n+1}) : d eps, so
+/// work - dissipation = 1/2 (S_n + S_{n+1}) : C^-1 (S_{n+1} - S_n), the exact change of
+/// the stored elastic energy, and the stored energy cannot drift below zero (with
+/// S_{n+1} : d eps_p the difference 1/2 (S_{n+1} - S_n) : d eps_p >= 0 is lost every plastic
+/// step). It is never negative: |s_n : n| <= sigma_y,n <= s_{n+1} : n under hardening.
+/// The heating of Johnson-Cook keeps the return's own S_{n+1} : d eps_p.
+pub fn trapezoid_dissipation(start: &Voigt, end: &Voigt, end_back: &Voigt, plastic_work: f64) -> f64 {
+    if plastic_work == 0.0 {
+        return 0.0;
+    }
+    let relative = end - end_back;
+    let p = (relative[0] + relative[1] + relative[2]) / 3.0;
+    let n = Voigt::new(relative[0] - p, relative[1] - p, relative[2] - p, relative[3]);
+    let dot = |a: &Voigt| a[0] * n[0] + a[1] * n[1] + a[2] * n[2] + 2.0 * a[3] * n[3];
+    let along_end = dot(end);
+    if along_end <= 0.0 {
+        return plastic_work;
+    }
+    0.5 * (1.0 + dot(start) / along_end) * plastic_work
+}
+
 /// Von Mises equivalent stress of [xx yy zz xy].
 pub fn von_mises(s: &Voigt) -> f64 {
     let p = (s[0] + s[1] + s[2]) / 3.0;

@@ -22,7 +22,9 @@ use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
 use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{FlowStart, PointState, StressCondition, UpdateContext};
+use crate::material::{
+    FlowStart, PointState, StressCondition, UpdateContext, trapezoid_dissipation,
+};
 use crate::scene::Model;
 use rayon::prelude::*;
 
@@ -179,7 +181,14 @@ fn element_step(
             * (0..4)
                 .map(|k| (stress_n[k] + stress[k]) * strain[q][k])
                 .sum::<f64>();
-        plastic_work += weight * plastic;
+        // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
+        plastic_work += weight
+            * trapezoid_dissipation(
+                &Voigt::from(stress_n),
+                &Voigt::from(stress),
+                &Voigt::from(state.back_stress[q]),
+                plastic,
+            );
         state.stress[q] = stress;
     }
     let at_end = quad4::values(&end, p.formulation, &state.thickness)?;

@@ -17,7 +17,9 @@ use super::{BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork,
 use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
 use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
-use crate::material::{FlowStart, PointState, StressCondition, UpdateContext};
+use crate::material::{
+    FlowStart, PointState, StressCondition, UpdateContext, trapezoid_dissipation,
+};
 use crate::scene::Model;
 use rayon::prelude::*;
 
@@ -123,7 +125,14 @@ fn element_step(
         state,
         force: end.force,
         work,
-        plastic_work: volume * plastic_density,
+        // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
+        plastic_work: volume
+            * trapezoid_dissipation(
+                &Voigt::from(stress_n),
+                &Voigt::from(stress),
+                &Voigt::from(back_stress),
+                plastic_density,
+            ),
         hourglass_work: hourglass.work,
         omega_squared,
     })
