@@ -408,3 +408,85 @@ fn lame_cylinder_plane_strain_matches_and_converges() {
         }
     }
 }
+
+/// Goal: the reaction probe sums the support reactions of a node set, and they balance the
+/// applied load.
+/// Setup: a plane-stress cantilever (4 x 1, thickness 0.1, 8 x 2 quads, finite strain,
+/// J2 material yielding at the root) clamped on the left, a dead traction (0.5, 1.0) on the
+/// right edge, ramped over 4 increments; probes `reaction_x` and `reaction_y` on `left`.
+/// Reference: global equilibrium, R = -(traction x edge length x thickness) times the ramp
+/// t / end_time: (-0.05, -0.1) at the end. Tolerance 1e-6 relative to the load: Newton
+/// stops at ||R_free|| / ||F|| < 1e-8, and the sum of the free residuals over the 27 nodes
+/// bounds the reactions' error.
+#[test]
+fn reaction_probe_balances_the_applied_traction() {
+    let text = r#"
+[[material]]
+name = "metal"
+young = 1000.0
+poisson = 0.3
+yield_stress = 15.0
+hardening_modulus = 100.0
+
+[[body]]
+name = "beam"
+material = "metal"
+formulation = "plane_stress"
+thickness = 0.1
+mesh = { type = "rectangle", width = 4.0, height = 1.0, nx = 8, ny = 2 }
+
+[[support]]
+set = "left"
+fix = ["x", "y"]
+
+[[load]]
+type = "traction"
+set = "right"
+traction = [0.5, 1.0]
+
+[analysis]
+type = "static"
+steps = 4
+
+[[output.probe]]
+quantity = "reaction_x"
+set = "left"
+
+[[output.probe]]
+quantity = "reaction_y"
+set = "left"
+
+[[output.probe]]
+quantity = "eq_plastic_strain"
+set = "all"
+statistic = "max"
+"#;
+    let model = common::model("reaction", text, &[]);
+    let (summary, _) = common::run("reaction", &model);
+    assert_eq!(summary.steps, 4);
+    let dir = common::out_dir_of("reaction");
+    let time = common::column(&dir, "time");
+    let rx = common::column(&dir, "reaction_x[left]");
+    let ry = common::column(&dir, "reaction_y[left]");
+    let plastic = common::column(&dir, "max_eq_plastic_strain[all]");
+    assert!(plastic[4] > 0.0, "the root yields: {plastic:?}");
+    let (fx, fy) = (0.5 * 1.0 * 0.1, 1.0 * 1.0 * 0.1);
+    for k in 0..time.len() {
+        let ramp = time[k] / 1.0;
+        let (ex, ey) = (-fx * ramp, -fy * ramp);
+        assert!(
+            (rx[k] - ex).abs() < 1e-6 * fy,
+            "row {k}: reaction_x {} vs {ex}",
+            rx[k]
+        );
+        assert!(
+            (ry[k] - ey).abs() < 1e-6 * fy,
+            "row {k}: reaction_y {} vs {ey}",
+            ry[k]
+        );
+    }
+    eprintln!(
+        "reaction at the end: ({}, {}), exact (-0.05, -0.1)",
+        rx[4], ry[4]
+    );
+}

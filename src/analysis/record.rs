@@ -31,6 +31,9 @@ pub struct Motion<'a> {
     pub acceleration: &'a [f64],
     /// Lumped mass per DOF (for the momentum probes); empty in statics.
     pub mass: &'a [f64],
+    /// The internal force of the committed state, all DOFs (for the reaction probes): the
+    /// one the step converged with, so the reactions balance the loads as the solution does.
+    pub internal_force: &'a [f64],
 }
 
 pub struct Recorder {
@@ -39,6 +42,8 @@ pub struct Recorder {
     grid: Grid,
     /// The initial coordinates (the `reference_coordinates` array).
     reference: Vec<[f64; 2]>,
+    /// Per cell of `grid`, its body's index (the `body` cell array).
+    body_ids: Vec<i64>,
     series: Option<Series>,
     history: History,
     frame_every: usize,
@@ -61,7 +66,7 @@ impl Recorder {
     pub fn create(model: &Model, dir: &Path) -> Result<Recorder, OutputError> {
         std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
             path: dir.to_path_buf(),
-            action: "cannot create folder",
+            action: "create folder",
             source,
         })?;
         let series = if model.output.frame_every > 0 || !model.output.frame_times.is_empty() {
@@ -77,6 +82,7 @@ impl Recorder {
         Ok(Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
+            body_ids: body_ids(model),
             reference: model.coordinates(),
             series,
             history,
@@ -126,6 +132,7 @@ impl Recorder {
         Ok(Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
+            body_ids: body_ids(model),
             reference: model.coordinates(),
             series,
             history,
@@ -197,11 +204,16 @@ impl Recorder {
                 model.contacts.len() + friction.iter().filter(|f| **f).count(),
             )),
         }
+        let reaction = if model.probes.iter().any(|p| is_reaction(p.quantity)) {
+            Some(reactions(model, state, motion))
+        } else {
+            None
+        };
         row.extend(
             model
                 .probes
                 .iter()
-                .map(|p| probe_value(model, state, motion, p)),
+                .map(|p| probe_value(model, state, motion, reaction.as_deref(), p)),
         );
         if self.pivots_column {
             row.push(self.negative_pivots.map_or(f64::NAN, |n| n as f64));
@@ -225,13 +237,17 @@ impl Recorder {
             || (self.series.is_some() && self.frame_due(model, time, force_frame, 1))
     }
 
-    /// `pending`: steps not yet counted in `steps_since_frame`.
+    /// `pending`: steps not yet counted in `steps_since_frame`. A listed frame time is due at
+    /// the step that ends there, or (a step that jumps over it: fixed central-difference steps,
+    /// static increments) at the first step past it; `step_length` is the step's length.
     fn frame_due(&self, model: &Model, time: f64, force_frame: bool, pending: usize) -> bool {
+        let tolerance = 1e-9 * time.abs().max(1e-300);
+        let previous = time - self.step_length;
         let listed = model
             .output
             .frame_times
             .iter()
-            .any(|t| (t - time).abs() <= 1e-9 * t.abs().max(1e-300));
+            .any(|t| (t - time).abs() <= tolerance || (*t < time && *t > previous + tolerance));
         force_frame
             || listed
             || (self.frame_every > 0 && self.steps_since_frame + pending >= self.frame_every)
@@ -281,6 +297,7 @@ impl Recorder {
             eq_plastic_strain: &cells.eq_plastic_strain,
             pressure: &cells.pressure,
             temperature: cells.temperature.as_deref(),
+            body: Some(&self.body_ids),
         };
         let points = match model.output.points {
             FramePoints::Current => &positions[..],
@@ -329,6 +346,19 @@ pub fn max_temperature(model: &Model, state: &State) -> Option<f64> {
             .flat_map(|(_, s)| s.points.iter().map(|p| p.temperature))
             .fold(f64::NEG_INFINITY, f64::max)
     })
+}
+
+/// Per cell of [`grid`], the index of its body in the scene (quads first, then rods).
+pub(crate) fn body_ids(model: &Model) -> Vec<i64> {
+    let of = |quads: bool| {
+        model
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(move |(_, b)| matches!(b.mesh.cells, Cells::Quad4(_)) == quads)
+            .flat_map(|(i, b)| std::iter::repeat_n(i as i64, b.elements()))
+    };
+    of(true).chain(of(false)).collect()
 }
 
 /// All bodies in one grid: initial coordinates, quads first, then rods.
@@ -416,10 +446,42 @@ fn cell_fields(model: &Model, state: &State) -> CellFields {
     out
 }
 
+fn is_reaction(quantity: Quantity) -> bool {
+    matches!(quantity, Quantity::ReactionX | Quantity::ReactionY)
+}
+
+/// The support reactions of the committed state, per DOF (zero at free DOFs):
+/// ```text
+/// R = f_int(sigma) - f_ext(t) + m a     at the constrained DOFs
+/// ```
+/// f_int the internal force the step converged with, f_ext the loads at the state's time, m
+/// the lumped mass (dynamics; absent in statics). Contact forces on constrained nodes and
+/// Rayleigh damping are not part of it.
+fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
+    let mut external = vec![0.0; model.dofs()];
+    super::loads::add_external_force(
+        model,
+        state,
+        &model.coordinates(),
+        state.time,
+        &mut external,
+    );
+    let mut reaction = vec![0.0; model.dofs()];
+    for dof in model.constrained_dofs() {
+        let inertia = motion
+            .mass
+            .get(dof)
+            .map_or(0.0, |m| m * motion.acceleration[dof]);
+        reaction[dof] = motion.internal_force[dof] - external[dof] + inertia;
+    }
+    reaction
+}
+
 fn probe_value(
     model: &Model,
     state: &State,
     motion: &Motion,
+    reaction: Option<&[f64]>,
     probe: &crate::scene::model::Probe,
 ) -> f64 {
     let combine = |values: &mut dyn Iterator<Item = f64>| -> f64 {
@@ -464,6 +526,11 @@ fn probe_value(
                         .map_or(0.0, |mass| mass * motion.velocity[2 * m + c])
                 })
                 .sum()
+        }
+        Quantity::ReactionX | Quantity::ReactionY => {
+            let c = (probe.quantity == Quantity::ReactionY) as usize;
+            let reaction = reaction.expect("computed when a reaction probe exists");
+            probe.members.iter().map(|m| reaction[2 * m + c]).sum()
         }
         Quantity::StressXX => points(&|p| p.stress[0]),
         Quantity::StressYY => points(&|p| p.stress[1]),

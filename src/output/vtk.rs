@@ -10,7 +10,8 @@
 //!             reference_coordinates
 //!             gap, contact_status                                   1 component
 //! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure,
-//!             temperature (only when given)
+//!             body (Int64: the index of the cell's body in the scene, from 0; only when
+//!             given), temperature (only when given)
 //! ```
 //! `displacement` is the active vectors array, so ParaView's Warp By Vector picks it by
 //! default (to exaggerate the motion of a frame drawn in the reference configuration);
@@ -53,6 +54,9 @@ pub struct Fields<'a> {
     pub pressure: &'a [f64],
     /// Written only when given (materials that carry a temperature).
     pub temperature: Option<&'a [f64]>,
+    /// Per cell, the index of its body in the scene (from 0): ParaView's Threshold on
+    /// `body` picks one body. Written only when given.
+    pub body: Option<&'a [i64]>,
 }
 
 /// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
@@ -428,7 +432,7 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
         width,
     };
     use Section::{CellData, PointData};
-    use Source::{Pairs, Singles, Sixes};
+    use Source::{Integers, Pairs, Singles, Sixes};
     let list = [
         field(PointData, "displacement", Pairs(fields.displacement), 3),
         field(PointData, "velocity", Pairs(fields.velocity), 3),
@@ -460,7 +464,8 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
     let temperature = fields
         .temperature
         .map(|t| field(CellData, "temperature", Singles(t), 1));
-    let list: Vec<Field> = list.into_iter().chain(temperature).collect();
+    let body = fields.body.map(|b| field(CellData, "body", Integers(b), 1));
+    let list: Vec<Field> = list.into_iter().chain(body).chain(temperature).collect();
     Payload::new(path, grid, &list, Some("displacement"))
 }
 
@@ -512,6 +517,7 @@ mod tests {
                 eq_plastic_strain: &self.cell_scalars[1],
                 pressure: &self.cell_scalars[2],
                 temperature: None,
+                body: None,
             }
         }
 

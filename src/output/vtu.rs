@@ -62,7 +62,8 @@ pub enum Section {
     Cells,
 }
 
-/// The scalar types written: Float64 fields, Int64 connectivity and offsets, UInt8 cell types.
+/// The scalar types written: Float64 fields, Int64 connectivity, offsets and integer fields
+/// (ids), UInt8 cell types.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scalar {
     Float64,
@@ -126,6 +127,8 @@ pub enum Source<'a> {
     Pairs(&'a [[f64; 2]]),
     Sixes(&'a [[f64; 6]]),
     Singles(&'a [f64]),
+    /// One integer per row, written as Int64 (ids).
+    Integers(&'a [i64]),
 }
 
 impl Source<'_> {
@@ -134,6 +137,7 @@ impl Source<'_> {
             Source::Pairs(v) => v.len(),
             Source::Sixes(v) => v.len(),
             Source::Singles(v) => v.len(),
+            Source::Integers(v) => v.len(),
         }
     }
 }
@@ -315,7 +319,8 @@ fn cell_arrays(path: &Path, grid: &Grid) -> Result<[Array; 3], OutputError> {
     ])
 }
 
-/// A checked Float64 array: `expected` rows, each finite, padded with zeros to the width.
+/// A checked array: `expected` rows; Float64 rows finite and padded with zeros to the
+/// width, integers as Int64.
 fn float_array(path: &Path, field: &Field, expected: usize) -> Result<Array, OutputError> {
     if field.source.len() != expected {
         return Err(OutputError::Length {
@@ -323,6 +328,15 @@ fn float_array(path: &Path, field: &Field, expected: usize) -> Result<Array, Out
             what: format!("field `{}`", field.name),
             expected,
             found: field.source.len(),
+        });
+    }
+    if let Source::Integers(values) = field.source {
+        return Ok(Array {
+            section: field.section,
+            name: field.name,
+            scalar: Scalar::Int64,
+            components: 1,
+            bytes: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
         });
     }
     let mut bytes = Vec::with_capacity(expected * field.width * 8);
@@ -351,6 +365,7 @@ fn float_array(path: &Path, field: &Field, expected: usize) -> Result<Array, Out
             .iter()
             .enumerate()
             .try_for_each(|(i, r)| push(i, std::slice::from_ref(r)))?,
+        Source::Integers(_) => unreachable!("written above"),
     }
     Ok(Array {
         section: field.section,
@@ -420,6 +435,14 @@ impl FrameData {
             Values::Float64(v) if a.section == section && a.name == name => {
                 Some((a.components, v.as_slice()))
             }
+            _ => None,
+        })
+    }
+
+    /// The Int64 array `name` of `section` (cell data: ids).
+    pub fn ids(&self, section: Section, name: &str) -> Option<&[i64]> {
+        self.arrays.iter().find_map(|a| match &a.values {
+            Values::Int64(v) if a.section == section && a.name == name => Some(v.as_slice()),
             _ => None,
         })
     }
