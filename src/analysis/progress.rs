@@ -81,6 +81,12 @@ impl Progress {
         }
     }
 
+    /// Measures the rate from simulated time `time` and now on (a resumed run).
+    pub fn start_at(&mut self, time: f64) {
+        self.start_time = time;
+        self.start = Instant::now();
+    }
+
     /// The run has reached simulated time `time` after `steps` steps.
     pub fn update(&mut self, time: f64, steps: usize) {
         match self.mode {

@@ -219,12 +219,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         }
         // a resumed run measures its rate from the checkpoint's time
         let time = run.stepper.state().time;
-        run.progress = Progress::new(
-            options.progress,
-            &model.name,
-            time,
-            model.analysis.end_time(),
-        );
+        run.progress.start_at(time);
         run.progress.update(time, run.summary.steps);
         if run.summary.steps == 0 && model.checkpoint_every > 0 && run.stepper.carry().is_ok() {
             run.save()?;
