@@ -488,7 +488,13 @@ fn j2_scene_writes_no_temperature() {
     let names = frame.names(Section::CellData);
     assert_eq!(
         names,
-        ["stress", "von_mises", "eq_plastic_strain", "pressure", "body"]
+        [
+            "stress",
+            "von_mises",
+            "eq_plastic_strain",
+            "pressure",
+            "body"
+        ]
     );
 }
 

@@ -928,7 +928,7 @@ frame_interval = 0.25
 "#;
 
 /// Goal: frames carry a `body` cell array (the body's index in the scene) so ParaView can
-/// tell bodies apart, and `output.frame_interval` writes frames at fixed simulated times,
+/// tell bodies apart (and a point array of the averaged stress), and `output.frame_interval` writes frames at fixed simulated times,
 /// with implicit steps ending exactly there.
 /// Setup: two plane-strain blocks of 2 x 1 and 3 x 2 quads; average acceleration with
 /// dt = 0.03 (0.25 is no multiple of it), frame_interval = 0.25, frame_every = 0.
@@ -949,6 +949,10 @@ fn frames_carry_body_ids_and_fall_on_the_frame_interval() {
     for frame in frames(&out, "two_blocks") {
         let ids = frame.ids(Section::CellData, "body").expect("a body array");
         assert_eq!(ids, [0, 0, 1, 1, 1, 1, 1, 1]);
+        let (components, values) = frame
+            .floats(Section::PointData, "nodal_stress")
+            .expect("a nodal stress array");
+        assert_eq!((components, values.len()), (6, 6 * frame.points));
     }
     // central difference with a fixed dt that does not divide the interval: the frame of
     // each listed time is the first step at or past it

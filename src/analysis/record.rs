@@ -284,6 +284,14 @@ impl Recorder {
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };
+        let nodal_stress = self.grid.cell_to_point_mean(&cells.stress);
+        let mises: Vec<[f64; 1]> = cells.von_mises.iter().map(|v| [*v]).collect();
+        let nodal_von_mises: Vec<f64> = self
+            .grid
+            .cell_to_point_mean(&mises)
+            .into_iter()
+            .map(|[v]| v)
+            .collect();
         let fields = Fields {
             displacement: &vectors(&state.displacement),
             velocity: &vectors(motion.velocity),
@@ -298,6 +306,7 @@ impl Recorder {
             pressure: &cells.pressure,
             temperature: cells.temperature.as_deref(),
             body: Some(&self.body_ids),
+            nodal_stress: Some((&nodal_stress, &nodal_von_mises)),
         };
         let points = match model.output.points {
             FramePoints::Current => &positions[..],

@@ -9,6 +9,8 @@
 //! point data  displacement, velocity, acceleration, contact_force,  3 components, z = 0
 //!             reference_coordinates
 //!             gap, contact_status                                   1 component
+//!             nodal_stress (6), nodal_von_mises (1): the cell values averaged to the
+//!             points (only when given)
 //! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure,
 //!             body (Int64: the index of the cell's body in the scene, from 0; only when
 //!             given), temperature (only when given)
@@ -57,6 +59,9 @@ pub struct Fields<'a> {
     /// Per cell, the index of its body in the scene (from 0): ParaView's Threshold on
     /// `body` picks one body. Written only when given.
     pub body: Option<&'a [i64]>,
+    /// Per point, `stress` and `von_mises` averaged over the cells around it. Written only
+    /// when given.
+    pub nodal_stress: Option<(&'a [[f64; 6]], &'a [f64])>,
 }
 
 /// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
@@ -465,13 +470,49 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
         .temperature
         .map(|t| field(CellData, "temperature", Singles(t), 1));
     let body = fields.body.map(|b| field(CellData, "body", Integers(b), 1));
-    let list: Vec<Field> = list.into_iter().chain(body).chain(temperature).collect();
+    let nodal = fields.nodal_stress.into_iter().flat_map(|(stress, mises)| {
+        [
+            field(PointData, "nodal_stress", Sixes(stress), 6),
+            field(PointData, "nodal_von_mises", Singles(mises), 1),
+        ]
+    });
+    let list: Vec<Field> = list
+        .into_iter()
+        .chain(nodal)
+        .chain(body)
+        .chain(temperature)
+        .collect();
     Payload::new(path, grid, &list, Some("displacement"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Goal: cell values averaged to the points count each cell around a point once.
+    /// Reference: two quads sharing an edge (points 1 and 4) and a line hanging off point 2:
+    /// shared points take the mean of their cells, the others their one cell's value.
+    #[test]
+    fn cell_values_average_to_the_points_around_them() {
+        let grid = Grid {
+            points: vec![[0.0, 0.0]; 7],
+            quads: vec![[0, 1, 4, 3], [1, 2, 5, 4]],
+            lines: vec![[2, 6]],
+        };
+        let mean = grid.cell_to_point_mean(&[[1.0, 10.0], [3.0, 30.0], [8.0, 80.0]]);
+        assert_eq!(
+            mean,
+            [
+                [1.0, 10.0],
+                [2.0, 20.0],
+                [5.5, 55.0],
+                [1.0, 10.0],
+                [2.0, 20.0],
+                [3.0, 30.0],
+                [8.0, 80.0]
+            ]
+        );
+    }
     use crate::output::vtu::{FrameData, read_frame};
     use crate::output::{temporary_path, test_dir};
 
@@ -518,6 +559,7 @@ mod tests {
                 pressure: &self.cell_scalars[2],
                 temperature: None,
                 body: None,
+                nodal_stress: None,
             }
         }
 

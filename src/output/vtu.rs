@@ -36,6 +36,33 @@ impl Grid {
     pub fn cells(&self) -> usize {
         self.quads.len() + self.lines.len()
     }
+
+    /// Per point, the mean of `cell_values` (one per cell: quads, then lines) over the cells
+    /// that hold the point, each cell counting once; zero at a point of no cell. The nodal
+    /// (averaged) field ParaView's Cell Data to Point Data would give.
+    pub fn cell_to_point_mean<const N: usize>(&self, cell_values: &[[f64; N]]) -> Vec<[f64; N]> {
+        let mut sum = vec![[0.0; N]; self.points.len()];
+        let mut count = vec![0usize; self.points.len()];
+        let cells = self
+            .quads
+            .iter()
+            .map(|q| &q[..])
+            .chain(self.lines.iter().map(|l| &l[..]));
+        for (nodes, value) in cells.zip(cell_values) {
+            for &n in nodes {
+                for (s, v) in sum[n].iter_mut().zip(value) {
+                    *s += v;
+                }
+                count[n] += 1;
+            }
+        }
+        for (s, c) in sum.iter_mut().zip(count) {
+            if c > 0 {
+                s.iter_mut().for_each(|x| *x /= c as f64);
+            }
+        }
+        sum
+    }
 }
 
 /// The `name="value"` pairs of a tag's text (after the element name, before `>`).
