@@ -493,6 +493,7 @@ fn j2_scene_writes_no_temperature() {
             "von_mises",
             "eq_plastic_strain",
             "pressure",
+            "strain",
             "body"
         ]
     );

@@ -228,6 +228,7 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
             temperature: None,
             body: Some(&body_ids),
             nodal_stress: None,
+            strain: None,
         };
         series.write_frame((i + 1) as f64, &grid, &fields)?;
     }

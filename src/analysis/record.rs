@@ -284,6 +284,7 @@ impl Recorder {
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };
+        let strain = cell_strains(model, &self.reference, state);
         let nodal_stress = self.grid.cell_to_point_mean(&cells.stress);
         let mises: Vec<[f64; 1]> = cells.von_mises.iter().map(|v| [*v]).collect();
         let nodal_von_mises: Vec<f64> = self
@@ -307,6 +308,7 @@ impl Recorder {
             temperature: cells.temperature.as_deref(),
             body: Some(&self.body_ids),
             nodal_stress: Some((&nodal_stress, &nodal_von_mises)),
+            strain: Some(&strain),
         };
         let points = match model.output.points {
             FramePoints::Current => &positions[..],
@@ -355,6 +357,102 @@ pub fn max_temperature(model: &Model, state: &State) -> Option<f64> {
             .flat_map(|(_, s)| s.points.iter().map(|p| p.temperature))
             .fold(f64::NEG_INFINITY, f64::max)
     })
+}
+
+/// Per cell of [`grid`] (quads first, then rods), the Green-Lagrange strain of the total
+/// displacement from the initial configuration at the cell's centre, [XX YY ZZ XY YZ XZ]
+/// with the tensor shear E_xy:
+/// ```text
+/// quads   H = grad_X u at the centre (xi = eta = 0), E = (H + H^T + H^T H) / 2
+///         ZZ: plane strain 0; axisymmetric (r^2 / R^2 - 1) / 2 with R, r the centre's
+///         initial and current radius; plane stress (lambda^2 - 1) / 2 with lambda the mean
+///         thickness stretch of the points
+/// rods    XX = (l^2 / L^2 - 1) / 2 along the rod, the rest 0
+/// ```
+pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -> Vec<[f64; 6]> {
+    use crate::element::Formulation;
+    use crate::scene::BodyKind;
+    let u = &state.displacement;
+    let at = |n: usize| {
+        (
+            initial[n],
+            [initial[n][0] + u[2 * n], initial[n][1] + u[2 * n + 1]],
+        )
+    };
+    let mut out = Vec::with_capacity(model.elements());
+    for (b, body) in model.bodies.iter().enumerate() {
+        let Cells::Quad4(quads) = &body.mesh.cells else {
+            continue;
+        };
+        for (e, q) in quads.iter().enumerate() {
+            let nodes = q.map(|n| at(body.global(n)));
+            // dN/dxi and dN/deta at the centre, nodes counter-clockwise
+            let dxi = [-0.25, 0.25, 0.25, -0.25];
+            let deta = [-0.25, -0.25, 0.25, 0.25];
+            let mut jacobian = [[0.0; 2]; 2]; // dX_i / d(xi, eta)_j
+            let mut du = [[0.0; 2]; 2]; // du_i / d(xi, eta)_j
+            for (a, (reference, current)) in nodes.iter().enumerate() {
+                for i in 0..2 {
+                    let displacement = current[i] - reference[i];
+                    jacobian[i][0] += reference[i] * dxi[a];
+                    jacobian[i][1] += reference[i] * deta[a];
+                    du[i][0] += displacement * dxi[a];
+                    du[i][1] += displacement * deta[a];
+                }
+            }
+            let det = jacobian[0][0] * jacobian[1][1] - jacobian[0][1] * jacobian[1][0];
+            // d(xi, eta) / dX = J^-1
+            let inverse = [
+                [jacobian[1][1] / det, -jacobian[0][1] / det],
+                [-jacobian[1][0] / det, jacobian[0][0] / det],
+            ];
+            let h: [[f64; 2]; 2] = std::array::from_fn(|i| {
+                std::array::from_fn(|j| du[i][0] * inverse[0][j] + du[i][1] * inverse[1][j])
+            });
+            let green = |i: usize, j: usize| {
+                0.5 * (h[i][j] + h[j][i] + h[0][i] * h[0][j] + h[1][i] * h[1][j])
+            };
+            let zz = match body.kind {
+                BodyKind::Continuum {
+                    formulation: Formulation::Axisymmetric,
+                    ..
+                } => {
+                    let radius =
+                        |k: usize| nodes.iter().map(|n| [n.0, n.1][k][0]).sum::<f64>() / 4.0;
+                    let (initial_r, current_r) = (radius(0), radius(1));
+                    if initial_r > 0.0 {
+                        0.5 * ((current_r / initial_r).powi(2) - 1.0)
+                    } else {
+                        0.0
+                    }
+                }
+                BodyKind::Continuum {
+                    formulation: Formulation::PlaneStress,
+                    thickness,
+                    ..
+                } => {
+                    let ppe = body.points_per_element();
+                    let now = &state.bodies[b].thickness[e * ppe..(e + 1) * ppe];
+                    let stretch = now.iter().sum::<f64>() / ppe as f64 / thickness;
+                    0.5 * (stretch * stretch - 1.0)
+                }
+                _ => 0.0,
+            };
+            out.push([green(0, 0), green(1, 1), zz, green(0, 1), 0.0, 0.0]);
+        }
+    }
+    for body in &model.bodies {
+        let Cells::Rod2(rods) = &body.mesh.cells else {
+            continue;
+        };
+        for r in rods {
+            let [(a0, a1), (b0, b1)] = r.map(|n| at(body.global(n)));
+            let length2 = |p: [f64; 2], q: [f64; 2]| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+            let xx = 0.5 * (length2(a1, b1) / length2(a0, b0) - 1.0);
+            out.push([xx, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        }
+    }
+    out
 }
 
 /// Per cell of [`grid`], the index of its body in the scene (quads first, then rods).

@@ -670,12 +670,10 @@ fn clip_segment(a: (f64, f64), b: (f64, f64), bounds: &Bounds) -> Option<((f64, 
             }
         }
     }
-    (t0 <= t1).then(|| {
-        (
-            (a.0 + t0 * dx, a.1 + t0 * dy),
-            (a.0 + t1 * dx, a.1 + t1 * dy),
-        )
-    })
+    (t0 <= t1).then_some((
+        (a.0 + t0 * dx, a.1 + t0 * dy),
+        (a.0 + t1 * dx, a.1 + t1 * dy),
+    ))
 }
 
 /// The corner of the plot whose legend-sized box (a third of the width, a band of the height

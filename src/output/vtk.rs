@@ -12,6 +12,7 @@
 //!             nodal_stress (6), nodal_von_mises (1): the cell values averaged to the
 //!             points (only when given)
 //! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure,
+//!             strain (XX YY ZZ XY YZ XZ, Green-Lagrange; only when given),
 //!             body (Int64: the index of the cell's body in the scene, from 0; only when
 //!             given), temperature (only when given)
 //! ```
@@ -62,6 +63,9 @@ pub struct Fields<'a> {
     /// Per point, `stress` and `von_mises` averaged over the cells around it. Written only
     /// when given.
     pub nodal_stress: Option<(&'a [[f64; 6]], &'a [f64])>,
+    /// Per cell, the Green-Lagrange strain XX YY ZZ XY YZ XZ (tensor shear). Written only
+    /// when given.
+    pub strain: Option<&'a [[f64; 6]]>,
 }
 
 /// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
@@ -476,9 +480,13 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
             field(PointData, "nodal_von_mises", Singles(mises), 1),
         ]
     });
+    let strain = fields
+        .strain
+        .map(|s| field(CellData, "strain", Sixes(s), 6));
     let list: Vec<Field> = list
         .into_iter()
         .chain(nodal)
+        .chain(strain)
         .chain(body)
         .chain(temperature)
         .collect();
@@ -560,6 +568,7 @@ mod tests {
                 temperature: None,
                 body: None,
                 nodal_stress: None,
+                strain: None,
             }
         }
 
