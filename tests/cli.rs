@@ -491,6 +491,23 @@ fn check_reports_wave_speed_yield_strain_and_step_ratio() {
     assert!(close(ratio, 1.9e-6 / (h / c)), "{ratio}\n{stdout}");
     assert!(stdout.contains("integrator central_difference"), "{stdout}");
     assert!(!stdout.contains("Rod {"), "a Rust debug struct: {stdout}");
+    // Newmark linear acceleration (beta 1/6, gamma 1/2) with the lumped mass: Omega_crit =
+    // 1 / sqrt(gamma/2 - beta) = 2 sqrt 3, so its limit is sqrt 3 times central difference's
+    let linear = impact(&[
+        "check",
+        scene.to_str().unwrap(),
+        "--set",
+        "analysis.integrator=\"linear\"",
+        "--set",
+        "analysis.mass=\"lumped\"",
+    ]);
+    let linear_out = String::from_utf8_lossy(&linear.stdout);
+    assert!(linear.status.success(), "{linear_out}");
+    let linear_crit = number_after(
+        &linear_out,
+        "integrator linear: dt = 1.9e-6, stability limit dt_crit = ",
+    );
+    assert!(close(linear_crit, 3f64.sqrt() * h / c), "{linear_out}");
     // just above the limit: check and run refuse it alike, naming the key
     let above = format!("analysis.dt={:e}", 1.05 * h / c);
     let check = impact(&["check", scene.to_str().unwrap(), "--set", &above]);

@@ -11,13 +11,14 @@
 //! dt_crit      central difference: 2 / omega_max (element eigenvalue bound);
 //!              Newmark (gamma >= 1/2, beta < gamma / 2): Omega_crit / omega_max with
 //!              Omega_crit = 1 / sqrt(gamma / 2 - beta) (Hughes 1987, section 9.1; 2 sqrt 3 for
-//!              linear acceleration); beta >= gamma / 2 >= 1/4: unconditionally stable
+//!              linear acceleration); beta >= gamma / 2 >= 1/4: unconditionally stable;
+//!              Wilson-theta: unconditionally stable for theta >= 1.37 only
 //! ```
 
 use super::explicit::{StableStep, checked_step, critical_time_step};
 use crate::element::Formulation;
 use crate::output::readable;
-use crate::scene::spec::{DynamicSpec, IntegratorKind, TimeStep};
+use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind, TimeStep};
 use crate::scene::{BodyKind, InputError, Model};
 
 /// A body's wave speed and the modulus it comes from.
@@ -88,6 +89,8 @@ pub enum StepStability {
     Conditional { dt: Option<f64>, dt_crit: f64 },
     /// Newmark with gamma < 1/2: unstable at any dt.
     Unstable,
+    /// Wilson-theta with theta < 1.37: conditionally stable, its limit not computed here.
+    WilsonBelowLimit { dt: f64, dt_crit_explicit: f64 },
 }
 
 /// The step of `spec` against the stability limit of its integrator; a central-difference
@@ -115,6 +118,12 @@ pub fn step_stability(model: &Model, spec: &DynamicSpec) -> Result<StepStability
     } else {
         f64::NAN
     };
+    if spec.integrator == IntegratorKind::Wilson && spec.theta < 1.37 {
+        return Ok(StepStability::WilsonBelowLimit {
+            dt,
+            dt_crit_explicit: explicit,
+        });
+    }
     if newmark && spec.beta < 0.5 * spec.gamma {
         // omega_max = 2 / dt_crit(central difference)
         let omega_crit = 1.0 / (0.5 * spec.gamma - spec.beta).sqrt();
@@ -162,10 +171,16 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
         let name = spec.integrator.name();
         lines.push(match step_stability(model, spec)? {
             StepStability::Conditional { dt: Some(dt), dt_crit } => format!(
-                "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}",
+                "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}{}",
                 readable(dt),
                 readable(dt_crit),
-                readable(dt / dt_crit)
+                readable(dt / dt_crit),
+                if spec.mass == MassKind::Consistent {
+                    " (from the lumped-mass frequency bound: the consistent mass's highest \
+                     frequency is higher, sqrt 3 times for rods, so its limit is lower)"
+                } else {
+                    ""
+                }
             ),
             StepStability::Conditional { dt: None, dt_crit } => format!(
                 "integrator {name}: stability limit dt_crit = {}",
@@ -183,6 +198,16 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
             StepStability::Unconditional { dt, .. } => {
                 format!("integrator {name}: unconditionally stable; dt = {}", readable(dt))
             }
+            StepStability::WilsonBelowLimit {
+                dt,
+                dt_crit_explicit,
+            } => format!(
+                "integrator {name}: theta = {} < 1.37 is only conditionally stable; dt = {} is {} times the central-difference limit {}",
+                readable(spec.theta),
+                readable(dt),
+                readable(dt / dt_crit_explicit),
+                readable(dt_crit_explicit)
+            ),
             StepStability::Unstable => format!(
                 "integrator {name}: gamma = {} < 1/2 is unstable at any dt",
                 readable(spec.gamma)
