@@ -7,7 +7,10 @@
 # Central difference is run at the paper's dt = 0.001, which its stability limit (4.6e-4 and
 # 5.1e-4 s) refuses (exit 2, as designed), and with its automatic stable step (dt = "auto").
 set -uo pipefail
-impact() { cargo run --release --quiet -- "$@"; }
+# `impact` from the PATH (cargo install --path .); else built and run from the repository
+if ! command -v impact >/dev/null; then
+  impact() { cargo run --release --quiet -- "$@"; }
+fi
 out=${1:-output/impact_study}
 fig=${2:-docs/figures}
 mkdir -p "$out" "$fig"

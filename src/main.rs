@@ -1,11 +1,11 @@
 //! The `impact` command line: subcommands only, no mechanics.
 
 use clap::{Parser, Subcommand};
+use impact::analysis::progress::Mode as Progress;
 use impact::analysis::{self, RunError, RunOptions};
-use impact::output::OutputError;
-use impact::output::plot::{self, Chart, Series, SeriesStyle};
+use impact::output::plot::{self, Chart, Limits, Series, SeriesStyle};
+use impact::output::{OutputError, readable};
 use impact::scene::{self, InputError};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -37,6 +37,9 @@ enum Command {
         /// No progress bar and no closing line.
         #[arg(long)]
         quiet: bool,
+        /// When stderr is not a terminal (a batch log), a progress line every SECONDS.
+        #[arg(long, value_name = "SECONDS", default_value_t = 5.0)]
+        progress_every: f64,
         /// Write DIR/checkpoint.bin every N steps (same as --set analysis.checkpoint_every=N).
         #[arg(long, value_name = "N")]
         checkpoint_every: Option<usize>,
@@ -51,6 +54,9 @@ enum Command {
         /// No progress bar and no closing line.
         #[arg(long)]
         quiet: bool,
+        /// When stderr is not a terminal (a batch log), a progress line every SECONDS.
+        #[arg(long, value_name = "SECONDS", default_value_t = 5.0)]
+        progress_every: f64,
     },
     /// Validate a scene and print the model's size.
     Check {
@@ -136,6 +142,19 @@ enum Command {
         /// (its folder's when the file names agree). Repeat for more runs.
         #[arg(long)]
         reference: Vec<PathBuf>,
+        /// One panel per --y column, stacked, each with its own vertical axis (columns of
+        /// different magnitude stay readable).
+        #[arg(long)]
+        panels: bool,
+        /// Ends of the axes (default: from the data).
+        #[arg(long, allow_hyphen_values = true)]
+        xmin: Option<f64>,
+        #[arg(long, allow_hyphen_values = true)]
+        xmax: Option<f64>,
+        #[arg(long, allow_hyphen_values = true)]
+        ymin: Option<f64>,
+        #[arg(long, allow_hyphen_values = true)]
+        ymax: Option<f64>,
     },
 }
 
@@ -147,6 +166,7 @@ fn main() -> ExitCode {
             out,
             set,
             quiet,
+            progress_every,
             checkpoint_every,
             strict,
         } => {
@@ -154,9 +174,14 @@ fn main() -> ExitCode {
             if let Some(n) = checkpoint_every {
                 set.push(format!("analysis.checkpoint_every={n}"));
             }
-            run(&scene, out, &set, quiet, strict)
+            progress_mode(quiet, progress_every)
+                .and_then(|p| run(&scene, out, &set, p, strict))
         }
-        Command::Resume { dir, quiet } => resume(&dir, quiet),
+        Command::Resume {
+            dir,
+            quiet,
+            progress_every,
+        } => progress_mode(quiet, progress_every).and_then(|p| resume(&dir, p)),
         Command::Check { scene, set } => check(&scene, &set),
         Command::Buckle {
             scene,
@@ -191,7 +216,30 @@ fn main() -> ExitCode {
             out,
             title,
             reference,
-        } => plot_history(&history, &x, &y, out, title, &reference),
+            panels,
+            xmin,
+            xmax,
+            ymin,
+            ymax,
+        } => plot_history(
+            &history,
+            &x,
+            &y,
+            out,
+            PlotLook {
+                title,
+                panels,
+                x_limits: Limits {
+                    low: xmin,
+                    high: xmax,
+                },
+                y_limits: Limits {
+                    low: ymin,
+                    high: ymax,
+                },
+            },
+            &reference,
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -202,9 +250,30 @@ fn main() -> ExitCode {
     }
 }
 
+/// `n` and the noun, plural unless n is 1: "1 factorization", "3 factorizations".
+fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
+/// The progress of a run on stderr: nothing with --quiet, a bar on a terminal, else a line
+/// every `every` seconds.
+fn progress_mode(quiet: bool, every: f64) -> Result<Progress, RunError> {
+    let every = std::time::Duration::try_from_secs_f64(every).map_err(|_| {
+        InputError::new(
+            Path::new("--progress-every"),
+            format!("needs a number of seconds >= 0, got {every}"),
+        )
+    })?;
+    Ok(Progress::for_stderr(quiet, every))
+}
+
 /// Options of a run, with SIGINT and SIGTERM turned into a request to stop after the step in
 /// progress (a second signal while that step finishes is the same request).
-fn run_options(quiet: bool) -> RunOptions {
+fn run_options(progress: Progress) -> RunOptions {
     let flag: &'static Arc<AtomicBool> = Box::leak(Box::new(Arc::new(AtomicBool::new(false))));
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         // without a handler the default action still stops the run, only less tidily
@@ -213,7 +282,7 @@ fn run_options(quiet: bool) -> RunOptions {
         }
     }
     RunOptions {
-        progress: !quiet && std::io::stderr().is_terminal(),
+        progress,
         interrupt: Some(&**flag),
         halt_after_steps: None,
     }
@@ -256,22 +325,24 @@ fn run(
     path: &Path,
     out: Option<PathBuf>,
     set: &[String],
-    quiet: bool,
+    progress: Progress,
     strict: bool,
 ) -> Result<(), RunError> {
+    let quiet = progress == Progress::Off;
     if std::env::var_os("IMPACT_PROFILE_FINE").is_some() {
         impact::profile::set_fine(true);
     }
     let model = scene::load(path, set)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
-    let summary = analysis::run(&model, &dir, run_options(quiet))?;
+    let summary = analysis::run(&model, &dir, run_options(progress))?;
     if !quiet {
         println!(
-            "{}: {} steps, {} Newton iterations, {} factorizations, {:.2} s -> {}",
+            "{}: {}, {}, {}, t = {}, {:.2} s -> {}",
             model.name,
-            summary.steps,
-            summary.newton_iterations,
-            summary.factorizations,
+            count(summary.steps, "step"),
+            count(summary.newton_iterations, "Newton iteration"),
+            count(summary.factorizations, "factorization"),
+            readable(summary.end_time),
             summary.wall_seconds,
             dir.display()
         );
@@ -289,14 +360,15 @@ fn run(
     Ok(())
 }
 
-fn resume(dir: &Path, quiet: bool) -> Result<(), RunError> {
-    let summary = analysis::resume(dir, run_options(quiet))?;
+fn resume(dir: &Path, progress: Progress) -> Result<(), RunError> {
+    let quiet = progress == Progress::Off;
+    let summary = analysis::resume(dir, run_options(progress))?;
     if !quiet {
         println!(
-            "resumed {}: {} steps in all, t = {} -> {}",
+            "resumed {}: {} in all, t = {} -> {}",
             summary.scene,
-            summary.steps,
-            summary.end_time,
+            count(summary.steps, "step"),
+            readable(summary.end_time),
             dir.display()
         );
     }
@@ -305,14 +377,17 @@ fn resume(dir: &Path, quiet: bool) -> Result<(), RunError> {
 
 fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
     let model = scene::load(path, set)?;
+    // the refusals a run makes before its first step (a central-difference dt above the
+    // stability limit) come first: a scene `check` calls valid runs
+    let report = analysis::check::report(&model)?;
     println!("{}: valid", path.display());
     for body in &model.bodies {
         println!(
-            "  body `{}`: {} nodes, {} elements, {:?}, material `{}`",
+            "  body `{}`: {} nodes, {} elements, {}, material `{}`",
             body.name,
             body.mesh.nodes.len(),
             body.elements(),
-            body.kind,
+            analysis::check::kind_in_words(body.kind),
             body.material.name
         );
     }
@@ -322,6 +397,9 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
         model.elements(),
         model.dofs()
     );
+    for line in report {
+        println!("  {line}");
+    }
     if model.bodies.iter().all(|b| b.material.density > 0.0) {
         let analysis::explicit::StableStep {
             dt: dt_crit,
@@ -329,7 +407,8 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
             element: e,
         } = analysis::explicit::critical_time_step(&model)?;
         println!(
-            "  central-difference stability limit: dt_crit = {dt_crit:.6e} (element eigenvalue bound; body `{}`, element {e})",
+            "  central-difference stability limit: dt_crit = {} (element eigenvalue bound; body `{}`, element {e})",
+            readable(dt_crit),
             model.bodies[b].name
         );
     }
@@ -354,14 +433,15 @@ fn buckle(
         return Err(InputError::new(path, "--modes: ask for at least one mode").into());
     }
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
+    analysis::create_output_folder(&dir)?;
     let found = analysis::buckling::linear_modes(&model, count)
         .map_err(|e| InputError::new(path, format!("linearized buckling: {e}")))?;
     analysis::buckling::write_modes(&model, &found, &dir)?;
     println!(
         "{}: linearized buckling of the loads at t = {} ({} free DOFs)",
         model.name,
-        model.analysis.end_time(),
-        model.dofs() - analysis::loads::constrained_dofs(&model).len()
+        readable(model.analysis.end_time()),
+        model.dofs() - model.constrained_dofs().len()
     );
     for (i, mode) in found.iter().enumerate() {
         println!("  mode {}: lambda = {:.6e}", i + 1, mode.lambda);
@@ -430,7 +510,7 @@ fn sweep(
         let options = SweepOptions {
             jobs,
             shard,
-            progress: !quiet && std::io::stderr().is_terminal(),
+            progress: Progress::for_stderr(quiet, std::time::Duration::ZERO),
         };
         sweep::run(&plan, &out, options)?
     };
@@ -447,8 +527,19 @@ fn sweep(
         for chart in &report.charts {
             println!("  {}", chart.display());
         }
+        for note in &report.notes {
+            println!("  note: {note}");
+        }
     }
     Ok(())
+}
+
+/// How `impact plot` draws: the title, one panel per column or one axis, the axis ends.
+struct PlotLook {
+    title: Option<String>,
+    panels: bool,
+    x_limits: Limits,
+    y_limits: Limits,
 }
 
 fn plot_history(
@@ -456,7 +547,7 @@ fn plot_history(
     x: &str,
     y: &[String],
     out: Option<PathBuf>,
-    title: Option<String>,
+    look: PlotLook,
     references: &[PathBuf],
 ) -> Result<(), RunError> {
     let names: Vec<&str> = std::iter::once(x)
@@ -494,15 +585,31 @@ fn plot_history(
             .collect();
         history.with_file_name(format!("plot_{stem}.svg"))
     });
-    let chart = Chart {
-        title: title.unwrap_or_else(|| history.display().to_string()),
+    let title = look.title.unwrap_or_else(|| history.display().to_string());
+    let chart = |title: String, y_label: String, series: Vec<Series>| Chart {
+        title,
         x_label: x.to_string(),
-        y_label: y.join(", "),
+        y_label,
         series,
         log_x: false,
         log_y: false,
+        x_limits: look.x_limits,
+        y_limits: look.y_limits,
     };
-    plot::write(&chart, &out).map_err(|e| match e {
+    let charts = if look.panels {
+        // the series of column k are the k-th of every run's group (own run, then references)
+        y.iter()
+            .enumerate()
+            .map(|(k, column)| {
+                let own: Vec<Series> = series.iter().skip(k).step_by(y.len()).cloned().collect();
+                let heading = if k == 0 { title.clone() } else { String::new() };
+                chart(heading, column.clone(), own)
+            })
+            .collect()
+    } else {
+        vec![chart(title, y.join(", "), series)]
+    };
+    plot::write_panels(&charts, &out).map_err(|e| match e {
         OutputError::Invalid { .. } => bad_input(e),
         other => RunError::Output(other),
     })?;

@@ -406,3 +406,286 @@ fn buckle_prints_load_factors_and_writes_modes() {
             > 1.0
     );
 }
+
+/// A steel rod (SI units) for `impact check`: 10 rods of h = 0.01 m, central difference.
+const STEEL_ROD: &str = r#"
+[[material]]
+name = "steel"
+young = 200e9
+poisson = 0.3
+density = 7850.0
+yield_stress = 250e6
+
+[[body]]
+name = "rod"
+material = "steel"
+formulation = "rod"
+area = 1e-4
+velocity = [1.0, 0.0]
+mesh = { type = "line", start = [0.0, 0.0], end = [0.1, 0.0], n = 10 }
+
+[[support]]
+set = "all"
+fix = ["y"]
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+dt = 1.9e-6
+end_time = 1e-5
+"#;
+
+/// The number printed right after `label` in `text` (up to a space, `;`, `,` or `)`).
+fn number_after(text: &str, label: &str) -> f64 {
+    let start = text
+        .find(label)
+        .unwrap_or_else(|| panic!("no `{label}` in:\n{text}"))
+        + label.len();
+    let rest = &text[start..];
+    let end = rest
+        .find(|c: char| c.is_whitespace() || matches!(c, ';' | ',' | ')'))
+        .unwrap_or(rest.len());
+    rest[..end]
+        .parse()
+        .unwrap_or_else(|e| panic!("`{}` after `{label}`: {e}", &rest[..end]))
+}
+
+/// Goal: `impact check` says what it knows about a scene: the wave speed of the
+/// formulation, the yield strain, dt against the central-difference limit; and it refuses
+/// the fixed dt a run refuses, with the same exit code 2.
+/// Setup: the steel rod above (E = 200 GPa, rho = 7850 kg/m^3, sigma_y = 250 MPa, h = 0.01 m).
+/// Reference: c = sqrt(E / rho); eps_y = sigma_y / E; the lumped two-node rod's only
+/// nonzero eigenvalue omega^2 = 4 c^2 / h^2 gives dt_crit = h / c exactly (Irons' element
+/// bound is attained by a uniform free rod). Tolerance 1e-5 relative: the report prints six
+/// significant digits (rounding error at most 5e-6).
+#[test]
+fn check_reports_wave_speed_yield_strain_and_step_ratio() {
+    let dir = common::out_dir("cli_check_rod");
+    let scene = write_scene(&dir, "steel_rod", STEEL_ROD);
+    let o = impact(&["check", scene.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let (young, density, yield_stress, h) = (200e9f64, 7850.0, 250e6, 0.01);
+    let c = (young / density).sqrt();
+    let close = |found: f64, exact: f64| (found / exact - 1.0).abs() < 1e-5;
+    let speed = number_after(&stdout, "c = sqrt(M / rho) = ");
+    assert!(close(speed, c), "c = {speed}, exact {c}\n{stdout}");
+    let strain = number_after(&stdout, "sigma_y / E = ");
+    assert!(close(strain, yield_stress / young), "{strain}\n{stdout}");
+    let dt_crit = number_after(&stdout, "dt_crit = ");
+    assert!(
+        close(dt_crit, h / c),
+        "dt_crit = {dt_crit}, exact {}\n{stdout}",
+        h / c
+    );
+    let ratio = number_after(&stdout, "dt / dt_crit = ");
+    assert!(close(ratio, 1.9e-6 / (h / c)), "{ratio}\n{stdout}");
+    assert!(stdout.contains("integrator central_difference"), "{stdout}");
+    assert!(!stdout.contains("Rod {"), "a Rust debug struct: {stdout}");
+    // Newmark linear acceleration (beta 1/6, gamma 1/2) with the lumped mass: Omega_crit =
+    // 1 / sqrt(gamma/2 - beta) = 2 sqrt 3, so its limit is sqrt 3 times central difference's
+    let linear = impact(&[
+        "check",
+        scene.to_str().unwrap(),
+        "--set",
+        "analysis.integrator=\"linear\"",
+        "--set",
+        "analysis.mass=\"lumped\"",
+    ]);
+    let linear_out = String::from_utf8_lossy(&linear.stdout);
+    assert!(linear.status.success(), "{linear_out}");
+    let linear_crit = number_after(
+        &linear_out,
+        "integrator linear: dt = 1.9e-6, stability limit dt_crit = ",
+    );
+    assert!(close(linear_crit, 3f64.sqrt() * h / c), "{linear_out}");
+    // just above the limit: check and run refuse it alike, naming the key
+    let above = format!("analysis.dt={:e}", 1.05 * h / c);
+    let check = impact(&["check", scene.to_str().unwrap(), "--set", &above]);
+    let check_err = String::from_utf8_lossy(&check.stderr);
+    assert_eq!(check.status.code(), Some(2), "{check_err}");
+    let (code, run_err) = run_text("steel_rod", STEEL_ROD, &["--set", &above]);
+    assert_eq!(code, 2, "{run_err}");
+    for stderr in [&*check_err, &*run_err] {
+        assert!(
+            stderr.contains("analysis.dt = ") && stderr.contains("steel_rod.toml"),
+            "{stderr}"
+        );
+        let limit = number_after(stderr, "stability limit ");
+        assert!(close(limit, h / c), "{stderr}");
+    }
+}
+
+/// Goal: the plane-strain wave speed is the dilatational one, and the body's kind reads in
+/// words. Reference: c = sqrt((lambda + 2 mu) / rho) with lambda = E nu / ((1 + nu)(1 - 2 nu)),
+/// mu = E / (2 (1 + nu)). Tolerance 1e-5 relative (six printed digits).
+#[test]
+fn check_prints_the_plane_strain_dilatational_wave_speed() {
+    let dir = common::out_dir("cli_check_beam");
+    let scene = write_scene(&dir, "beam", BEAM);
+    let o = impact(&["check", scene.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}");
+    let (young, nu, density) = (1000.0f64, 0.3, 1.0);
+    let lambda = young * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let mu = young / (2.0 * (1.0 + nu));
+    let c = ((lambda + 2.0 * mu) / density).sqrt();
+    let speed = number_after(&stdout, "c = sqrt(M / rho) = ");
+    assert!(
+        (speed / c - 1.0).abs() < 1e-5,
+        "c = {speed}, exact {c}\n{stdout}"
+    );
+    assert!(stdout.contains("lambda + 2 mu (plane strain)"), "{stdout}");
+    assert!(stdout.contains("plane strain (per unit depth)"), "{stdout}");
+    assert!(
+        !stdout.contains("Continuum {"),
+        "a Rust debug struct: {stdout}"
+    );
+}
+
+/// Goal: messages read as a person writes: integrator names as the scene spells them, the
+/// plane-strain thickness refusal says forces are per unit depth, and an output folder that
+/// cannot be made is bad input (exit 2) naming the folder, with "cannot" said once.
+#[test]
+fn messages_name_things_as_the_scene_does() {
+    assert_input_error(
+        "auto_implicit",
+        &BEAM.replace(
+            "type = \"static\"\nsteps = 4",
+            "type = \"dynamic\"\nintegrator = \"average\"\ndt = \"auto\"\nend_time = 1.0",
+        ),
+        &[],
+        &["integrator average"],
+    );
+    assert_input_error(
+        "strain_thickness",
+        &BEAM.replace(
+            "formulation = \"plane_strain\"",
+            "formulation = \"plane_strain\"\nthickness = 0.1",
+        ),
+        &[],
+        &["thickness", "per unit depth"],
+    );
+    let dir = common::out_dir("cli_bad_out");
+    let scene = write_scene(&dir, "beam", BEAM);
+    let blocker = dir.join("a_file");
+    std::fs::write(&blocker, "in the way").unwrap();
+    let out = blocker.join("out");
+    let o = impact(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains(out.to_str().unwrap()), "{stderr}");
+    assert!(
+        stderr.contains("output folder") && !stderr.contains("cannot cannot"),
+        "{stderr}"
+    );
+}
+
+/// Goal: the closing line of a run counts in words ("1 factorization", "4 steps") and gives
+/// the end time. Setup: the static beam in small strain with `strategy = "initial"` (one
+/// factorization for the run). Reference: the summary.json of the same run.
+#[test]
+fn closing_line_counts_in_words() {
+    let dir = common::out_dir("cli_closing");
+    let scene = write_scene(&dir, "beam", BEAM);
+    let out = dir.join("out");
+    let o = impact(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "analysis.geometry=\"linear\"",
+        "--set",
+        "analysis.newton.strategy=\"initial\"",
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let factorizations = summary["factorizations"].as_u64().unwrap();
+    let expected = if factorizations == 1 {
+        "1 factorization,".to_string()
+    } else {
+        format!("{factorizations} factorizations,")
+    };
+    assert!(stdout.contains(&expected), "{expected} in {stdout}");
+    assert!(stdout.contains("4 steps"), "{stdout}");
+    assert_eq!(factorizations, 1, "{stdout}");
+    assert!(stdout.contains("t = 1,"), "{stdout}");
+}
+
+/// Goal: without a terminal (a batch log) a run prints plain progress lines with the
+/// simulated time, the steps and an ETA, and a sweep prints a line per finished case.
+/// Setup: the static beam (4 increments to t = 1) with `--progress-every 0` (a line at every
+/// step); a sweep of it over analysis.steps = 2, 4. Reference: the scene's end time and
+/// increment count, the sweep's two cases.
+#[test]
+fn batch_logs_get_progress_lines() {
+    let dir = common::out_dir("cli_progress");
+    let scene = write_scene(&dir, "beam", BEAM);
+    let out = dir.join("out");
+    let o = impact(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--progress-every",
+        "0",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("beam: t = 0.25 / 1 (25 %), 1 step"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("beam: t = 1 / 1 (100 %), 4 steps"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("ETA"), "{stderr}");
+    let o = impact(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--vary",
+        "analysis.steps=2,4",
+        "--jobs",
+        "1",
+        "--out",
+        dir.join("sweep").to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    for line in [
+        "case 1 of 2 (analysis.steps=2): ok",
+        "case 2 of 2 (analysis.steps=4): ok",
+    ] {
+        assert!(stderr.contains(line), "`{line}` in:\n{stderr}");
+    }
+}
+
+/// Goal: an error in a scene edited by `--set` names the edit and no line number (the edited
+/// text is not the user's file, so its line numbers would point nowhere).
+#[test]
+fn set_errors_name_the_edit_not_a_line() {
+    let (code, stderr) = run_text(
+        "set_type",
+        BEAM,
+        &["--set", "material.steel.young=\"stiff\""],
+    );
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("--set material.steel.young=\"stiff\""),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("line "), "{stderr}");
+}

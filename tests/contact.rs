@@ -494,3 +494,54 @@ fn ring_wall_return_coefficient_lies_between_its_limits() {
     assert!(free[0].abs() < 1e-8);
     assert!(some[0] < 0.0 && stuck[0] < some[0], "{some:?} {stuck:?}");
 }
+
+/// Goal: the "write your own scene" example runs as documented (models/steel_block_wall.toml,
+/// SI units): the block reaches the wall when it has crossed the gap, the wall's impulse is
+/// the block's loss of momentum, and the face yields.
+/// Setup: the scene as shipped: a 20 x 10 mm plane-strain J2 steel block at V = 50 m/s,
+/// 0.05 mm from a rigid wall, central difference with the automatic step, 12 us.
+/// Reference: first contact at gap / V = 1 us (to within one step: contact is detected at
+/// step ends; steps are about 0.13 us); Newton's second law for the block: the wall is the
+/// only external force and the internal forces cancel, so the sum of force x step length over
+/// the rows (the forward-increment multiplier is the step's impulse) equals p_x(0) - p_x(end),
+/// to 1e-9 relative (round-off over some 140 steps); p_x(0) = rho A V = 7850 x 2e-4 x 50 =
+/// 78.5 kg m/s per metre; the impact stress rho c V = 2.4 GPa is far above sigma_y = 250 MPa,
+/// so plastic work > 0.
+#[test]
+fn steel_block_wall_contact_time_impulse_and_yield() {
+    let r = run("steel_block_wall", "steel_block_wall", &[]);
+    assert_eq!(r.summary.status, impact::analysis::Status::Ok);
+    let dt_max = r
+        .summary
+        .dt_max
+        .expect("central difference reports its steps");
+    let first = r
+        .summary
+        .contact
+        .first_contact_time
+        .expect("the block hits");
+    let (gap, speed) = (0.05e-3, 50.0);
+    assert!(
+        first >= gap / speed - 1e-12 && first <= gap / speed + dt_max,
+        "first contact at {first}, exact {}",
+        gap / speed
+    );
+    let force = column(&r.dir, "contact_force[wall]");
+    let dt = column(&r.dir, "dt");
+    let momentum = column(&r.dir, "p_x[all]");
+    let impulse: f64 = force.iter().zip(&dt).map(|(f, h)| f * h).sum();
+    let (p0, p_end) = (momentum[0], *momentum.last().unwrap());
+    approx::assert_relative_eq!(p0, 7850.0 * 0.02 * 0.01 * 50.0, max_relative = 1e-12);
+    assert!(
+        (impulse - (p0 - p_end)).abs() < 1e-9 * p0,
+        "impulse {impulse} vs momentum lost {}",
+        p0 - p_end
+    );
+    assert!(r.summary.energy.plastic_dissipation > 0.0);
+    eprintln!(
+        "steel block: first contact {first:e} s (exact 1e-6), impulse {impulse} vs momentum lost {}, plastic work {} J/m of {} J/m",
+        p0 - p_end,
+        r.summary.energy.plastic_dissipation,
+        r.summary.energy.initial
+    );
+}

@@ -266,7 +266,7 @@ fn fixed_explicit_step_too_large_stops_unstable_and_reports_contact() {
     for needle in [
         "body `bar`",
         "element",
-        "dt = 0.0004",
+        "dt = 4e-4",
         "stability limit",
         "at t = ",
     ] {

@@ -490,7 +490,14 @@ fn j2_scene_writes_no_temperature() {
     let names = frame.names(Section::CellData);
     assert_eq!(
         names,
-        ["stress", "von_mises", "eq_plastic_strain", "pressure"]
+        [
+            "stress",
+            "von_mises",
+            "eq_plastic_strain",
+            "pressure",
+            "strain",
+            "body"
+        ]
     );
 }
 

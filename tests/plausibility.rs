@@ -88,7 +88,7 @@ fn an_obstacle_the_wrong_way_round_and_slaves_starting_inside_are_refused() {
     refused(
         "models/round_bar_wall.toml",
         &["obstacle.wall.points=[[0.03, 0.001], [-0.03, 0.001]]"],
-        &["contact `tip`", "start inside", "gap -1e-3"],
+        &["contact `tip`", "start inside", "gap -0.001"],
     );
 }
 

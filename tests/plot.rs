@@ -35,6 +35,8 @@ fn sin_cos_chart() -> Chart {
         ],
         log_x: false,
         log_y: false,
+        x_limits: Default::default(),
+        y_limits: Default::default(),
     }
 }
 
@@ -165,6 +167,8 @@ fn log_log_convergence_chart_writes() {
         }],
         log_x: true,
         log_y: true,
+        x_limits: Default::default(),
+        y_limits: Default::default(),
     };
     for name in ["convergence.svg", "convergence.png"] {
         plot::write(&chart, &dir.join(name)).unwrap();
@@ -260,4 +264,149 @@ fn cli_plot_exit_codes() {
     assert_eq!(run.status.code(), Some(2));
     let run = impact(&["plot", history]);
     assert_eq!(run.status.code(), Some(2), "--y is required");
+}
+
+/// The RGB pixels of a PNG file: (width, height, rows of pixels).
+fn png_pixels(path: &Path) -> (usize, usize, Vec<[u8; 3]>) {
+    let bytes = std::fs::read(path).unwrap();
+    let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes))
+        .read_info()
+        .unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let frame = reader.next_frame(&mut pixels).unwrap();
+    let rgb = pixels[..frame.buffer_size()]
+        .chunks(3)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    (frame.width as usize, frame.height as usize, rgb)
+}
+
+/// Goal: a PNG draws a chattering curve inside its axes (the bitmap backend's mitred joins of
+/// a thick polyline drew a vertical line below the x axis at t = 0.046, the SVG did not).
+/// Setup: the contact force of models/round_bar.toml (tests/data/round_bar_contact_force.csv,
+/// 211 rows between 0 and 23.3; near t = 0.046 two steps of 2e-4 and 1e-4 go 6.0 -> 13.4 ->
+/// 5.5), drawn as PNG.
+/// Reference: the layout: a 16 px margin and a 48 px x-label area below the plot, so no pixel
+/// of the series' colour may lie in the bottom 64 rows (labels and ticks are black or grey).
+#[test]
+fn png_curve_stays_inside_the_axes() {
+    let dir = common::out_dir("plot_chatter");
+    let columns = plot::history_columns(
+        Path::new("tests/data/round_bar_contact_force.csv"),
+        &["time", "contact_force[tip]"],
+    )
+    .unwrap();
+    let chart = Chart {
+        title: "round_bar".into(),
+        x_label: "time".into(),
+        y_label: "contact_force[tip]".into(),
+        series: vec![Series {
+            label: "contact_force[tip]".into(),
+            points: columns[0]
+                .iter()
+                .copied()
+                .zip(columns[1].iter().copied())
+                .collect(),
+            style: SeriesStyle::Line,
+        }],
+        log_x: false,
+        log_y: false,
+        x_limits: Default::default(),
+        y_limits: Default::default(),
+    };
+    let path = dir.join("round_bar.png");
+    plot::write(&chart, &path).unwrap();
+    let (width, height, rgb) = png_pixels(&path);
+    let blue = [31, 119, 180];
+    let below: Vec<(usize, usize)> = rgb
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| **p == blue)
+        .map(|(k, _)| (k % width, k / width))
+        .filter(|(_, row)| *row >= height - 64)
+        .collect();
+    assert!(
+        rgb.iter().filter(|p| **p == blue).count() > 1000,
+        "the curve is drawn"
+    );
+    assert!(
+        below.is_empty(),
+        "{} series pixels below the axis, e.g. {:?}",
+        below.len(),
+        &below[..below.len().min(5)]
+    );
+}
+
+/// Goal: `impact plot` offers one panel per column (a 1e-3 column beside a 4.5 one stays
+/// readable) and fixed axis ends; a legend goes where it covers the fewest points.
+/// Reference: the panel layout (300 px per panel), the SVG's tick labels within the asked
+/// x range [0.1, 0.2], and the legend of a curve rising to the upper right placed elsewhere.
+#[test]
+fn cli_plot_panels_and_axis_ranges() {
+    let dir = common::out_dir("plot_panels");
+    let history = write_history(&dir);
+    let history = history.to_str().unwrap();
+    let out = dir.join("panels.png");
+    let run = impact(&[
+        "plot",
+        history,
+        "--y",
+        "u_y[tip]",
+        "--y",
+        "kinetic_energy",
+        "--panels",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(png_size(&std::fs::read(&out).unwrap()), (800, 600));
+    let svg_out = dir.join("range.svg");
+    let run = impact(&[
+        "plot",
+        history,
+        "--y",
+        "kinetic_energy",
+        "--xmin",
+        "0.1",
+        "--xmax",
+        "0.2",
+        "--ymin",
+        "-1",
+        "--out",
+        svg_out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let svg = std::fs::read_to_string(&svg_out).unwrap();
+    let ticks: Vec<f64> = svg_texts(&svg)
+        .iter()
+        .filter_map(|t| t.parse::<f64>().ok())
+        .collect();
+    assert!(ticks.contains(&0.1) && ticks.contains(&0.2), "{ticks:?}");
+    assert!(ticks.contains(&-1.0), "{ticks:?}");
+    let bad = impact(&[
+        "plot",
+        history,
+        "--y",
+        "kinetic_energy",
+        "--xmin",
+        "1",
+        "--xmax",
+        "0",
+    ]);
+    assert_eq!(
+        bad.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&bad.stderr)
+    );
 }

@@ -20,7 +20,7 @@ fn options(jobs: usize, shard: Option<(usize, usize)>) -> SweepOptions {
     SweepOptions {
         jobs,
         shard,
-        progress: false,
+        progress: impact::analysis::progress::Mode::Off,
     }
 }
 

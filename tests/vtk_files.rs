@@ -894,3 +894,81 @@ fn lame_cylinder_from_a_vtu_matches_lame_and_the_generated_ring() {
         "{from_vtu} vs {generated}"
     );
 }
+
+/// Two blocks, not touching, the first struck towards the second: frames at fixed times.
+const TWO_BLOCKS: &str = r#"
+[[material]]
+name = "soft"
+young = 1000.0
+poisson = 0.3
+density = 1.0
+
+[[body]]
+name = "small"
+material = "soft"
+formulation = "plane_strain"
+velocity = [0.1, 0.0]
+mesh = { type = "rectangle", width = 2.0, height = 1.0, nx = 2, ny = 1 }
+
+[[body]]
+name = "large"
+material = "soft"
+formulation = "plane_strain"
+mesh = { type = "rectangle", width = 3.0, height = 2.0, nx = 3, ny = 2, origin = [5.0, 0.0] }
+
+[analysis]
+type = "dynamic"
+integrator = "average"
+dt = 0.03
+end_time = 1.0
+
+[output]
+frame_every = 0
+frame_interval = 0.25
+"#;
+
+/// Goal: frames carry a `body` cell array (the body's index in the scene) so ParaView can
+/// tell bodies apart (and a point array of the averaged stress), and `output.frame_interval` writes frames at fixed simulated times,
+/// with implicit steps ending exactly there.
+/// Setup: two plane-strain blocks of 2 x 1 and 3 x 2 quads; average acceleration with
+/// dt = 0.03 (0.25 is no multiple of it), frame_interval = 0.25, frame_every = 0.
+/// Reference: the cells in scene order (2 of body 0, then 6 of body 1); the frame times
+/// 0 (the first frame), 0.25, 0.5, 0.75, 1. Tolerance 1e-12: the times are k * 0.25
+/// computed once, written at full precision.
+#[test]
+fn frames_carry_body_ids_and_fall_on_the_frame_interval() {
+    let dir = common::out_dir("vtk_frame_interval");
+    let out = run_scene(&dir, "two_blocks", TWO_BLOCKS, &[]);
+    let listed = impact::output::vtk::read_pvd(&out.join("two_blocks.pvd")).unwrap();
+    let times: Vec<f64> = listed.iter().map(|(t, _)| *t).collect();
+    let expected = [0.0, 0.25, 0.5, 0.75, 1.0];
+    assert_eq!(times.len(), expected.len(), "{times:?}");
+    for (t, e) in times.iter().zip(expected) {
+        assert!((t - e).abs() < 1e-12, "{times:?}");
+    }
+    for frame in frames(&out, "two_blocks") {
+        let ids = frame.ids(Section::CellData, "body").expect("a body array");
+        assert_eq!(ids, [0, 0, 1, 1, 1, 1, 1, 1]);
+        let (components, values) = frame
+            .floats(Section::PointData, "nodal_stress")
+            .expect("a nodal stress array");
+        assert_eq!((components, values.len()), (6, 6 * frame.points));
+    }
+    // central difference with a fixed dt that does not divide the interval: the frame of
+    // each listed time is the first step at or past it
+    let dt = 0.007;
+    let explicit = TWO_BLOCKS
+        .replace(
+            "integrator = \"average\"",
+            "integrator = \"central_difference\"",
+        )
+        .replace("dt = 0.03", &format!("dt = {dt}"));
+    std::fs::create_dir_all(dir.join("explicit")).unwrap();
+    let out = run_scene(&dir.join("explicit"), "two_blocks", &explicit, &[]);
+    let listed = impact::output::vtk::read_pvd(&out.join("two_blocks.pvd")).unwrap();
+    let times: Vec<f64> = listed.iter().map(|(t, _)| *t).collect();
+    assert_eq!(times.len(), expected.len(), "{times:?}");
+    for (t, e) in times.iter().zip(expected) {
+        assert!(*t >= e - 1e-12 && *t < e + dt, "{times:?}");
+    }
+}

@@ -2,7 +2,10 @@
 # Regenerates the charts of docs/validation.md from fresh runs (release build).
 # Usage: bash docs/figures/regenerate.sh   (from the repository root)
 set -euo pipefail
-impact() { cargo run --release --quiet -- "$@"; }
+# `impact` from the PATH (cargo install --path .); else built and run from the repository
+if ! command -v impact >/dev/null; then
+  impact() { cargo run --release --quiet -- "$@"; }
+fi
 out=output/figures
 fig=docs/figures
 

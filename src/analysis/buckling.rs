@@ -34,7 +34,7 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
     };
     let initial = model.coordinates();
     let mut state = State::initial(model);
-    let mut system = System::new(model, &loads::constrained_dofs(model));
+    let mut system = System::new(model, &model.constrained_dofs());
     let mut d = vec![0.0; model.dofs()];
     for (dof, value) in loads::prescribed(model, &initial, end) {
         d[dof] = value;
@@ -74,13 +74,13 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
 /// state), ascending load factors.
 pub fn linear_modes(model: &Model, count: usize) -> Result<Vec<Mode>, StabilityError> {
     let state = prebuckling_state(model)?;
-    let mut system = System::new(model, &loads::constrained_dofs(model));
+    let mut system = System::new(model, &model.constrained_dofs());
     stability::eigen_buckling(model, &state, &mut system, count)
 }
 
 /// The lowest `count` buckling modes at a committed state of a run.
 pub fn modes_at(model: &Model, state: &State, count: usize) -> Result<Vec<Mode>, StabilityError> {
-    let mut system = System::new(model, &loads::constrained_dofs(model));
+    let mut system = System::new(model, &model.constrained_dofs());
     stability::eigen_buckling(model, state, &mut system, count)
 }
 
@@ -92,7 +92,7 @@ pub struct InertiaCheck {
 
 impl InertiaCheck {
     pub fn new(model: &Model) -> Result<InertiaCheck, StabilityError> {
-        let system = System::new(model, &loads::constrained_dofs(model));
+        let system = System::new(model, &model.constrained_dofs());
         let counter = InertiaCounter::new(&system.pattern)?;
         Ok(InertiaCheck { system, counter })
     }
@@ -210,6 +210,7 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
     let zeros = vec![0.0; points];
     let cell_zeros = vec![0.0; cells];
     let stress = vec![[0.0; 6]; cells];
+    let body_ids = record::body_ids(model);
     for (i, mode) in modes.iter().enumerate() {
         let shape: Vec<[f64; 2]> = mode.shape.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
         let fields = Fields {
@@ -225,6 +226,9 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
             eq_plastic_strain: &cell_zeros,
             pressure: &cell_zeros,
             temperature: None,
+            body: Some(&body_ids),
+            nodal_stress: None,
+            strain: None,
         };
         series.write_frame((i + 1) as f64, &grid, &fields)?;
     }

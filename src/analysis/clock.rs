@@ -16,6 +16,7 @@
 use super::Status;
 use super::run::StepError;
 use crate::assembly::FrequencyBound;
+use crate::output::readable;
 use crate::scene::Model;
 use crate::scene::spec::{DynamicSpec, TimeStep};
 use serde::{Deserialize, Serialize};
@@ -108,8 +109,11 @@ impl Clock {
                     return Err(StepError {
                         status: Status::Unstable,
                         message: format!(
-                            "at t = {time}: dt = {dt} exceeds the stability limit {limit:.6e} of the current configuration, set by {}; \
+                            "at t = {}: dt = {} exceeds the stability limit {} of the current configuration, set by {}; \
                              lower dt or use dt = \"auto\"",
+                            readable(time),
+                            readable(dt),
+                            readable(limit),
                             element()
                         ),
                         frame: true,
@@ -126,7 +130,10 @@ impl Clock {
                     return Err(StepError {
                         status: Status::Diverged,
                         message: format!(
-                            "at t = {time}: the stable step fell to {h:.6e}, below analysis.dt_min = {min:e}, set by {}",
+                            "at t = {}: the stable step fell to {}, below analysis.dt_min = {}, set by {}",
+                            readable(time),
+                            readable(h),
+                            readable(min),
                             element()
                         ),
                         frame: true,

@@ -22,6 +22,7 @@ use super::{StepControl, loads};
 use crate::assembly::{self, Mass, State, System};
 use crate::contact::{ContactResult, ContactState, Interfaces, Tangential};
 use crate::integrator::{Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, Wilson};
+use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
@@ -104,7 +105,7 @@ impl<'a> Dynamics<'a> {
         spec: &'a DynamicSpec,
         dir: &Path,
     ) -> Result<Dynamics<'a>, super::RunError> {
-        let system = System::new(model, &loads::constrained_dofs(model));
+        let system = System::new(model, &model.constrained_dofs());
         let mass =
             Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
         check_mass(model, &mass, &system)?;
@@ -509,7 +510,7 @@ impl Stepper for Dynamics<'_> {
                 Err(StepFailure(reason)) => {
                     self.method.reject();
                     if let Err(why) = self.control.reject(nominal, counters) {
-                        let message = format!("step to t = {target} {why}: {reason}");
+                        let message = format!("step to t = {} {why}: {reason}", readable(target));
                         return Err(StepError::diverged(message));
                     }
                 }
@@ -525,6 +526,7 @@ impl Stepper for Dynamics<'_> {
             velocity: &self.kin.velocity,
             acceleration: &self.kin.acceleration,
             mass: &self.mass.lumped,
+            internal_force: &self.last_internal,
         }
     }
     fn energies(&self) -> &Energies {
@@ -541,13 +543,6 @@ impl Stepper for Dynamics<'_> {
     }
     fn solver_mut(&mut self) -> Option<&mut Solver> {
         Some(&mut self.solver)
-    }
-    fn progress(&self) -> (u64, u64) {
-        let spec = self.spec;
-        (
-            (self.state.time / spec.dt()).round() as u64,
-            (spec.end_time / spec.dt()).round().max(1.0) as u64,
-        )
     }
     fn last_step(&self) -> f64 {
         self.last_step

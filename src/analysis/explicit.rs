@@ -22,7 +22,8 @@ use super::{DtLimit, RunError, Status, loads};
 use crate::assembly::explicit::{ExplicitKernel, Full, Reduced, StepWork};
 use crate::assembly::{self, ElementMasses, FrequencyBound, Mass, State, System};
 use crate::contact::{ContactState, Interfaces};
-use crate::scene::spec::{DynamicSpec, MassKind, Quadrature, TimeStep};
+use crate::output::readable;
+use crate::scene::spec::{DynamicSpec, MassKind, Quadrature};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use rayon::prelude::*;
@@ -49,6 +50,30 @@ pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
         body: bound.body,
         element: bound.element,
     })
+}
+
+/// The stability limit of `model`, or the refusal of a fixed dt above it (unless the scene
+/// sets `allow_unstable` to watch it blow up): the one check `impact check` and a run share.
+pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, InputError> {
+    let limit = critical_time_step(model)?;
+    if let Some(dt) = spec.fixed_dt()
+        && dt > limit.dt
+        && !spec.allow_unstable
+    {
+        return Err(InputError::new(
+            &model.file,
+            format!(
+                "analysis.dt = {} exceeds the central-difference stability limit {} (dt / dt_crit = {}; set by body `{}`, element {}); \
+                 lower dt, use dt = \"auto\", or set analysis.allow_unstable = true to watch it blow up",
+                readable(dt),
+                readable(limit.dt),
+                readable(dt / limit.dt),
+                model.bodies[limit.body].name,
+                limit.element
+            ),
+        ));
+    }
+    Ok(limit)
 }
 
 /// Central difference: the state, the motion, the one-point kernel when asked, and what the
@@ -78,10 +103,8 @@ pub struct Explicit<'a> {
     initial_kinetic: f64,
     last_total: Vec<f64>,
     energy_reference: f64,
-    /// Steps taken; with a fixed step, `steps` in all (the last one shorter to end at
-    /// end_time).
+    /// Steps taken (with a fixed step the last one is shorter to end at end_time).
     step: usize,
-    steps: usize,
     /// The step rule and the stable step of the committed configuration.
     clock: Clock,
     masses: ElementMasses,
@@ -98,28 +121,10 @@ impl<'a> Explicit<'a> {
     /// Refuses a fixed dt above the stability limit of the initial configuration (the
     /// element eigenvalues), unless the scene asks to watch it blow up.
     pub fn new(model: &'a Model, spec: &'a DynamicSpec) -> Result<Explicit<'a>, RunError> {
-        let StableStep {
-            dt: dt_crit,
-            body: b,
-            element: e,
-        } = critical_time_step(model)?;
-        if let Some(dt) = spec.fixed_dt()
-            && dt > dt_crit
-            && !spec.allow_unstable
-        {
-            return Err(InputError::new(
-                &model.file,
-                format!(
-                    "analysis.dt = {dt} exceeds the central-difference stability limit {dt_crit:.6e} (set by body `{}`, element {e}); \
-                     lower dt, use dt = \"auto\", or set analysis.allow_unstable = true to watch it blow up",
-                    model.bodies[b].name
-                ),
-            )
-            .into());
-        }
+        let dt_crit = checked_step(model, spec)?.dt;
         let masses = ElementMasses::new(model)
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-        let system = System::new(model, &loads::constrained_dofs(model));
+        let system = System::new(model, &model.constrained_dofs());
         let mass = Mass::new(model, MassKind::Lumped)
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
         check_mass(model, &mass, &system)?;
@@ -136,11 +141,6 @@ impl<'a> Explicit<'a> {
         }
         .map_err(|err| InputError::new(&model.file, err.to_string()))?;
         let clock = Clock::new(spec, dt_crit, first);
-        // fixed: whole steps, and a shorter last one that ends exactly at end_time
-        let steps = match spec.step {
-            TimeStep::Fixed(dt) => ((spec.end_time / dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize,
-            TimeStep::Auto { .. } => (spec.end_time / clock.dt0).ceil().max(1.0) as usize,
-        };
         let dofs = model.dofs();
         Ok(Explicit {
             model,
@@ -163,7 +163,6 @@ impl<'a> Explicit<'a> {
             last_total: vec![0.0; dofs],
             energy_reference: 0.0,
             step: 0,
-            steps,
             clock,
             masses,
             contact: ContactState::new(&model.contacts),
@@ -388,7 +387,7 @@ impl Stepper for Explicit<'_> {
                 };
                 return Err(StepError {
                     status,
-                    message: format!("at t = {time}: {err}"),
+                    message: format!("at t = {}: {err}", readable(time)),
                     frame: false,
                 });
             }
@@ -432,8 +431,12 @@ impl Stepper for Explicit<'_> {
             return Err(StepError {
                 status: Status::Unstable,
                 message: format!(
-                    "the energy grew to {energy:.3e} (reference {:.3e}) at t = {}: dt = {} is above the stability limit {:.6e}",
-                    self.energy_reference, self.state.time, self.clock.last, self.dt_crit
+                    "the energy grew to {} (reference {}) at t = {}: dt = {} is above the stability limit {}",
+                    readable(energy),
+                    readable(self.energy_reference),
+                    readable(self.state.time),
+                    readable(self.clock.last),
+                    readable(self.dt_crit)
                 ),
                 frame: true,
             });
@@ -449,6 +452,7 @@ impl Stepper for Explicit<'_> {
             velocity: &self.v,
             acceleration: &self.a,
             mass: &self.mass,
+            internal_force: &self.internal,
         }
     }
     fn energies(&self) -> &Energies {
@@ -476,9 +480,6 @@ impl Stepper for Explicit<'_> {
     }
     fn hourglass_energy(&self) -> Option<f64> {
         self.kernel.as_ref().and_then(|k| k.hourglass_energy())
-    }
-    fn progress(&self) -> (u64, u64) {
-        (self.step as u64, self.steps as u64)
     }
     fn last_step(&self) -> f64 {
         self.clock.last

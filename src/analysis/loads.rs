@@ -4,32 +4,6 @@ use crate::assembly::State;
 use crate::element::quad4;
 use crate::scene::{BodyKind, Load, Model};
 
-/// Constrained DOFs: supports and prescribed-displacement loads (sorted, unique).
-pub fn constrained_dofs(model: &Model) -> Vec<usize> {
-    let mut dofs = model.fixed_dofs.clone();
-    for load in &model.loads {
-        match load {
-            Load::Displacement { nodes, x, y, .. } => {
-                for n in nodes {
-                    if x.is_some() {
-                        dofs.push(2 * n);
-                    }
-                    if y.is_some() {
-                        dofs.push(2 * n + 1);
-                    }
-                }
-            }
-            Load::Rotation { nodes, .. } | Load::Affine { nodes, .. } => {
-                dofs.extend(nodes.iter().flat_map(|n| [2 * n, 2 * n + 1]))
-            }
-            _ => {}
-        }
-    }
-    dofs.sort_unstable();
-    dofs.dedup();
-    dofs
-}
-
 /// Prescribed total displacements (DOF, value) at time t: supports give 0; a DOF named by
 /// several loads takes the last one's value.
 pub fn prescribed(model: &Model, initial: &[[f64; 2]], t: f64) -> Vec<(usize, f64)> {

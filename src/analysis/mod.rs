@@ -4,6 +4,7 @@
 //! (`explicit`); their output is VTK frames, history.csv and summary.json (`record`).
 
 pub mod buckling;
+pub mod check;
 pub mod checkpoint;
 pub mod clock;
 pub mod dynamics;
@@ -11,12 +12,13 @@ pub mod explicit;
 pub mod loads;
 pub mod newton;
 pub mod plausibility;
+pub mod progress;
 pub mod record;
 pub mod run;
 pub mod statics;
 
 use crate::assembly::State;
-use crate::output::OutputError;
+use crate::output::{OutputError, readable};
 use crate::scene::{InputError, Model};
 use newton::Counters;
 use record::Energies;
@@ -244,15 +246,18 @@ impl StepControl {
     fn reject(&mut self, attempted: f64, counters: &mut Counters) -> Result<(), String> {
         if self.cuts_in_a_row >= self.max_cuts {
             return Err(format!(
-                "did not converge after {} cuts (dt = {attempted:e})",
-                self.cuts_in_a_row
+                "did not converge after {} cuts (dt = {})",
+                self.cuts_in_a_row,
+                readable(attempted)
             ));
         }
         let floor = self.shortest();
         if 0.5 * attempted < floor {
             return Err(format!(
-                "did not converge: repeated cuts brought the step to {attempted:e}, and halving it would go below dt / 2^{} / 10 = {floor:e}",
-                self.max_cuts
+                "did not converge: repeated cuts brought the step to {}, and halving it would go below dt / 2^{} / 10 = {}",
+                readable(attempted),
+                self.max_cuts,
+                readable(floor)
             ));
         }
         self.length = 0.5 * attempted;
@@ -363,8 +368,8 @@ impl RunError {
 /// Options of a run that are not part of the scene.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct RunOptions {
-    /// Show a progress bar (on a terminal).
-    pub progress: bool,
+    /// How the run shows its progress (a bar, plain lines, nothing).
+    pub progress: progress::Mode,
     /// Set (by a signal handler) to stop the run after the step in progress.
     pub interrupt: Option<&'static AtomicBool>,
     /// For tests: stop dead after this many converged steps, writing nothing more (as a
@@ -432,6 +437,17 @@ pub fn run_outcome(
     run_from(model, out_dir, options, None)
 }
 
+/// Creates the output folder `dir` (and its parents); a folder that cannot be made (a file
+/// in the way, no permission) is bad input: the user names another with `--out`.
+pub fn create_output_folder(dir: &Path) -> Result<(), InputError> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        InputError::new(
+            dir,
+            format!("cannot create the output folder (choose another with --out): {e}"),
+        )
+    })
+}
+
 /// A run from the start, or from a checkpoint of the same scene.
 fn run_from(
     model: &Model,
@@ -440,6 +456,7 @@ fn run_from(
     resume: Option<checkpoint::Checkpoint>,
 ) -> Result<Outcome, RunError> {
     crate::profile::reset();
+    create_output_folder(out_dir)?;
     let imperfect = buckling::with_imperfection(model).map_err(|e| {
         InputError::new(
             &model.file,

@@ -6,6 +6,7 @@ use super::Summary;
 use super::record::Energies;
 use crate::assembly::{self, State};
 use crate::contact::penetration_limits;
+use crate::output::readable;
 use crate::scene::Model;
 use crate::scene::model::Analysis;
 use crate::scene::spec::{IntegratorKind, TimeStep};
@@ -57,9 +58,10 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
     let supplied = summary.energy.initial + energies.external_work.max(0.0);
     if energies.plastic_work > supplied * (1.0 + 1e-6) && energies.plastic_work > 0.0 {
         out.push(format!(
-            "the plastic work {:.6e} exceeds the energy supplied {:.6e} (initial energy and \
-             external work): the step is too long for the plastic flow",
-            energies.plastic_work, supplied
+            "the plastic work {} exceeds the energy supplied {} (initial energy and external \
+             work): the step is too long for the plastic flow",
+            readable(energies.plastic_work),
+            readable(supplied)
         ));
     }
     if let Some(problem) = time_step_warning(model, summary) {
@@ -76,11 +78,13 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
         let bound = tolerance.max(PENETRATION_SHARE * spacing);
         if depth > bound {
             out.push(format!(
-                "contact: a node went {depth:.6e} deep into the other body, more than {} % of \
-                 the slave node spacing {spacing:.3e}; history.csv `penetration` shows when \
-                 (a master node sinking into the slave body is not seen by one-pass contact: \
-                 swap the roles or refine the slave surface)",
-                100.0 * PENETRATION_SHARE
+                "contact: a node went {} deep into the other body, more than {} % of the slave \
+                 node spacing {}; history.csv `penetration` shows when (a master node sinking \
+                 into the slave body is not seen by one-pass contact: swap the roles or refine \
+                 the slave surface)",
+                readable(depth),
+                100.0 * PENETRATION_SHARE,
+                readable(spacing)
             ));
         }
     }
@@ -98,8 +102,9 @@ fn time_step_warning(model: &Model, summary: &Summary) -> Option<String> {
     };
     if dt > d.end_time {
         return Some(format!(
-            "analysis.dt = {dt:e} is longer than end_time = {:e}: the run is one shortened step",
-            d.end_time
+            "analysis.dt = {} is longer than end_time = {}: the run is one shortened step",
+            readable(dt),
+            readable(d.end_time)
         ));
     }
     let first = summary.contact.first_contact_time;
@@ -115,11 +120,12 @@ fn time_step_warning(model: &Model, summary: &Summary) -> Option<String> {
     let typical = median_stable_step(model)?;
     (dt > IMPACT_STEP_RATIO * typical).then(|| {
         format!(
-            "analysis.dt = {dt:e} is {:.0} times the explicit stable step of the median element \
-             ({typical:.3e}) and the contact lasted {contact_steps:.1} steps: stable, but the \
-             impact is resolved by too few steps; steps nearer the stable step follow the \
-             contact force",
-            dt / typical
+            "analysis.dt = {} is {:.0} times the explicit stable step of the median element \
+             ({}) and the contact lasted {contact_steps:.1} steps: stable, but the impact is \
+             resolved by too few steps; steps nearer the stable step follow the contact force",
+            readable(dt),
+            dt / typical,
+            readable(typical)
         )
     })
 }

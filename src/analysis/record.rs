@@ -31,6 +31,9 @@ pub struct Motion<'a> {
     pub acceleration: &'a [f64],
     /// Lumped mass per DOF (for the momentum probes); empty in statics.
     pub mass: &'a [f64],
+    /// The internal force of the committed state, all DOFs (for the reaction probes): the
+    /// one the step converged with, so the reactions balance the loads as the solution does.
+    pub internal_force: &'a [f64],
 }
 
 pub struct Recorder {
@@ -39,6 +42,8 @@ pub struct Recorder {
     grid: Grid,
     /// The initial coordinates (the `reference_coordinates` array).
     reference: Vec<[f64; 2]>,
+    /// Per cell of `grid`, its body's index (the `body` cell array).
+    body_ids: Vec<i64>,
     series: Option<Series>,
     history: History,
     frame_every: usize,
@@ -61,7 +66,7 @@ impl Recorder {
     pub fn create(model: &Model, dir: &Path) -> Result<Recorder, OutputError> {
         std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
             path: dir.to_path_buf(),
-            action: "cannot create folder",
+            action: "create folder",
             source,
         })?;
         let series = if model.output.frame_every > 0 || !model.output.frame_times.is_empty() {
@@ -77,6 +82,7 @@ impl Recorder {
         Ok(Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
+            body_ids: body_ids(model),
             reference: model.coordinates(),
             series,
             history,
@@ -126,6 +132,7 @@ impl Recorder {
         Ok(Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
+            body_ids: body_ids(model),
             reference: model.coordinates(),
             series,
             history,
@@ -197,11 +204,16 @@ impl Recorder {
                 model.contacts.len() + friction.iter().filter(|f| **f).count(),
             )),
         }
+        let reaction = if model.probes.iter().any(|p| is_reaction(p.quantity)) {
+            Some(reactions(model, state, motion))
+        } else {
+            None
+        };
         row.extend(
             model
                 .probes
                 .iter()
-                .map(|p| probe_value(model, state, motion, p)),
+                .map(|p| probe_value(model, state, motion, reaction.as_deref(), p)),
         );
         if self.pivots_column {
             row.push(self.negative_pivots.map_or(f64::NAN, |n| n as f64));
@@ -228,13 +240,17 @@ impl Recorder {
             || (self.series.is_some() && self.frame_due(model, time, force_frame, 1))
     }
 
-    /// `pending`: steps not yet counted in `steps_since_frame`.
+    /// `pending`: steps not yet counted in `steps_since_frame`. A listed frame time is due at
+    /// the step that ends there, or (a step that jumps over it: fixed central-difference steps,
+    /// static increments) at the first step past it; `step_length` is the step's length.
     fn frame_due(&self, model: &Model, time: f64, force_frame: bool, pending: usize) -> bool {
+        let tolerance = 1e-9 * time.abs().max(1e-300);
+        let previous = time - self.step_length;
         let listed = model
             .output
             .frame_times
             .iter()
-            .any(|t| (t - time).abs() <= 1e-9 * t.abs().max(1e-300));
+            .any(|t| (t - time).abs() <= tolerance || (*t < time && *t > previous + tolerance));
         force_frame
             || listed
             || (self.frame_every > 0 && self.steps_since_frame + pending >= self.frame_every)
@@ -271,6 +287,15 @@ impl Recorder {
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };
+        let strain = cell_strains(model, &self.reference, state);
+        let nodal_stress = self.grid.cell_to_point_mean(&cells.stress);
+        let mises: Vec<[f64; 1]> = cells.von_mises.iter().map(|v| [*v]).collect();
+        let nodal_von_mises: Vec<f64> = self
+            .grid
+            .cell_to_point_mean(&mises)
+            .into_iter()
+            .map(|[v]| v)
+            .collect();
         let fields = Fields {
             displacement: &vectors(&state.displacement),
             velocity: &vectors(motion.velocity),
@@ -284,6 +309,9 @@ impl Recorder {
             eq_plastic_strain: &cells.eq_plastic_strain,
             pressure: &cells.pressure,
             temperature: cells.temperature.as_deref(),
+            body: Some(&self.body_ids),
+            nodal_stress: Some((&nodal_stress, &nodal_von_mises)),
+            strain: Some(&strain),
         };
         let points = match model.output.points {
             FramePoints::Current => &positions[..],
@@ -332,6 +360,115 @@ pub fn max_temperature(model: &Model, state: &State) -> Option<f64> {
             .flat_map(|(_, s)| s.points.iter().map(|p| p.temperature))
             .fold(f64::NEG_INFINITY, f64::max)
     })
+}
+
+/// Per cell of [`grid`] (quads first, then rods), the Green-Lagrange strain of the total
+/// displacement from the initial configuration at the cell's centre, [XX YY ZZ XY YZ XZ]
+/// with the tensor shear E_xy:
+/// ```text
+/// quads   H = grad_X u at the centre (xi = eta = 0), E = (H + H^T + H^T H) / 2
+///         ZZ: plane strain 0; axisymmetric (r^2 / R^2 - 1) / 2 with R, r the centre's
+///         initial and current radius; plane stress (lambda^2 - 1) / 2 with lambda the mean
+///         thickness stretch of the points
+/// rods    XX = (l^2 / L^2 - 1) / 2 along the rod, the rest 0
+/// ```
+pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -> Vec<[f64; 6]> {
+    use crate::element::Formulation;
+    use crate::scene::BodyKind;
+    let u = &state.displacement;
+    let at = |n: usize| {
+        (
+            initial[n],
+            [initial[n][0] + u[2 * n], initial[n][1] + u[2 * n + 1]],
+        )
+    };
+    let mut out = Vec::with_capacity(model.elements());
+    for (b, body) in model.bodies.iter().enumerate() {
+        let Cells::Quad4(quads) = &body.mesh.cells else {
+            continue;
+        };
+        for (e, q) in quads.iter().enumerate() {
+            let nodes = q.map(|n| at(body.global(n)));
+            // dN/dxi and dN/deta at the centre, nodes counter-clockwise
+            let dxi = [-0.25, 0.25, 0.25, -0.25];
+            let deta = [-0.25, -0.25, 0.25, 0.25];
+            let mut jacobian = [[0.0; 2]; 2]; // dX_i / d(xi, eta)_j
+            let mut du = [[0.0; 2]; 2]; // du_i / d(xi, eta)_j
+            for (a, (reference, current)) in nodes.iter().enumerate() {
+                for i in 0..2 {
+                    let displacement = current[i] - reference[i];
+                    jacobian[i][0] += reference[i] * dxi[a];
+                    jacobian[i][1] += reference[i] * deta[a];
+                    du[i][0] += displacement * dxi[a];
+                    du[i][1] += displacement * deta[a];
+                }
+            }
+            let det = jacobian[0][0] * jacobian[1][1] - jacobian[0][1] * jacobian[1][0];
+            // d(xi, eta) / dX = J^-1
+            let inverse = [
+                [jacobian[1][1] / det, -jacobian[0][1] / det],
+                [-jacobian[1][0] / det, jacobian[0][0] / det],
+            ];
+            let h: [[f64; 2]; 2] = std::array::from_fn(|i| {
+                std::array::from_fn(|j| du[i][0] * inverse[0][j] + du[i][1] * inverse[1][j])
+            });
+            let green = |i: usize, j: usize| {
+                0.5 * (h[i][j] + h[j][i] + h[0][i] * h[0][j] + h[1][i] * h[1][j])
+            };
+            let zz = match body.kind {
+                BodyKind::Continuum {
+                    formulation: Formulation::Axisymmetric,
+                    ..
+                } => {
+                    let radius =
+                        |k: usize| nodes.iter().map(|n| [n.0, n.1][k][0]).sum::<f64>() / 4.0;
+                    let (initial_r, current_r) = (radius(0), radius(1));
+                    if initial_r > 0.0 {
+                        0.5 * ((current_r / initial_r).powi(2) - 1.0)
+                    } else {
+                        0.0
+                    }
+                }
+                BodyKind::Continuum {
+                    formulation: Formulation::PlaneStress,
+                    thickness,
+                    ..
+                } => {
+                    let ppe = body.points_per_element();
+                    let now = &state.bodies[b].thickness[e * ppe..(e + 1) * ppe];
+                    let stretch = now.iter().sum::<f64>() / ppe as f64 / thickness;
+                    0.5 * (stretch * stretch - 1.0)
+                }
+                _ => 0.0,
+            };
+            out.push([green(0, 0), green(1, 1), zz, green(0, 1), 0.0, 0.0]);
+        }
+    }
+    for body in &model.bodies {
+        let Cells::Rod2(rods) = &body.mesh.cells else {
+            continue;
+        };
+        for r in rods {
+            let [(a0, a1), (b0, b1)] = r.map(|n| at(body.global(n)));
+            let length2 = |p: [f64; 2], q: [f64; 2]| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+            let xx = 0.5 * (length2(a1, b1) / length2(a0, b0) - 1.0);
+            out.push([xx, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        }
+    }
+    out
+}
+
+/// Per cell of [`grid`], the index of its body in the scene (quads first, then rods).
+pub(crate) fn body_ids(model: &Model) -> Vec<i64> {
+    let of = |quads: bool| {
+        model
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(move |(_, b)| matches!(b.mesh.cells, Cells::Quad4(_)) == quads)
+            .flat_map(|(i, b)| std::iter::repeat_n(i as i64, b.elements()))
+    };
+    of(true).chain(of(false)).collect()
 }
 
 /// All bodies in one grid: initial coordinates, quads first, then rods.
@@ -419,10 +556,42 @@ fn cell_fields(model: &Model, state: &State) -> CellFields {
     out
 }
 
+fn is_reaction(quantity: Quantity) -> bool {
+    matches!(quantity, Quantity::ReactionX | Quantity::ReactionY)
+}
+
+/// The support reactions of the committed state, per DOF (zero at free DOFs):
+/// ```text
+/// R = f_int(sigma) - f_ext(t) + m a     at the constrained DOFs
+/// ```
+/// f_int the internal force the step converged with, f_ext the loads at the state's time, m
+/// the lumped mass (dynamics; absent in statics). Contact forces on constrained nodes and
+/// Rayleigh damping are not part of it.
+fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
+    let mut external = vec![0.0; model.dofs()];
+    super::loads::add_external_force(
+        model,
+        state,
+        &model.coordinates(),
+        state.time,
+        &mut external,
+    );
+    let mut reaction = vec![0.0; model.dofs()];
+    for dof in model.constrained_dofs() {
+        let inertia = motion
+            .mass
+            .get(dof)
+            .map_or(0.0, |m| m * motion.acceleration[dof]);
+        reaction[dof] = motion.internal_force[dof] - external[dof] + inertia;
+    }
+    reaction
+}
+
 fn probe_value(
     model: &Model,
     state: &State,
     motion: &Motion,
+    reaction: Option<&[f64]>,
     probe: &crate::scene::model::Probe,
 ) -> f64 {
     let combine = |values: &mut dyn Iterator<Item = f64>| -> f64 {
@@ -467,6 +636,11 @@ fn probe_value(
                         .map_or(0.0, |mass| mass * motion.velocity[2 * m + c])
                 })
                 .sum()
+        }
+        Quantity::ReactionX | Quantity::ReactionY => {
+            let c = (probe.quantity == Quantity::ReactionY) as usize;
+            let reaction = reaction.expect("computed when a reaction probe exists");
+            probe.members.iter().map(|m| reaction[2 * m + c]).sum()
         }
         Quantity::StressXX => points(&|p| p.stress[0]),
         Quantity::StressYY => points(&|p| p.stress[1]),

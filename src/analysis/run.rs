@@ -21,14 +21,15 @@
 use super::buckling::{self, Monitor};
 use super::checkpoint::{self, Carry, Checkpoint};
 use super::newton::Counters;
+use super::progress::Progress;
 use super::record::{Energies, Motion, Recorder};
 use super::{DtLimit, Outcome, RunError, RunOptions, Status, Summary};
 use crate::assembly::State;
 use crate::contact::ContactState;
+use crate::output::readable;
 use crate::profile::{self, Phase};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::Path;
 use std::time::Instant;
 
@@ -104,8 +105,6 @@ pub trait Stepper {
     fn hourglass_energy(&self) -> Option<f64> {
         None
     }
-    /// The progress bar's position and length, in nominal steps.
-    fn progress(&self) -> (u64, u64);
     /// The length of the last step (0 before the first).
     fn last_step(&self) -> f64;
     /// What the time step did (central difference): summary.json `dt_min`, `dt_max`,
@@ -125,7 +124,7 @@ struct Run<'a, S: Stepper> {
     counters: Counters,
     monitor: Option<Monitor>,
     start: Instant,
-    progress: ProgressBar,
+    progress: Progress,
     penetration_limits: Vec<f64>,
 }
 
@@ -188,7 +187,6 @@ impl<'a, S: Stepper> Run<'a, S> {
         } else {
             None
         };
-        let (position, length) = stepper.progress();
         let mut run = Run {
             model,
             options,
@@ -198,7 +196,12 @@ impl<'a, S: Stepper> Run<'a, S> {
             counters: Counters::default(),
             monitor,
             start,
-            progress: progress_bar(options.progress, length),
+            progress: Progress::new(
+                options.progress,
+                &model.name,
+                0.0,
+                model.analysis.end_time(),
+            ),
             penetration_limits,
         };
         run.summary.energy.initial = run.stepper.initial_kinetic();
@@ -214,7 +217,10 @@ impl<'a, S: Stepper> Run<'a, S> {
                 run.record(true)?;
             }
         }
-        run.progress.set_position(position);
+        // a resumed run measures its rate from the checkpoint's time
+        let time = run.stepper.state().time;
+        run.progress.start_at(time);
+        run.progress.update(time, run.summary.steps);
         if run.summary.steps == 0 && model.checkpoint_every > 0 && run.stepper.carry().is_ok() {
             run.save()?;
         }
@@ -283,10 +289,10 @@ impl<'a, S: Stepper> Run<'a, S> {
             )
         });
         if let Some(message) = runaway {
-            let message = format!("at t = {time}: {message}");
+            let message = format!("at t = {}: {message}", readable(time));
             return Err(self.fail(Status::Diverged, message));
         }
-        self.progress.set_position(self.stepper.progress().0);
+        self.progress.update(time, self.summary.steps);
         if stop {
             self.summary.message = Some(stop_message(time, &self.recorder));
             return Ok(Some(self.finish_early()));
@@ -325,7 +331,10 @@ impl<'a, S: Stepper> Run<'a, S> {
                 Ok(halt)
             }
             Err(e) => {
-                let message = format!("buckling check at t = {}: {e}", self.stepper.state().time);
+                let message = format!(
+                    "buckling check at t = {}: {e}",
+                    readable(self.stepper.state().time)
+                );
                 Err(self.fail(Status::Diverged, message))
             }
         }
@@ -334,13 +343,13 @@ impl<'a, S: Stepper> Run<'a, S> {
     /// A history row of the committed state (and a frame when due, or when `last`).
     fn record(&mut self, last: bool) -> Result<(), RunError> {
         let time = self.stepper.state().time;
+        self.recorder.step_length = self.stepper.last_step();
         if self.recorder.reads_stresses(self.model, time, last) {
             self.stepper.sync_points();
         }
         if let Some(energy) = self.stepper.hourglass_energy() {
             self.recorder.hourglass_energy = energy;
         }
-        self.recorder.step_length = self.stepper.last_step();
         let s = &self.stepper;
         let contact = (self.summary.steps > 0).then(|| s.contact());
         self.recorder.step_with_contact(
@@ -425,7 +434,8 @@ impl<'a, S: Stepper> Run<'a, S> {
     /// A failed run: the summary is written with its status and message, then returned in
     /// the error.
     fn fail(&mut self, status: Status, message: String) -> RunError {
-        self.progress.abandon();
+        self.progress
+            .finish(self.stepper.state().time, self.summary.steps);
         self.fill_summary();
         let mut summary = self.summary.clone();
         summary.status = status;
@@ -441,7 +451,8 @@ impl<'a, S: Stepper> Run<'a, S> {
 
     /// A run stopped by a signal after a whole step: summary.json with status `interrupted`.
     fn interrupted(&mut self, time: f64) -> RunError {
-        self.progress.abandon();
+        self.progress
+            .finish(self.stepper.state().time, self.summary.steps);
         self.fill_summary();
         let what_next = match self.stepper.carry() {
             Ok(_) => format!(
@@ -451,7 +462,8 @@ impl<'a, S: Stepper> Run<'a, S> {
             Err(reason) => reason.to_string(),
         };
         let message = format!(
-            "interrupted by a signal at t = {time} after {} steps; {what_next}",
+            "interrupted by a signal at t = {} after {} steps; {what_next}",
+            readable(time),
             self.summary.steps
         );
         let mut summary = self.summary.clone();
@@ -468,12 +480,14 @@ impl<'a, S: Stepper> Run<'a, S> {
 
     /// A run stopped before its end time on purpose (the buckling check's `stop`).
     fn finish_early(&mut self) -> Result<Outcome, RunError> {
-        self.progress.finish_and_clear();
+        self.progress
+            .finish(self.stepper.state().time, self.summary.steps);
         self.end()
     }
 
     fn finish(mut self) -> Result<Outcome, RunError> {
-        self.progress.finish_and_clear();
+        self.progress
+            .finish(self.stepper.state().time, self.summary.steps);
         self.end()
     }
 
@@ -510,19 +524,6 @@ fn monitor_error(model: &Model, e: buckling::MonitorError) -> RunError {
     }
 }
 
-fn progress_bar(show: bool, steps: u64) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(steps);
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps {msg}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    bar
-}
-
 /// The start instant of a resumed run: as if it had been running for `wall_seconds`.
 fn resumed_start(wall_seconds: f64) -> Instant {
     let now = Instant::now();
@@ -533,7 +534,8 @@ fn resumed_start(wall_seconds: f64) -> Instant {
 /// summary.json `message` of a run stopped by `on_critical = "stop"`.
 fn stop_message(time: f64, recorder: &Recorder) -> String {
     format!(
-        "stopped by analysis.buckling.on_critical at t = {time}: K_T has {} negative pivot(s)",
+        "stopped by analysis.buckling.on_critical at t = {}: K_T has {} negative pivot(s)",
+        readable(time),
         recorder.negative_pivots.unwrap_or(0)
     )
 }

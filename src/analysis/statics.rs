@@ -19,6 +19,7 @@ use super::{StepControl, loads};
 use crate::assembly::{self, State, System};
 use crate::contact::{ContactState, Interfaces, Tangential};
 use crate::integrator::StepForm;
+use crate::output::readable;
 use crate::scene::Model;
 use crate::scene::spec::{StaticSpec, Strategy};
 use crate::solver::Solver;
@@ -62,7 +63,7 @@ pub struct Statics<'a> {
 
 impl<'a> Statics<'a> {
     pub fn new(model: &'a Model, spec: &'a StaticSpec) -> Result<Statics<'a>, String> {
-        let system = System::new(model, &loads::constrained_dofs(model));
+        let system = System::new(model, &model.constrained_dofs());
         let solver = Solver::new(&system.pattern).map_err(|e| e.to_string())?;
         let dt = spec.end_time / spec.steps as f64;
         Ok(Statics {
@@ -264,7 +265,8 @@ impl Stepper for Statics<'_> {
                 }
                 Err(StepFailure(reason)) => {
                     if let Err(why) = self.control.reject(target - self.state.time, counters) {
-                        let message = format!("increment to t = {target} {why}: {reason}");
+                        let message =
+                            format!("increment to t = {} {why}: {reason}", readable(target));
                         return Err(StepError::diverged(message));
                     }
                 }
@@ -280,6 +282,7 @@ impl Stepper for Statics<'_> {
             velocity: &self.zeros,
             acceleration: &self.zeros,
             mass: &[],
+            internal_force: &self.last_force,
         }
     }
     fn energies(&self) -> &Energies {
@@ -296,12 +299,6 @@ impl Stepper for Statics<'_> {
     }
     fn solver_mut(&mut self) -> Option<&mut Solver> {
         Some(&mut self.solver)
-    }
-    fn progress(&self) -> (u64, u64) {
-        (
-            (self.state.time / self.dt).round() as u64,
-            self.spec.steps as u64,
-        )
     }
     fn last_step(&self) -> f64 {
         self.last_step

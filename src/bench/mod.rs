@@ -523,6 +523,8 @@ fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                 series: throughput,
                 log_x: true,
                 log_y: true,
+                x_limits: Default::default(),
+                y_limits: Default::default(),
             },
             &dir.join("bench_throughput.svg"),
         )?;
@@ -551,6 +553,8 @@ fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                 series: shares,
                 log_x: true,
                 log_y: false,
+                x_limits: Default::default(),
+                y_limits: Default::default(),
             },
             &dir.join("bench_time_breakdown.svg"),
         )?;

@@ -305,6 +305,8 @@ pub fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                     series,
                     log_x: true,
                     log_y: false,
+                    x_limits: Default::default(),
+                    y_limits: Default::default(),
                 },
                 &dir.join(format!("{}_{}.svg", b.key, measure.file())),
             )?;

@@ -8,6 +8,7 @@
 use super::geometry::{ContactPair, Master, project, winding_number};
 use super::search::slave_gaps;
 use crate::mesh::plane::{dot, sub};
+use crate::output::readable;
 
 /// What the checks need of the two bodies besides the pair's own nodes.
 pub struct Bodies<'a> {
@@ -83,9 +84,11 @@ fn penetration_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
         .copied()
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
     Some(format!(
-        "{} slave node(s) start inside the master beyond TOL = {tolerance:e}, the deepest \
-         node {node} at gap {gap:e}: move the bodies apart (or the obstacle)",
-        inside.len()
+        "{} slave node(s) start inside the master beyond TOL = {}, the deepest node {node} at \
+         gap {}: move the bodies apart (or the obstacle)",
+        inside.len(),
+        readable(tolerance),
+        readable(gap)
     ))
 }
 

@@ -106,6 +106,37 @@ pub(crate) fn temporary_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// `x` as a person reads it in a message: six significant digits at most, trailing zeros
+/// dropped, scientific notation when |x| < 1e-3 or |x| >= 1e6 (0.000014695294616961851
+/// reads `1.46953e-5`, 0.0000002 reads `2e-7`, 1234.5678 reads `1234.57`). For messages
+/// and progress lines only: files keep full precision (`format_f64`).
+pub fn readable(x: f64) -> String {
+    if !x.is_finite() || x == 0.0 {
+        return format!("{x}");
+    }
+    // the exponent after rounding to six digits, so 999999.7 reads 1e6, not 1000000
+    let scientific = format!("{x:.5e}");
+    let (mantissa, exponent) = scientific
+        .split_once('e')
+        .expect("`{:e}` always writes an exponent");
+    let exponent: i32 = exponent.parse().expect("`{:e}` writes an integer exponent");
+    if (-3..6).contains(&exponent) {
+        let decimals = (5 - exponent) as usize;
+        trim_zeros(&format!("{x:.decimals$}")).to_string()
+    } else {
+        format!("{}e{exponent}", trim_zeros(mantissa))
+    }
+}
+
+/// `1.50000` -> `1.5`, `2.000` -> `2`; text without a decimal point is left alone.
+fn trim_zeros(text: &str) -> &str {
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        text
+    }
+}
+
 /// Shortest text of `x` that parses back to the same bits: `{}` or `{:e}`, whichever is shorter.
 ///
 /// Never fixed decimals: 1e-12 stays 1e-12, 0.1 stays 0.1.
@@ -180,5 +211,31 @@ mod tests {
         assert_eq!(format_f64(0.1), "0.1");
         assert_eq!(format_f64(1e-12), "1e-12");
         assert_eq!(format_f64(2.0), "2");
+    }
+
+    /// Goal: message numbers read as a person writes them. Reference: the values written by
+    /// hand at six significant digits (the times and steps of the messages a user reported).
+    #[test]
+    fn readable_numbers_have_six_significant_digits_at_most() {
+        let cases = [
+            (0.000014695294616961851, "1.46953e-5"),
+            (0.0000002, "2e-7"),
+            (1.742757e-7, "1.74276e-7"),
+            (0.05, "0.05"),
+            (0.001, "0.001"),
+            (0.00099999995, "0.001"),
+            (1234.5678, "1234.57"),
+            (123456.7, "123457"),
+            (999999.7, "1e6"),
+            (2.1e11, "2.1e11"),
+            (-0.5, "-0.5"),
+            (-3.0e-9, "-3e-9"),
+            (200.0, "200"),
+            (0.0, "0"),
+        ];
+        for (x, expected) in cases {
+            assert_eq!(readable(x), expected, "{x:e}");
+        }
+        assert_eq!(readable(f64::INFINITY), "inf");
     }
 }

@@ -59,6 +59,16 @@ pub struct Chart {
     pub series: Vec<Series>,
     pub log_x: bool,
     pub log_y: bool,
+    /// Axis ends given by the user; the others follow the data (with a margin).
+    pub x_limits: Limits,
+    pub y_limits: Limits,
+}
+
+/// Ends of an axis fixed by the user (`--xmin` ...); None: from the data.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Limits {
+    pub low: Option<f64>,
+    pub high: Option<f64>,
 }
 
 /// Writes `chart` to `path`: PNG or SVG by the extension, 800 x 500, legend when more than one series.
@@ -67,39 +77,78 @@ pub struct Chart {
 /// value, or a value <= 0 on a logarithmic axis is an [`OutputError::Invalid`] naming the file;
 /// nothing is written then.
 pub fn write(chart: &Chart, path: &Path) -> Result<(), OutputError> {
+    write_panels(std::slice::from_ref(chart), path)
+}
+
+/// Writes `panels` stacked from top to bottom in one file (800 wide, 500 high for one panel,
+/// 300 per panel for several), each with its own axes, like [`write`].
+pub fn write_panels(panels: &[Chart], path: &Path) -> Result<(), OutputError> {
     let format = Format::of(path)?;
-    let x = axis_range(chart, path, Axis::X)?;
-    let y = axis_range(chart, path, Axis::Y)?;
+    if panels.is_empty() {
+        return Err(OutputError::invalid(path, "the chart has no series"));
+    }
+    let ranges = panels
+        .iter()
+        .map(|chart| {
+            Ok((
+                axis_range(chart, path, Axis::X)?,
+                axis_range(chart, path, Axis::Y)?,
+            ))
+        })
+        .collect::<Result<Vec<_>, OutputError>>()?;
     register_embedded_font();
+    let size = if panels.len() == 1 {
+        SIZE
+    } else {
+        (SIZE.0, PANEL_HEIGHT * panels.len() as u32)
+    };
     let drawing_error =
         |e: String| OutputError::invalid(path, format!("cannot draw the chart: {e}"));
     match format {
         Format::Svg => {
             let mut text = String::new();
-            draw(
-                SVGBackend::with_string(&mut text, SIZE).into_drawing_area(),
-                chart,
-                x,
-                y,
+            draw_all(
+                SVGBackend::with_string(&mut text, size).into_drawing_area(),
+                panels,
+                &ranges,
             )
             .map_err(drawing_error)?;
             write_atomic(path, text.as_bytes())
         }
         Format::Png => {
-            let (width, height) = SIZE;
+            let (width, height) = size;
             let mut pixels = vec![0u8; 3 * width as usize * height as usize];
-            draw(
-                BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(),
-                chart,
-                x,
-                y,
+            draw_all(
+                BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area(),
+                panels,
+                &ranges,
             )
             .map_err(drawing_error)?;
-            let bytes = encode_png(&pixels, SIZE)
+            let bytes = encode_png(&pixels, size)
                 .map_err(|e| OutputError::invalid(path, format!("cannot encode the PNG: {e}")))?;
             write_atomic(path, &bytes)
         }
     }
+}
+
+/// The height of one of several panels, in pixels.
+const PANEL_HEIGHT: u32 = 300;
+
+type Ranges = ((f64, f64), (f64, f64));
+
+/// Draws the panels one below the other on `root` and presents it.
+fn draw_all<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    panels: &[Chart],
+    ranges: &[Ranges],
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let areas = root.split_evenly((panels.len(), 1));
+    for ((area, chart), (x, y)) in areas.into_iter().zip(panels).zip(ranges) {
+        draw(area, chart, *x, *y)?;
+    }
+    root.present().map_err(e)
 }
 
 /// What a cell of a [`Map`] shows; the kind sets its colour.
@@ -375,7 +424,11 @@ fn axis_range(chart: &Chart, path: &Path, axis: Axis) -> Result<(f64, f64), Outp
         Axis::X => 0.03,
         Axis::Y => 0.05,
     };
-    Ok(if log {
+    let limits = match axis {
+        Axis::X => chart.x_limits,
+        Axis::Y => chart.y_limits,
+    };
+    let (auto_low, auto_high) = if log {
         let factor = if high > low {
             (high / low).powf(margin)
         } else {
@@ -388,7 +441,25 @@ fn axis_range(chart: &Chart, path: &Path, axis: Axis) -> Result<(f64, f64), Outp
     } else {
         let pad = if low == 0.0 { 1.0 } else { 0.1 * low.abs() };
         (low - pad, high + pad)
-    })
+    };
+    let (low, high) = (
+        limits.low.unwrap_or(auto_low),
+        limits.high.unwrap_or(auto_high),
+    );
+    if !(low.is_finite() && high.is_finite() && low < high) || (log && low <= 0.0) {
+        return Err(OutputError::invalid(
+            path,
+            format!(
+                "the {name} axis from {low} to {high} is empty{}",
+                if log {
+                    " or not positive (logarithmic)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    Ok((low, high))
 }
 
 /// Makes the embedded font the `sans-serif` family plotters measures and rasterizes text with.
@@ -409,7 +480,6 @@ fn draw<DB: DrawingBackend>(
     y: (f64, f64),
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-    root.fill(&WHITE).map_err(e)?;
     let mut builder = ChartBuilder::on(&root);
     builder
         .caption(&chart.title, (FontFamily::SansSerif, 22))
@@ -451,8 +521,7 @@ fn draw<DB: DrawingBackend>(
             y_span,
         ),
     }
-    .map_err(e)?;
-    root.present().map_err(e)
+    .map_err(e)
 }
 
 /// Colours of the series in order (the matplotlib "tab10" cycle), repeated past ten.
@@ -498,6 +567,11 @@ where
         .light_line_style(BLACK.mix(0.05))
         .draw()?;
     let legend = chart.series.len() > 1;
+    let (x_range, y_range) = (context.x_range(), context.y_range());
+    let bounds = Bounds {
+        x: (x_range.start, x_range.end),
+        y: (y_range.start, y_range.end),
+    };
     for (index, series) in chart.series.iter().enumerate() {
         let color = COLORS[index % COLORS.len()];
         let line = color.stroke_width(2);
@@ -505,10 +579,15 @@ where
         let with_line = series.style != SeriesStyle::Markers;
         let with_markers = series.style != SeriesStyle::Line;
         if with_line {
-            let annotation = context.draw_series(std::iter::once(PathElement::new(
-                series.points.clone(),
-                line,
-            )))?;
+            // segment by segment, clipped to the axes: plotters joins a thick polyline's
+            // segments with miters, which on a curve that turns back sharply (a contact force
+            // that chatters between steps) reach far outside the plot in the bitmap backend
+            let segments = series
+                .points
+                .windows(2)
+                .filter_map(|w| clip_segment(w[0], w[1], &bounds))
+                .map(|(a, b)| PathElement::new(vec![a, b], line));
+            let annotation = context.draw_series(segments)?;
             if legend && !with_markers {
                 annotation
                     .label(series.label.as_str())
@@ -520,6 +599,7 @@ where
                 series
                     .points
                     .iter()
+                    .filter(|p| bounds.contains(**p))
                     .map(|&point| Circle::new(point, 3, dot)),
             )?;
             if legend {
@@ -537,13 +617,102 @@ where
     if legend {
         context
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(legend_corner(chart, &bounds))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK.mix(0.4))
             .label_font((FontFamily::SansSerif, 14))
             .draw()?;
     }
     Ok(())
+}
+
+/// The plotted ranges of a chart's axes (in data values).
+struct Bounds {
+    x: (f64, f64),
+    y: (f64, f64),
+}
+
+impl Bounds {
+    fn contains(&self, (x, y): (f64, f64)) -> bool {
+        (self.x.0..=self.x.1).contains(&x) && (self.y.0..=self.y.1).contains(&y)
+    }
+
+    /// The point as fractions of the axes (0 at the low end, 1 at the high one); logarithmic
+    /// axes are measured linearly here, which is enough to choose a corner.
+    fn fraction(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        (
+            (x - self.x.0) / (self.x.1 - self.x.0),
+            (y - self.y.0) / (self.y.1 - self.y.0),
+        )
+    }
+}
+
+/// The part of the segment a-b inside `bounds` (Liang-Barsky), or None.
+fn clip_segment(a: (f64, f64), b: (f64, f64), bounds: &Bounds) -> Option<((f64, f64), (f64, f64))> {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-dx, a.0 - bounds.x.0),
+        (dx, bounds.x.1 - a.0),
+        (-dy, a.1 - bounds.y.0),
+        (dy, bounds.y.1 - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let t = q / p;
+            if p < 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+    }
+    (t0 <= t1).then_some((
+        (a.0 + t0 * dx, a.1 + t0 * dy),
+        (a.0 + t1 * dx, a.1 + t1 * dy),
+    ))
+}
+
+/// The corner of the plot whose legend-sized box (a third of the width, a band of the height
+/// growing with the entries) covers the fewest points of the series; upper right on a tie.
+fn legend_corner(chart: &Chart, bounds: &Bounds) -> SeriesLabelPosition {
+    let width = 0.4;
+    let height = (0.08 * chart.series.len() as f64 + 0.05).min(0.6);
+    let corners = [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ];
+    let covered = |right: bool, upper: bool| -> usize {
+        let inside = |(fx, fy): (f64, f64)| {
+            let in_x = if right {
+                fx >= 1.0 - width
+            } else {
+                fx <= width
+            };
+            let in_y = if upper {
+                fy >= 1.0 - height
+            } else {
+                fy <= height
+            };
+            in_x && in_y
+        };
+        chart
+            .series
+            .iter()
+            .flat_map(|s| &s.points)
+            .filter(|p| inside(bounds.fraction(**p)))
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|(_, right, upper)| covered(*right, *upper))
+        .map(|(position, _, _)| position)
+        .expect("four corners")
 }
 
 /// A logarithmic axis over `low..high` with its own ticks.
@@ -676,6 +845,8 @@ mod tests {
             series: vec![series(vec![(0.0, -1.0), (2.0, 1.0)])],
             log_x: false,
             log_y: false,
+            x_limits: Default::default(),
+            y_limits: Default::default(),
         };
         let path = Path::new("a.svg");
         assert_eq!(axis_range(&chart, path, Axis::X).unwrap(), (0.0, 2.0));
@@ -687,5 +858,50 @@ mod tests {
         chart.series = vec![series(vec![(1.0, 0.0)])];
         let err = axis_range(&chart, path, Axis::Y).unwrap_err().to_string();
         assert!(err.contains("logarithmic"), "{err}");
+    }
+
+    /// Goal: the legend goes to the corner with the fewest points, and segments are clipped
+    /// to the axes. Reference: a line rising from the lower left to the upper right leaves the
+    /// upper-left corner empty; a segment crossing x = 1 is cut at its midpoint.
+    #[test]
+    fn legend_avoids_the_curve_and_segments_are_clipped() {
+        let rising = Series {
+            label: "rising".into(),
+            points: (0..=100).map(|i| (i as f64, i as f64)).collect(),
+            style: SeriesStyle::Line,
+        };
+        let mut other = rising.clone();
+        other.label = "other".into();
+        let chart = Chart {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            series: vec![rising, other],
+            log_x: false,
+            log_y: false,
+            x_limits: Limits::default(),
+            y_limits: Limits::default(),
+        };
+        let bounds = Bounds {
+            x: (0.0, 100.0),
+            y: (0.0, 100.0),
+        };
+        assert!(matches!(
+            legend_corner(&chart, &bounds),
+            SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
+        ));
+        let unit = Bounds {
+            x: (0.0, 1.0),
+            y: (0.0, 1.0),
+        };
+        assert_eq!(
+            clip_segment((0.5, 0.5), (1.5, 0.5), &unit),
+            Some(((0.5, 0.5), (1.0, 0.5)))
+        );
+        assert_eq!(clip_segment((2.0, 0.5), (3.0, 0.5), &unit), None);
+        assert_eq!(
+            clip_segment((0.5, -1.0), (0.5, 2.0), &unit),
+            Some(((0.5, 0.0), (0.5, 1.0)))
+        );
     }
 }

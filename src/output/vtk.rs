@@ -9,8 +9,12 @@
 //! point data  displacement, velocity, acceleration, contact_force,  3 components, z = 0
 //!             reference_coordinates
 //!             gap, contact_status                                   1 component
+//!             nodal_stress (6), nodal_von_mises (1): the cell values averaged to the
+//!             points (only when given)
 //! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure,
-//!             temperature (only when given)
+//!             strain (XX YY ZZ XY YZ XZ, Green-Lagrange; only when given),
+//!             body (Int64: the index of the cell's body in the scene, from 0; only when
+//!             given), temperature (only when given)
 //! ```
 //! `displacement` is the active vectors array, so ParaView's Warp By Vector picks it by
 //! default (to exaggerate the motion of a frame drawn in the reference configuration);
@@ -53,6 +57,15 @@ pub struct Fields<'a> {
     pub pressure: &'a [f64],
     /// Written only when given (materials that carry a temperature).
     pub temperature: Option<&'a [f64]>,
+    /// Per cell, the index of its body in the scene (from 0): ParaView's Threshold on
+    /// `body` picks one body. Written only when given.
+    pub body: Option<&'a [i64]>,
+    /// Per point, `stress` and `von_mises` averaged over the cells around it. Written only
+    /// when given.
+    pub nodal_stress: Option<(&'a [[f64; 6]], &'a [f64])>,
+    /// Per cell, the Green-Lagrange strain XX YY ZZ XY YZ XZ (tensor shear). Written only
+    /// when given.
+    pub strain: Option<&'a [[f64; 6]]>,
 }
 
 /// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
@@ -428,7 +441,7 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
         width,
     };
     use Section::{CellData, PointData};
-    use Source::{Pairs, Singles, Sixes};
+    use Source::{Integers, Pairs, Singles, Sixes};
     let list = [
         field(PointData, "displacement", Pairs(fields.displacement), 3),
         field(PointData, "velocity", Pairs(fields.velocity), 3),
@@ -460,13 +473,54 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
     let temperature = fields
         .temperature
         .map(|t| field(CellData, "temperature", Singles(t), 1));
-    let list: Vec<Field> = list.into_iter().chain(temperature).collect();
+    let body = fields.body.map(|b| field(CellData, "body", Integers(b), 1));
+    let nodal = fields.nodal_stress.into_iter().flat_map(|(stress, mises)| {
+        [
+            field(PointData, "nodal_stress", Sixes(stress), 6),
+            field(PointData, "nodal_von_mises", Singles(mises), 1),
+        ]
+    });
+    let strain = fields
+        .strain
+        .map(|s| field(CellData, "strain", Sixes(s), 6));
+    let list: Vec<Field> = list
+        .into_iter()
+        .chain(nodal)
+        .chain(strain)
+        .chain(body)
+        .chain(temperature)
+        .collect();
     Payload::new(path, grid, &list, Some("displacement"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Goal: cell values averaged to the points count each cell around a point once.
+    /// Reference: two quads sharing an edge (points 1 and 4) and a line hanging off point 2:
+    /// shared points take the mean of their cells, the others their one cell's value.
+    #[test]
+    fn cell_values_average_to_the_points_around_them() {
+        let grid = Grid {
+            points: vec![[0.0, 0.0]; 7],
+            quads: vec![[0, 1, 4, 3], [1, 2, 5, 4]],
+            lines: vec![[2, 6]],
+        };
+        let mean = grid.cell_to_point_mean(&[[1.0, 10.0], [3.0, 30.0], [8.0, 80.0]]);
+        assert_eq!(
+            mean,
+            [
+                [1.0, 10.0],
+                [2.0, 20.0],
+                [5.5, 55.0],
+                [1.0, 10.0],
+                [2.0, 20.0],
+                [3.0, 30.0],
+                [8.0, 80.0]
+            ]
+        );
+    }
     use crate::output::vtu::{FrameData, read_frame};
     use crate::output::{temporary_path, test_dir};
 
@@ -512,6 +566,9 @@ mod tests {
                 eq_plastic_strain: &self.cell_scalars[1],
                 pressure: &self.cell_scalars[2],
                 temperature: None,
+                body: None,
+                nodal_stress: None,
+                strain: None,
             }
         }
 

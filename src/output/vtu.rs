@@ -36,6 +36,33 @@ impl Grid {
     pub fn cells(&self) -> usize {
         self.quads.len() + self.lines.len()
     }
+
+    /// Per point, the mean of `cell_values` (one per cell: quads, then lines) over the cells
+    /// that hold the point, each cell counting once; zero at a point of no cell. The nodal
+    /// (averaged) field ParaView's Cell Data to Point Data would give.
+    pub fn cell_to_point_mean<const N: usize>(&self, cell_values: &[[f64; N]]) -> Vec<[f64; N]> {
+        let mut sum = vec![[0.0; N]; self.points.len()];
+        let mut count = vec![0usize; self.points.len()];
+        let cells = self
+            .quads
+            .iter()
+            .map(|q| &q[..])
+            .chain(self.lines.iter().map(|l| &l[..]));
+        for (nodes, value) in cells.zip(cell_values) {
+            for &n in nodes {
+                for (s, v) in sum[n].iter_mut().zip(value) {
+                    *s += v;
+                }
+                count[n] += 1;
+            }
+        }
+        for (s, c) in sum.iter_mut().zip(count) {
+            if c > 0 {
+                s.iter_mut().for_each(|x| *x /= c as f64);
+            }
+        }
+        sum
+    }
 }
 
 /// The `name="value"` pairs of a tag's text (after the element name, before `>`).
@@ -62,7 +89,8 @@ pub enum Section {
     Cells,
 }
 
-/// The scalar types written: Float64 fields, Int64 connectivity and offsets, UInt8 cell types.
+/// The scalar types written: Float64 fields, Int64 connectivity, offsets and integer fields
+/// (ids), UInt8 cell types.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scalar {
     Float64,
@@ -126,6 +154,8 @@ pub enum Source<'a> {
     Pairs(&'a [[f64; 2]]),
     Sixes(&'a [[f64; 6]]),
     Singles(&'a [f64]),
+    /// One integer per row, written as Int64 (ids).
+    Integers(&'a [i64]),
 }
 
 impl Source<'_> {
@@ -134,6 +164,7 @@ impl Source<'_> {
             Source::Pairs(v) => v.len(),
             Source::Sixes(v) => v.len(),
             Source::Singles(v) => v.len(),
+            Source::Integers(v) => v.len(),
         }
     }
 }
@@ -315,7 +346,8 @@ fn cell_arrays(path: &Path, grid: &Grid) -> Result<[Array; 3], OutputError> {
     ])
 }
 
-/// A checked Float64 array: `expected` rows, each finite, padded with zeros to the width.
+/// A checked array: `expected` rows; Float64 rows finite and padded with zeros to the
+/// width, integers as Int64.
 fn float_array(path: &Path, field: &Field, expected: usize) -> Result<Array, OutputError> {
     if field.source.len() != expected {
         return Err(OutputError::Length {
@@ -323,6 +355,15 @@ fn float_array(path: &Path, field: &Field, expected: usize) -> Result<Array, Out
             what: format!("field `{}`", field.name),
             expected,
             found: field.source.len(),
+        });
+    }
+    if let Source::Integers(values) = field.source {
+        return Ok(Array {
+            section: field.section,
+            name: field.name,
+            scalar: Scalar::Int64,
+            components: 1,
+            bytes: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
         });
     }
     let mut bytes = Vec::with_capacity(expected * field.width * 8);
@@ -351,6 +392,7 @@ fn float_array(path: &Path, field: &Field, expected: usize) -> Result<Array, Out
             .iter()
             .enumerate()
             .try_for_each(|(i, r)| push(i, std::slice::from_ref(r)))?,
+        Source::Integers(_) => unreachable!("written above"),
     }
     Ok(Array {
         section: field.section,
@@ -420,6 +462,14 @@ impl FrameData {
             Values::Float64(v) if a.section == section && a.name == name => {
                 Some((a.components, v.as_slice()))
             }
+            _ => None,
+        })
+    }
+
+    /// The Int64 array `name` of `section` (cell data: ids).
+    pub fn ids(&self, section: Section, name: &str) -> Option<&[i64]> {
+        self.arrays.iter().find_map(|a| match &a.values {
+            Values::Int64(v) if a.section == section && a.name == name => Some(v.as_slice()),
             _ => None,
         })
     }

@@ -126,7 +126,8 @@ fn time_step(
             Ok(TimeStep::Fixed(positive(cx, "analysis.dt", dt)?))
         }
         Some(StepSpec::Auto) if !explicit => Err(cx.err(format!(
-            "analysis.dt: \"auto\" (the stable step of central difference) does not apply to integrator {integrator:?}: give a time step"
+            "analysis.dt: \"auto\" (the stable step of central difference) does not apply to integrator {}: give a time step",
+            integrator.name()
         ))),
         Some(StepSpec::Auto) => {
             let scale = spec.time_step_scale.unwrap_or(0.9);
@@ -158,7 +159,8 @@ fn check_integrator_keys(
     let only_for = |present: bool, key: &str, kinds: &[IntegratorKind]| {
         if present && !kinds.contains(&integrator) {
             Err(cx.err(format!(
-                "analysis.{key}: does not apply to integrator {integrator:?}"
+                "analysis.{key}: does not apply to integrator {}",
+                integrator.name()
             )))
         } else {
             Ok(())
@@ -272,7 +274,8 @@ fn quadrature(
         if integrator != IntegratorKind::CentralDifference {
             return Err(cx.err(format!(
                 "analysis.quadrature: `reduced` (one-point Quad4 with hourglass control) is the explicit fast path; \
-                 integrator {integrator:?} needs the tangent of the full 2x2 kernel: use quadrature = \"full\" or integrator = \"central_difference\""
+                 integrator {} needs the tangent of the full 2x2 kernel: use quadrature = \"full\" or integrator = \"central_difference\"",
+                integrator.name()
             )));
         }
         if spec.geometry == Strain::Small {

@@ -62,8 +62,17 @@ fn body(
     }
     let is_rod = spec.formulation == FormulationSpec::Rod;
     if spec.thickness.is_some() && spec.formulation != FormulationSpec::PlaneStress {
+        let why = match spec.formulation {
+            FormulationSpec::PlaneStrain => {
+                "a plane_strain body is per unit depth (its forces, masses and energies are per unit of thickness: multiply by the depth for totals)"
+            }
+            FormulationSpec::Axisymmetric => {
+                "an axisymmetric body is the full ring (its forces are totals over 2 pi r)"
+            }
+            _ => "a rod has a cross-section `area` instead",
+        };
         return Err(cx.err(format!(
-            "{key}.thickness: only plane_stress bodies have a thickness"
+            "{key}.thickness: only plane_stress bodies have a thickness; {why}"
         )));
     }
     if spec.area.is_some() && !is_rod {

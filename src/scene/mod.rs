@@ -60,8 +60,17 @@ pub fn from_str(text: &str, path: &Path, overrides: &[String]) -> Result<Model, 
                 .map_err(|m| InputError::new(path, format!("--set {assignment}: {m}")))?;
         }
         let edited = toml::to_string(&table).expect("a TOML table serializes");
+        // the edited text is not the user's file: its line numbers would mislead, so only
+        // the message (which names the key or value) is given
         toml::from_str(&edited).map_err(|e: toml::de::Error| {
-            InputError::new(path, format!("(as edited by --set) {e}"))
+            InputError::new(
+                path,
+                format!(
+                    "(as edited by --set {}) {}",
+                    overrides.join(" --set "),
+                    e.message()
+                ),
+            )
         })?
     };
     let base_dir: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();

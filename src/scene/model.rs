@@ -232,6 +232,38 @@ impl Reference {
 }
 
 impl Model {
+    /// Constrained DOFs: supports and prescribed-displacement loads (sorted, unique).
+    pub fn constrained_dofs(&self) -> Vec<usize> {
+        Model::constrained_dofs_of(&self.fixed_dofs, &self.loads)
+    }
+
+    /// The constrained DOFs of supports `fixed_dofs` and `loads` (for validation, before
+    /// the model exists).
+    pub(super) fn constrained_dofs_of(fixed_dofs: &[usize], loads: &[Load]) -> Vec<usize> {
+        let mut dofs = fixed_dofs.to_vec();
+        for load in loads {
+            match load {
+                Load::Displacement { nodes, x, y, .. } => {
+                    for n in nodes {
+                        if x.is_some() {
+                            dofs.push(2 * n);
+                        }
+                        if y.is_some() {
+                            dofs.push(2 * n + 1);
+                        }
+                    }
+                }
+                Load::Rotation { nodes, .. } | Load::Affine { nodes, .. } => {
+                    dofs.extend(nodes.iter().flat_map(|n| [2 * n, 2 * n + 1]))
+                }
+                _ => {}
+            }
+        }
+        dofs.sort_unstable();
+        dofs.dedup();
+        dofs
+    }
+
     pub fn dofs(&self) -> usize {
         2 * self.node_count
     }

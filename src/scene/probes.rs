@@ -16,6 +16,40 @@ pub(super) fn check_frame_times(cx: &Context, times: &[f64]) -> Result<(), Input
     Ok(())
 }
 
+/// The frame times of `output`: `frame_times` with the multiples of `frame_interval` up to
+/// `end_time` merged in (sorted; a multiple within 1e-9 relative of a listed time is that
+/// time).
+pub(super) fn frame_times(
+    cx: &Context,
+    output: &super::spec::OutputSpec,
+    end_time: f64,
+) -> Result<Vec<f64>, InputError> {
+    check_frame_times(cx, &output.frame_times)?;
+    let mut times = output.frame_times.clone();
+    if let Some(interval) = output.frame_interval {
+        if !(interval.is_finite() && interval > 0.0) {
+            return Err(cx.err(format!(
+                "output.frame_interval: must be a time > 0, got {interval}"
+            )));
+        }
+        let count = (end_time / interval * (1.0 + 1e-9)).floor();
+        if count > 1e6 {
+            return Err(cx.err(format!(
+                "output.frame_interval: {interval} asks for {count} frames up to the end time {end_time}; at most 1e6"
+            )));
+        }
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        for k in 1..=count as usize {
+            let t = (k as f64 * interval).min(end_time);
+            if !times.iter().any(|listed| close(*listed, t)) {
+                times.push(t);
+            }
+        }
+        times.sort_by(f64::total_cmp);
+    }
+    Ok(times)
+}
+
 /// The `[[output.probe]]` tables: each probe's members (global nodes or elements of its body)
 /// and its history.csv column.
 pub(super) fn probes(

@@ -10,10 +10,10 @@ use super::contacts::{check_contact_setup, contacts};
 use super::context::Context;
 use super::loads::{curves, default_curve, fixed_dofs, loads};
 use super::materials::materials;
-use super::model::{Analysis, Body, BodyKind, Model, SceneSource};
-use super::probes::{check_frame_times, probes};
+use super::model::{Analysis, Body, BodyKind, Load, Model, Probe, SceneSource};
+use super::probes::{frame_times, probes};
 use super::reference::reference;
-use super::spec::{IntegratorKind, Quadrature, Scene};
+use super::spec::{IntegratorKind, OutputSpec, Quadrature, Quantity, Scene, Statistic};
 use crate::contact::{ContactPair, Friction};
 use std::path::Path;
 
@@ -31,9 +31,10 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let fixed_dofs = fixed_dofs(&cx, &scene, &bodies)?;
     let loads = loads(&cx, &scene, &bodies, &curves, &default_curve)?;
     let probes = probes(&cx, &bodies, &scene.output.probe)?;
-    check_frame_times(&cx, &scene.output.frame_times)?;
+    let frame_times = frame_times(&cx, &scene.output, analysis.end_time())?;
     let contacts = contacts(&cx, &scene, &bodies)?;
     check_contact_setup(&cx, &scene, &bodies, &contacts)?;
+    check_reaction_probes(&cx, &probes, &fixed_dofs, &loads)?;
     check_reduced_quadrature(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
@@ -54,7 +55,10 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         fixed_dofs,
         loads,
         analysis,
-        output: scene.output,
+        output: OutputSpec {
+            frame_times,
+            ..scene.output
+        },
         probes,
         initial_velocity,
         reference,
@@ -62,6 +66,45 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         checkpoint_every: scene.analysis.checkpoint_every,
         source: SceneSource::default(),
     })
+}
+
+/// A reaction probe sums the support reactions of its set: the set needs a constrained DOF
+/// in the probe's direction (a support or a prescribed displacement), and the statistic is
+/// the sum (`mean`, the default, stands for it; `max` and `min` do not apply).
+fn check_reaction_probes(
+    cx: &Context,
+    probes: &[Probe],
+    fixed_dofs: &[usize],
+    loads: &[Load],
+) -> Result<(), InputError> {
+    let constrained = Model::constrained_dofs_of(fixed_dofs, loads);
+    for (k, probe) in probes.iter().enumerate() {
+        let component = match probe.quantity {
+            Quantity::ReactionX => 0,
+            Quantity::ReactionY => 1,
+            _ => continue,
+        };
+        if probe.statistic != Statistic::Mean {
+            return Err(cx.err(format!(
+                "output.probe[{k}].statistic: {} is the sum over the set; leave statistic out",
+                probe.quantity.name()
+            )));
+        }
+        let dof = |n: &usize| 2 * n + component;
+        if !probe
+            .members
+            .iter()
+            .any(|n| constrained.binary_search(&dof(n)).is_ok())
+        {
+            return Err(cx.err(format!(
+                "output.probe[{k}]: {} needs a node set with {} supported or prescribed;                  no node of `{}` has (the reaction would be 0)",
+                probe.quantity.name(),
+                ["x", "y"][component],
+                probe.column
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// One-point quadrature in a dynamic run covers Quad4 bodies only (no rods).

@@ -146,6 +146,8 @@ fn error_vs_wall(
         series,
         log_x: true,
         log_y: true,
+        x_limits: Default::default(),
+        y_limits: Default::default(),
     };
     both(&chart, out, "error_vs_wall")
 }
@@ -205,6 +207,8 @@ fn convergence(
                 series,
                 log_x: true,
                 log_y: true,
+                x_limits: Default::default(),
+                y_limits: Default::default(),
             };
             written.extend(both(&chart, out, &format!("error_vs_{name}"))?);
         }

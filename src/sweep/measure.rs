@@ -103,7 +103,14 @@ pub struct ReferenceUsed {
     pub finest: Option<String>,
     /// The observed order of the Richardson extrapolation of the peak force.
     pub richardson_order: Option<f64>,
+    /// What a column measures when it is not a discretization error (printed by the sweep).
+    pub notes: Vec<String>,
 }
+
+/// Why `peak_force_error` against a force pulse does not converge.
+pub const PULSE_PEAK_NOTE: &str = "peak_force_error against a force pulse measures the overshoot \
+    where the exact force jumps at t = 0 (the integrator's first steps), which does not shrink \
+    with dt or h: it is no discretization error; force_l2 and force_l2_smooth are";
 
 /// A finished case's files.
 struct Loaded {
@@ -258,6 +265,7 @@ fn pulse_reference(
         duration: Some(duration),
         finest: None,
         richardson_order: None,
+        notes: vec![PULSE_PEAK_NOTE.to_string()],
     }
 }
 
@@ -296,6 +304,7 @@ fn hertz_reference(
         duration: Some(duration),
         finest: None,
         richardson_order: None,
+        notes: Vec::new(),
     }
 }
 
@@ -326,6 +335,7 @@ fn finest_reference(
         duration: None,
         finest: None,
         richardson_order: None,
+        notes: Vec::new(),
     };
     let Some(&finest) = ok.first() else {
         return used;

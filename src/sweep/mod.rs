@@ -18,6 +18,7 @@ pub mod charts;
 pub mod measure;
 pub mod plan;
 
+use crate::analysis::progress::Mode;
 use crate::analysis::{self, RunError, RunOptions};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::{self, InputError, Model};
@@ -35,8 +36,9 @@ pub struct SweepOptions {
     pub jobs: usize,
     /// (i, n): run only the cases k with k mod n = i.
     pub shard: Option<(usize, usize)>,
-    /// Show a progress bar over the cases.
-    pub progress: bool,
+    /// A bar over the cases (with a line per finished case above it), a line per finished
+    /// case, or nothing.
+    pub progress: Mode,
 }
 
 /// What a sweep did.
@@ -55,6 +57,8 @@ pub struct Report {
     pub rows: Vec<measure::Row>,
     pub csv: PathBuf,
     pub charts: Vec<PathBuf>,
+    /// What some columns measure (reference.json `notes`), for the closing lines.
+    pub notes: Vec<String>,
 }
 
 fn output_error(path: &Path, action: &'static str, e: std::io::Error) -> RunError {
@@ -88,7 +92,7 @@ fn models(plan: &Plan, cases: &[Case]) -> Result<Vec<Model>, RunError> {
 pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, RunError> {
     let cases = plan.cases();
     let models = models(plan, &cases)?;
-    std::fs::create_dir_all(dir).map_err(|e| output_error(dir, "create", e))?;
+    crate::analysis::create_output_folder(dir)?;
     let plan_path = dir.join("sweep.json");
     if let Ok(text) = std::fs::read_to_string(&plan_path) {
         let existing: Option<Plan> = serde_json::from_str(&text).ok();
@@ -111,7 +115,7 @@ pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, Run
         .copied()
         .filter(|&k| !dir.join(plan.folder(&cases[k])).join("case.json").is_file())
         .collect();
-    let bar = if options.progress && !todo.is_empty() {
+    let bar = if options.progress == Mode::Bar && !todo.is_empty() {
         let bar = ProgressBar::new(todo.len() as u64);
         bar.set_style(
             ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} cases {msg}")
@@ -130,8 +134,18 @@ pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, Run
         todo.par_iter()
             .map(|&k| {
                 let result = run_case(plan, &cases[k], &models[k], dir);
+                if options.progress != Mode::Off
+                    && let Ok(record) = &result
+                {
+                    let line = case_line(record, cases.len());
+                    if bar.is_hidden() {
+                        eprintln!("{line}");
+                    } else {
+                        bar.println(line);
+                    }
+                }
                 bar.inc(1);
-                result
+                result.map(|_| ())
             })
             .collect()
     });
@@ -150,8 +164,29 @@ pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, Run
     Ok(report)
 }
 
-/// Runs one case into DIR/FOLDER (cleared first) on one thread; writes case.json last.
-fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<(), RunError> {
+/// `case 3 of 12 (analysis.dt=0.005): ok, 0.52 s` (and the message of a case not ok).
+fn case_line(record: &CaseRecord, cases: usize) -> String {
+    let values: Vec<String> = record
+        .values
+        .iter()
+        .map(|(key, value)| format!("{key}={value}"))
+        .collect();
+    let mut line = format!(
+        "case {} of {cases} ({}): {}, {:.2} s",
+        record.index + 1,
+        values.join(", "),
+        record.status,
+        record.wall_seconds
+    );
+    if let Some(message) = &record.message {
+        line.push_str(&format!(": {message}"));
+    }
+    line
+}
+
+/// Runs one case into DIR/FOLDER (cleared first) on one thread; writes case.json last and
+/// returns it.
+fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<CaseRecord, RunError> {
     let folder = dir.join(plan.folder(case));
     if folder.exists() {
         std::fs::remove_dir_all(&folder).map_err(|e| output_error(&folder, "clear", e))?;
@@ -188,7 +223,7 @@ fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<(), R
     };
     let text = serde_json::to_string_pretty(&record).expect("the record serializes");
     write_atomic(&folder.join("case.json"), text.as_bytes())?;
-    Ok(())
+    Ok(record)
 }
 
 /// Joins the finished cases of sweeps run into `dirs` (shards of one plan) and writes the
@@ -226,7 +261,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Report, RunError> {
                 .find(|f| f.join("case.json").is_file())
         })
         .collect();
-    std::fs::create_dir_all(out).map_err(|e| output_error(out, "create", e))?;
+    crate::analysis::create_output_folder(out)?;
     let text = serde_json::to_string_pretty(&plan).expect("the plan serializes");
     write_atomic(&out.join("sweep.json"), text.as_bytes())?;
     write_results(&plan, &cases, &models, &folders, out)
@@ -256,5 +291,6 @@ fn write_results(
         rows,
         csv,
         charts,
+        notes: reference.notes,
     })
 }

@@ -38,6 +38,23 @@ pub enum IntegratorKind {
     CentralDifference,
 }
 
+impl IntegratorKind {
+    /// The scene's name of the integrator (`average`, `central_difference`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Average => "average",
+            IntegratorKind::Linear => "linear",
+            IntegratorKind::Hu => "hu",
+            IntegratorKind::Newmark => "newmark",
+            IntegratorKind::Wilson => "wilson",
+            IntegratorKind::Houbolt => "houbolt",
+            IntegratorKind::Hht => "hht",
+            IntegratorKind::GeneralizedAlpha => "generalized_alpha",
+            IntegratorKind::CentralDifference => "central_difference",
+        }
+    }
+}
+
 /// Consistent (sum rho N^T N over the initial configuration) or lumped (row sums) mass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -10,8 +10,13 @@ pub struct OutputSpec {
     #[serde(default = "default_frame_every")]
     pub frame_every: usize,
     /// Times at which a frame is written besides (dynamic steps end exactly there).
+    /// Validation adds the multiples of `frame_interval` to it.
     #[serde(default)]
     pub frame_times: Vec<f64>,
+    /// A frame every this much simulated time (seconds in SI scenes), besides: the times
+    /// k * frame_interval up to the end time join `frame_times`.
+    #[serde(default)]
+    pub frame_interval: Option<f64>,
     /// `none` (default), `lz4` or `zlib` for the .vtu arrays.
     #[serde(default)]
     pub compression: Compression,
@@ -39,6 +44,7 @@ impl Default for OutputSpec {
         OutputSpec {
             frame_every: default_frame_every(),
             frame_times: Vec::new(),
+            frame_interval: None,
             compression: Compression::default(),
             points: FramePoints::default(),
             probe: Vec::new(),
@@ -70,6 +76,13 @@ pub enum Quantity {
     MomentumX,
     #[serde(rename = "p_y")]
     MomentumY,
+    /// Support reaction summed over the set's constrained DOFs: f_int - f_ext (+ m a with
+    /// the lumped mass in dynamics), the force the supports exert on the body; f_int the
+    /// internal force the step converged with.
+    #[serde(rename = "reaction_x")]
+    ReactionX,
+    #[serde(rename = "reaction_y")]
+    ReactionY,
     #[serde(rename = "s_xx")]
     StressXX,
     #[serde(rename = "s_yy")]
@@ -99,6 +112,8 @@ impl Quantity {
             Quantity::AccelerationY => "a_y",
             Quantity::MomentumX => "p_x",
             Quantity::MomentumY => "p_y",
+            Quantity::ReactionX => "reaction_x",
+            Quantity::ReactionY => "reaction_y",
             Quantity::StressXX => "s_xx",
             Quantity::StressYY => "s_yy",
             Quantity::StressXY => "s_xy",
@@ -121,6 +136,8 @@ impl Quantity {
                 | Quantity::AccelerationY
                 | Quantity::MomentumX
                 | Quantity::MomentumY
+                | Quantity::ReactionX
+                | Quantity::ReactionY
         )
     }
 }
@@ -133,7 +150,7 @@ pub struct ProbeSpec {
     pub quantity: Quantity,
     pub body: Option<String>,
     pub set: String,
-    /// How the set's values combine: `mean` (default; momentum: the sum), `max` or `min`
+    /// How the set's values combine: `mean` (default; momentum and reaction: the sum), `max` or `min`
     /// (over nodes, or over the elements' integration points).
     #[serde(default)]
     pub statistic: Statistic,

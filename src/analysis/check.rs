@@ -1,0 +1,218 @@
+//! What `impact check` says about a valid scene besides its size: per body the wave speed
+//! of its formulation and the yield strain of its material, and the time step against the
+//! stability limit of the chosen integrator (with the same refusal as a run).
+//!
+//! Legend
+//! ```text
+//! c            dilatational wave speed: sqrt(M / rho) with the constrained modulus M of the
+//!              formulation: lambda + 2 mu (plane strain, axisymmetric), E / (1 - nu^2)
+//!              (plane stress), E (rod)
+//! eps_y        yield strain sigma_y / E (the initial yield stress)
+//! dt_crit      central difference: 2 / omega_max (element eigenvalue bound);
+//!              Newmark (gamma >= 1/2, beta < gamma / 2): Omega_crit / omega_max with
+//!              Omega_crit = 1 / sqrt(gamma / 2 - beta) (Hughes 1987, section 9.1; 2 sqrt 3 for
+//!              linear acceleration); beta >= gamma / 2 >= 1/4: unconditionally stable;
+//!              Wilson-theta: unconditionally stable for theta >= 1.37 only
+//! ```
+
+use super::explicit::{StableStep, checked_step, critical_time_step};
+use crate::element::Formulation;
+use crate::output::readable;
+use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind, TimeStep};
+use crate::scene::{BodyKind, InputError, Model};
+
+/// A body's wave speed and the modulus it comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WaveSpeed {
+    /// sqrt(modulus / rho).
+    pub speed: f64,
+    pub modulus: f64,
+    /// The modulus in words: `lambda + 2 mu (plane strain)`, ...
+    pub modulus_name: &'static str,
+}
+
+/// The dilatational wave speed of `body`'s material in its formulation (None without
+/// density: a static scene may leave it out).
+pub fn wave_speed(body: &crate::scene::Body) -> Option<WaveSpeed> {
+    let m = &body.material;
+    if m.density <= 0.0 {
+        return None;
+    }
+    let e = &m.elastic;
+    let (lambda, mu) = e.lame();
+    let (modulus, modulus_name) = match body.kind {
+        BodyKind::Rod { .. } => (e.young, "E (rod)"),
+        BodyKind::Continuum { formulation, .. } => match formulation {
+            Formulation::PlaneStrain => (lambda + 2.0 * mu, "lambda + 2 mu (plane strain)"),
+            Formulation::Axisymmetric => (lambda + 2.0 * mu, "lambda + 2 mu (axisymmetric)"),
+            Formulation::PlaneStress => (
+                e.young / (1.0 - e.poisson * e.poisson),
+                "E / (1 - nu^2) (plane stress)",
+            ),
+        },
+    };
+    Some(WaveSpeed {
+        speed: (modulus / m.density).sqrt(),
+        modulus,
+        modulus_name,
+    })
+}
+
+/// The body's kind in words: `plane strain, B-bar`, `plane stress, thickness 0.01`, ...
+pub fn kind_in_words(kind: BodyKind) -> String {
+    match kind {
+        BodyKind::Rod { area } => format!("rod, area {}", readable(area)),
+        BodyKind::Continuum {
+            formulation,
+            bbar,
+            thickness,
+        } => {
+            let name = match formulation {
+                Formulation::PlaneStrain => "plane strain (per unit depth)".to_string(),
+                Formulation::PlaneStress => {
+                    format!("plane stress, thickness {}", readable(thickness))
+                }
+                Formulation::Axisymmetric => "axisymmetric (full ring)".to_string(),
+            };
+            if bbar { format!("{name}, B-bar") } else { name }
+        }
+    }
+}
+
+/// How the time step of a dynamic analysis stands against its integrator's limit.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepStability {
+    /// The integrator has no limit: dt over the central-difference limit tells how many
+    /// shortest-element transits a step spans (accuracy, not stability).
+    Unconditional { dt: f64, dt_crit_explicit: f64 },
+    /// A limit dt_crit (central difference, linear acceleration, a conditional Newmark).
+    Conditional { dt: Option<f64>, dt_crit: f64 },
+    /// Newmark with gamma < 1/2: unstable at any dt.
+    Unstable,
+    /// Wilson-theta with theta < 1.37: conditionally stable, its limit not computed here.
+    WilsonBelowLimit { dt: f64, dt_crit_explicit: f64 },
+}
+
+/// The step of `spec` against the stability limit of its integrator; a central-difference
+/// fixed dt above its limit is refused exactly as a run refuses it.
+pub fn step_stability(model: &Model, spec: &DynamicSpec) -> Result<StepStability, InputError> {
+    let has_mass = model.bodies.iter().all(|b| b.material.density > 0.0);
+    if spec.integrator == IntegratorKind::CentralDifference {
+        let StableStep { dt: dt_crit, .. } = checked_step(model, spec)?;
+        let dt = match spec.step {
+            TimeStep::Fixed(dt) => Some(dt),
+            TimeStep::Auto { scale, .. } => Some(scale * dt_crit),
+        };
+        return Ok(StepStability::Conditional { dt, dt_crit });
+    }
+    let dt = spec.dt();
+    let newmark = matches!(
+        spec.integrator,
+        IntegratorKind::Average | IntegratorKind::Linear | IntegratorKind::Newmark
+    );
+    if newmark && spec.gamma < 0.5 {
+        return Ok(StepStability::Unstable);
+    }
+    let explicit = if has_mass {
+        critical_time_step(model)?.dt
+    } else {
+        f64::NAN
+    };
+    if spec.integrator == IntegratorKind::Wilson && spec.theta < 1.37 {
+        return Ok(StepStability::WilsonBelowLimit {
+            dt,
+            dt_crit_explicit: explicit,
+        });
+    }
+    if newmark && spec.beta < 0.5 * spec.gamma {
+        // omega_max = 2 / dt_crit(central difference)
+        let omega_crit = 1.0 / (0.5 * spec.gamma - spec.beta).sqrt();
+        return Ok(StepStability::Conditional {
+            dt: Some(dt),
+            dt_crit: 0.5 * omega_crit * explicit,
+        });
+    }
+    Ok(StepStability::Unconditional {
+        dt,
+        dt_crit_explicit: explicit,
+    })
+}
+
+/// The lines `impact check` prints after the model's size.
+pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
+    let mut lines = Vec::new();
+    for body in &model.bodies {
+        let m = &body.material;
+        let mut parts = Vec::new();
+        if let Some(c) = wave_speed(body) {
+            parts.push(format!(
+                "wave speed c = sqrt(M / rho) = {} with M = {} = {}",
+                readable(c.speed),
+                c.modulus_name,
+                readable(c.modulus)
+            ));
+        }
+        if let Some(j2) = &m.plasticity {
+            parts.push(format!(
+                "yield strain sigma_y / E = {}",
+                readable(j2.yield_stress / m.elastic.young)
+            ));
+        } else {
+            parts.push("elastic".into());
+        }
+        lines.push(format!(
+            "body `{}` (material `{}`): {}",
+            body.name,
+            m.name,
+            parts.join("; ")
+        ));
+    }
+    if let crate::scene::model::Analysis::Dynamic(spec) = &model.analysis {
+        let name = spec.integrator.name();
+        lines.push(match step_stability(model, spec)? {
+            StepStability::Conditional { dt: Some(dt), dt_crit } => format!(
+                "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}{}",
+                readable(dt),
+                readable(dt_crit),
+                readable(dt / dt_crit),
+                if spec.mass == MassKind::Consistent {
+                    " (from the lumped-mass frequency bound: the consistent mass's highest \
+                     frequency is higher, sqrt 3 times for rods, so its limit is lower)"
+                } else {
+                    ""
+                }
+            ),
+            StepStability::Conditional { dt: None, dt_crit } => format!(
+                "integrator {name}: stability limit dt_crit = {}",
+                readable(dt_crit)
+            ),
+            StepStability::Unconditional {
+                dt,
+                dt_crit_explicit,
+            } if dt_crit_explicit.is_finite() => format!(
+                "integrator {name}: unconditionally stable; dt = {} is {} times the central-difference limit {} (about the number of elements a wave crosses in one step)",
+                readable(dt),
+                readable(dt / dt_crit_explicit),
+                readable(dt_crit_explicit)
+            ),
+            StepStability::Unconditional { dt, .. } => {
+                format!("integrator {name}: unconditionally stable; dt = {}", readable(dt))
+            }
+            StepStability::WilsonBelowLimit {
+                dt,
+                dt_crit_explicit,
+            } => format!(
+                "integrator {name}: theta = {} < 1.37 is only conditionally stable; dt = {} is {} times the central-difference limit {}",
+                readable(spec.theta),
+                readable(dt),
+                readable(dt / dt_crit_explicit),
+                readable(dt_crit_explicit)
+            ),
+            StepStability::Unstable => format!(
+                "integrator {name}: gamma = {} < 1/2 is unstable at any dt",
+                readable(spec.gamma)
+            ),
+        });
+    }
+    Ok(lines)
+}
