@@ -122,6 +122,10 @@ enum Command {
         /// Output folder. Default: output/bench/
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Instead of the generated plan: every scene of models/ (in the current folder) as
+        /// shipped, frames off, one child process each.
+        #[arg(long)]
+        scenes: bool,
     },
     /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
     Plot {
@@ -208,7 +212,12 @@ fn main() -> ExitCode {
             out,
             quiet,
         ),
-        Command::Bench { quick, cases, out } => bench(quick, &cases, out),
+        Command::Bench {
+            quick,
+            cases,
+            out,
+            scenes,
+        } => bench(quick, scenes, &cases, out),
         Command::Plot {
             history,
             y,
@@ -288,7 +297,7 @@ fn run_options(progress: Progress) -> RunOptions {
     }
 }
 
-fn bench(quick: bool, only: &[String], out: Option<PathBuf>) -> Result<(), RunError> {
+fn bench(quick: bool, scenes: bool, only: &[String], out: Option<PathBuf>) -> Result<(), RunError> {
     let exe = std::env::current_exe().map_err(|e| {
         RunError::Output(OutputError::Io {
             path: PathBuf::from("impact"),
@@ -297,7 +306,15 @@ fn bench(quick: bool, only: &[String], out: Option<PathBuf>) -> Result<(), RunEr
         })
     })?;
     let dir = out.unwrap_or_else(impact::bench::default_dir);
-    let cases: Vec<_> = impact::bench::plan(quick)
+    let plan = if scenes {
+        let models = Path::new("models");
+        impact::bench::scene_cases(models).map_err(|message| {
+            RunError::Input(impact::scene::InputError::new(Path::new("impact bench --scenes"), message))
+        })?
+    } else {
+        impact::bench::plan(quick)
+    };
+    let cases: Vec<_> = plan
         .into_iter()
         .filter(|c| only.is_empty() || only.iter().any(|text| c.name.contains(text.as_str())))
         .collect();

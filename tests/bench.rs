@@ -88,3 +88,27 @@ fn bench_case_filter_runs_matching_cases_and_rejects_an_empty_selection() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("no_such_case"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Goal: `impact bench --scenes` runs the shipped scenes as they are. Setup: `--scenes --case
+/// scene_two_bars --case scene_bar_wall` from the repository root. Reference: the scenes' own steps,
+/// end_time / dt = 0.4 / 0.005 = 80 each (Newmark at a fixed step, no cut), status ok.
+#[test]
+fn bench_scenes_runs_the_shipped_scenes() {
+    let dir = std::env::temp_dir().join(format!("impact_bench_scenes_{}", std::process::id()));
+    let o = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(["bench", "--scenes", "--case", "scene_two_bars", "--case", "scene_bar_wall", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows: Vec<impact::bench::Row> =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(names, ["scene_bar_wall", "scene_two_bars"]);
+    for row in &rows {
+        assert_eq!(row.status, "ok");
+        assert_eq!(row.steps, 80, "{}", row.name);
+        assert!(row.scene.as_deref().is_some_and(|s| s.ends_with(".toml")));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -8,7 +8,10 @@
 //! explicit: central difference at dt = 0.5 h / c (below its limit h / c for these squares).
 //! Each case is a child `impact run` so that its peak memory is its own.
 
+mod scenes;
 mod taylor;
+
+pub use scenes::cases as scene_cases;
 
 use crate::output::plot::{self, Chart, Series, SeriesStyle};
 use crate::output::{OutputError, write_atomic};
