@@ -75,16 +75,18 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
             .iter()
             .map(|c| c.options.tolerance)
             .fold(0.0, f64::max);
-        let bound = tolerance.max(PENETRATION_SHARE * spacing);
+        // a pair with one slave has no spacing: TOL alone then
+        let share = if spacing.is_finite() { PENETRATION_SHARE * spacing } else { 0.0 };
+        let bound = tolerance.max(share);
         if depth > bound {
             out.push(format!(
-                "contact: a node went {} deep into the other body, more than {} % of the slave \
-                 node spacing {}; history.csv `penetration` shows when (a master node sinking \
-                 into the slave body is not seen by one-pass contact: swap the roles or refine \
-                 the slave surface)",
+                "contact: a node went {} deep into the other body, beyond {} (the larger of TOL \
+                 and {} % of the slave node spacing); history.csv `penetration` shows when (a \
+                 master node sinking into the slave body is not seen by one-pass contact: swap \
+                 the roles or refine the slave surface)",
                 readable(depth),
-                100.0 * PENETRATION_SHARE,
-                readable(spacing)
+                readable(bound),
+                100.0 * PENETRATION_SHARE
             ));
         }
     }
