@@ -222,9 +222,9 @@ impl<'a> Dynamics<'a> {
             &self.model.contacts,
             positions,
             nominal,
-            |h, active, forces, tangential| {
+            |h, active, forces, tangential, warm| {
                 let constraints = (h, active, forces, tangential);
-                attempt.solve(constraints, system, solver, factored_for, counters)
+                attempt.solve(constraints, warm, system, solver, factored_for, counters)
             },
         )?;
         let h = step.length;
@@ -345,6 +345,7 @@ impl Attempt<'_> {
     fn solve(
         &self,
         constraints: (f64, &[(usize, usize)], Vec<f64>, &[Tangential]),
+        warm: Option<&[f64]>,
         system: &mut System,
         solver: &mut Solver,
         factored_for: &mut Option<[f64; 3]>,
@@ -354,12 +355,16 @@ impl Attempt<'_> {
         let (model, spec, state) = (self.model, self.spec, self.state);
         let form = self.method.form(h, self.kin);
         let solve_time = state.time + form.solve_fraction * h;
-        let mut d: Vec<f64> = self
-            .kin
-            .velocity
-            .iter()
-            .map(|v| form.solve_fraction * h * v)
-            .collect();
+        // the predictor h v, or the increment the last active set converged to
+        let mut d: Vec<f64> = match warm {
+            Some(d) => d.to_vec(),
+            None => self
+                .kin
+                .velocity
+                .iter()
+                .map(|v| form.solve_fraction * h * v)
+                .collect(),
+        };
         for (dof, value) in loads::prescribed(model, self.initial, solve_time) {
             d[dof] = value - self.kin.displacement[dof];
         }

@@ -106,6 +106,7 @@ impl Increment<'_> {
     fn attempt(
         &self,
         constraints: (f64, &[(usize, usize)], Vec<f64>, &[Tangential]),
+        warm: Option<&[f64]>,
         system: &mut System,
         solver: &mut Solver,
         counters: &mut Counters,
@@ -117,7 +118,8 @@ impl Increment<'_> {
         } else {
             state.time + h
         };
-        let mut d = vec![0.0; model.dofs()];
+        // zero, or the increment the last active set converged to
+        let mut d = warm.map_or_else(|| vec![0.0; model.dofs()], <[f64]>::to_vec);
         for (dof, value) in loads::prescribed(model, self.initial, end) {
             d[dof] = value - state.displacement[dof];
         }
@@ -233,8 +235,9 @@ impl Stepper for Statics<'_> {
                 &self.model.contacts,
                 &positions,
                 target - self.state.time,
-                |h, active, forces, tangential| {
-                    increment.attempt((h, active, forces, tangential), system, solver, counters)
+                |h, active, forces, tangential, warm| {
+                    let constraints = (h, active, forces, tangential);
+                    increment.attempt(constraints, warm, system, solver, counters)
                 },
             );
             match outcome {

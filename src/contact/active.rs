@@ -208,27 +208,38 @@ impl ContactState {
     }
 
     /// Runs one step with contact from the positions `start`. `solve(length, active (pair,
-    /// slave node), forces, tangential conditions)` solves the step for a given active set.
+    /// slave node), forces, tangential conditions, warm start)` solves the step for a given
+    /// active set; after a change of the active set at the same length, the last pass's
+    /// increment is handed over as the warm start (Newton then starts at the solution it had,
+    /// not at the predictor again); after a split or a change of a slip status none.
     pub fn step<S: ConstrainedSolution, E: From<Unsettled>>(
         &self,
         pairs: &[ContactPair],
         start: &[[f64; 2]],
         length: f64,
-        mut solve: impl FnMut(f64, &[(usize, usize)], Vec<f64>, &[Tangential]) -> Result<S, E>,
+        mut solve: impl FnMut(
+            f64,
+            &[(usize, usize)],
+            Vec<f64>,
+            &[Tangential],
+            Option<&[f64]>,
+        ) -> Result<S, E>,
     ) -> Result<ContactResult<S>, E> {
         let (mut entries, mut forces) = self.entries();
         let mut slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(pairs, *e)).collect();
         let mut returned = false;
         let mut length = length;
         let mut split = false;
+        let mut warm: Option<Vec<f64>> = None;
         for pass in 0..100 {
             let nodes: Vec<(usize, usize)> = entries
                 .iter()
                 .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
                 .collect();
             let tangential = tangential_conditions(&slips);
-            let solution = solve(length, &nodes, forces.clone(), &tangential)?;
+            let solution = solve(length, &nodes, forces.clone(), &tangential, warm.as_deref())?;
             let (normal, d) = (solution.normal_forces(), solution.increment());
+            warm = Some(d.to_vec());
             // release entries in tension, most negative first, and solve again
             if let Some(worst) = (0..entries.len())
                 .filter(|i| normal[*i] < 0.0)
@@ -286,7 +297,11 @@ impl ContactState {
                     }
                 }
                 if changed && pass < 50 {
+                    // a new slip status starts from the predictor: from the last increment
+                    // the sliding equality |t| = mu tau lands at the Newton tolerance, not
+                    // below it
                     forces = normal.to_vec();
+                    warm = None;
                     continue;
                 }
                 let forces = normal.to_vec();
@@ -304,6 +319,7 @@ impl ContactState {
                 length *= alpha;
                 split = true;
                 returned = false;
+                warm = None;
                 forces = normal.to_vec();
                 continue;
             }
