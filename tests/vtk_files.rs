@@ -96,6 +96,25 @@ fn assert_initial_grid(points: &[[f64; 2]]) {
     assert_eq!(lattice, expected);
 }
 
+/// Asserts that a frame's points are its `reference_coordinates` plus its `displacement`
+/// within `tolerance`; returns the largest displacement.
+fn points_are_reference_plus_displacement(frame: &FrameData, tolerance: f64, what: &str) -> f64 {
+    let reference = rows(frame, Section::PointData, "reference_coordinates");
+    let u = rows(frame, Section::PointData, "displacement");
+    let points = rows(frame, Section::Points, "Points");
+    let mut largest: f64 = 0.0;
+    for ((x, reference), u) in points.iter().zip(&reference).zip(&u) {
+        for c in 0..2 {
+            assert!(
+                (x[c] - (reference[c] + u[c])).abs() <= tolerance,
+                "{what}: point {x:?}, reference {reference:?} + displacement {u:?}"
+            );
+        }
+        largest = largest.max(u[0].hypot(u[1]));
+    }
+    largest
+}
+
 /// Goal: a frame's points are the current configuration, the initial coordinates plus the
 /// displacement, to round-off; `reference_coordinates` holds the initial coordinates.
 /// Setup: the finite-strain cantilever above (tip displacement about 1.3, a third of the
@@ -114,20 +133,8 @@ fn frame_points_are_reference_coordinates_plus_displacement() {
         assert_eq!(frames.len(), 9, "{case}");
         let mut largest: f64 = 0.0;
         for frame in &frames {
-            let reference = rows(frame, Section::PointData, "reference_coordinates");
-            assert_initial_grid(&reference);
-            let u = rows(frame, Section::PointData, "displacement");
-            let points = rows(frame, Section::Points, "Points");
-            for ((x, reference), u) in points.iter().zip(&reference).zip(&u) {
-                for c in 0..2 {
-                    let expected = reference[c] + u[c];
-                    assert!(
-                        (x[c] - expected).abs() <= 1e-12 * 4.0,
-                        "{case}: point {x:?}, reference {reference:?} + displacement {u:?}"
-                    );
-                }
-                largest = largest.max(u[1].abs());
-            }
+            assert_initial_grid(&rows(frame, Section::PointData, "reference_coordinates"));
+            largest = largest.max(points_are_reference_plus_displacement(frame, 1e-12 * 4.0, case));
         }
         assert!(largest > 1.0, "{case}: the tip moves by {largest}");
     }
@@ -158,19 +165,8 @@ fn dynamic_frames_show_the_current_configuration() {
         assert!(frames.len() > 2, "{scene}");
         let mut largest: f64 = 0.0;
         for frame in &frames {
-            let reference = rows(frame, Section::PointData, "reference_coordinates");
-            let u = rows(frame, Section::PointData, "displacement");
-            let points = rows(frame, Section::Points, "Points");
-            for ((x, reference), u) in points.iter().zip(&reference).zip(&u) {
-                for c in 0..2 {
-                    let expected = reference[c] + u[c];
-                    assert!(
-                        (x[c] - expected).abs() <= 1e-12 * length,
-                        "{scene} {quadrature}: point {x:?}, reference {reference:?} + {u:?}"
-                    );
-                }
-                largest = largest.max(u[0].hypot(u[1]));
-            }
+            let what = format!("{scene} {quadrature}");
+            largest = largest.max(points_are_reference_plus_displacement(frame, 1e-12 * length, &what));
         }
         assert!(largest > 0.05 * length, "{scene} {quadrature}: moves {largest}");
     }
