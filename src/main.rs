@@ -178,8 +178,7 @@ fn main() -> ExitCode {
             if let Some(n) = checkpoint_every {
                 set.push(format!("analysis.checkpoint_every={n}"));
             }
-            progress_mode(quiet, progress_every)
-                .and_then(|p| run(&scene, out, &set, p, strict))
+            progress_mode(quiet, progress_every).and_then(|p| run(&scene, out, &set, p, strict))
         }
         Command::Resume {
             dir,
@@ -309,7 +308,10 @@ fn bench(quick: bool, scenes: bool, only: &[String], out: Option<PathBuf>) -> Re
     let plan = if scenes {
         let models = Path::new("models");
         impact::bench::scene_cases(models).map_err(|message| {
-            RunError::Input(impact::scene::InputError::new(Path::new("impact bench --scenes"), message))
+            RunError::Input(impact::scene::InputError::new(
+                Path::new("impact bench --scenes"),
+                message,
+            ))
         })?
     } else {
         impact::bench::plan(quick)

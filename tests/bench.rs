@@ -96,7 +96,15 @@ fn bench_case_filter_runs_matching_cases_and_rejects_an_empty_selection() {
 fn bench_scenes_runs_the_shipped_scenes() {
     let dir = std::env::temp_dir().join(format!("impact_bench_scenes_{}", std::process::id()));
     let o = Command::new(env!("CARGO_BIN_EXE_impact"))
-        .args(["bench", "--scenes", "--case", "scene_two_bars", "--case", "scene_bar_wall", "--out"])
+        .args([
+            "bench",
+            "--scenes",
+            "--case",
+            "scene_two_bars",
+            "--case",
+            "scene_bar_wall",
+            "--out",
+        ])
         .arg(&dir)
         .output()
         .unwrap();

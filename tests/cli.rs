@@ -38,7 +38,6 @@ quantity = "u_y"
 set = "right"
 "#;
 
-
 fn write_scene(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();

@@ -141,8 +141,11 @@ fn uniaxial_cycle_energy_terms_match_the_closed_form() {
         ("hardening_modulus = 10.0", 10.0, 0.0),
         ("kinematic_modulus = 10.0", 0.0, 10.0),
     ] {
-        let text = format!("{}\n{ROD}", CYCLE.replace("hardening_modulus = 10.0", hardening))
-            .replace("end_nodes", "end");
+        let text = format!(
+            "{}\n{ROD}",
+            CYCLE.replace("hardening_modulus = 10.0", hardening)
+        )
+        .replace("end_nodes", "end");
         let model = common::model("cycle_energy", &text, &[]);
         let dir = common::out_dir(&format!("cycle_energy_{h_kin}"));
         impact::analysis::run(&model, &dir, Default::default()).unwrap();
@@ -154,7 +157,10 @@ fn uniaxial_cycle_energy_terms_match_the_closed_form() {
         let largest = stored.iter().fold(0.0f64, |m, w| m.max(*w));
         for (k, (w, s)) in stored.iter().zip(&exact).enumerate() {
             let expected = s * s / (2.0 * young);
-            assert!((w - expected).abs() <= 1e-10 * largest, "step {k}: {w} vs {expected}");
+            assert!(
+                (w - expected).abs() <= 1e-10 * largest,
+                "step {k}: {w} vs {expected}"
+            );
         }
         // the dissipation along the path, fine sub-steps between the recorded strains
         let mut dissipation = vec![0.0];
@@ -175,11 +181,24 @@ fn uniaxial_cycle_energy_terms_match_the_closed_form() {
         }
         let total = *dissipation.last().unwrap();
         assert!(total > 5e-3, "the cycle must dissipate: {total}");
-        let worst = (0..strain.len()).map(|k| (plastic[k] - dissipation[k]).abs()).fold(0.0, f64::max);
-        println!("kinematic {h_kin}: dissipation {total:.6e}, largest error {:.2e} relative", worst / total);
+        let worst = (0..strain.len())
+            .map(|k| (plastic[k] - dissipation[k]).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "kinematic {h_kin}: dissipation {total:.6e}, largest error {:.2e} relative",
+            worst / total
+        );
         for k in 0..strain.len() {
-            assert!((plastic[k] - dissipation[k]).abs() <= 5e-3 * total, "step {k}: {} vs {}", plastic[k], dissipation[k]);
-            assert!(k == 0 || plastic[k] >= plastic[k - 1], "step {k}: dissipation decreased");
+            assert!(
+                (plastic[k] - dissipation[k]).abs() <= 5e-3 * total,
+                "step {k}: {} vs {}",
+                plastic[k],
+                dissipation[k]
+            );
+            assert!(
+                k == 0 || plastic[k] >= plastic[k - 1],
+                "step {k}: dissipation decreased"
+            );
             assert!(plastic[k] <= external[k] + 1e-12, "step {k}");
         }
     }

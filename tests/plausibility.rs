@@ -26,7 +26,10 @@ fn refused(scene: &str, sets: &[&str], words: &[&str]) {
         args.push((*s).into());
     }
     let dir = dir.to_str().unwrap().to_string();
-    for command in [vec!["check", scene], vec!["run", scene, "--quiet", "--out", &dir]] {
+    for command in [
+        vec!["check", scene],
+        vec!["run", scene, "--quiet", "--out", &dir],
+    ] {
         let mut all: Vec<&str> = command.clone();
         all.extend(args.iter().map(String::as_str));
         let o = impact(&all);
@@ -56,7 +59,11 @@ fn a_node_to_node_normal_into_the_master_body_is_refused() {
     refused(
         "models/two_bars.toml",
         &swap,
-        &["contact `bars`", "normal", "contact.bars.setup_check = false"],
+        &[
+            "contact `bars`",
+            "normal",
+            "contact.bars.setup_check = false",
+        ],
     );
     // the key that accepts it: the run goes through as before (and the bars pass)
     let dir = out_dir("swapped_accepted");
@@ -122,7 +129,14 @@ fn a_master_sinking_into_the_slave_body_is_reported() {
     ];
     let dir = out_dir("round_bar_swapped");
     let d = dir.to_str().unwrap().to_string();
-    let mut args = vec!["run", "models/round_bar.toml", "--quiet", "--strict", "--out", &d];
+    let mut args = vec![
+        "run",
+        "models/round_bar.toml",
+        "--quiet",
+        "--strict",
+        "--out",
+        &d,
+    ];
     let sets: Vec<String> = swap
         .iter()
         .flat_map(|s| ["--set".to_string(), s.to_string()])
@@ -130,7 +144,11 @@ fn a_master_sinking_into_the_slave_body_is_reported() {
     args.extend(sets.iter().map(String::as_str));
     let o = impact(&args);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
-    assert!(text(&o).contains("warning: contact: a node went"), "{}", text(&o));
+    assert!(
+        text(&o).contains("warning: contact: a node went"),
+        "{}",
+        text(&o)
+    );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["status"], "ok");
@@ -142,7 +160,14 @@ fn a_master_sinking_into_the_slave_body_is_reported() {
 
     let dir = out_dir("round_bar_as_given");
     let d = dir.to_str().unwrap().to_string();
-    let o = impact(&["run", "models/round_bar.toml", "--quiet", "--strict", "--out", &d]);
+    let o = impact(&[
+        "run",
+        "models/round_bar.toml",
+        "--quiet",
+        "--strict",
+        "--out",
+        &d,
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
@@ -224,6 +249,13 @@ fn steps_too_long_for_the_run_or_the_impact_warn() {
     }
     let dir = out_dir("block_dt_fine");
     let d = dir.to_str().unwrap().to_string();
-    let o = impact(&["run", scene.to_str().unwrap(), "--quiet", "--strict", "--out", &d]);
+    let o = impact(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "--strict",
+        "--out",
+        &d,
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 }

@@ -205,7 +205,6 @@ fn write_history(dir: &Path) -> std::path::PathBuf {
     path
 }
 
-
 /// Goal: `impact plot` exits 0 and writes the chart (with a reference run overlaid); an unknown
 /// column or a missing history exits 2 with a message naming it; clap's own errors also exit 2.
 #[test]

@@ -101,7 +101,10 @@ fn every_scene_runs_and_writes_the_output_contract() {
         .flatten()
         .fold(0.0f64, |m, x| m.max(x.abs()));
         for (k, w) in stored.iter().enumerate() {
-            assert!(*w >= -1e-12 * scale, "{name}: stored energy {w} < 0 at row {k}");
+            assert!(
+                *w >= -1e-12 * scale,
+                "{name}: stored energy {w} < 0 at row {k}"
+            );
         }
         let frames = impact::output::vtk::read_pvd(&dir.join(format!("{name}.pvd"))).unwrap();
         assert!(frames.len() >= 2, "{name}: frames");

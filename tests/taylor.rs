@@ -190,10 +190,16 @@ fn taylor_jc_implicit_average_lands_with_the_explicit_run() {
 /// The Johnson-Cook rod of models/taylor_jc.toml on a frictionless rigid wall (an obstacle
 /// with contact) in place of the held impact face: the face slides out and its nodes are
 /// released and struck again as the rod rebounds.
-fn taylor_jc_on_contact_wall(name: &str, overrides: &[&str]) -> ([f64; 4], impact::analysis::Summary) {
+fn taylor_jc_on_contact_wall(
+    name: &str,
+    overrides: &[&str],
+) -> ([f64; 4], impact::analysis::Summary) {
     let text = std::fs::read_to_string("models/taylor_jc.toml").unwrap();
     let held = "[[support]]\nset = \"bottom\"\nfix = [\"y\"]\n";
-    assert!(text.contains(held), "models/taylor_jc.toml holds its face with a support");
+    assert!(
+        text.contains(held),
+        "models/taylor_jc.toml holds its face with a support"
+    );
     let wall = "[[obstacle]]\nname = \"wall\"\npoints = [[0.02, 0.0], [-0.01, 0.0]]\n\n\
                 [[contact]]\nname = \"wall\"\nslave = { set = \"bottom\" }\nobstacle = \"wall\"\n";
     let mut all = vec!["output.frame_every=0"];
@@ -220,7 +226,12 @@ fn taylor_jc_on_a_contact_wall_runs_implicit_through_the_release() {
         "taylor_jc_contact_average",
         &["analysis.integrator=average", "analysis.dt=1e-7"],
     );
-    assert_eq!(summary.status, impact::analysis::Status::Ok, "{:?}", summary.message);
+    assert_eq!(
+        summary.status,
+        impact::analysis::Status::Ok,
+        "{:?}",
+        summary.message
+    );
     assert!(summary.contact.last_release_time.is_some());
     let (explicit, _) = taylor_jc_on_contact_wall("taylor_jc_contact_explicit", &[]);
     let d = deviations(&implicit, &explicit);

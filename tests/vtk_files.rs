@@ -134,7 +134,11 @@ fn frame_points_are_reference_coordinates_plus_displacement() {
         let mut largest: f64 = 0.0;
         for frame in &frames {
             assert_initial_grid(&rows(frame, Section::PointData, "reference_coordinates"));
-            largest = largest.max(points_are_reference_plus_displacement(frame, 1e-12 * 4.0, case));
+            largest = largest.max(points_are_reference_plus_displacement(
+                frame,
+                1e-12 * 4.0,
+                case,
+            ));
         }
         assert!(largest > 1.0, "{case}: the tip moves by {largest}");
     }
@@ -166,9 +170,16 @@ fn dynamic_frames_show_the_current_configuration() {
         let mut largest: f64 = 0.0;
         for frame in &frames {
             let what = format!("{scene} {quadrature}");
-            largest = largest.max(points_are_reference_plus_displacement(frame, 1e-12 * length, &what));
+            largest = largest.max(points_are_reference_plus_displacement(
+                frame,
+                1e-12 * length,
+                &what,
+            ));
         }
-        assert!(largest > 0.05 * length, "{scene} {quadrature}: moves {largest}");
+        assert!(
+            largest > 0.05 * length,
+            "{scene} {quadrature}: moves {largest}"
+        );
     }
 }
 

@@ -76,7 +76,11 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
             .map(|c| c.options.tolerance)
             .fold(0.0, f64::max);
         // a pair with one slave has no spacing: TOL alone then
-        let share = if spacing.is_finite() { PENETRATION_SHARE * spacing } else { 0.0 };
+        let share = if spacing.is_finite() {
+            PENETRATION_SHARE * spacing
+        } else {
+            0.0
+        };
         let bound = tolerance.max(share);
         if depth > bound {
             out.push(format!(
@@ -114,7 +118,10 @@ fn time_step_warning(model: &Model, summary: &Summary) -> Option<String> {
         return None;
     }
     // the contact's length in steps: to the last release, or to the end while still closed
-    let last = summary.contact.last_release_time.unwrap_or(summary.end_time);
+    let last = summary
+        .contact
+        .last_release_time
+        .unwrap_or(summary.end_time);
     let contact_steps = (last - first.unwrap_or(0.0)) / dt;
     if contact_steps >= CONTACT_STEPS {
         return None;

@@ -263,7 +263,13 @@ impl<'a, S: Stepper> Run<'a, S> {
             return Err(self.fail_step(e));
         }
         let e = self.stepper.energies();
-        let energies = [e.kinetic, e.internal, e.plastic_work, e.external_work, e.contact_work];
+        let energies = [
+            e.kinetic,
+            e.internal,
+            e.plastic_work,
+            e.external_work,
+            e.contact_work,
+        ];
         if energies.iter().any(|x| !x.is_finite()) {
             let time = self.stepper.state().time;
             let message = format!(

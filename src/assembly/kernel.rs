@@ -189,7 +189,11 @@ impl Kernel {
                 let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
                 // 1/2 (S_n + S_{n+1}) dep, as the work (see trapezoid_dissipation)
                 let (start, end) = (committed.points[e].stress[0], stress);
-                let share = if end != 0.0 { 0.5 * (1.0 + start / end) } else { 1.0 };
+                let share = if end != 0.0 {
+                    0.5 * (1.0 + start / end)
+                } else {
+                    1.0
+                };
                 let plastic_work = area * length * share * response.plastic_work;
                 let f4 = rod2::internal_force(&x, &de, stress, area, geometry)?;
                 let matrix = match tangent {

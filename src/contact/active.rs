@@ -505,7 +505,8 @@ impl ContactState {
         }
         for pair in &interfaces.pairs {
             let boundary = interfaces.boundary(pair.slave_body);
-            penetration = penetration.max(super::setup::master_penetration(pair, coords, &boundary));
+            penetration =
+                penetration.max(super::setup::master_penetration(pair, coords, &boundary));
         }
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);

@@ -81,7 +81,8 @@ impl Interfaces {
     pub fn impedance(&self, body: usize, node: usize, coords: &[[f64; 2]]) -> f64 {
         let b = &self.bodies[body];
         let edges = &b.boundary_at_node[node - b.node_offset];
-        let length = |a: [f64; 2], c: [f64; 2]| ((a[0] - c[0]).powi(2) + (a[1] - c[1]).powi(2)).sqrt();
+        let length =
+            |a: [f64; 2], c: [f64; 2]| ((a[0] - c[0]).powi(2) + (a[1] - c[1]).powi(2)).sqrt();
         let area = match b.section {
             Section::Rod { area } => area,
             Section::Plane { thickness } => {
@@ -158,7 +159,10 @@ mod tests {
         let exact = [PI / 4.0, PI * (4.0 - 0.25), PI * (9.0 - 4.0)];
         for (node, area) in exact.iter().enumerate() {
             let z = interfaces.impedance(0, node, &coords);
-            assert!((z / area - 1.0).abs() < 1e-14, "node {node}: {z} against {area}");
+            assert!(
+                (z / area - 1.0).abs() < 1e-14,
+                "node {node}: {z} against {area}"
+            );
         }
     }
 }

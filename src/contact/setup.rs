@@ -79,10 +79,7 @@ fn penetration_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
         .filter(|s| s.gap.gap < -tolerance)
         .map(|s| (s.node, s.gap.gap))
         .collect();
-    let (node, gap) = inside
-        .iter()
-        .copied()
-        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    let (node, gap) = inside.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1))?;
     Some(format!(
         "{} slave node(s) start inside the master beyond TOL = {}, the deepest node {node} at \
          gap {}: move the bodies apart (or the obstacle)",
@@ -99,7 +96,8 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
     }
     let x = |n: usize| bodies.coords[n];
     let pairs = std::slice::from_ref(pair);
-    let nearest = slave_gaps(pairs, &x, &|_, _| false).min_by(|a, b| a.gap.gap.total_cmp(&b.gap.gap))?;
+    let nearest =
+        slave_gaps(pairs, &x, &|_, _| false).min_by(|a, b| a.gap.gap.total_cmp(&b.gap.gap))?;
     let outward = (bodies.slave_normal)(nearest.node)?;
     let n = nearest.gap.normal;
     (dot(outward, n) > 0.0).then(|| {
@@ -116,7 +114,11 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
 /// boundary edges are `slave_boundary` (global ids): for each master node inside that
 /// boundary (winding number above 1/2), its distance to the nearest boundary edge. Zero when
 /// none is inside. Only master nodes within the slave boundary's bounding box are tested.
-pub fn master_penetration(pair: &ContactPair, coords: &[[f64; 2]], slave_boundary: &[[usize; 2]]) -> f64 {
+pub fn master_penetration(
+    pair: &ContactPair,
+    coords: &[[f64; 2]],
+    slave_boundary: &[[usize; 2]],
+) -> f64 {
     let Master::Segments { edges, .. } = &pair.master else {
         return 0.0;
     };

@@ -342,13 +342,23 @@ pub struct UniaxialResponse {
 /// S_{n+1} : d eps_p the difference 1/2 (S_{n+1} - S_n) : d eps_p >= 0 is lost every plastic
 /// step). It is never negative: |s_n : n| <= sigma_y,n <= s_{n+1} : n under hardening.
 /// The heating of Johnson-Cook keeps the return's own S_{n+1} : d eps_p.
-pub fn trapezoid_dissipation(start: &Voigt, end: &Voigt, end_back: &Voigt, plastic_work: f64) -> f64 {
+pub fn trapezoid_dissipation(
+    start: &Voigt,
+    end: &Voigt,
+    end_back: &Voigt,
+    plastic_work: f64,
+) -> f64 {
     if plastic_work == 0.0 {
         return 0.0;
     }
     let relative = end - end_back;
     let p = (relative[0] + relative[1] + relative[2]) / 3.0;
-    let n = Voigt::new(relative[0] - p, relative[1] - p, relative[2] - p, relative[3]);
+    let n = Voigt::new(
+        relative[0] - p,
+        relative[1] - p,
+        relative[2] - p,
+        relative[3],
+    );
     let dot = |a: &Voigt| a[0] * n[0] + a[1] * n[1] + a[2] * n[2] + 2.0 * a[3] * n[3];
     let along_end = dot(end);
     if along_end <= 0.0 {

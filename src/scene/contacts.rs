@@ -234,14 +234,19 @@ pub(super) fn check_contact_setup(
     bodies: &[Body],
     contacts: &[ContactPair],
 ) -> Result<(), InputError> {
-    let coords: Vec<[f64; 2]> = bodies.iter().flat_map(|b| b.mesh.nodes.iter().copied()).collect();
+    let coords: Vec<[f64; 2]> = bodies
+        .iter()
+        .flat_map(|b| b.mesh.nodes.iter().copied())
+        .collect();
     for (spec, pair) in scene.contact.iter().zip(contacts) {
         if !spec.setup_check {
             continue;
         }
         let slave = &bodies[pair.slave_body];
         let master_interior = match &pair.master {
-            Master::Segments { body, .. } | Master::Nodes { body, .. } => Some(interior(&bodies[*body])),
+            Master::Segments { body, .. } | Master::Nodes { body, .. } => {
+                Some(interior(&bodies[*body]))
+            }
             Master::Obstacle(_) => None,
         };
         let slave_normal = |node: usize| outward_normal(slave, node - slave.node_offset);
