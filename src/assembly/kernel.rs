@@ -13,7 +13,9 @@ use crate::element::{
     Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
 };
 use crate::kinematics;
-use crate::material::{PointState, StressCondition, UpdateContext, trapezoid_dissipation};
+use crate::material::{
+    PointState, Response, StressCondition, UpdateContext, trapezoid_dissipation,
+};
 use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind};
 use std::time::Instant;
@@ -138,24 +140,8 @@ impl Kernel {
                     crate::profile::add_constitutive(start);
                 }
                 let stress = responses.map(|r| r.stress);
-                let mut work = 0.0;
-                let mut plastic_work = 0.0;
-                for q in 0..4 {
-                    let start = &committed.points[4 * e + q].stress;
-                    let end = &responses[q].state;
-                    plastic_work += geom.points[q].weight
-                        * trapezoid_dissipation(
-                            start,
-                            &end.stress,
-                            &end.back_stress,
-                            responses[q].plastic_work,
-                        );
-                    let mut strain = strains[q];
-                    strain[2] = responses[q].strain_zz;
-                    work += geom.points[q].weight
-                        * 0.5
-                        * (committed.points[4 * e + q].stress + stress[q]).dot(&strain);
-                }
+                let start = &committed.points[4 * e..4 * e + 4];
+                let (work, plastic_work) = quad_work(&geom, start, &strains, &responses);
                 let force = quad4::internal_force(&geom, &de, &stress, op);
                 let matrix = tangent.map(|_| {
                     let moduli = if elastic_moduli {
@@ -188,13 +174,14 @@ impl Kernel {
                 let length = rod2::length(&x)?;
                 let work = area * length * 0.5 * (committed.points[e].stress[0] + stress) * strain;
                 // 1/2 (S_n + S_{n+1}) dep, as the work (see trapezoid_dissipation)
-                let (start, end) = (committed.points[e].stress[0], stress);
-                let share = if end != 0.0 {
-                    0.5 * (1.0 + start / end)
-                } else {
-                    1.0
-                };
-                let plastic_work = area * length * share * response.plastic_work;
+                let plastic_work = area
+                    * length
+                    * trapezoid_dissipation(
+                        &committed.points[e].stress,
+                        &response.state.stress,
+                        &response.state.back_stress,
+                        response.plastic_work,
+                    );
                 let f4 = rod2::internal_force(&x, &de, stress, area, geometry)?;
                 let matrix = match tangent {
                     Some(_) => {
@@ -420,4 +407,30 @@ fn check_orientation(geom: &quad4::QuadValues, d: &Vec8) -> Result<(), KernelErr
         }
     }
     Ok(())
+}
+
+/// The increments of the internal work and of the plastic dissipation of a Quad4 element,
+/// both by the trapezoidal rule over its four points: 1/2 (S_n + S_{n+1}) : dE (with plane
+/// stress's dE_zz from the material) and 1/2 (S_n + S_{n+1}) : d eps_p.
+fn quad_work(
+    geom: &quad4::QuadValues,
+    start: &[PointState],
+    strains: &[Voigt; 4],
+    responses: &[Response; 4],
+) -> (f64, f64) {
+    let (mut work, mut plastic_work) = (0.0, 0.0);
+    for q in 0..4 {
+        let (weight, end) = (geom.points[q].weight, &responses[q]);
+        plastic_work += weight
+            * trapezoid_dissipation(
+                &start[q].stress,
+                &end.state.stress,
+                &end.state.back_stress,
+                end.plastic_work,
+            );
+        let mut strain = strains[q];
+        strain[2] = end.strain_zz;
+        work += weight * 0.5 * (start[q].stress + end.stress).dot(&strain);
+    }
+    (work, plastic_work)
 }
