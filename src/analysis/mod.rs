@@ -76,6 +76,9 @@ pub fn interfaces(model: &Model) -> crate::contact::Interfaces {
                     .iter()
                     .map(|edges| edges.iter().map(|e| e.map(|n| b.global(n))).collect())
                     .collect(),
+                boundary: (b.mesh.boundary_edges().iter())
+                    .map(|e| e.map(|n| b.global(n)))
+                    .collect(),
                 node_offset: b.node_offset,
             }
         })

@@ -277,25 +277,8 @@ impl ContactState {
                         }
                     }
                 }
-                for i in 0..entries.len() {
-                    let Friction::Coulomb { mu } = pairs[entries[i].0].options.friction else {
-                        continue;
-                    };
-                    let tau = normal[i];
-                    let tol = pairs[entries[i].0].options.tolerance;
-                    match slips[i] {
-                        Slip::Stick if forces_t[i].abs() > mu * tau * (1.0 + 1e-9) => {
-                            slips[i] = Slip::Slide(mu * forces_t[i].signum());
-                            changed = true;
-                        }
-                        // the friction force may not push along the slip
-                        Slip::Slide(c) if c * slip_of(i) > 1e-3 * tol.max(1e-300) => {
-                            slips[i] = Slip::Stick;
-                            changed = true;
-                        }
-                        _ => {}
-                    }
-                }
+                changed |=
+                    coulomb_switches(pairs, &entries, &mut slips, normal, &forces_t, &slip_of);
                 if changed && pass < 50 {
                     // a new slip status starts from the predictor: from the last increment
                     // the sliding equality |t| = mu tau lands at the Newton tolerance, not
@@ -504,9 +487,8 @@ impl ContactState {
             penetration = penetration.max(-g);
         }
         for pair in &interfaces.pairs {
-            let boundary = interfaces.boundary(pair.slave_body);
-            penetration =
-                penetration.max(super::setup::master_penetration(pair, coords, &boundary));
+            let boundary = &interfaces.bodies[pair.slave_body].boundary;
+            penetration = penetration.max(super::setup::master_penetration(pair, coords, boundary));
         }
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);
@@ -695,4 +677,37 @@ pub fn apply_conditions<S>(
             conditions::spread(acceleration, &side, t, friction / side.mass);
         }
     }
+}
+
+/// Coulomb stick <-> slide switches of a converged pass: a sticking entry whose friction
+/// force exceeds mu tau slides, a sliding one whose friction force would push along its slip
+/// (`slip_of`) sticks. Whether any status changed.
+fn coulomb_switches(
+    pairs: &[ContactPair],
+    entries: &[(usize, usize)],
+    slips: &mut [Slip],
+    normal: &[f64],
+    forces_t: &[f64],
+    slip_of: &dyn Fn(usize) -> f64,
+) -> bool {
+    let mut changed = false;
+    for i in 0..entries.len() {
+        let Friction::Coulomb { mu } = pairs[entries[i].0].options.friction else {
+            continue;
+        };
+        let tol = pairs[entries[i].0].options.tolerance;
+        match slips[i] {
+            Slip::Stick if forces_t[i].abs() > mu * normal[i] * (1.0 + 1e-9) => {
+                slips[i] = Slip::Slide(mu * forces_t[i].signum());
+                changed = true;
+            }
+            // the friction force may not push along the slip
+            Slip::Slide(c) if c * slip_of(i) > 1e-3 * tol.max(1e-300) => {
+                slips[i] = Slip::Stick;
+                changed = true;
+            }
+            _ => {}
+        }
+    }
+    changed
 }

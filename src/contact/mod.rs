@@ -62,6 +62,9 @@ pub struct BodySurface {
     /// The boundary edges at each node of the body (global node ids), for the tributary
     /// area; the body's first global node.
     pub boundary_at_node: Vec<Vec<[usize; 2]>>,
+    /// The body's boundary edges (global ids), each once: the closed outline in which a
+    /// master node's penetration into this body is sought.
+    pub boundary: Vec<[usize; 2]>,
     pub node_offset: usize,
 }
 
@@ -103,19 +106,6 @@ impl Interfaces {
         };
         b.impedance_per_area * area
     }
-
-    /// The boundary edges of body `body` (global ids), each once.
-    pub fn boundary(&self, body: usize) -> Vec<[usize; 2]> {
-        let mut edges: Vec<[usize; 2]> = self.bodies[body]
-            .boundary_at_node
-            .iter()
-            .flatten()
-            .copied()
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
-        edges
-    }
 }
 
 /// The contact block of summary.json.
@@ -153,6 +143,7 @@ mod tests {
                 section: Section::Axisymmetric,
                 impedance_per_area: 1.0,
                 boundary_at_node: vec![vec![[0, 1]], vec![[0, 1], [1, 2]], vec![[1, 2]]],
+                boundary: vec![[0, 1], [1, 2]],
                 node_offset: 0,
             }],
         };
