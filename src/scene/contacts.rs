@@ -278,10 +278,9 @@ fn interior(body: &Body) -> [f64; 2] {
         [sum[0] / count, sum[1] / count]
     };
     match &body.mesh.cells {
-        Cells::Quad4(quads) => mean(&mut quads.iter().map(|q| {
-            let c = mean(&mut q.iter().map(|n| nodes[*n]));
-            c
-        })),
+        Cells::Quad4(quads) => {
+            mean(&mut quads.iter().map(|q| mean(&mut q.iter().map(|n| nodes[*n]))))
+        }
         _ => mean(&mut nodes.iter().copied()),
     }
 }
