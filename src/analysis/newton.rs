@@ -267,6 +267,9 @@ fn constrained_solve(
     Ok((delta, tau.iter().copied().collect()))
 }
 
+/// A residual this share of the force tolerance is round-off: the step has converged.
+const ROUND_OFF: f64 = 1e-4;
+
 /// Stiffness-proportional damping matrix of the step (the tangent at D = 0), free DOFs.
 struct Damping {
     values: Vec<f64>,
@@ -399,9 +402,12 @@ impl Step<'_> {
             } else {
                 0.0
             };
+            // a residual at round-off ends the iteration whatever the last correction was: at
+            // rest (a bar stopped against a wall) the increment is round-off too, and the
+            // displacement ratio compares round-off with round-off
             let converged = iteration > 0
                 && ((eps_displacement < newton.tol_displacement && eps_force < newton.tol_force)
-                    || residual_norm == 0.0);
+                    || eps_force <= ROUND_OFF * newton.tol_force);
             if converged {
                 let tangential = match &self.contact {
                     Some(c) => rows.tangential_forces(c.tangential, &forces),
