@@ -378,8 +378,8 @@ impl Step<'_> {
             let refactor =
                 newton.strategy == Strategy::Full || (iteration == 0 && self.factor_first);
             let evaluation = self.evaluate(state, &d, refactor.then_some(&mut *system))?;
-            let (residual, scale) = self.residual(&d, &evaluation, system, &damping, external_norm);
-            let (mut residual, scale) = (residual, scale);
+            let (mut residual, forces_scale) =
+                self.residual(&d, &evaluation, system, &damping, external_norm);
             let rows = match &self.contact {
                 Some(c) => profile::time(Phase::Contact, || c.rows(&d, system))?,
                 None => Rows::empty(),
@@ -396,18 +396,20 @@ impl Step<'_> {
             // the force scale cannot fall below what the stiffness makes of the increment:
             // a rigid motion has no loads and no reactions, only round-off to compare with
             let d_max = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let scale = scale.max(system.diagonal_max * d_max);
+            let scale = forces_scale.max(system.diagonal_max * d_max);
             let eps_force = if scale > 0.0 {
                 residual_norm / scale
             } else {
                 0.0
             };
-            // a residual at round-off ends the iteration whatever the last correction was: at
-            // rest (a bar stopped against a wall) the increment is round-off too, and the
-            // displacement ratio compares round-off with round-off
+            // a residual at round-off of the forces in play ends the iteration whatever the
+            // last correction was: at rest (a bar stopped against a wall) the increment is
+            // round-off too, and the displacement ratio compares round-off with round-off.
+            // (Not against the stiffness floor of the scale: past a limit load the increment
+            // grows without bound and would make any residual look small.)
             let converged = iteration > 0
                 && ((eps_displacement < newton.tol_displacement && eps_force < newton.tol_force)
-                    || eps_force <= ROUND_OFF * newton.tol_force);
+                    || residual_norm <= ROUND_OFF * newton.tol_force * forces_scale);
             if converged {
                 let tangential = match &self.contact {
                     Some(c) => rows.tangential_forces(c.tangential, &forces),
