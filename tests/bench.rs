@@ -90,8 +90,9 @@ fn bench_case_filter_runs_matching_cases_and_rejects_an_empty_selection() {
 }
 
 /// Goal: `impact bench --scenes` runs the shipped scenes as they are. Setup: `--scenes --case
-/// scene_two_bars --case scene_bar_wall` from the repository root. Reference: the scenes' own steps,
-/// end_time / dt = 0.4 / 0.005 = 80 each (Newmark at a fixed step, no cut), status ok.
+/// scene_two_bars --case scene_bar_wall` from the repository root (which also picks their
+/// `_smooth` variants). Reference: the scenes' own steps, end_time / dt = 0.4 / 0.005 = 80
+/// each (Newmark at a fixed step, no cut), status ok.
 #[test]
 fn bench_scenes_runs_the_shipped_scenes() {
     let dir = std::env::temp_dir().join(format!("impact_bench_scenes_{}", std::process::id()));
@@ -112,7 +113,16 @@ fn bench_scenes_runs_the_shipped_scenes() {
     let rows: Vec<impact::bench::Row> =
         serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
     let names: Vec<&str> = rows.iter().map(|r| r.name.as_str()).collect();
-    assert_eq!(names, ["scene_bar_wall", "scene_two_bars"]);
+    // `--case` picks the cases whose name contains it: the smooth variants come along
+    assert_eq!(
+        names,
+        [
+            "scene_bar_wall",
+            "scene_bar_wall_smooth",
+            "scene_two_bars",
+            "scene_two_bars_smooth"
+        ]
+    );
     for row in &rows {
         assert_eq!(row.status, "ok");
         assert_eq!(row.steps, 80, "{}", row.name);

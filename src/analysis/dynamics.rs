@@ -21,9 +21,11 @@ use super::run::{StepError, Stepper};
 use super::{StepControl, loads};
 use crate::assembly::{self, Mass, State, System};
 use crate::contact::{ContactResult, ContactState, Interfaces, Tangential};
-use crate::integrator::{Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, Wilson};
+use crate::integrator::{
+    Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
+};
 use crate::output::readable;
-use crate::scene::spec::{DynamicSpec, IntegratorKind, Strategy};
+use crate::scene::spec::{ContactDynamics, DynamicSpec, IntegratorKind, MassKind, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
@@ -47,6 +49,42 @@ pub fn integrator(spec: &DynamicSpec) -> Box<dyn Integrator> {
             unreachable!("the explicit stepper runs central difference")
         }
     }
+}
+
+/// `mass = "dispersion_free"` is the rod blend: refused for a continuum body.
+fn check_dispersion_free(model: &Model, spec: &DynamicSpec) -> Result<(), InputError> {
+    if spec.mass != MassKind::DispersionFree {
+        return Ok(());
+    }
+    match model
+        .bodies
+        .iter()
+        .find(|b| !matches!(b.kind, crate::scene::BodyKind::Rod { .. }))
+    {
+        Some(body) => Err(InputError::new(
+            &model.file,
+            format!(
+                "analysis.mass: `dispersion_free` is the blend for rods; body `{}` is a continuum (use `consistent` or `lumped`)",
+                body.name
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The nodes of every contact surface (slaves, and the nodes of deformable masters).
+fn contact_nodes(model: &Model) -> Vec<bool> {
+    use crate::contact::Master;
+    let mut flags = vec![false; model.dofs() / 2];
+    for pair in &model.contacts {
+        pair.slaves.iter().for_each(|s| flags[*s] = true);
+        match &pair.master {
+            Master::Segments { edges, .. } => edges.iter().flatten().for_each(|n| flags[*n] = true),
+            Master::Nodes { nodes, .. } => nodes.iter().for_each(|n| flags[*n] = true),
+            Master::Obstacle(_) => {}
+        }
+    }
+    flags
 }
 
 /// Refuses a dynamic model without mass on some free DOF (zero density).
@@ -106,15 +144,29 @@ impl<'a> Dynamics<'a> {
         dir: &Path,
     ) -> Result<Dynamics<'a>, super::RunError> {
         let system = System::new(model, &model.constrained_dofs());
-        let mass =
+        check_dispersion_free(model, spec)?;
+        let mut mass =
             Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
         check_mass(model, &mass, &system)?;
+        let mut interfaces = super::interfaces(model);
+        if spec.contact_dynamics != ContactDynamics::Hughes {
+            // no velocity jumps; a pair releases when its multiplier turns to tension
+            for pair in &mut interfaces.pairs {
+                pair.options.impact_conditions = false;
+                pair.options.release_conditions = false;
+                pair.options.release_fraction = 0.0;
+                pair.options.persistency = spec.contact_dynamics == ContactDynamics::Persistency;
+            }
+        }
+        if spec.contact_dynamics == ContactDynamics::MassRedistribution {
+            mass = mass.redistributed(model, &contact_nodes(model));
+        }
         let solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
         let n = model.dofs();
         Ok(Dynamics {
             model,
             spec,
-            interfaces: super::interfaces(model),
+            interfaces,
             initial: model.coordinates(),
             method: integrator(spec),
             state: State::initial(model),
@@ -164,7 +216,14 @@ impl<'a> Dynamics<'a> {
         let mut a = vec![0.0; model.dofs()];
         if free.iter().any(|v| *v != 0.0) {
             self.system.values.iter_mut().for_each(|v| *v = 0.0);
-            self.mass.add_to(model, &mut self.system, 1.0);
+            // massless contact nodes would leave M singular: their acceleration at t = 0 is
+            // the one of the mass before redistribution
+            if spec.contact_dynamics == ContactDynamics::MassRedistribution {
+                let full = Mass::new(model, spec.mass).map_err(|e| e.to_string())?;
+                full.add_to(model, &mut self.system, 1.0);
+            } else {
+                self.mass.add_to(model, &mut self.system, 1.0);
+            }
             self.solver
                 .factor(&self.system.values)
                 .map_err(|e| e.to_string())?;
@@ -215,11 +274,13 @@ impl<'a> Dynamics<'a> {
             last_internal: &self.last_internal,
             positions,
             increments: self.increments,
+            pairs: &self.interfaces.pairs,
+            persistent: self.persistent_entries(),
         };
         let (system, solver, factored_for) =
             (&mut self.system, &mut self.solver, &mut self.factored_for);
         let mut step = self.contact.step(
-            &self.model.contacts,
+            &self.interfaces.pairs,
             positions,
             nominal,
             |h, active, forces, tangential, warm| {
@@ -291,7 +352,9 @@ impl<'a> Dynamics<'a> {
         );
         self.contact
             .commit(&self.interfaces, &step, self.state.time, &positions);
-        let contact_force = self.contact.nodal_forces(&model.contacts, &positions);
+        let contact_force = self
+            .contact
+            .nodal_forces(&self.interfaces.pairs, &positions);
         let total = self.total_force(&internal);
         let energies = &mut self.energies;
         energies.external_work += super::trapezoid_work(&d, &total, &self.last_total);
@@ -308,6 +371,27 @@ impl<'a> Dynamics<'a> {
         self.last_contact = contact_force;
         self.increments += 1;
         self.control.accept(true);
+    }
+
+    /// Velocity-level persistency: the (pair, slave node) entries closed at the start of the
+    /// step, which keep their relative normal velocity at zero; none for the other methods.
+    fn persistent_entries(&self) -> Vec<(usize, usize)> {
+        if self.spec.contact_dynamics != ContactDynamics::Persistency {
+            return Vec::new();
+        }
+        let pairs = &self.interfaces.pairs;
+        self.contact
+            .active
+            .iter()
+            .enumerate()
+            .flat_map(|(p, flags)| {
+                flags
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, a)| **a)
+                    .map(move |(k, _)| (p, pairs[p].slaves[k]))
+            })
+            .collect()
     }
 
     /// F: f_ext on the free DOFs, the reaction M a + a_R M v + f_int on the prescribed ones.
@@ -337,9 +421,40 @@ struct Attempt<'s> {
     last_internal: &'s [f64],
     positions: &'s [[f64; 2]],
     increments: usize,
+    pairs: &'s [crate::contact::ContactPair],
+    /// Entries held by velocity-level persistency (see `Dynamics::persistent_entries`).
+    persistent: Vec<(usize, usize)>,
 }
 
 impl Attempt<'_> {
+    /// The end-of-step gap each active entry must have: 0 (the gap constraint), or for a
+    /// persistent entry the start gap plus the increment that makes the relative normal
+    /// velocity at the solve point zero: with v* = c_v D + v_hat,
+    /// n . (c_v D_rel + v_hat_rel) = 0, so g_end = g_start - n . v_hat_rel / c_v.
+    fn targets(&self, active: &[(usize, usize)], form: &StepForm) -> Vec<f64> {
+        if self.persistent.is_empty() {
+            return Vec::new();
+        }
+        let x = |n: usize| self.positions[n];
+        active
+            .iter()
+            .map(|entry| {
+                let (pair, slave) = *entry;
+                if !self.persistent.contains(entry) {
+                    return 0.0;
+                }
+                self.pairs[pair].gap(slave, &x).map_or(0.0, |gap| {
+                    let relative: f64 = gap
+                        .row(slave)
+                        .iter()
+                        .map(|(dof, c)| c * form.velocity_offset[*dof])
+                        .sum();
+                    gap.gap - relative / form.damping_coefficient
+                })
+            })
+            .collect()
+    }
+
     /// Solves the step with a given length and active contact set; K* is factored again
     /// when its coefficients changed or the strategy asks.
     fn solve(
@@ -399,11 +514,12 @@ impl Attempt<'_> {
             internal_start: self.last_internal,
             factor_first,
             contact: Some(Constraints {
-                pairs: &model.contacts,
+                pairs: self.pairs,
                 active,
                 start: self.positions,
                 forces,
                 tangential,
+                targets: self.targets(active, &form),
             }),
         };
         let result = step.solve(state, d, system, solver, counters);

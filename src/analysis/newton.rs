@@ -75,6 +75,10 @@ pub struct Constraints<'a> {
     pub forces: Vec<f64>,
     /// Friction on some of the active entries.
     pub tangential: &'a [Tangential],
+    /// Per active entry, the gap it must have at the end of the step: 0 for the gap
+    /// constraint, the start gap plus the persistency increment for velocity-level
+    /// persistency. Empty: all 0.
+    pub targets: Vec<f64>,
 }
 
 /// A converged step: the increment, its evaluation, the contact multipliers (tau, the
@@ -156,7 +160,7 @@ impl Constraints<'_> {
         };
         let mut rows = Rows::empty();
         let mut gaps = Vec::with_capacity(self.active.len());
-        for &(pair, slave) in self.active {
+        for (i, &(pair, slave)) in self.active.iter().enumerate() {
             let gap = self.pairs[pair].gap(slave, &x).ok_or_else(|| {
                 StepFailure(format!(
                     "contact `{}`: node {slave} lost its master",
@@ -164,7 +168,8 @@ impl Constraints<'_> {
                 ))
             })?;
             rows.rows.push(free(gap.row(slave)));
-            rows.gaps.push(gap.gap);
+            rows.gaps
+                .push(gap.gap - self.targets.get(i).copied().unwrap_or(0.0));
             gaps.push(gap);
         }
         rows.normal = rows.rows.len();

@@ -68,14 +68,23 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
         out.push(problem);
     }
     if let Some(depth) = summary.contact.max_penetration {
-        let limits = penetration_limits(&model.contacts, &model.coordinates());
-        let spacing = 2.0 * limits.iter().copied().fold(f64::INFINITY, f64::min);
+        let coords = model.coordinates();
+        let limits = penetration_limits(&model.contacts, &coords);
+        // a pair with one slave (a rod's end) has no spacing: the length of its elements
+        let spacing = model
+            .contacts
+            .iter()
+            .zip(&limits)
+            .map(|(pair, limit)| match pair.slaves.as_slice() {
+                [single] => shortest_edge_at(model, &coords, *single),
+                _ => 2.0 * limit,
+            })
+            .fold(f64::INFINITY, f64::min);
         let tolerance = model
             .contacts
             .iter()
             .map(|c| c.options.tolerance)
             .fold(0.0, f64::max);
-        // a pair with one slave has no spacing: TOL alone then
         let share = if spacing.is_finite() {
             PENETRATION_SHARE * spacing
         } else {
@@ -85,7 +94,7 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
         if depth > bound {
             out.push(format!(
                 "contact: a node went {} deep into the other body, beyond {} (the larger of TOL \
-                 and {} % of the slave node spacing); history.csv `penetration` shows when (a \
+                 and {} % of the slave node spacing, or of a lone slave's element); history.csv `penetration` shows when (a \
                  master node sinking into the slave body is not seen by one-pass contact: swap \
                  the roles or refine the slave surface)",
                 readable(depth),
@@ -95,6 +104,30 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
         }
     }
     out
+}
+
+/// The shortest element edge that ends at global node `node`.
+fn shortest_edge_at(model: &Model, coords: &[[f64; 2]], node: usize) -> f64 {
+    let mut shortest = f64::INFINITY;
+    for body in &model.bodies {
+        for e in 0..body.elements() {
+            let nodes: Vec<usize> = body
+                .mesh
+                .cells
+                .nodes_of(e)
+                .iter()
+                .map(|n| body.global(*n))
+                .collect();
+            for (i, a) in nodes.iter().enumerate() {
+                let b = nodes[(i + 1) % nodes.len()];
+                if (*a == node || b == node) && *a != b {
+                    let (p, q) = (coords[*a], coords[b]);
+                    shortest = shortest.min((q[0] - p[0]).hypot(q[1] - p[1]));
+                }
+            }
+        }
+    }
+    shortest
 }
 
 /// A dynamic step longer than the run, or an implicit step far above the explicit stable

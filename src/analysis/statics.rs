@@ -140,6 +140,7 @@ impl Increment<'_> {
                 start: self.positions,
                 forces,
                 tangential,
+                targets: Vec::new(),
             }),
         };
         step.solve(state, d, system, solver, counters)

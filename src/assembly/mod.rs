@@ -382,7 +382,10 @@ impl Mass {
                     element: e,
                     error,
                 };
-                let m = kernel.mass(body, &coords, e).map_err(failure)?;
+                let mut m = kernel.mass(body, &coords, e).map_err(failure)?;
+                if kind == MassKind::DispersionFree {
+                    dispersion_free(&mut m, nn);
+                }
                 for (i, n) in nodes.iter().enumerate() {
                     let row: f64 = m[i * nn..(i + 1) * nn].iter().sum();
                     lumped[2 * body.global(*n)] += row;
@@ -399,11 +402,37 @@ impl Mass {
         })
     }
 
+    /// The same mass with the nodes flagged in `massless` (per node) carrying none: in each
+    /// element their rows and columns are removed and the mass they held goes onto the
+    /// element's other nodes in proportion to those nodes' row sums, so every element keeps
+    /// its mass (Khenous, Laborde & Renard 2008). An element whose nodes are all flagged
+    /// keeps its mass as it is.
+    pub fn redistributed(mut self, model: &Model, massless: &[bool]) -> Mass {
+        self.lumped.iter_mut().for_each(|m| *m = 0.0);
+        for (b, body) in model.bodies.iter().enumerate() {
+            let nn = body.mesh.cells.nodes_of(0).len();
+            for e in 0..body.elements() {
+                let nodes = body.mesh.cells.nodes_of(e);
+                let flagged: Vec<bool> = nodes.iter().map(|n| massless[body.global(*n)]).collect();
+                let m = &mut self.elements[b][e * nn * nn..(e + 1) * nn * nn];
+                if flagged.iter().any(|f| *f) && !flagged.iter().all(|f| *f) {
+                    redistribute(m, nn, &flagged);
+                }
+                for (i, n) in nodes.iter().enumerate() {
+                    let row: f64 = m[i * nn..(i + 1) * nn].iter().sum();
+                    self.lumped[2 * body.global(*n)] += row;
+                    self.lumped[2 * body.global(*n) + 1] += row;
+                }
+            }
+        }
+        self
+    }
+
     /// M x over all DOFs.
     pub fn product(&self, model: &Model, x: &[f64]) -> Vec<f64> {
         match self.kind {
             MassKind::Lumped => self.lumped.iter().zip(x).map(|(m, v)| m * v).collect(),
-            MassKind::Consistent => {
+            MassKind::Consistent | MassKind::DispersionFree => {
                 let mut y = vec![0.0; x.len()];
                 for (b, body) in model.bodies.iter().enumerate() {
                     let nn = body.mesh.cells.nodes_of(0).len();
@@ -446,7 +475,7 @@ impl Mass {
                 for i in 0..nn {
                     for j in 0..nn {
                         let value = match self.kind {
-                            MassKind::Consistent => m[i * nn + j],
+                            MassKind::Consistent | MassKind::DispersionFree => m[i * nn + j],
                             // the element's own row sum: summed over elements, the lumped diagonal
                             MassKind::Lumped if i == j => m[i * nn..(i + 1) * nn].iter().sum(),
                             MassKind::Lumped => 0.0,
@@ -461,6 +490,42 @@ impl Mass {
                 }
             }
         }
+    }
+}
+
+/// The rod blend 3/2 consistent - 1/2 lumped in place (an nn x nn element matrix): for the
+/// two-node rod rho A h / 4 [[1, 1], [1, 1]], with which the trapezoidal rule is free of
+/// dispersion at Courant number 1 (docs/theory.md "Contact in implicit dynamics").
+fn dispersion_free(m: &mut [f64], nn: usize) {
+    let rows: Vec<f64> = (0..nn)
+        .map(|i| m[i * nn..(i + 1) * nn].iter().sum())
+        .collect();
+    for i in 0..nn {
+        for j in 0..nn {
+            let lumped = if i == j { rows[i] } else { 0.0 };
+            m[i * nn + j] = 1.5 * m[i * nn + j] - 0.5 * lumped;
+        }
+    }
+}
+
+/// Removes the rows and columns of the `flagged` nodes of an element matrix and puts the
+/// mass they held on the diagonal of the others, in proportion to their row sums.
+fn redistribute(m: &mut [f64], nn: usize, flagged: &[bool]) {
+    let total: f64 = m.iter().sum();
+    let rows: Vec<f64> = (0..nn)
+        .map(|i| m[i * nn..(i + 1) * nn].iter().sum())
+        .collect();
+    for i in 0..nn {
+        for j in 0..nn {
+            if flagged[i] || flagged[j] {
+                m[i * nn + j] = 0.0;
+            }
+        }
+    }
+    let kept: f64 = m.iter().sum();
+    let weight: f64 = (0..nn).filter(|i| !flagged[*i]).map(|i| rows[i]).sum();
+    for i in (0..nn).filter(|i| !flagged[*i]) {
+        m[i * nn + i] += (total - kept) * rows[i] / weight;
     }
 }
 

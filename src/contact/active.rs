@@ -148,8 +148,11 @@ fn first_event(
     let mut alpha = 1.0f64;
     for s in search::penetrating(pairs, end, &|p, k| entries.contains(&(p, k))) {
         let options = &pairs[s.pair].options;
-        penetrating.push((s.pair, s.index));
         let g0 = pairs[s.pair].gap(s.node, &at_start).map_or(0.0, |g| g.gap);
+        if options.persistency && g0 < 0.0 && s.gap.gap >= g0 - options.tolerance {
+            continue; // the gap a persistent pair closed with, not deeper
+        }
+        penetrating.push((s.pair, s.index));
         if options.split_at_events && g0 > options.tolerance {
             alpha = alpha.min(g0 / (g0 - s.gap.gap));
         } else {

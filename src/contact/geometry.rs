@@ -73,6 +73,10 @@ pub struct PairOptions {
     pub split_at_events: bool,
     /// The tangential law of the interface.
     pub friction: Friction,
+    /// Velocity-level persistency (implicit dynamics): a closed pair may keep the small gap
+    /// it closed with, so an open slave that starts inside its master counts as penetrating
+    /// only when it goes deeper.
+    pub persistency: bool,
 }
 
 /// The tangential law of a contact pair.
@@ -464,6 +468,7 @@ mod tests {
             search_distance: f64::INFINITY,
             split_at_events: true,
             friction: Friction::None,
+            persistency: false,
         }
     }
 

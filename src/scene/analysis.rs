@@ -5,8 +5,8 @@ use super::InputError;
 use super::context::{Context, positive};
 use super::model::Analysis;
 use super::spec::{
-    AnalysisKind, AnalysisSpec, BucklingSpec, DynamicSpec, IntegratorKind, MassKind, NewtonSpec,
-    Quadrature, StaticSpec, StepSpec, TimeStep,
+    AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics, DynamicSpec, IntegratorKind,
+    MassKind, NewtonSpec, Quadrature, StaticSpec, StepSpec, TimeStep,
 };
 use crate::element::Strain;
 
@@ -36,6 +36,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 (spec.alpha.is_some(), "alpha"),
                 (spec.rho_infinity.is_some(), "rho_infinity"),
                 (spec.mass.is_some(), "mass"),
+                (spec.contact_dynamics.is_some(), "contact_dynamics"),
                 (spec.rayleigh.is_some(), "rayleigh"),
                 (spec.allow_unstable, "allow_unstable"),
                 (spec.quadrature.is_some(), "quadrature"),
@@ -93,6 +94,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
         alpha,
         rho_infinity,
         mass,
+        contact_dynamics: contact_dynamics(cx, spec, integrator)?,
         rayleigh,
         allow_unstable: spec.allow_unstable,
         geometry: spec.geometry,
@@ -242,7 +244,7 @@ fn mass_and_damping(
 ) -> Result<(MassKind, [f64; 2]), InputError> {
     use IntegratorKind as I;
     let mass = match (integrator, spec.mass) {
-        (I::CentralDifference, Some(MassKind::Consistent)) => {
+        (I::CentralDifference, Some(MassKind::Consistent | MassKind::DispersionFree)) => {
             return Err(cx.err("analysis.mass: central difference uses the lumped mass"));
         }
         (I::CentralDifference, _) => MassKind::Lumped,
@@ -260,6 +262,23 @@ fn mass_and_damping(
         )));
     }
     Ok((mass, rayleigh))
+}
+
+/// `analysis.contact_dynamics`: the implicit integrators' contact treatment; central
+/// difference has its own (forward-increment multipliers).
+fn contact_dynamics(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<ContactDynamics, InputError> {
+    match spec.contact_dynamics {
+        Some(c) if c != ContactDynamics::Hughes && integrator == IntegratorKind::CentralDifference => {
+            Err(cx.err(
+                "analysis.contact_dynamics: applies to the implicit integrators; central difference enforces contact by forward-increment multipliers",
+            ))
+        }
+        c => Ok(c.unwrap_or_default()),
+    }
 }
 
 /// The Quad4 quadrature and its hourglass coefficient: `reduced` is the explicit,

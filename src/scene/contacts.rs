@@ -131,6 +131,7 @@ fn contact(
             search_distance,
             split_at_events: spec.split_at_events,
             friction,
+            persistency: false,
         },
     })
 }

@@ -55,13 +55,33 @@ impl IntegratorKind {
     }
 }
 
-/// Consistent (sum rho N^T N over the initial configuration) or lumped (row sums) mass.
+/// Consistent (sum rho N^T N over the initial configuration) or lumped (row sums) mass, or
+/// for rods the blend 3/2 consistent - 1/2 lumped, with which the trapezoidal rule carries a
+/// wave without dispersion at Courant number 1 (docs/theory.md "Contact in implicit dynamics").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MassKind {
     #[default]
     Consistent,
     Lumped,
+    DispersionFree,
+}
+
+/// How an implicit dynamic run treats contact in time (docs/theory.md "Contact in implicit
+/// dynamics").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactDynamics {
+    /// Hughes et al. (1975): gap constraint, impact conditions II-8 at closure, release
+    /// conditions II-11/II-12 with the fraction rule.
+    #[default]
+    Hughes,
+    /// A closed pair keeps its relative normal velocity at zero at the end of the step
+    /// (velocity-level persistency); no velocity jumps, release in tension.
+    Persistency,
+    /// The nodes of the contact surfaces carry no mass (their share goes to the other nodes
+    /// of their elements); gap constraint, no velocity jumps, release in tension.
+    MassRedistribution,
 }
 
 /// The analysis block. One flat table (so every message points at its key's line); keys
@@ -101,8 +121,11 @@ pub struct AnalysisSpec {
     pub alpha: Option<f64>,
     /// Generalized-alpha's spectral radius at infinite frequency (default 0.8).
     pub rho_infinity: Option<f64>,
-    /// `consistent` (default for implicit) or `lumped` (always for central difference).
+    /// `consistent` (default for implicit), `lumped` (always for central difference) or
+    /// `dispersion_free` (rods, implicit).
     pub mass: Option<MassKind>,
+    /// Implicit dynamics: `hughes` (default), `persistency` or `mass_redistribution`.
+    pub contact_dynamics: Option<ContactDynamics>,
     /// Rayleigh damping C = a M + b K (K: the tangent at the start of the step). Default [0, 0].
     pub rayleigh: Option<[f64; 2]>,
     /// Central difference: run even if dt exceeds the critical step, and report the blow-up
@@ -259,6 +282,7 @@ pub struct DynamicSpec {
     pub alpha: f64,
     pub rho_infinity: f64,
     pub mass: MassKind,
+    pub contact_dynamics: ContactDynamics,
     pub rayleigh: [f64; 2],
     pub allow_unstable: bool,
     pub geometry: Strain,
