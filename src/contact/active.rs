@@ -390,7 +390,11 @@ impl ContactState {
     ) -> Vec<(usize, usize)> {
         let x = |n: usize| coords[n];
         let touching: Vec<SlaveGap> = slave_gaps(&interfaces.pairs, &x, &|p, k| self.active[p][k])
-            .filter(|s| s.gap.gap.abs() <= interfaces.pairs[s.pair].options.tolerance)
+            .filter(|s| {
+                let pair = &interfaces.pairs[s.pair];
+                s.gap.gap.abs() <= pair.options.tolerance
+                    && !pair.covers(&interfaces.pairs, &s.gap, &x, &|p, k| self.active[p][k])
+            })
             .collect();
         let mut closed = Vec::new();
         for SlaveGap {

@@ -101,6 +101,23 @@ pub struct ContactPair {
     pub slaves: Vec<usize>,
     pub master: Master,
     pub options: PairOptions,
+    /// The second pass of a two-pass contact: the first pass (its pair index) and its slave
+    /// nodes with their indices there, sorted by node. A slave whose nearest master point lies
+    /// on one of them (weight >= COVERED) while that one is closed does not close: the first
+    /// pass's row for that node would be the same row again (coincident nodes), and the two
+    /// rows would make the multipliers indeterminate.
+    pub covered: Option<Covered>,
+}
+
+/// See [`ContactPair::covered`].
+pub const COVERED: f64 = 0.9;
+
+/// The first pass of a two-pass contact, as its second pass sees it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Covered {
+    pub pair: usize,
+    /// (global node, slave index in the first pass), sorted by node.
+    pub slaves: Vec<(usize, usize)>,
 }
 
 /// A slave node's relation to its master at a given configuration.
@@ -241,6 +258,35 @@ fn gap_to_segments(
 }
 
 impl ContactPair {
+    /// Whether a slave at `gap` is left to the first pass of a two-pass contact (see
+    /// [`ContactPair::covered`]): its nearest master point lies on a first-pass slave that
+    /// is closed (`closed(pair, index)`) or touches or penetrates its own master at `x`. Such
+    /// a slave may not close; once closed it stays until released.
+    pub fn covers(
+        &self,
+        pairs: &[ContactPair],
+        gap: &Gap,
+        x: &dyn Fn(usize) -> [f64; 2],
+        closed: &dyn Fn(usize, usize) -> bool,
+    ) -> bool {
+        let Some(first) = &self.covered else {
+            return false;
+        };
+        let pair = &pairs[first.pair];
+        gap.masters.iter().any(|(m, w)| {
+            *w >= COVERED
+                && first
+                    .slaves
+                    .binary_search_by_key(m, |(node, _)| *node)
+                    .is_ok_and(|i| {
+                        closed(first.pair, first.slaves[i].1)
+                            || pair
+                                .gap(*m, x)
+                                .is_some_and(|g| g.gap <= pair.options.tolerance)
+                    })
+        })
+    }
+
     /// The gap of slave node `slave` at positions `x` (global node -> position), or None
     /// when there is no master within the search distance.
     pub fn gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
@@ -456,6 +502,7 @@ mod tests {
             slaves: vec![0],
             master,
             options: options(),
+            covered: None,
         }
     }
 

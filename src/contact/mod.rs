@@ -35,7 +35,9 @@ pub use active::{
     ConstrainedSolution, ContactResult, ContactState, Events, NodalStatus, Tangential, Unsettled,
     apply_conditions,
 };
-pub use geometry::{ContactPair, Friction, Gap, Master, Obstacle, PairOptions, winding_number};
+pub use geometry::{
+    ContactPair, Covered, Friction, Gap, Master, Obstacle, PairOptions, winding_number,
+};
 pub use search::{SlaveGap, penetration_limits, runaway_penetration, slave_gaps};
 
 use serde::{Deserialize, Serialize};

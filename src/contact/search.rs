@@ -45,7 +45,10 @@ pub fn penetrating<'a>(
     x: &'a dyn Fn(usize) -> [f64; 2],
     skip: &'a dyn Fn(usize, usize) -> bool,
 ) -> impl Iterator<Item = SlaveGap> + 'a {
-    slave_gaps(pairs, x, skip).filter(|s| s.gap.gap < -pairs[s.pair].options.tolerance)
+    slave_gaps(pairs, x, skip).filter(|s| {
+        s.gap.gap < -pairs[s.pair].options.tolerance
+            && !pairs[s.pair].covers(pairs, &s.gap, x, skip)
+    })
 }
 
 /// Per pair, the penetration beyond which a run stops: half the smallest distance between

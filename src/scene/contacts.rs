@@ -6,7 +6,7 @@ use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
 use super::model::Body;
 use super::spec::{ContactSpec, Scene, SurfaceSpec};
-use crate::contact::{ContactPair, Friction, Master, Obstacle, PairOptions, setup};
+use crate::contact::{ContactPair, Covered, Friction, Master, Obstacle, PairOptions, setup};
 use crate::mesh::Cells;
 
 /// The scene's contact pairs in order, their names unique.
@@ -22,6 +22,13 @@ pub(super) fn contacts(
         .enumerate()
         .map(|(k, c)| contact(cx, bodies, &obstacles, k, c))
         .collect::<Result<Vec<_>, _>>()?;
+    let mut contacts = contacts;
+    for (k, spec) in scene.contact.iter().enumerate() {
+        if spec.two_pass {
+            let reverse = reverse_pair(cx, bodies, k, spec, &contacts[k])?;
+            contacts.push(reverse);
+        }
+    }
     if let Some(k) =
         (0..contacts.len()).find(|k| contacts[..*k].iter().any(|c| c.name == contacts[*k].name))
     {
@@ -133,6 +140,65 @@ fn contact(
             friction,
             persistency: false,
         },
+        covered: None,
+    })
+}
+
+/// The second pair of a two-pass contact: the master surface's nodes as slaves of the slave
+/// surface's edges, with the same options, named `NAME:reverse`.
+fn reverse_pair(
+    cx: &Context,
+    bodies: &[Body],
+    k: usize,
+    spec: &ContactSpec,
+    pair: &ContactPair,
+) -> Result<ContactPair, InputError> {
+    let key = format!("contact[{k}] (`{}`).two_pass", spec.name);
+    let Master::Segments { body, edges, .. } = &pair.master else {
+        return Err(cx.err(format!(
+            "{key}: needs a master edge set on a body (node-to-segment); a node-to-node master or an obstacle has no surface to be slave to"
+        )));
+    };
+    let slave_body = &bodies[pair.slave_body];
+    let (_, slave_edges) = edge_set(
+        cx,
+        bodies,
+        Some(&slave_body.name),
+        &spec.slave.set,
+        &format!("contact[{k}] (`{}`).slave", spec.name),
+    )?;
+    let mut slaves: Vec<usize> = edges.iter().flatten().copied().collect();
+    slaves.sort_unstable();
+    slaves.dedup();
+    let boundary = slave_body
+        .mesh
+        .boundary_edges()
+        .iter()
+        .map(|e| e.map(|n| slave_body.global(n)))
+        .collect();
+    Ok(ContactPair {
+        name: format!("{}:reverse", pair.name),
+        slave_body: *body,
+        slaves,
+        master: Master::Segments {
+            body: pair.slave_body,
+            edges: slave_edges,
+            boundary,
+        },
+        options: pair.options.clone(),
+        covered: Some(Covered {
+            pair: k,
+            slaves: {
+                let mut first: Vec<(usize, usize)> = pair
+                    .slaves
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| (*n, i))
+                    .collect();
+                first.sort_unstable();
+                first
+            },
+        }),
     })
 }
 
@@ -239,7 +305,11 @@ pub(super) fn check_contact_setup(
         .iter()
         .flat_map(|b| b.mesh.nodes.iter().copied())
         .collect();
-    for (spec, pair) in scene.contact.iter().zip(contacts) {
+    for pair in contacts {
+        let name = pair.name.strip_suffix(":reverse").unwrap_or(&pair.name);
+        let Some(spec) = scene.contact.iter().find(|s| s.name == name) else {
+            continue;
+        };
         if !spec.setup_check {
             continue;
         }

@@ -312,6 +312,11 @@ pub struct ContactSpec {
     /// solid side of an obstacle, a slave surface facing away from its master. Default true.
     #[serde(default = "yes")]
     pub setup_check: bool,
+    /// Two-pass (symmetric) node-to-segment contact: the master surface's nodes are also
+    /// slaves of the slave surface (a second pair `NAME:reverse`), so neither body can sink
+    /// into the other whatever the roles. Needs edge sets on both sides. Default false.
+    #[serde(default)]
+    pub two_pass: bool,
     /// Coulomb friction coefficient mu (stick/slip). Default: frictionless.
     pub friction: Option<f64>,
     /// The return coefficient R in [0, 1] of Greco & Coda (2003) (eq 36), instead of
