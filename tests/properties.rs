@@ -50,7 +50,7 @@ fn stiffness(x: &Coords, bbar: bool, stress: [f64; 4]) -> Mat8 {
     let s = impact::element::Voigt::new(stress[0], stress[1], stress[2], stress[3]);
     quad4::tangent(
         &geom,
-        &Vec8::zeros(),
+        &quad4::Kinematics::new(&geom, &Vec8::zeros(), op(bbar)),
         &[s; 4],
         &[moduli(); 4],
         op(bbar),
@@ -133,10 +133,12 @@ proptest! {
         let r = stress_rotated(stress, angle);
         let s_moved = impact::element::Voigt::new(r[0], r[1], r[2], r[3]);
         let geom_moved = quad4::values(&moved, Formulation::PlaneStrain, &[1.0; 4]).unwrap();
-        let f0 = quad4::internal_force(&geom, &Vec8::zeros(), &[s0; 4], op(bbar));
-        let f_rigid = quad4::internal_force(&geom, &d, &[s0; 4], op(bbar));
-        let f_moved =
-            quad4::internal_force(&geom_moved, &Vec8::zeros(), &[s_moved; 4], op(bbar));
+        let force = |geom: &quad4::QuadValues, d: &Vec8, s: impact::element::Voigt| {
+            quad4::internal_force(geom, &quad4::Kinematics::new(geom, d, op(bbar)), &[s; 4])
+        };
+        let f0 = force(&geom, &Vec8::zeros(), s0);
+        let f_rigid = force(&geom, &d, s0);
+        let f_moved = force(&geom_moved, &Vec8::zeros(), s_moved);
         let k = stiffness(&x, bbar, stress);
         let k_moved = stiffness(&moved, bbar, stress_rotated(stress, angle));
         let mut t = Mat8::zeros();
@@ -213,7 +215,8 @@ proptest! {
         };
         let geom = quad4::values(&x, formulation, &[1.0; 4]).unwrap();
         let op = quad4::Operator { strain: Strain::Small, bbar };
-        let k = quad4::tangent(&geom, &Vec8::zeros(), &[impact::element::Voigt::zeros(); 4],
+        let kin = quad4::Kinematics::new(&geom, &Vec8::zeros(), op);
+        let k = quad4::tangent(&geom, &kin, &[impact::element::Voigt::zeros(); 4],
             &[elastic.moduli(condition); 4], op, GeometricStiffness::Omitted);
         let m = quad4::mass(&geom);
         let lumped: [f64; 4] = std::array::from_fn(|i| m.row(i).sum());

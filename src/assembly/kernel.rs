@@ -121,14 +121,15 @@ impl Kernel {
                 let thickness = point_thickness(committed, e);
                 let geom = quad4::values(&x, formulation, &thickness)?;
                 let de: Vec8 = increment(body, e, d);
-                if geometry == Strain::Finite {
-                    check_orientation(&geom, &de)?;
-                }
                 let op = quad4::Operator {
                     strain: geometry,
                     bbar,
                 };
-                let strains = quad4::strains(&geom, &de, op);
+                let kinematics = quad4::Kinematics::new(&geom, &de, op);
+                if geometry == Strain::Finite {
+                    check_orientation(&kinematics)?;
+                }
+                let strains = kinematics.strains();
                 let condition = stress_condition(formulation);
                 let context = UpdateContext { condition, dt };
                 let fine = crate::profile::fine().then(Instant::now);
@@ -142,14 +143,14 @@ impl Kernel {
                 let stress = responses.map(|r| r.stress);
                 let start = &committed.points[4 * e..4 * e + 4];
                 let (work, plastic_work) = quad_work(&geom, start, &strains, &responses);
-                let force = quad4::internal_force(&geom, &de, &stress, op);
+                let force = quad4::internal_force(&geom, &kinematics, &stress);
                 let matrix = tangent.map(|_| {
                     let moduli = if elastic_moduli {
                         [body.material.elastic.moduli(condition); 4]
                     } else {
                         responses.map(|r| r.moduli)
                     };
-                    let k = quad4::tangent(&geom, &de, &stress, &moduli, op, geometric);
+                    let k = quad4::tangent(&geom, &kinematics, &stress, &moduli, op, geometric);
                     let mut m = [0.0; 64];
                     m.copy_from_slice(k.transpose().as_slice()); // row-major
                     m
@@ -399,8 +400,8 @@ fn stress_condition(formulation: Formulation) -> StressCondition {
 }
 
 /// det F > 0 at every Gauss point of the increment (the element does not turn inside out).
-fn check_orientation(geom: &quad4::QuadValues, d: &Vec8) -> Result<(), KernelError> {
-    for (point, (f, f_zz)) in quad4::deformation(geom, d).iter().enumerate() {
+fn check_orientation(kinematics: &quad4::Kinematics) -> Result<(), KernelError> {
+    for (point, (f, f_zz)) in kinematics.deformation().iter().enumerate() {
         let det = f.determinant() * f_zz;
         if !(det > 0.0) {
             return Err(KernelError::NegativeJacobian { point, det });

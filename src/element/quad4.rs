@@ -148,12 +148,35 @@ struct PointStrain {
     b: BMatrix,
 }
 
+impl PointStrain {
+    const ZERO: PointStrain = PointStrain {
+        theta: [0.0; 4],
+        hoop: 0.0,
+        strain: Voigt::new(0.0, 0.0, 0.0, 0.0),
+        b: BMatrix::from_array_storage(nalgebra::ArrayStorage([[0.0; 4]; 8])),
+    };
+}
+
 fn point_strain(
     p: &PointValues,
     d: &Vec8,
     formulation: Formulation,
     geometry: Strain,
 ) -> PointStrain {
+    let mut k = PointStrain::ZERO;
+    point_strain_into(p, d, formulation, geometry, &mut k);
+    k
+}
+
+/// `point_strain` written into `out`, whose operator entries that stay zero (the hoop row
+/// off the axisymmetric case, the v columns of the hoop row) must be zero already.
+fn point_strain_into(
+    p: &PointValues,
+    d: &Vec8,
+    formulation: Formulation,
+    geometry: Strain,
+    out: &mut PointStrain,
+) {
     let mut theta = [0.0; 4];
     for i in 0..4 {
         let [nx, ny] = p.dndx[i];
@@ -177,7 +200,10 @@ fn point_strain(
         hoop + 0.5 * nl * hoop * hoop,
         uy + vx + nl * (ux * uy + vx * vy),
     );
-    let mut b = BMatrix::zeros();
+    out.theta = theta;
+    out.hoop = hoop;
+    out.strain = strain;
+    let b = &mut out.b;
     for i in 0..4 {
         let [nx, ny] = p.dndx[i];
         let (cu, cv) = (2 * i, 2 * i + 1);
@@ -191,12 +217,6 @@ fn point_strain(
         b[(3, cu)] = ny * (1.0 + nl * ux) + nx * nl * uy;
         b[(3, cv)] = nx * (1.0 + nl * vy) + ny * nl * vx;
     }
-    PointStrain {
-        theta,
-        hoop,
-        strain,
-        b,
-    }
 }
 
 /// How a Quad4 body forms its strains: small or finite strain, and the volumetric part
@@ -207,20 +227,40 @@ pub struct Operator {
     pub bbar: bool,
 }
 
-/// The four points' strain operators with the B-bar modification applied when asked.
-fn point_strains(geom: &QuadValues, d: &Vec8, op: Operator) -> [PointStrain; 4] {
-    let mut k = geom
-        .points
-        .map(|p| point_strain(&p, d, geom.formulation, op.strain));
-    if op.bbar {
+/// The four points' strains and strain operators of an increment, B-bar applied when the
+/// operator asks: computed once per element evaluation and shared by the strains, the
+/// internal force and the tangent.
+pub struct Kinematics {
+    points: [PointStrain; 4],
+}
+
+impl Kinematics {
+    pub fn new(geom: &QuadValues, d: &Vec8, op: Operator) -> Kinematics {
+        let mut kin = Kinematics {
+            points: [PointStrain::ZERO; 4],
+        };
+        // filled in place: a map over the points copied the 1.3 kB array several times
+        for (k, p) in kin.points.iter_mut().zip(&geom.points) {
+            point_strain_into(p, d, geom.formulation, op.strain, k);
+        }
+        if op.bbar {
+            kin.average_volumetric(geom);
+        }
+        kin
+    }
+
+    /// B-bar: the volumetric part of each point's strain and operator replaced by its
+    /// volume mean.
+    fn average_volumetric(&mut self, geom: &QuadValues) {
+        let k = &mut self.points;
         let volume = geom.volume();
         let mut mean_trace = 0.0;
         let mut mean_b = SMatrix::<f64, 1, 8>::zeros();
-        for (p, kp) in geom.points.iter().zip(&k) {
+        for (p, kp) in geom.points.iter().zip(k.iter()) {
             mean_trace += p.weight * trace(&kp.strain) / volume;
             mean_b += (kp.b.row(0) + kp.b.row(1) + kp.b.row(2)) * (p.weight / volume);
         }
-        for kp in &mut k {
+        for kp in k.iter_mut() {
             let dev_trace = (mean_trace - trace(&kp.strain)) / 3.0;
             let dev_b = (mean_b - (kp.b.row(0) + kp.b.row(1) + kp.b.row(2))) / 3.0;
             for r in 0..3 {
@@ -230,7 +270,24 @@ fn point_strains(geom: &QuadValues, d: &Vec8, op: Operator) -> [PointStrain; 4] 
             }
         }
     }
-    k
+
+    /// Green-Lagrange strain increments at the four Gauss points (zz = 0 in plane stress:
+    /// the material decides it).
+    pub fn strains(&self) -> [Voigt; 4] {
+        std::array::from_fn(|q| self.points[q].strain)
+    }
+
+    /// As [`deformation`], from the displacement gradients already formed (B-bar changes
+    /// the strains and operators, not these).
+    pub fn deformation(&self) -> [(Matrix2<f64>, f64); 4] {
+        std::array::from_fn(|q| {
+            let [ux, uy, vx, vy] = self.points[q].theta;
+            (
+                Matrix2::new(1.0 + ux, uy, vx, 1.0 + vy),
+                1.0 + self.points[q].hoop,
+            )
+        })
+    }
 }
 
 fn trace(v: &Voigt) -> f64 {
@@ -240,7 +297,7 @@ fn trace(v: &Voigt) -> f64 {
 /// Green-Lagrange strain increments at the four Gauss points (zz = 0 in plane stress: the
 /// material decides it).
 pub fn strains(geom: &QuadValues, d: &Vec8, op: Operator) -> [Voigt; 4] {
-    point_strains(geom, d, op).map(|k| k.strain)
+    Kinematics::new(geom, d, op).strains()
 }
 
 /// In-plane deformation gradient F = I + [[u,x u,y] [v,x v,y]] and the hoop stretch 1 + u/r
@@ -254,8 +311,8 @@ pub fn deformation(geom: &QuadValues, d: &Vec8) -> [(Matrix2<f64>, f64); 4] {
 }
 
 /// Internal force f = sum_q w_q B_q^T S_q (Erklig eq 25).
-pub fn internal_force(geom: &QuadValues, d: &Vec8, stress: &[Voigt; 4], op: Operator) -> Vec8 {
-    let k = point_strains(geom, d, op);
+pub fn internal_force(geom: &QuadValues, kin: &Kinematics, stress: &[Voigt; 4]) -> Vec8 {
+    let k = &kin.points;
     let mut f = Vec8::zeros();
     for q in 0..4 {
         f += k[q].b.transpose() * stress[q] * geom.points[q].weight;
@@ -267,13 +324,13 @@ pub fn internal_force(geom: &QuadValues, d: &Vec8, stress: &[Voigt; 4], op: Oper
 /// for the given material moduli dS/dE; K_sigma only when `geometric` includes it.
 pub fn tangent(
     geom: &QuadValues,
-    d: &Vec8,
+    kin: &Kinematics,
     stress: &[Voigt; 4],
     moduli: &[Moduli; 4],
     op: Operator,
     geometric: GeometricStiffness,
 ) -> Mat8 {
-    let k = point_strains(geom, d, op);
+    let k = &kin.points;
     let mut kt = Mat8::zeros();
     for q in 0..4 {
         let w = geom.points[q].weight;
@@ -444,12 +501,13 @@ mod tests {
                 let geom = values(&distorted(), form, &[0.7; 4]).unwrap();
                 let force = |d: &Vec8| {
                     let e = strains(&geom, d, op);
-                    internal_force(&geom, d, &e.map(|e| stress_of(&e, &s0)), op)
+                    let kin = Kinematics::new(&geom, d, op);
+                    internal_force(&geom, &kin, &e.map(|e| stress_of(&e, &s0)))
                 };
                 let e = strains(&geom, &d, op);
                 let kt = tangent(
                     &geom,
-                    &d,
+                    &Kinematics::new(&geom, &d, op),
                     &e.map(|e| stress_of(&e, &s0)),
                     &[moduli(); 4],
                     op,
