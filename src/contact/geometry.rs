@@ -192,6 +192,23 @@ pub fn winding_number(s: [f64; 2], segments: &[[[f64; 2]; 2]]) -> f64 {
     total / (2.0 * PI)
 }
 
+/// Whether `s` lies inside the closed boundary `segments` (any orientation, holes
+/// included): an odd number of the boundary's crossings of the ray from `s` along +x. For a
+/// point off the boundary this is `winding_number(s) > 0.5` without its two arc tangents a
+/// segment, which made the inside test the costliest part of a contact search.
+fn inside_by_crossings(s: [f64; 2], segments: impl Iterator<Item = [[f64; 2]; 2]>) -> bool {
+    let mut inside = false;
+    for [a, b] in segments {
+        if (a[1] > s[1]) != (b[1] > s[1]) {
+            let crossing = a[0] + (s[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+            if s[0] < crossing {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
 /// Nearest point of segment [a, b] to x: (xi, distance).
 pub(super) fn project(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
     let ab = sub(b, a);
@@ -216,17 +233,20 @@ fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
 /// left; `inside` decides the sign where the nearest point is a corner.
 fn gap_to_segments(
     x: [f64; 2],
-    segments: &[[[f64; 2]; 2]],
+    count: usize,
+    segment: impl Fn(usize) -> [[f64; 2]; 2],
     inside: impl Fn() -> bool,
 ) -> Option<(usize, f64, f64, [f64; 2])> {
     let mut best: Option<(usize, f64, f64)> = None;
-    for (k, [a, b]) in segments.iter().enumerate() {
-        let (xi, d) = project(x, *a, *b);
+    for k in 0..count {
+        let [a, b] = segment(k);
+        let (xi, d) = project(x, a, b);
         let interior = xi > 0.0 && xi < 1.0;
         let better = match best {
             None => true,
             Some((kb, _, db)) => {
-                let (xib, _) = project(x, segments[kb][0], segments[kb][1]);
+                let [ka, kb] = segment(kb);
+                let (xib, _) = project(x, ka, kb);
                 d < db - 1e-12 * db.max(1e-300)
                     || ((d - db).abs() <= 1e-12 * db.max(1e-300)
                         && interior
@@ -238,7 +258,7 @@ fn gap_to_segments(
         }
     }
     let (k, xi, d) = best?;
-    let [a, b] = segments[k];
+    let [a, b] = segment(k);
     let n = outward(a, b);
     let p = [a[0] + xi * (b[0] - a[0]), a[1] + xi * (b[1] - a[1])];
     let along_normal = dot(sub(x, p), n);
@@ -305,14 +325,10 @@ impl ContactPair {
             Master::Segments {
                 edges, boundary, ..
             } => {
-                let segments: Vec<[[f64; 2]; 2]> =
-                    edges.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
-                let inside = || {
-                    let closed: Vec<[[f64; 2]; 2]> =
-                        boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
-                    winding_number(xs, &closed) > 0.5
-                };
-                let (k, xi, _, _) = gap_to_segments(xs, &segments, inside)?;
+                let inside =
+                    || inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)]));
+                let segment = |k: usize| [x(edges[k][0]), x(edges[k][1])];
+                let (k, xi, _, _) = gap_to_segments(xs, edges.len(), segment, inside)?;
                 let [a, b] = edges[k];
                 // the normal interpolated between the master nodes' averaged normals: it
                 // turns continuously across a vertex, where a dented deformable surface would
@@ -368,7 +384,8 @@ impl ContactPair {
                         dot(sub(xs, a), outward(a, b)) < 0.0
                     }
                 };
-                let (_, _, gap, normal) = gap_to_segments(xs, &segments, inside)?;
+                let (_, _, gap, normal) =
+                    gap_to_segments(xs, segments.len(), |k| segments[k], inside)?;
                 Gap {
                     gap,
                     normal,
