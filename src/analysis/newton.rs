@@ -275,6 +275,47 @@ fn constrained_solve(
 /// A residual this share of the force tolerance is round-off: the step has converged.
 const ROUND_OFF: f64 = 1e-4;
 
+/// The force measure of an iterate: eps_2 against its scale, and the residual against the
+/// forces in play for the round-off exit.
+struct Convergence {
+    residual_norm: f64,
+    forces_scale: f64,
+    /// ||F||, floored by what the stiffness makes of the increment.
+    scale: f64,
+    eps_force: f64,
+}
+
+impl Convergence {
+    fn of(residual_norm: f64, forces_scale: f64, d: &[f64], diagonal_max: f64) -> Convergence {
+        // the force scale cannot fall below what the stiffness makes of the increment: a
+        // rigid motion has no loads and no reactions, only round-off to compare with
+        let d_max = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = forces_scale.max(diagonal_max * d_max);
+        let eps_force = if scale > 0.0 {
+            residual_norm / scale
+        } else {
+            0.0
+        };
+        Convergence {
+            residual_norm,
+            forces_scale,
+            scale,
+            eps_force,
+        }
+    }
+
+    /// Both measures of Erklig 2.1.2 (viii) under their tolerances, or the residual at
+    /// round-off of the forces in play, whatever the last correction was: at rest (a bar
+    /// stopped against a wall) the increment is round-off too, and the displacement ratio
+    /// compares round-off with round-off. (Not against the stiffness floor of the scale:
+    /// past a limit load the increment grows without bound and would make any residual look
+    /// small.)
+    fn passed(&self, newton: &NewtonSpec, eps_displacement: f64) -> bool {
+        (eps_displacement < newton.tol_displacement && self.eps_force < newton.tol_force)
+            || self.residual_norm <= ROUND_OFF * newton.tol_force * self.forces_scale
+    }
+}
+
 /// Stiffness-proportional damping matrix of the step (the tangent at D = 0), free DOFs.
 struct Damping {
     values: Vec<f64>,
@@ -398,24 +439,8 @@ impl Step<'_> {
             if !residual_norm.is_finite() {
                 return Err(StepFailure(non_finite(system, &balance, &d)));
             }
-            // the force scale cannot fall below what the stiffness makes of the increment:
-            // a rigid motion has no loads and no reactions, only round-off to compare with
-            let d_max = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let scale = forces_scale.max(system.diagonal_max * d_max);
-            let eps_force = if scale > 0.0 {
-                residual_norm / scale
-            } else {
-                0.0
-            };
-            // a residual at round-off of the forces in play ends the iteration whatever the
-            // last correction was: at rest (a bar stopped against a wall) the increment is
-            // round-off too, and the displacement ratio compares round-off with round-off.
-            // (Not against the stiffness floor of the scale: past a limit load the increment
-            // grows without bound and would make any residual look small.)
-            let converged = iteration > 0
-                && ((eps_displacement < newton.tol_displacement && eps_force < newton.tol_force)
-                    || residual_norm <= ROUND_OFF * newton.tol_force * forces_scale);
-            if converged {
+            let test = Convergence::of(residual_norm, forces_scale, &d, system.diagonal_max);
+            if iteration > 0 && test.passed(newton, eps_displacement) {
                 let tangential = match &self.contact {
                     Some(c) => rows.tangential_forces(c.tangential, &forces),
                     None => Vec::new(),
@@ -436,7 +461,7 @@ impl Step<'_> {
                     iteration,
                     residual_norm / previous_residual,
                     residual_norm,
-                    scale,
+                    test.scale,
                 );
             if stalled && !refactor {
                 // the same state again, now with the tangent assembled
