@@ -175,37 +175,49 @@ fn ring_wall_with_each_option_keeps_tangential_momentum() {
     }
 }
 
-/// Goal: the keys are refused where they do not apply, exit 2 naming the key.
+/// Goal: the keys are refused where they do not apply, by `check` and `run` alike, exit 2
+/// naming the key.
 #[test]
 fn contact_dynamics_keys_are_refused_where_they_do_not_apply() {
-    for (scene, set, key) in [
+    let explicit = [
+        "--set",
+        "analysis.integrator=central_difference",
+        "--set",
+        "analysis.mass=lumped",
+    ];
+    for (scene, set, key, extra) in [
         (
             "models/sphere_wall.toml",
             "analysis.mass=dispersion_free",
             "analysis.mass",
+            &[][..],
         ),
         (
             "models/bar_wall.toml",
             "analysis.contact_dynamics=persistency",
             "analysis.contact_dynamics",
+            &explicit[..],
         ),
         (
             "models/hertz_sphere.toml",
             "analysis.contact_dynamics=persistency",
             "analysis.contact_dynamics",
+            &[][..],
         ),
     ] {
-        let mut args = vec!["run", scene, "--quiet", "--set", set];
         let out = common::out_dir(&format!("refused_{}", key.replace('.', "_")));
         let out = out.to_string_lossy().to_string();
-        if scene.contains("bar_wall") {
-            args.extend(["--set", "analysis.integrator=central_difference"]);
-            args.extend(["--set", "analysis.mass=lumped"]);
+        for command in [
+            vec!["check", scene],
+            vec!["run", scene, "--quiet", "--out", &out],
+        ] {
+            let mut args = command.clone();
+            args.extend(["--set", set]);
+            args.extend(extra);
+            let output = common::impact(&args);
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+            assert!(stderr.contains(key), "{args:?}: {stderr}");
         }
-        args.extend(["--out", &out]);
-        let output = common::impact(&args);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert_eq!(output.status.code(), Some(2), "{scene} {set}: {stderr}");
-        assert!(stderr.contains(key), "{scene} {set}: {stderr}");
     }
 }

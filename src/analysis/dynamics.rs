@@ -25,7 +25,7 @@ use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
 };
 use crate::output::readable;
-use crate::scene::spec::{ContactDynamics, DynamicSpec, IntegratorKind, MassKind, Strategy};
+use crate::scene::spec::{ContactDynamics, DynamicSpec, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
@@ -48,27 +48,6 @@ pub fn integrator(spec: &DynamicSpec) -> Box<dyn Integrator> {
         IntegratorKind::CentralDifference => {
             unreachable!("the explicit stepper runs central difference")
         }
-    }
-}
-
-/// `mass = "dispersion_free"` is the rod blend: refused for a continuum body.
-fn check_dispersion_free(model: &Model, spec: &DynamicSpec) -> Result<(), InputError> {
-    if spec.mass != MassKind::DispersionFree {
-        return Ok(());
-    }
-    match model
-        .bodies
-        .iter()
-        .find(|b| !matches!(b.kind, crate::scene::BodyKind::Rod { .. }))
-    {
-        Some(body) => Err(InputError::new(
-            &model.file,
-            format!(
-                "analysis.mass: `dispersion_free` is the blend for rods; body `{}` is a continuum (use `consistent` or `lumped`)",
-                body.name
-            ),
-        )),
-        None => Ok(()),
     }
 }
 
@@ -114,6 +93,8 @@ pub fn check_mass(model: &Model, mass: &Mass, system: &System) -> Result<(), Inp
 pub struct Dynamics<'a> {
     model: &'a Model,
     spec: &'a DynamicSpec,
+    /// The contact pairs and surfaces; under `persistency` and `mass_redistribution` the
+    /// pairs' impact and release conditions and fraction rule are off (see `new`).
     interfaces: Interfaces,
     initial: Vec<[f64; 2]>,
     system: System,
@@ -144,7 +125,6 @@ impl<'a> Dynamics<'a> {
         dir: &Path,
     ) -> Result<Dynamics<'a>, super::RunError> {
         let system = System::new(model, &model.constrained_dofs());
-        check_dispersion_free(model, spec)?;
         let mut mass =
             Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
         check_mass(model, &mass, &system)?;

@@ -13,7 +13,7 @@ use super::materials::materials;
 use super::model::{Analysis, Body, BodyKind, Load, Model, Probe, SceneSource};
 use super::probes::{frame_times, probes};
 use super::reference::reference;
-use super::spec::{IntegratorKind, OutputSpec, Quadrature, Quantity, Scene, Statistic};
+use super::spec::{IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene, Statistic};
 use crate::contact::{ContactPair, Friction};
 use std::path::Path;
 
@@ -36,6 +36,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     check_contact_setup(&cx, &scene, &bodies, &contacts)?;
     check_reaction_probes(&cx, &probes, &fixed_dofs, &loads)?;
     check_reduced_quadrature(&cx, &analysis, &bodies)?;
+    check_dispersion_free(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
     let reference = match &scene.reference {
@@ -121,6 +122,27 @@ fn check_reduced_quadrature(
     {
         return Err(cx.err(format!(
             "analysis.quadrature: `reduced` covers Quad4 bodies (plane strain, plane stress, axisymmetric); body `{}` is a rod: use quadrature = \"full\"",
+            body.name
+        )));
+    }
+    Ok(())
+}
+
+/// `mass = "dispersion_free"` is the rod blend: refused for a continuum body (the
+/// quadrilateral blend is indefinite, docs/theory.md 8.9).
+fn check_dispersion_free(
+    cx: &Context,
+    analysis: &Analysis,
+    bodies: &[Body],
+) -> Result<(), InputError> {
+    if let Analysis::Dynamic(d) = analysis
+        && d.mass == MassKind::DispersionFree
+        && let Some(body) = bodies
+            .iter()
+            .find(|b| !matches!(b.kind, BodyKind::Rod { .. }))
+    {
+        return Err(cx.err(format!(
+            "analysis.mass: `dispersion_free` is the blend for rods; body `{}` is a continuum (use `consistent` or `lumped`)",
             body.name
         )));
     }
