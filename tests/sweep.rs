@@ -72,7 +72,7 @@ fn two_bars_force_error_converges_with_h_and_dt_together() {
         "order of the whole history {p_whole}: {whole:?}"
     );
     assert!(report.csv.is_file());
-    for chart in ["error_vs_dt.png", "error_vs_h.svg", "error_vs_wall.svg"] {
+    for chart in ["error_vs_dt.png", "error_vs_h.svg", "error_vs_cpu.svg"] {
         assert!(dir.join(chart).is_file(), "{chart}");
     }
 }
@@ -135,16 +135,20 @@ fn stability_map_central_difference_fails_just_above_dt_crit() {
     assert!(dir.join("stability_map.png").is_file());
 }
 
-/// The sweep.csv columns that do not depend on timing (all but wall_seconds).
+/// The sweep.csv columns that do not depend on timing (all but wall_seconds and
+/// cpu_seconds).
 fn deterministic(csv: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(csv).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let wall = header.iter().position(|h| *h == "wall_seconds").unwrap();
+    let timing: Vec<usize> = ["wall_seconds", "cpu_seconds"]
+        .iter()
+        .map(|c| header.iter().position(|h| h == c).unwrap())
+        .collect();
     text.lines()
         .map(|l| {
             l.split(',')
                 .enumerate()
-                .filter(|(k, _)| *k != wall)
+                .filter(|(k, _)| !timing.contains(k))
                 .map(|(_, v)| v)
                 .collect::<Vec<_>>()
                 .join(",")
@@ -155,7 +159,7 @@ fn deterministic(csv: &Path) -> Vec<String> {
 /// Goal: a rerun of a finished sweep does no work, and two shards merged
 /// equal the unsharded sweep. Setup: two_bars to t = 0.05, 2 integrators x 2 dt (4 cases).
 /// Reference: the report's count of executed runs (0 on the rerun); the merged sweep.csv
-/// equals the unsharded one in every column but wall_seconds (each case runs on one thread:
+/// equals the unsharded one in every column but the timings (each case runs on one thread:
 /// bitwise the same numbers).
 #[test]
 fn rerun_does_no_work_and_merged_shards_equal_the_whole() {

@@ -1,8 +1,9 @@
 //! The sweep's charts, PNG and SVG each:
 //!
 //! ```text
-//! error_vs_wall   primary error against wall time, one series per integrator (and other
-//!                 varied values that are not dt or a mesh): the speed-vs-accuracy chart
+//! error_vs_cpu    primary error against each case's CPU time, one series per integrator
+//!                 (and other varied values that are not dt or a mesh), and the Pareto
+//!                 front over all of them: the speed-vs-accuracy chart
 //! error_vs_dt     the errors against dt, with the least-squares slope of log e against
 //!                 log dt of each series printed in its fit line's legend entry
 //! error_vs_h      the same against the shortest element edge h
@@ -101,7 +102,7 @@ pub fn write_all(
     } else {
         "|peak force error| (relative)"
     };
-    written.extend(error_vs_wall(&groups, title, primary_name, out)?);
+    written.extend(error_vs_cpu(&groups, title, primary_name, out)?);
     written.extend(convergence(rows, &groups, title, primary_name, out)?);
     written.extend(stability_map(rows, &groups, title, out)?);
     Ok(written)
@@ -112,20 +113,22 @@ fn finished(r: &&&Row) -> bool {
     r.status == "ok"
 }
 
-/// Speed against accuracy: error_vs_wall, the primary error against wall time.
-fn error_vs_wall(
+/// Speed against accuracy: error_vs_cpu, the primary error against each case's own CPU time
+/// (its wall time where a record predates it), with the Pareto front: the cases no other
+/// case beats on both time and error, the cheapest way to each accuracy.
+fn error_vs_cpu(
     groups: &Groups,
     title: &str,
     primary_name: &str,
     out: &Path,
 ) -> Result<Vec<PathBuf>, RunError> {
-    let series: Vec<Series> = groups
+    let mut series: Vec<Series> = groups
         .iter()
         .filter_map(|(label, members)| {
             let mut points: Vec<(f64, f64)> = members
                 .iter()
                 .filter(finished)
-                .filter_map(|r| Some((r.wall_seconds?, r.primary_error()?)))
+                .filter_map(|r| Some((r.cpu_seconds.or(r.wall_seconds)?, r.primary_error()?)))
                 .filter(|(x, y)| *x > 0.0 && *y > 0.0)
                 .collect();
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -139,9 +142,15 @@ fn error_vs_wall(
     if series.is_empty() {
         return Ok(Vec::new());
     }
+    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.clone()).collect();
+    series.push(Series {
+        label: "Pareto front".into(),
+        points: pareto_front(all),
+        style: SeriesStyle::Line,
+    });
     let chart = Chart {
-        title: format!("{title}: error against wall time"),
-        x_label: "wall time [s]".into(),
+        title: format!("{title}: error against CPU time"),
+        x_label: "CPU time of the case [s]".into(),
         y_label: primary_name.into(),
         series,
         log_x: true,
@@ -149,7 +158,20 @@ fn error_vs_wall(
         x_limits: Default::default(),
         y_limits: Default::default(),
     };
-    both(&chart, out, "error_vs_wall")
+    both(&chart, out, "error_vs_cpu")
+}
+
+/// The (time, error) points no other point beats on both, by increasing time: each has a
+/// lower error than every cheaper one.
+pub fn pareto_front(mut points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    points.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    for p in points {
+        if front.last().is_none_or(|last| p.1 < last.1) {
+            front.push(p);
+        }
+    }
+    front
 }
 
 /// Convergence: error_vs_dt and error_vs_h, each series with its fitted slope.
@@ -308,4 +330,28 @@ fn both(chart: &Chart, out: &Path, stem: &str) -> Result<Vec<PathBuf>, RunError>
         paths.push(path);
     }
     Ok(paths)
+}
+
+#[cfg(test)]
+mod tests {
+    /// Goal: the Pareto front keeps exactly the points no other beats on both time and error.
+    /// Reference, by hand: of (1, 0.5), (2, 0.6), (2, 0.1), (3, 0.3), (4, 0.05), (5, 0.05),
+    /// (0.5, 0.9), the front is (0.5, 0.9), (1, 0.5), (2, 0.1), (4, 0.05): (2, 0.6) and
+    /// (3, 0.3) are beaten by (2, 0.1), and (5, 0.05) by (4, 0.05) at a lower time.
+    #[test]
+    fn pareto_front_keeps_the_cheapest_point_of_each_accuracy() {
+        let points = vec![
+            (1.0, 0.5),
+            (2.0, 0.6),
+            (2.0, 0.1),
+            (3.0, 0.3),
+            (4.0, 0.05),
+            (5.0, 0.05),
+            (0.5, 0.9),
+        ];
+        assert_eq!(
+            super::pareto_front(points),
+            vec![(0.5, 0.9), (1.0, 0.5), (2.0, 0.1), (4.0, 0.05)]
+        );
+    }
 }

@@ -37,6 +37,10 @@ pub struct CaseRecord {
     pub status: String,
     pub message: Option<String>,
     pub wall_seconds: f64,
+    /// The CPU time of the thread the case ran on (its own work, whatever else ran beside it
+    /// under `--jobs`); absent in records written before it was kept.
+    #[serde(default)]
+    pub cpu_seconds: Option<f64>,
 }
 
 /// What one case measured (None where it does not apply or is unknown).
@@ -71,6 +75,7 @@ pub struct Row {
     pub h: f64,
     pub dt_crit: Option<f64>,
     pub wall_seconds: Option<f64>,
+    pub cpu_seconds: Option<f64>,
     pub measures: Measures,
 }
 
@@ -219,6 +224,7 @@ fn row(
         h: shortest_edge(model),
         dt_crit,
         wall_seconds: record.map(|r| r.wall_seconds),
+        cpu_seconds: record.and_then(|r| r.cpu_seconds),
         measures,
     })
 }
@@ -546,6 +552,7 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
             "newton_iterations",
             "factorizations",
             "wall_seconds",
+            "cpu_seconds",
         ]
         .map(String::from),
     );
@@ -579,6 +586,7 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
         let count = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.0}"));
         cells.extend([m.steps, m.newton_iterations, m.factorizations].map(count));
         cells.push(num(row.wall_seconds));
+        cells.push(num(row.cpu_seconds));
         text.push_str(&cells.join(","));
         text.push('\n');
     }

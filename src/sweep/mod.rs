@@ -197,7 +197,12 @@ fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<CaseR
         .build()
         .map_err(|e| output_error(&folder, "start the thread of", std::io::Error::other(e)))?;
     let start = Instant::now();
-    let result = single.install(|| analysis::run(model, &folder, RunOptions::default()));
+    // the case runs on the single pool's thread: its CPU time is the case's own
+    let (result, cpu_seconds) = single.install(|| {
+        let cpu = cpu_time::ThreadTime::now();
+        let result = analysis::run(model, &folder, RunOptions::default());
+        (result, cpu.elapsed().as_secs_f64())
+    });
     let wall = start.elapsed().as_secs_f64();
     let (status, message, wall_seconds) = match result {
         Ok(summary) => ("ok".to_string(), None, summary.wall_seconds),
@@ -220,6 +225,7 @@ fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<CaseR
         status,
         message,
         wall_seconds,
+        cpu_seconds: Some(cpu_seconds),
     };
     let text = serde_json::to_string_pretty(&record).expect("the record serializes");
     write_atomic(&folder.join("case.json"), text.as_bytes())?;
