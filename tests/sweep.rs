@@ -37,7 +37,8 @@ fn observed_order(points: &[(f64, f64)]) -> f64 {
 /// tests/contact.rs) falls with observed order >= 1 (measured 1.46 over these three levels,
 /// 1.5 with a fourth); (b) the whole-history L2 error falls with an order in [0.3, 0.7]:
 /// a jump in the exact force caps it at 1/2 (measured 0.46); (c) the release time lies
-/// within one dt of 0.2 on every level.
+/// within one dt of 0.2 on every level; (d) the converged-reference columns name the finest
+/// case as that reference.
 #[test]
 fn two_bars_force_error_converges_with_h_and_dt_together() {
     let dir = common::out_dir("sweep_two_bars_convergence");
@@ -72,7 +73,21 @@ fn two_bars_force_error_converges_with_h_and_dt_together() {
         "order of the whole history {p_whole}: {whole:?}"
     );
     assert!(report.csv.is_file());
-    for chart in ["error_vs_dt.png", "error_vs_h.svg", "error_vs_cpu.svg"] {
+    // (d) beside the declared reference, the converged one is the finest case (n = 56): it
+    // has no error against itself, the two coarser levels have one
+    let converged: Vec<Option<f64>> = report
+        .rows
+        .iter()
+        .map(|r| r.measures.converged_force_l2)
+        .collect();
+    assert!(converged[2].is_none(), "{converged:?}");
+    assert!(converged[..2].iter().all(|e| e.is_some_and(|e| e > 0.0)));
+    for chart in [
+        "error_vs_dt.png",
+        "error_vs_h.svg",
+        "error_vs_cpu.svg",
+        "error_vs_cpu_converged.svg",
+    ] {
         assert!(dir.join(chart).is_file(), "{chart}");
     }
 }

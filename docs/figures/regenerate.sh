@@ -53,6 +53,7 @@ methods='analysis.integrator,analysis.allow_unstable,analysis.mass=central_diffe
 sweep models/two_bars.toml --vary "$methods" --vary "$refine_bars" \
   --out $out/sweep_two_bars_methods
 copy $out/sweep_two_bars_methods/error_vs_cpu sweep_two_bars_speed
+copy $out/sweep_two_bars_methods/error_vs_cpu_converged sweep_two_bars_speed_converged
 # dt_crit of bar_wall and two_bars: h / c = 1/140 (impact check)
 ratios=$(python3 -c "print(','.join(repr(r / 140) for r in (0.5, 0.9, 0.95, 1.05, 2, 10)))")
 sweep models/bar_wall.toml --vary "$methods" --vary "analysis.dt=$ratios" --out $out/sweep_bar_wall_stability
@@ -62,6 +63,7 @@ copy $out/sweep_two_bars_stability/stability_map sweep_two_bars_stability
 sweep models/sphere_wall.toml --vary 'analysis.integrator=average,hu,houbolt,wilson' \
   --vary 'analysis.dt=0.02,0.01,0.005,0.0025' --out $out/sweep_sphere_wall_methods
 copy $out/sweep_sphere_wall_methods/error_vs_cpu sweep_sphere_wall_speed
+copy $out/sweep_sphere_wall_methods/error_vs_cpu_converged sweep_sphere_wall_speed_converged
 
 # The Taylor rods (aluminium, Johnson-Cook steel): three meshes, one-point and 2x2 explicit,
 # implicit Newmark on the two coarser Johnson-Cook meshes; about four minutes

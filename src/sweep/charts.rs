@@ -4,6 +4,8 @@
 //! error_vs_cpu    primary error against each case's CPU time, one series per integrator
 //!                 (and other varied values that are not dt or a mesh), and the Pareto
 //!                 front over all of them: the speed-vs-accuracy chart
+//! error_vs_cpu_converged  the same against the converged reference (the finest case or
+//!                 Richardson's extrapolation), beside a declared closed-form reference
 //! error_vs_dt     the errors against dt, with the least-squares slope of log e against
 //!                 log dt of each series printed in its fit line's legend entry
 //! error_vs_h      the same against the shortest element edge h
@@ -102,7 +104,27 @@ pub fn write_all(
     } else {
         "|peak force error| (relative)"
     };
-    written.extend(error_vs_cpu(&groups, title, primary_name, out)?);
+    written.extend(error_vs_cpu(
+        &groups,
+        title,
+        primary_name,
+        out,
+        Accuracy::Primary,
+    )?);
+    if rows.iter().any(|r| r.converged_error().is_some()) {
+        let name = if rows.iter().any(|r| r.measures.converged_force_l2.is_some()) {
+            "contact force L2 error against the converged reference"
+        } else {
+            "|peak force error| against the converged reference"
+        };
+        written.extend(error_vs_cpu(
+            &groups,
+            title,
+            name,
+            out,
+            Accuracy::Converged,
+        )?);
+    }
     written.extend(convergence(rows, &groups, title, primary_name, out)?);
     written.extend(stability_map(rows, &groups, title, out)?);
     Ok(written)
@@ -121,14 +143,19 @@ fn error_vs_cpu(
     title: &str,
     primary_name: &str,
     out: &Path,
+    accuracy: Accuracy,
 ) -> Result<Vec<PathBuf>, RunError> {
+    let error = |r: &Row| match accuracy {
+        Accuracy::Primary => r.primary_error(),
+        Accuracy::Converged => r.converged_error(),
+    };
     let mut series: Vec<Series> = groups
         .iter()
         .filter_map(|(label, members)| {
             let mut points: Vec<(f64, f64)> = members
                 .iter()
                 .filter(finished)
-                .filter_map(|r| Some((r.cpu_seconds.or(r.wall_seconds)?, r.primary_error()?)))
+                .filter_map(|r| Some((r.cpu_seconds.or(r.wall_seconds)?, error(r)?)))
                 .filter(|(x, y)| *x > 0.0 && *y > 0.0)
                 .collect();
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -158,7 +185,19 @@ fn error_vs_cpu(
         x_limits: Default::default(),
         y_limits: Default::default(),
     };
-    both(&chart, out, "error_vs_cpu")
+    let name = match accuracy {
+        Accuracy::Primary => "error_vs_cpu",
+        Accuracy::Converged => "error_vs_cpu_converged",
+    };
+    both(&chart, out, name)
+}
+
+/// Which error a speed chart plots: against the scene's reference (or the finest case
+/// without one), or against the converged reference beside a declared one.
+#[derive(Clone, Copy)]
+enum Accuracy {
+    Primary,
+    Converged,
 }
 
 /// The (time, error) points no other point beats on both, by increasing time: each has a

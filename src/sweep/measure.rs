@@ -48,6 +48,11 @@ pub struct CaseRecord {
 pub struct Measures {
     pub force_l2: Option<f64>,
     pub force_l2_smooth: Option<f64>,
+    /// With a declared (closed-form) reference, the force L2 error and the peak force error
+    /// against the converged one as well (the finest case, or Richardson's extrapolation):
+    /// the discretization error without the closed form's own model error.
+    pub converged_force_l2: Option<f64>,
+    pub converged_peak_force_error: Option<f64>,
     pub release_time: Option<f64>,
     pub release_error: Option<f64>,
     pub peak_force: Option<f64>,
@@ -91,6 +96,13 @@ impl Row {
             .force_l2
             .or(self.measures.peak_force_error.map(f64::abs))
     }
+
+    /// The same against the converged reference (declared references only).
+    pub fn converged_error(&self) -> Option<f64> {
+        self.measures
+            .converged_force_l2
+            .or(self.measures.converged_peak_force_error.map(f64::abs))
+    }
 }
 
 /// The reference used, for the report.
@@ -110,6 +122,9 @@ pub struct ReferenceUsed {
     pub richardson_order: Option<f64>,
     /// What a column measures when it is not a discretization error (printed by the sweep).
     pub notes: Vec<String>,
+    /// Beside a declared reference: the converged one the `converged_` columns use.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub converged: Option<Box<ReferenceUsed>>,
 }
 
 /// Why `peak_force_error` against a force pulse does not converge.
@@ -165,7 +180,11 @@ pub fn tabulate(
             radius,
             duration,
         }) => hertz_reference(&mut rows, &loaded, pair, *peak_force, *radius, *duration),
-        None => finest_reference(&mut rows, &loaded, pair),
+        None => finest_reference(&mut rows, &loaded, pair.clone()),
+    };
+    let used = match reference {
+        Some(_) => with_converged(used, &mut rows, &loaded, pair),
+        None => used,
     };
     Ok((rows, used))
 }
@@ -272,6 +291,7 @@ fn pulse_reference(
         finest: None,
         richardson_order: None,
         notes: vec![PULSE_PEAK_NOTE.to_string()],
+        converged: None,
     }
 }
 
@@ -311,7 +331,31 @@ fn hertz_reference(
         finest: None,
         richardson_order: None,
         notes: Vec::new(),
+        converged: None,
     }
+}
+
+/// Beside a declared reference, the errors against the converged one (the finest case or
+/// Richardson's extrapolation, `finest_reference` on a copy of the rows) in the `converged_`
+/// measures.
+fn with_converged(
+    mut used: ReferenceUsed,
+    rows: &mut [Row],
+    loaded: &[(Option<Loaded>, Option<CaseRecord>)],
+    pair: Option<String>,
+) -> ReferenceUsed {
+    let mut copy = rows.to_vec();
+    let converged = finest_reference(&mut copy, loaded, pair);
+    for (row, measured) in rows.iter_mut().zip(&copy) {
+        // the finest case is the reference's own history: no error to measure
+        if converged.finest.as_ref() == Some(&row.folder) {
+            continue;
+        }
+        row.measures.converged_force_l2 = measured.measures.force_l2;
+        row.measures.converged_peak_force_error = measured.measures.peak_force_error;
+    }
+    used.converged = Some(Box::new(converged));
+    used
 }
 
 /// Without a declared reference: the finest ok case (smallest dt, then the most elements
@@ -342,6 +386,7 @@ fn finest_reference(
         finest: None,
         richardson_order: None,
         notes: Vec::new(),
+        converged: None,
     };
     let Some(&finest) = ok.first() else {
         return used;
@@ -548,6 +593,8 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
             "radius_error",
             "energy_drift",
             "energy_change",
+            "converged_force_l2",
+            "converged_peak_force_error",
             "steps",
             "newton_iterations",
             "factorizations",
@@ -580,6 +627,8 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
                 m.radius_error,
                 m.energy_drift,
                 m.energy_change,
+                m.converged_force_l2,
+                m.converged_peak_force_error,
             ]
             .map(num),
         );
