@@ -186,7 +186,7 @@ impl<'a> Dynamics<'a> {
             spec.newton.tangent,
         )
         .map_err(|e| e.to_string())?;
-        let damping = self.mass.product(velocity);
+        let damping = self.mass.product(model, velocity);
         let rhs: Vec<f64> = external
             .iter()
             .zip(evaluation.force.iter().zip(&damping))
@@ -319,7 +319,7 @@ impl<'a> Dynamics<'a> {
         for (u, du) in kin.displacement.iter_mut().zip(&d) {
             *u += du;
         }
-        let kinetic_before = self.mass.kinetic_energy(&kin.velocity);
+        let kinetic_before = self.mass.kinetic_energy(model, &kin.velocity);
         let positions = self.state.positions(spec.geometry);
         crate::contact::apply_conditions(
             &self.interfaces,
@@ -338,7 +338,7 @@ impl<'a> Dynamics<'a> {
         let total = self.total_force(&internal);
         let energies = &mut self.energies;
         energies.external_work += super::trapezoid_work(&d, &total, &self.last_total);
-        energies.kinetic = self.mass.kinetic_energy(&self.kin.velocity);
+        energies.kinetic = self.mass.kinetic_energy(model, &self.kin.velocity);
         // energy taken up by the interface: minus the work of the contact forces on the
         // bodies, plus what the impact/release conditions removed
         energies.contact_work += -super::trapezoid_work(&d, &contact_force, &self.last_contact)
@@ -378,8 +378,8 @@ impl<'a> Dynamics<'a> {
     fn total_force(&self, internal: &[f64]) -> Vec<f64> {
         let model = self.model;
         let external = loads::external_force(model, &self.state, &self.initial, self.state.time);
-        let ma = self.mass.product(&self.kin.acceleration);
-        let mv = self.mass.product(&self.kin.velocity);
+        let ma = self.mass.product(model, &self.kin.acceleration);
+        let mv = self.mass.product(model, &self.kin.velocity);
         (0..model.dofs())
             .map(|i| match self.system.equation[i] {
                 Some(_) => external[i],
@@ -541,7 +541,7 @@ impl Stepper for Dynamics<'_> {
         self.kin.velocity = velocity;
         self.kin.acceleration = acceleration;
         self.last_internal = internal;
-        self.energies.kinetic = self.mass.kinetic_energy(&self.kin.velocity);
+        self.energies.kinetic = self.mass.kinetic_energy(self.model, &self.kin.velocity);
         self.initial_kinetic = self.energies.kinetic;
         self.last_total = self.total_force(&self.last_internal.clone());
         Ok(())
@@ -593,7 +593,7 @@ impl Stepper for Dynamics<'_> {
         loop {
             let (target, nominal) = self.target();
             let positions = self.state.positions(self.spec.geometry).into_owned();
-            let kinetic_before_impact = self.mass.kinetic_energy(&self.kin.velocity);
+            let kinetic_before_impact = self.mass.kinetic_energy(self.model, &self.kin.velocity);
             self.contact.close_touching(
                 &self.interfaces,
                 &positions,
@@ -602,7 +602,7 @@ impl Stepper for Dynamics<'_> {
                 &mut self.kin.acceleration,
             );
             self.energies.contact_work +=
-                kinetic_before_impact - self.mass.kinetic_energy(&self.kin.velocity);
+                kinetic_before_impact - self.mass.kinetic_energy(self.model, &self.kin.velocity);
             match self.attempt(nominal, &positions, counters) {
                 Ok((step, advance)) => {
                     self.commit(step, advance, target, nominal);

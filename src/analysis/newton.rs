@@ -531,11 +531,11 @@ impl Step<'_> {
         let mut inertia_norm = 0.0;
         if let Some(inertia) = &self.inertia {
             let (a, v) = self.form.motion(d);
-            let ma = inertia.mass.product(&a);
+            let ma = inertia.mass.product(self.model, &a);
             inertia_norm = norm(&ma);
             let [a_r, b_r] = inertia.rayleigh;
             let mv = if a_r > 0.0 {
-                inertia.mass.product(&v)
+                inertia.mass.product(self.model, &v)
             } else {
                 vec![0.0; v.len()]
             };

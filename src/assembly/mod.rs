@@ -364,27 +364,6 @@ pub struct Mass {
     elements: Vec<Vec<f64>>,
     /// Row sums per DOF (the lumped mass; also used by the explicit method).
     pub lumped: Vec<f64>,
-    /// The element matrices' entries as (global node i, global node j, m_ij), element by
-    /// element in the order of `elements`: the product's loop without the index lookups.
-    entries: Vec<(usize, usize, f64)>,
-}
-
-/// See [`Mass::entries`].
-fn entries(model: &Model, elements: &[Vec<f64>]) -> Vec<(usize, usize, f64)> {
-    let mut out = Vec::new();
-    for (b, body) in model.bodies.iter().enumerate() {
-        let nn = body.mesh.cells.nodes_of(0).len();
-        for e in 0..body.elements() {
-            let nodes = body.mesh.cells.nodes_of(e);
-            let m = &elements[b][e * nn * nn..(e + 1) * nn * nn];
-            for i in 0..nn {
-                for j in 0..nn {
-                    out.push((body.global(nodes[i]), body.global(nodes[j]), m[i * nn + j]));
-                }
-            }
-        }
-    }
-    out
 }
 
 impl Mass {
@@ -418,7 +397,6 @@ impl Mass {
         }
         Ok(Mass {
             kind,
-            entries: entries(model, &elements),
             elements,
             lumped,
         })
@@ -447,19 +425,29 @@ impl Mass {
                 }
             }
         }
-        self.entries = entries(model, &self.elements);
         self
     }
 
     /// M x over all DOFs.
-    pub fn product(&self, x: &[f64]) -> Vec<f64> {
+    pub fn product(&self, model: &Model, x: &[f64]) -> Vec<f64> {
         match self.kind {
             MassKind::Lumped => self.lumped.iter().zip(x).map(|(m, v)| m * v).collect(),
             MassKind::Consistent | MassKind::DispersionFree => {
                 let mut y = vec![0.0; x.len()];
-                for &(gi, gj, m) in &self.entries {
-                    y[2 * gi] += m * x[2 * gj];
-                    y[2 * gi + 1] += m * x[2 * gj + 1];
+                for (b, body) in model.bodies.iter().enumerate() {
+                    let nn = body.mesh.cells.nodes_of(0).len();
+                    for e in 0..body.elements() {
+                        let nodes = body.mesh.cells.nodes_of(e);
+                        let m = &self.elements[b][e * nn * nn..(e + 1) * nn * nn];
+                        for i in 0..nn {
+                            let gi = body.global(nodes[i]);
+                            for j in 0..nn {
+                                let gj = body.global(nodes[j]);
+                                y[2 * gi] += m[i * nn + j] * x[2 * gj];
+                                y[2 * gi + 1] += m[i * nn + j] * x[2 * gj + 1];
+                            }
+                        }
+                    }
                 }
                 y
             }
@@ -467,9 +455,9 @@ impl Mass {
     }
 
     /// 1/2 v . M v
-    pub fn kinetic_energy(&self, v: &[f64]) -> f64 {
+    pub fn kinetic_energy(&self, model: &Model, v: &[f64]) -> f64 {
         0.5 * self
-            .product(v)
+            .product(model, v)
             .iter()
             .zip(v)
             .map(|(a, b)| a * b)
