@@ -130,13 +130,18 @@ pub struct System {
     pub equation: Vec<Option<usize>>,
     pub free: usize,
     pub pattern: Pattern,
-    /// Per body: scatter positions, element-major, (2 nn)^2 per element.
-    scatter: Vec<Vec<usize>>,
+    /// Per body: scatter positions, element-major, (2 nn)^2 per element; u32 (NONE where
+    /// the entry is not assembled: a constrained DOF or the upper triangle), half the
+    /// memory of usize: 0.13 kB a DOF on Quad4 meshes.
+    scatter: Vec<Vec<u32>>,
     /// Lower-triangle values of the last assembled matrix.
     pub values: Vec<f64>,
     /// The largest diagonal entry of the last factored matrix (a stiffness scale).
     pub diagonal_max: f64,
 }
+
+/// A scatter position that is not assembled.
+const NONE: u32 = u32::MAX;
 
 /// Global DOFs of element e of body b.
 fn element_dofs(body: &Body, e: usize) -> Vec<usize> {
@@ -173,9 +178,19 @@ impl System {
             free,
             element_equations.iter().flatten().map(|v| v.as_slice()),
         );
+        assert!(
+            pattern.nonzeros() < NONE as usize,
+            "scatter positions are u32: fewer than 2^32 - 1 nonzeros"
+        );
+        let compact = |p: usize| if p == usize::MAX { NONE } else { p as u32 };
         let scatter = element_equations
             .iter()
-            .map(|body| body.iter().flat_map(|eqs| pattern.scatter(eqs)).collect())
+            .map(|body| {
+                body.iter()
+                    .flat_map(|eqs| pattern.scatter(eqs))
+                    .map(compact)
+                    .collect()
+            })
             .collect();
         let values = vec![0.0; pattern.nonzeros()];
         System {
@@ -280,8 +295,8 @@ pub fn evaluate(
                     let n = dofs.len();
                     let positions = &s.scatter[b][e * n * n..(e + 1) * n * n];
                     for (k, p) in positions.iter().enumerate() {
-                        if *p != usize::MAX {
-                            s.values[*p] += m[k];
+                        if *p != NONE {
+                            s.values[*p as usize] += m[k];
                         }
                     }
                 }
@@ -482,8 +497,8 @@ impl Mass {
                         };
                         for c in 0..2 {
                             let p = positions[(2 * i + c) * n + 2 * j + c];
-                            if p != usize::MAX {
-                                system.values[p] += coefficient * value;
+                            if p != NONE {
+                                system.values[p as usize] += coefficient * value;
                             }
                         }
                     }
