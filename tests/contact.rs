@@ -3,41 +3,12 @@
 
 mod common;
 
-use common::{column, mean};
-
+use common::{SceneRun as Run, column, mean, run_scene as run};
 use std::path::Path;
 
-fn scene(name: &str) -> String {
-    std::fs::read_to_string(format!("models/{name}.toml")).unwrap()
-}
-
-struct Run {
-    dir: std::path::PathBuf,
-    summary: impact::analysis::Summary,
-}
-
-fn run(name: &str, scene_name: &str, overrides: &[&str]) -> Run {
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let model = impact::scene::from_str(
-        &scene(scene_name),
-        Path::new(&format!("models/{scene_name}.toml")),
-        &overrides,
-    )
-    .unwrap();
-    let dir = common::out_dir(name);
-    let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
-    Run { dir, summary }
-}
-
-/// Values of `column` for time in [from, to].
+/// The values of `column_name` for time in [from, to].
 fn window(run: &Run, column_name: &str, from: f64, to: f64) -> Vec<f64> {
-    let t = column(&run.dir, "time");
-    let v = column(&run.dir, column_name);
-    t.iter()
-        .zip(v)
-        .filter(|(t, _)| **t >= from - 1e-12 && **t <= to + 1e-12)
-        .map(|(_, v)| v)
-        .collect()
+    common::window(&run.dir, column_name, from, to)
 }
 
 /// Goal: the two-bar impact of Hughes et al. 1975 (Figs I-12..I-15).

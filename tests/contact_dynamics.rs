@@ -4,33 +4,11 @@
 
 mod common;
 
-use common::{column, mean};
-use impact::analysis::Summary;
-use std::path::{Path, PathBuf};
+use common::{SceneRun as Run, column, mean, run_scene as run};
 
-struct Run {
-    dir: PathBuf,
-    summary: Summary,
-}
-
-fn run(name: &str, scene_name: &str, overrides: &[&str]) -> Run {
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let path = format!("models/{scene_name}.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let model = impact::scene::from_str(&text, Path::new(&path), &overrides).unwrap();
-    let dir = common::out_dir(name);
-    let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
-    Run { dir, summary }
-}
-
-/// (time, value) of a column on [from, to].
+/// The values of a column for time in [from, to].
 fn window(run: &Run, name: &str, from: f64, to: f64) -> Vec<f64> {
-    let t = column(&run.dir, "time");
-    t.iter()
-        .zip(column(&run.dir, name))
-        .filter(|(t, _)| **t >= from - 1e-12 && **t <= to + 1e-12)
-        .map(|(_, v)| v)
-        .collect()
+    common::window(&run.dir, name, from, to)
 }
 
 /// Kinetic plus strain energy at the end against the start (relative).

@@ -260,19 +260,6 @@ fn steps_too_long_for_the_run_or_the_impact_warn() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 }
 
-/// Runs a shipped scene with `sets` through the library; its summary and output folder.
-fn run_scene(
-    name: &str,
-    scene: &str,
-    sets: &[&str],
-) -> (impact::analysis::Summary, std::path::PathBuf) {
-    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let model = impact::scene::load(Path::new(scene), &sets).unwrap_or_else(|e| panic!("{e}"));
-    let dir = out_dir(name);
-    let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
-    (summary, dir)
-}
-
 const ROUND_BAR_SWAP: [&str; 5] = [
     "contact.tip.slave.body=block",
     "contact.tip.slave.set=top",
@@ -298,16 +285,8 @@ const ROUND_BAR_SWAP: [&str; 5] = [
 fn two_pass_round_bar_gives_the_same_answer_with_either_role_order() {
     let mut swapped_sets = ROUND_BAR_SWAP.to_vec();
     swapped_sets.push("contact.tip.two_pass=true");
-    let (a, dir_a) = run_scene(
-        "round_bar_2p",
-        "models/round_bar.toml",
-        &["contact.tip.two_pass=true"],
-    );
-    let (b, dir_b) = run_scene(
-        "round_bar_2p_swapped",
-        "models/round_bar.toml",
-        &swapped_sets,
-    );
+    let a = common::run_scene("round_bar_2p", "round_bar", &["contact.tip.two_pass=true"]);
+    let b = common::run_scene("round_bar_2p_swapped", "round_bar", &swapped_sets);
     let impulse = |dir: &Path| {
         let t = common::column(dir, "time");
         let forward = common::column(dir, "contact_force[tip]");
@@ -323,10 +302,10 @@ fn two_pass_round_bar_gives_the_same_answer_with_either_role_order() {
             .fold(0.0, f64::min)
     };
     let plastic = |dir: &Path| *common::column(dir, "plastic_work").last().unwrap();
-    approx::assert_relative_eq!(impulse(&dir_a), impulse(&dir_b), max_relative = 0.05);
-    approx::assert_relative_eq!(tip(&dir_a), tip(&dir_b), max_relative = 0.01);
-    approx::assert_relative_eq!(plastic(&dir_a), plastic(&dir_b), max_relative = 0.01);
-    for s in [&a, &b] {
+    approx::assert_relative_eq!(impulse(&a.dir), impulse(&b.dir), max_relative = 0.05);
+    approx::assert_relative_eq!(tip(&a.dir), tip(&b.dir), max_relative = 0.01);
+    approx::assert_relative_eq!(plastic(&a.dir), plastic(&b.dir), max_relative = 0.01);
+    for s in [&a.summary, &b.summary] {
         let depth = s.contact.max_penetration.unwrap();
         assert!(depth < 0.05 * 3.9e-3, "{depth}");
         assert!(
@@ -355,11 +334,11 @@ fn two_pass_rings_do_not_depend_on_the_roles_and_do_not_sink() {
         "contact.ab.setup_check=false",
         "contact.bc.setup_check=false",
     ];
-    let (one, _) = run_scene("rings_one_pass", "models/three_rings.toml", &[]);
+    let one = common::run_scene("rings_one_pass", "three_rings", &[]).summary;
     assert!(one.contact.max_penetration.unwrap() > 1e-3);
-    let (a, _) = run_scene("rings_2p", "models/three_rings.toml", &both);
+    let a = common::run_scene("rings_2p", "three_rings", &both).summary;
     let swapped: Vec<&str> = swap.iter().chain(&both).copied().collect();
-    let (b, _) = run_scene("rings_2p_swapped", "models/three_rings.toml", &swapped);
+    let b = common::run_scene("rings_2p_swapped", "three_rings", &swapped).summary;
     approx::assert_relative_eq!(
         a.contact.peak_force,
         b.contact.peak_force,

@@ -55,6 +55,34 @@ pub fn column(dir: &Path, name: &str) -> Vec<f64> {
         .collect()
 }
 
+/// A finished run of a shipped scene: its output folder and summary.
+pub struct SceneRun {
+    pub dir: PathBuf,
+    pub summary: Summary,
+}
+
+/// Runs models/SCENE.toml with `--set` overrides through the library into a fresh folder
+/// named `name`.
+pub fn run_scene(name: &str, scene: &str, overrides: &[&str]) -> SceneRun {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let path = PathBuf::from(format!("models/{scene}.toml"));
+    let model = scene::load(&path, &overrides).unwrap_or_else(|e| panic!("{e}"));
+    let dir = out_dir(name);
+    let summary = analysis::run(&model, &dir, RunOptions::default())
+        .unwrap_or_else(|e| panic!("run `{name}` failed: {e}"));
+    SceneRun { dir, summary }
+}
+
+/// The values of a history.csv column for time in [from, to] (1e-12 either side).
+pub fn window(dir: &Path, name: &str, from: f64, to: f64) -> Vec<f64> {
+    column(dir, "time")
+        .iter()
+        .zip(column(dir, name))
+        .filter(|(t, _)| **t >= from - 1e-12 && **t <= to + 1e-12)
+        .map(|(_, v)| v)
+        .collect()
+}
+
 /// The arithmetic mean.
 pub fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
