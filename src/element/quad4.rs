@@ -157,19 +157,9 @@ impl PointStrain {
     };
 }
 
-fn point_strain(
-    p: &PointValues,
-    d: &Vec8,
-    formulation: Formulation,
-    geometry: Strain,
-) -> PointStrain {
-    let mut k = PointStrain::ZERO;
-    point_strain_into(p, d, formulation, geometry, &mut k);
-    k
-}
-
-/// `point_strain` written into `out`, whose operator entries that stay zero (the hoop row
-/// off the axisymmetric case, the v columns of the hoop row) must be zero already.
+/// A point's displacement gradient, strain and B operator, written into `out`, whose
+/// operator entries that stay zero (the hoop row off the axisymmetric case, the v columns of
+/// the hoop row) must be zero already.
 fn point_strain_into(
     p: &PointValues,
     d: &Vec8,
@@ -303,11 +293,11 @@ pub fn strains(geom: &QuadValues, d: &Vec8, op: Operator) -> [Voigt; 4] {
 /// In-plane deformation gradient F = I + [[u,x u,y] [v,x v,y]] and the hoop stretch 1 + u/r
 /// (1 unless axisymmetric) at the four Gauss points.
 pub fn deformation(geom: &QuadValues, d: &Vec8) -> [(Matrix2<f64>, f64); 4] {
-    geom.points.map(|p| {
-        let k = point_strain(&p, d, geom.formulation, Strain::Finite);
-        let [ux, uy, vx, vy] = k.theta;
-        (Matrix2::new(1.0 + ux, uy, vx, 1.0 + vy), 1.0 + k.hoop)
-    })
+    let op = Operator {
+        strain: Strain::Finite,
+        bbar: false,
+    };
+    Kinematics::new(geom, d, op).deformation()
 }
 
 /// Internal force f = sum_q w_q B_q^T S_q (Erklig eq 25).
