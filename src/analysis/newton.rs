@@ -17,6 +17,7 @@
 //! more than half of the iterations left to reach the force tolerance.
 
 use crate::assembly::{self, Evaluation, Mass, State, System};
+use crate::contact::linearization::Linearization;
 use crate::contact::{ConstrainedSolution, ContactPair, Tangential, Unsettled};
 use crate::element::Strain;
 use crate::integrator::StepForm;
@@ -111,6 +112,47 @@ struct Rows {
     /// The number of normal rows (the first ones).
     normal: usize,
     sliding: Vec<(Vec<(usize, f64)>, usize, f64)>,
+    /// Per normal row, its exact derivatives where the row is not dg/dx.
+    exact: Vec<Option<Exact>>,
+    /// The largest |gap| of the normal rows against its pair's tolerance (TOL of Hughes II-7).
+    worst_gap: f64,
+}
+
+/// The exact derivatives of a normal row on a deformable master, on the free DOFs (see
+/// `contact::linearization`).
+struct Exact {
+    gradient: Vec<(usize, f64)>,
+    /// (equation p, equation q, d C_p / d x_q).
+    row_jacobian: Vec<(usize, usize, f64)>,
+}
+
+impl Exact {
+    fn free(l: &Linearization, system: &System) -> Exact {
+        let dofs: Vec<(Option<usize>, usize)> = l
+            .dofs()
+            .map(|(dof, local)| (system.equation[dof], local))
+            .collect();
+        let gradient = dofs
+            .iter()
+            .filter_map(|(eq, i)| eq.map(|eq| (eq, l.gradient[*i])))
+            .filter(|(_, v)| *v != 0.0)
+            .collect();
+        let mut row_jacobian = Vec::new();
+        for (p, i) in &dofs {
+            for (q, j) in &dofs {
+                if let (Some(p), Some(q)) = (p, q) {
+                    let v = l.row_jacobian[(*i, *j)];
+                    if v != 0.0 {
+                        row_jacobian.push((*p, *q, v));
+                    }
+                }
+            }
+        }
+        Exact {
+            gradient,
+            row_jacobian,
+        }
+    }
 }
 
 impl Rows {
@@ -120,6 +162,8 @@ impl Rows {
             gaps: Vec::new(),
             normal: 0,
             sliding: Vec::new(),
+            exact: Vec::new(),
+            worst_gap: 0.0,
         }
     }
 
@@ -151,6 +195,18 @@ impl Rows {
 }
 
 impl Constraints<'_> {
+    /// Whether pair `pair` is either pass of a two-pass contact. Its rows keep C for dg/dx:
+    /// with the exact terms the two passes' near-coincident rows make the active set cycle
+    /// (round_bar two-pass: 14 step cuts and 2.3 % more plastic work than the swapped
+    /// roles, against 4 cuts and 0.6 % with C).
+    fn two_pass(&self, pair: usize) -> bool {
+        self.pairs[pair].covered.is_some()
+            || self
+                .pairs
+                .iter()
+                .any(|p| p.covered.as_ref().is_some_and(|c| c.pair == pair))
+    }
+
     fn rows(&self, d: &[f64], system: &System) -> Result<Rows, StepFailure> {
         let x = |n: usize| [self.start[n][0] + d[2 * n], self.start[n][1] + d[2 * n + 1]];
         let free = |row: Vec<(usize, f64)>| -> Vec<(usize, f64)> {
@@ -168,8 +224,14 @@ impl Constraints<'_> {
                 ))
             })?;
             rows.rows.push(free(gap.row(slave)));
-            rows.gaps
-                .push(gap.gap - self.targets.get(i).copied().unwrap_or(0.0));
+            let violation = gap.gap - self.targets.get(i).copied().unwrap_or(0.0);
+            rows.gaps.push(violation);
+            let tolerance = self.pairs[pair].options.tolerance;
+            rows.worst_gap = rows.worst_gap.max(violation.abs() / tolerance);
+            let exact = (!self.two_pass(pair))
+                .then(|| self.pairs[pair].linearization(slave, &gap, &x))
+                .flatten();
+            rows.exact.push(exact.map(|l| Exact::free(&l, system)));
             gaps.push(gap);
         }
         rows.normal = rows.rows.len();
@@ -211,12 +273,16 @@ fn constrained_solve(
     solver: &mut Solver,
     rows: &Rows,
     residual: Vec<f64>,
+    forces: &[f64],
 ) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
     let m = rows.rows.len();
     if m == 0 {
         let mut delta = residual;
         solver.solve(&mut delta);
         return Ok((delta, Vec::new()));
+    }
+    if rows.exact.iter().any(Option::is_some) {
+        return exact_solve(solver, rows, residual, forces);
     }
     // entries with a zero coefficient, as the x entry of a row on a horizontal wall, are
     // left out: they would cost a path each for nothing
@@ -238,10 +304,7 @@ fn constrained_solve(
         })
         .collect();
     if local.iter().any(|row| row.is_empty()) {
-        return Err(StepFailure(
-            "a contact constraint acts on prescribed DOFs only (a supported slave node against its obstacle): it cannot be enforced"
-                .into(),
-        ));
+        return Err(StepFailure(ON_PRESCRIBED_ONLY.into()));
     }
     let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| {
         let mut s = 0.0;
@@ -266,6 +329,101 @@ fn constrained_solve(
         for (eq, c) in row {
             solver.add_unit(&mut w, *eq, c * t);
         }
+    }
+    profile::add(Phase::Contact, schur_start);
+    let delta = solver.backward(w);
+    Ok((delta, tau.iter().copied().collect()))
+}
+
+const ON_PRESCRIBED_ONLY: &str = "a contact constraint acts on prescribed DOFs only (a supported slave node against its obstacle): it cannot be enforced";
+
+/// The constrained solve with the exact linearization of the rows on deformable masters
+/// (`contact::linearization`): Newton's step for R(d) + C(d)^T tau = 0, g(d) = 0 is
+/// ```text
+/// K* delta = R + C^T tau + A delta,   G delta = -g,   A = sum_i tau_i dC_i/dx,  G = dg/dx
+/// ```
+/// (tau in A from the last solve). A and the rows live on the few equations E the contact
+/// touches, so with Z = (K*^-1)_EE and q = delta_E it closes on E:
+/// ```text
+/// [ I - Z A   -Z C_E^T ] [ q   ]   [ (K*^-1 R)_E ]
+/// [ G_E        0       ] [ tau ] = [ -g          ],   delta = K*^-1 (R + C^T tau + A q)
+/// ```
+/// in the same single back-substitution as `constrained_solve`, and without refactoring.
+fn exact_solve(
+    solver: &mut Solver,
+    rows: &Rows,
+    residual: Vec<f64>,
+    forces: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
+    use nalgebra::{DMatrix, DVector};
+    let m = rows.rows.len();
+    let mut equations: Vec<usize> = rows
+        .rows
+        .iter()
+        .flatten()
+        .filter(|(_, c)| *c != 0.0)
+        .map(|(eq, _)| *eq)
+        .collect();
+    for e in rows.exact.iter().flatten() {
+        equations.extend(e.gradient.iter().map(|(eq, _)| *eq));
+        equations.extend(e.row_jacobian.iter().flat_map(|(p, q, _)| [*p, *q]));
+    }
+    equations.sort_unstable();
+    equations.dedup();
+    let n = equations.len();
+    let at = |eq: usize| equations.binary_search(&eq).expect("equation in E");
+    solver.know_inverse(&equations);
+    let mut w = solver.forward(&residual);
+    let schur_start = std::time::Instant::now();
+    let local: Vec<usize> = equations
+        .iter()
+        .map(|eq| solver.inverse_local(*eq))
+        .collect();
+    let z = DMatrix::from_fn(n, n, |i, j| solver.inverse_entry(local[i], local[j]));
+    let mut a = DMatrix::<f64>::zeros(n, n);
+    let mut c = DMatrix::<f64>::zeros(m, n);
+    for (i, row) in rows.rows.iter().enumerate() {
+        for (eq, v) in row.iter().filter(|(_, v)| *v != 0.0) {
+            c[(i, at(*eq))] += v;
+        }
+        if c.row(i).iter().all(|v| *v == 0.0) {
+            return Err(StepFailure(ON_PRESCRIBED_ONLY.into()));
+        }
+    }
+    let mut g = c.clone();
+    for (i, exact) in rows.exact.iter().enumerate() {
+        let Some(e) = exact else { continue };
+        let tau = forces.get(i).copied().unwrap_or(0.0);
+        for (p, q, v) in &e.row_jacobian {
+            a[(at(*p), at(*q))] += tau * v;
+        }
+        g.row_mut(i).fill(0.0);
+        for (eq, v) in &e.gradient {
+            g[(i, at(*eq))] += v;
+        }
+    }
+    let mut system = DMatrix::<f64>::zeros(n + m, n + m);
+    system
+        .view_mut((0, 0), (n, n))
+        .copy_from(&(DMatrix::identity(n, n) - &z * &a));
+    system
+        .view_mut((0, n), (n, m))
+        .copy_from(&(-(&z * c.transpose())));
+    system.view_mut((n, 0), (m, n)).copy_from(&g);
+    let rhs = DVector::from_fn(n + m, |i, _| {
+        if i < n {
+            solver.solution_entry(&w, equations[i])
+        } else {
+            -rows.gaps[i - n]
+        }
+    });
+    let solution = system.lu().solve(&rhs).ok_or_else(|| {
+        StepFailure("the contact constraints are redundant (singular Schur complement)".into())
+    })?;
+    let (q, tau) = (solution.rows(0, n), solution.rows(n, m));
+    let load = c.transpose() * tau + a * q;
+    for (eq, f) in equations.iter().zip(load.iter()) {
+        solver.add_unit(&mut w, *eq, *f);
     }
     profile::add(Phase::Contact, schur_start);
     let delta = solver.backward(w);
@@ -440,7 +598,14 @@ impl Step<'_> {
                 return Err(StepFailure(non_finite(system, &balance, &d)));
             }
             let test = Convergence::of(residual_norm, forces_scale, &d, system.diagonal_max);
-            if iteration > 0 && test.passed(newton, eps_displacement) {
+            if std::env::var("IMPACT_EST").is_ok() && iteration > 0 {
+                let r = residual_norm / previous_residual;
+                if r < 0.5 {
+                    eps_displacement *= r / (1.0 - r);
+                }
+            }
+            // the active constraints hold within their tolerance too
+            if iteration > 0 && test.passed(newton, eps_displacement) && rows.worst_gap <= 1.0 {
                 let tangential = match &self.contact {
                     Some(c) => rows.tangential_forces(c.tangential, &forces),
                     None => Vec::new(),
@@ -479,7 +644,7 @@ impl Step<'_> {
                     .factor(&system.values)
                     .map_err(|e| StepFailure(e.to_string()))?;
             }
-            let (delta, tau) = constrained_solve(solver, &rows, residual)?;
+            let (delta, tau) = constrained_solve(solver, &rows, residual, &forces)?;
             forces = tau;
             counters.iterations += 1;
             system.scatter_add(&delta, &mut d);

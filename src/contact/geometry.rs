@@ -398,7 +398,7 @@ impl ContactPair {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     fn square() -> Vec<[[f64; 2]; 2]> {
@@ -512,7 +512,7 @@ mod tests {
     }
 
     /// A pair whose only slave is node 0.
-    fn slave_node_0(master: Master) -> ContactPair {
+    pub(in crate::contact) fn slave_node_0(master: Master) -> ContactPair {
         ContactPair {
             name: "p".into(),
             slave_body: 0,

@@ -28,6 +28,7 @@ pub mod active;
 pub mod conditions;
 pub mod explicit;
 pub mod geometry;
+pub mod linearization;
 pub mod search;
 pub mod setup;
 
