@@ -474,6 +474,19 @@ impl Convergence {
     }
 }
 
+/// Erklig's eps_1 measures the last correction; what is left to the solution is the sum of the
+/// corrections still to come. While the iteration contracts at `ratio` (the residual's, which
+/// the next correction K*^-1 R follows) that sum is the last correction times
+/// ratio / (1 - ratio), smaller than it for ratio < 1/2: the test takes it there, and the
+/// last correction itself otherwise (never looser than Erklig's measure on a slow iteration).
+fn remaining(eps_last: f64, ratio: f64) -> f64 {
+    if ratio < 0.5 {
+        eps_last * ratio / (1.0 - ratio)
+    } else {
+        eps_last
+    }
+}
+
 /// Stiffness-proportional damping matrix of the step (the tangent at D = 0), free DOFs.
 struct Damping {
     values: Vec<f64>,
@@ -603,6 +616,9 @@ impl Step<'_> {
                 if r < 0.5 {
                     eps_displacement *= r / (1.0 - r);
                 }
+            }
+            if iteration > 0 {
+                eps_displacement = remaining(eps_displacement, residual_norm / previous_residual);
             }
             // the active constraints hold within their tolerance too
             if iteration > 0 && test.passed(newton, eps_displacement) && rows.worst_gap <= 1.0 {

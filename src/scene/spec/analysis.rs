@@ -354,7 +354,7 @@ pub struct NewtonSpec {
     /// Default 1e-8.
     #[serde(default = "default_tolerance")]
     pub tol_force: f64,
-    /// Modified Newton refactors when ||R_k|| > contraction ||R_k-1||. Default 0.8.
+    /// Modified Newton refactors when ||R_k|| > contraction ||R_k-1||. Default 0.1.
     #[serde(default = "default_contraction")]
     pub contraction: f64,
     /// Halvings of an increment that does not converge before the run stops `diverged`. Default 6.
@@ -387,7 +387,7 @@ fn default_tolerance() -> f64 {
     1e-8
 }
 fn default_contraction() -> f64 {
-    0.8
+    0.1
 }
 fn default_cuts() -> usize {
     6
