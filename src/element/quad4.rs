@@ -330,6 +330,8 @@ pub fn tangent(
         return kt;
     }
     let axisymmetric = geom.formulation == Formulation::Axisymmetric;
+    // the B-bar correction's point matrices, only where it applies
+    let bbar = op.bbar;
     let mut mean_m = Mat8::zeros();
     let mut ms = [Mat8::zeros(); 4];
     for q in 0..4 {
@@ -350,13 +352,17 @@ pub fn tangent(
                 }
                 kt[(2 * i, 2 * j)] += p.weight * guu;
                 kt[(2 * i + 1, 2 * j + 1)] += p.weight * g;
-                ms[q][(2 * i, 2 * j)] = m_uu;
-                ms[q][(2 * i + 1, 2 * j + 1)] = m_vv;
+                if bbar {
+                    ms[q][(2 * i, 2 * j)] = m_uu;
+                    ms[q][(2 * i + 1, 2 * j + 1)] = m_vv;
+                }
             }
         }
-        mean_m += ms[q] * (p.weight / geom.volume());
+        if bbar {
+            mean_m += ms[q] * (p.weight / geom.volume());
+        }
     }
-    if op.bbar {
+    if bbar {
         for q in 0..4 {
             let w = geom.points[q].weight;
             kt += (mean_m - ms[q]) * (w * trace(&stress[q]) / 3.0);
