@@ -477,7 +477,10 @@ impl Attempt<'_> {
         let factor_first = *factored_for != Some(coefficients)
             || match spec.newton.strategy {
                 Strategy::Full => true,
-                Strategy::Modified => self.increments.is_multiple_of(spec.newton.refactor_every),
+                Strategy::Modified => spec
+                    .newton
+                    .refactor_every
+                    .is_some_and(|n| self.increments.is_multiple_of(n)),
                 Strategy::Initial => !solver.is_factored(),
             };
         let step = Step {

@@ -215,7 +215,9 @@ impl Stepper for Statics<'_> {
                 || match spec.newton.strategy {
                     Strategy::Full => true,
                     Strategy::Modified => {
-                        self.increments.is_multiple_of(spec.newton.refactor_every)
+                        spec.newton
+                            .refactor_every
+                            .is_some_and(|n| self.increments.is_multiple_of(n))
                             || self.control.after_cut()
                     }
                     Strategy::Initial => !self.solver.is_factored() || self.control.after_cut(),

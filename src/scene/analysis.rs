@@ -350,7 +350,7 @@ fn buckling(cx: &Context, spec: &AnalysisSpec) -> Result<Option<BucklingSpec>, I
 
 /// `[analysis.newton]`: counts at least 1, tolerances positive, contraction in (0, 1].
 fn newton(cx: &Context, n: &NewtonSpec) -> Result<(), InputError> {
-    if n.refactor_every == 0 {
+    if n.refactor_every == Some(0) {
         return Err(cx.err("analysis.newton.refactor_every: must be at least 1"));
     }
     if n.max_iterations == 0 {

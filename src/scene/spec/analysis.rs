@@ -360,9 +360,11 @@ pub struct NewtonSpec {
     /// Halvings of an increment that does not converge before the run stops `diverged`. Default 6.
     #[serde(default = "default_cuts")]
     pub max_cuts: usize,
-    /// Modified Newton: factor at the start of every N-th increment. Default 1.
-    #[serde(default = "default_refactor_every")]
-    pub refactor_every: usize,
+    /// Modified Newton: also factor at the start of every N-th increment (Erklig's
+    /// algorithm: 1). Default: none, only when the iteration stalls, after a cut and when
+    /// K*'s coefficients change.
+    #[serde(default)]
+    pub refactor_every: Option<usize>,
 }
 
 impl Default for NewtonSpec {
@@ -375,7 +377,7 @@ impl Default for NewtonSpec {
             tol_force: default_tolerance(),
             contraction: default_contraction(),
             max_cuts: default_cuts(),
-            refactor_every: default_refactor_every(),
+            refactor_every: None,
         }
     }
 }
@@ -391,7 +393,4 @@ fn default_contraction() -> f64 {
 }
 fn default_cuts() -> usize {
     6
-}
-fn default_refactor_every() -> usize {
-    1
 }
