@@ -237,27 +237,35 @@ fn gap_to_segments(
     segment: impl Fn(usize) -> [[f64; 2]; 2],
     inside: impl Fn() -> bool,
 ) -> Option<(usize, f64, f64, [f64; 2])> {
-    let mut best: Option<(usize, f64, f64)> = None;
+    // (segment, xi, distance, xi interior)
+    let mut best: Option<(usize, f64, f64, bool)> = None;
     for k in 0..count {
         let [a, b] = segment(k);
+        if let Some((_, _, db, _)) = best {
+            // a segment whose bounding box lies farther than the best distance (and its tie
+            // band) cannot win: skip its projection
+            let outside = |lo: f64, hi: f64, v: f64| (lo - v).max(v - hi).max(0.0);
+            let bx = outside(a[0].min(b[0]), a[0].max(b[0]), x[0]);
+            let by = outside(a[1].min(b[1]), a[1].max(b[1]), x[1]);
+            let reach = db * (1.0 + 1e-9);
+            if bx * bx + by * by > reach * reach {
+                continue;
+            }
+        }
         let (xi, d) = project(x, a, b);
         let interior = xi > 0.0 && xi < 1.0;
         let better = match best {
             None => true,
-            Some((kb, _, db)) => {
-                let [ka, kb] = segment(kb);
-                let (xib, _) = project(x, ka, kb);
+            Some((_, _, db, best_interior)) => {
                 d < db - 1e-12 * db.max(1e-300)
-                    || ((d - db).abs() <= 1e-12 * db.max(1e-300)
-                        && interior
-                        && !(xib > 0.0 && xib < 1.0))
+                    || ((d - db).abs() <= 1e-12 * db.max(1e-300) && interior && !best_interior)
             }
         };
         if better {
-            best = Some((k, xi, d));
+            best = Some((k, xi, d, interior));
         }
     }
-    let (k, xi, d) = best?;
+    let (k, xi, d, _) = best?;
     let [a, b] = segment(k);
     let n = outward(a, b);
     let p = [a[0] + xi * (b[0] - a[0]), a[1] + xi * (b[1] - a[1])];
