@@ -634,6 +634,8 @@ impl Step<'_> {
                     tangential,
                 });
             }
+            // not the answer: its trial states need not sit beside the factor about to be made
+            drop(evaluation);
             if iteration == newton.max_iterations {
                 break;
             }

@@ -23,6 +23,7 @@ use crate::scene::spec::{MassKind, Tangent};
 use crate::scene::{Body, Model};
 use crate::solver::Pattern;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Per body, per material point (element-major: element e's points are e*ppe .. (e+1)*ppe).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -129,7 +130,8 @@ pub struct System {
     /// Global DOF -> free equation number (None: constrained).
     pub equation: Vec<Option<usize>>,
     pub free: usize,
-    pub pattern: Pattern,
+    /// Shared with the solver that factors the matrix (one copy of the largest index array).
+    pub pattern: Arc<Pattern>,
     /// Per body: scatter positions, element-major, (2 nn)^2 per element; u32 (NONE where
     /// the entry is not assembled: a constrained DOF or the upper triangle), half the
     /// memory of usize: 0.13 kB a DOF on Quad4 meshes.
@@ -196,7 +198,7 @@ impl System {
         System {
             equation,
             free,
-            pattern,
+            pattern: Arc::new(pattern),
             scatter,
             values,
             diagonal_max: 0.0,
@@ -328,14 +330,16 @@ pub fn commit(
     geometry: Strain,
 ) {
     let Evaluation {
-        trial,
+        mut trial,
         strain_zz,
         work,
         plastic_work: evaluation_plastic_work,
         ..
     } = evaluation;
     for (b, body) in model.bodies.iter().enumerate() {
-        let mut points = trial[b].clone();
+        // the trial states become the committed ones (taken, not copied: a copy of every
+        // point's state beside the factor set the implicit memory peak)
+        let mut points = std::mem::take(&mut trial[b]);
         if geometry == Strain::Finite {
             let kernel = Kernel::of(body);
             for e in 0..body.elements() {
