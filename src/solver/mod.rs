@@ -21,9 +21,10 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Accum, Par};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Lower-triangular CSC pattern of the free-DOF matrix.
 #[derive(Debug, Clone)]
@@ -50,12 +51,16 @@ impl Pattern {
                 }
             }
         }
-        let mut col_ptr = Vec::with_capacity(size + 1);
-        let mut row_idx = Vec::new();
-        col_ptr.push(0);
-        for mut col in columns {
+        for col in &mut columns {
             col.sort_unstable();
             col.dedup();
+        }
+        // allocated to size: grown by doubling, the largest array of the pattern held up to
+        // twice its entries (58 MB too many at 1e6 DOFs)
+        let mut col_ptr = Vec::with_capacity(size + 1);
+        let mut row_idx = Vec::with_capacity(columns.iter().map(Vec::len).sum());
+        col_ptr.push(0);
+        for col in columns {
             row_idx.extend_from_slice(&col);
             col_ptr.push(row_idx.len());
         }
@@ -129,7 +134,8 @@ pub enum SolverError {
 /// faer's LL^T: the symbolic analysis (AMD ordering, supernodes) once per pattern, the
 /// numeric factor in `values` once per K*.
 pub struct Solver {
-    matrix: SymbolicSparseColMat<usize>,
+    /// The matrix's pattern, shared with the system that assembles it.
+    pattern: Arc<Pattern>,
     /// None for an empty system (every DOF prescribed): factor and solve do nothing.
     symbolic: Option<Symbolic>,
     /// The values of L of the last successful factorization (empty: none).
@@ -268,19 +274,19 @@ fn path_dot(a: &[(usize, Vec<f64>)], b: &[(usize, Vec<f64>)]) -> f64 {
 const SUPERNODAL_FROM: SupernodalThreshold = SupernodalThreshold(0.3);
 
 impl Solver {
-    pub fn new(pattern: &Pattern) -> Result<Solver, SolverError> {
-        let matrix = SymbolicSparseColMat::new_checked(
+    pub fn new(pattern: &Arc<Pattern>) -> Result<Solver, SolverError> {
+        let matrix = SymbolicSparseColMatRef::new_checked(
             pattern.size,
             pattern.size,
-            pattern.col_ptr.clone(),
+            &pattern.col_ptr,
             None,
-            pattern.row_idx.clone(),
+            &pattern.row_idx,
         );
         let symbolic = if pattern.size == 0 {
             None
         } else {
             let cholesky = factorize_symbolic_cholesky(
-                matrix.as_ref(),
+                matrix,
                 Side::Lower,
                 SymmetricOrdering::Amd,
                 CholeskySymbolicParams {
@@ -306,13 +312,23 @@ impl Solver {
             })
         };
         Ok(Solver {
-            matrix,
+            pattern: Arc::clone(pattern),
             symbolic,
             values: Vec::new(),
             factorizations: 0,
             solves: 0,
             inverse: InverseEntries::default(),
         })
+    }
+
+    /// The pattern as faer reads it.
+    fn matrix(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        let p = &*self.pattern;
+        // SAFETY: the same arrays passed `new_checked` in `Solver::new`, and a Pattern is
+        // not changed after it is built (it is shared, immutable, behind the Arc)
+        unsafe {
+            SymbolicSparseColMatRef::new_unchecked(p.size, p.size, &p.col_ptr, None, &p.row_idx)
+        }
     }
 
     /// Numeric factorization of the matrix with the given lower-triangle values.
@@ -342,7 +358,7 @@ impl Solver {
         let scratch = cholesky.factorize_numeric_llt_scratch::<f64>(par, Default::default());
         let mut buffer = MemBuffer::try_new(scratch)
             .map_err(|_| SolverError::Factorization("out of memory for the workspace".into()))?;
-        let a = SparseColMatRef::new(self.matrix.as_ref(), values);
+        let a = SparseColMatRef::new(self.matrix(), values);
         cholesky
             .factorize_numeric_llt::<f64>(
                 &mut factor,
@@ -387,7 +403,7 @@ impl Solver {
         let paths: Vec<Vec<(usize, Vec<f64>)>> = new
             .par_iter()
             .map_init(
-                || (vec![0.0; self.matrix.nrows()], Vec::new()),
+                || (vec![0.0; self.pattern.size], Vec::new()),
                 |(work, below), &eq| {
                     let row = inverse_perm.map_or(eq, |inv| inv[eq]);
                     forward_path(factor, row, work, below)
@@ -600,7 +616,7 @@ mod tests {
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).sin()).collect();
         let mut b = vec![0.0; n];
         pattern.symmetric_product(&values, &x, &mut b);
-        let mut solver = Solver::new(&pattern).unwrap();
+        let mut solver = Solver::new(&Arc::new(pattern.clone())).unwrap();
         solver.factor(&values).unwrap();
         solver.solve(&mut b);
         for (xi, bi) in x.iter().zip(&b) {
@@ -681,7 +697,7 @@ mod tests {
         for (nx, ny) in [(31, 13), (201, 101)] {
             let (pattern, values) = grid(nx, ny);
             let size = pattern.size;
-            let mut solver = Solver::new(&pattern).unwrap();
+            let mut solver = Solver::new(&Arc::new(pattern.clone())).unwrap();
             solver.factor(&values).unwrap();
             kinds.push(is_supernodal(&solver));
             let named: Vec<usize> = (0..20)
@@ -699,7 +715,7 @@ mod tests {
         let singles: Vec<[Option<usize>; 1]> = (0..n).map(|i| [Some(i)]).collect();
         let diagonal = Pattern::from_elements(n, singles.iter().map(|e| e.as_slice()));
         let values: Vec<f64> = (0..n).map(|i| 1.0 + i as f64).collect();
-        let mut solver = Solver::new(&diagonal).unwrap();
+        let mut solver = Solver::new(&Arc::new(diagonal.clone())).unwrap();
         solver.factor(&values).unwrap();
         kinds.push(is_supernodal(&solver));
         let (worst, largest) = inverse_errors(&mut solver, n, &[0, 3, 7, 11, 5, 2]);
@@ -727,7 +743,7 @@ mod tests {
         ];
         for (pattern, values) in cases {
             let n = pattern.size;
-            let mut solver = Solver::new(&pattern).unwrap();
+            let mut solver = Solver::new(&Arc::new(pattern.clone())).unwrap();
             solver.factor(&values).unwrap();
             let r: Vec<f64> = (0..n)
                 .map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.3)
