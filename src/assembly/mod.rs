@@ -170,8 +170,14 @@ impl Scatter {
                 for b in 0..=a {
                     positions.push(match (eqs[a], eqs[b]) {
                         (Some(i), Some(j)) => {
-                            let (row, col, flag) = if i >= j { (i, j, 0) } else { (j, i, TRANSPOSED) };
-                            let p = pattern.position(row, col).expect("pattern holds the element");
+                            let (row, col, flag) = if i >= j {
+                                (i, j, 0)
+                            } else {
+                                (j, i, TRANSPOSED)
+                            };
+                            let p = pattern
+                                .position(row, col)
+                                .expect("pattern holds the element");
                             p as u32 | flag
                         }
                         _ => NONE,
@@ -270,7 +276,7 @@ impl System {
 
     /// The diagonal of the assembled matrix (the first entry of each lower-triangle column).
     pub fn diagonal(&self) -> impl Iterator<Item = f64> + '_ {
-        (0..self.free).map(|j| self.values[self.pattern.col_ptr[j]])
+        (0..self.free).map(|j| self.values[self.pattern.col_ptr[j] as usize])
     }
 
     /// Restricts a global vector to the free equations.

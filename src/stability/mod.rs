@@ -26,7 +26,7 @@ use crate::assembly::{self, ElementFailure, State, System};
 use crate::element::Strain;
 use crate::scene::Model;
 use crate::scene::spec::Tangent;
-use crate::solver::{Pattern, Solver, SolverError};
+use crate::solver::{Ix, Pattern, Solver, SolverError};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::SupernodalThreshold;
@@ -57,8 +57,8 @@ pub enum StabilityError {
 /// sparse simplicial L D L^T (AMD ordering, no pivoting, no regularization). The symbolic
 /// analysis is done once.
 pub struct InertiaCounter {
-    matrix: SymbolicSparseColMat<usize>,
-    symbolic: Option<SymbolicCholesky<usize>>,
+    matrix: SymbolicSparseColMat<Ix>,
+    symbolic: Option<SymbolicCholesky<Ix>>,
     factor: Vec<f64>,
 }
 
@@ -122,7 +122,7 @@ impl InertiaCounter {
         };
         let col_ptr = simplicial.col_ptr();
         let count = (0..symbolic.nrows())
-            .filter(|&j| self.factor[col_ptr[j]] < 0.0)
+            .filter(|&j| self.factor[col_ptr[j] as usize] < 0.0)
             .count();
         Ok(count)
     }
