@@ -20,17 +20,23 @@ use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind};
 use std::time::Instant;
 
-/// What a kernel gives for one element at an increment.
-pub struct ElementResult {
-    /// Internal force (the first 2 nn entries).
-    pub force: Vec8,
-    /// The tangent, row-major in the first (2 nn)^2 entries, when asked.
-    pub matrix: Option<[f64; 64]>,
-    /// Trial point states (rods: the first).
-    pub trial: [PointState; 4],
-    /// Out-of-plane Green-Lagrange strain per point (plane stress).
-    pub strain_zz: [f64; 4],
-    /// Increments of the internal and plastic work.
+/// Where a kernel writes one element's results: slices of the caller's arrays, so a result
+/// is written once, in place, and never moved (a whole-result struct sized for a Quad4 was
+/// ~1 kB a rod, copied three times an evaluation).
+pub struct ElementOut<'a> {
+    /// Internal force, 2 nn entries.
+    pub force: &'a mut [f64],
+    /// The tangent, row-major (2 nn)^2, when asked.
+    pub matrix: Option<&'a mut [f64]>,
+    /// Trial point states, one a point.
+    pub trial: &'a mut [PointState],
+    /// Out-of-plane Green-Lagrange strain a point, when asked (plane stress).
+    pub strain_zz: Option<&'a mut [f64]>,
+}
+
+/// Increments of the internal and plastic work of one element.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ElementWork {
     pub work: f64,
     pub plastic_work: f64,
 }
@@ -92,8 +98,7 @@ impl Kernel {
     }
 
     /// Internal force, trial point states and work of element `e` at the increment `d` over
-    /// the time step `dt` from the committed state; with `tangent`, its matrix (row-major,
-    /// 2 nn x 2 nn in the first entries of 64).
+    /// the time step `dt` from the committed state, into `out`; with `tangent`, its matrix.
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
@@ -105,7 +110,8 @@ impl Kernel {
         e: usize,
         geometry: Strain,
         tangent: Option<Tangent>,
-    ) -> Result<ElementResult, KernelError> {
+        out: ElementOut<'_>,
+    ) -> Result<ElementWork, KernelError> {
         // the material's tangent, or D_e (Erklig's modified Newton); K_sigma unless `elastic`
         let elastic_moduli = tangent.is_some_and(|t| t != Tangent::Consistent);
         let geometric = if tangent == Some(Tangent::Elastic) {
@@ -144,25 +150,25 @@ impl Kernel {
                 let start = &committed.points[4 * e..4 * e + 4];
                 let (work, plastic_work) = quad_work(&geom, start, &strains, &responses);
                 let force = quad4::internal_force(&geom, &kinematics, &stress);
-                let matrix = tangent.map(|_| {
+                out.force.copy_from_slice(force.as_slice());
+                if let Some(m) = out.matrix {
                     let moduli = if elastic_moduli {
                         [body.material.elastic.moduli(condition); 4]
                     } else {
                         responses.map(|r| r.moduli)
                     };
                     let k = quad4::tangent(&geom, &kinematics, &stress, &moduli, op, geometric);
-                    let mut m = [0.0; 64];
                     m.copy_from_slice(k.transpose().as_slice()); // row-major
-                    m
-                });
-                Ok(ElementResult {
-                    force,
-                    matrix,
-                    trial: responses.map(|r| r.state),
-                    strain_zz: responses.map(|r| r.strain_zz),
-                    work,
-                    plastic_work,
-                })
+                }
+                for (t, r) in out.trial.iter_mut().zip(&responses) {
+                    *t = r.state;
+                }
+                if let Some(zz) = out.strain_zz {
+                    for (z, r) in zz.iter_mut().zip(&responses) {
+                        *z = r.strain_zz;
+                    }
+                }
+                Ok(ElementWork { work, plastic_work })
             }
             Kernel::Rod2 { area } => {
                 let x = rod_nodes(body, e, coordinates);
@@ -184,31 +190,22 @@ impl Kernel {
                         response.plastic_work,
                     );
                 let f4 = rod2::internal_force(&x, &de, stress, area, geometry)?;
-                let matrix = match tangent {
-                    Some(_) => {
-                        let modulus = if elastic_moduli {
-                            body.material.elastic.young
-                        } else {
-                            response.tangent
-                        };
-                        let k: Mat4 =
-                            rod2::tangent(&x, &de, stress, modulus, area, geometry, geometric)?;
-                        let mut m = [0.0; 64];
-                        m[..16].copy_from_slice(k.transpose().as_slice());
-                        Some(m)
-                    }
-                    None => None,
-                };
-                let mut force = Vec8::zeros();
-                force.fixed_rows_mut::<4>(0).copy_from(&f4);
-                Ok(ElementResult {
-                    force,
-                    matrix,
-                    trial: [response.state; 4],
-                    strain_zz: [0.0; 4],
-                    work,
-                    plastic_work,
-                })
+                if let Some(m) = out.matrix {
+                    let modulus = if elastic_moduli {
+                        body.material.elastic.young
+                    } else {
+                        response.tangent
+                    };
+                    let k: Mat4 =
+                        rod2::tangent(&x, &de, stress, modulus, area, geometry, geometric)?;
+                    m.copy_from_slice(k.transpose().as_slice());
+                }
+                out.force.copy_from_slice(f4.as_slice());
+                out.trial[0] = response.state;
+                if let Some(zz) = out.strain_zz {
+                    zz[0] = 0.0;
+                }
+                Ok(ElementWork { work, plastic_work })
             }
         }
     }
@@ -369,8 +366,12 @@ impl Kernel {
         e: usize,
         geometry: Strain,
     ) -> Result<f64, KernelError> {
+        let lumped = self.lumped_mass(body, initial, e)?;
+        let n = 2 * lumped.len();
+        let (mut force, mut k) = ([0.0; 8], [0.0; 64]);
+        let mut trial = [PointState::default(); 4];
         // a zero increment: no step, no rate
-        let r = self.evaluate(
+        self.evaluate(
             body,
             committed,
             coordinates,
@@ -379,10 +380,13 @@ impl Kernel {
             e,
             geometry,
             Some(Tangent::Consistent),
+            ElementOut {
+                force: &mut force[..n],
+                matrix: Some(&mut k[..n * n]),
+                trial: &mut trial[..body.points_per_element()],
+                strain_zz: None,
+            },
         )?;
-        let k = r.matrix.expect("tangent requested");
-        let lumped = self.lumped_mass(body, initial, e)?;
-        let n = 2 * lumped.len();
         let scale: Vec<f64> = (0..n).map(|i| 1.0 / lumped[i / 2].sqrt()).collect();
         let a = nalgebra::DMatrix::from_fn(n, n, |i, j| k[i * n + j] * scale[i] * scale[j]);
         let a = (&a + a.transpose()) * 0.5;

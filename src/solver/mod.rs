@@ -276,6 +276,12 @@ fn path_dot(a: &[(usize, Vec<f64>)], b: &[(usize, Vec<f64>)]) -> f64 {
     sum
 }
 
+/// New equations of `know_inverse` from which their paths and dot products are formed in
+/// parallel: a contact step names a handful, and handing a few paths of microseconds to the
+/// thread pool costs more than it saves (the penetration of the plastic impact bench names
+/// hundreds at once).
+const PARALLEL_PATHS_FROM: usize = 32;
+
 /// faer factors supernodally where the factorization's flops per entry of L exceed 40 times
 /// this (its default: 1). The quadrilateral meshes here have small supernodes that still pay
 /// below that: at 0.3, sphere_wall (2156 DOFs) factors in 1.0 ms against 2.6 ms and runs in
@@ -410,16 +416,19 @@ impl Solver {
         };
         let start = std::time::Instant::now();
         let inverse_perm = self.permutation().map(|p| p.arrays().1);
-        let paths: Vec<Vec<(usize, Vec<f64>)>> = new
-            .par_iter()
-            .map_init(
-                || (vec![0.0; self.pattern.size], Vec::new()),
-                |(work, below), &eq| {
-                    let row = inverse_perm.map_or(eq, |inv| inv[eq] as usize);
-                    forward_path(factor, row, work, below)
-                },
-            )
-            .collect();
+        let path = |(work, below): &mut (Vec<f64>, Vec<f64>), eq: usize| {
+            let row = inverse_perm.map_or(eq, |inv| inv[eq] as usize);
+            forward_path(factor, row, work, below)
+        };
+        let scratch = || (vec![0.0; self.pattern.size], Vec::new());
+        let paths: Vec<Vec<(usize, Vec<f64>)>> = if new.len() >= PARALLEL_PATHS_FROM {
+            new.par_iter()
+                .map_init(scratch, |s, &eq| path(s, eq))
+                .collect()
+        } else {
+            let mut s = scratch();
+            new.iter().map(|&eq| path(&mut s, eq)).collect()
+        };
         for (eq, path) in new.into_iter().zip(paths) {
             let k = self.inverse.equations.len();
             self.inverse.local.insert(eq, k);
@@ -429,10 +438,12 @@ impl Solver {
         // the rows of the new equations: dot products with every equation known
         let first = self.inverse.lower.len();
         let paths = &self.inverse.paths;
-        let rows: Vec<Vec<f64>> = (first..paths.len())
-            .into_par_iter()
-            .map(|k| (0..=k).map(|j| path_dot(&paths[k], &paths[j])).collect())
-            .collect();
+        let row = |k: usize| (0..=k).map(|j| path_dot(&paths[k], &paths[j])).collect();
+        let rows: Vec<Vec<f64>> = if paths.len() - first >= PARALLEL_PATHS_FROM {
+            (first..paths.len()).into_par_iter().map(row).collect()
+        } else {
+            (first..paths.len()).map(row).collect()
+        };
         self.inverse.lower.extend(rows);
         crate::profile::add(crate::profile::Phase::Solve, start);
     }
