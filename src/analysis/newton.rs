@@ -611,12 +611,6 @@ impl Step<'_> {
                 return Err(StepFailure(non_finite(system, &balance, &d)));
             }
             let test = Convergence::of(residual_norm, forces_scale, &d, system.diagonal_max);
-            if std::env::var("IMPACT_EST").is_ok() && iteration > 0 {
-                let r = residual_norm / previous_residual;
-                if r < 0.5 {
-                    eps_displacement *= r / (1.0 - r);
-                }
-            }
             if iteration > 0 {
                 eps_displacement = remaining(eps_displacement, residual_norm / previous_residual);
             }
