@@ -99,6 +99,9 @@ pub struct Row {
     /// Steps per second after the setup.
     pub steps_per_second: f64,
     pub element_updates_per_second: f64,
+    /// Element updates per second of the assembly phase alone (evaluation and scatter): the
+    /// element cost, where `element_updates_per_second` is the throughput of whole steps.
+    pub assembly_updates_per_second: f64,
     pub newton_iterations: usize,
     pub factorizations: usize,
     pub back_substitutions: usize,
@@ -422,6 +425,11 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
         setup_seconds: t.setup,
         steps_per_second: s.steps as f64 / stepping,
         element_updates_per_second: t.element_updates as f64 / stepping,
+        assembly_updates_per_second: if t.assembly > 0.0 {
+            t.element_updates as f64 / t.assembly
+        } else {
+            0.0
+        },
         newton_iterations: s.newton_iterations,
         factorizations: s.factorizations,
         back_substitutions: s.back_substitutions,
