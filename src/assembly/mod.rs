@@ -816,3 +816,52 @@ pub fn frequency_bounds(
     }
     Ok(bounds)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The lower-triangle scatter adds, at every global entry (i, j), i >= j, the element
+    /// entries (a, b) with equations (i, j): what a dense assembly of the full element
+    /// matrices gives there. The element matrices are deliberately not symmetric, so a
+    /// transposed entry taken where the plain one belongs (or the reverse) shows.
+    #[test]
+    fn lower_triangle_scatter_matches_a_dense_assembly() {
+        // three 4-DOF elements, equations in both orders, one constrained DOF (None)
+        let elements: Vec<Vec<Option<usize>>> = vec![
+            vec![Some(4), Some(1), Some(0), Some(3)],
+            vec![Some(2), Some(4), None, Some(5)],
+            vec![Some(5), Some(0), Some(1), Some(2)],
+        ];
+        let size = 6;
+        let pattern = Pattern::from_elements(size, elements.iter().map(|v| v.as_slice()));
+        let scatter = Scatter::new(&pattern, &elements);
+        let n = 4;
+        let matrix = |e: usize| -> Vec<f64> {
+            (0..n * n)
+                .map(|k| 1.0 + (e * 16 + k) as f64 * 0.37 + (k % 3) as f64 * 1e-3)
+                .collect()
+        };
+        let mut values = vec![0.0; pattern.nonzeros()];
+        let mut dense = vec![vec![0.0; size]; size];
+        for (e, eqs) in elements.iter().enumerate() {
+            let m = matrix(e);
+            scatter.add(e, &m, &mut values);
+            for a in 0..n {
+                for b in 0..n {
+                    if let (Some(i), Some(j)) = (eqs[a], eqs[b]) {
+                        dense[i][j] += m[a * n + b];
+                    }
+                }
+            }
+        }
+        for j in 0..size {
+            for i in j..size {
+                let got = pattern.position(i, j).map_or(0.0, |p| values[p]);
+                // exact: each entry receives one element entry per element, in element order
+                // in both sums
+                assert_eq!(got, dense[i][j], "entry ({i}, {j})");
+            }
+        }
+    }
+}
