@@ -319,7 +319,10 @@ impl<'a> Dynamics<'a> {
         for (u, du) in kin.displacement.iter_mut().zip(&d) {
             *u += du;
         }
-        let kinetic_before = self.mass.kinetic_energy(model, &kin.velocity);
+        // the impact and release conditions change velocities only at a step's events
+        let events = &step.events;
+        let conditions = !events.closed.is_empty() || !events.released.is_empty();
+        let kinetic_before = conditions.then(|| self.mass.kinetic_energy(model, &kin.velocity));
         let positions = self.state.positions(spec.geometry);
         crate::contact::apply_conditions(
             &self.interfaces,
@@ -342,7 +345,7 @@ impl<'a> Dynamics<'a> {
         // energy taken up by the interface: minus the work of the contact forces on the
         // bodies, plus what the impact/release conditions removed
         energies.contact_work += -super::trapezoid_work(&d, &contact_force, &self.last_contact)
-            + kinetic_before
+            + kinetic_before.unwrap_or(energies.kinetic)
             - energies.kinetic;
         energies.internal = self.state.internal_work - self.state.plastic_work;
         energies.plastic_work = self.state.plastic_work;
@@ -379,11 +382,12 @@ impl<'a> Dynamics<'a> {
         let model = self.model;
         let external = loads::external_force(model, &self.state, &self.initial, self.state.time);
         let ma = self.mass.product(model, &self.kin.acceleration);
-        let mv = self.mass.product(model, &self.kin.velocity);
+        let a_r = self.spec.rayleigh[0];
+        let mv = (a_r != 0.0).then(|| self.mass.product(model, &self.kin.velocity));
         (0..model.dofs())
             .map(|i| match self.system.equation[i] {
                 Some(_) => external[i],
-                None => ma[i] + self.spec.rayleigh[0] * mv[i] + internal[i],
+                None => ma[i] + mv.as_ref().map_or(0.0, |mv| a_r * mv[i]) + internal[i],
             })
             .collect()
     }

@@ -20,6 +20,7 @@ pub use kernel::Kernel;
 use crate::element::{KernelError, Strain};
 use crate::kinematics;
 use crate::material::PointState;
+use crate::mesh::Cells;
 use crate::scene::spec::{MassKind, Tangent};
 use crate::scene::{Body, Model};
 use crate::solver::Pattern;
@@ -559,17 +560,15 @@ impl Mass {
             MassKind::Consistent | MassKind::DispersionFree => {
                 let mut y = vec![0.0; x.len()];
                 for (b, body) in model.bodies.iter().enumerate() {
-                    let nn = body.mesh.cells.nodes_of(0).len();
-                    for e in 0..body.elements() {
-                        let nodes = body.mesh.cells.nodes_of(e);
-                        let m = &self.elements[b][e * nn * nn..(e + 1) * nn * nn];
-                        for i in 0..nn {
-                            let gi = body.global(nodes[i]);
-                            for j in 0..nn {
-                                let gj = body.global(nodes[j]);
-                                y[2 * gi] += m[i * nn + j] * x[2 * gj];
-                                y[2 * gi + 1] += m[i * nn + j] * x[2 * gj + 1];
-                            }
+                    // the node count fixed at compile time: the loops unroll (the products
+                    // of the residual, the reactions and the kinetic energy run several
+                    // times a step)
+                    match &body.mesh.cells {
+                        Cells::Quad4(cells) => {
+                            block_product(body, cells, &self.elements[b], x, &mut y)
+                        }
+                        Cells::Rod2(cells) => {
+                            block_product(body, cells, &self.elements[b], x, &mut y)
                         }
                     }
                 }
@@ -609,6 +608,26 @@ impl Mass {
                     };
                     values[p] += coefficient * value;
                 });
+            }
+        }
+    }
+}
+
+/// y += M x over one body's elements, each an nn x nn scalar block (row-major in `blocks`)
+/// acting on both components.
+fn block_product<const NN: usize>(
+    body: &Body,
+    cells: &[[usize; NN]],
+    blocks: &[f64],
+    x: &[f64],
+    y: &mut [f64],
+) {
+    for (nodes, m) in cells.iter().zip(blocks.chunks_exact(NN * NN)) {
+        let g: [usize; NN] = std::array::from_fn(|i| 2 * body.global(nodes[i]));
+        for i in 0..NN {
+            for j in 0..NN {
+                y[g[i]] += m[i * NN + j] * x[g[j]];
+                y[g[i] + 1] += m[i * NN + j] * x[g[j] + 1];
             }
         }
     }
