@@ -1,7 +1,8 @@
 //! Global assembly: DOF numbering with constrained DOFs eliminated, the sparsity pattern and
-//! every element's scatter positions computed once per topology, and the element loop
-//! (rayon over elements, deterministic: element results are collected in order, then
-//! scattered serially).
+//! every element's scatter positions computed once per topology (`scatter`), the element loop
+//! (in chunks; a chunk's elements in parallel where it pays, their results written in place
+//! and scattered serially in element order, so the sums do not depend on the thread count),
+//! and the mass matrix (`mass`).
 //!
 //! Legend
 //! ```text
@@ -13,15 +14,18 @@
 
 pub mod explicit;
 mod kernel;
+mod mass;
+mod scatter;
 
 use kernel::ElementOut;
 pub use kernel::Kernel;
+pub use mass::Mass;
+use scatter::{Scatter, TRANSPOSED};
 
 use crate::element::{KernelError, Strain};
 use crate::kinematics;
 use crate::material::PointState;
-use crate::mesh::Cells;
-use crate::scene::spec::{MassKind, Tangent};
+use crate::scene::spec::Tangent;
 use crate::scene::{Body, Model};
 use crate::solver::Pattern;
 use rayon::prelude::*;
@@ -142,86 +146,6 @@ pub struct System {
     pub values: Vec<f64>,
     /// The largest diagonal entry of the last factored matrix (a stiffness scale).
     pub diagonal_max: f64,
-}
-
-/// Scatter positions of one body's element matrices, element-major: one u32 for each entry
-/// of an element's lower triangle, pairs of local DOFs (a, b), b <= a, in the order (0, 0),
-/// (1, 0), (1, 1), (2, 0), ... The element matrices are symmetric, so the upper triangle is
-/// not looked at: 36 positions a Quad4 where the full n x n took 64, 0.07 kB a DOF less at
-/// 1e6 DOFs. A position with `TRANSPOSED` set takes entry (b, a) of the element matrix, the
-/// one the global lower triangle holds when b's equation number is the larger, so the sum
-/// is bit for bit the one a full n x n scatter gives.
-struct Scatter {
-    /// Element DOFs.
-    n: usize,
-    /// Entries of one element's lower triangle, n (n + 1) / 2.
-    per_element: usize,
-    positions: Vec<u32>,
-}
-
-/// A scatter position that is not assembled (a constrained DOF).
-const NONE: u32 = u32::MAX;
-/// The flag of a position that takes the element matrix's transposed entry.
-const TRANSPOSED: u32 = 1 << 31;
-
-impl Scatter {
-    fn new(pattern: &Pattern, elements: &[Vec<Option<usize>>]) -> Scatter {
-        let n = elements.first().map_or(0, Vec::len);
-        let per_element = n * (n + 1) / 2;
-        let mut positions = Vec::with_capacity(elements.len() * per_element);
-        for eqs in elements {
-            for a in 0..n {
-                for b in 0..=a {
-                    positions.push(match (eqs[a], eqs[b]) {
-                        (Some(i), Some(j)) => {
-                            let (row, col, flag) = if i >= j {
-                                (i, j, 0)
-                            } else {
-                                (j, i, TRANSPOSED)
-                            };
-                            let p = pattern
-                                .position(row, col)
-                                .expect("pattern holds the element");
-                            p as u32 | flag
-                        }
-                        _ => NONE,
-                    });
-                }
-            }
-        }
-        Scatter {
-            n,
-            per_element,
-            positions,
-        }
-    }
-
-    /// Adds element e's n x n row-major matrix `m` into `values`.
-    fn add(&self, e: usize, m: &[f64], values: &mut [f64]) {
-        self.for_each(e, |p, a, b| values[p] += m[a * self.n + b]);
-    }
-
-    /// Calls `f(position, a, b)` for each assembled lower-triangle entry of element e, with
-    /// (a, b) the element matrix entry that goes there.
-    fn for_each(&self, e: usize, mut f: impl FnMut(usize, usize, usize)) {
-        let n = self.n;
-        let positions = &self.positions[e * self.per_element..(e + 1) * self.per_element];
-        let mut k = 0;
-        for a in 0..n {
-            for b in 0..=a {
-                let p = positions[k];
-                k += 1;
-                if p == NONE {
-                    continue;
-                }
-                if p & TRANSPOSED == 0 {
-                    f(p as usize, a, b);
-                } else {
-                    f((p & !TRANSPOSED) as usize, b, a);
-                }
-            }
-        }
-    }
 }
 
 /// Global DOFs of element e of body b.
@@ -481,194 +405,6 @@ pub fn commit(
     state.plastic_work += evaluation_plastic_work;
 }
 
-/// The mass matrix. In the updated-Lagrangian description rho dV is invariant, so the mass
-/// is computed once on the initial configuration and never changes.
-pub struct Mass {
-    pub kind: MassKind,
-    /// Per body, per element: the scalar nn x nn matrix (the same for x and y), row-major.
-    elements: Vec<Vec<f64>>,
-    /// Row sums per DOF (the lumped mass; also used by the explicit method).
-    pub lumped: Vec<f64>,
-}
-
-impl Mass {
-    pub fn new(model: &Model, kind: MassKind) -> Result<Mass, ElementFailure> {
-        let coords = model.coordinates();
-        let mut lumped = vec![0.0; model.dofs()];
-        let mut elements = Vec::with_capacity(model.bodies.len());
-        for body in &model.bodies {
-            let kernel = Kernel::of(body);
-            let nn = body.mesh.cells.nodes_of(0).len();
-            let mut body_m = Vec::with_capacity(body.elements() * nn * nn);
-            for e in 0..body.elements() {
-                let nodes = body.mesh.cells.nodes_of(e);
-                let failure = |error| ElementFailure {
-                    body: body.name.clone(),
-                    element: e,
-                    error,
-                };
-                let mut m = kernel.mass(body, &coords, e).map_err(failure)?;
-                if kind == MassKind::DispersionFree {
-                    dispersion_free(&mut m, nn);
-                }
-                for (i, n) in nodes.iter().enumerate() {
-                    let row: f64 = m[i * nn..(i + 1) * nn].iter().sum();
-                    lumped[2 * body.global(*n)] += row;
-                    lumped[2 * body.global(*n) + 1] += row;
-                }
-                body_m.extend(m);
-            }
-            elements.push(body_m);
-        }
-        Ok(Mass {
-            kind,
-            elements,
-            lumped,
-        })
-    }
-
-    /// The same mass with the nodes flagged in `massless` (per node) carrying none: in each
-    /// element their rows and columns are removed and the mass they held goes onto the
-    /// element's other nodes in proportion to those nodes' row sums, so every element keeps
-    /// its mass (Khenous, Laborde & Renard 2008). An element whose nodes are all flagged
-    /// keeps its mass as it is.
-    pub fn redistributed(mut self, model: &Model, massless: &[bool]) -> Mass {
-        self.lumped.iter_mut().for_each(|m| *m = 0.0);
-        for (b, body) in model.bodies.iter().enumerate() {
-            let nn = body.mesh.cells.nodes_of(0).len();
-            for e in 0..body.elements() {
-                let nodes = body.mesh.cells.nodes_of(e);
-                let flagged: Vec<bool> = nodes.iter().map(|n| massless[body.global(*n)]).collect();
-                let m = &mut self.elements[b][e * nn * nn..(e + 1) * nn * nn];
-                if flagged.iter().any(|f| *f) && !flagged.iter().all(|f| *f) {
-                    redistribute(m, nn, &flagged);
-                }
-                for (i, n) in nodes.iter().enumerate() {
-                    let row: f64 = m[i * nn..(i + 1) * nn].iter().sum();
-                    self.lumped[2 * body.global(*n)] += row;
-                    self.lumped[2 * body.global(*n) + 1] += row;
-                }
-            }
-        }
-        self
-    }
-
-    /// M x over all DOFs.
-    pub fn product(&self, model: &Model, x: &[f64]) -> Vec<f64> {
-        match self.kind {
-            MassKind::Lumped => self.lumped.iter().zip(x).map(|(m, v)| m * v).collect(),
-            MassKind::Consistent | MassKind::DispersionFree => {
-                let mut y = vec![0.0; x.len()];
-                for (b, body) in model.bodies.iter().enumerate() {
-                    // the node count fixed at compile time: the loops unroll (the products
-                    // of the residual, the reactions and the kinetic energy run several
-                    // times a step)
-                    match &body.mesh.cells {
-                        Cells::Quad4(cells) => {
-                            block_product(body, cells, &self.elements[b], x, &mut y)
-                        }
-                        Cells::Rod2(cells) => {
-                            block_product(body, cells, &self.elements[b], x, &mut y)
-                        }
-                    }
-                }
-                y
-            }
-        }
-    }
-
-    /// 1/2 v . M v
-    pub fn kinetic_energy(&self, model: &Model, v: &[f64]) -> f64 {
-        0.5 * self
-            .product(model, v)
-            .iter()
-            .zip(v)
-            .map(|(a, b)| a * b)
-            .sum::<f64>()
-    }
-
-    /// Adds `coefficient` M into the free-DOF matrix of `system`.
-    pub fn add_to(&self, model: &Model, system: &mut System, coefficient: f64) {
-        for (b, body) in model.bodies.iter().enumerate() {
-            let nn = body.mesh.cells.nodes_of(0).len();
-            for e in 0..body.elements() {
-                let m = &self.elements[b][e * nn * nn..(e + 1) * nn * nn];
-                let values = &mut system.values;
-                // DOF a is node a / 2's component a % 2; the mass couples equal components only
-                system.scatter[b].for_each(e, |p, a, b| {
-                    let (i, j) = (a / 2, b / 2);
-                    if a % 2 != b % 2 {
-                        return;
-                    }
-                    let value = match self.kind {
-                        MassKind::Consistent | MassKind::DispersionFree => m[i * nn + j],
-                        // the element's own row sum: summed over elements, the lumped diagonal
-                        MassKind::Lumped if i == j => m[i * nn..(i + 1) * nn].iter().sum(),
-                        MassKind::Lumped => 0.0,
-                    };
-                    values[p] += coefficient * value;
-                });
-            }
-        }
-    }
-}
-
-/// y += M x over one body's elements, each an nn x nn scalar block (row-major in `blocks`)
-/// acting on both components.
-fn block_product<const NN: usize>(
-    body: &Body,
-    cells: &[[usize; NN]],
-    blocks: &[f64],
-    x: &[f64],
-    y: &mut [f64],
-) {
-    for (nodes, m) in cells.iter().zip(blocks.chunks_exact(NN * NN)) {
-        let g: [usize; NN] = std::array::from_fn(|i| 2 * body.global(nodes[i]));
-        for i in 0..NN {
-            for j in 0..NN {
-                y[g[i]] += m[i * NN + j] * x[g[j]];
-                y[g[i] + 1] += m[i * NN + j] * x[g[j] + 1];
-            }
-        }
-    }
-}
-
-/// The rod blend 3/2 consistent - 1/2 lumped in place (an nn x nn element matrix): for the
-/// two-node rod rho A h / 4 [[1, 1], [1, 1]], with which the trapezoidal rule is free of
-/// dispersion at Courant number 1 (docs/theory.md "Contact in implicit dynamics").
-fn dispersion_free(m: &mut [f64], nn: usize) {
-    let rows: Vec<f64> = (0..nn)
-        .map(|i| m[i * nn..(i + 1) * nn].iter().sum())
-        .collect();
-    for i in 0..nn {
-        for j in 0..nn {
-            let lumped = if i == j { rows[i] } else { 0.0 };
-            m[i * nn + j] = 1.5 * m[i * nn + j] - 0.5 * lumped;
-        }
-    }
-}
-
-/// Removes the rows and columns of the `flagged` nodes of an element matrix and puts the
-/// mass they held on the diagonal of the others, in proportion to their row sums.
-fn redistribute(m: &mut [f64], nn: usize, flagged: &[bool]) {
-    let total: f64 = m.iter().sum();
-    let rows: Vec<f64> = (0..nn)
-        .map(|i| m[i * nn..(i + 1) * nn].iter().sum())
-        .collect();
-    for i in 0..nn {
-        for j in 0..nn {
-            if flagged[i] || flagged[j] {
-                m[i * nn + j] = 0.0;
-            }
-        }
-    }
-    let kept: f64 = m.iter().sum();
-    let weight: f64 = (0..nn).filter(|i| !flagged[*i]).map(|i| rows[i]).sum();
-    for i in (0..nn).filter(|i| !flagged[*i]) {
-        m[i * nn + i] += (total - kept) * rows[i] / weight;
-    }
-}
-
 /// The lumped mass of every element at its nodes (per body, element-major, nodes per
 /// element each): invariant in the updated-Lagrangian description (rho dV is).
 #[derive(Debug, Clone)]
@@ -834,53 +570,4 @@ pub fn frequency_bounds(
         }
     }
     Ok(bounds)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The lower-triangle scatter adds, at every global entry (i, j), i >= j, the element
-    /// entries (a, b) with equations (i, j): what a dense assembly of the full element
-    /// matrices gives there. The element matrices are deliberately not symmetric, so a
-    /// transposed entry taken where the plain one belongs (or the reverse) shows.
-    #[test]
-    fn lower_triangle_scatter_matches_a_dense_assembly() {
-        // three 4-DOF elements, equations in both orders, one constrained DOF (None)
-        let elements: Vec<Vec<Option<usize>>> = vec![
-            vec![Some(4), Some(1), Some(0), Some(3)],
-            vec![Some(2), Some(4), None, Some(5)],
-            vec![Some(5), Some(0), Some(1), Some(2)],
-        ];
-        let size = 6;
-        let pattern = Pattern::from_elements(size, elements.iter().map(|v| v.as_slice()));
-        let scatter = Scatter::new(&pattern, &elements);
-        let n = 4;
-        let matrix = |e: usize| -> Vec<f64> {
-            (0..n * n)
-                .map(|k| 1.0 + (e * 16 + k) as f64 * 0.37 + (k % 3) as f64 * 1e-3)
-                .collect()
-        };
-        let mut values = vec![0.0; pattern.nonzeros()];
-        let mut dense = vec![vec![0.0; size]; size];
-        for (e, eqs) in elements.iter().enumerate() {
-            let m = matrix(e);
-            scatter.add(e, &m, &mut values);
-            for a in 0..n {
-                for b in 0..n {
-                    if let (Some(i), Some(j)) = (eqs[a], eqs[b]) {
-                        dense[i][j] += m[a * n + b];
-                    }
-                }
-            }
-        }
-        for j in 0..size {
-            for i in j..size {
-                let got = pattern.position(i, j).map_or(0.0, |p| values[p]);
-                // exact: each entry receives one element entry per element, in element order
-                // in both sums
-                assert_eq!(got, dense[i][j], "entry ({i}, {j})");
-            }
-        }
-    }
 }
