@@ -29,7 +29,8 @@ pub const FILE: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// Bumped whenever a stored type changes: an old checkpoint is refused, not misread.
 /// 2: material points carry a temperature, the explicit carry its clock.
-const FORMAT: u32 = 3;
+/// 4: the implicit dynamic carry holds the last step's mean velocity (the predictor).
+const FORMAT: u32 = 4;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -79,6 +80,8 @@ pub struct DynamicCarry {
     pub control: StepControl,
     pub increments: usize,
     pub contact: ContactState,
+    /// The last step's mean velocity, the next step's predictor (None before the first).
+    pub mean_velocity: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

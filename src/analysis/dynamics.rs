@@ -116,6 +116,9 @@ pub struct Dynamics<'a> {
     contact: ContactState,
     /// The length of the last step.
     last_step: f64,
+    /// The mean velocity of the last step (its increment over its length): the next step's
+    /// predictor. None before the first step.
+    mean_velocity: Option<Vec<f64>>,
 }
 
 impl<'a> Dynamics<'a> {
@@ -165,6 +168,7 @@ impl<'a> Dynamics<'a> {
             increments: 0,
             contact: ContactState::new(&model.contacts),
             last_step: 0.0,
+            mean_velocity: None,
             system,
             solver,
             mass,
@@ -256,6 +260,7 @@ impl<'a> Dynamics<'a> {
             increments: self.increments,
             pairs: &self.interfaces.pairs,
             persistent: self.persistent_entries(),
+            mean_velocity: self.mean_velocity.as_deref(),
         };
         let (system, solver, factored_for) =
             (&mut self.system, &mut self.solver, &mut self.factored_for);
@@ -313,6 +318,8 @@ impl<'a> Dynamics<'a> {
             self.state.time + h
         };
         self.last_step = self.state.time - start;
+        // the next step's predictor (theory 8.2)
+        self.mean_velocity = Some(d.iter().map(|x| x / h).collect());
         let kin = &mut self.kin;
         let previous_velocity = std::mem::replace(&mut kin.velocity, advance.velocity);
         kin.acceleration = advance.acceleration;
@@ -408,6 +415,7 @@ struct Attempt<'s> {
     pairs: &'s [crate::contact::ContactPair],
     /// Entries held by velocity-level persistency (see `Dynamics::persistent_entries`).
     persistent: Vec<(usize, usize)>,
+    mean_velocity: Option<&'s [f64]>,
 }
 
 impl Attempt<'_> {
@@ -454,12 +462,12 @@ impl Attempt<'_> {
         let (model, spec, state) = (self.model, self.spec, self.state);
         let form = self.method.form(h, self.kin);
         let solve_time = state.time + form.solve_fraction * h;
-        // the predictor h v, or the increment the last active set converged to
+        // the predictor: the last step's mean velocity over this step (the end velocity at
+        // the first step; theory 8.2), or the increment the last active set converged to
+        let predictor = self.mean_velocity.unwrap_or(&self.kin.velocity);
         let mut d: Vec<f64> = match warm {
             Some(d) => d.to_vec(),
-            None => self
-                .kin
-                .velocity
+            None => predictor
                 .iter()
                 .map(|v| form.solve_fraction * h * v)
                 .collect(),
@@ -569,6 +577,7 @@ impl Stepper for Dynamics<'_> {
         self.control = carry.control;
         self.increments = carry.increments;
         self.contact = carry.contact;
+        self.mean_velocity = carry.mean_velocity;
         true
     }
 
@@ -585,6 +594,7 @@ impl Stepper for Dynamics<'_> {
             control: self.control.clone(),
             increments: self.increments,
             contact: self.contact.clone(),
+            mean_velocity: self.mean_velocity.clone(),
         }))
     }
 
