@@ -463,8 +463,12 @@ impl Attempt<'_> {
         let form = self.method.form(h, self.kin);
         let solve_time = state.time + form.solve_fraction * h;
         // the predictor: the last step's mean velocity over this step (the end velocity at
-        // the first step; theory 8.2), or the increment the last active set converged to
-        let predictor = self.mean_velocity.unwrap_or(&self.kin.velocity);
+        // the first step, and for Wilson's extrapolated solve; theory 8.2), or the increment
+        // the last active set converged to
+        let predictor = match self.mean_velocity {
+            Some(v) if form.solve_fraction == 1.0 => v,
+            _ => &self.kin.velocity,
+        };
         let mut d: Vec<f64> = match warm {
             Some(d) => d.to_vec(),
             None => predictor
