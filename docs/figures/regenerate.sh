@@ -37,7 +37,10 @@ impact plot $out/hill_cylinder/history.csv --y 'u_x[bore]' --reference $out/hill
 bash models/impact_study.sh $out/impact_study $fig
 
 # Sweeps: convergence, speed against accuracy, stability maps.
-# Each writes DIR/sweep.csv and charts; the docs' copies are taken from there.
+# Each writes DIR/sweep.csv and charts; the docs' copies are taken from there. A sweep skips
+# the cases its folder already holds, so the folders go first: the charts must come from
+# this build's runs, not from an earlier one's.
+rm -rf "$out"/sweep_*
 sweep() { impact sweep "$@" --quiet; }
 copy() { for ext in png svg; do cp "$1.$ext" "$fig/$2.$ext"; done; }
 refine_bars='body.bar1.mesh.n,body.bar2.mesh.n,analysis.dt=14,14,0.005;28,28,0.0025;56,56,0.00125;112,112,0.000625;224,224,0.0003125'
