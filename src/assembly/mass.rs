@@ -23,7 +23,7 @@ impl Mass {
         let mut elements = Vec::with_capacity(model.bodies.len());
         for body in &model.bodies {
             let kernel = Kernel::of(body);
-            let nn = body.mesh.cells.nodes_of(0).len();
+            let nn = body.mesh.cells.nodes_per_cell();
             let mut body_m = Vec::with_capacity(body.elements() * nn * nn);
             for e in 0..body.elements() {
                 let nodes = body.mesh.cells.nodes_of(e);
@@ -60,7 +60,7 @@ impl Mass {
     pub fn redistributed(mut self, model: &Model, massless: &[bool]) -> Mass {
         self.lumped.iter_mut().for_each(|m| *m = 0.0);
         for (b, body) in model.bodies.iter().enumerate() {
-            let nn = body.mesh.cells.nodes_of(0).len();
+            let nn = body.mesh.cells.nodes_per_cell();
             for e in 0..body.elements() {
                 let nodes = body.mesh.cells.nodes_of(e);
                 let flagged: Vec<bool> = nodes.iter().map(|n| massless[body.global(*n)]).collect();
@@ -115,7 +115,7 @@ impl Mass {
     /// Adds `coefficient` M into the free-DOF matrix of `system`.
     pub fn add_to(&self, model: &Model, system: &mut System, coefficient: f64) {
         for (b, body) in model.bodies.iter().enumerate() {
-            let nn = body.mesh.cells.nodes_of(0).len();
+            let nn = body.mesh.cells.nodes_per_cell();
             for e in 0..body.elements() {
                 let m = &self.elements[b][e * nn * nn..(e + 1) * nn * nn];
                 let values = &mut system.values;

@@ -265,7 +265,7 @@ pub fn evaluate(
     for (b, body) in model.bodies.iter().enumerate() {
         let kernel = Kernel::of(body);
         let ppe = body.points_per_element();
-        let nodes = body.mesh.cells.nodes_of(0).len();
+        let nodes = body.mesh.cells.nodes_per_cell();
         let thins = kernel.thins();
         // each element's results in one stride of `out`: force, then the matrix when asked,
         // then the out-of-plane strains of a plane-stress body; trial states in place

@@ -45,6 +45,14 @@ impl Cells {
         self.len() == 0
     }
 
+    /// Nodes of each element (4 or 2), whether or not there is an element.
+    pub fn nodes_per_cell(&self) -> usize {
+        match self {
+            Cells::Quad4(_) => 4,
+            Cells::Rod2(_) => 2,
+        }
+    }
+
     /// Node ids of element `e`.
     pub fn nodes_of(&self, e: usize) -> &[usize] {
         match self {
