@@ -322,9 +322,10 @@ fn constrained_solve(
                 .map(|(eq, c)| c * solver.solution_entry(&w, *eq))
                 .sum::<f64>()
     });
-    let tau = schur.lu().solve(&rhs).ok_or_else(|| {
-        StepFailure("the contact constraints are redundant (singular Schur complement)".into())
-    })?;
+    let tau = schur
+        .lu()
+        .solve(&rhs)
+        .ok_or_else(|| StepFailure(REDUNDANT.into()))?;
     for (row, t) in nonzero.iter().zip(tau.iter()) {
         for (eq, c) in row {
             solver.add_unit(&mut w, *eq, c * t);
@@ -335,6 +336,7 @@ fn constrained_solve(
     Ok((delta, tau.iter().copied().collect()))
 }
 
+const REDUNDANT: &str = "the contact constraints are redundant (singular Schur complement)";
 const ON_PRESCRIBED_ONLY: &str = "a contact constraint acts on prescribed DOFs only (a supported slave node against its obstacle): it cannot be enforced";
 
 /// The constrained solve with the exact linearization of the rows on deformable masters
@@ -417,9 +419,10 @@ fn exact_solve(
             -rows.gaps[i - n]
         }
     });
-    let solution = system.lu().solve(&rhs).ok_or_else(|| {
-        StepFailure("the contact constraints are redundant (singular Schur complement)".into())
-    })?;
+    let solution = system
+        .lu()
+        .solve(&rhs)
+        .ok_or_else(|| StepFailure(REDUNDANT.into()))?;
     let (q, tau) = (solution.rows(0, n), solution.rows(n, m));
     let load = c.transpose() * tau + a * q;
     for (eq, f) in equations.iter().zip(load.iter()) {
