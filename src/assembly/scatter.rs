@@ -13,8 +13,6 @@ use crate::solver::Pattern;
 pub(super) struct Scatter {
     /// Element DOFs.
     n: usize,
-    /// Entries of one element's lower triangle, n (n + 1) / 2.
-    per_element: usize,
     positions: Vec<u32>,
 }
 
@@ -48,11 +46,7 @@ impl Scatter {
                 }
             }
         }
-        Scatter {
-            n,
-            per_element,
-            positions,
-        }
+        Scatter { n, positions }
     }
 
     /// Adds element e's n x n row-major matrix `m` into `values`.
@@ -64,7 +58,9 @@ impl Scatter {
     /// (a, b) the element matrix entry that goes there.
     pub(super) fn for_each(&self, e: usize, mut f: impl FnMut(usize, usize, usize)) {
         let n = self.n;
-        let positions = &self.positions[e * self.per_element..(e + 1) * self.per_element];
+        // an element's lower triangle: n (n + 1) / 2 entries
+        let per_element = n * (n + 1) / 2;
+        let positions = &self.positions[e * per_element..(e + 1) * per_element];
         let mut k = 0;
         for a in 0..n {
             for b in 0..=a {
