@@ -323,7 +323,9 @@ fn plate_with_hole_plane_stress_converges() {
 /// Goal: the Newton strategies and tangents reach the same answer at the same tolerance
 /// (the table of strategies and tangents). Setup: models/hill_cylinder.toml with modified, full and initial
 /// strategies on the consistent tangent, and modified with Erklig's elastic tangent (the
-/// initial-stress method proper, which needs many iterations near the limit: 400 allowed).
+/// initial-stress method proper, which needs many iterations near the limit: 400 allowed),
+/// and the initial-stress method with BFGS updates within the default 30 iterations (without
+/// them it stops `diverged` at 0.8 p_lim).
 /// Reference: the full-Newton bore displacement; agreement within 1e-6 relative (the
 /// convergence tolerances are 1e-8).
 #[test]
@@ -348,6 +350,14 @@ fn newton_strategies_and_tangents_agree() {
                 "analysis.newton.strategy=modified",
                 "analysis.newton.tangent=elastic",
                 "analysis.newton.max_iterations=400",
+            ],
+        ),
+        (
+            "hill_elastic_bfgs",
+            vec![
+                "analysis.newton.strategy=initial",
+                "analysis.newton.tangent=elastic",
+                "analysis.newton.updates=bfgs",
             ],
         ),
     ] {

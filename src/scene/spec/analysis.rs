@@ -320,6 +320,17 @@ pub enum Strategy {
     Initial,
 }
 
+/// What the iteration does with its residuals between factorizations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Updates {
+    /// None: every correction is K*^-1 R with the factored K*.
+    #[default]
+    None,
+    /// Quasi-Newton: BFGS updates of K*^-1 (Matthies & Strang 1979).
+    Bfgs,
+}
+
 /// Which matrix the factorized tangent holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -360,6 +371,12 @@ pub struct NewtonSpec {
     /// Halvings of an increment that does not converge before the run stops `diverged`. Default 6.
     #[serde(default = "default_cuts")]
     pub max_cuts: usize,
+    /// Between factorizations, the factored matrix alone (`none`, default: the modified Newton
+    /// of Erklig, Guzelbey & Cevik 2010) or with BFGS updates from the residuals of the
+    /// iterates (`bfgs`, for a factor kept long: `initial`, the elastic tangent). `full` has
+    /// nothing to update.
+    #[serde(default)]
+    pub updates: Updates,
     /// Modified Newton: also factor at the start of every N-th increment (Erklig's
     /// algorithm: 1). Default: none, only when the iteration stalls, after a cut and when
     /// K*'s coefficients change.
@@ -377,6 +394,7 @@ impl Default for NewtonSpec {
             tol_force: default_tolerance(),
             contraction: default_contraction(),
             max_cuts: default_cuts(),
+            updates: Updates::default(),
             refactor_every: None,
         }
     }

@@ -16,15 +16,19 @@
 //! contracting (||R_k|| > contraction ||R_k-1||) or when, at its current rate, it would need
 //! more than half of the iterations left to reach the force tolerance.
 
+mod constrained;
+mod secant;
+
 use crate::assembly::{self, Evaluation, Mass, State, System};
-use crate::contact::linearization::Linearization;
 use crate::contact::{ConstrainedSolution, ContactPair, Tangential, Unsettled};
 use crate::element::Strain;
 use crate::integrator::StepForm;
 use crate::profile::{self, Phase};
 use crate::scene::Model;
-use crate::scene::spec::{NewtonSpec, Strategy, Tangent};
+use crate::scene::spec::{NewtonSpec, Strategy, Tangent, Updates};
 use crate::solver::Solver;
+use constrained::{Rows, add_constraint_forces, constrained_solve};
+use secant::Secant;
 
 /// Counters of the nonlinear solution.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
@@ -102,335 +106,6 @@ impl ConstrainedSolution for Solution {
     fn tangential_forces(&self) -> &[f64] {
         &self.tangential
     }
-}
-
-/// Active constraint rows restricted to the free DOFs, and their gaps (normal rows first,
-/// then the fixed tangential ones); the sliding rows carry known forces.
-struct Rows {
-    rows: Vec<Vec<(usize, f64)>>,
-    gaps: Vec<f64>,
-    /// The number of normal rows (the first ones).
-    normal: usize,
-    sliding: Vec<(Vec<(usize, f64)>, usize, f64)>,
-    /// Per normal row, its exact derivatives where the row is not dg/dx.
-    exact: Vec<Option<Exact>>,
-    /// The largest |gap| of the normal rows against its pair's tolerance (TOL of Hughes II-7).
-    worst_gap: f64,
-}
-
-/// The exact derivatives of a normal row on a deformable master, on the free DOFs (see
-/// `contact::linearization`).
-struct Exact {
-    gradient: Vec<(usize, f64)>,
-    /// (equation p, equation q, d C_p / d x_q).
-    row_jacobian: Vec<(usize, usize, f64)>,
-}
-
-impl Exact {
-    fn free(l: &Linearization, system: &System) -> Exact {
-        let dofs: Vec<(Option<usize>, usize)> = l
-            .dofs()
-            .map(|(dof, local)| (system.equation[dof], local))
-            .collect();
-        let gradient = dofs
-            .iter()
-            .filter_map(|(eq, i)| eq.map(|eq| (eq, l.gradient[*i])))
-            .filter(|(_, v)| *v != 0.0)
-            .collect();
-        let mut row_jacobian = Vec::new();
-        for (p, i) in &dofs {
-            for (q, j) in &dofs {
-                if let (Some(p), Some(q)) = (p, q) {
-                    let v = l.row_jacobian[(*i, *j)];
-                    if v != 0.0 {
-                        row_jacobian.push((*p, *q, v));
-                    }
-                }
-            }
-        }
-        Exact {
-            gradient,
-            row_jacobian,
-        }
-    }
-}
-
-impl Rows {
-    fn empty() -> Rows {
-        Rows {
-            rows: Vec::new(),
-            gaps: Vec::new(),
-            normal: 0,
-            sliding: Vec::new(),
-            exact: Vec::new(),
-            worst_gap: 0.0,
-        }
-    }
-
-    /// The sliding forces for normal multipliers `forces`, added into a free-DOF vector.
-    fn add_sliding_forces(&self, forces: &[f64], target: &mut [f64]) {
-        for (row, entry, coefficient) in &self.sliding {
-            let f = coefficient * forces.get(*entry).copied().unwrap_or(0.0);
-            for (eq, c) in row {
-                target[*eq] += f * c;
-            }
-        }
-    }
-
-    /// The tangential forces in the order of `Constraints::tangential`, from the multipliers
-    /// of a solve (normal rows, then fixed tangential rows).
-    fn tangential_forces(&self, tangential: &[Tangential], multipliers: &[f64]) -> Vec<f64> {
-        let mut fixed = self.normal;
-        tangential
-            .iter()
-            .map(|t| match t {
-                Tangential::Fixed { .. } => {
-                    fixed += 1;
-                    multipliers[fixed - 1]
-                }
-                Tangential::Sliding { entry, coefficient } => coefficient * multipliers[*entry],
-            })
-            .collect()
-    }
-}
-
-impl Constraints<'_> {
-    /// Whether pair `pair` is either pass of a two-pass contact. Its rows keep C for dg/dx:
-    /// with the exact terms the two passes' near-coincident rows make the active set cycle
-    /// (round_bar two-pass: 14 step cuts and 2.3 % more plastic work than the swapped
-    /// roles, against 4 cuts and 0.6 % with C).
-    fn two_pass(&self, pair: usize) -> bool {
-        self.pairs[pair].covered.is_some()
-            || self
-                .pairs
-                .iter()
-                .any(|p| p.covered.as_ref().is_some_and(|c| c.pair == pair))
-    }
-
-    fn rows(&self, d: &[f64], system: &System) -> Result<Rows, StepFailure> {
-        let x = |n: usize| [self.start[n][0] + d[2 * n], self.start[n][1] + d[2 * n + 1]];
-        let free = |row: Vec<(usize, f64)>| -> Vec<(usize, f64)> {
-            row.into_iter()
-                .filter_map(|(dof, c)| system.equation[dof].map(|eq| (eq, c)))
-                .collect()
-        };
-        let mut rows = Rows::empty();
-        let mut gaps = Vec::with_capacity(self.active.len());
-        for (i, &(pair, slave)) in self.active.iter().enumerate() {
-            let gap = self.pairs[pair].gap(slave, &x).ok_or_else(|| {
-                StepFailure(format!(
-                    "contact `{}`: node {slave} lost its master",
-                    self.pairs[pair].name
-                ))
-            })?;
-            rows.rows.push(free(gap.row(slave)));
-            let violation = gap.gap - self.targets.get(i).copied().unwrap_or(0.0);
-            rows.gaps.push(violation);
-            let tolerance = self.pairs[pair].options.tolerance;
-            rows.worst_gap = rows.worst_gap.max(violation.abs() / tolerance);
-            let exact = (!self.two_pass(pair))
-                .then(|| self.pairs[pair].linearization(slave, &gap, &x))
-                .flatten();
-            rows.exact.push(exact.map(|l| Exact::free(&l, system)));
-            gaps.push(gap);
-        }
-        rows.normal = rows.rows.len();
-        for t in self.tangential {
-            match *t {
-                Tangential::Fixed { entry, target } => {
-                    let row = gaps[entry].tangent_row(self.active[entry].1);
-                    let slip: f64 = row.iter().map(|(dof, c)| c * d[*dof]).sum();
-                    rows.rows.push(free(row));
-                    rows.gaps.push(slip - target);
-                }
-                Tangential::Sliding { entry, coefficient } => {
-                    let row = free(gaps[entry].tangent_row(self.active[entry].1));
-                    rows.sliding.push((row, entry, coefficient));
-                }
-            }
-        }
-        Ok(rows)
-    }
-}
-
-/// sum_i tau_i C_i^T added into a free-DOF vector.
-fn add_constraint_forces(rows: &Rows, forces: &[f64], target: &mut [f64]) {
-    for (row, tau) in rows.rows.iter().zip(forces) {
-        for (eq, c) in row {
-            target[*eq] += tau * c;
-        }
-    }
-}
-
-/// The Schur complement solve on the factored K* = P^T L L^T P, in one back-substitution:
-/// ```text
-/// w = L^-1 P R,  (delta_0)_a = y_a . w,  S = C K*^-1 C^T,  S tau = -g - C delta_0,
-/// delta = P^T L^-T (w + sum_rows tau_i sum_a c_ia y_a)      (y_a = L^-1 P e_a)
-/// ```
-/// (= delta_0 + K*^-1 C^T tau). Contact never refactors K*; the y_a come with the entries of
-/// K*^-1 among the constrained equations (`Solver::know_inverse`, once per factorization).
-fn constrained_solve(
-    solver: &mut Solver,
-    rows: &Rows,
-    residual: Vec<f64>,
-    forces: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
-    let m = rows.rows.len();
-    if m == 0 {
-        let mut delta = residual;
-        solver.solve(&mut delta);
-        return Ok((delta, Vec::new()));
-    }
-    if rows.exact.iter().any(Option::is_some) {
-        return exact_solve(solver, rows, residual, forces);
-    }
-    // entries with a zero coefficient, as the x entry of a row on a horizontal wall, are
-    // left out: they would cost a path each for nothing
-    let nonzero: Vec<Vec<(usize, f64)>> = rows
-        .rows
-        .iter()
-        .map(|row| row.iter().filter(|(_, c)| *c != 0.0).copied().collect())
-        .collect();
-    let equations: Vec<usize> = nonzero.iter().flatten().map(|(eq, _)| *eq).collect();
-    solver.know_inverse(&equations);
-    let mut w = solver.forward(&residual);
-    let schur_start = std::time::Instant::now();
-    let local: Vec<Vec<(usize, f64)>> = nonzero
-        .iter()
-        .map(|row| {
-            row.iter()
-                .map(|(eq, c)| (solver.inverse_local(*eq), *c))
-                .collect()
-        })
-        .collect();
-    if local.iter().any(|row| row.is_empty()) {
-        return Err(StepFailure(ON_PRESCRIBED_ONLY.into()));
-    }
-    let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| {
-        let mut s = 0.0;
-        for (a, ca) in &local[i] {
-            for (b, cb) in &local[j] {
-                s += ca * cb * solver.inverse_entry(*a, *b);
-            }
-        }
-        s
-    });
-    let rhs = nalgebra::DVector::from_fn(m, |i, _| {
-        -rows.gaps[i]
-            - nonzero[i]
-                .iter()
-                .map(|(eq, c)| c * solver.solution_entry(&w, *eq))
-                .sum::<f64>()
-    });
-    let tau = schur
-        .lu()
-        .solve(&rhs)
-        .ok_or_else(|| StepFailure(REDUNDANT.into()))?;
-    for (row, t) in nonzero.iter().zip(tau.iter()) {
-        for (eq, c) in row {
-            solver.add_unit(&mut w, *eq, c * t);
-        }
-    }
-    profile::add(Phase::Contact, schur_start);
-    let delta = solver.backward(w);
-    Ok((delta, tau.iter().copied().collect()))
-}
-
-const REDUNDANT: &str = "the contact constraints are redundant (singular Schur complement)";
-const ON_PRESCRIBED_ONLY: &str = "a contact constraint acts on prescribed DOFs only (a supported slave node against its obstacle): it cannot be enforced";
-
-/// The constrained solve with the exact linearization of the rows on deformable masters
-/// (`contact::linearization`): Newton's step for R(d) + C(d)^T tau = 0, g(d) = 0 is
-/// ```text
-/// K* delta = R + C^T tau + A delta,   G delta = -g,   A = sum_i tau_i dC_i/dx,  G = dg/dx
-/// ```
-/// (tau in A from the last solve). A and the rows live on the few equations E the contact
-/// touches, so with Z = (K*^-1)_EE and q = delta_E it closes on E:
-/// ```text
-/// [ I - Z A   -Z C_E^T ] [ q   ]   [ (K*^-1 R)_E ]
-/// [ G_E        0       ] [ tau ] = [ -g          ],   delta = K*^-1 (R + C^T tau + A q)
-/// ```
-/// in the same single back-substitution as `constrained_solve`, and without refactoring.
-fn exact_solve(
-    solver: &mut Solver,
-    rows: &Rows,
-    residual: Vec<f64>,
-    forces: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
-    use nalgebra::{DMatrix, DVector};
-    let m = rows.rows.len();
-    let mut equations: Vec<usize> = rows
-        .rows
-        .iter()
-        .flatten()
-        .filter(|(_, c)| *c != 0.0)
-        .map(|(eq, _)| *eq)
-        .collect();
-    for e in rows.exact.iter().flatten() {
-        equations.extend(e.gradient.iter().map(|(eq, _)| *eq));
-        equations.extend(e.row_jacobian.iter().flat_map(|(p, q, _)| [*p, *q]));
-    }
-    equations.sort_unstable();
-    equations.dedup();
-    let n = equations.len();
-    let at = |eq: usize| equations.binary_search(&eq).expect("equation in E");
-    solver.know_inverse(&equations);
-    let mut w = solver.forward(&residual);
-    let schur_start = std::time::Instant::now();
-    let local: Vec<usize> = equations
-        .iter()
-        .map(|eq| solver.inverse_local(*eq))
-        .collect();
-    let z = DMatrix::from_fn(n, n, |i, j| solver.inverse_entry(local[i], local[j]));
-    let mut a = DMatrix::<f64>::zeros(n, n);
-    let mut c = DMatrix::<f64>::zeros(m, n);
-    for (i, row) in rows.rows.iter().enumerate() {
-        for (eq, v) in row.iter().filter(|(_, v)| *v != 0.0) {
-            c[(i, at(*eq))] += v;
-        }
-        if c.row(i).iter().all(|v| *v == 0.0) {
-            return Err(StepFailure(ON_PRESCRIBED_ONLY.into()));
-        }
-    }
-    let mut g = c.clone();
-    for (i, exact) in rows.exact.iter().enumerate() {
-        let Some(e) = exact else { continue };
-        let tau = forces.get(i).copied().unwrap_or(0.0);
-        for (p, q, v) in &e.row_jacobian {
-            a[(at(*p), at(*q))] += tau * v;
-        }
-        g.row_mut(i).fill(0.0);
-        for (eq, v) in &e.gradient {
-            g[(i, at(*eq))] += v;
-        }
-    }
-    let mut system = DMatrix::<f64>::zeros(n + m, n + m);
-    system
-        .view_mut((0, 0), (n, n))
-        .copy_from(&(DMatrix::identity(n, n) - &z * &a));
-    system
-        .view_mut((0, n), (n, m))
-        .copy_from(&(-(&z * c.transpose())));
-    system.view_mut((n, 0), (m, n)).copy_from(&g);
-    let rhs = DVector::from_fn(n + m, |i, _| {
-        if i < n {
-            solver.solution_entry(&w, equations[i])
-        } else {
-            -rows.gaps[i - n]
-        }
-    });
-    let solution = system
-        .lu()
-        .solve(&rhs)
-        .ok_or_else(|| StepFailure(REDUNDANT.into()))?;
-    let (q, tau) = (solution.rows(0, n), solution.rows(n, m));
-    let load = c.transpose() * tau + a * q;
-    for (eq, f) in equations.iter().zip(load.iter()) {
-        solver.add_unit(&mut w, *eq, *f);
-    }
-    profile::add(Phase::Contact, schur_start);
-    let delta = solver.backward(w);
-    Ok((delta, tau.iter().copied().collect()))
 }
 
 /// A residual this share of the force tolerance is round-off: the step has converged.
@@ -592,6 +267,10 @@ impl Step<'_> {
             _ => None,
         };
         let external_norm = norm(&system.gather(self.external));
+        let mut secant =
+            Secant::new(newton.updates == Updates::Bfgs && newton.strategy != Strategy::Full);
+        // the last correction and the residual it was solved from: a BFGS pair with the next
+        let mut last: Option<(Vec<f64>, Vec<f64>)> = None;
         let mut previous_residual = f64::INFINITY;
         let mut eps_displacement = f64::INFINITY;
         for iteration in 0..=newton.max_iterations {
@@ -604,6 +283,8 @@ impl Step<'_> {
                 Some(c) => profile::time(Phase::Contact, || c.rows(&d, system))?,
                 None => Rows::empty(),
             };
+            // R alone, without the contact and friction forces: K* is its derivative
+            let own = secant.enabled().then(|| residual.clone());
             // sliding friction: known forces from the last solve's normal multipliers
             rows.add_sliding_forces(&forces, &mut residual);
             // the equilibrium residual includes the contact forces of the last solve
@@ -643,23 +324,17 @@ impl Step<'_> {
                     residual_norm,
                     test.scale,
                 );
-            if stalled && !refactor {
-                // the same state again, now with the tangent assembled
-                self.evaluate(state, &d, Some(&mut *system))?;
-            }
             if refactor || stalled || !solver.is_factored() {
-                if !(refactor || stalled) {
+                if !refactor {
+                    // the same state again, now with the tangent assembled
                     self.evaluate(state, &d, Some(&mut *system))?;
                 }
-                // the stiffness alone sets the floor of the force scale (K*'s mass term
-                // would make any residual look small next to a rigid motion)
-                system.diagonal_max = system.diagonal().fold(0.0, f64::max);
-                self.effective(system, &damping);
-                solver
-                    .factor(&system.values)
-                    .map_err(|e| StepFailure(e.to_string()))?;
+                self.factor(system, solver, &damping)?;
+                secant.clear();
+            } else if let (Some((s, start)), Some(now)) = (last.take(), &own) {
+                secant.learn(solver, s, &start, now);
             }
-            let (delta, tau) = constrained_solve(solver, &rows, residual, &forces)?;
+            let (delta, tau) = constrained_solve(solver, &rows, residual, &forces, &secant)?;
             forces = tau;
             counters.iterations += 1;
             system.scatter_add(&delta, &mut d);
@@ -670,11 +345,28 @@ impl Step<'_> {
                 0.0
             };
             previous_residual = residual_norm;
+            last = own.map(|r| (delta, r));
         }
         Err(StepFailure(format!(
             "no convergence in {} iterations",
             newton.max_iterations
         )))
+    }
+
+    /// Factors K* from the tangent assembled in `system`.
+    fn factor(
+        &self,
+        system: &mut System,
+        solver: &mut Solver,
+        damping: &Option<Damping>,
+    ) -> Result<(), StepFailure> {
+        // the stiffness alone sets the floor of the force scale (K*'s mass term would make
+        // any residual look small next to a rigid motion)
+        system.diagonal_max = system.diagonal().fold(0.0, f64::max);
+        self.effective(system, damping);
+        solver
+            .factor(&system.values)
+            .map_err(|e| StepFailure(e.to_string()))
     }
 
     /// Whether the iteration should refactor: the residual stops contracting (`ratio` of the
