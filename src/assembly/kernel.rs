@@ -139,9 +139,14 @@ impl Kernel {
                 let condition = stress_condition(formulation);
                 let context = UpdateContext { condition, dt };
                 let fine = crate::profile::fine().then(Instant::now);
+                let with_tangent = out.matrix.is_some();
                 let update = |q: usize| {
-                    body.material
-                        .update(&committed.points[4 * e + q], &strains[q], context)
+                    let point = &committed.points[4 * e + q];
+                    if with_tangent {
+                        body.material.update(point, &strains[q], context)
+                    } else {
+                        body.material.update_stress(point, &strains[q], context)
+                    }
                 };
                 // written out, not array::from_fn: whether that generic helper is inlined
                 // depends on how the build splits the crate, and out of line it moved the

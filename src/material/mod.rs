@@ -170,7 +170,29 @@ impl Material {
         }
     }
 
+    /// `update` for a caller that reads no tangent (a residual): a plastic point of the
+    /// general condition skips its algorithmic moduli and carries the elastic ones in their
+    /// place. Stress and state are those of `update`, bit for bit. (Plane stress solves for
+    /// its out-of-plane strain with the tangent, so it keeps it.)
+    pub fn update_stress(
+        &self,
+        committed: &PointState,
+        strain: &Voigt,
+        context: UpdateContext,
+    ) -> Response {
+        match context.condition {
+            StressCondition::General => self.general(committed, strain, context.dt, false),
+            StressCondition::PlaneStress => self.update_plane_stress(committed, strain, context.dt),
+        }
+    }
+
     fn update_general(&self, committed: &PointState, strain: &Voigt, dt: f64) -> Response {
+        self.general(committed, strain, dt, true)
+    }
+
+    /// The 3D update (plane strain, axisymmetric), with the algorithmic tangent or not.
+    #[inline(always)]
+    fn general(&self, committed: &PointState, strain: &Voigt, dt: f64, tangent: bool) -> Response {
         let moduli = self.elastic.moduli(StressCondition::General);
         let trial = committed.stress + moduli * strain;
         let (_, mu) = self.elastic.lame();
@@ -185,7 +207,16 @@ impl Material {
                     dt,
                 },
             )
-            .map(|r| (j2.tangent(&r, &moduli, mu), r))
+            .map(|r| {
+                (
+                    if tangent {
+                        j2.tangent(&r, &moduli, mu)
+                    } else {
+                        moduli
+                    },
+                    r,
+                )
+            })
         });
         match plastic {
             None => Response {
@@ -510,6 +541,33 @@ mod plasticity_tests {
                 }
             }
         }
+    }
+
+    /// The residual's update (`update_stress`, no tangent) returns the stress and state of
+    /// `update` bit for bit, plastic and elastic, in both conditions: the Newton iteration
+    /// mixes the two within a step.
+    #[test]
+    fn the_update_without_tangent_keeps_the_state() {
+        let m = steel(Hardening::Linear { modulus: 10.0 }, 5.0);
+        for state in [StressCondition::General, StressCondition::PlaneStress] {
+            for strain in [
+                Voigt::new(0.004, -0.001, 0.0005, 0.003),
+                Voigt::new(1e-5, 0.0, 0.0, 0.0),
+            ] {
+                let full = m.update(&committed(), &strain, at(state));
+                let residual = m.update_stress(&committed(), &strain, at(state));
+                assert_eq!(full.stress, residual.stress);
+                assert_eq!(full.state, residual.state);
+                assert_eq!(full.plastic_work, residual.plastic_work);
+                assert_eq!(full.strain_zz, residual.strain_zz);
+            }
+        }
+        let r = m.update(
+            &committed(),
+            &Voigt::new(0.004, -0.001, 0.0005, 0.003),
+            at(StressCondition::General),
+        );
+        assert!(r.plastic_work > 0.0, "the first strain must be plastic");
     }
 
     /// After a plastic step the stress lies on the yield surface, sqrt(3/2) |dev S - alpha| =
