@@ -252,22 +252,50 @@ impl TreeFactor<'_> {
 struct InverseEntries {
     local: std::collections::HashMap<usize, usize>,
     equations: Vec<usize>,
-    /// y_{equations[k]}: (block, its segment of y), blocks ascending (the path).
-    paths: Vec<Vec<(usize, Vec<f64>)>>,
+    /// y_{equations[k]} along its path.
+    paths: Vec<Path>,
     /// `lower[k][j]` = (K^-1)_{equations[k], equations[j]} for j <= k.
     lower: Vec<Vec<f64>>,
 }
 
+/// y_a on the blocks of its elimination-tree path (ascending), the blocks' segments of y end
+/// to end in one array (a simplicial factor's blocks are single columns: one allocation a
+/// path, not one an entry).
+#[derive(Default)]
+struct Path {
+    blocks: Vec<usize>,
+    /// Segment k is `values[ends[k - 1]..ends[k]]` (from 0 for k = 0).
+    ends: Vec<usize>,
+    values: Vec<f64>,
+}
+
+impl Path {
+    fn segment(&self, k: usize) -> &[f64] {
+        let start = if k == 0 { 0 } else { self.ends[k - 1] };
+        &self.values[start..self.ends[k]]
+    }
+
+    /// (block, segment of y) along the path.
+    fn segments(&self) -> impl Iterator<Item = (usize, &[f64])> {
+        (0..self.blocks.len()).map(|k| (self.blocks[k], self.segment(k)))
+    }
+}
+
 /// y_a . y_b over the blocks both paths hold (their common ancestors): a merge of the two
 /// ascending paths.
-fn path_dot(a: &[(usize, Vec<f64>)], b: &[(usize, Vec<f64>)]) -> f64 {
+fn path_dot(a: &Path, b: &Path) -> f64 {
     let (mut i, mut j, mut sum) = (0, 0, 0.0);
-    while i < a.len() && j < b.len() {
-        match a[i].0.cmp(&b[j].0) {
+    while i < a.blocks.len() && j < b.blocks.len() {
+        match a.blocks[i].cmp(&b.blocks[j]) {
             std::cmp::Ordering::Less => i += 1,
             std::cmp::Ordering::Greater => j += 1,
             std::cmp::Ordering::Equal => {
-                sum += a[i].1.iter().zip(&b[j].1).map(|(x, y)| x * y).sum::<f64>();
+                sum += a
+                    .segment(i)
+                    .iter()
+                    .zip(b.segment(j))
+                    .map(|(x, y)| x * y)
+                    .sum::<f64>();
                 i += 1;
                 j += 1;
             }
@@ -421,7 +449,7 @@ impl Solver {
             forward_path(factor, row, work, below)
         };
         let scratch = || (vec![0.0; self.pattern.size], Vec::new());
-        let paths: Vec<Vec<(usize, Vec<f64>)>> = if new.len() >= PARALLEL_PATHS_FROM {
+        let paths: Vec<Path> = if new.len() >= PARALLEL_PATHS_FROM {
             new.par_iter()
                 .map_init(scratch, |s, &eq| path(s, eq))
                 .collect()
@@ -516,9 +544,9 @@ impl Solver {
     pub fn solution_entry(&self, w: &Forward, equation: usize) -> f64 {
         let path = &self.inverse.paths[self.inverse.local[&equation]];
         let factor = self.tree().expect("equations known: a factor at hand");
-        path.iter()
+        path.segments()
             .map(|(block, y)| {
-                let w = &w.0[factor.columns(*block)];
+                let w = &w.0[factor.columns(block)];
                 y.iter().zip(w).map(|(a, b)| a * b).sum::<f64>()
             })
             .sum()
@@ -528,8 +556,8 @@ impl Solver {
     pub fn add_unit(&self, w: &mut Forward, equation: usize, value: f64) {
         let path = &self.inverse.paths[self.inverse.local[&equation]];
         let factor = self.tree().expect("equations known: a factor at hand");
-        for (block, y) in path {
-            for (x, y) in w.0[factor.columns(*block)].iter_mut().zip(y) {
+        for (block, y) in path.segments() {
+            for (x, y) in w.0[factor.columns(block)].iter_mut().zip(y) {
                 *x += value * y;
             }
         }
@@ -600,14 +628,16 @@ fn forward_path(
     row: usize,
     work: &mut [f64],
     below: &mut Vec<f64>,
-) -> Vec<(usize, Vec<f64>)> {
-    let mut path = Vec::new();
+) -> Path {
+    let mut path = Path::default();
     work[row] = 1.0;
     let mut block = Some(factor.block_of(row));
     while let Some(b) = block {
         block = factor.forward_block(b, work, below);
         let segment = &mut work[factor.columns(b)];
-        path.push((b, segment.to_vec()));
+        path.blocks.push(b);
+        path.values.extend_from_slice(segment);
+        path.ends.push(path.values.len());
         segment.fill(0.0);
     }
     path
