@@ -142,11 +142,8 @@ impl Kernel {
                 let with_tangent = out.matrix.is_some();
                 let update = |q: usize| {
                     let point = &committed.points[4 * e + q];
-                    if with_tangent {
-                        body.material.update(point, &strains[q], context)
-                    } else {
-                        body.material.update_stress(point, &strains[q], context)
-                    }
+                    body.material
+                        .update_with(point, &strains[q], context, with_tangent)
                 };
                 // written out, not array::from_fn: whether that generic helper is inlined
                 // depends on how the build splits the crate, and out of line it moved the

@@ -170,18 +170,19 @@ impl Material {
         }
     }
 
-    /// `update` for a caller that reads no tangent (a residual): a plastic point of the
-    /// general condition skips its algorithmic moduli and carries the elastic ones in their
-    /// place. Stress and state are those of `update`, bit for bit. (Plane stress solves for
-    /// its out-of-plane strain with the tangent, so it keeps it.)
-    pub fn update_stress(
+    /// `update`, or (`tangent` false) for a caller that reads no tangent (a residual): a
+    /// plastic point of the general condition then skips its algorithmic moduli and carries
+    /// the elastic ones in their place. Stress and state are those of `update`, bit for bit.
+    /// (Plane stress solves for its out-of-plane strain with the tangent, so it keeps it.)
+    pub fn update_with(
         &self,
         committed: &PointState,
         strain: &Voigt,
         context: UpdateContext,
+        tangent: bool,
     ) -> Response {
         match context.condition {
-            StressCondition::General => self.general(committed, strain, context.dt, false),
+            StressCondition::General => self.general(committed, strain, context.dt, tangent),
             StressCondition::PlaneStress => self.update_plane_stress(committed, strain, context.dt),
         }
     }
@@ -543,7 +544,7 @@ mod plasticity_tests {
         }
     }
 
-    /// The residual's update (`update_stress`, no tangent) returns the stress and state of
+    /// The residual's update (`update_with`, no tangent) returns the stress and state of
     /// `update` bit for bit, plastic and elastic, in both conditions: the Newton iteration
     /// mixes the two within a step.
     #[test]
@@ -555,7 +556,7 @@ mod plasticity_tests {
                 Voigt::new(1e-5, 0.0, 0.0, 0.0),
             ] {
                 let full = m.update(&committed(), &strain, at(state));
-                let residual = m.update_stress(&committed(), &strain, at(state));
+                let residual = m.update_with(&committed(), &strain, at(state), false);
                 assert_eq!(full.stress, residual.stress);
                 assert_eq!(full.state, residual.state);
                 assert_eq!(full.plastic_work, residual.plastic_work);
