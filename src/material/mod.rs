@@ -304,6 +304,7 @@ impl Material {
     }
 
     /// Response of a rod to an axial strain increment over the time step `dt`.
+    #[inline]
     pub fn update_uniaxial(
         &self,
         committed: &PointState,
