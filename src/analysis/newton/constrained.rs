@@ -7,7 +7,7 @@ use crate::assembly::System;
 use crate::contact::Tangential;
 use crate::contact::linearization::Linearization;
 use crate::profile::{self, Phase};
-use crate::solver::Solver;
+use crate::solver::{Forward, Solver};
 use nalgebra::DVector;
 
 /// Active constraint rows restricted to the free DOFs, and their gaps (normal rows first,
@@ -266,14 +266,36 @@ pub(super) fn constrained_solve(
         }
     }
     profile::add(Phase::Contact, schur_start);
+    let delta = backward(
+        solver,
+        w,
+        secant,
+        projected_residual,
+        &projected_rows,
+        tau.iter(),
+    );
+    Ok((delta, tau.iter().copied().collect()))
+}
+
+/// The backward half of a constrained solve, plus the BFGS correction W M W^T of the whole
+/// load: `projected_residual` = W^T R (None without pairs) and `projected[i]` = W^T of the
+/// unit load that `loads[i]` scales.
+fn backward<'a>(
+    solver: &mut Solver,
+    w: Forward,
+    secant: &Secant,
+    projected_residual: Option<DVector<f64>>,
+    projected: &[DVector<f64>],
+    loads: impl Iterator<Item = &'a f64>,
+) -> Vec<f64> {
     let mut delta = solver.backward(w);
     if let Some(mut p) = projected_residual {
-        for (row, t) in projected_rows.iter().zip(tau.iter()) {
-            p.axpy(*t, row, 1.0);
+        for (row, f) in projected.iter().zip(loads) {
+            p.axpy(*f, row, 1.0);
         }
         secant.add_correction(&p, &mut delta);
     }
-    Ok((delta, tau.iter().copied().collect()))
+    delta
 }
 
 const REDUNDANT: &str = "the contact constraints are redundant (singular Schur complement)";
@@ -388,12 +410,6 @@ fn exact_solve(
         solver.add_unit(&mut w, *eq, *f);
     }
     profile::add(Phase::Contact, schur_start);
-    let mut delta = solver.backward(w);
-    if let Some(mut p) = projected_residual {
-        for (row, f) in w_at.iter().zip(load.iter()) {
-            p.axpy(*f, row, 1.0);
-        }
-        secant.add_correction(&p, &mut delta);
-    }
+    let delta = backward(solver, w, secant, projected_residual, &w_at, load.iter());
     Ok((delta, tau.iter().copied().collect()))
 }
