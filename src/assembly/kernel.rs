@@ -139,7 +139,8 @@ impl Kernel {
                 let condition = stress_condition(formulation);
                 let context = UpdateContext { condition, dt };
                 let fine = crate::profile::fine().then(Instant::now);
-                let with_tangent = out.matrix.is_some();
+                // the algorithmic moduli only where the matrix is asked for and made of them
+                let with_tangent = out.matrix.is_some() && !elastic_moduli;
                 let update = |q: usize| {
                     let point = &committed.points[4 * e + q];
                     body.material

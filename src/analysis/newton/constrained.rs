@@ -232,6 +232,8 @@ pub(super) fn constrained_solve(
             .collect(),
         None => Vec::new(),
     };
+    let weighted_rows: Vec<DVector<f64>> = projected_rows.iter().map(|r| secant.weigh(r)).collect();
+    let weighted_residual = projected_residual.as_ref().map(|p| secant.weigh(p));
     let schur = nalgebra::DMatrix::from_fn(m, m, |i, j| {
         let mut s = 0.0;
         for (a, ca) in &local[i] {
@@ -240,13 +242,13 @@ pub(super) fn constrained_solve(
             }
         }
         if projected_residual.is_some() {
-            s += secant.form(&projected_rows[i], &projected_rows[j]);
+            s += projected_rows[i].dot(&weighted_rows[j]);
         }
         s
     });
     let rhs = nalgebra::DVector::from_fn(m, |i, _| {
-        let secant_part = match &projected_residual {
-            Some(p) => secant.form(&projected_rows[i], p),
+        let secant_part = match &weighted_residual {
+            Some(mp) => projected_rows[i].dot(mp),
             None => 0.0,
         };
         -rows.gaps[i]
@@ -352,10 +354,12 @@ fn exact_solve(
         Some(_) => equations.iter().map(|eq| secant.row(*eq)).collect(),
         None => Vec::new(),
     };
+    let weighted_at: Vec<DVector<f64>> = w_at.iter().map(|r| secant.weigh(r)).collect();
+    let weighted_residual = projected_residual.as_ref().map(|p| secant.weigh(p));
     let z = DMatrix::from_fn(n, n, |i, j| {
         let h0 = solver.inverse_entry(local[i], local[j]);
         match &projected_residual {
-            Some(_) => h0 + secant.form(&w_at[i], &w_at[j]),
+            Some(_) => h0 + w_at[i].dot(&weighted_at[j]),
             None => h0,
         }
     });
@@ -392,8 +396,8 @@ fn exact_solve(
     let rhs = DVector::from_fn(n + m, |i, _| {
         if i < n {
             let h0r = solver.solution_entry(&w, equations[i]);
-            match &projected_residual {
-                Some(p) => h0r + secant.form(&w_at[i], p),
+            match &weighted_residual {
+                Some(mp) => h0r + w_at[i].dot(mp),
                 None => h0r,
             }
         } else {

@@ -14,7 +14,8 @@
 //! Factorization policy: `full` every iteration; otherwise the caller says whether the step
 //! starts with a fresh factorization, and the iteration refactors only when it stops
 //! contracting (||R_k|| > contraction ||R_k-1||) or when, at its current rate, it would need
-//! more than half of the iterations left to reach the force tolerance.
+//! more than half of the iterations left to reach the force tolerance. Between
+//! factorizations, `updates = "bfgs"` corrects the factored matrix by BFGS updates (`secant`).
 
 mod constrained;
 mod secant;

@@ -6,9 +6,9 @@
 //!     [ -R^-1                        0    ]     D = diag(s_i . y_i)
 //! ```
 //! s_i: a correction, y_i = R(d_i) - R(d_i + s_i) (what K* makes of it, from the residuals of
-//! the iterates), H_0 = K*^-1 of the current factorization. H_k maps y_i to s_i for every
-//! pair, so the iteration learns the part of the tangent the factor has gone stale on, for a
-//! back-substitution per pair. The contact solves need H_k only through products with the
+//! the iterates), H_0 = K*^-1 of the current factorization. Each update makes H_k map the
+//! latest y to its s, so the iteration learns the part of the tangent the factor has gone
+//! stale on, for a back-substitution per pair. The contact solves need H_k only through products with the
 //! few rows W has at the constrained equations, so W M W^T stays a correction beside the
 //! single back-substitution of H_0 (see `constrained_solve`).
 
@@ -124,9 +124,10 @@ impl Secant {
         )
     }
 
-    /// a^T M b for two projections.
-    pub fn form(&self, a: &DVector<f64>, b: &DVector<f64>) -> f64 {
-        a.dot(&(&self.middle * b))
+    /// M b for a projection b: a^T M b, an entry of the correction, is then a dot product,
+    /// and M b is formed once for all the a it meets.
+    pub fn weigh(&self, b: &DVector<f64>) -> DVector<f64> {
+        &self.middle * b
     }
 
     /// target += W M p for a projection p = W^T v: adds (H_k - H_0) v.
