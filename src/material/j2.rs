@@ -87,12 +87,12 @@ impl Radial {
 
 const SQRT_2_3: f64 = 0.816_496_580_927_726;
 
-fn norm(x: &Voigt) -> f64 {
-    (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + 2.0 * x[3] * x[3]).sqrt()
+fn squared_norm(x: &Voigt) -> f64 {
+    x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + 2.0 * x[3] * x[3]
 }
 
 fn deviator(s: &Voigt) -> Voigt {
-    let p = (s[0] + s[1] + s[2]) / 3.0;
+    let p = (s[0] + s[1] + s[2]) * (1.0 / 3.0);
     Voigt::new(s[0] - p, s[1] - p, s[2] - p, s[3])
 }
 
@@ -120,6 +120,7 @@ fn table_flow_stress(yield_stress: f64, points: &[[f64; 2]], eps_p: f64) -> (f64
 impl J2 {
     /// The flow stress of an increment from `start` with the equivalent plastic strain
     /// increment `dep`, and its slope d sigma_y / d dep.
+    #[inline]
     pub fn flow_stress(&self, start: &FlowStart, dep: f64) -> (f64, f64) {
         let eps_p = start.eq_plastic_strain + dep;
         match &self.hardening {
@@ -143,6 +144,7 @@ impl J2 {
     /// rate Newton does not see the rate term and overshoots; from there, on the convex g of
     /// the logarithm, it can fall back to 0.) Returns dl and the hardening slope at the
     /// solution.
+    #[inline]
     fn plastic_multiplier(&self, a: f64, b: f64, start: &FlowStart) -> (f64, f64) {
         if let Hardening::Linear { modulus } = self.hardening {
             let yield_stress = self.yield_stress + modulus * start.eq_plastic_strain;
@@ -189,15 +191,21 @@ impl J2 {
         let (n, dl, eta_norm) = (r.direction, r.multiplier, r.eta_norm);
         let c1 = 2.0 * mu / (2.0 * mu + 2.0 / 3.0 * (r.slope + self.kinematic_modulus));
         let c2 = 2.0 * mu * dl / eta_norm;
-        let nn = n * n.transpose();
-        let mut i_dev = Moduli::zeros();
-        for a in 0..3 {
-            for b in 0..3 {
-                i_dev[(a, b)] = if a == b { 2.0 / 3.0 } else { -1.0 / 3.0 };
+        // D_e - 2 mu [(c1 - c2) n n^T + c2 I_dev], entry by entry (symmetric)
+        let (a, b) = (2.0 * mu * (c1 - c2), 2.0 * mu * c2);
+        let mut d = *elastic;
+        for j in 0..4 {
+            for i in 0..4 {
+                let i_dev = match (i, j) {
+                    (3, 3) => 0.5,
+                    (3, _) | (_, 3) => 0.0,
+                    _ if i == j => 2.0 / 3.0,
+                    _ => -1.0 / 3.0,
+                };
+                d[(i, j)] -= a * n[i] * n[j] + b * i_dev;
             }
         }
-        i_dev[(3, 3)] = 0.5;
-        elastic - (nn * c1 + (i_dev - nn) * c2) * (2.0 * mu)
+        d
     }
 
     /// The radial return of a trial stress (plane strain, axisymmetric, the 3D update inside
@@ -208,11 +216,13 @@ impl J2 {
     pub fn radial(&self, trial: &Voigt, mu: f64, back: &Voigt, start: FlowStart) -> Option<Radial> {
         // dev of the difference: the pushed-forward back stress need not stay traceless
         let eta = deviator(&(trial - back));
-        let eta_norm = norm(&eta);
+        let eta_squared = squared_norm(&eta);
         let (sy, _) = self.flow_stress(&start, 0.0);
-        if (1.5f64).sqrt() * eta_norm - sy <= 0.0 {
+        // f = sqrt(3/2) ||eta|| - sigma_y <= 0 without the root (most points are elastic)
+        if sy >= 0.0 && 1.5 * eta_squared <= sy * sy {
             return None;
         }
+        let eta_norm = eta_squared.sqrt();
         let h_kin = self.kinematic_modulus;
         let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, &start);
         let n = eta / eta_norm;
@@ -359,7 +369,7 @@ mod tests {
         };
         let mu = 200.0 / 2.6;
         let shape = deviator(&Voigt::new(1.4, -0.3, 0.2, 0.6));
-        let shape = shape / (1.5 * norm(&shape).powi(2)).sqrt();
+        let shape = shape / (1.5 * squared_norm(&shape)).sqrt();
         let pressure = Voigt::new(-0.3, -0.3, -0.3, 0.0);
         for (eps_p, temperature, over) in
             itertools(&[0.0, 0.05], &[0.0, 0.5, 1.0], &[1.001, 1.1, 4.0])
@@ -377,7 +387,7 @@ mod tests {
                     // from the multiplier: eps_p,n+1 - eps_p,n would lose the digits of a
                     // tiny dep
                     let dep = SQRT_2_3 * r.multiplier;
-                    let mises = (1.5 * norm(&deviator(&r.stress)).powi(2)).sqrt();
+                    let mises = (1.5 * squared_norm(&deviator(&r.stress))).sqrt();
                     let expected = flow(eps_p + dep, dep / dt, temperature);
                     assert!(
                         (mises - expected).abs() <= 1e-12 * trial_mises,
