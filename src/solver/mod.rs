@@ -281,25 +281,45 @@ impl Path {
     }
 }
 
-/// y_a . y_b over the blocks both paths hold (their common ancestors): a merge of the two
-/// ascending paths.
+/// y_a . y_b over the blocks both paths hold, their common ancestors. Two paths to the root
+/// of a tree share a suffix: from the block where they meet up to the root they are the same
+/// blocks with segments of the same length, and below it they hold none in common. The
+/// suffix's length is found by bisection, and the sum runs over it alone, block by block in
+/// ascending order (a merge of the two paths adds the same products in the same order).
 fn path_dot(a: &Path, b: &Path) -> f64 {
-    let (mut i, mut j, mut sum) = (0, 0, 0.0);
-    while i < a.blocks.len() && j < b.blocks.len() {
-        match a.blocks[i].cmp(&b.blocks[j]) {
-            std::cmp::Ordering::Less => i += 1,
-            std::cmp::Ordering::Greater => j += 1,
-            std::cmp::Ordering::Equal => {
-                sum += a
-                    .segment(i)
-                    .iter()
-                    .zip(b.segment(j))
-                    .map(|(x, y)| x * y)
-                    .sum::<f64>();
-                i += 1;
-                j += 1;
-            }
+    let (na, nb) = (a.blocks.len(), b.blocks.len());
+    // the last l blocks agree for l <= common and differ for every longer l
+    let (mut common, mut beyond) = (0, na.min(nb) + 1);
+    while beyond - common > 1 {
+        let l = (common + beyond) / 2;
+        if a.blocks[na - l] == b.blocks[nb - l] {
+            common = l;
+        } else {
+            beyond = l;
         }
+    }
+    if common == 0 {
+        return 0.0;
+    }
+    let (ia, ib) = (na - common, nb - common);
+    let from = |p: &Path, k: usize| if k == 0 { 0 } else { p.ends[k - 1] };
+    let (sa, sb) = (from(a, ia), from(b, ib));
+    if a.values.len() - sa == common {
+        // single columns (a simplicial factor): the suffix is one contiguous run
+        let mut sum = 0.0;
+        for (x, y) in a.values[sa..].iter().zip(&b.values[sb..]) {
+            sum += x * y;
+        }
+        return sum;
+    }
+    let mut sum = 0.0;
+    for k in 0..common {
+        sum += a
+            .segment(ia + k)
+            .iter()
+            .zip(b.segment(ib + k))
+            .map(|(x, y)| x * y)
+            .sum::<f64>();
     }
     sum
 }
