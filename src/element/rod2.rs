@@ -33,15 +33,20 @@ fn b_vector(x: &[[f64; 2]; 2], d: &Vec4, length: f64, geometry: Strain) -> Vec4 
     Vec4::new(-dx[0], -dx[1], dx[0], dx[1]) / l2
 }
 
-/// Axial Green-Lagrange strain increment.
+/// Axial Green-Lagrange strain increment, (dX . du + 1/2 du . du) / L^2 (the linear part
+/// alone in linear kinematics). From L^2, not L: the material update that waits on the strain
+/// does not wait on a square root too.
 pub fn strain(x: &[[f64; 2]; 2], d: &Vec4, geometry: Strain) -> Result<f64, KernelError> {
-    let l = length(x)?;
-    let e = [(x[1][0] - x[0][0]) / l, (x[1][1] - x[0][1]) / l];
+    let dx = [x[1][0] - x[0][0], x[1][1] - x[0][1]];
+    let l2 = dx[0] * dx[0] + dx[1] * dx[1];
+    if !(l2 > 0.0) {
+        return Err(KernelError::ZeroLength);
+    }
     let du = [d[2] - d[0], d[3] - d[1]];
-    let linear = (e[0] * du[0] + e[1] * du[1]) / l;
+    let linear = (dx[0] * du[0] + dx[1] * du[1]) / l2;
     Ok(match geometry {
         Strain::Small => linear,
-        Strain::Finite => linear + 0.5 * (du[0] * du[0] + du[1] * du[1]) / (l * l),
+        Strain::Finite => linear + 0.5 * (du[0] * du[0] + du[1] * du[1]) / l2,
     })
 }
 
