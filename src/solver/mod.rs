@@ -250,12 +250,35 @@ impl TreeFactor<'_> {
 /// factorization, so an equation named later costs its own path and its dot products.
 #[derive(Default)]
 struct InverseEntries {
-    local: std::collections::HashMap<usize, usize>,
+    /// Per equation, its local index (`UNKNOWN` until named): a look-up for every entry a
+    /// contact solve reads, so an array over the equations (4 bytes a DOF) and no hashing.
+    local: Vec<u32>,
     equations: Vec<usize>,
     /// y_{equations[k]} along its path.
     paths: Vec<Path>,
     /// `lower[k][j]` = (K^-1)_{equations[k], equations[j]} for j <= k.
     lower: Vec<Vec<f64>>,
+}
+
+/// `InverseEntries::local` of an equation not named since the last factorization.
+const UNKNOWN: u32 = u32::MAX;
+
+impl InverseEntries {
+    fn local(&self, equation: usize) -> Option<usize> {
+        match self.local.get(equation) {
+            Some(&k) if k != UNKNOWN => Some(k as usize),
+            _ => None,
+        }
+    }
+
+    /// Forgets the entries (a new factorization); the index array is kept.
+    fn clear(&mut self) {
+        for eq in self.equations.drain(..) {
+            self.local[eq] = UNKNOWN;
+        }
+        self.paths.clear();
+        self.lower.clear();
+    }
 }
 
 /// y_a on the blocks of its elimination-tree path (ascending), the blocks' segments of y end
@@ -407,7 +430,7 @@ impl Solver {
         // the last factor's buffer is reused (one factor in memory at a time); it is left
         // empty, i.e. not factored, until the new factorization succeeds
         let mut factor = std::mem::take(&mut self.values);
-        self.inverse = InverseEntries::default();
+        self.inverse.clear();
         self.factorizations += 1;
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
@@ -452,7 +475,7 @@ impl Solver {
         let mut new: Vec<usize> = equations
             .iter()
             .copied()
-            .filter(|eq| !self.inverse.local.contains_key(eq))
+            .filter(|eq| self.inverse.local(*eq).is_none())
             .collect();
         new.sort_unstable();
         new.dedup();
@@ -479,7 +502,10 @@ impl Solver {
         };
         for (eq, path) in new.into_iter().zip(paths) {
             let k = self.inverse.equations.len();
-            self.inverse.local.insert(eq, k);
+            if self.inverse.local.len() < self.pattern.size {
+                self.inverse.local.resize(self.pattern.size, UNKNOWN);
+            }
+            self.inverse.local[eq] = k as u32;
             self.inverse.equations.push(eq);
             self.inverse.paths.push(path);
         }
@@ -498,7 +524,9 @@ impl Solver {
 
     /// The local index of an equation made known by `know_inverse`.
     pub fn inverse_local(&self, equation: usize) -> usize {
-        self.inverse.local[&equation]
+        self.inverse
+            .local(equation)
+            .expect("an equation named to know_inverse")
     }
 
     /// (K^-1)_{ab} for local indices a, b from `inverse_local`.
@@ -562,7 +590,7 @@ impl Solver {
 
     /// (K^-1 r)_eq for the w of r and an equation made known by `know_inverse`.
     pub fn solution_entry(&self, w: &Forward, equation: usize) -> f64 {
-        let path = &self.inverse.paths[self.inverse.local[&equation]];
+        let path = &self.inverse.paths[self.inverse_local(equation)];
         let factor = self.tree().expect("equations known: a factor at hand");
         path.segments()
             .map(|(block, y)| {
@@ -574,7 +602,7 @@ impl Solver {
 
     /// w += value y_eq: the backward solve then adds value K^-1 e_eq.
     pub fn add_unit(&self, w: &mut Forward, equation: usize, value: f64) {
-        let path = &self.inverse.paths[self.inverse.local[&equation]];
+        let path = &self.inverse.paths[self.inverse_local(equation)];
         let factor = self.tree().expect("equations known: a factor at hand");
         for (block, y) in path.segments() {
             for (x, y) in w.0[factor.columns(block)].iter_mut().zip(y) {

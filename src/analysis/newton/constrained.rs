@@ -30,6 +30,8 @@ pub(super) struct Exact {
     pub(super) gradient: Vec<(usize, f64)>,
     /// (equation p, equation q, d C_p / d x_q).
     pub(super) row_jacobian: Vec<(usize, usize, f64)>,
+    /// The equations either of the two names (once each).
+    pub(super) equations: Vec<usize>,
 }
 
 impl Exact {
@@ -44,19 +46,27 @@ impl Exact {
             .filter(|(_, v)| *v != 0.0)
             .collect();
         let mut row_jacobian = Vec::new();
+        let mut equations = Vec::new();
         for (p, i) in &dofs {
+            let Some(p) = p else { continue };
+            let mut named = l.gradient[*i] != 0.0;
             for (q, j) in &dofs {
-                if let (Some(p), Some(q)) = (p, q) {
+                if let Some(q) = q {
                     let v = l.row_jacobian[(*i, *j)];
                     if v != 0.0 {
                         row_jacobian.push((*p, *q, v));
                     }
+                    named |= v != 0.0 || l.row_jacobian[(*j, *i)] != 0.0;
                 }
+            }
+            if named {
+                equations.push(*p);
             }
         }
         Exact {
             gradient,
             row_jacobian,
+            equations,
         }
     }
 }
@@ -334,8 +344,7 @@ fn exact_solve(
         .map(|(eq, _)| *eq)
         .collect();
     for e in rows.exact.iter().flatten() {
-        equations.extend(e.gradient.iter().map(|(eq, _)| *eq));
-        equations.extend(e.row_jacobian.iter().flat_map(|(p, q, _)| [*p, *q]));
+        equations.extend(&e.equations);
     }
     equations.sort_unstable();
     equations.dedup();
@@ -363,7 +372,9 @@ fn exact_solve(
             None => h0,
         }
     });
-    let mut a = DMatrix::<f64>::zeros(n, n);
+    // A = sum_i tau_i dC_i/dx has a few entries a row (the slave's and its segment's
+    // equations): kept as (p, q, A_pq), so that Z A costs n per entry, not n^2 per column
+    let mut a: Vec<(usize, usize, f64)> = Vec::new();
     let mut c = DMatrix::<f64>::zeros(m, n);
     for (i, row) in rows.rows.iter().enumerate() {
         for (eq, v) in row.iter().filter(|(_, v)| *v != 0.0) {
@@ -377,18 +388,26 @@ fn exact_solve(
     for (i, exact) in rows.exact.iter().enumerate() {
         let Some(e) = exact else { continue };
         let tau = forces.get(i).copied().unwrap_or(0.0);
-        for (p, q, v) in &e.row_jacobian {
-            a[(at(*p), at(*q))] += tau * v;
-        }
+        a.extend(
+            e.row_jacobian
+                .iter()
+                .map(|(p, q, v)| (at(*p), at(*q), tau * v)),
+        );
         g.row_mut(i).fill(0.0);
         for (eq, v) in &e.gradient {
             g[(i, at(*eq))] += v;
         }
     }
     let mut system = DMatrix::<f64>::zeros(n + m, n + m);
-    system
-        .view_mut((0, 0), (n, n))
-        .copy_from(&(DMatrix::identity(n, n) - &z * &a));
+    // I - Z A, column q of Z A being the sum of A_pq Z[:, p]
+    for i in 0..n {
+        system[(i, i)] = 1.0;
+    }
+    for &(p, q, v) in &a {
+        for i in 0..n {
+            system[(i, q)] -= z[(i, p)] * v;
+        }
+    }
     system
         .view_mut((0, n), (n, m))
         .copy_from(&(-(&z * c.transpose())));
@@ -409,7 +428,10 @@ fn exact_solve(
         .solve(&rhs)
         .ok_or_else(|| StepFailure(REDUNDANT.into()))?;
     let (q, tau) = (solution.rows(0, n), solution.rows(n, m));
-    let load = c.transpose() * tau + a * q;
+    let mut load = c.transpose() * tau;
+    for &(p, q_, v) in &a {
+        load[p] += v * q[q_];
+    }
     for (eq, f) in equations.iter().zip(load.iter()) {
         solver.add_unit(&mut w, *eq, *f);
     }
