@@ -18,6 +18,7 @@ use crate::material::{
 };
 use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind};
+use nalgebra::Matrix2;
 use std::time::Instant;
 
 /// Where a kernel writes one element's results: slices of the caller's arrays, so a result
@@ -131,9 +132,14 @@ impl Kernel {
                     strain: geometry,
                     bbar,
                 };
-                let kinematics = quad4::Kinematics::new(&geom, &de, op);
+                // a residual without B-bar forms no operators (see quad4::Gradients)
+                let kinematics = if out.matrix.is_none() && !bbar {
+                    Points::Gradients(quad4::Gradients::new(&geom, &de, geometry))
+                } else {
+                    Points::Operators(quad4::Kinematics::new(&geom, &de, op))
+                };
                 if geometry == Strain::Finite {
-                    check_orientation(&kinematics)?;
+                    check_orientation(&kinematics.deformation())?;
                 }
                 let strains = kinematics.strains();
                 let condition = stress_condition(formulation);
@@ -156,9 +162,9 @@ impl Kernel {
                 let stress = responses.map(|r| r.stress);
                 let start = &committed.points[4 * e..4 * e + 4];
                 let (work, plastic_work) = quad_work(&geom, start, &strains, &responses);
-                let force = quad4::internal_force(&geom, &kinematics, &stress);
+                let force = kinematics.internal_force(&geom, &stress);
                 out.force.copy_from_slice(force.as_slice());
-                if let Some(m) = out.matrix {
+                if let (Some(m), Points::Operators(kinematics)) = (out.matrix, &kinematics) {
                     let moduli = if elastic_moduli {
                         [body.material.elastic.moduli(condition); 4]
                     } else {
@@ -411,14 +417,44 @@ fn stress_condition(formulation: Formulation) -> StressCondition {
 }
 
 /// det F > 0 at every Gauss point of the increment (the element does not turn inside out).
-fn check_orientation(kinematics: &quad4::Kinematics) -> Result<(), KernelError> {
-    for (point, (f, f_zz)) in kinematics.deformation().iter().enumerate() {
+fn check_orientation(deformation: &[(Matrix2<f64>, f64); 4]) -> Result<(), KernelError> {
+    for (point, (f, f_zz)) in deformation.iter().enumerate() {
         let det = f.determinant() * f_zz;
         if !(det > 0.0) {
             return Err(KernelError::NegativeJacobian { point, det });
         }
     }
     Ok(())
+}
+
+/// A Quad4 element's points: with their operators B (a tangent, B-bar), or their gradients
+/// alone (a residual).
+enum Points {
+    Operators(quad4::Kinematics),
+    Gradients(quad4::Gradients),
+}
+
+impl Points {
+    fn strains(&self) -> [Voigt; 4] {
+        match self {
+            Points::Operators(k) => k.strains(),
+            Points::Gradients(g) => g.strains(),
+        }
+    }
+
+    fn deformation(&self) -> [(Matrix2<f64>, f64); 4] {
+        match self {
+            Points::Operators(k) => k.deformation(),
+            Points::Gradients(g) => g.deformation(),
+        }
+    }
+
+    fn internal_force(&self, geom: &quad4::QuadValues, stress: &[Voigt; 4]) -> Vec8 {
+        match self {
+            Points::Operators(k) => quad4::internal_force(geom, k, stress),
+            Points::Gradients(g) => g.internal_force(geom, stress),
+        }
+    }
 }
 
 /// The increments of the internal work and of the plastic dissipation of a Quad4 element,

@@ -333,6 +333,7 @@ mod tests {
                     Some(Exact {
                         gradient,
                         row_jacobian,
+                        equations: vec![1, 3, 4],
                     }),
                     None,
                 ]
