@@ -108,8 +108,12 @@ pub fn values(
         if !(det > 0.0) {
             return Err(KernelError::NegativeJacobian { point: q, det });
         }
-        // J^-1 = [[j11 -j01] [-j10 j00]] / det
-        let inv = [[j11 / det, -j01 / det], [-j10 / det, j00 / det]];
+        // J^-1 = [[j11 -j01] [-j10 j00]] / det (one division, four products)
+        let inv_det = 1.0 / det;
+        let inv = [
+            [j11 * inv_det, -j01 * inv_det],
+            [-j10 * inv_det, j00 * inv_det],
+        ];
         let p = &mut points[q];
         for i in 0..4 {
             // dN/dX_a = dN/dxi_b (J^-1)_ba
