@@ -487,11 +487,11 @@ impl Solver {
         };
         let start = std::time::Instant::now();
         let inverse_perm = self.permutation().map(|p| p.arrays().1);
-        let path = |(work, below): &mut (Vec<f64>, Vec<f64>), eq: usize| {
+        let path = |(work, below, grown): &mut (Vec<f64>, Vec<f64>, Path), eq: usize| {
             let row = inverse_perm.map_or(eq, |inv| inv[eq] as usize);
-            forward_path(factor, row, work, below)
+            forward_path(factor, row, work, below, grown)
         };
-        let scratch = || (vec![0.0; self.pattern.size], Vec::new());
+        let scratch = || (vec![0.0; self.pattern.size], Vec::new(), Path::default());
         let paths: Vec<Path> = if new.len() >= PARALLEL_PATHS_FROM {
             new.par_iter()
                 .map_init(scratch, |s, &eq| path(s, eq))
@@ -670,14 +670,18 @@ pub struct Forward(Vec<f64>);
 /// y = L^-1 e_row along the elimination-tree path from `row`'s block (supernode, or column
 /// of a simplicial factor) to the root, as (block, its segment of y) in path order: the
 /// forward solve's block steps on that path only (e_row is zero before it). `work` is zero
-/// on entry and on return; `below` is scratch.
+/// on entry and on return; `below` and `path` are scratch: the path is grown there (its
+/// length is not known before the walk) and returned as a copy of its exact size.
 fn forward_path(
     factor: TreeFactor<'_>,
     row: usize,
     work: &mut [f64],
     below: &mut Vec<f64>,
+    path: &mut Path,
 ) -> Path {
-    let mut path = Path::default();
+    path.blocks.clear();
+    path.ends.clear();
+    path.values.clear();
     work[row] = 1.0;
     let mut block = Some(factor.block_of(row));
     while let Some(b) = block {
@@ -688,7 +692,11 @@ fn forward_path(
         path.ends.push(path.values.len());
         segment.fill(0.0);
     }
-    path
+    Path {
+        blocks: path.blocks.clone(),
+        ends: path.ends.clone(),
+        values: path.values.clone(),
+    }
 }
 
 #[cfg(test)]
