@@ -78,6 +78,7 @@ pub struct Elastic {
 }
 
 impl Elastic {
+    #[inline]
     pub fn lame(&self) -> (f64, f64) {
         let (e, nu) = (self.young, self.poisson);
         (
@@ -88,6 +89,7 @@ impl Elastic {
 
     /// Elastic moduli; in plane stress the condensed in-plane moduli with the zz row and
     /// column zero.
+    #[inline]
     pub fn moduli(&self, state: StressCondition) -> Moduli {
         let (lambda, mu) = self.lame();
         let lambda = match state {

@@ -407,13 +407,15 @@ impl Step<'_> {
             let ma = inertia.mass.product(self.model, &a);
             inertia_norm = norm(&ma);
             let [a_r, b_r] = inertia.rayleigh;
-            let mv = if a_r > 0.0 {
-                inertia.mass.product(self.model, &v)
+            if a_r > 0.0 {
+                let mv = inertia.mass.product(self.model, &v);
+                for (t, (m_a, m_v)) in total.iter_mut().zip(ma.iter().zip(&mv)) {
+                    *t += m_a + a_r * m_v;
+                }
             } else {
-                vec![0.0; v.len()]
-            };
-            for (t, (m_a, m_v)) in total.iter_mut().zip(ma.iter().zip(&mv)) {
-                *t += m_a + a_r * m_v;
+                for (t, m_a) in total.iter_mut().zip(&ma) {
+                    *t += m_a;
+                }
             }
             if let Some(dm) = damping {
                 let v_free = system.gather(&v);
@@ -429,11 +431,10 @@ impl Step<'_> {
                     .for_each(|(t, k)| *t += b_r * k);
             }
         }
-        let mut residual = system.gather(self.external);
-        residual
-            .iter_mut()
-            .zip(system.gather(&total))
-            .for_each(|(r, t)| *r -= t);
+        for (t, f) in total.iter_mut().zip(self.external) {
+            *t = f - *t;
+        }
+        let residual = system.gather(&total);
         (residual, external_norm.max(internal_norm).max(inertia_norm))
     }
 }
