@@ -84,10 +84,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 pub fn write_atomic_parts(path: &Path, parts: &[impl AsRef<[u8]>]) -> Result<(), OutputError> {
     use std::io::Write;
     let tmp = temporary_path(path);
-    let written = fs::File::create(&tmp).and_then(|mut file| {
+    // through a buffer: a frame comes as ~50 parts of a few kB, and a system call each was
+    // most of the writer thread's time on a small mesh
+    let written = fs::File::create(&tmp).and_then(|file| {
+        let mut file = std::io::BufWriter::with_capacity(1 << 16, file);
         parts
             .iter()
-            .try_for_each(|part| file.write_all(part.as_ref()))
+            .try_for_each(|part| file.write_all(part.as_ref()))?;
+        file.flush()
     });
     written.map_err(|e| {
         let _ = fs::remove_file(&tmp);
