@@ -197,8 +197,16 @@ impl Material {
     #[inline(always)]
     fn general(&self, committed: &PointState, strain: &Voigt, dt: f64, tangent: bool) -> Response {
         let moduli = self.elastic.moduli(StressCondition::General);
-        let trial = committed.stress + moduli * strain;
-        let (_, mu) = self.elastic.lame();
+        // D_e dE from the Lame constants (the same moduli, fewer products than D_e's 16)
+        let (lambda, mu) = self.elastic.lame();
+        let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
+        let trial = committed.stress
+            + Voigt::new(
+                volumetric + 2.0 * mu * strain[0],
+                volumetric + 2.0 * mu * strain[1],
+                volumetric + 2.0 * mu * strain[2],
+                mu * strain[3],
+            );
         let plastic = self.plasticity.as_ref().and_then(|j2| {
             j2.radial(
                 &trial,
