@@ -148,7 +148,7 @@ impl Kernel {
                 let strains = kinematics.strains();
                 let condition = stress_condition(formulation);
                 let context = UpdateContext { condition, dt };
-                let fine = crate::profile::fine().then(Instant::now);
+                let fine = crate::profile::fine_sample(e).then(Instant::now);
                 // the algorithmic moduli only where the matrix is asked for and made of them
                 let with_tangent = out.matrix.is_some() && !elastic_moduli;
                 let update = |q: usize| {
