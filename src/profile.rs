@@ -66,7 +66,7 @@ const SAMPLE: usize = 8;
 
 /// Whether element `element` is one the fine profile times (see `add_constitutive`).
 pub fn fine_sample(element: usize) -> bool {
-    element % SAMPLE == 0 && fine()
+    element.is_multiple_of(SAMPLE) && fine()
 }
 
 /// Adds the time since `start` of a sampled element (`fine_sample`), scaled by the sample's

@@ -174,7 +174,7 @@ impl Kernel {
                     } else {
                         responses.map(|r| r.moduli)
                     };
-                    let k = quad4::tangent(&geom, &kinematics, &stress, &moduli, op, geometric);
+                    let k = quad4::tangent(&geom, kinematics, &stress, &moduli, op, geometric);
                     m.copy_from_slice(k.transpose().as_slice()); // row-major
                 }
                 for (t, r) in out.trial.iter_mut().zip(&responses) {
@@ -432,7 +432,9 @@ fn check_orientation(deformation: &[(Matrix2<f64>, f64); 4]) -> Result<(), Kerne
 }
 
 /// A Quad4 element's points: with their operators B (a tangent, B-bar), or their gradients
-/// alone (a residual).
+/// alone (a residual). It lives on the stack for one element, so the larger variant is not
+/// boxed (a heap allocation an element would cost more than the unused bytes).
+#[allow(clippy::large_enum_variant)]
 enum Points {
     Operators(quad4::Kinematics),
     Gradients(quad4::Gradients),
