@@ -136,12 +136,7 @@ impl Kernel {
                     strain: geometry,
                     bbar,
                 };
-                // a residual without B-bar forms no operators (see quad4::Gradients)
-                let kinematics = if out.matrix.is_none() && !bbar {
-                    Points::Gradients(quad4::Gradients::new(&geom, &de, geometry))
-                } else {
-                    Points::Operators(quad4::Kinematics::new(&geom, &de, op))
-                };
+                let kinematics = Points::new(&geom, &de, op, out.matrix.is_some());
                 if geometry == Strain::Finite {
                     check_orientation(&kinematics.deformation())?;
                 }
@@ -441,6 +436,17 @@ enum Points {
 }
 
 impl Points {
+    /// The operators where a matrix is asked or B-bar changes them; a residual without B-bar
+    /// forms none (see quad4::Gradients).
+    #[inline(always)]
+    fn new(geom: &quad4::QuadValues, de: &Vec8, op: quad4::Operator, matrix: bool) -> Points {
+        if matrix || op.bbar {
+            Points::Operators(quad4::Kinematics::new(geom, de, op))
+        } else {
+            Points::Gradients(quad4::Gradients::new(geom, de, op.strain))
+        }
+    }
+
     fn strains(&self) -> [Voigt; 4] {
         match self {
             Points::Operators(k) => k.strains(),
