@@ -326,10 +326,12 @@ impl Recorder {
     }
 
     pub fn write_summary(&self, summary: &Summary) -> Result<(), OutputError> {
-        // every frame on disk and listed before the summary says how the run ended
+        // every frame and row on disk (and the frames listed) before the summary says how
+        // the run ended
         if let Some(series) = &self.series {
             series.flush()?;
         }
+        self.history.flush()?;
         let path = self.dir.join("summary.json");
         let file = SummaryFile {
             summary,
