@@ -102,8 +102,8 @@ impl Kernel {
     /// the time step `dt` from the committed state, into `out`; with `tangent`, its matrix.
     #[allow(clippy::too_many_arguments)]
     // inlined into the assembly's element loop, whose kernel is fixed for a body: the rod
-    // loop then runs without the Quad4 arm's frame (the 224-rod bars 0.92x, the Quad4
-    // scenes 0.99-1.0x)
+    // loop then runs without the Quad4 arm's frame (the 224-rod bars 0.90x, the Quad4
+    // scenes 0.97-1.0x)
     #[inline(always)]
     pub fn evaluate(
         &self,
