@@ -30,7 +30,7 @@ pub(super) struct Exact {
     pub(super) gradient: Vec<(usize, f64)>,
     /// (equation p, equation q, d C_p / d x_q).
     pub(super) row_jacobian: Vec<(usize, usize, f64)>,
-    /// The equations either of the two names (once each).
+    /// The equations the gradient or the row Jacobian names, each once.
     pub(super) equations: Vec<usize>,
 }
 
@@ -429,8 +429,8 @@ fn exact_solve(
         .ok_or_else(|| StepFailure(REDUNDANT.into()))?;
     let (q, tau) = (solution.rows(0, n), solution.rows(n, m));
     let mut load = c.transpose() * tau;
-    for &(p, q_, v) in &a {
-        load[p] += v * q[q_];
+    for &(p, column, v) in &a {
+        load[p] += v * q[column];
     }
     for (eq, f) in equations.iter().zip(load.iter()) {
         solver.add_unit(&mut w, *eq, *f);
