@@ -500,11 +500,11 @@ impl Solver {
             let mut s = scratch();
             new.iter().map(|&eq| path(&mut s, eq)).collect()
         };
+        if self.inverse.local.len() < self.pattern.size {
+            self.inverse.local.resize(self.pattern.size, UNKNOWN);
+        }
         for (eq, path) in new.into_iter().zip(paths) {
             let k = self.inverse.equations.len();
-            if self.inverse.local.len() < self.pattern.size {
-                self.inverse.local.resize(self.pattern.size, UNKNOWN);
-            }
             self.inverse.local[eq] = k as u32;
             self.inverse.equations.push(eq);
             self.inverse.paths.push(path);

@@ -199,6 +199,10 @@ pub(super) fn constrained_solve(
     forces: &[f64],
     secant: &Secant,
 ) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
+    if rows.exact.iter().any(Option::is_some) {
+        // before W^T R is formed: the exact solve forms its own
+        return exact_solve(solver, rows, residual, forces, secant);
+    }
     let m = rows.rows.len();
     let projected_residual = (!secant.is_empty()).then(|| secant.project(&residual));
     if m == 0 {
@@ -208,9 +212,6 @@ pub(super) fn constrained_solve(
             secant.add_correction(p, &mut delta);
         }
         return Ok((delta, Vec::new()));
-    }
-    if rows.exact.iter().any(Option::is_some) {
-        return exact_solve(solver, rows, residual, forces, secant);
     }
     // entries with a zero coefficient, as the x entry of a row on a horizontal wall, are
     // left out: they would cost a path each for nothing
