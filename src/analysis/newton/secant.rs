@@ -12,6 +12,7 @@
 //! few rows W has at the constrained equations, so W M W^T stays a correction beside the
 //! single back-substitution of H_0 (see `constrained_solve`).
 
+use super::norm;
 use crate::solver::Solver;
 use nalgebra::{DMatrix, DVector};
 
@@ -160,10 +161,6 @@ fn middle(r: &DMatrix<f64>, yhy: &DMatrix<f64>) -> DMatrix<f64> {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn norm(v: &[f64]) -> f64 {
-    dot(v, v).sqrt()
 }
 
 #[cfg(test)]
