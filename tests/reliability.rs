@@ -2,7 +2,9 @@
 //!
 //! Each test compares a stopped-and-resumed run with an uninterrupted one of the same scene
 //! (same `analysis.checkpoint_every`): history.csv, the .pvd and every frame must be equal
-//! byte for byte.
+//! byte for byte, and summary.json in every field but the timings (the contact's peak
+//! force, first contact and last release, gaps and penetration, the energy drift, counters,
+//! step cuts and warnings would show a state reset or counted twice at the resume).
 
 mod common;
 
@@ -89,8 +91,32 @@ fn run_killed_and_resumed(name: &str, text: &str, overrides: &[&str], halt: usiz
     dir
 }
 
-/// history.csv, the .pvd and every listed frame, byte-equal.
+/// summary.json without what measures the machine (`wall_seconds`, `timing`).
+fn summary_without_timings(dir: &Path) -> serde_json::Value {
+    let path = dir.join("summary.json");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let object = json.as_object_mut().expect("summary.json is an object");
+    for key in ["wall_seconds", "timing"] {
+        assert!(object.remove(key).is_some(), "summary.json has `{key}`");
+    }
+    json
+}
+
+/// history.csv, the .pvd and every listed frame byte-equal; summary.json equal in every
+/// field but the timings.
 fn assert_same_output(a: &Path, b: &Path, name: &str) {
+    let (summary_a, summary_b) = (summary_without_timings(a), summary_without_timings(b));
+    if let Some(fields) = summary_a.as_object() {
+        for (key, value) in fields {
+            assert_eq!(
+                Some(value),
+                summary_b.get(key),
+                "{name}: summary.json `{key}` differs"
+            );
+        }
+    }
+    assert_eq!(summary_a, summary_b, "{name}: summary.json differs");
     let read = |p: PathBuf| std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     let history = read(a.join("history.csv"));
     assert!(
@@ -260,6 +286,125 @@ set = "all"
     let full = run_full(name, text, &[]);
     let resumed = run_killed_and_resumed(name, text, &[], 33);
     assert_same_output(&full, &resumed, name);
+}
+
+/// Goal: the state each implicit integrator carries besides Newmark's (Wilson-theta's end
+/// velocity as its Newton start, HHT's and generalized-alpha's force and acceleration
+/// history) and Rayleigh damping's matrix survive a checkpoint taken while the block is on
+/// the floor. Setup: PLASTIC_BLOCK (J2, Coulomb friction; Wilson-theta without it: with it
+/// the theta-extrapolated step inverts an element at t = 0.105), checkpoints every 20
+/// steps, killed at step 37; the block lands at step 11-16 and is on the floor at the
+/// checkpoint of step 20.
+/// Reference: the uninterrupted run, every output byte for byte, summary.json field by field.
+#[test]
+fn implicit_integrators_and_damping_resume_bit_identically() {
+    let every = "analysis.checkpoint_every=20";
+    for (name, text, set) in [
+        (
+            "plastic_block_wilson",
+            frictionless(),
+            vec!["analysis.integrator=wilson", every],
+        ),
+        (
+            "plastic_block_hht",
+            PLASTIC_BLOCK.to_string(),
+            vec!["analysis.integrator=hht", every],
+        ),
+        (
+            "plastic_block_generalized_alpha",
+            PLASTIC_BLOCK.to_string(),
+            vec!["analysis.integrator=generalized_alpha", every],
+        ),
+        (
+            "plastic_block_rayleigh",
+            PLASTIC_BLOCK.to_string(),
+            vec!["analysis.rayleigh=[0.5, 1.0e-4]", every],
+        ),
+    ] {
+        let full = run_full(name, &text, &set);
+        assert_in_contact_at(&full, name, 20);
+        let resumed = run_killed_and_resumed(name, &text, &set, 37);
+        assert_same_output(&full, &resumed, name);
+    }
+}
+
+/// Goal: the contact treatments in time resume bit-identically: velocity-level persistency
+/// (the closed pairs' committed velocities) and mass redistribution (the massless contact
+/// nodes' mass matrix), on PLASTIC_BLOCK without friction (neither treatment takes it),
+/// checkpoints every 20 steps, killed at 37, in contact at the checkpoint of step 20.
+#[test]
+fn persistency_and_mass_redistribution_resume_bit_identically() {
+    let text = frictionless();
+    for (name, treatment) in [
+        ("plastic_block_persistency", "persistency"),
+        ("plastic_block_redistribution", "mass_redistribution"),
+    ] {
+        let set = [
+            format!("analysis.contact_dynamics={treatment}"),
+            "analysis.checkpoint_every=20".to_string(),
+        ];
+        let set: Vec<&str> = set.iter().map(String::as_str).collect();
+        let full = run_full(name, &text, &set);
+        assert_in_contact_at(&full, name, 20);
+        let resumed = run_killed_and_resumed(name, &text, &set, 37);
+        assert_same_output(&full, &resumed, name);
+    }
+}
+
+/// Goal: two-pass contact between two deformable bodies (the pair and its `:reverse` twin,
+/// each with its own active set) resumes bit-identically, implicit and explicit; and so does
+/// an axisymmetric body (its hoop terms and ring areas in the contact rows). Setup:
+/// models/round_bar.toml with `two_pass = true`, checkpoint every 40 steps, killed at 90
+/// (the bar rests on the block from the start to past step 150); PLASTIC_BLOCK as an
+/// axisymmetric ring (inner radius 0.5), checkpoints every 20 steps, killed at 37.
+#[test]
+fn two_pass_and_axisymmetric_contact_resume_bit_identically() {
+    let bar = std::fs::read_to_string("models/round_bar.toml").unwrap();
+    let set = [
+        "contact.tip.two_pass=true",
+        "analysis.checkpoint_every=40",
+        "output.frame_times=[]",
+    ];
+    let explicit = [
+        &set[..],
+        &["analysis.integrator=central_difference", "analysis.dt=auto"],
+    ]
+    .concat();
+    for (name, set) in [
+        ("round_bar_two_pass", &set[..]),
+        ("round_bar_two_pass_explicit", &explicit[..]),
+    ] {
+        let full = run_full(name, &bar, set);
+        assert_in_contact_at(&full, name, 80);
+        let resumed = run_killed_and_resumed(name, &bar, set, 90);
+        assert_same_output(&full, &resumed, name);
+    }
+
+    let ring = PLASTIC_BLOCK
+        .replace("\"plane_strain\"", "\"axisymmetric\"")
+        .replace("origin = [0.0, 0.02]", "origin = [0.5, 0.02]");
+    let name = "plastic_ring";
+    let set = ["analysis.checkpoint_every=20"];
+    let full = run_full(name, &ring, &set);
+    assert_in_contact_at(&full, name, 20);
+    let resumed = run_killed_and_resumed(name, &ring, &set, 37);
+    assert_same_output(&full, &resumed, name);
+}
+
+/// The uninterrupted run in `dir` carried a contact force at step `step` (its row `step`
+/// of history.csv): the checkpoint written there holds a closed contact.
+fn assert_in_contact_at(dir: &Path, name: &str, step: usize) {
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let header = text.lines().next().unwrap();
+    let force = header
+        .split(',')
+        .find(|h| h.starts_with("contact_force["))
+        .unwrap_or_else(|| panic!("{name}: no contact force column"));
+    let column = common::column(dir, force);
+    assert!(
+        column[step].abs() > 0.0,
+        "{name}: no contact force at step {step}"
+    );
 }
 
 /// Goal: `impact resume` refuses a folder without a checkpoint with exit 2, naming the file.
