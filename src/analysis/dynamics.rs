@@ -670,3 +670,74 @@ impl Stepper for Dynamics<'_> {
         self.last_step
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::spec::MassKind;
+
+    /// A 4 x 2 block (density 2) 1 mm above a clamped 6 x 2 one, the upper block's bottom
+    /// edge the slave surface and the lower block's top edge the master.
+    const STACK: &str = r#"
+[[material]]
+name = "m"
+young = 100.0
+poisson = 0.3
+density = 2.0
+
+[[body]]
+name = "upper"
+material = "m"
+formulation = "plane_strain"
+velocity = [0.0, -1.0]
+mesh = { type = "rectangle", origin = [0.5, 0.001], width = 2.0, height = 1.0, nx = 4, ny = 2 }
+
+[[body]]
+name = "lower"
+material = "m"
+formulation = "plane_strain"
+mesh = { type = "rectangle", origin = [0.0, -1.0], width = 3.0, height = 1.0, nx = 6, ny = 2 }
+
+[[support]]
+body = "lower"
+set = "bottom"
+fix = ["x", "y"]
+
+[[contact]]
+name = "stack"
+slave = { body = "upper", set = "bottom" }
+master = { body = "lower", set = "top" }
+
+[analysis]
+type = "dynamic"
+contact_dynamics = "mass_redistribution"
+dt = 0.01
+end_time = 0.1
+"#;
+
+    /// Goal: under `mass_redistribution` the nodes of both contact surfaces carry no mass
+    /// and each body keeps its own. Setup: STACK. Reference (by hand): the slave nodes are
+    /// the upper block's five at y = 0.001, the master nodes the lower block's seven at
+    /// y = 0; the bodies weigh rho A = 2 x 2 x 1 = 4 and 2 x 3 x 1 = 6 (per unit depth).
+    /// Tolerance 1e-13: sums of 8 and 12 element masses of O(1).
+    #[test]
+    fn mass_redistribution_leaves_both_contact_surfaces_massless() {
+        let model = crate::scene::from_str(STACK, Path::new("stack.toml"), &[]).unwrap();
+        let mass = Mass::new(&model, MassKind::Consistent)
+            .unwrap()
+            .redistributed(&model, &contact_nodes(&model));
+        let coords = model.coordinates();
+        for (body, surface_y, nodes_on_surface, total) in [(0, 0.001, 5, 4.0), (1, 0.0, 7, 6.0)] {
+            let b = &model.bodies[body];
+            let nodes = b.node_offset..b.node_offset + b.mesh.nodes.len();
+            let on_surface = nodes.clone().filter(|n| coords[*n][1] == surface_y);
+            assert_eq!(on_surface.clone().count(), nodes_on_surface);
+            for n in on_surface {
+                assert_eq!(mass.lumped[2 * n], 0.0, "node {n} of body {body}");
+                assert_eq!(mass.lumped[2 * n + 1], 0.0, "node {n} of body {body}");
+            }
+            let carried: f64 = nodes.map(|n| mass.lumped[2 * n]).sum();
+            assert!((carried - total).abs() < 1e-13, "body {body}: {carried}");
+        }
+    }
+}

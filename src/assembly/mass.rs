@@ -193,3 +193,123 @@ fn redistribute(m: &mut [f64], nn: usize, flagged: &[bool]) {
         m[i * nn + i] += (total - kept) * rows[i] / weight;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// Two unit squares side by side (density 3, plane strain: mass per unit depth), and a
+    /// lone square to the right of them whose lower-left node alone is flagged below.
+    const SQUARES: &str = r#"
+[[material]]
+name = "m"
+young = 1.0
+poisson = 0.25
+density = 3.0
+
+[[body]]
+name = "pair"
+material = "m"
+formulation = "plane_strain"
+mesh = { type = "rectangle", width = 2.0, height = 1.0, nx = 2, ny = 1 }
+
+[[body]]
+name = "lone"
+material = "m"
+formulation = "plane_strain"
+mesh = { type = "rectangle", origin = [5.0, 0.0], width = 1.0, height = 1.0, nx = 1, ny = 1 }
+
+[analysis]
+type = "dynamic"
+dt = 0.1
+end_time = 1.0
+"#;
+
+    /// The consistent mass of a unit square with density 3 between its nodes at `a` and
+    /// `b` (by hand: rho A / 36 times 4 on the diagonal, 2 along an edge, 1 across).
+    fn square(a: [f64; 2], b: [f64; 2]) -> f64 {
+        let differ = (a[0] != b[0]) as usize + (a[1] != b[1]) as usize;
+        3.0 / 36.0 * [4.0, 2.0, 1.0][differ]
+    }
+
+    /// Goal: `Mass::redistributed` leaves the flagged nodes massless, keeps every element's
+    /// mass, and moves the removed mass onto the other nodes' diagonals in proportion to
+    /// their row sums (Khenous, Laborde & Renard 2008).
+    /// Setup: SQUARES with the nodes at y = 0 of the pair and the lone square's node at
+    /// (5, 0) flagged: each square of the pair loses two adjacent nodes, the lone one one.
+    /// Reference (by hand from the closed-form square matrix rho A / 36 [4 2 1 2; ...] with
+    /// rho A = 3): a pair square keeps [4 2; 2 4] / 12 (sum 1), its removed 2 goes half and
+    /// half (equal row sums 3/4) onto the two top diagonals: [16 2; 2 16] / 12, rows 3/2
+    /// each; the pair's top corners carry 3/2, its top middle node 3. The lone square keeps
+    /// the 3 x 3 block (sum 22 / 12), its removed 14 / 12 goes in thirds (equal row sums)
+    /// onto the three diagonals: 38 / 36 at the node across, 35 / 36 beside. Tolerance 1e-14:
+    /// sums of a few O(1) numbers.
+    #[test]
+    fn redistributed_mass_leaves_flagged_nodes_massless_and_keeps_element_totals() {
+        let model = crate::scene::from_str(SQUARES, Path::new("squares.toml"), &[]).unwrap();
+        let coords = model.coordinates();
+        let flagged: Vec<bool> = coords
+            .iter()
+            .map(|p| p[1] == 0.0 && (p[0] < 3.0 || p[0] == 5.0))
+            .collect();
+        assert_eq!(flagged.iter().filter(|f| **f).count(), 4);
+        let mass = Mass::new(&model, MassKind::Consistent)
+            .unwrap()
+            .redistributed(&model, &flagged);
+        for (b, body) in model.bodies.iter().enumerate() {
+            for e in 0..body.elements() {
+                let nodes: Vec<usize> = body
+                    .mesh
+                    .cells
+                    .nodes_of(e)
+                    .iter()
+                    .map(|n| body.global(*n))
+                    .collect();
+                let m = &mass.elements[b][e * 16..(e + 1) * 16];
+                let kept: Vec<bool> = nodes.iter().map(|n| !flagged[*n]).collect();
+                let removed: f64 = (0..4)
+                    .flat_map(|i| (0..4).map(move |j| (i, j)))
+                    .filter(|(i, j)| !kept[*i] || !kept[*j])
+                    .map(|(i, j)| square(coords[nodes[i]], coords[nodes[j]]))
+                    .sum();
+                let share = removed / kept.iter().filter(|k| **k).count() as f64;
+                for i in 0..4 {
+                    for j in 0..4 {
+                        let expected = if !kept[i] || !kept[j] {
+                            0.0
+                        } else {
+                            square(coords[nodes[i]], coords[nodes[j]])
+                                + if i == j { share } else { 0.0 }
+                        };
+                        assert!(
+                            (m[4 * i + j] - expected).abs() < 1e-14,
+                            "body {b} element {e} entry ({i}, {j}): {} vs {expected}",
+                            m[4 * i + j]
+                        );
+                    }
+                }
+                let total: f64 = m.iter().sum();
+                assert!((total - 3.0).abs() < 1e-14, "element total {total}");
+            }
+        }
+        for (node, p) in coords.iter().enumerate() {
+            let expected = match (flagged[node], p[0] < 3.0, p[0]) {
+                (true, _, _) => 0.0,
+                (false, true, 1.0) => 3.0,
+                (false, true, _) => 1.5,
+                // the lone square: a kept row (8 / 36 across from the flagged node, 7 / 36
+                // beside it, times 3) plus its third of 14 / 12
+                (false, false, _) if p == &[6.0, 1.0] => 38.0 / 36.0,
+                (false, false, _) => 35.0 / 36.0,
+            };
+            for dof in [2 * node, 2 * node + 1] {
+                assert!(
+                    (mass.lumped[dof] - expected).abs() < 1e-14,
+                    "node {node} at {p:?}: {} vs {expected}",
+                    mass.lumped[dof]
+                );
+            }
+        }
+    }
+}
