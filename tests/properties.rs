@@ -349,3 +349,135 @@ proptest! {
         prop_assert!(bound <= 16.0 * exact, "bound {bound} far above {exact}");
     }
 }
+
+/// One elastic element (E = 1, rho = 1) of `formulation`, run explicit with `quadrature`
+/// (`reduced` with hourglass coefficient `kappa`, or `full`), its nodes moved to `x`.
+fn one_element_model(
+    x: &Coords,
+    formulation: &str,
+    quadrature: &str,
+    nu: f64,
+    kappa: f64,
+) -> impact::scene::Model {
+    let text = format!(
+        r#"
+[[material]]
+name = "m"
+young = 1.0
+poisson = {nu}
+density = 1.0
+
+[[body]]
+name = "element"
+material = "m"
+formulation = "{formulation}"
+mesh = {{ type = "rectangle", origin = [1.0, 0.0], width = 1.0, height = 1.0, nx = 1, ny = 1 }}
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+quadrature = "{quadrature}"
+{hourglass}
+end_time = 1.0
+"#,
+        hourglass = if quadrature == "reduced" {
+            format!("hourglass = {kappa}")
+        } else {
+            String::new()
+        }
+    );
+    let mut model =
+        impact::scene::from_str(&text, std::path::Path::new("element.toml"), &[]).unwrap();
+    let body = &mut model.bodies[0];
+    let cell: Vec<usize> = body.mesh.cells.nodes_of(0).to_vec();
+    for (a, n) in cell.iter().enumerate() {
+        body.mesh.nodes[*n] = x[a];
+    }
+    model
+}
+
+/// A fresh explicit kernel of `model`'s quadrature on its initial (stress-free) state.
+fn explicit_kernel(
+    model: &impact::scene::Model,
+    quadrature: &str,
+    kappa: f64,
+) -> Box<dyn impact::assembly::explicit::ExplicitKernel> {
+    use impact::assembly::explicit::{Full, Reduced};
+    let state = impact::assembly::State::initial(model);
+    let masses = impact::assembly::ElementMasses::new(model).unwrap();
+    if quadrature == "reduced" {
+        Box::new(Reduced::new(model, &state, kappa, &masses))
+    } else {
+        Box::new(Full::new(model, &state, &masses))
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Goal: the stable step that the explicit run takes is safe for the kernel that runs:
+    /// each explicit kernel's frequency bound is not below the highest frequency of that
+    /// kernel's own force, on distorted and crushed elements of every formulation.
+    /// Setup: one elastic element (random convex shape squashed along y down to 1e-3,
+    /// placed 1e-3 to 10 widths from the axis), plane strain, plane stress or axisymmetric,
+    /// the one-point kernel (kappa 0 to 1) or the 2x2 rate-form kernel, nu 0 to 0.499.
+    /// Reference: the largest eigenvalue of M^-1 K with K the kernel's linearized force,
+    /// by central differences of its one-step force from the stress-free state (a fresh
+    /// kernel for each of the 16 perturbed steps, size 1e-7 of the shortest edge: the
+    /// force is linear to O(h^2 / L^2) = 1e-14 and round-off is relative), M the lumped
+    /// mass the run uses. The bound must not be below it (1e-6: the differences' error)
+    /// and, to stay useful, not above 16 times it.
+    #[test]
+    fn explicit_kernel_frequency_bound_exceeds_the_kernel_frequency(
+        (x, _) in crushed_quad(),
+        nu in 0.0f64..0.499,
+        kappa in 0.0f64..1.0,
+        form in 0usize..3,
+        reduced: bool,
+    ) {
+        let formulation = ["plane_strain", "plane_stress", "axisymmetric"][form];
+        let quadrature = if reduced { "reduced" } else { "full" };
+        let model = one_element_model(&x, formulation, quadrature, nu, kappa);
+        let positions = model.coordinates();
+        let edge = (0..4)
+            .map(|a| {
+                let (p, q) = (x[a], x[(a + 1) % 4]);
+                (q[0] - p[0]).hypot(q[1] - p[1])
+            })
+            .fold(f64::INFINITY, f64::min);
+        let h = 1e-7 * edge;
+        let cell: Vec<usize> = model.bodies[0].mesh.cells.nodes_of(0).to_vec();
+        let dofs = model.dofs();
+        let force_at = |dof: usize, sign: f64| -> Vec<f64> {
+            let mut kernel = explicit_kernel(&model, quadrature, kappa);
+            let mut du = vec![0.0; dofs];
+            du[dof] = sign * h;
+            let mut force = vec![0.0; dofs];
+            kernel.step(&positions, &du, 1.0, &mut force).unwrap();
+            force
+        };
+        let mut k = Mat8::zeros();
+        for (a, node) in cell.iter().enumerate() {
+            for i in 0..2 {
+                let (plus, minus) = (force_at(2 * node + i, 1.0), force_at(2 * node + i, -1.0));
+                for (c, other) in cell.iter().enumerate() {
+                    for j in 0..2 {
+                        k[(2 * c + j, 2 * a + i)] =
+                            (plus[2 * other + j] - minus[2 * other + j]) / (2.0 * h);
+                    }
+                }
+            }
+        }
+        let lumped_all = impact::assembly::Mass::new(&model, impact::scene::spec::MassKind::Lumped)
+            .unwrap()
+            .lumped;
+        let lumped: [f64; 4] = std::array::from_fn(|a| lumped_all[2 * cell[a]]);
+        let exact = max_frequency_squared(&k, &lumped);
+        let bound = explicit_kernel(&model, quadrature, kappa)
+            .frequency_bound(&positions)
+            .unwrap()
+            .omega_squared;
+        prop_assert!(bound >= exact * (1.0 - 1e-6), "{formulation} {quadrature}: bound {bound} below {exact}");
+        prop_assert!(bound <= 16.0 * exact, "{formulation} {quadrature}: bound {bound} far above {exact}");
+    }
+}
