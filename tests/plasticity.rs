@@ -325,7 +325,7 @@ fn plate_with_hole_plane_stress_converges() {
 /// strategies on the consistent tangent, and modified with Erklig's elastic tangent (the
 /// initial-stress method proper, which needs many iterations near the limit: 400 allowed),
 /// and the initial-stress method with BFGS updates within the default 30 iterations (without
-/// them it stops `diverged` at 0.8 p_lim).
+/// them it stops `diverged` after t = 0.8 of the ramp to 0.98 p_lim, i.e. at 0.78 p_lim).
 /// Reference: the full-Newton bore displacement; agreement within 1e-6 relative (the
 /// convergence tolerances are 1e-8).
 #[test]
