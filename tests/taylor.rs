@@ -13,11 +13,11 @@ use std::path::Path;
 /// results (VMC8: 1.067 to 1.078 times the experiment), in metres.
 const EXPERIMENT: f64 = 13.19e-3;
 const MANUAL: [f64; 2] = [14.07e-3, 14.22e-3];
-const L0: f64 = 23.47e-3;
-const R0: f64 = 3.81e-3;
 
-/// The final length (the top of the axis) and impact-face radius (its outer node) of a run
-/// of the scene with a mesh of `nx` x `6 nx` quads and `quadrature`.
+/// The final length and impact-face radius of a run of the scene with a mesh of `nx` x
+/// `6 nx` quads and `quadrature`: the extent of the rod's current shape (top minus lowest
+/// point, the largest radius). The rod leaves the contact wall before the end (at 34-36 us,
+/// its face 0.2 to 1.2 mm above the wall at 45 us), so the top's height is not its length.
 fn taylor(nx: usize, quadrature: &str) -> (f64, f64, f64) {
     let name = format!("taylor_{quadrature}_{nx}");
     let overrides = [
@@ -28,10 +28,26 @@ fn taylor(nx: usize, quadrature: &str) -> (f64, f64, f64) {
     ];
     let model = impact::scene::load(Path::new("models/taylor_aluminum.toml"), &overrides).unwrap();
     let dir = common::out_dir(&name);
-    let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();
-    let last = |c: &str| *column(&dir, c).last().unwrap();
-    let length = L0 + last("u_y[top_axis]");
-    let radius = R0 + last("u_x[foot_edge]");
+    let (summary, state) =
+        impact::analysis::run_to_state(&model, &dir, Default::default()).unwrap();
+    let current: Vec<[f64; 2]> = model
+        .coordinates()
+        .iter()
+        .enumerate()
+        .map(|(n, p)| {
+            [
+                p[0] + state.displacement[2 * n],
+                p[1] + state.displacement[2 * n + 1],
+            ]
+        })
+        .collect();
+    let (low, high) = current
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p[1]), h.max(p[1]))
+        });
+    let length = high - low;
+    let radius = current.iter().map(|p| p[0]).fold(0.0, f64::max);
     println!(
         "{name}: L_f = {:.3} mm, R_f = {:.3} mm, {} steps, dt {:.2e}..{:.2e}, {:.2} s",
         length * 1e3,
@@ -47,33 +63,49 @@ fn taylor(nx: usize, quadrature: &str) -> (f64, f64, f64) {
 /// Goal: the Taylor bar converges under refinement and lands where bilinear models land.
 /// Setup: models/taylor_aluminum.toml, 5 x 30 and 10 x 60 quads with the one-point kernel,
 /// 5 x 30 with the 2x2 B-bar kernel (the 20 x 120 meshes are in the study below and in
-/// docs/validation.md: too slow for the suite). References:
-/// - convergence: the final length changes by less than 1 % between the two meshes
-///   (measured 0.1 %; 0.3 % between 10 x 60 and 20 x 120, and 0.02 % for the 2x2 kernel);
-/// - the two kernels agree within 1.5 % on the final length (measured 0.4 %) and 5 % on the
-///   impact-face radius (measured 3 %: the one-point foot is softer at its edge);
-/// - the experiment, 13.19 mm: a bilinear model without rate effects overpredicts it; the
-///   manual's own finite-element results are 6.7 % to 7.8 % long, and ours are asserted
-///   within 10 % (measured 9.0 % to 9.4 %) and within 2.5 % of the manual's 14.07-14.22 mm
-///   (measured +1.1 % to +1.5 % above its upper end).
+/// docs/validation.md: too slow for the suite). References and the reasoning of each band:
+/// - convergence: the final length changes by less than 1 % between the two meshes (the
+///   criterion of the mesh study; measured 0.10 %);
+/// - VMC8's finite-element results, 14.07 to 14.22 mm: bilinear models of the same shot
+///   that differ from each other by 0.15 mm (1.1 %), their choice of element, contact and
+///   step. Ours is one more such model, so it may lie that far beyond either end: the band
+///   is [14.07 - 0.15, 14.22 + 0.15] mm. Measured 14.262 (5 x 30), 14.248 (10 x 60),
+///   14.224 mm (2x2), the length being the extent of the final shape (the rod has left the
+///   wall). The experiment (13.19 mm) is no band for a model without rate hardening
+///   (VMC8's own results are 6.7 % to 7.8 % long); the band's lower end lies above it, so
+///   "longer than the experiment" is not asserted separately;
+/// - the two kernels on the same mesh are two discretizations of the same model: their final
+///   lengths agree within VMC8's spread, 0.15 / 14.07 = 1.07 % (measured 0.27 %);
+/// - the impact-face radius: neither docs/validation.md nor src/reference has a published
+///   radius for this shot (Wilkins & Guinan and VMC8 are quoted for the length only), so it
+///   is checked for convergence, not against a reference: the two kernels' radii differ by
+///   their discretization errors on 5 x 30, which must lie within the first-order estimate
+///   of the one-point kernel's error there, twice its change under one halving, 2 |R(10 x
+///   60) - R(5 x 30)| (first order, the conservative choice for a radius set by the foot's
+///   edge; measured: kernels 0.280 mm apart, the estimate 0.460 mm).
 #[test]
 fn taylor_aluminum_converges_and_lands_with_the_bilinear_models() {
     let (coarse, coarse_r, _) = taylor(5, "reduced");
-    let (fine, _, _) = taylor(10, "reduced");
+    let (fine, fine_r, _) = taylor(10, "reduced");
     let (full, full_r, _) = taylor(5, "full");
     assert!((fine / coarse - 1.0).abs() < 0.01, "{coarse} -> {fine}");
-    assert!((full / coarse - 1.0).abs() < 0.015, "{full} vs {coarse}");
+    let spread = MANUAL[1] - MANUAL[0];
     assert!(
-        (full_r / coarse_r - 1.0).abs() < 0.05,
-        "{full_r} vs {coarse_r}"
+        (full / coarse - 1.0).abs() < spread / MANUAL[0],
+        "{full} vs {coarse}"
     );
+    let (low, high) = (MANUAL[0] - spread, MANUAL[1] + spread);
     for length in [coarse, fine, full] {
         assert!(
-            length > EXPERIMENT && length < 1.10 * EXPERIMENT,
-            "{length}"
+            length > low && length < high,
+            "{length} not in [{low}, {high}]"
         );
-        assert!(length > MANUAL[0] && length < 1.025 * MANUAL[1], "{length}");
     }
+    let estimate = 2.0 * (fine_r - coarse_r).abs();
+    assert!(
+        (full_r - coarse_r).abs() < estimate,
+        "kernels {full_r} vs {coarse_r}, error estimate {estimate}"
+    );
 }
 
 /// The study of docs/validation.md (not run by default: about two minutes): three meshes,
@@ -88,9 +120,10 @@ fn taylor_aluminum_mesh_study() {
             .map(|&nx| taylor(nx, quadrature).0)
             .collect();
         println!(
-            "{quadrature}: changes {:.2} %, {:.2} %",
+            "{quadrature}: changes {:.2} %, {:.2} %; finest {:+.1} % from the experiment",
             100.0 * (lengths[1] / lengths[0] - 1.0),
-            100.0 * (lengths[2] / lengths[1] - 1.0)
+            100.0 * (lengths[2] / lengths[1] - 1.0),
+            100.0 * (lengths[2] / EXPERIMENT - 1.0)
         );
         assert!((lengths[2] / lengths[1] - 1.0).abs() < 0.01);
     }
@@ -140,37 +173,96 @@ fn deviations(finals: &[f64; 4], reference: &[f64; 4]) -> [f64; 4] {
     std::array::from_fn(|k| finals[k] / reference[k] - 1.0)
 }
 
+/// The names of [L_f, D_f, T, eps_p] in messages.
+const NAMES: [&str; 4] = ["L_f", "D_f", "T", "eps_p"];
+
+/// The band the published values give a third code on the authors' mesh, per quantity: the
+/// interval between DynELA and Abaqus widened on each side by their difference (two codes
+/// of the same model on the same mesh differ by that much, so a third may lie that far
+/// beyond either) and by half a unit of the last printed digit (0.005 for each quantity).
+/// L_f [26.475, 26.605] mm, D_f [11.135, 11.175] mm, T [573.7, 599.6] C, eps_p [1.745,
+/// 1.845].
+fn reference_band(k: usize) -> (f64, f64) {
+    let (low, high) = (DYNELA[k].min(ABAQUS[k]), DYNELA[k].max(ABAQUS[k]));
+    let widen = (high - low) + 0.005;
+    (low - widen, high + widen)
+}
+
+/// Asserts `finals[k]` inside the reference band of each k of `which`, widened by
+/// `error[k]` either side.
+fn assert_in_bands(run: &str, finals: &[f64; 4], which: &[usize], error: &[f64; 4]) {
+    for &k in which {
+        let (low, high) = reference_band(k);
+        let (low, high) = (low - error[k], high + error[k]);
+        assert!(
+            finals[k] >= low && finals[k] <= high,
+            "{run}: {} = {} outside [{low}, {high}]",
+            NAMES[k],
+            finals[k]
+        );
+    }
+}
+
 /// Goal: the explicit Johnson-Cook Taylor impact lands on the published results.
 /// Setup: models/taylor_jc.toml as it ships (5 x 50, 2x2 B-bar like DynELA's ElQua4NAx,
-/// automatic stable step), then the one-point kernel on the same mesh.
-/// Reference: Abaqus/Explicit and DynELA (above). Bands: L_f and D_f within 0.5 %, T and eps_p
-/// within 3 % of Abaqus (the goal; measured -0.11 %, -0.11 %, -0.19 %, -0.15 %; DynELA and
-/// Abaqus themselves differ by 0.15 %, 0.09 %, 1.5 %, 1.7 %). The one-point kernel (kappa 0.1)
-/// gets L_f within 0.5 % (measured 0.0 %) but a narrower foot and a cooler, less strained axis
-/// element: D_f within 6 % (measured -5.1 %), eps_p within 20 % (measured -15 %); they converge
-/// towards the 2x2 values under refinement (docs/validation.md).
+/// automatic stable step), then the one-point kernel (kappa 0.1) on the same mesh and on the
+/// mesh twice as fine (10 x 100).
+/// Reference: DynELA and Abaqus/Explicit on the 5 x 50 mesh, in the bands of
+/// `reference_band` (the references' own spread; not the measured values). The 2x2 run on
+/// their mesh must lie in them (measured 26.530 mm, 11.148 mm, 589.8 C, 1.807: -0.11 %,
+/// -0.11 %, -0.19 %, -0.15 % from Abaqus). D_f, T and eps_p are asserted on the published
+/// mesh only: under one halving they move by more than their bands (docs/validation.md 10.2:
+/// +0.65 %, +3.0 %, +3.7 %; the last two are values of an element that shrinks into the
+/// corner of axis and wall, not converged quantities); L_f moves by 0.06 %, inside its band.
+/// The one-point kernel's L_f lies in the same band (its change under halving, 0.13 %, is
+/// inside it; measured 26.560 mm). Its foot is under-resolved with one point per element
+/// five elements across: D_f, T and eps_p are not in the bands on this mesh (measured
+/// 10.593 mm, 516.2 C, 1.541). Its known error there is its discretization error, estimated
+/// to first order (strains and what follows from them converge as h) by twice its change
+/// under one halving, 2 |x(10 x 100) - x(5 x 50)|: the 5 x 50 values must lie in the bands
+/// widened by that estimate (measured estimates 0.82 mm, 133 C, 0.48), and the 10 x 100
+/// values nearer the references than the 5 x 50 ones (measured 11.003 mm, 582.5 C, 1.780).
 #[test]
 fn taylor_jc_explicit_matches_abaqus() {
     let (full, summary) = taylor_jc("taylor_jc_full", &[]);
     assert_eq!(summary.status, impact::analysis::Status::Ok);
-    let d = deviations(&full, &ABAQUS);
-    assert!(d[0].abs() < 0.005 && d[1].abs() < 0.005, "{d:?}");
-    assert!(d[2].abs() < 0.03 && d[3].abs() < 0.03, "{d:?}");
-    let dynela = deviations(&full, &DYNELA);
-    assert!(dynela.iter().all(|x| x.abs() < 0.03), "{dynela:?}");
+    assert_in_bands("2x2 5 x 50", &full, &[0, 1, 2, 3], &[0.0; 4]);
+    println!("2x2 against Abaqus: {:?}", deviations(&full, &ABAQUS));
     let (reduced, _) = taylor_jc("taylor_jc_reduced", &["analysis.quadrature=reduced"]);
-    let d = deviations(&reduced, &ABAQUS);
-    assert!(d[0].abs() < 0.005, "{d:?}");
-    assert!(d[1].abs() < 0.06 && d[3].abs() < 0.20, "{d:?}");
+    assert_in_bands("one-point 5 x 50", &reduced, &[0], &[0.0; 4]);
+    let (finer, _) = taylor_jc(
+        "taylor_jc_reduced_10",
+        &[
+            "analysis.quadrature=reduced",
+            "body.rod.mesh.nx=10",
+            "body.rod.mesh.ny=100",
+        ],
+    );
+    let estimate: [f64; 4] = std::array::from_fn(|k| 2.0 * (finer[k] - reduced[k]).abs());
+    println!("one-point first-order error estimates: {estimate:?}");
+    assert_in_bands("one-point 5 x 50", &reduced, &[1, 2, 3], &estimate);
+    for k in 1..4 {
+        let middle = 0.5 * (DYNELA[k] + ABAQUS[k]);
+        assert!(
+            (finer[k] - middle).abs() < (reduced[k] - middle).abs(),
+            "{}: {} -> {}",
+            NAMES[k],
+            reduced[k],
+            finer[k]
+        );
+    }
 }
 
 /// Goal: implicit Newmark (average acceleration, modified Newton, B-bar 2x2) survives the
 /// crushed foot and lands where the explicit run does.
 /// Setup: models/taylor_jc.toml with `integrator = "average"`, dt = 1e-7 s (800 steps; about
 /// 2.5 times the explicit stable step at the start, 10 times the smallest one at the end).
-/// Reference: Abaqus/Explicit within the bands of the explicit test (measured -0.35 %,
-/// +0.25 %, +0.55 %, +0.6 %) and the explicit run of the same mesh within 1 % on L_f and D_f
-/// (measured -0.23 %, +0.36 %); no step is cut at this dt.
+/// Reference: the explicit run of the same mesh within 1 % on L_f and D_f (the accuracy
+/// docs/validation.md 10.3 asks of an implicit step against the explicit one; measured
+/// -0.23 %, +0.36 %); with the explicit run inside the reference bands (the test above),
+/// this bounds L_f and D_f against the references too, and they are not asserted again.
+/// T and eps_p of the axis element in the reference bands of the explicit test, on the same
+/// mesh (measured 594.2 C, 1.821). No step is cut at this dt.
 #[test]
 fn taylor_jc_implicit_average_lands_with_the_explicit_run() {
     let (implicit, summary) = taylor_jc(
@@ -179,9 +271,7 @@ fn taylor_jc_implicit_average_lands_with_the_explicit_run() {
     );
     assert_eq!(summary.status, impact::analysis::Status::Ok);
     assert_eq!(summary.step_cuts, 0);
-    let d = deviations(&implicit, &ABAQUS);
-    assert!(d[0].abs() < 0.005 && d[1].abs() < 0.005, "{d:?}");
-    assert!(d[2].abs() < 0.03 && d[3].abs() < 0.03, "{d:?}");
+    assert_in_bands("implicit 5 x 50", &implicit, &[2, 3], &[0.0; 4]);
     let (explicit, _) = taylor_jc("taylor_jc_explicit_for_average", &[]);
     let d = deviations(&implicit, &explicit);
     assert!(d[0].abs() < 0.01 && d[1].abs() < 0.01, "{d:?}");
