@@ -30,7 +30,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// Bumped whenever a stored type changes: an old checkpoint is refused, not misread.
 /// 2: material points carry a temperature, the explicit carry its clock.
 /// 4: the implicit dynamic carry holds the last step's mean velocity (the predictor).
-const FORMAT: u32 = 4;
+/// 5: the explicit clock keeps the range of the steps it set apart from the clipped ones.
+const FORMAT: u32 = 5;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -8,10 +8,14 @@
 //! dt_bound     2 / sqrt(max_e omega^2_e): a stable step (Irons: the assembled model's
 //!              highest frequency is at most the elements')
 //! auto         h = scale dt_bound, ended early at a listed frame time or the end time
+//!              (a clipped step: shorter than the rule's by more than 1e-9 h)
 //! fixed        h = dt; stopped (status `unstable`) when dt > c dt_bound, c the ratio of the
 //!              initial element-eigenvalue limit to the initial dt_bound (so the first check
-//!              is the exact one, and the later ones follow the elements as they deform)
+//!              is the exact one, and the later ones follow the elements as they deform);
+//!              the last step ends at the end time (clipped when shorter than dt)
 //! ```
+//! The shortest and the longest step (summary.json `dt_min`, `dt_max`) are over the steps
+//! the rule set: a clipped step says where a frame or the end fell, not what the mesh needed.
 
 use super::Status;
 use super::run::StepError;
@@ -49,8 +53,28 @@ pub struct Clock {
     calibration: f64,
     /// The stable step of the committed configuration (the bound's, unscaled).
     pub limit: Limit,
-    /// The last step taken, the shortest and the longest (0 before the first).
+    /// The last step taken (0 before the first).
     pub last: f64,
+    /// The shortest and the longest step the rule set (clipped steps not counted).
+    shortest: f64,
+    longest: f64,
+    /// The shortest and the longest step taken, clipped ones included.
+    shortest_taken: f64,
+    longest_taken: f64,
+}
+
+/// A step of the clock: where it ends, its length, and whether it was clipped (ended early
+/// at a frame time or the end time, shorter than the rule's step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Step {
+    pub end: f64,
+    pub length: f64,
+    pub clipped: bool,
+}
+
+/// The shortest and the longest step of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepRange {
     pub shortest: f64,
     pub longest: f64,
 }
@@ -85,17 +109,19 @@ impl Clock {
             last: 0.0,
             shortest: f64::INFINITY,
             longest: 0.0,
+            shortest_taken: f64::INFINITY,
+            longest_taken: 0.0,
         }
     }
 
-    /// The end time and length of step number `step` from `time`, or why it cannot be taken.
+    /// Step number `step` from `time`, or why it cannot be taken.
     pub fn next(
         &self,
         model: &Model,
         spec: &DynamicSpec,
         time: f64,
         step: usize,
-    ) -> Result<(f64, f64), StepError> {
+    ) -> Result<Step, StepError> {
         let limit = self.calibration * self.limit.dt;
         let element = || {
             format!(
@@ -120,7 +146,12 @@ impl Clock {
                     });
                 }
                 let end = super::snap(step as f64 * dt, dt).min(spec.end_time);
-                Ok((end, super::step_length(end - time, dt)))
+                let length = super::step_length(end - time, dt);
+                Ok(Step {
+                    end,
+                    length,
+                    clipped: length < dt,
+                })
             }
             Rule::Auto { scale, min } => {
                 let h = scale * limit;
@@ -147,21 +178,46 @@ impl Clock {
                     .find(|t| *t > time * (1.0 + 1e-12))
                     .unwrap_or(f64::INFINITY);
                 let stop = spec.end_time.min(next_frame);
-                let mut end = (time + h).min(stop);
-                if stop - end <= 1e-9 * h {
-                    end = stop;
-                }
-                Ok((end, end - time))
+                let full = time + h;
+                let end = if stop - full <= 1e-9 * h { stop } else { full };
+                Ok(Step {
+                    end,
+                    length: end - time,
+                    clipped: full - stop > 1e-9 * h,
+                })
             }
         }
     }
 
-    /// A step of length `h` was taken; `bound` is that of the new configuration.
-    pub fn took(&mut self, h: f64, bound: FrequencyBound) {
+    /// `step` was taken; `bound` is that of the new configuration.
+    pub fn took(&mut self, step: Step, bound: FrequencyBound) {
+        let h = step.length;
         self.last = h;
-        self.shortest = self.shortest.min(h);
-        self.longest = self.longest.max(h);
+        if !step.clipped {
+            self.shortest = self.shortest.min(h);
+            self.longest = self.longest.max(h);
+        }
+        self.shortest_taken = self.shortest_taken.min(h);
+        self.longest_taken = self.longest_taken.max(h);
         self.limit = Limit::of(bound);
+    }
+
+    /// The shortest and the longest step the rule set; the steps taken when every step was
+    /// clipped (an end time or frames closer than one stable step). None before the first.
+    pub fn range(&self) -> Option<StepRange> {
+        if self.longest > 0.0 {
+            Some(StepRange {
+                shortest: self.shortest,
+                longest: self.longest,
+            })
+        } else if self.longest_taken > 0.0 {
+            Some(StepRange {
+                shortest: self.shortest_taken,
+                longest: self.longest_taken,
+            })
+        } else {
+            None
+        }
     }
 
     /// A fixed step above the limit of the committed configuration (the run was allowed to

@@ -367,7 +367,8 @@ impl Stepper for Explicit<'_> {
     fn advance(&mut self, _: &mut Counters) -> Result<(), StepError> {
         let (model, spec) = (self.model, self.spec);
         let step = self.step + 1;
-        let (time, h) = self.clock.next(model, spec, self.state.time, step)?;
+        let clock_step = self.clock.next(model, spec, self.state.time, step)?;
+        let (time, h) = (clock_step.end, clock_step.length);
         predict(&self.v, &self.a, h, &mut self.v_half, &mut self.du);
         for (dof, value) in loads::prescribed(model, &self.initial, time) {
             self.du[dof] = value - self.state.displacement[dof];
@@ -421,7 +422,7 @@ impl Stepper for Explicit<'_> {
         }
         self.energy_reference = self.energy_reference.max(energies.external_work.abs());
         self.step = step;
-        self.clock.took(h, bound);
+        self.clock.took(clock_step, bound);
         Ok(())
     }
 
@@ -486,9 +487,10 @@ impl Stepper for Explicit<'_> {
     }
     fn time_step_report(&self) -> Option<TimeStepReport> {
         let c = &self.clock;
-        (self.step > 0).then(|| TimeStepReport {
-            shortest: c.shortest,
-            longest: c.longest,
+        let range = c.range()?;
+        Some(TimeStepReport {
+            shortest: range.shortest,
+            longest: range.longest,
             limit: DtLimit {
                 dt: c.limit.dt,
                 body: self.model.bodies[c.limit.body].name.clone(),

@@ -138,7 +138,8 @@ pub struct Summary {
     pub contact: ContactSummary,
     pub energy: EnergySummary,
     pub buckling: Option<BucklingSummary>,
-    /// Central difference: the shortest and the longest step taken.
+    /// Central difference: the shortest and the longest step the step rule set (steps
+    /// clipped to a frame time or the end time not counted).
     pub dt_min: Option<f64>,
     pub dt_max: Option<f64>,
     /// Central difference: the stable step of the final configuration and the element that

@@ -55,6 +55,8 @@ impl StepError {
 /// The steps a central-difference run took and what limits them at the end.
 #[derive(Debug, Clone)]
 pub struct TimeStepReport {
+    /// The shortest and the longest step the step rule set (`Clock::range`: steps clipped to
+    /// a frame time or the end time are not counted).
     pub shortest: f64,
     pub longest: f64,
     pub limit: DtLimit,
