@@ -474,10 +474,12 @@ fn ring_wall_return_coefficient_lies_between_its_limits() {
 /// Setup: the scene as shipped: a 20 x 10 mm plane-strain J2 steel block at V = 50 m/s,
 /// 0.05 mm from a rigid wall, central difference with the automatic step, 12 us.
 /// Reference: first contact at gap / V = 1 us (to within one step: contact is detected at
-/// step ends; steps are about 0.13 us); Newton's second law for the block: the wall is the
-/// only external force and the internal forces cancel, so the sum of force x step length over
-/// the rows (the forward-increment multiplier is the step's impulse) equals p_x(0) - p_x(end),
-/// to 1e-9 relative (round-off over some 140 steps); p_x(0) = rho A V = 7850 x 2e-4 x 50 =
+/// step ends; steps are about 0.09 us); Newton's second law for the block: the wall is the
+/// only external force and the internal forces cancel, so the sum of force x the time it
+/// stands for over the rows (dt on a row after one without force, where the face closes at
+/// once; (dt_prev + dt) / 2 on the others) equals p_x(0) - p_x(end), to 1e-5 relative (a
+/// slave joining the closed face stands for dt alone: measured 8e-7);
+/// p_x(0) = rho A V = 7850 x 2e-4 x 50 =
 /// 78.5 kg m/s per metre; the impact stress rho c V = 2.4 GPa is far above sigma_y = 250 MPa,
 /// so plastic work > 0.
 #[test]
@@ -502,11 +504,20 @@ fn steel_block_wall_contact_time_impulse_and_yield() {
     let force = column(&r.dir, "contact_force[wall]");
     let dt = column(&r.dir, "dt");
     let momentum = column(&r.dir, "p_x[all]");
-    let impulse: f64 = force.iter().zip(&dt).map(|(f, h)| f * h).sum();
+    let impulse: f64 = (1..force.len())
+        .map(|k| {
+            let span = if force[k - 1] == 0.0 {
+                dt[k]
+            } else {
+                0.5 * (dt[k - 1] + dt[k])
+            };
+            force[k] * span
+        })
+        .sum();
     let (p0, p_end) = (momentum[0], *momentum.last().unwrap());
     approx::assert_relative_eq!(p0, 7850.0 * 0.02 * 0.01 * 50.0, max_relative = 1e-12);
     assert!(
-        (impulse - (p0 - p_end)).abs() < 1e-9 * p0,
+        (impulse - (p0 - p_end)).abs() < 1e-5 * (p0 - p_end),
         "impulse {impulse} vs momentum lost {}",
         p0 - p_end
     );

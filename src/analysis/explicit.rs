@@ -177,12 +177,13 @@ impl<'a> Explicit<'a> {
     /// The contact correction of the predicted increment (forward-increment multipliers).
     fn contact_correction(&mut self, h: f64, time: f64) {
         let positions = self.state.positions(self.spec.geometry);
-        let correction = self.contact.explicit_step(
+        let step = self.contact.explicit_step(
             &self.interfaces,
             &positions,
             &self.du,
             &self.inverse_mass,
             h,
+            self.clock.last,
             time,
         );
         (
@@ -190,15 +191,14 @@ impl<'a> Explicit<'a> {
             self.v_half.par_chunks_mut(DOF_CHUNK),
         )
             .into_par_iter()
-            .zip(correction.par_chunks(DOF_CHUNK))
+            .zip(step.correction.par_chunks(DOF_CHUNK))
             .for_each(|((du, v_half), correction)| {
                 for ((du, v), c) in du.iter_mut().zip(v_half).zip(correction) {
                     *du += c;
                     *v += c / h;
                 }
             });
-        let force = self.contact.nodal_forces(&self.model.contacts, &positions);
-        self.energies.contact_work -= chunked_sum(&force, &self.du, |f, u| f * u);
+        self.energies.contact_work -= chunked_sum(&step.step_force, &self.du, |f, u| f * u);
     }
 
     /// The internal force at u_{n+1} (a step of length `h`), the committed element state and

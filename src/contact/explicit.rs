@@ -1,19 +1,46 @@
 //! Explicit contact: forward-increment Lagrange multipliers on the lumped mass (Carpenter,
 //! Taylor & Katona 1991), in the velocity-Verlet form of central difference.
+//!
+//! Legend (a step of length h from t_n, the step before it h_prev)
+//! ```text
+//! mu        multipliers of (C M^-1 C^T) mu = -g; the correction delta = M^-1 C^T mu
+//! J         the step's impulse, M delta / h = C^T mu / h (delta / h enters v_{n+1/2})
+//! f_step    J / h = C^T mu / h^2: the force that does the step's contact work on du
+//! span      the time an entry's multiplier stands for:
+//!             (h_prev + h) / 2  an entry closed at t_n: v_{n+1/2} = v_{n-1/2}
+//!                               + (h_prev + h) / 2 a_n, so the force holding it at t_n
+//!                               carries that impulse (the averaged step of central
+//!                               difference with varying steps)
+//!             h                 an entry that closes in the step: its multiplier arrests the
+//!                               approach within the step
+//! f         mu / (h span): the reported force (history, frames, peak_force); f span = J
+//!           per entry, so the impulses sum exactly, and a step clipped to a frame time
+//!           (h << h_prev) reports the force of its neighbours, not J / h
+//! ```
 
 use super::Interfaces;
 use super::active::ContactState;
 use super::geometry::Gap;
 use super::search::penetrating;
 
+/// What an explicit contact step gives the driver.
+pub struct ExplicitContact {
+    /// The correction delta of the predicted increment (all DOFs).
+    pub correction: Vec<f64>,
+    /// The nodal forces f_step = C^T mu / h^2 on the rows at the start positions (all DOFs):
+    /// what does the step's contact work on its corrected increment.
+    pub step_force: Vec<f64>,
+}
+
 impl ContactState {
     /// Explicit contact by forward-increment Lagrange multipliers (Carpenter, Taylor & Katona
     /// 1991) in the velocity-Verlet form of central difference: the predicted increment `du`
-    /// (positions `start + du`) is corrected by delta = M^-1 C^T mu with (C M^-1 C^T) mu = -g
-    /// over the penetrated entries, mu >= 0 (entries in tension leave, penetrations join, the
-    /// rows are rebuilt at the corrected positions until the gaps close to TOL). The correction
-    /// enters the half-step velocity as delta / h, a full step's impulse M delta / h, so the
-    /// contact force of the step is mu / h^2. Returns the correction delta (all DOFs).
+    /// (positions `start + du`) of a step of length `h` is corrected by delta = M^-1 C^T mu
+    /// with (C M^-1 C^T) mu = -g over the penetrated entries, mu >= 0 (entries in tension
+    /// leave, penetrations join, the rows are rebuilt at the corrected positions until the
+    /// gaps close to TOL). The status takes the reported forces mu / (h span) (module legend;
+    /// `previous` is the length of the step before, 0 before the first).
+    #[allow(clippy::too_many_arguments)]
     pub fn explicit_step(
         &mut self,
         interfaces: &Interfaces,
@@ -21,8 +48,9 @@ impl ContactState {
         du: &[f64],
         inverse_mass: &[f64],
         h: f64,
+        previous: f64,
         time: f64,
-    ) -> Vec<f64> {
+    ) -> ExplicitContact {
         let n = du.len();
         let mut delta = vec![0.0; n];
         let mut active: Vec<(usize, usize)> = Vec::new();
@@ -100,7 +128,23 @@ impl ContactState {
             active.retain(|_| kept.next().expect("one flag per entry"));
             mu_total.retain(|mu| *mu >= 0.0);
         }
-        let forces: Vec<f64> = mu_total.iter().map(|mu| mu / (h * h)).collect();
+        let forces: Vec<f64> = active
+            .iter()
+            .zip(&mu_total)
+            .map(|((p, k), mu)| {
+                let span = if self.active[*p][*k] && previous > 0.0 {
+                    0.5 * (previous + h)
+                } else {
+                    h
+                };
+                mu / (h * span)
+            })
+            .collect();
+        let mut step_forces: Vec<Vec<f64>> =
+            self.force.iter().map(|f| vec![0.0; f.len()]).collect();
+        for ((p, k), mu) in active.iter().zip(&mu_total) {
+            step_forces[*p][*k] = mu / (h * h);
+        }
         let released = self
             .active
             .iter()
@@ -110,7 +154,11 @@ impl ContactState {
             .map(|node| position(&delta, node))
             .collect();
         self.set(interfaces, &active, &forces, released, time, &end);
-        delta
+        let step_force = self.nodal_forces_of(&interfaces.pairs, start, &step_forces);
+        ExplicitContact {
+            correction: delta,
+            step_force,
+        }
     }
 }
 
