@@ -107,6 +107,18 @@ pub struct ContactPair {
     /// pass's row for that node would be the same row again (coincident nodes), and the two
     /// rows would make the multipliers indeterminate.
     pub covered: Option<Covered>,
+    /// Segment-to-segment (mortar) contact: the slave surface whose segments carry the
+    /// weighted gaps (`mortar`); None: node-to-segment, the slave node against the master.
+    pub mortar: Option<MortarSurface>,
+}
+
+/// The slave surface of a mortar pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MortarSurface {
+    /// The slave body's boundary edges of the slave set (global ids, solid on the left).
+    pub edges: Vec<[usize; 2]>,
+    /// Surface integrals over the surface of revolution (weight 2 pi r).
+    pub axisymmetric: bool,
 }
 
 /// See [`ContactPair::covered`].
@@ -127,13 +139,30 @@ pub struct Gap {
     pub normal: [f64; 2],
     /// Master nodes and their weights (empty for a rigid obstacle).
     pub masters: Vec<(usize, f64)>,
+    /// The slave-side nodes and weights of a mortar gap (the slave node's neighbours on its
+    /// surface share its weighted gap); empty: the slave node alone, weight 1.
+    pub spread: Vec<(usize, f64)>,
 }
 
 impl Gap {
+    /// The slave-side nodes of the gap and their weights: `slave` alone, or the mortar
+    /// spread.
+    fn slave_side(&self, slave: usize) -> Vec<(usize, f64)> {
+        if self.spread.is_empty() {
+            vec![(slave, 1.0)]
+        } else {
+            self.spread.clone()
+        }
+    }
+
     /// The constraint row as (DOF, coefficient) pairs for slave node `slave`.
     pub fn row(&self, slave: usize) -> Vec<(usize, f64)> {
         let n = self.normal;
-        let mut row = vec![(2 * slave, n[0]), (2 * slave + 1, n[1])];
+        let mut row = Vec::with_capacity(2 * (self.masters.len() + self.spread.len() + 1));
+        for (s, w) in self.slave_side(slave) {
+            row.push((2 * s, w * n[0]));
+            row.push((2 * s + 1, w * n[1]));
+        }
         for (m, w) in &self.masters {
             row.push((2 * m, -w * n[0]));
             row.push((2 * m + 1, -w * n[1]));
@@ -150,7 +179,11 @@ impl Gap {
     /// increment it gives the relative slip of the slave along the master.
     pub fn tangent_row(&self, slave: usize) -> Vec<(usize, f64)> {
         let t = self.tangent();
-        let mut row = vec![(2 * slave, t[0]), (2 * slave + 1, t[1])];
+        let mut row = Vec::with_capacity(2 * (self.masters.len() + self.spread.len() + 1));
+        for (s, w) in self.slave_side(slave) {
+            row.push((2 * s, w * t[0]));
+            row.push((2 * s + 1, w * t[1]));
+        }
         for (m, w) in &self.masters {
             row.push((2 * m, -w * t[0]));
             row.push((2 * m + 1, -w * t[1]));
@@ -223,7 +256,7 @@ pub(super) fn project(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
 }
 
 /// Outward unit normal of a -> b (solid on the left).
-fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+pub(super) fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     let d = sub(b, a);
     let l = length(d);
     [d[1] / l, -d[0] / l]
@@ -318,6 +351,19 @@ impl ContactPair {
     /// The gap of slave node `slave` at positions `x` (global node -> position), or None
     /// when there is no master within the search distance.
     pub fn gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
+        match (&self.mortar, &self.master) {
+            (Some(surface), Master::Segments { edges, .. }) => {
+                super::mortar::weighted_gap(surface, edges, slave, x)
+                    .filter(|g| g.gap <= self.options.search_distance)
+            }
+            _ => self.node_gap(slave, x),
+        }
+    }
+
+    /// The gap of slave node `slave` itself (node-to-segment) at positions `x`, or None when
+    /// there is no master within the search distance: the pointwise gap, also of a mortar
+    /// pair's nodes (their penetration).
+    pub fn node_gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
         let xs = x(slave);
         let result = match &self.master {
             Master::Nodes { nodes, normal, .. } => {
@@ -328,6 +374,7 @@ impl ContactPair {
                     gap: dot(sub(xs, x(m)), *normal),
                     normal: *normal,
                     masters: vec![(m, 1.0)],
+                    spread: Vec::new(),
                 }
             }
             Master::Segments {
@@ -369,6 +416,7 @@ impl ContactPair {
                     gap,
                     normal,
                     masters: vec![(a, 1.0 - xi), (b, xi)],
+                    spread: Vec::new(),
                 }
             }
             Master::Obstacle(o) => {
@@ -398,6 +446,7 @@ impl ContactPair {
                     gap,
                     normal,
                     masters: Vec::new(),
+                    spread: Vec::new(),
                 }
             }
         };
@@ -528,6 +577,7 @@ pub(super) mod tests {
             master,
             options: options(),
             covered: None,
+            mortar: None,
         }
     }
 

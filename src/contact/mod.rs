@@ -29,6 +29,7 @@ pub mod conditions;
 pub mod explicit;
 pub mod geometry;
 pub mod linearization;
+pub mod mortar;
 pub mod search;
 pub mod setup;
 
@@ -37,7 +38,8 @@ pub use active::{
     apply_conditions,
 };
 pub use geometry::{
-    ContactPair, Covered, Friction, Gap, Master, Obstacle, PairOptions, winding_number,
+    ContactPair, Covered, Friction, Gap, Master, MortarSurface, Obstacle, PairOptions,
+    winding_number,
 };
 pub use search::{SlaveGap, penetration_limits, runaway_penetration, slave_gaps};
 

@@ -4,9 +4,12 @@
 
 use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
-use super::model::Body;
-use super::spec::{ContactSpec, Scene, SurfaceSpec};
-use crate::contact::{ContactPair, Covered, Friction, Master, Obstacle, PairOptions, setup};
+use super::model::{Body, BodyKind};
+use super::spec::{ContactDiscretization, ContactSpec, Scene, SurfaceSpec};
+use crate::contact::{
+    ContactPair, Covered, Friction, Master, MortarSurface, Obstacle, PairOptions, setup,
+};
+use crate::element::Formulation;
 use crate::mesh::Cells;
 
 /// The scene's contact pairs in order, their names unique.
@@ -125,6 +128,7 @@ fn contact(
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
         None => f64::INFINITY,
     };
+    let mortar = mortar_surface(cx, bodies, &key, spec, slave_body, &master)?;
     Ok(ContactPair {
         name: spec.name.clone(),
         slave_body,
@@ -141,7 +145,52 @@ fn contact(
             persistency: false,
         },
         covered: None,
+        mortar,
     })
+}
+
+/// The slave surface of a `discretization = "mortar"` pair: the slave set's edges, against a
+/// master edge set of another body.
+fn mortar_surface(
+    cx: &Context,
+    bodies: &[Body],
+    key: &str,
+    spec: &ContactSpec,
+    slave_body: usize,
+    master: &Master,
+) -> Result<Option<MortarSurface>, InputError> {
+    if spec.discretization != ContactDiscretization::Mortar {
+        return Ok(None);
+    }
+    if !matches!(master, Master::Segments { .. }) {
+        return Err(cx.err(format!(
+            "{key}.discretization: mortar contact needs a master edge set on a body (an obstacle or a node-to-node master has no segments to weigh against); use node_to_segment"
+        )));
+    }
+    if spec.two_pass {
+        return Err(cx.err(format!(
+            "{key}.two_pass: mortar contact weighs both surfaces already; give one of `two_pass` and `discretization = \"mortar\"`"
+        )));
+    }
+    let body = &bodies[slave_body];
+    let (_, edges) = edge_set(
+        cx,
+        bodies,
+        Some(&body.name),
+        &spec.slave.set,
+        &format!("{key}.slave"),
+    )?;
+    let axisymmetric = matches!(
+        body.kind,
+        BodyKind::Continuum {
+            formulation: Formulation::Axisymmetric,
+            ..
+        }
+    );
+    Ok(Some(MortarSurface {
+        edges,
+        axisymmetric,
+    }))
 }
 
 /// The second pair of a two-pass contact: the master surface's nodes as slaves of the slave
@@ -186,6 +235,7 @@ fn reverse_pair(
             boundary,
         },
         options: pair.options.clone(),
+        mortar: None,
         covered: Some(Covered {
             pair: k,
             slaves: {

@@ -322,6 +322,23 @@ pub struct ContactSpec {
     /// The return coefficient R in [0, 1] of Greco & Coda (2003) (eq 36), instead of
     /// `friction`.
     pub return_coefficient: Option<f64>,
+    /// `node_to_segment` (default: each slave node against the master) or `mortar`
+    /// (segment-to-segment: the gap weighted over the slave surface; a master edge set and
+    /// a slave edge set on two deformable bodies).
+    #[serde(default)]
+    pub discretization: ContactDiscretization,
+}
+
+/// How a contact pair's constraints are discretized.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactDiscretization {
+    /// Each slave node against the nearest master point (Hughes et al. 1975, II-13..16).
+    #[default]
+    NodeToSegment,
+    /// Segment-to-segment: a weighted gap per slave node over its slave segments (Puso &
+    /// Laursen 2004; Yang, Laursen & Meng 2005).
+    Mortar,
 }
 
 pub(super) fn yes() -> bool {

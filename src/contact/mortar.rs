@@ -1,0 +1,189 @@
+//! Segment-to-segment (mortar) contact in 2D: the gap of a slave node is the weighted mean
+//! of the gap over its part of the slave surface, measured against whatever master segments
+//! lie across it (Puso & Laursen 2004; Yang, Laursen & Meng 2005 for 2D large sliding;
+//! docs/theory.md "Mortar contact").
+//!
+//! Legend
+//! ```text
+//! s_a, s_b     a slave segment (solid on its left), eta in [0, 1] along it, length L
+//! N_j(eta)     the slave node j's linear shape function on its segments
+//! p, q         a master segment across it, xi in [0, 1] along it, N^_p = 1 - xi, N^_q = xi
+//! n_j          the normal at j: minus the mean of j's slave segments' outward normals (it
+//!              points from the master towards the slave, as a node-to-segment normal does)
+//! dA           ds (plane), 2 pi r ds (axisymmetric, r at the slave point)
+//! D_jk         int N_j N_k dA over the overlaps (slave side)
+//! M_jm         int N_j N^_m dA over the overlaps (master side)
+//! w_j          int N_j dA over the overlaps = sum_k D_jk = sum_m M_jm
+//! g~_j         (sum_k D_jk x_k - sum_m M_jm x_m) . n_j / w_j: the mean gap over the overlaps
+//! ```
+//! The row of g~_j is D_jk / w_j n_j on the slave nodes and -M_jm / w_j n_j on the master
+//! nodes (normal and overlaps frozen): its slave and master weights each sum to one, so the
+//! force tau C^T is equal and opposite on the two surfaces. A master node that pokes into the
+//! slave between two slave nodes enters the gaps of both, where node-to-segment contact would
+//! not see it; on matching meshes D = M and the constraints tie the facing nodes.
+//!
+//! The overlap of a slave segment and a master segment is found by projecting the master's
+//! end points onto the slave segment's line; a slave point at eta meets the master point of
+//! the same projection (the overlap maps linearly), so the integrands are cubic in eta and
+//! two Gauss points integrate them exactly.
+
+use super::geometry::{Gap, MortarSurface, outward};
+use crate::mesh::plane::{dot, sub};
+use std::f64::consts::PI;
+
+/// The two-point Gauss rule on [0, 1]: positions and weights.
+const GAUSS: [(f64, f64); 2] = [
+    (0.211_324_865_405_187_1, 0.5),
+    (0.788_675_134_594_812_9, 0.5),
+];
+
+/// The weighted gap g~ of slave node `slave` of `surface` against the master segments
+/// `master` at positions `x`, or None when no master segment faces its segments.
+pub fn weighted_gap(
+    surface: &MortarSurface,
+    master: &[[usize; 2]],
+    slave: usize,
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> Option<Gap> {
+    let own: Vec<[usize; 2]> = surface
+        .edges
+        .iter()
+        .filter(|e| e.contains(&slave))
+        .copied()
+        .collect();
+    let mut sum = [0.0; 2];
+    for [a, b] in &own {
+        let n = outward(x(*a), x(*b));
+        sum = [sum[0] + n[0], sum[1] + n[1]];
+    }
+    let l = dot(sum, sum).sqrt();
+    if !(l > 0.0) {
+        return None;
+    }
+    let slave_normal = [-sum[0] / l, -sum[1] / l];
+    let mut master_normal = [0.0; 2];
+    let mut masters: Vec<(usize, f64)> = Vec::new();
+    // D_jj over the whole support, and int Phi_j dA over the overlaps
+    let mut full = 0.0;
+    let mut covered = 0.0;
+    for [a, b] in &own {
+        let (xa, xb) = (x(*a), x(*b));
+        let ab = sub(xb, xa);
+        let length2 = dot(ab, ab);
+        if !(length2 > 0.0) {
+            continue;
+        }
+        let length = length2.sqrt();
+        let area = |eta: f64| {
+            if surface.axisymmetric {
+                2.0 * PI * (xa[0] + eta * ab[0])
+            } else {
+                1.0
+            }
+        };
+        let Some((phi, d)) = dual_shape(length, &area, usize::from(*b == slave)) else {
+            continue;
+        };
+        full += d;
+        let facing = outward(xa, xb);
+        for [p, q] in master {
+            let (xp, xq) = (x(*p), x(*q));
+            let across = outward(xp, xq);
+            if dot(across, facing) >= 0.0 {
+                continue;
+            }
+            let (eta_p, eta_q) = (
+                dot(sub(xp, xa), ab) / length2,
+                dot(sub(xq, xa), ab) / length2,
+            );
+            let low = eta_p.min(eta_q).max(0.0);
+            let high = eta_p.max(eta_q).min(1.0);
+            if !(high > low) {
+                continue;
+            }
+            let mut overlap = 0.0;
+            for (g, w) in GAUSS {
+                let eta = low + g * (high - low);
+                let xi = (eta - eta_p) / (eta_q - eta_p);
+                let da = w * (high - low) * length * area(eta);
+                let dphi = da * (phi[0] * (1.0 - eta) + phi[1] * eta);
+                covered += dphi;
+                overlap += da;
+                add(&mut masters, *p, dphi * (1.0 - xi));
+                add(&mut masters, *q, dphi * xi);
+            }
+            master_normal = [
+                master_normal[0] + overlap * across[0],
+                master_normal[1] + overlap * across[1],
+            ];
+        }
+    }
+    let share = covered / full;
+    if !(share > 0.0) {
+        return None;
+    }
+    masters.iter_mut().for_each(|(_, w)| *w /= full);
+    // the mean of the two surfaces' normals: on a plane of symmetry between two mirror
+    // bodies it is the plane's normal, where either surface's own would push the other
+    // body sideways as the surfaces curl
+    let lm = dot(master_normal, master_normal).sqrt();
+    let both = [
+        slave_normal[0] + master_normal[0] / lm,
+        slave_normal[1] + master_normal[1] / lm,
+    ];
+    let lb = dot(both, both).sqrt();
+    let normal = if lb > 0.0 {
+        [both[0] / lb, both[1] / lb]
+    } else {
+        slave_normal
+    };
+    let xs = x(slave);
+    let xm = masters.iter().fold([0.0; 2], |acc, (n, w)| {
+        let p = x(*n);
+        [acc[0] + w * p[0], acc[1] + w * p[1]]
+    });
+    let gap = dot([share * xs[0] - xm[0], share * xs[1] - xm[1]], normal);
+    Some(Gap {
+        gap,
+        normal,
+        masters,
+        spread: vec![(slave, share)],
+    })
+}
+
+/// Adds weight `w` to `node` in `list`.
+fn add(list: &mut Vec<(usize, f64)>, node: usize, w: f64) {
+    match list.iter_mut().find(|(n, _)| *n == node) {
+        Some(entry) => entry.1 += w,
+        None => list.push((node, w)),
+    }
+}
+
+/// The dual shape function of local node `local` (0: the segment's start, 1: its end) on a
+/// slave segment of length `length` with the area weight `area(eta)`: the coefficients of
+/// Phi = c_0 N_0 + c_1 N_1 such that int Phi N_k dA = delta_local,k int N_local dA
+/// (biorthogonal: Wohlmuth 2000; Popp, Gee & Wall 2009), and D = int N_local dA. Plane
+/// segments give Phi_0 = 2 N_0 - N_1.
+fn dual_shape(length: f64, area: &dyn Fn(f64) -> f64, local: usize) -> Option<([f64; 2], f64)> {
+    let mut m = [[0.0; 2]; 2];
+    for (g, w) in GAUSS {
+        let n = [1.0 - g, g];
+        let da = w * length * area(g);
+        for i in 0..2 {
+            for k in 0..2 {
+                m[i][k] += n[i] * n[k] * da;
+            }
+        }
+    }
+    let d = m[local][0] + m[local][1];
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    if !(det > 0.0) {
+        return None;
+    }
+    // row `local` of diag(d) M^-1
+    let inverse_row = [
+        [m[1][1] / det, -m[0][1] / det],
+        [-m[1][0] / det, m[0][0] / det],
+    ][local];
+    Some(([d * inverse_row[0], d * inverse_row[1]], d))
+}
