@@ -123,7 +123,8 @@ fn local_edges(edges: &[[usize; 2]], end: usize, nodes: &mut Vec<usize>) -> Vec<
 impl ContactPair {
     /// The exact linearization of slave `slave`'s row at positions `x`, for a deformable
     /// master (None for obstacles and node-to-node masters, whose rows are already dg/dx, and
-    /// where the master edges at the segment span more nodes than a linearization holds).
+    /// where the master edges at the segment span more nodes than a linearization holds; and for mortar
+    /// gaps).
     pub fn linearization(
         &self,
         slave: usize,
@@ -133,6 +134,10 @@ impl ContactPair {
         let Master::Segments { edges, .. } = &self.master else {
             return None;
         };
+        if self.mortar.is_some() {
+            // a weighted gap: its row is the frozen-geometry derivative
+            return None;
+        }
         let [(a, _), (b, xi)] = gap.masters[..] else {
             return None;
         };
