@@ -2,7 +2,10 @@
 //! Greco & Coda 2003, section 2). The solver owns the system; this file only says where the
 //! slaves are, how far from their masters, and along which direction (legend in `contact`).
 
-use crate::mesh::plane::{dot, sub};
+use super::mortar::{MortarSurface, weighted_gap};
+use crate::mesh::plane::{dot, outward, sub};
+
+pub use super::gap::Gap;
 use std::f64::consts::PI;
 
 /// A rigid obstacle: a fixed polyline, solid on its left (a closed counter-clockwise polygon
@@ -112,15 +115,6 @@ pub struct ContactPair {
     pub mortar: Option<MortarSurface>,
 }
 
-/// The slave surface of a mortar pair.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MortarSurface {
-    /// The slave body's boundary edges of the slave set (global ids, solid on the left).
-    pub edges: Vec<[usize; 2]>,
-    /// Surface integrals over the surface of revolution (weight 2 pi r).
-    pub axisymmetric: bool,
-}
-
 /// See [`ContactPair::covered`].
 pub const COVERED: f64 = 0.9;
 
@@ -130,66 +124,6 @@ pub struct Covered {
     pub pair: usize,
     /// (global node, slave index in the first pass), sorted by node.
     pub slaves: Vec<(usize, usize)>,
-}
-
-/// A slave node's relation to its master at a given configuration.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Gap {
-    pub gap: f64,
-    pub normal: [f64; 2],
-    /// Master nodes and their weights (empty for a rigid obstacle).
-    pub masters: Vec<(usize, f64)>,
-    /// The slave-side nodes and weights of a mortar gap (the slave node's neighbours on its
-    /// surface share its weighted gap); empty: the slave node alone, weight 1.
-    pub spread: Vec<(usize, f64)>,
-}
-
-impl Gap {
-    /// The slave-side nodes of the gap and their weights: `slave` alone, or the mortar
-    /// spread.
-    fn slave_side(&self, slave: usize) -> Vec<(usize, f64)> {
-        if self.spread.is_empty() {
-            vec![(slave, 1.0)]
-        } else {
-            self.spread.clone()
-        }
-    }
-
-    /// The constraint row as (DOF, coefficient) pairs for slave node `slave`.
-    pub fn row(&self, slave: usize) -> Vec<(usize, f64)> {
-        let n = self.normal;
-        let mut row = Vec::with_capacity(2 * (self.masters.len() + self.spread.len() + 1));
-        for (s, w) in self.slave_side(slave) {
-            row.push((2 * s, w * n[0]));
-            row.push((2 * s + 1, w * n[1]));
-        }
-        for (m, w) in &self.masters {
-            row.push((2 * m, -w * n[0]));
-            row.push((2 * m + 1, -w * n[1]));
-        }
-        row
-    }
-
-    /// The tangent t = (-n_y, n_x): the direction of positive slip.
-    pub fn tangent(&self) -> [f64; 2] {
-        [-self.normal[1], self.normal[0]]
-    }
-
-    /// The tangential row t . (x_s - sum w_m x_m) as (DOF, coefficient) pairs: applied to an
-    /// increment it gives the relative slip of the slave along the master.
-    pub fn tangent_row(&self, slave: usize) -> Vec<(usize, f64)> {
-        let t = self.tangent();
-        let mut row = Vec::with_capacity(2 * (self.masters.len() + self.spread.len() + 1));
-        for (s, w) in self.slave_side(slave) {
-            row.push((2 * s, w * t[0]));
-            row.push((2 * s + 1, w * t[1]));
-        }
-        for (m, w) in &self.masters {
-            row.push((2 * m, -w * t[0]));
-            row.push((2 * m + 1, -w * t[1]));
-        }
-        row
-    }
 }
 
 /// |a| as sqrt(a . a) (the gaps' own rounding; `plane::norm` uses hypot).
@@ -253,13 +187,6 @@ pub(super) fn project(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
     };
     let p = [a[0] + xi * ab[0], a[1] + xi * ab[1]];
     (xi, length(sub(x, p)))
-}
-
-/// Outward unit normal of a -> b (solid on the left).
-pub(super) fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    let d = sub(b, a);
-    let l = length(d);
-    [d[1] / l, -d[0] / l]
 }
 
 /// The gap of a point to a polyline of (possibly degenerate) segments with the solid on the
@@ -353,7 +280,7 @@ impl ContactPair {
     pub fn gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
         match (&self.mortar, &self.master) {
             (Some(surface), Master::Segments { edges, .. }) => {
-                super::mortar::weighted_gap(surface, edges, slave, x)
+                weighted_gap(surface, edges, slave, x)
                     .filter(|g| g.gap <= self.options.search_distance)
             }
             _ => self.node_gap(slave, x),

@@ -27,6 +27,7 @@
 pub mod active;
 pub mod conditions;
 pub mod explicit;
+pub mod gap;
 pub mod geometry;
 pub mod linearization;
 pub mod mortar;
@@ -38,9 +39,9 @@ pub use active::{
     apply_conditions,
 };
 pub use geometry::{
-    ContactPair, Covered, Friction, Gap, Master, MortarSurface, Obstacle, PairOptions,
-    winding_number,
+    ContactPair, Covered, Friction, Gap, Master, Obstacle, PairOptions, winding_number,
 };
+pub use mortar::MortarSurface;
 pub use search::{SlaveGap, penetration_limits, runaway_penetration, slave_gaps};
 
 use serde::{Deserialize, Serialize};

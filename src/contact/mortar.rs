@@ -1,35 +1,49 @@
-//! Segment-to-segment (mortar) contact in 2D: the gap of a slave node is the weighted mean
-//! of the gap over its part of the slave surface, measured against whatever master segments
-//! lie across it (Puso & Laursen 2004; Yang, Laursen & Meng 2005 for 2D large sliding;
-//! docs/theory.md "Mortar contact").
+//! Segment-to-segment (dual mortar) contact in 2D: the gap of a slave node is the mean of
+//! the gap over its part of the slave surface, weighted by its dual shape function and
+//! measured against whatever master segments lie across it (Puso & Laursen 2004; Yang,
+//! Laursen & Meng 2005 for 2D large sliding; the dual basis of Wohlmuth 2000 and Popp, Gee &
+//! Wall 2009; docs/theory.md "Mortar contact").
 //!
 //! Legend
 //! ```text
 //! s_a, s_b     a slave segment (solid on its left), eta in [0, 1] along it, length L
 //! N_j(eta)     the slave node j's linear shape function on its segments
+//! Phi_j(eta)   its dual shape function: int Phi_j N_k dA = delta_jk int N_j dA per segment
 //! p, q         a master segment across it, xi in [0, 1] along it, N^_p = 1 - xi, N^_q = xi
-//! n_j          the normal at j: minus the mean of j's slave segments' outward normals (it
-//!              points from the master towards the slave, as a node-to-segment normal does)
 //! dA           ds (plane), 2 pi r ds (axisymmetric, r at the slave point)
-//! D_jk         int N_j N_k dA over the overlaps (slave side)
-//! M_jm         int N_j N^_m dA over the overlaps (master side)
-//! w_j          int N_j dA over the overlaps = sum_k D_jk = sum_m M_jm
-//! g~_j         (sum_k D_jk x_k - sum_m M_jm x_m) . n_j / w_j: the mean gap over the overlaps
+//! D_j          int N_j dA over j's whole support (= int Phi_j N_j dA)
+//! M_jm         int Phi_j N^_m dA over the overlaps
+//! s_j          int Phi_j dA over the overlaps / D_j: the share of j's support a master
+//!              covers (1 inside a contact zone; it falls to 0 as a master end slides off)
+//! n_j          the mean of the slave's and the master's unit normals at j, pointing from
+//!              the master towards the slave (on a plane of symmetry: the plane's normal)
+//! g~_j         (s_j x_j - sum_m M_jm / D_j x_m) . n_j
 //! ```
-//! The row of g~_j is D_jk / w_j n_j on the slave nodes and -M_jm / w_j n_j on the master
-//! nodes (normal and overlaps frozen): its slave and master weights each sum to one, so the
-//! force tau C^T is equal and opposite on the two surfaces. A master node that pokes into the
-//! slave between two slave nodes enters the gaps of both, where node-to-segment contact would
-//! not see it; on matching meshes D = M and the constraints tie the facing nodes.
+//! The row of g~_j is s_j n_j on the slave node and -M_jm / D_j n_j on the master nodes
+//! (normal and overlaps frozen): the master weights sum to s_j, so the force tau C^T is equal
+//! and opposite on the two surfaces. With the dual basis the slave side is the node alone:
+//! a neighbour that opens does not pass its gap on to the node (the standard basis leaves a
+//! checkerboard of alternating gaps there), on matching meshes the constraints tie facing
+//! nodes, and a master node between two slave nodes enters the gaps of both, where
+//! node-to-segment contact would not see it.
 //!
 //! The overlap of a slave segment and a master segment is found by projecting the master's
 //! end points onto the slave segment's line; a slave point at eta meets the master point of
 //! the same projection (the overlap maps linearly), so the integrands are cubic in eta and
 //! two Gauss points integrate them exactly.
 
-use super::geometry::{Gap, MortarSurface, outward};
-use crate::mesh::plane::{dot, sub};
+use super::gap::Gap;
+use crate::mesh::plane::{dot, outward, sub};
 use std::f64::consts::PI;
+
+/// The slave surface of a mortar pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MortarSurface {
+    /// The slave body's boundary edges of the slave set (global ids, solid on the left).
+    pub edges: Vec<[usize; 2]>,
+    /// Surface integrals over the surface of revolution (weight 2 pi r).
+    pub axisymmetric: bool,
+}
 
 /// The two-point Gauss rule on [0, 1]: positions and weights.
 const GAUSS: [(f64, f64); 2] = [

@@ -25,3 +25,11 @@ pub fn norm(a: Point) -> f64 {
 pub fn quad_area(q: [Point; 4]) -> f64 {
     0.5 * (0..4).map(|k| cross(q[k], q[(k + 1) % 4])).sum::<f64>()
 }
+
+/// The outward unit normal of the segment a -> b with the solid on its left (its right-hand
+/// normal), its length taken as sqrt(d . d).
+pub fn outward(a: Point, b: Point) -> Point {
+    let d = sub(b, a);
+    let l = dot(d, d).sqrt();
+    [d[1] / l, -d[0] / l]
+}
