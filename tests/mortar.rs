@@ -119,46 +119,6 @@ fn mortar_contact_passes_the_patch_test_with_either_role_order() {
     }
 }
 
-/// One rod of models/rod_on_rod.toml alone on a frictionless rigid wall at y = 0.
-const WALL: &str = r#"
-[[material]]
-name = "42CrMo4"
-young = 206.0e9
-poisson = 0.3
-density = 7830.0
-johnson_cook = { a = 806.0e6, b = 614.0e6, n = 0.168, c = 0.0089, reference_rate = 1.0, m = 1.1, room_temperature = 20.0, melting_temperature = 1540.0, specific_heat = 460.0, taylor_quinney = 0.9 }
-
-[[body]]
-name = "upper"
-material = "42CrMo4"
-formulation = "axisymmetric"
-velocity = [0.0, -287.0]
-mesh = { type = "rectangle", width = 3.2e-3, height = 32.4e-3, nx = 5, ny = 50 }
-
-[[support]]
-body = "upper"
-set = "left"
-fix = ["x"]
-
-[[obstacle]]
-name = "wall"
-points = [[1.0, 0.0], [-1.0, 0.0]]
-
-[[contact]]
-name = "faces"
-slave = { body = "upper", set = "bottom" }
-obstacle = "wall"
-
-[analysis]
-type = "dynamic"
-integrator = "central_difference"
-quadrature = "full"
-end_time = 80.0e-6
-
-[output]
-frame_every = 0
-"#;
-
 /// The length (top minus lowest point) and the largest diameter of each body's final shape,
 /// in mm.
 fn extents(model: &Model, state: &State) -> Vec<(f64, f64)> {
@@ -219,8 +179,8 @@ fn axial_momentum(model: &Model, dir: &Path, name: &str) -> f64 {
 /// rho A L V of one rod: the scale of the axial momentum.
 const MOMENTUM: f64 = 7830.0 * std::f64::consts::PI * 3.2e-3 * 3.2e-3 * 32.4e-3 * 287.0;
 
-/// The rod pair with `overrides` against the rod on the wall with `wall_overrides` (upper
-/// rod) and `lower_wall` (the lower rod's mesh on the wall, None: the same as the upper's):
+/// The rod pair with `overrides` against the rod on the wall (models/rod_wall.toml) with the
+/// upper rod's mesh and `lower_wall` (the lower rod's mesh on the wall, None: the same):
 /// each rod within `length` and `diameter` (relative) of its wall run, and the two halves
 /// within 0.5 % of each other when the meshes match; axial momentum, energy balance and
 /// penetration as `rod_pair_on_explicit_and_implicit_paths_matches_the_wall` states.
@@ -234,11 +194,16 @@ fn pair_against_wall(
     let pair_text = std::fs::read_to_string("models/rod_on_rod.toml").unwrap();
     let (model, summary, state, dir) = run(name, &pair_text, overrides);
     let pair = extents(&model, &state);
+    let wall_text = std::fs::read_to_string("models/rod_wall.toml").unwrap();
     let wall_for = |tag: &str, extra: &[&str]| {
-        let mut all = overrides.to_vec();
-        all.retain(|s| !s.starts_with("body."));
-        all.extend_from_slice(extra);
-        let (m, _, s, _) = run(&format!("{name}_{tag}"), WALL, &all);
+        let mut all: Vec<String> = overrides
+            .iter()
+            .filter(|s| !s.starts_with("body."))
+            .map(|s| s.to_string())
+            .collect();
+        all.extend(extra.iter().map(|s| s.replace("body.upper.", "body.rod.")));
+        let all: Vec<&str> = all.iter().map(String::as_str).collect();
+        let (m, _, s, _) = run(&format!("{name}_{tag}"), &wall_text, &all);
         extents(&m, &s)[0]
     };
     let upper_mesh: Vec<&str> = overrides
@@ -309,8 +274,8 @@ fn pair_against_wall(
 /// Setup: models/rod_on_rod.toml (mortar contact) on explicit 2x2, explicit one-point and
 /// Newmark average (dt 1e-7); then non-matching meshes (the lower rod 7 x 70) on both
 /// explicit kernels.
-/// Reference: the rod of the pair alone on a frictionless rigid wall, same mesh, kernel and
-/// step (a different contact problem: a rigid obstacle, node-to-segment). Bands (the
+/// Reference: the rod of the pair alone on a frictionless rigid wall (models/rod_wall.toml),
+/// same mesh, kernel and step (a different contact problem: a rigid obstacle, node-to-segment). Bands (the
 /// issue's): L_f within 0.5 %, D_f within 1 %, the halves within 0.5 % of each other
 /// (measured: 2x2 identical to the wall to 1e-3 mm; one-point +0.01 % / -0.03 % L_f,
 /// -0.03 % / +0.09 % D_f; Newmark -0.004 %, +0.01 %); non-matching within 1 % of each rod's

@@ -112,7 +112,8 @@ pub fn weighted_gap(
             );
             let low = eta_p.min(eta_q).max(0.0);
             let high = eta_p.max(eta_q).min(1.0);
-            if !(high > low) {
+            if !(high > low) || !within_reach(xa, ab, facing, [xp, xq], [eta_p, eta_q], [low, high])
+            {
                 continue;
             }
             let mut overlap = 0.0;
@@ -162,6 +163,32 @@ pub fn weighted_gap(
         normal,
         masters,
         spread: vec![(slave, share)],
+    })
+}
+
+/// Whether the master segment `master` (its end points' projections `etas` on the slave
+/// segment from `xa` along `ab`, outward normal `facing`) lies across the slave segment
+/// rather than behind it: at the overlap `[low, high]` it is not deeper inside the slave
+/// body than one slave segment length. A closed master (a ring) faces a slave segment from
+/// its far side too, where the "gap" is the body's thickness.
+fn within_reach(
+    xa: [f64; 2],
+    ab: [f64; 2],
+    facing: [f64; 2],
+    master: [[f64; 2]; 2],
+    etas: [f64; 2],
+    overlap: [f64; 2],
+) -> bool {
+    let length = dot(ab, ab).sqrt();
+    overlap.iter().any(|eta| {
+        let xi = (eta - etas[0]) / (etas[1] - etas[0]);
+        let on_master = [
+            master[0][0] + xi * (master[1][0] - master[0][0]),
+            master[0][1] + xi * (master[1][1] - master[0][1]),
+        ];
+        let on_slave = [xa[0] + eta * ab[0], xa[1] + eta * ab[1]];
+        // along the slave's outward normal: positive apart, negative inside
+        dot(sub(on_master, on_slave), facing) > -length
     })
 }
 

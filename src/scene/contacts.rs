@@ -5,7 +5,7 @@
 use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
 use super::model::{Body, BodyKind};
-use super::spec::{ContactDiscretization, ContactSpec, Scene, SurfaceSpec};
+use super::spec::{ContactDiscretization, ContactSpec, IntegratorKind, Scene, SurfaceSpec};
 use crate::contact::{
     ContactPair, Covered, Friction, Master, MortarSurface, Obstacle, PairOptions, setup,
 };
@@ -23,7 +23,7 @@ pub(super) fn contacts(
         .contact
         .iter()
         .enumerate()
-        .map(|(k, c)| contact(cx, bodies, &obstacles, k, c))
+        .map(|(k, c)| contact(cx, bodies, &obstacles, k, c, explicit(scene)))
         .collect::<Result<Vec<_>, _>>()?;
     let mut contacts = contacts;
     for (k, spec) in scene.contact.iter().enumerate() {
@@ -81,6 +81,7 @@ fn contact(
     obstacles: &[Obstacle],
     k: usize,
     spec: &ContactSpec,
+    explicit: bool,
 ) -> Result<ContactPair, InputError> {
     let key = format!("contact[{k}] (`{}`)", spec.name);
     let (slave_body, slaves) = node_set(
@@ -128,7 +129,7 @@ fn contact(
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
         None => f64::INFINITY,
     };
-    let mortar = mortar_surface(cx, bodies, &key, spec, slave_body, &master)?;
+    let mortar = mortar_surface(cx, bodies, &key, spec, slave_body, &master, explicit)?;
     Ok(ContactPair {
         name: spec.name.clone(),
         slave_body,
@@ -158,8 +159,19 @@ fn mortar_surface(
     spec: &ContactSpec,
     slave_body: usize,
     master: &Master,
+    explicit: bool,
 ) -> Result<Option<MortarSurface>, InputError> {
-    if spec.discretization != ContactDiscretization::Mortar {
+    let slave_edges = bodies[slave_body]
+        .mesh
+        .edge_sets
+        .contains_key(&spec.slave.set);
+    let between_bodies = matches!(master, Master::Segments { .. }) && slave_edges;
+    let default = if explicit && between_bodies && !spec.two_pass {
+        ContactDiscretization::Mortar
+    } else {
+        ContactDiscretization::NodeToSegment
+    };
+    if spec.discretization.unwrap_or(default) != ContactDiscretization::Mortar {
         return Ok(None);
     }
     if !matches!(master, Master::Segments { .. }) {
@@ -191,6 +203,12 @@ fn mortar_surface(
         edges,
         axisymmetric,
     }))
+}
+
+/// Whether the scene steps with central difference (the default discretization of a pair
+/// between two bodies depends on it).
+fn explicit(scene: &Scene) -> bool {
+    scene.analysis.integrator == Some(IntegratorKind::CentralDifference)
 }
 
 /// The second pair of a two-pass contact: the master surface's nodes as slaves of the slave

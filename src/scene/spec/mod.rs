@@ -322,19 +322,19 @@ pub struct ContactSpec {
     /// The return coefficient R in [0, 1] of Greco & Coda (2003) (eq 36), instead of
     /// `friction`.
     pub return_coefficient: Option<f64>,
-    /// `node_to_segment` (default: each slave node against the master) or `mortar`
-    /// (segment-to-segment: the gap weighted over the slave surface; a master edge set and
-    /// a slave edge set on two deformable bodies).
-    #[serde(default)]
-    pub discretization: ContactDiscretization,
+    /// `node_to_segment` (each slave node against the master) or `mortar` (segment-to-segment:
+    /// the gap weighted over the slave surface; a slave and a master edge set on two
+    /// deformable bodies). Default: `mortar` for such a pair under central difference (where
+    /// node-to-segment crushes the master's corners at large strain), `node_to_segment`
+    /// otherwise (implicit and static runs, obstacles, node-to-node, `two_pass`).
+    pub discretization: Option<ContactDiscretization>,
 }
 
 /// How a contact pair's constraints are discretized.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactDiscretization {
     /// Each slave node against the nearest master point (Hughes et al. 1975, II-13..16).
-    #[default]
     NodeToSegment,
     /// Segment-to-segment: a weighted gap per slave node over its slave segments (Puso &
     /// Laursen 2004; Yang, Laursen & Meng 2005).
