@@ -18,6 +18,10 @@ pub(super) struct Rows {
     /// The number of normal rows (the first ones).
     pub(super) normal: usize,
     pub(super) sliding: Vec<(Vec<(usize, f64)>, usize, f64)>,
+    /// Per fixed tangential condition (in their order), its row among `rows`, or None when
+    /// the row acts on prescribed DOFs only: the support holds that slip already (an axis
+    /// node held in x against a wall whose tangent is x) and the row is left out.
+    pub(super) fixed: Vec<Option<usize>>,
     /// Per normal row, its exact derivatives where the row is not dg/dx.
     pub(super) exact: Vec<Option<Exact>>,
     /// The largest |gap| of the normal rows against its pair's tolerance (TOL of Hughes II-7).
@@ -78,6 +82,7 @@ impl Rows {
             gaps: Vec::new(),
             normal: 0,
             sliding: Vec::new(),
+            fixed: Vec::new(),
             exact: Vec::new(),
             worst_gap: 0.0,
         }
@@ -94,20 +99,21 @@ impl Rows {
     }
 
     /// The tangential forces in the order of `Constraints::tangential`, from the multipliers
-    /// of a solve (normal rows, then fixed tangential rows).
+    /// of a solve (normal rows, then the fixed tangential rows kept); a fixed condition left
+    /// to a support has none of its own (0).
     pub(super) fn tangential_forces(
         &self,
         tangential: &[Tangential],
         multipliers: &[f64],
     ) -> Vec<f64> {
-        let mut fixed = self.normal;
+        let mut fixed = self.fixed.iter();
         tangential
             .iter()
             .map(|t| match t {
-                Tangential::Fixed { .. } => {
-                    fixed += 1;
-                    multipliers[fixed - 1]
-                }
+                Tangential::Fixed { .. } => fixed
+                    .next()
+                    .expect("a row or none per fixed condition")
+                    .map_or(0.0, |row| multipliers[row]),
                 Tangential::Sliding { entry, coefficient } => coefficient * multipliers[*entry],
             })
             .collect()
@@ -160,7 +166,16 @@ impl Constraints<'_> {
                 Tangential::Fixed { entry, target } => {
                     let row = gaps[entry].tangent_row(self.active[entry].1);
                     let slip: f64 = row.iter().map(|(dof, c)| c * d[*dof]).sum();
-                    rows.rows.push(free(row));
+                    // a row whose free coefficients are round-off next to its largest one
+                    // acts on prescribed DOFs only
+                    let scale = row.iter().fold(0.0f64, |m, (_, c)| m.max(c.abs()));
+                    let on_free = free(row);
+                    if on_free.iter().all(|(_, c)| c.abs() <= 1e-12 * scale) {
+                        rows.fixed.push(None);
+                        continue;
+                    }
+                    rows.fixed.push(Some(rows.rows.len()));
+                    rows.rows.push(on_free);
                     rows.gaps.push(slip - target);
                 }
                 Tangential::Sliding { entry, coefficient } => {

@@ -342,6 +342,7 @@ mod tests {
                 gaps: gaps.clone(),
                 normal: 2,
                 sliding: Vec::new(),
+                fixed: Vec::new(),
                 exact: exact_rows,
                 worst_gap: 0.0,
             };
