@@ -199,10 +199,12 @@ impl ContactState {
         (entries, forces)
     }
 
-    /// The friction status an entry starts a step with.
+    /// The friction status an entry starts a step with (Coulomb with mu = 0 is frictionless:
+    /// no tangential condition, rather than rows that would only ever slide with 0).
     fn slip_start(&self, pairs: &[ContactPair], (p, k): (usize, usize)) -> Slip {
         match pairs[p].options.friction {
             Friction::None | Friction::Return { .. } => Slip::Free,
+            Friction::Coulomb { mu } if mu == 0.0 => Slip::Free,
             Friction::Coulomb { .. } if self.active[p][k] && self.sliding[p][k] != 0.0 => {
                 Slip::Slide(self.sliding[p][k])
             }
@@ -313,7 +315,7 @@ impl ContactState {
             for e in penetrating {
                 entries.push(e);
                 slips.push(match pairs[e.0].options.friction {
-                    Friction::Coulomb { .. } => Slip::Stick,
+                    Friction::Coulomb { mu } if mu > 0.0 => Slip::Stick,
                     _ => Slip::Free,
                 });
                 forces.push(0.0);
