@@ -196,7 +196,7 @@ fn houbolt_modified_newton_resume_is_bit_identical() {
     assert_same_output(&full, &resumed, name);
 }
 
-/// PLASTIC_BLOCK without friction (explicit contact is frictionless).
+/// PLASTIC_BLOCK without its friction (the explicit runs below were set up frictionless).
 fn frictionless() -> String {
     PLASTIC_BLOCK.replace("friction = 0.2\n", "")
 }

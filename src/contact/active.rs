@@ -531,16 +531,17 @@ impl ContactState {
     /// Nodal contact forces (all DOFs) at positions `coords`: +tau n on slaves, -w tau n on
     /// master nodes.
     pub fn nodal_forces(&self, pairs: &[ContactPair], coords: &[[f64; 2]]) -> Vec<f64> {
-        self.nodal_forces_of(pairs, coords, &self.force)
+        self.nodal_forces_of(pairs, coords, &self.force, &self.tangential)
     }
 
-    /// As `nodal_forces`, with the normal forces `normal` (per pair, per slave) on the
-    /// active entries.
+    /// As `nodal_forces`, with the normal forces `normal` and the tangential ones
+    /// `tangential` (per pair, per slave) on the active entries.
     pub(super) fn nodal_forces_of(
         &self,
         pairs: &[ContactPair],
         coords: &[[f64; 2]],
         normal: &[Vec<f64>],
+        tangential: &[Vec<f64>],
     ) -> Vec<f64> {
         let mut f = vec![0.0; 2 * coords.len()];
         let x = |n: usize| coords[n];
@@ -550,7 +551,7 @@ impl ContactState {
                 f[dof] += normal[p][k] * c;
             }
             for (dof, c) in s.gap.tangent_row(s.node) {
-                f[dof] += self.tangential[p][k] * c;
+                f[dof] += tangential[p][k] * c;
             }
         }
         f

@@ -16,19 +16,27 @@
 //! f         mu / (h span): the reported force (history, frames, peak_force); f span = J
 //!           per entry, so the impulses sum exactly, and a step clipped to a frame time
 //!           (h << h_prev) reports the force of its neighbours, not J / h
+//! T         tangential rows t . (x_s - sum w_m x_m) (`Gap::tangent_row`): T du is the
+//!           relative slip of the step
+//! lambda    tangential multipliers, in the units of mu; Coulomb's return (theory 8.3):
+//!             stick   (T M^-1 T^T) lambda = -T du     (the slip of the step undone)
+//!             slide   lambda = -mu_f mu sign(T du)    where the stick value exceeds it
+//!           i.e. lambda = clamp(lambda_stick, -mu_f mu, mu_f mu), applied as M^-1 T^T lambda;
+//!           mu_f the pair's Coulomb coefficient
 //! ```
 
 use super::Interfaces;
 use super::active::ContactState;
-use super::geometry::Gap;
+use super::geometry::{Friction, Gap};
 use super::search::penetrating;
 
 /// What an explicit contact step gives the driver.
 pub struct ExplicitContact {
     /// The correction delta of the predicted increment (all DOFs).
     pub correction: Vec<f64>,
-    /// The nodal forces f_step = C^T mu / h^2 on the rows at the start positions (all DOFs):
-    /// what does the step's contact work on its corrected increment.
+    /// The nodal forces f_step = (C^T mu + T^T lambda) / h^2 on the rows at the start
+    /// positions (all DOFs): what does the step's contact work on its corrected increment
+    /// (the friction's share is the work it dissipates).
     pub step_force: Vec<f64>,
     /// The kinetic energy the entries that closed in this step lose to it: their relative
     /// normal velocity is stopped within the step (a perfectly inelastic impact of the
@@ -43,8 +51,11 @@ impl ContactState {
     /// (positions `start + du`) of a step of length `h` is corrected by delta = M^-1 C^T mu
     /// with (C M^-1 C^T) mu = -g over the penetrated entries, mu >= 0 (entries in tension
     /// leave, penetrations join, the rows are rebuilt at the corrected positions until the
-    /// gaps close to TOL). The status takes the reported forces mu / (h span) (module legend;
-    /// `previous` is the length of the step before, 0 before the first).
+    /// gaps close to TOL). On a pair with Coulomb friction each pass then returns the
+    /// tangential multipliers into the cone |lambda| <= mu_f mu (`friction_correction`);
+    /// the passes go on until a sticking entry's slip is within TOL too. The status takes the
+    /// reported forces mu / (h span) and lambda / (h span) (module legend; `previous` is the
+    /// length of the step before, 0 before the first).
     #[allow(clippy::too_many_arguments)]
     pub fn explicit_step(
         &mut self,
@@ -66,6 +77,12 @@ impl ContactState {
             .map(|pair| vec![false; pair.slaves.len()])
             .collect();
         let mut mu_total: Vec<f64> = Vec::new();
+        // per active entry, its tangential multiplier lambda
+        let mut friction_total: Vec<f64> = Vec::new();
+        let coulomb = |p: usize| match interfaces.pairs[p].options.friction {
+            Friction::Coulomb { mu } if mu > 0.0 => Some(mu),
+            _ => None,
+        };
         let position = |delta: &[f64], node: usize| {
             [
                 start[node][0] + du[2 * node] + delta[2 * node],
@@ -84,6 +101,7 @@ impl ContactState {
                 active.push((p, k));
                 in_active[p][k] = true;
                 mu_total.push(0.0);
+                friction_total.push(0.0);
             }
             let gaps: Vec<Gap> = active
                 .iter()
@@ -104,7 +122,34 @@ impl ContactState {
                             .max(f64::MIN_POSITIVE)
                 })
                 .fold(0.0, f64::max);
-            if !changed && worst <= 1.0 {
+            let tangent_rows: Vec<Option<Vec<(usize, f64)>>> = active
+                .iter()
+                .zip(&gaps)
+                .map(|((p, k), g)| {
+                    coulomb(*p).map(|_| g.tangent_row(interfaces.pairs[*p].slaves[*k]))
+                })
+                .collect();
+            // the slip left on the entries inside the friction cone (sticking)
+            let slip_left = active
+                .iter()
+                .enumerate()
+                .filter_map(|(i, (p, _))| {
+                    let limit = coulomb(*p)? * mu_total[i].max(0.0);
+                    let row = tangent_rows[i].as_ref()?;
+                    (friction_total[i].abs() < limit).then(|| {
+                        let slip: f64 = row
+                            .iter()
+                            .map(|(dof, c)| c * (du[*dof] + delta[*dof]))
+                            .sum();
+                        slip.abs()
+                            / interfaces.pairs[*p]
+                                .options
+                                .tolerance
+                                .max(f64::MIN_POSITIVE)
+                    })
+                })
+                .fold(0.0, f64::max);
+            if !changed && worst <= 1.0 && slip_left <= 1.0 {
                 break;
             }
             let rows: Vec<Vec<(usize, f64)>> = active
@@ -112,13 +157,29 @@ impl ContactState {
                 .zip(&gaps)
                 .map(|((p, k), g)| g.row(interfaces.pairs[*p].slaves[*k]))
                 .collect();
-            let mu = lumped_multipliers(&rows, &gaps, inverse_mass);
+            let violations: Vec<f64> = gaps.iter().map(|g| g.gap).collect();
+            let mu = lumped_multipliers(&rows, &violations, inverse_mass);
             for (i, row) in rows.iter().enumerate() {
                 for (dof, c) in row {
                     delta[*dof] += inverse_mass[*dof] * c * mu[i];
                 }
                 mu_total[i] += mu[i];
             }
+            // before the release below: an entry pulled off gets the cone of a zero normal
+            // multiplier, so its friction is gone with it
+            let coefficients: Vec<f64> = active
+                .iter()
+                .map(|(p, _)| coulomb(*p).unwrap_or(0.0))
+                .collect();
+            friction_correction(
+                &tangent_rows,
+                &coefficients,
+                &mu_total,
+                &mut friction_total,
+                du,
+                &mut delta,
+                inverse_mass,
+            );
             // entries pulled (total multiplier negative) leave and give back their correction
             for (i, row) in rows.iter().enumerate() {
                 if mu_total[i] < 0.0 {
@@ -129,21 +190,26 @@ impl ContactState {
                     in_active[p][k] = false;
                 }
             }
-            let mut kept = mu_total.iter().map(|mu| *mu >= 0.0);
-            active.retain(|_| kept.next().expect("one flag per entry"));
+            let kept: Vec<bool> = mu_total.iter().map(|mu| *mu >= 0.0).collect();
+            let mut flags = kept.iter();
+            active.retain(|_| *flags.next().expect("one flag per entry"));
+            let mut flags = kept.iter();
+            friction_total.retain(|_| *flags.next().expect("one flag per entry"));
             mu_total.retain(|mu| *mu >= 0.0);
         }
-        let forces: Vec<f64> = active
+        // entries closed at the start of the step (their multiplier is the step's force)
+        let persistent: Vec<bool> = active
             .iter()
-            .zip(&mu_total)
-            .map(|((p, k), mu)| {
-                let span = if self.active[*p][*k] && previous > 0.0 {
-                    0.5 * (previous + h)
-                } else {
-                    h
-                };
-                mu / (h * span)
-            })
+            .map(|(p, k)| self.active[*p][*k] && previous > 0.0)
+            .collect();
+        let spans: Vec<f64> = persistent
+            .iter()
+            .map(|closed| if *closed { 0.5 * (previous + h) } else { h })
+            .collect();
+        let forces: Vec<f64> = mu_total
+            .iter()
+            .zip(&spans)
+            .map(|(mu, span)| mu / (h * span))
             .collect();
         let end_position = |node: usize| position(&delta, node);
         let impact_loss: f64 = active
@@ -160,8 +226,10 @@ impl ContactState {
             .sum();
         let mut step_forces: Vec<Vec<f64>> =
             self.force.iter().map(|f| vec![0.0; f.len()]).collect();
-        for ((p, k), mu) in active.iter().zip(&mu_total) {
-            step_forces[*p][*k] = mu / (h * h);
+        let mut step_friction = step_forces.clone();
+        for (i, (p, k)) in active.iter().enumerate() {
+            step_forces[*p][*k] = mu_total[i] / (h * h);
+            step_friction[*p][*k] = friction_total[i] / (h * h);
         }
         let released = self
             .active
@@ -172,7 +240,16 @@ impl ContactState {
             .map(|node| position(&delta, node))
             .collect();
         self.set(interfaces, &active, &forces, released, time, &end);
-        let step_force = self.nodal_forces_of(&interfaces.pairs, start, &step_forces);
+        for (i, (p, k)) in active.iter().enumerate() {
+            self.tangential[*p][*k] = friction_total[i] / (h * spans[i]);
+            // a sliding entry: on the cone, with the signed coefficient of its force
+            let limit = coulomb(*p).unwrap_or(0.0) * mu_total[i];
+            if limit > 0.0 && friction_total[i].abs() >= limit * (1.0 - 1e-12) {
+                self.sliding[*p][*k] = coulomb(*p).unwrap_or(0.0) * friction_total[i].signum();
+            }
+        }
+        let step_force =
+            self.nodal_forces_of(&interfaces.pairs, start, &step_forces, &step_friction);
         ExplicitContact {
             correction: delta,
             step_force,
@@ -181,15 +258,66 @@ impl ContactState {
     }
 }
 
+/// Coulomb's return of the tangential multipliers of the entries with friction (those with
+/// a row in `tangent_rows`, coefficient `coefficients[i]`): the stick increment that undoes
+/// the slip T (du + delta) left by the step so far, (T M^-1 T^T) d_lambda = -T (du + delta),
+/// then the total lambda + d_lambda clamped to the cone |lambda| <= mu_f max(mu, 0) (slide);
+/// the change of lambda is added to `delta` through M^-1 T^T. A row on prescribed DOFs only
+/// (T M^-1 T^T = 0: an axis node held in x against a wall whose tangent is x) is satisfied
+/// by its support and takes no multiplier; it is left out, so that it cannot make the
+/// rows it shares DOFs with singular.
+fn friction_correction(
+    tangent_rows: &[Option<Vec<(usize, f64)>>],
+    coefficients: &[f64],
+    mu_total: &[f64],
+    friction_total: &mut [f64],
+    du: &[f64],
+    delta: &mut [f64],
+    inverse_mass: &[f64],
+) {
+    let movable = |row: &[(usize, f64)]| {
+        row.iter()
+            .any(|(dof, c)| *c != 0.0 && inverse_mass[*dof] > 0.0)
+    };
+    let entries: Vec<usize> = (0..tangent_rows.len())
+        .filter(|i| tangent_rows[*i].as_deref().is_some_and(movable))
+        .collect();
+    if entries.is_empty() {
+        return;
+    }
+    let rows: Vec<Vec<(usize, f64)>> = entries
+        .iter()
+        .map(|i| tangent_rows[*i].clone().expect("filtered above"))
+        .collect();
+    let slips: Vec<f64> = rows
+        .iter()
+        .map(|row| {
+            row.iter()
+                .map(|(dof, c)| c * (du[*dof] + delta[*dof]))
+                .sum()
+        })
+        .collect();
+    let stick = lumped_multipliers(&rows, &slips, inverse_mass);
+    for (a, &i) in entries.iter().enumerate() {
+        let limit = coefficients[i] * mu_total[i].max(0.0);
+        let total = (friction_total[i] + stick[a]).clamp(-limit, limit);
+        let change = total - friction_total[i];
+        for (dof, c) in &rows[a] {
+            delta[*dof] += inverse_mass[*dof] * c * change;
+        }
+        friction_total[i] = total;
+    }
+}
+
 /// The multipliers mu of (C M^-1 C^T) mu = -g for the rows C of the explicit contact step
-/// (lumped M). C M^-1 C^T couples two rows only through a shared DOF, so it is solved per
+/// (lumped M), `g` the rows' violations (the gaps; the slips of tangential rows). C M^-1 C^T couples two rows only through a shared DOF, so it is solved per
 /// group of rows linked by shared DOFs (one row each on a rigid wall; a run of slaves on a
 /// shared master segment otherwise; on a deformable master a continuous contact zone is one
 /// group, so the gain is on rigid obstacles): dense LU of the groups instead of the whole
 /// m x m matrix. A singular group (redundant rows, or rows on prescribed DOFs only, which no
 /// multiplier can move) gets mu = 0 and is left to the penetration check; the others are
 /// solved.
-fn lumped_multipliers(rows: &[Vec<(usize, f64)>], gaps: &[Gap], inverse_mass: &[f64]) -> Vec<f64> {
+fn lumped_multipliers(rows: &[Vec<(usize, f64)>], gaps: &[f64], inverse_mass: &[f64]) -> Vec<f64> {
     let m = rows.len();
     // union-find of the rows over their DOFs
     let mut parent: Vec<usize> = (0..m).collect();
@@ -235,7 +363,7 @@ fn lumped_multipliers(rows: &[Vec<(usize, f64)>], gaps: &[Gap], inverse_mass: &[
         };
         let k = members.len();
         let matrix = nalgebra::DMatrix::from_fn(k, k, |a, b| w(members[a], members[b]));
-        let rhs = nalgebra::DVector::from_fn(k, |a, _| -gaps[members[a]].gap);
+        let rhs = nalgebra::DVector::from_fn(k, |a, _| -gaps[members[a]]);
         let Some(solution) = matrix.lu().solve(&rhs) else {
             continue;
         };

@@ -149,7 +149,9 @@ fn check_dispersion_free(
     Ok(())
 }
 
-/// The explicit central difference contact is frictionless: no pair may have friction.
+/// The explicit central difference contact has Coulomb friction; Greco's return coefficient
+/// (the slip of a step a fraction of the frictionless one, solved again with its target) is
+/// implemented for the implicit integrators and statics only.
 fn check_explicit_friction(
     cx: &Context,
     analysis: &Analysis,
@@ -159,10 +161,10 @@ fn check_explicit_friction(
         && d.integrator == IntegratorKind::CentralDifference
         && let Some(c) = contacts
             .iter()
-            .find(|c| c.options.friction != Friction::None)
+            .find(|c| matches!(c.options.friction, Friction::Return { .. }))
     {
         return Err(cx.err(format!(
-            "contact `{}`: friction is implemented for the implicit integrators and statics; the explicit central difference contact is frictionless",
+            "contact `{}`: return_coefficient is implemented for the implicit integrators and statics; with central_difference use Coulomb's `friction`",
             c.name
         )));
     }
