@@ -16,6 +16,12 @@
 //! f         mu / (h span): the reported force (history, frames, peak_force); f span = J
 //!           per entry, so the impulses sum exactly, and a step clipped to a frame time
 //!           (h << h_prev) reports the force of its neighbours, not J / h
+//! W_c       the step's contact work: f_step . du (du corrected) for an entry closed at t_n
+//!           (its multiplier is the discrete force of the step), and for an entry that
+//!           closes in the step the work of an impulse on the velocities before and after
+//!           it, J . (v_{n+1/2} + v_{n+1/2} + delta / h) / 2 = f_step . du - mu (C delta)
+//!           / (2 h^2): the kinetic energy of the arrest (the whole of 1/2 m v^2 for a node
+//!           that strikes a rigid wall) is dissipated by the interface
 //! T         tangential rows t . (x_s - sum w_m x_m) (`Gap::tangent_row`): T du is the
 //!           relative slip of the step
 //! lambda    tangential multipliers, in the units of mu; Coulomb's return (theory 8.3):
@@ -38,10 +44,8 @@ pub struct ExplicitContact {
     /// positions (all DOFs): what does the step's contact work on its corrected increment
     /// (the friction's share is the work it dissipates).
     pub step_force: Vec<f64>,
-    /// The kinetic energy the entries that closed in this step lose to it: their relative
-    /// normal velocity is stopped within the step (a perfectly inelastic impact of the
-    /// contact nodes' lumped mass), (1/2) sum over them of (mu / h^2) C . delta. The work
-    /// f_step . du of the corrected increment does not see it.
+    /// The kinetic energy the impulses of the entries that close in the step remove beyond
+    /// f_step . du: sum (mu C delta + lambda T delta) / (2 h^2) over them (>= 0; legend, W_c).
     pub impact_loss: f64,
 }
 
@@ -211,19 +215,6 @@ impl ContactState {
             .zip(&spans)
             .map(|(mu, span)| mu / (h * span))
             .collect();
-        let end_position = |node: usize| position(&delta, node);
-        let impact_loss: f64 = active
-            .iter()
-            .zip(&mu_total)
-            .filter(|((p, k), _)| !self.active[*p][*k])
-            .filter_map(|((p, k), mu)| {
-                let pair = &interfaces.pairs[*p];
-                let slave = pair.slaves[*k];
-                let gap = pair.gap(slave, &end_position)?;
-                let moved: f64 = gap.row(slave).iter().map(|(dof, c)| c * delta[*dof]).sum();
-                Some(0.5 * mu / (h * h) * moved)
-            })
-            .sum();
         let mut step_forces: Vec<Vec<f64>> =
             self.force.iter().map(|f| vec![0.0; f.len()]).collect();
         let mut step_friction = step_forces.clone();
@@ -239,6 +230,22 @@ impl ContactState {
         let end: Vec<[f64; 2]> = (0..start.len())
             .map(|node| position(&delta, node))
             .collect();
+        let along =
+            |row: Vec<(usize, f64)>| -> f64 { row.iter().map(|(dof, c)| c * delta[*dof]).sum() };
+        let impact_loss: f64 = active
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !persistent[*i])
+            .filter_map(|(i, (p, k))| {
+                let slave = interfaces.pairs[*p].slaves[*k];
+                let g = interfaces.pairs[*p].gap(slave, &|n| end[n])?;
+                Some(
+                    mu_total[i] * along(g.row(slave))
+                        + friction_total[i] * along(g.tangent_row(slave)),
+                )
+            })
+            .sum::<f64>()
+            / (2.0 * h * h);
         self.set(interfaces, &active, &forces, released, time, &end);
         for (i, (p, k)) in active.iter().enumerate() {
             self.tangential[*p][*k] = friction_total[i] / (h * spans[i]);
