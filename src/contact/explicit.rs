@@ -133,14 +133,15 @@ impl ContactState {
                     coulomb(*p).map(|_| g.tangent_row(interfaces.pairs[*p].slaves[*k]))
                 })
                 .collect();
-            // the slip left on the entries inside the friction cone (sticking)
+            // the slip left on the entries inside the friction cone (sticking) that a
+            // multiplier can move (a held node's slip is its support's)
             let slip_left = active
                 .iter()
                 .enumerate()
                 .filter_map(|(i, (p, _))| {
                     let limit = coulomb(*p)? * mu_total[i].max(0.0);
                     let row = tangent_rows[i].as_ref()?;
-                    (friction_total[i].abs() < limit).then(|| {
+                    (friction_total[i].abs() < limit && moves(row, inverse_mass)).then(|| {
                         let slip: f64 = row
                             .iter()
                             .map(|(dof, c)| c * (du[*dof] + delta[*dof]))
@@ -282,12 +283,12 @@ fn friction_correction(
     delta: &mut [f64],
     inverse_mass: &[f64],
 ) {
-    let movable = |row: &[(usize, f64)]| {
-        row.iter()
-            .any(|(dof, c)| *c != 0.0 && inverse_mass[*dof] > 0.0)
-    };
     let entries: Vec<usize> = (0..tangent_rows.len())
-        .filter(|i| tangent_rows[*i].as_deref().is_some_and(movable))
+        .filter(|i| {
+            tangent_rows[*i]
+                .as_deref()
+                .is_some_and(|row| moves(row, inverse_mass))
+        })
         .collect();
     if entries.is_empty() {
         return;
@@ -316,15 +317,27 @@ fn friction_correction(
     }
 }
 
+/// Whether a multiplier on `row` moves anything: a coefficient on a free DOF (prescribed
+/// DOFs have a zero inverse mass).
+fn moves(row: &[(usize, f64)], inverse_mass: &[f64]) -> bool {
+    row.iter()
+        .any(|(dof, c)| *c != 0.0 && inverse_mass[*dof] > 0.0)
+}
+
 /// The multipliers mu of (C M^-1 C^T) mu = -g for the rows C of the explicit contact step
-/// (lumped M), `g` the rows' violations (the gaps; the slips of tangential rows). C M^-1 C^T couples two rows only through a shared DOF, so it is solved per
+/// (lumped M), g the rows' `violations` (the gaps of normal rows, the slips of tangential
+/// ones). C M^-1 C^T couples two rows only through a shared DOF, so it is solved per
 /// group of rows linked by shared DOFs (one row each on a rigid wall; a run of slaves on a
 /// shared master segment otherwise; on a deformable master a continuous contact zone is one
 /// group, so the gain is on rigid obstacles): dense LU of the groups instead of the whole
 /// m x m matrix. A singular group (redundant rows, or rows on prescribed DOFs only, which no
 /// multiplier can move) gets mu = 0 and is left to the penetration check; the others are
 /// solved.
-fn lumped_multipliers(rows: &[Vec<(usize, f64)>], gaps: &[f64], inverse_mass: &[f64]) -> Vec<f64> {
+fn lumped_multipliers(
+    rows: &[Vec<(usize, f64)>],
+    violations: &[f64],
+    inverse_mass: &[f64],
+) -> Vec<f64> {
     let m = rows.len();
     // union-find of the rows over their DOFs
     let mut parent: Vec<usize> = (0..m).collect();
@@ -370,7 +383,7 @@ fn lumped_multipliers(rows: &[Vec<(usize, f64)>], gaps: &[f64], inverse_mass: &[
         };
         let k = members.len();
         let matrix = nalgebra::DMatrix::from_fn(k, k, |a, b| w(members[a], members[b]));
-        let rhs = nalgebra::DVector::from_fn(k, |a, _| -gaps[members[a]]);
+        let rhs = nalgebra::DVector::from_fn(k, |a, _| -violations[members[a]]);
         let Some(solution) = matrix.lu().solve(&rhs) else {
             continue;
         };
