@@ -207,7 +207,38 @@ pub fn cases() -> Vec<Case> {
             }
         }
     }
+    cases.extend(rod_pair_cases());
     cases
+}
+
+/// Two rods striking each other (models/rod_on_rod.toml, mortar contact) and one of them on
+/// a rigid wall (models/rod_wall.toml), one-point kernel, frames off: the pair should cost
+/// about twice the single rod, its contact a small share of the run.
+fn rod_pair_cases() -> Vec<Case> {
+    [
+        ("rod_on_rod", "rod_pair_reduced"),
+        ("rod_wall", "rod_wall_reduced"),
+    ]
+    .into_iter()
+    .map(|(file, name)| Case {
+        name: name.to_string(),
+        method: Method::ExplicitReduced,
+        n: 5,
+        steps: 0,
+        bottom: Bottom::Wall,
+        frame_every: 0,
+        threads: None,
+        speed: 0.0,
+        strategy: "modified",
+        scene: Some(SceneCase {
+            file: PathBuf::from(format!("models/{file}.toml")),
+            overrides: vec![
+                "analysis.quadrature=reduced".to_string(),
+                "output.frame_every=0".to_string(),
+            ],
+        }),
+    })
+    .collect()
 }
 
 /// The final value of `measure` in the run of row `r` (its history in `dir`).

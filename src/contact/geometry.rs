@@ -163,7 +163,10 @@ pub fn winding_number(s: [f64; 2], segments: &[[[f64; 2]; 2]]) -> f64 {
 /// included): an odd number of the boundary's crossings of the ray from `s` along +x. For a
 /// point off the boundary this is `winding_number(s) > 0.5` without its two arc tangents a
 /// segment, which made the inside test the costliest part of a contact search.
-fn inside_by_crossings(s: [f64; 2], segments: impl Iterator<Item = [[f64; 2]; 2]>) -> bool {
+pub(super) fn inside_by_crossings(
+    s: [f64; 2],
+    segments: impl Iterator<Item = [[f64; 2]; 2]>,
+) -> bool {
     let mut inside = false;
     for [a, b] in segments {
         if (a[1] > s[1]) != (b[1] > s[1]) {

@@ -59,14 +59,19 @@ pub fn weighted_gap(
     slave: usize,
     x: &dyn Fn(usize) -> [f64; 2],
 ) -> Option<Gap> {
-    let own: Vec<[usize; 2]> = surface
-        .edges
-        .iter()
-        .filter(|e| e.contains(&slave))
-        .copied()
-        .collect();
+    // a surface node has at most two segments
+    let mut own = [[0usize; 2]; 2];
+    let mut count = 0;
+    for e in surface.edges.iter().filter(|e| e.contains(&slave)) {
+        if count == own.len() {
+            return None;
+        }
+        own[count] = *e;
+        count += 1;
+    }
+    let own = &own[..count];
     let mut sum = [0.0; 2];
-    for [a, b] in &own {
+    for [a, b] in own {
         let n = outward(x(*a), x(*b));
         sum = [sum[0] + n[0], sum[1] + n[1]];
     }
@@ -76,11 +81,11 @@ pub fn weighted_gap(
     }
     let slave_normal = [-sum[0] / l, -sum[1] / l];
     let mut master_normal = [0.0; 2];
-    let mut masters: Vec<(usize, f64)> = Vec::new();
+    let mut masters: Vec<(usize, f64)> = Vec::with_capacity(4);
     // D_jj over the whole support, and int Phi_j dA over the overlaps
     let mut full = 0.0;
     let mut covered = 0.0;
-    for [a, b] in &own {
+    for [a, b] in own {
         let (xa, xb) = (x(*a), x(*b));
         let ab = sub(xb, xa);
         let length2 = dot(ab, ab);

@@ -5,7 +5,7 @@
 //! slaves that start inside their master, master nodes sinking into a slave body that a
 //! one-pass search never looks at).
 
-use super::geometry::{ContactPair, Master, project, winding_number};
+use super::geometry::{ContactPair, Master, inside_by_crossings, project};
 use super::search::slave_gaps;
 use crate::mesh::plane::{dot, sub};
 use crate::output::readable;
@@ -112,8 +112,8 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
 
 /// The deepest penetration of a deformable master's nodes into the slave body, whose
 /// boundary edges are `slave_boundary` (global ids): for each master node inside that
-/// boundary (winding number above 1/2), its distance to the nearest boundary edge. Zero when
-/// none is inside. Only master nodes within the slave boundary's bounding box are tested.
+/// boundary (an odd number of crossings of a ray), its distance to the nearest boundary edge.
+/// Zero when none is inside. Only master nodes within the slave boundary's bounding box are tested.
 pub fn master_penetration(
     pair: &ContactPair,
     coords: &[[f64; 2]],
@@ -143,7 +143,7 @@ pub fn master_penetration(
     for m in nodes {
         let p = coords[m];
         let boxed = (0..2).all(|c| p[c] > lo[c] && p[c] < hi[c]);
-        if !boxed || winding_number(p, &segments) <= 0.5 {
+        if !boxed || !inside_by_crossings(p, segments.iter().copied()) {
             continue;
         }
         let depth = segments
