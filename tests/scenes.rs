@@ -114,3 +114,44 @@ fn every_scene_runs_and_writes_the_output_contract() {
         }
     }
 }
+
+/// Goal: `impact check` prints the step the run takes: on every explicit scene of models/
+/// the step `check` reports is the run's first step (what the user plans cost and accuracy
+/// with). Setup: each central-difference scene, run for three of its first steps with no
+/// frame times. Reference: the run's own first row of history.csv (its time is the first
+/// step); equal to round-off (1e-12 relative: the same arithmetic, a sum of one term).
+#[test]
+fn check_reports_the_first_step_of_the_run_on_every_explicit_scene() {
+    let mut explicit = 0;
+    for path in scenes() {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let model = impact::scene::load(&path, &[]).unwrap();
+        let impact::scene::model::Analysis::Dynamic(spec) = &model.analysis else {
+            continue;
+        };
+        if spec.integrator != impact::scene::spec::IntegratorKind::CentralDifference {
+            continue;
+        }
+        explicit += 1;
+        let impact::analysis::check::StepStability::Conditional { dt: Some(dt), .. } =
+            impact::analysis::check::step_stability(&model, spec).unwrap()
+        else {
+            panic!("{name}: central difference has a conditional step");
+        };
+        let overrides = [
+            format!("analysis.end_time={:e}", 3.0 * dt),
+            "output.frame_every=0".to_string(),
+            "output.frame_times=[]".to_string(),
+        ];
+        let model = impact::scene::load(&path, &overrides).unwrap();
+        let dir = common::out_dir(&format!("first_step_{name}"));
+        impact::analysis::run(&model, &dir, Default::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let first = common::column(&dir, "time")[1];
+        assert!(
+            (first / dt - 1.0).abs() < 1e-12,
+            "{name}: check says {dt:e}, the run's first step is {first:e}"
+        );
+    }
+    assert!(explicit >= 4, "{explicit} explicit scenes");
+}

@@ -15,10 +15,10 @@
 //!              Wilson-theta: unconditionally stable for theta >= 1.37 only
 //! ```
 
-use super::explicit::{StableStep, checked_step, critical_time_step};
+use super::explicit::{StableStep, checked_step, critical_time_step, first_step};
 use crate::element::Formulation;
 use crate::output::readable;
-use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind, TimeStep};
+use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind};
 use crate::scene::{BodyKind, InputError, Model};
 
 /// A body's wave speed and the modulus it comes from.
@@ -93,16 +93,27 @@ pub enum StepStability {
     WilsonBelowLimit { dt: f64, dt_crit_explicit: f64 },
 }
 
+/// How many steps of `dt` the run takes to its end time: exactly for a fixed step, at least
+/// for the automatic one (the stable step falls as elements crush).
+fn step_count(spec: &DynamicSpec, dt: f64) -> String {
+    let steps = (spec.end_time / dt).ceil();
+    match spec.step {
+        crate::scene::spec::TimeStep::Fixed(_) => format!("{steps:.0} steps to end_time"),
+        crate::scene::spec::TimeStep::Auto { .. } => format!(
+            "at least {steps:.0} steps to end_time (the automatic step falls as elements deform)"
+        ),
+    }
+}
+
 /// The step of `spec` against the stability limit of its integrator; a central-difference
 /// fixed dt above its limit is refused exactly as a run refuses it.
 pub fn step_stability(model: &Model, spec: &DynamicSpec) -> Result<StepStability, InputError> {
     let has_mass = model.bodies.iter().all(|b| b.material.density > 0.0);
     if spec.integrator == IntegratorKind::CentralDifference {
+        // the element-eigenvalue limit, and the step the run will take (the automatic step
+        // scales the explicit kernel's conservative bound, below the limit)
         let StableStep { dt: dt_crit, .. } = checked_step(model, spec)?;
-        let dt = match spec.step {
-            TimeStep::Fixed(dt) => Some(dt),
-            TimeStep::Auto { scale, .. } => Some(scale * dt_crit),
-        };
+        let dt = Some(first_step(model, spec)?);
         return Ok(StepStability::Conditional { dt, dt_crit });
     }
     let dt = spec.dt();
@@ -171,10 +182,11 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
         let name = spec.integrator.name();
         lines.push(match step_stability(model, spec)? {
             StepStability::Conditional { dt: Some(dt), dt_crit } => format!(
-                "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}{}",
+                "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}; {}{}",
                 readable(dt),
                 readable(dt_crit),
                 readable(dt / dt_crit),
+                step_count(spec, dt),
                 if spec.mass == MassKind::Consistent {
                     " (from the lumped-mass frequency bound: the consistent mass's highest \
                      frequency is higher, sqrt 3 times for rods, so its limit is lower)"

@@ -52,6 +52,37 @@ pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
     })
 }
 
+/// The clock of a run's first step: the element frequency bound of the kernel that will
+/// step `state` (one-point, 2x2 in rate form, or the general element loop), with the
+/// element-eigenvalue limit `exact` for a fixed step's check.
+fn initial_clock(
+    model: &Model,
+    spec: &DynamicSpec,
+    exact: f64,
+    state: &State,
+    masses: &ElementMasses,
+    kernel: Option<&dyn ExplicitKernel>,
+) -> Result<Clock, InputError> {
+    let first = match kernel {
+        Some(kernel) => kernel.frequency_bound(&state.coordinates),
+        None => assembly::frequency_bound(model, state, masses),
+    }
+    .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    Ok(Clock::new(spec, exact, first))
+}
+
+/// The first step a central-difference run of `model` takes (a fixed dt, or the automatic
+/// step of the kernel that will run), computed as the run computes it: what `impact check`
+/// prints.
+pub fn first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, InputError> {
+    let exact = checked_step(model, spec)?.dt;
+    let masses =
+        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    let state = State::initial(model);
+    let (kernel, _) = explicit_kernel(model, spec, &state, &masses);
+    Ok(initial_clock(model, spec, exact, &state, &masses, kernel.as_deref())?.dt0)
+}
+
 /// The stability limit of `model`, or the refusal of a fixed dt above it (unless the scene
 /// sets `allow_unstable` to watch it blow up): the one check `impact check` and a run share.
 pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, InputError> {
@@ -135,12 +166,7 @@ impl<'a> Explicit<'a> {
             .collect();
         let state = State::initial(model);
         let (kernel, kernel_has_own_state) = explicit_kernel(model, spec, &state, &masses);
-        let first = match &kernel {
-            Some(kernel) => kernel.frequency_bound(&state.coordinates),
-            None => assembly::frequency_bound(model, &state, &masses),
-        }
-        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-        let clock = Clock::new(spec, dt_crit, first);
+        let clock = initial_clock(model, spec, dt_crit, &state, &masses, kernel.as_deref())?;
         let dofs = model.dofs();
         Ok(Explicit {
             model,
