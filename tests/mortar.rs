@@ -1,6 +1,7 @@
 //! Segment-to-segment (mortar) contact between deformable bodies: the contact patch test
 //! (Taylor & Papadopoulos 1991; Crisfield 2000) and two rods striking each other, whose
-//! plane of symmetry makes each rod the same rod on a frictionless rigid wall.
+//! plane of symmetry makes each rod the same rod on a frictionless rigid wall; a block on a
+//! plate with either surface the slave.
 
 mod common;
 
@@ -324,4 +325,217 @@ fn rod_pair_with_non_matching_meshes_matches_the_wall() {
             0.01,
         );
     }
+}
+
+/// A steel block (10 mm x 10 mm, J2, E 210 GPa, yield 500 MPa, 30 x 30 elements) falling at
+/// 10 m/s onto an aluminium plate (40 mm x 4 mm, J2, E 70 GPa, yield 250 MPa, 80 x 8
+/// elements) clamped at both ends, plane strain, 0.02 mm apart at the start, 20 us. The
+/// block's bottom edge is the slave and the plate's top edge the master (the right roles:
+/// the shorter, finer surface as the slave); `SWAP_ROLES` gives the plate's longer edge the
+/// slave role and makes the block's open edge the master.
+const BLOCK_ON_PLATE: &str = r#"
+[[material]]
+name = "steel"
+young = 210.0e9
+poisson = 0.3
+density = 7850.0
+yield_stress = 500.0e6
+
+[[material]]
+name = "aluminium"
+young = 70.0e9
+poisson = 0.33
+density = 2700.0
+yield_stress = 250.0e6
+
+[[body]]
+name = "plate"
+material = "aluminium"
+formulation = "plane_strain"
+mesh = { type = "rectangle", origin = [-20.0e-3, -4.0e-3], width = 40.0e-3, height = 4.0e-3, nx = 80, ny = 8 }
+
+[[body]]
+name = "block"
+material = "steel"
+formulation = "plane_strain"
+velocity = [0.0, -10.0]
+mesh = { type = "rectangle", origin = [-5.0e-3, 0.02e-3], width = 10.0e-3, height = 10.0e-3, nx = 30, ny = 30 }
+
+[[support]]
+body = "plate"
+set = "left"
+fix = ["x", "y"]
+
+[[support]]
+body = "plate"
+set = "right"
+fix = ["x", "y"]
+
+[[contact]]
+name = "impact"
+slave = { body = "block", set = "bottom" }
+master = { body = "plate", set = "top" }
+discretization = "mortar"
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+end_time = 20.0e-6
+
+[output]
+frame_every = 0
+"#;
+
+/// The overrides that make the plate's top edge the slave and the block's bottom the master.
+const SWAP_ROLES: [&str; 4] = [
+    "contact.impact.slave.body=plate",
+    "contact.impact.slave.set=top",
+    "contact.impact.master.body=block",
+    "contact.impact.master.set=bottom",
+];
+
+/// What a run's history says about the energy where contact closes, as fractions of the
+/// initial kinetic energy.
+struct ClosureEnergy {
+    /// The largest rise of the kinetic energy between consecutive rows from the row before
+    /// first touch to 0.5 us after it.
+    first_touch_rise: f64,
+    /// The largest rise of kinetic + stored + plastic energy over a later step in which the
+    /// pair closes again (its normal force rising from zero).
+    later_closure_rise: f64,
+    /// The largest |external_work| of the run.
+    external_work: f64,
+}
+
+fn closure_energy(dir: &Path) -> ClosureEnergy {
+    let time = common::column(dir, "time");
+    let kinetic = common::column(dir, "kinetic_energy");
+    let stored = common::column(dir, "internal_energy");
+    let plastic = common::column(dir, "plastic_work");
+    let force = common::column(dir, "contact_force[impact]");
+    let initial = kinetic[0];
+    let mechanical: Vec<f64> = (0..time.len())
+        .map(|i| kinetic[i] + stored[i] + plastic[i])
+        .collect();
+    let closures: Vec<usize> = (1..time.len())
+        .filter(|&i| force[i] > 0.0 && force[i - 1] == 0.0)
+        .collect();
+    let touch = closures[0];
+    let first_touch_rise = (touch..time.len())
+        .take_while(|&i| time[i] <= time[touch] + 0.5e-6)
+        .map(|i| (kinetic[i] - kinetic[i - 1]) / initial)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let later_closure_rise = closures[1..]
+        .iter()
+        .map(|&i| (mechanical[i] - mechanical[i - 1]) / initial)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let external_work = common::column(dir, "external_work")
+        .iter()
+        .fold(0.0f64, |m, w| m.max(w.abs()));
+    ClosureEnergy {
+        first_touch_rise,
+        later_closure_rise,
+        external_work,
+    }
+}
+
+/// The block-on-plate pair run with the right roles and with the roles swapped, with
+/// `overrides`: the plastic work of the swapped run within `band` of the right roles', and
+/// the closure energies of both as `block_on_plate_with_the_plate_edge_as_slave_explicit`
+/// states. Returns the two plastic works.
+fn block_on_plate_both_roles(name: &str, overrides: &[&str], band: f64) -> (f64, f64) {
+    let mut swapped = overrides.to_vec();
+    swapped.extend_from_slice(&SWAP_ROLES);
+    let mut plastic = Vec::new();
+    for (tag, all) in [("right", overrides), ("swapped", &swapped[..])] {
+        let run_name = format!("{name}_{tag}");
+        let (_, summary, _, dir) = run(&run_name, BLOCK_ON_PLATE, all);
+        let energy = closure_energy(&dir);
+        println!(
+            "{run_name}: plastic work {:.5} J/m of {:.4}, first-touch KE rise {:.2e}, later \
+             closure rise {:.2e}, penetration {:.2e} m, warnings {:?}",
+            summary.energy.plastic_dissipation,
+            summary.energy.initial,
+            energy.first_touch_rise,
+            energy.later_closure_rise,
+            summary.contact.max_penetration.unwrap(),
+            summary.warnings
+        );
+        assert_eq!(energy.external_work, 0.0, "{run_name}: clamped supports");
+        assert!(
+            energy.first_touch_rise < 1e-9,
+            "{run_name}: kinetic energy rises at first touch by {:e} of KE_0",
+            energy.first_touch_rise
+        );
+        assert!(
+            energy.later_closure_rise < 1e-3,
+            "{run_name}: energy rises at a closure by {:e} of KE_0",
+            energy.later_closure_rise
+        );
+        assert!(
+            summary.energy.max_relative_drift < 0.01,
+            "{run_name}: energy balance {}",
+            summary.energy.max_relative_drift
+        );
+        plastic.push(summary.energy.plastic_dissipation);
+    }
+    let (right, swapped) = (plastic[0], plastic[1]);
+    assert!(
+        (swapped / right - 1.0).abs() < band,
+        "{name}: plastic work {swapped} with the plate's edge as slave, {right} with the right roles"
+    );
+    (right, swapped)
+}
+
+/// Goal: mortar contact between two deformable bodies does not depend on which surface is
+/// the slave, also when the slave surface is four times longer than an open master: a
+/// steel block dropped on an aluminium plate, with the plate's 40 mm top edge as the slave
+/// and the block's 10 mm bottom edge as the master, dissipates the plastic work of the run
+/// with the right roles, and no closure creates kinetic energy; explicit, at 10 and 100 m/s.
+/// Setup: BLOCK_ON_PLATE (mortar, central difference, automatic step 4.2e-8 s) at 10 m/s and
+/// at 100 m/s, each with both role orders.
+/// Reference: the run with the right roles (block bottom slave, the finer surface), which
+/// is independent of the swapped one's slave set, weights and search; and energy: before
+/// first touch nothing but the block moves, so from the row before first touch to 0.5 us
+/// after it (the compression wave crossing the 4 mm plate, 0.65 us, not yet back at the
+/// interface) the kinetic energy may only fall (tolerance 1e-9 KE_0: round-off; measured
+/// falling by 4e-3 KE_0 a step); at a later closure the bodies vibrate and stored energy
+/// turns kinetic, so there the kinetic + stored + plastic energy must not rise by more
+/// than 1e-3 KE_0 (measured up to 3e-5 at closures, while central difference's measured
+/// energy moves by up to 3.7e-4 KE_0 between any two rows; a closure takes 5e-3 KE_0).
+/// The supports are clamped: no external work. Band (the issue's): plastic work within 2 %
+/// (measured 10 m/s 0.955 vs 0.959 J/m, +0.4 %; 100 m/s 1042.5 vs 1035.3 J/m, -0.7 %).
+/// With node-to-segment contact the swapped runs stop on an inverted plate element: at
+/// 0.21 us at 100 m/s and at 2.02 us (first touch) at 10 m/s, a block corner 0.69 mm deep
+/// in the plate. At 100 m/s the swapped mortar run lets the block's corner (a master node)
+/// sink 5.0e-5 m into the plate, which one-pass contact does not see (the run warns); the
+/// right roles keep it to 1.5e-7 m.
+#[test]
+fn block_on_plate_with_the_plate_edge_as_slave_explicit() {
+    let slow = block_on_plate_both_roles("plate_10", &[], 0.02);
+    let fast = block_on_plate_both_roles("plate_100", &["body.block.velocity=[0.0,-100.0]"], 0.02);
+    println!("plastic work (right, swapped): 10 m/s {slow:?}, 100 m/s {fast:?}");
+}
+
+/// Goal: as `block_on_plate_with_the_plate_edge_as_slave_explicit`, on the implicit path:
+/// Newmark average acceleration at 10 m/s, dt 4e-8 s (near the explicit stable step).
+/// Setup: BLOCK_ON_PLATE with `integrator = "average"`, mortar (set explicitly), Hughes'
+/// impact and release conditions, both role orders.
+/// Reference and bands as the explicit test.
+/// Fails (measured): the swapped run ends `ok` with plastic work 1.572 J/m against 0.985
+/// J/m with the right roles (1.60 times), its normal force chattering step to step while
+/// plate nodes beyond the block's edges close and open, and mechanical energy created at
+/// active steps that contact_work does not account for: energy balance off by 16 % (right
+/// roles 0.8 %); the first check it trips is the closure bound, the mechanical energy
+/// rising by 1.7e-3 KE_0 at a closure (right roles 2.0e-4). With node-to-segment contact
+/// the swapped run gives 4.92 J/m (5.0 times).
+#[test]
+#[ignore = "implicit mortar with the plate's longer edge as slave: plastic work 1.60 times the right roles', energy balance off by 16 %"]
+fn block_on_plate_with_the_plate_edge_as_slave_newmark() {
+    let newmark = block_on_plate_both_roles(
+        "plate_newmark",
+        &["analysis.integrator=average", "analysis.dt=4.0e-8"],
+        0.02,
+    );
+    println!("plastic work (right, swapped): {newmark:?}");
 }
