@@ -71,139 +71,17 @@ impl ContactState {
         previous: f64,
         time: f64,
     ) -> ExplicitContact {
-        let n = du.len();
-        let mut delta = vec![0.0; n];
-        let mut active: Vec<(usize, usize)> = Vec::new();
-        // whether (p, k) is in `active`: keeps the bookkeeping linear in the slaves
-        let mut in_active: Vec<Vec<bool>> = interfaces
-            .pairs
-            .iter()
-            .map(|pair| vec![false; pair.slaves.len()])
-            .collect();
-        let mut mu_total: Vec<f64> = Vec::new();
-        // per active entry, its tangential multiplier lambda
-        let mut friction_total: Vec<f64> = Vec::new();
-        let coulomb = |p: usize| match interfaces.pairs[p].options.friction {
-            Friction::Coulomb { mu } if mu > 0.0 => Some(mu),
-            _ => None,
+        let step = Predicted {
+            interfaces,
+            start,
+            du,
+            inverse_mass,
         };
-        let position = |delta: &[f64], node: usize| {
-            [
-                start[node][0] + du[2 * node] + delta[2 * node],
-                start[node][1] + du[2 * node + 1] + delta[2 * node + 1],
-            ]
-        };
-        for _ in 0..20 {
-            // gaps at the corrected positions; penetrated entries join
-            let x = |node: usize| position(&delta, node);
-            let joining: Vec<(usize, usize)> =
-                penetrating(&interfaces.pairs, &x, &|p, k| in_active[p][k])
-                    .map(|s| (s.pair, s.index))
-                    .collect();
-            let changed = !joining.is_empty();
-            for (p, k) in joining {
-                active.push((p, k));
-                in_active[p][k] = true;
-                mu_total.push(0.0);
-                friction_total.push(0.0);
-            }
-            let gaps: Vec<Gap> = active
-                .iter()
-                .map(|(p, k)| {
-                    interfaces.pairs[*p]
-                        .gap(interfaces.pairs[*p].slaves[*k], &x)
-                        .expect("found above")
-                })
-                .collect();
-            let worst = active
-                .iter()
-                .zip(&gaps)
-                .map(|((p, _), g)| {
-                    g.gap.abs()
-                        / interfaces.pairs[*p]
-                            .options
-                            .tolerance
-                            .max(f64::MIN_POSITIVE)
-                })
-                .fold(0.0, f64::max);
-            let tangent_rows: Vec<Option<Vec<(usize, f64)>>> = active
-                .iter()
-                .zip(&gaps)
-                .map(|((p, k), g)| {
-                    coulomb(*p).map(|_| g.tangent_row(interfaces.pairs[*p].slaves[*k]))
-                })
-                .collect();
-            // the slip left on the entries inside the friction cone (sticking) that a
-            // multiplier can move (a held node's slip is its support's)
-            let slip_left = active
-                .iter()
-                .enumerate()
-                .filter_map(|(i, (p, _))| {
-                    let limit = coulomb(*p)? * mu_total[i].max(0.0);
-                    let row = tangent_rows[i].as_ref()?;
-                    (friction_total[i].abs() < limit && moves(row, inverse_mass)).then(|| {
-                        let slip: f64 = row
-                            .iter()
-                            .map(|(dof, c)| c * (du[*dof] + delta[*dof]))
-                            .sum();
-                        slip.abs()
-                            / interfaces.pairs[*p]
-                                .options
-                                .tolerance
-                                .max(f64::MIN_POSITIVE)
-                    })
-                })
-                .fold(0.0, f64::max);
-            if !changed && worst <= 1.0 && slip_left <= 1.0 {
-                break;
-            }
-            let rows: Vec<Vec<(usize, f64)>> = active
-                .iter()
-                .zip(&gaps)
-                .map(|((p, k), g)| g.row(interfaces.pairs[*p].slaves[*k]))
-                .collect();
-            let violations: Vec<f64> = gaps.iter().map(|g| g.gap).collect();
-            let mu = lumped_multipliers(&rows, &violations, inverse_mass);
-            for (i, row) in rows.iter().enumerate() {
-                for (dof, c) in row {
-                    delta[*dof] += inverse_mass[*dof] * c * mu[i];
-                }
-                mu_total[i] += mu[i];
-            }
-            // before the release below: an entry pulled off gets the cone of a zero normal
-            // multiplier, so its friction is gone with it
-            let coefficients: Vec<f64> = active
-                .iter()
-                .map(|(p, _)| coulomb(*p).unwrap_or(0.0))
-                .collect();
-            friction_correction(
-                &tangent_rows,
-                &coefficients,
-                &mu_total,
-                &mut friction_total,
-                du,
-                &mut delta,
-                inverse_mass,
-            );
-            // entries pulled (total multiplier negative) leave and give back their correction
-            for (i, row) in rows.iter().enumerate() {
-                if mu_total[i] < 0.0 {
-                    for (dof, c) in row {
-                        delta[*dof] -= inverse_mass[*dof] * c * mu_total[i];
-                    }
-                    let (p, k) = active[i];
-                    in_active[p][k] = false;
-                }
-            }
-            let kept: Vec<bool> = mu_total.iter().map(|mu| *mu >= 0.0).collect();
-            let mut flags = kept.iter();
-            active.retain(|_| *flags.next().expect("one flag per entry"));
-            let mut flags = kept.iter();
-            friction_total.retain(|_| *flags.next().expect("one flag per entry"));
-            mu_total.retain(|mu| *mu >= 0.0);
-        }
+        let c = step.correct();
+        let coulomb = |p: usize| coulomb(interfaces, p);
         // entries closed at the start of the step (their multiplier is the step's force)
-        let persistent: Vec<bool> = active
+        let persistent: Vec<bool> = c
+            .active
             .iter()
             .map(|(p, k)| self.active[*p][*k] && previous > 0.0)
             .collect();
@@ -211,7 +89,8 @@ impl ContactState {
             .iter()
             .map(|closed| if *closed { 0.5 * (previous + h) } else { h })
             .collect();
-        let forces: Vec<f64> = mu_total
+        let forces: Vec<f64> = c
+            .mu_total
             .iter()
             .zip(&spans)
             .map(|(mu, span)| mu / (h * span))
@@ -219,21 +98,237 @@ impl ContactState {
         let mut step_forces: Vec<Vec<f64>> =
             self.force.iter().map(|f| vec![0.0; f.len()]).collect();
         let mut step_friction = step_forces.clone();
-        for (i, (p, k)) in active.iter().enumerate() {
-            step_forces[*p][*k] = mu_total[i] / (h * h);
-            step_friction[*p][*k] = friction_total[i] / (h * h);
+        for (i, (p, k)) in c.active.iter().enumerate() {
+            step_forces[*p][*k] = c.mu_total[i] / (h * h);
+            step_friction[*p][*k] = c.friction_total[i] / (h * h);
         }
         let released = self
             .active
             .iter()
-            .zip(&in_active)
+            .zip(&c.in_active)
             .any(|(was, is)| was.iter().zip(is).any(|(was, is)| *was && !*is));
         let end: Vec<[f64; 2]> = (0..start.len())
-            .map(|node| position(&delta, node))
+            .map(|node| step.position(&c.delta, node))
             .collect();
-        let along =
-            |row: Vec<(usize, f64)>| -> f64 { row.iter().map(|(dof, c)| c * delta[*dof]).sum() };
-        let impact_loss: f64 = active
+        let impact_loss = c.impact_loss(interfaces, &persistent, &end, h);
+        self.set(interfaces, &c.active, &forces, released, time, &end);
+        for (i, (p, k)) in c.active.iter().enumerate() {
+            self.tangential[*p][*k] = c.friction_total[i] / (h * spans[i]);
+            // a sliding entry: on the cone, with the signed coefficient of its force
+            let limit = coulomb(*p).unwrap_or(0.0) * c.mu_total[i];
+            if limit > 0.0 && c.friction_total[i].abs() >= limit * (1.0 - 1e-12) {
+                self.sliding[*p][*k] = coulomb(*p).unwrap_or(0.0) * c.friction_total[i].signum();
+            }
+        }
+        let step_force =
+            self.nodal_forces_of(&interfaces.pairs, start, &step_forces, &step_friction);
+        ExplicitContact {
+            correction: c.delta,
+            step_force,
+            impact_loss,
+        }
+    }
+}
+
+/// Pair `p`'s Coulomb coefficient, when it has friction.
+fn coulomb(interfaces: &Interfaces, p: usize) -> Option<f64> {
+    match interfaces.pairs[p].options.friction {
+        Friction::Coulomb { mu } if mu > 0.0 => Some(mu),
+        _ => None,
+    }
+}
+
+/// The predicted step that the contact corrects: positions `start + du`.
+struct Predicted<'a> {
+    interfaces: &'a Interfaces,
+    start: &'a [[f64; 2]],
+    du: &'a [f64],
+    inverse_mass: &'a [f64],
+}
+
+/// The correction of a step: delta, the active entries and their accumulated normal (mu)
+/// and tangential (lambda) multipliers.
+struct Correction {
+    delta: Vec<f64>,
+    active: Vec<(usize, usize)>,
+    /// Whether (p, k) is in `active`: keeps the bookkeeping linear in the slaves.
+    in_active: Vec<Vec<bool>>,
+    mu_total: Vec<f64>,
+    friction_total: Vec<f64>,
+}
+
+impl Predicted<'_> {
+    fn position(&self, delta: &[f64], node: usize) -> [f64; 2] {
+        [
+            self.start[node][0] + self.du[2 * node] + delta[2 * node],
+            self.start[node][1] + self.du[2 * node + 1] + delta[2 * node + 1],
+        ]
+    }
+
+    /// The passes of the correction (at most 20): penetrated entries join, the multipliers
+    /// close the gaps, friction returns into its cone, entries in tension leave; until no
+    /// entry joins and the gaps and sticking slips are within TOL.
+    fn correct(&self) -> Correction {
+        let interfaces = self.interfaces;
+        let mut c = Correction {
+            delta: vec![0.0; self.du.len()],
+            active: Vec::new(),
+            in_active: interfaces
+                .pairs
+                .iter()
+                .map(|pair| vec![false; pair.slaves.len()])
+                .collect(),
+            mu_total: Vec::new(),
+            friction_total: Vec::new(),
+        };
+        for _ in 0..20 {
+            // gaps at the corrected positions; penetrated entries join
+            let delta = &c.delta;
+            let x = |node: usize| self.position(delta, node);
+            let joining: Vec<(usize, usize)> =
+                penetrating(&interfaces.pairs, &x, &|p, k| c.in_active[p][k])
+                    .map(|s| (s.pair, s.index))
+                    .collect();
+            let changed = !joining.is_empty();
+            for (p, k) in joining {
+                c.active.push((p, k));
+                c.in_active[p][k] = true;
+                c.mu_total.push(0.0);
+                c.friction_total.push(0.0);
+            }
+            let gaps: Vec<Gap> = c
+                .active
+                .iter()
+                .map(|(p, k)| {
+                    interfaces.pairs[*p]
+                        .gap(interfaces.pairs[*p].slaves[*k], &x)
+                        .expect("found above")
+                })
+                .collect();
+            let tangent_rows: Vec<Option<Vec<(usize, f64)>>> = c
+                .active
+                .iter()
+                .zip(&gaps)
+                .map(|((p, k), g)| {
+                    coulomb(interfaces, *p).map(|_| g.tangent_row(interfaces.pairs[*p].slaves[*k]))
+                })
+                .collect();
+            if !changed && self.settled(&c, &gaps, &tangent_rows) {
+                break;
+            }
+            self.pass(&mut c, &gaps, &tangent_rows);
+        }
+        c
+    }
+
+    /// Whether the active entries' gaps are within TOL and the sticking entries' slips too
+    /// (those a multiplier can move: a held node's slip is its support's).
+    fn settled(
+        &self,
+        c: &Correction,
+        gaps: &[Gap],
+        tangent_rows: &[Option<Vec<(usize, f64)>>],
+    ) -> bool {
+        let tolerance = |p: usize| {
+            self.interfaces.pairs[p]
+                .options
+                .tolerance
+                .max(f64::MIN_POSITIVE)
+        };
+        let worst = c
+            .active
+            .iter()
+            .zip(gaps)
+            .map(|((p, _), g)| g.gap.abs() / tolerance(*p))
+            .fold(0.0, f64::max);
+        let slip_left = c
+            .active
+            .iter()
+            .enumerate()
+            .filter_map(|(i, (p, _))| {
+                let limit = coulomb(self.interfaces, *p)? * c.mu_total[i].max(0.0);
+                let row = tangent_rows[i].as_ref()?;
+                (c.friction_total[i].abs() < limit && moves(row, self.inverse_mass)).then(|| {
+                    let slip: f64 = row
+                        .iter()
+                        .map(|(dof, coefficient)| coefficient * (self.du[*dof] + c.delta[*dof]))
+                        .sum();
+                    slip.abs() / tolerance(*p)
+                })
+            })
+            .fold(0.0, f64::max);
+        worst <= 1.0 && slip_left <= 1.0
+    }
+
+    /// One pass: the normal multipliers that close `gaps`, the friction return, and the
+    /// release of the entries left in tension (they give back their correction).
+    fn pass(&self, c: &mut Correction, gaps: &[Gap], tangent_rows: &[Option<Vec<(usize, f64)>>]) {
+        let (interfaces, inverse_mass) = (self.interfaces, self.inverse_mass);
+        let rows: Vec<Vec<(usize, f64)>> = c
+            .active
+            .iter()
+            .zip(gaps)
+            .map(|((p, k), g)| g.row(interfaces.pairs[*p].slaves[*k]))
+            .collect();
+        let violations: Vec<f64> = gaps.iter().map(|g| g.gap).collect();
+        let mu = lumped_multipliers(&rows, &violations, inverse_mass);
+        for (i, row) in rows.iter().enumerate() {
+            for (dof, coefficient) in row {
+                c.delta[*dof] += inverse_mass[*dof] * coefficient * mu[i];
+            }
+            c.mu_total[i] += mu[i];
+        }
+        // before the release below: an entry pulled off gets the cone of a zero normal
+        // multiplier, so its friction is gone with it
+        let coefficients: Vec<f64> = c
+            .active
+            .iter()
+            .map(|(p, _)| coulomb(interfaces, *p).unwrap_or(0.0))
+            .collect();
+        friction_correction(
+            tangent_rows,
+            &coefficients,
+            &c.mu_total,
+            &mut c.friction_total,
+            self.du,
+            &mut c.delta,
+            inverse_mass,
+        );
+        // entries pulled (total multiplier negative) leave and give back their correction
+        for (i, row) in rows.iter().enumerate() {
+            if c.mu_total[i] < 0.0 {
+                for (dof, coefficient) in row {
+                    c.delta[*dof] -= inverse_mass[*dof] * coefficient * c.mu_total[i];
+                }
+                let (p, k) = c.active[i];
+                c.in_active[p][k] = false;
+            }
+        }
+        let kept: Vec<bool> = c.mu_total.iter().map(|mu| *mu >= 0.0).collect();
+        let mut flags = kept.iter();
+        c.active
+            .retain(|_| *flags.next().expect("one flag per entry"));
+        let mut flags = kept.iter();
+        c.friction_total
+            .retain(|_| *flags.next().expect("one flag per entry"));
+        c.mu_total.retain(|mu| *mu >= 0.0);
+    }
+}
+
+impl Correction {
+    /// The kinetic energy the impulses of the entries that closed in the step (not
+    /// `persistent`) remove beyond f_step . du, at the end positions `end` (legend, W_c).
+    fn impact_loss(
+        &self,
+        interfaces: &Interfaces,
+        persistent: &[bool],
+        end: &[[f64; 2]],
+        h: f64,
+    ) -> f64 {
+        let along = |row: Vec<(usize, f64)>| -> f64 {
+            row.iter().map(|(dof, c)| c * self.delta[*dof]).sum()
+        };
+        self.active
             .iter()
             .enumerate()
             .filter(|(i, _)| !persistent[*i])
@@ -241,28 +336,12 @@ impl ContactState {
                 let slave = interfaces.pairs[*p].slaves[*k];
                 let g = interfaces.pairs[*p].gap(slave, &|n| end[n])?;
                 Some(
-                    mu_total[i] * along(g.row(slave))
-                        + friction_total[i] * along(g.tangent_row(slave)),
+                    self.mu_total[i] * along(g.row(slave))
+                        + self.friction_total[i] * along(g.tangent_row(slave)),
                 )
             })
             .sum::<f64>()
-            / (2.0 * h * h);
-        self.set(interfaces, &active, &forces, released, time, &end);
-        for (i, (p, k)) in active.iter().enumerate() {
-            self.tangential[*p][*k] = friction_total[i] / (h * spans[i]);
-            // a sliding entry: on the cone, with the signed coefficient of its force
-            let limit = coulomb(*p).unwrap_or(0.0) * mu_total[i];
-            if limit > 0.0 && friction_total[i].abs() >= limit * (1.0 - 1e-12) {
-                self.sliding[*p][*k] = coulomb(*p).unwrap_or(0.0) * friction_total[i].signum();
-            }
-        }
-        let step_force =
-            self.nodal_forces_of(&interfaces.pairs, start, &step_forces, &step_friction);
-        ExplicitContact {
-            correction: delta,
-            step_force,
-            impact_loss,
-        }
+            / (2.0 * h * h)
     }
 }
 
