@@ -1,13 +1,15 @@
 //! Segment-to-segment (mortar) contact between deformable bodies: the contact patch test
 //! (Taylor & Papadopoulos 1991; Crisfield 2000) and two rods striking each other, whose
 //! plane of symmetry makes each rod the same rod on a frictionless rigid wall; a block on a
-//! plate with either surface the slave; a block dragged with friction across another.
+//! plate with either surface the slave; a block dragged with friction across another; Hertz
+//! line contact between two elastic cylinders.
 
 mod common;
 
 use impact::analysis::{self, Status, Summary};
 use impact::assembly::State;
 use impact::scene::Model;
+use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 /// Two plane-strain blocks stacked at y = 0.5 with non-matching meshes (3 and 4 elements
@@ -690,4 +692,215 @@ fn drag_with_friction_keeps_mu_and_no_jump_at_segment_ends() {
         coarse.largest_jump,
         fine.largest_jump
     );
+}
+
+/// Two elastic cylinders pressed together along a line, plane strain, as quarter models
+/// (x >= 0, symmetric about x = 0) touching at the origin: the upper R1 = 1, E1 = 1000
+/// (centre (0, 1)), the lower R2 = 2, E2 = 2000 (centre (0, -2)), nu = 0.3 for both. The
+/// lower's flat face is held in y, the upper's pushed down by 0.02 (displacement control:
+/// statics cannot carry a body held by contact alone); both axes on rollers. Small strain.
+/// Both arcs are graded toward the contact with different first steps (0.0045 and 0.0053 at
+/// n = 40), so no two nodes face each other; the upper arc, the finer, is the slave.
+const CYLINDERS: &str = r#"
+[[material]]
+name = "soft"
+young = 1000.0
+poisson = 0.3
+
+[[material]]
+name = "stiff"
+young = 2000.0
+poisson = 0.3
+
+[[body]]
+name = "upper"
+material = "soft"
+formulation = "plane_strain"
+mesh = { type = "quarter_disc", center = [0.0, 1.0], radius = 1.0, n = 40, grading = 30.0, quadrant = "lower" }
+
+[[body]]
+name = "lower"
+material = "stiff"
+formulation = "plane_strain"
+mesh = { type = "quarter_disc", center = [0.0, -2.0], radius = 2.0, n = 40, grading = 60.0, quadrant = "upper" }
+
+[[support]]
+body = "upper"
+set = "axis"
+fix = ["x"]
+
+[[support]]
+body = "lower"
+set = "axis"
+fix = ["x"]
+
+[[support]]
+body = "lower"
+set = "flat"
+fix = ["y"]
+
+[[load]]
+type = "displacement"
+body = "upper"
+set = "flat"
+y = -0.02
+
+[[contact]]
+name = "line"
+slave = { body = "upper", set = "arc" }
+master = { body = "lower", set = "arc" }
+discretization = "mortar"
+
+[analysis]
+type = "static"
+steps = 4
+geometry = "linear"
+
+[output]
+frame_every = 0
+"#;
+
+/// Hertz line contact of two cylinders with parallel axes, plane strain (Johnson, Contact
+/// Mechanics, 1985, section 4.3): for the load P per unit length,
+/// ```text
+/// 1/R* = 1/R1 + 1/R2,  1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
+/// b = sqrt(4 P R* / (pi E*)),  p0 = 2 P / (pi b),  p(x) = p0 sqrt(1 - x^2/b^2)
+/// ```
+/// Returns (half-width b, peak pressure p0) for CYLINDERS' radii and moduli.
+fn hertz_cylinders(force: f64) -> (f64, f64) {
+    let (r1, r2, e1, e2, nu) = (1.0, 2.0, 1000.0, 2000.0, 0.3);
+    let radius = 1.0 / (1.0 / r1 + 1.0 / r2);
+    let modulus = 1.0 / ((1.0 - nu * nu) / e1 + (1.0 - nu * nu) / e2);
+    let b = (4.0 * force * radius / (PI * modulus)).sqrt();
+    (b, 2.0 * force / (PI * b))
+}
+
+/// What a CYLINDERS run gives at the contact line, per unit length of the full cylinders.
+struct LineContact {
+    /// The total normal force P (twice the quarter model's).
+    force: f64,
+    /// The pressure at x = 0: the first slave node's force over its tributary length.
+    center_pressure: f64,
+    /// b of the least-squares fit of p^2 = p0^2 (1 - x^2 / b^2) (a line in x^2).
+    fitted_half_width: f64,
+    /// p0 of the same fit.
+    fitted_peak: f64,
+    /// Slave nodes that carry a force.
+    loaded: usize,
+    /// The largest | p_j - p(x_j) | / p0 against Hertz's profile for x_j <= 0.8 b (b and p0
+    /// of Hertz for the computed force).
+    profile_error: f64,
+}
+
+/// Runs CYLINDERS with `overrides` and measures the contact line on the slave arc. With
+/// mortar contact a slave node's force is int N_j p ds, so its pressure is the force over
+/// D_j = int N_j ds: half the length of its two arc segments (one at x = 0).
+fn line_contact(name: &str, overrides: &[&str]) -> LineContact {
+    let model = common::model(name, CYLINDERS, overrides);
+    let outcome = analysis::run_outcome(&model, &common::out_dir(name), Default::default())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(outcome.summary.status, Status::Ok, "{name}");
+    let upper = &model.bodies[0];
+    let coords = model.coordinates();
+    let mut arc: Vec<usize> = upper.mesh.node_sets["arc"]
+        .iter()
+        .map(|n| upper.global(*n))
+        .collect();
+    // the quarter arc runs from x = 0 (the contact) to x = R1
+    arc.sort_by(|a, b| coords[*a][0].total_cmp(&coords[*b][0]));
+    let length = |a: usize, b: usize| {
+        let (p, q) = (coords[a], coords[b]);
+        (p[0] - q[0]).hypot(p[1] - q[1])
+    };
+    let f = &outcome.contact_force;
+    // (x_j, p_j) along the arc; frictionless, so the whole nodal force is normal (upward
+    // on the upper body: positive pressure)
+    let pressure: Vec<(f64, f64)> = (0..arc.len() - 1)
+        .map(|k| {
+            let n = arc[k];
+            let before = if k == 0 { 0.0 } else { length(arc[k - 1], n) };
+            let tributary = 0.5 * (before + length(n, arc[k + 1]));
+            let (fx, fy) = (f[2 * n], f[2 * n + 1]);
+            (coords[n][0], fx.hypot(fy).copysign(fy) / tributary)
+        })
+        .collect();
+    let force = 2.0 * arc.iter().map(|&n| f[2 * n + 1]).sum::<f64>();
+    let loaded = pressure.iter().take_while(|(_, p)| *p > 0.0).count();
+    assert!(
+        pressure[loaded..].iter().all(|(_, p)| *p == 0.0),
+        "{name}: one contact zone from x = 0"
+    );
+    // least squares p^2 = A + C x^2 over the loaded nodes but the outermost, whose support
+    // straddles the edge of the zone (its value is a mean over a pressure that ends inside it)
+    let fit = &pressure[..loaded - 1];
+    let m = fit.len() as f64;
+    let (st, sy, stt, sty) = fit.iter().fold((0.0, 0.0, 0.0, 0.0), |s, (x, p)| {
+        let (t, y) = (x * x, p * p);
+        (s.0 + t, s.1 + y, s.2 + t * t, s.3 + t * y)
+    });
+    let slope = (m * sty - st * sy) / (m * stt - st * st);
+    let intercept = (sy - slope * st) / m;
+    let (b, p0) = hertz_cylinders(force);
+    let profile_error = pressure
+        .iter()
+        .filter(|(x, _)| *x <= 0.8 * b)
+        .map(|(x, p)| (p - p0 * (1.0 - x * x / (b * b)).sqrt()).abs() / p0)
+        .fold(0.0, f64::max);
+    LineContact {
+        force,
+        center_pressure: pressure[0].1,
+        fitted_half_width: (-intercept / slope).sqrt(),
+        fitted_peak: intercept.sqrt(),
+        loaded,
+        profile_error,
+    }
+}
+
+/// Goal: mortar contact between two deformable bodies with different radii, moduli and
+/// non-matching meshes reproduces Hertz's line contact: half-width and peak pressure within
+/// 2 % (the issue's bound).
+/// Setup: CYLINDERS (static, small strain, mortar) at n = 40 and n = 80 arc elements on
+/// both bodies (12 and 24 loaded slave nodes, b = 0.0865, b / R1 = 0.087). The
+/// pressure is each slave node's force over its tributary length; b and p0 come from the
+/// least-squares ellipse through the loaded nodes (the edge of the zone falls between two
+/// nodes: interpolating to zero there overshoots b by 2 % to 8 %, the pressure being a
+/// square root at the edge).
+/// Reference: Hertz (`hertz_cylinders`, written out here) for the computed total force P:
+/// a half-space theory with a parabolic profile, which the finite cylinders meet to
+/// O((b / R1)^2) (the circle's x^4 / (8 R^3) term: 0.2 % of the gap at x = b). Measured
+/// (n = 40 / 80 / 160, the last 4.4 s): P = 6.470 / 6.456 / 6.454; fitted b -0.62 % /
+/// +0.11 % / +0.04 %, fitted p0 +0.12 % / -0.12 % / -0.19 %, p(0) +0.12 % / -0.11 % /
+/// -0.20 %; profile within 0.54 % / 0.11 % / 0.20 % of p0 up to 0.8 b. Tolerance 2 % for all,
+/// asserted at n = 40 and 80. Also measured: the roles swapped (the coarser arc the slave,
+/// setup_check off: a slave node starts 4.7e-7 inside) within 0.6 %; node-to-segment
+/// contact on the same meshes fits b and p0 within 0.8 % but puts p(0) 4.3 % low at every
+/// density (compare its 4.9 % in the patch test above), so the p(0) check fails it.
+#[test]
+fn hertz_cylinders_half_width_and_peak_pressure_within_two_percent() {
+    for n in [40, 80] {
+        let name = format!("hertz_cylinders_{n}");
+        let upper = format!("body.upper.mesh.n={n}");
+        let lower = format!("body.lower.mesh.n={n}");
+        let c = line_contact(&name, &[&upper, &lower]);
+        let (b, p0) = hertz_cylinders(c.force);
+        println!(
+            "n {n}: P {:.4}, Hertz b {b:.5} p0 {p0:.3}; fitted b {:+.2} %, p0 {:+.2} %; \
+             p(0) {:+.2} %; profile within {:.2} % of p0; {} loaded nodes",
+            c.force,
+            100.0 * (c.fitted_half_width / b - 1.0),
+            100.0 * (c.fitted_peak / p0 - 1.0),
+            100.0 * (c.center_pressure / p0 - 1.0),
+            100.0 * c.profile_error,
+            c.loaded
+        );
+        assert!(c.loaded >= 10, "n {n}: only {} loaded nodes", c.loaded);
+        approx::assert_relative_eq!(c.fitted_half_width, b, max_relative = 0.02);
+        approx::assert_relative_eq!(c.fitted_peak, p0, max_relative = 0.02);
+        approx::assert_relative_eq!(c.center_pressure, p0, max_relative = 0.02);
+        assert!(
+            c.profile_error < 0.02,
+            "n {n}: pressure off Hertz's profile by {} p0",
+            c.profile_error
+        );
+    }
 }
