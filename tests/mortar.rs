@@ -9,7 +9,6 @@ mod common;
 use impact::analysis::{self, Status, Summary};
 use impact::assembly::State;
 use impact::scene::Model;
-use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 /// Two plane-strain blocks stacked at y = 0.5 with non-matching meshes (3 and 4 elements
@@ -760,19 +759,10 @@ geometry = "linear"
 frame_every = 0
 "#;
 
-/// Hertz line contact of two cylinders with parallel axes, plane strain (Johnson, Contact
-/// Mechanics, 1985, section 4.3): for the load P per unit length,
-/// ```text
-/// 1/R* = 1/R1 + 1/R2,  1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
-/// b = sqrt(4 P R* / (pi E*)),  p0 = 2 P / (pi b),  p(x) = p0 sqrt(1 - x^2/b^2)
-/// ```
-/// Returns (half-width b, peak pressure p0) for CYLINDERS' radii and moduli.
+/// Hertz's half-width and peak pressure (`impact::reference::hertz_cylinders`) for the
+/// cylinders of CYLINDERS (R 1 and 2, E 1000 and 2000, nu 0.3) at a load P per unit length.
 fn hertz_cylinders(force: f64) -> (f64, f64) {
-    let (r1, r2, e1, e2, nu) = (1.0, 2.0, 1000.0, 2000.0, 0.3);
-    let radius = 1.0 / (1.0 / r1 + 1.0 / r2);
-    let modulus = 1.0 / ((1.0 - nu * nu) / e1 + (1.0 - nu * nu) / e2);
-    let b = (4.0 * force * radius / (PI * modulus)).sqrt();
-    (b, 2.0 * force / (PI * b))
+    impact::reference::hertz_cylinders([1.0, 2.0], [1000.0, 2000.0], [0.3, 0.3], force)
 }
 
 /// What a CYLINDERS run gives at the contact line, per unit length of the full cylinders.
