@@ -163,21 +163,7 @@ pub fn cases() -> Vec<Case> {
                 "output.frame_every=0".to_string(),
             ];
             overrides.extend(extra);
-            Case {
-                name,
-                method,
-                n: nx,
-                steps: 0,
-                bottom: Bottom::Wall,
-                frame_every: 0,
-                threads: None,
-                speed: 0.0,
-                strategy: "modified",
-                scene: Some(SceneCase {
-                    file: file.clone(),
-                    overrides,
-                }),
-            }
+            scene_case(name, method, nx, file.clone(), overrides)
         };
         let mesh = |nx: usize| format!("{nx}x{}", b.aspect * nx);
         for (method, quadrature) in [
@@ -220,25 +206,43 @@ fn rod_pair_cases() -> Vec<Case> {
         ("rod_wall", "rod_wall_reduced"),
     ]
     .into_iter()
-    .map(|(file, name)| Case {
-        name: name.to_string(),
-        method: Method::ExplicitReduced,
-        n: 5,
+    .map(|(file, name)| {
+        let overrides = vec![
+            "analysis.quadrature=reduced".to_string(),
+            "output.frame_every=0".to_string(),
+        ];
+        let file = PathBuf::from(format!("models/{file}.toml"));
+        scene_case(
+            name.to_string(),
+            Method::ExplicitReduced,
+            5,
+            file,
+            overrides,
+        )
+    })
+    .collect()
+}
+
+/// A case that runs the scene `file` with `overrides`; `n` is its mesh's elements across.
+fn scene_case(
+    name: String,
+    method: Method,
+    n: usize,
+    file: PathBuf,
+    overrides: Vec<String>,
+) -> Case {
+    Case {
+        name,
+        method,
+        n,
         steps: 0,
         bottom: Bottom::Wall,
         frame_every: 0,
         threads: None,
         speed: 0.0,
         strategy: "modified",
-        scene: Some(SceneCase {
-            file: PathBuf::from(format!("models/{file}.toml")),
-            overrides: vec![
-                "analysis.quadrature=reduced".to_string(),
-                "output.frame_every=0".to_string(),
-            ],
-        }),
-    })
-    .collect()
+        scene: Some(SceneCase { file, overrides }),
+    }
 }
 
 /// The final value of `measure` in the run of row `r` (its history in `dir`).
