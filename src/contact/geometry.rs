@@ -304,7 +304,7 @@ impl ContactPair {
                     gap: dot(sub(xs, x(m)), *normal),
                     normal: *normal,
                     masters: vec![(m, 1.0)],
-                    spread: Vec::new(),
+                    weight: 1.0,
                 }
             }
             Master::Segments {
@@ -346,7 +346,7 @@ impl ContactPair {
                     gap,
                     normal,
                     masters: vec![(a, 1.0 - xi), (b, xi)],
-                    spread: Vec::new(),
+                    weight: 1.0,
                 }
             }
             Master::Obstacle(o) => {
@@ -376,7 +376,7 @@ impl ContactPair {
                     gap,
                     normal,
                     masters: Vec::new(),
-                    spread: Vec::new(),
+                    weight: 1.0,
                 }
             }
         };

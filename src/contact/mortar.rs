@@ -167,7 +167,7 @@ pub fn weighted_gap(
         gap,
         normal,
         masters,
-        spread: vec![(slave, share)],
+        weight: share,
     })
 }
 
