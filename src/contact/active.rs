@@ -447,7 +447,7 @@ impl ContactState {
             &step.forces,
             released,
             time,
-            coords,
+            &|n| coords[n],
         );
         for (i, (p, k)) in step.active.iter().enumerate() {
             self.tangential[*p][*k] = step.tangential[i];
@@ -455,7 +455,8 @@ impl ContactState {
         }
     }
 
-    /// Sets the status: the active entries and their forces after a step ending at `time`.
+    /// Sets the status: the active entries and their forces after a step ending at `time`
+    /// with the nodes at `x`.
     pub(super) fn set(
         &mut self,
         interfaces: &Interfaces,
@@ -463,7 +464,7 @@ impl ContactState {
         forces: &[f64],
         released: bool,
         time: f64,
-        coords: &[[f64; 2]],
+        x: &dyn Fn(usize) -> [f64; 2],
     ) {
         for flags in &mut self.active {
             flags.iter_mut().for_each(|a| *a = false);
@@ -488,20 +489,19 @@ impl ContactState {
         }
         let total: f64 = forces.iter().sum();
         self.peak_force = self.peak_force.max(total);
-        let x = |n: usize| coords[n];
         let mut penetration = 0.0f64;
-        for s in slave_gaps(&interfaces.pairs, &x, &|_, _| false) {
+        for s in slave_gaps(&interfaces.pairs, x, &|_, _| false) {
             let g = s.gap.gap;
             self.min_gap = Some(self.min_gap.map_or(g, |m| m.min(g)));
             penetration = penetration.max(-g);
         }
         for pair in &interfaces.pairs {
             let boundary = &interfaces.bodies[pair.slave_body].boundary;
-            penetration = penetration.max(super::setup::master_penetration(pair, coords, boundary));
+            penetration = penetration.max(super::setup::master_penetration(pair, x, boundary));
         }
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);
-        self.peak_extent = self.peak_extent.max(extent(interfaces, active, coords));
+        self.peak_extent = self.peak_extent.max(extent(interfaces, active, x));
     }
 }
 
@@ -583,13 +583,17 @@ pub struct NodalStatus {
 
 /// Largest extent of the closed entries: the largest radius for axisymmetric slaves, else
 /// the largest distance between two closed slaves of a pair.
-fn extent(interfaces: &Interfaces, active: &[(usize, usize)], coords: &[[f64; 2]]) -> f64 {
+fn extent(
+    interfaces: &Interfaces,
+    active: &[(usize, usize)],
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> f64 {
     let mut best: f64 = 0.0;
     for (p, pair) in interfaces.pairs.iter().enumerate() {
         let nodes: Vec<[f64; 2]> = active
             .iter()
             .filter(|(q, _)| *q == p)
-            .map(|(_, k)| coords[pair.slaves[*k]])
+            .map(|(_, k)| x(pair.slaves[*k]))
             .collect();
         let axisymmetric = interfaces.bodies[pair.slave_body].section == Section::Axisymmetric;
         for (i, a) in nodes.iter().enumerate() {

@@ -107,9 +107,7 @@ impl ContactState {
             .iter()
             .zip(&c.in_active)
             .any(|(was, is)| was.iter().zip(is).any(|(was, is)| *was && !*is));
-        let end: Vec<[f64; 2]> = (0..start.len())
-            .map(|node| step.position(&c.delta, node))
-            .collect();
+        let end = |node: usize| step.position(&c.delta, node);
         let impact_loss = c.impact_loss(interfaces, &persistent, &end, h);
         self.set(interfaces, &c.active, &forces, released, time, &end);
         for (i, (p, k)) in c.active.iter().enumerate() {
@@ -322,7 +320,7 @@ impl Correction {
         &self,
         interfaces: &Interfaces,
         persistent: &[bool],
-        end: &[[f64; 2]],
+        end: &dyn Fn(usize) -> [f64; 2],
         h: f64,
     ) -> f64 {
         let along = |row: Vec<(usize, f64)>| -> f64 {
@@ -334,7 +332,7 @@ impl Correction {
             .filter(|(i, _)| !persistent[*i])
             .filter_map(|(i, (p, k))| {
                 let slave = interfaces.pairs[*p].slaves[*k];
-                let g = interfaces.pairs[*p].gap(slave, &|n| end[n])?;
+                let g = interfaces.pairs[*p].gap(slave, end)?;
                 Some(
                     self.mu_total[i] * along(g.row(slave))
                         + self.friction_total[i] * along(g.tangent_row(slave)),

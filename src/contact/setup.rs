@@ -116,7 +116,7 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
 /// Zero when none is inside. Only master nodes within the slave boundary's bounding box are tested.
 pub fn master_penetration(
     pair: &ContactPair,
-    coords: &[[f64; 2]],
+    x: &dyn Fn(usize) -> [f64; 2],
     slave_boundary: &[[usize; 2]],
 ) -> f64 {
     let Master::Segments { edges, .. } = &pair.master else {
@@ -125,10 +125,7 @@ pub fn master_penetration(
     if slave_boundary.is_empty() {
         return 0.0;
     }
-    let segments: Vec<[[f64; 2]; 2]> = slave_boundary
-        .iter()
-        .map(|[a, b]| [coords[*a], coords[*b]])
-        .collect();
+    let segments: Vec<[[f64; 2]; 2]> = slave_boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in segments.iter().flatten() {
         for c in 0..2 {
@@ -141,7 +138,7 @@ pub fn master_penetration(
     nodes.dedup();
     let mut deepest = 0.0f64;
     for m in nodes {
-        let p = coords[m];
+        let p = x(m);
         let boxed = (0..2).all(|c| p[c] > lo[c] && p[c] < hi[c]);
         if !boxed || !inside_by_crossings(p, segments.iter().copied()) {
             continue;
