@@ -4,12 +4,26 @@ use clap::{Parser, Subcommand};
 use impact::analysis::progress::Mode as Progress;
 use impact::analysis::{self, RunError, RunOptions};
 use impact::output::plot::{self, Chart, Limits, Series, SeriesStyle};
-use impact::output::{OutputError, readable};
+use impact::output::{OutputError, console, readable};
 use impact::scene::{self, InputError};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
+
+/// A line on stdout that a closed reader (`| head`) cannot turn into a panic.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        console::out(format_args!($($arg)*))
+    };
+}
+
+/// A line on stderr that a closed reader cannot turn into a panic.
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        console::err(format_args!($($arg)*))
+    };
+}
 
 #[derive(Parser)]
 #[command(
@@ -252,7 +266,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             ExitCode::from(e.exit_code() as u8)
         }
     }
@@ -286,7 +300,7 @@ fn run_options(progress: Progress) -> RunOptions {
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         // without a handler the default action still stops the run, only less tidily
         if let Err(e) = signal_hook::flag::register(signal, Arc::clone(flag)) {
-            eprintln!("warning: cannot catch signal {signal}: {e}");
+            errln!("warning: cannot catch signal {signal}: {e}");
         }
     }
     RunOptions {
@@ -329,14 +343,16 @@ fn bench(quick: bool, scenes: bool, only: &[String], out: Option<PathBuf>) -> Re
             ),
         )));
     }
-    println!("impact bench: {} cases -> {}", cases.len(), dir.display());
+    outln!("impact bench: {} cases -> {}", cases.len(), dir.display());
     let rows = impact::bench::run(&exe, &dir, &cases, |row| {
-        println!(
+        outln!(
             "  {}: {} DOFs, {:.3} s",
-            row.name, row.dofs, row.wall_seconds
+            row.name,
+            row.dofs,
+            row.wall_seconds
         )
     })?;
-    print!("{}", impact::bench::table(&rows));
+    console::out_text(&impact::bench::table(&rows));
     Ok(())
 }
 
@@ -355,7 +371,7 @@ fn run(
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
     let summary = analysis::run(&model, &dir, run_options(progress))?;
     if !quiet {
-        println!(
+        outln!(
             "{}: {}, {}, {}, t = {}, {:.2} s -> {}",
             model.name,
             count(summary.steps, "step"),
@@ -368,7 +384,7 @@ fn run(
     }
     // warnings are printed even with --quiet: they are about the answer
     for warning in &summary.warnings {
-        eprintln!("warning: {warning}");
+        errln!("warning: {warning}");
     }
     if strict && !summary.warnings.is_empty() {
         return Err(RunError::Warnings {
@@ -383,7 +399,7 @@ fn resume(dir: &Path, progress: Progress) -> Result<(), RunError> {
     let quiet = progress == Progress::Off;
     let summary = analysis::resume(dir, run_options(progress))?;
     if !quiet {
-        println!(
+        outln!(
             "resumed {}: {} in all, t = {} -> {}",
             summary.scene,
             count(summary.steps, "step"),
@@ -399,9 +415,9 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
     // the refusals a run makes before its first step (a central-difference dt above the
     // stability limit) come first: a scene `check` calls valid runs
     let report = analysis::check::report(&model)?;
-    println!("{}: valid", path.display());
+    outln!("{}: valid", path.display());
     for body in &model.bodies {
-        println!(
+        outln!(
             "  body `{}`: {} nodes, {} elements, {}, material `{}`",
             body.name,
             body.mesh.nodes.len(),
@@ -410,14 +426,14 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
             body.material.name
         );
     }
-    println!(
+    outln!(
         "  total: {} nodes, {} elements, {} DOFs",
         model.node_count,
         model.elements(),
         model.dofs()
     );
     for line in report {
-        println!("  {line}");
+        outln!("  {line}");
     }
     if model.bodies.iter().all(|b| b.material.density > 0.0) {
         let analysis::explicit::StableStep {
@@ -425,7 +441,7 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
             body: b,
             element: e,
         } = analysis::explicit::critical_time_step(&model)?;
-        println!(
+        outln!(
             "  central-difference stability limit: dt_crit = {} (element eigenvalue bound; body `{}`, element {e})",
             readable(dt_crit),
             model.bodies[b].name
@@ -456,19 +472,19 @@ fn buckle(
     let found = analysis::buckling::linear_modes(&model, count)
         .map_err(|e| InputError::new(path, format!("linearized buckling: {e}")))?;
     analysis::buckling::write_modes(&model, &found, &dir)?;
-    println!(
+    outln!(
         "{}: linearized buckling of the loads at t = {} ({} free DOFs)",
         model.name,
         readable(model.analysis.end_time()),
         model.dofs() - model.constrained_dofs().len()
     );
     for (i, mode) in found.iter().enumerate() {
-        println!("  mode {}: lambda = {:.6e}", i + 1, mode.lambda);
+        outln!("  mode {}: lambda = {:.6e}", i + 1, mode.lambda);
     }
     if found.len() < count {
-        println!("  ({} of {count} modes converged)", found.len());
+        outln!("  ({} of {count} modes converged)", found.len());
     }
-    println!(
+    outln!(
         "  mode shapes: {}",
         dir.join(format!("{}_buckling.pvd", model.name)).display()
     );
@@ -534,7 +550,7 @@ fn sweep(
         sweep::run(&plan, &out, options)?
     };
     if !quiet {
-        println!(
+        outln!(
             "sweep: {} cases, {} in this shard, {} executed, {} skipped (finished before), {} not ok -> {}",
             report.cases,
             report.in_shard,
@@ -544,10 +560,10 @@ fn sweep(
             report.csv.display()
         );
         for chart in &report.charts {
-            println!("  {}", chart.display());
+            outln!("  {}", chart.display());
         }
         for note in &report.notes {
-            println!("  note: {note}");
+            outln!("  note: {note}");
         }
     }
     Ok(())
@@ -632,7 +648,7 @@ fn plot_history(
         OutputError::Invalid { .. } => bad_input(e),
         other => RunError::Output(other),
     })?;
-    println!("{}", out.display());
+    outln!("{}", out.display());
     Ok(())
 }
 

@@ -688,3 +688,97 @@ fn set_errors_name_the_edit_not_a_line() {
     );
     assert!(!stderr.contains("line "), "{stderr}");
 }
+
+/// Runs `impact ARGS` with stdout and stderr pipes whose reading ends are closed before the
+/// child writes anything (a run piped into `head -1` that has already exited), and returns
+/// its exit code.
+fn with_closed_output(args: &[&str]) -> Option<i32> {
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    // the child holds only the writing ends now: every write it makes fails with EPIPE
+    drop(child.stdout.take());
+    drop(child.stderr.take());
+    child.wait().expect("the child ends").code()
+}
+
+/// Goal: a reader that stops reading (`impact run scene.toml 2>&1 | head -1`) never costs a
+/// run its output or its exit code. Before: `println!` panicked on the closed pipe after the
+/// last step (exit 101) and summary.json was never written. Setup: the static beam with a
+/// progress line at every step and the closing line; the two bars with a step longer than
+/// the run (a warning on stderr) under --strict; check, sweep and plot of the same, all with
+/// both pipes closed. Reference: the exit codes of the contract (0, and 3 for --strict with
+/// a warning) and a summary.json that parses with status "ok".
+#[test]
+fn closed_stdout_and_stderr_cost_no_output() {
+    let dir = common::out_dir("cli_closed_pipe");
+    let scene = write_scene(&dir, "beam", BEAM);
+    let scene = scene.to_str().unwrap();
+    let out = dir.join("out");
+    let code = with_closed_output(&[
+        "run",
+        scene,
+        "--out",
+        out.to_str().unwrap(),
+        "--progress-every",
+        "0",
+    ]);
+    assert_eq!(code, Some(0));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "ok");
+    assert_eq!(summary["steps"], 4);
+
+    let bars = dir.join("bars");
+    let code = with_closed_output(&[
+        "run",
+        "models/two_bars.toml",
+        "--out",
+        bars.to_str().unwrap(),
+        "--set",
+        "analysis.dt=0.5",
+        "--strict",
+    ]);
+    assert_eq!(code, Some(3), "--strict with a warning exits 3");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(bars.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "ok");
+    assert!(!summary["warnings"].as_array().unwrap().is_empty());
+
+    assert_eq!(with_closed_output(&["check", scene]), Some(0));
+    let sweep = dir.join("sweep");
+    let code = with_closed_output(&[
+        "sweep",
+        scene,
+        "--vary",
+        "analysis.steps=2,4",
+        "--jobs",
+        "1",
+        "--out",
+        sweep.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0));
+    assert!(sweep.join("sweep.csv").is_file());
+    let chart = dir.join("u.svg");
+    let history = out.join("history.csv");
+    let code = with_closed_output(&[
+        "plot",
+        history.to_str().unwrap(),
+        "--y",
+        "u_y[right]",
+        "--out",
+        chart.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0));
+    assert!(chart.is_file());
+    // a refused scene keeps its exit code 2 with stderr closed
+    assert_eq!(
+        with_closed_output(&["check", "no_such_scene.toml"]),
+        Some(2)
+    );
+}

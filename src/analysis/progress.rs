@@ -9,7 +9,7 @@
 //! Steps are counted as taken (split and cut steps count one each), so the time, not the
 //! step count, measures how far the run is.
 
-use crate::output::readable;
+use crate::output::{console, readable};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::time::{Duration, Instant};
 
@@ -103,7 +103,7 @@ impl Progress {
                     .is_none_or(|last| now.duration_since(last) >= every);
                 if due {
                     self.last_line = Some(now);
-                    eprintln!("{}: {}", self.name, self.status(time, steps));
+                    console::err(format_args!("{}: {}", self.name, self.status(time, steps)));
                 }
             }
         }
@@ -130,7 +130,7 @@ impl Progress {
     pub fn finish(&mut self, time: f64, steps: usize) {
         self.bar.finish_and_clear();
         if matches!(self.mode, Mode::Lines { .. }) && self.last_line.is_some() {
-            eprintln!("{}: {}", self.name, self.status(time, steps));
+            console::err(format_args!("{}: {}", self.name, self.status(time, steps)));
         }
     }
 }

@@ -6,6 +6,7 @@
 //! previous version or the new one, never a truncated file. Numbers are written at full
 //! precision (shortest text that parses back to the same f64).
 
+pub mod console;
 pub mod history;
 pub mod plot;
 pub mod vtk;

@@ -20,7 +20,7 @@ pub mod plan;
 
 use crate::analysis::progress::Mode;
 use crate::analysis::{self, RunError, RunOptions};
-use crate::output::{OutputError, write_atomic};
+use crate::output::{OutputError, console, write_atomic};
 use crate::scene::{self, InputError, Model};
 use indicatif::{ProgressBar, ProgressStyle};
 use measure::CaseRecord;
@@ -139,7 +139,7 @@ pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, Run
                 {
                     let line = case_line(record, cases.len());
                     if bar.is_hidden() {
-                        eprintln!("{line}");
+                        console::err(format_args!("{line}"));
                     } else {
                         bar.println(line);
                     }
