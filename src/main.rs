@@ -72,11 +72,15 @@ enum Command {
         #[arg(long, value_name = "SECONDS", default_value_t = 5.0)]
         progress_every: f64,
     },
-    /// Validate a scene and print the model's size.
+    /// Validate a scene and print the model's size; warn of what the scene alone shows to be
+    /// implausible (the same warnings the run repeats in summary.json).
     Check {
         scene: PathBuf,
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Exit 3 when the scene has warnings.
+        #[arg(long)]
+        strict: bool,
     },
     /// Linearized buckling of the scene's end loads: prints the load factors lambda_i (the
     /// end loads times lambda_i are the critical loads) and writes the mode shapes as the
@@ -199,7 +203,11 @@ fn main() -> ExitCode {
             quiet,
             progress_every,
         } => progress_mode(quiet, progress_every).and_then(|p| resume(&dir, p)),
-        Command::Check { scene, set } => check(&scene, &set),
+        Command::Check { scene, set, strict } => match check(&scene, &set) {
+            // the warnings are on stderr above; like `run --strict`, they exit 3
+            Ok(warnings) if strict && warnings > 0 => return ExitCode::from(3),
+            other => other.map(|_| ()),
+        },
         Command::Buckle {
             scene,
             modes,
@@ -410,7 +418,8 @@ fn resume(dir: &Path, progress: Progress) -> Result<(), RunError> {
     Ok(())
 }
 
-fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
+/// Checks the scene and returns the number of its warnings.
+fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
     let model = scene::load(path, set)?;
     // the refusals a run makes before its first step (a central-difference dt above the
     // stability limit) come first: a scene `check` calls valid runs
@@ -447,7 +456,11 @@ fn check(path: &Path, set: &[String]) -> Result<(), RunError> {
             model.bodies[b].name
         );
     }
-    Ok(())
+    let warnings = analysis::plausibility::setup_warnings(&model);
+    for warning in &warnings {
+        errln!("warning: {warning}");
+    }
+    Ok(warnings.len())
 }
 
 fn buckle(

@@ -224,7 +224,10 @@ end_time = 2.0e-5
 fn steps_too_long_for_the_run_or_the_impact_warn() {
     let scene = out_dir("block_scene").join("block.toml");
     std::fs::write(&scene, BLOCK).unwrap();
-    for (dt, word) in [("3e-5", "longer than end_time"), ("1e-5", "contact lasted")] {
+    for (dt, word) in [
+        ("3e-5", "spans 0.666667 step(s)"),
+        ("1e-5", "contact lasted"),
+    ] {
         let dir = out_dir(&format!("block_dt_{dt}"));
         let d = dir.to_str().unwrap().to_string();
         let set = format!("analysis.dt={dt}");
@@ -773,7 +776,7 @@ fn penetration_warning_edge_is_five_percent_of_the_slave_spacing_or_tol() {
 /// Goal: the implicit-step warning's edges: a step over 10 explicit stable steps of the
 /// median element, on a contact that lasted fewer than 20 steps.
 /// Setup: `ROD` (stable step h / c = 0.01, by hand above); contact from t = 0 to its release
-/// at 5 dt with dt = 0.1 (1 -+ 1e-3); then dt = 0.2 (20 stable steps, end_time 10) with the
+/// at 5 dt with dt = 0.1 (1 -+ 1e-3), end_time 2 (20 steps: the step count stays out); then dt = 0.2 (20 stable steps, end_time 10) with the
 /// release at 20 dt (1 -+ 1e-3): fewer than 20 steps warns, more does not.
 /// Reference: the user guide: "an implicit `dt` over 10 times the explicit stable step of the
 /// median element when the contact lasted fewer than 20 steps".
@@ -795,8 +798,8 @@ fn impact_step_warning_edges_are_ten_stable_steps_and_twenty_contact_steps() {
     };
     let ratio = 10.0 * 0.01;
     edge(
-        &at(ratio * (1.0 - 1e-3), 5.0, 0.4),
-        &at(ratio * (1.0 + 1e-3), 5.0, 0.4),
+        &at(ratio * (1.0 - 1e-3), 5.0, 2.0),
+        &at(ratio * (1.0 + 1e-3), 5.0, 2.0),
         "contact lasted 5.0 steps",
     );
     edge(
@@ -806,18 +809,167 @@ fn impact_step_warning_edges_are_ten_stable_steps_and_twenty_contact_steps() {
     );
 }
 
-/// Goal: the warning of a step longer than the run: its edge is end_time. Setup: `ROD`,
-/// end_time 0.4, dt 0.4 (1 -+ 1e-3), no contact (the impact-step warning stays out).
-/// Reference: the user guide: "a dynamic `dt` longer than `end_time`".
+/// Goal: the warning of a run of too few steps: its edge is ten steps of the scene's dt, a
+/// step longer than the run included. Setup: `ROD`, end_time 0.4, dt 0.04 (1 -+ 1e-3), and
+/// dt 0.5 (one step clipped to end_time); no contact (the impact-step warning stays out).
+/// Reference: the user guide: "a dynamic run of fewer than 10 steps".
 #[test]
-fn step_longer_than_the_run_warning_edge_is_end_time() {
+fn too_few_steps_warning_edge_is_ten_steps() {
     let at = |dt: f64| {
-        let model = common::model("edge_end_time", ROD, &[&format!("analysis.dt={dt}")]);
+        let model = common::model("edge_steps", ROD, &[&format!("analysis.dt={dt}")]);
         warnings_with(&model, |_, _| {})
     };
     edge(
-        &at(0.4 * (1.0 - 1e-3)),
-        &at(0.4 * (1.0 + 1e-3)),
-        "is longer than end_time",
+        &at(0.04 * (1.0 - 1e-3)),
+        &at(0.04 * (1.0 + 1e-3)),
+        "spans 9.99001 step(s) of analysis.dt",
     );
+    let one = at(0.5);
+    assert_eq!(one.len(), 1, "{one:?}");
+    assert!(one[0].contains("spans 0.8 step(s)"), "{one:?}");
+    assert!(one[0].contains("lower analysis.dt"), "{one:?}");
+}
+
+/// Goal: the wave-transit warning's edge is the time a wave takes to cross the smallest
+/// body: a rod along its length, a continuum across the shorter side of its bounding box.
+/// Setup and reference (by hand): `ROD`, L = 10, c = sqrt(E / rho) = 100: 0.1; `PLATE`,
+/// 1 x 0.5 with E = 1, nu = 0.3, rho = 1 in plane strain, M = E (1 - nu) / ((1 + nu)
+/// (1 - 2 nu)) = 0.7 / 0.52, c = sqrt(M / rho) = 1.160239: 0.5 / c = 0.430946; each with
+/// end_time 1 -+ 1e-3 of it and dt a fortieth of the edge (the step count stays out).
+#[test]
+fn wave_transit_warning_edge_is_the_smallest_body_crossing() {
+    let cases = [(ROD, 10.0 / 100.0), (PLATE, 0.5 / (0.7_f64 / 0.52).sqrt())];
+    for (text, transit) in cases {
+        let at = |end_time: f64| {
+            let model = common::model(
+                "edge_transit",
+                text,
+                &[
+                    &format!("analysis.end_time={end_time}"),
+                    &format!("analysis.dt={}", transit / 40.0),
+                ],
+            );
+            warnings_with(&model, |_, _| {})
+        };
+        edge(
+            &at(transit * (1.0 + 1e-3)),
+            &at(transit * (1.0 - 1e-3)),
+            "shorter than one wave transit of the smallest body",
+        );
+    }
+}
+
+/// `check` and `run` of models/steel_block_wall.toml with `sets`: check's output and exit
+/// code, and the run's summary.json `warnings`.
+fn check_and_run(name: &str, sets: &[String]) -> (String, Option<i32>, Vec<String>) {
+    let dir = out_dir(name);
+    let d = dir.to_str().unwrap().to_string();
+    let mut args: Vec<&str> = vec!["check", "models/steel_block_wall.toml", "--strict"];
+    for s in sets {
+        args.extend(["--set", s.as_str()]);
+    }
+    let o = impact(&args);
+    let said = text(&o);
+    args[0] = "run";
+    args[2] = "--quiet";
+    args.extend(["--out", &d]);
+    let r = impact(&args);
+    assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let warnings = summary["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap().to_string())
+        .collect();
+    (said, o.status.code(), warnings)
+}
+
+/// The steel block of models/steel_block_wall.toml in mm, t (tonne), s and MPa: the same
+/// problem in other consistent units (velocity 50 m/s = 5e4 mm/s), but for the density.
+fn block_in_mm(density: &str) -> Vec<String> {
+    [
+        "material.steel.young=210e3",
+        "material.steel.yield_stress=250",
+        "material.steel.hardening_modulus=1e3",
+        "body.block.mesh.width=20",
+        "body.block.mesh.height=10",
+        "obstacle.wall.points=[[20.05, 20.0], [20.05, -10.0]]",
+        "body.block.velocity=[5e4, 0.0]",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([format!("material.steel.density={density}")])
+    .collect()
+}
+
+/// Goal: a scene in mm and MPa with its density left in kg/m^3 is named as such by check and
+/// run. Before: the whole impact ran in one stable step (c = 6.0 for steel, dt_crit 0.14
+/// against end_time 1.2e-5), warnings []. Setup: the steel block in mm, t, s, MPa with
+/// density 7.85e-9 t/mm^3 (correct) and 7850 (the mistake, the only difference).
+/// Reference: c = sqrt(M / rho) is 6000 m/s = 6e6 mm/s for steel; 7850 makes it 3e4 times
+/// slower, the step 3e4 times longer than the 0.085 us of the SI scene, and a wave takes
+/// 10 mm / 6.0 = 1.7 s to cross the block against a 12 us run.
+#[test]
+fn a_density_in_kg_per_m3_beside_mpa_and_mm_warns() {
+    let (said, code, warnings) = check_and_run("units_mm_ok", &block_in_mm("7.85e-9"));
+    assert_eq!(code, Some(0), "{said}");
+    assert!(!said.contains("warning"), "{said}");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let (said, code, warnings) = check_and_run("units_mm_density", &block_in_mm("7850"));
+    assert_eq!(code, Some(3), "check --strict with warnings: {said}");
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(warnings[0].contains("fewer than 10 steps"), "{warnings:?}");
+    assert!(
+        warnings[0].contains("lengthen analysis.end_time"),
+        "{warnings:?}"
+    );
+    assert!(warnings[1].contains("wave transit"), "{warnings:?}");
+    for w in &warnings {
+        assert!(
+            said.contains(w.as_str()),
+            "check prints what the run warns: {said}"
+        );
+        assert!(w.contains("density = 7850 (kg/m^3?)"), "{w}");
+        assert!(w.contains("t/mm^3"), "{w}");
+    }
+}
+
+/// Goal: a geometry in mm with every other value in SI is named by check and run. Before:
+/// the 20 x 10 "m" block ran silently. Setup: models/steel_block_wall.toml as shipped
+/// (correct) and with its mesh and wall in mm (the mistake). Reference: a wave crosses the
+/// 10 "m" block in 10 / 6001 = 1.7 ms against a 12 us run, and the stable step of its
+/// 0.5 "m" elements (0.13 ms) is longer than the run.
+#[test]
+fn a_geometry_in_mm_beside_si_material_data_warns() {
+    let (said, code, warnings) = check_and_run("units_si_ok", &[]);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(!said.contains("warning"), "{said}");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let mm: Vec<String> = [
+        "body.block.mesh.width=20",
+        "body.block.mesh.height=10",
+        "obstacle.wall.points=[[20.05, 20.0], [20.05, -10.0]]",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let (said, code, warnings) = check_and_run("units_si_mm_geometry", &mm);
+    assert_eq!(code, Some(3), "{said}");
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(
+        warnings[1].contains("size 10 / wave speed 6000.98"),
+        "{warnings:?}"
+    );
+    for w in &warnings {
+        assert!(
+            said.contains(w.as_str()),
+            "check prints what the run warns: {said}"
+        );
+        assert!(
+            w.contains("a geometry meant in mm must be given in m"),
+            "{w}"
+        );
+    }
 }

@@ -39,6 +39,22 @@ fn every_scene_runs_and_writes_the_output_contract() {
         let summary = impact::analysis::run(&model, &dir, Default::default())
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(summary.status, impact::analysis::Status::Ok);
+        // a shipped scene warns of nothing but three_rings' energy balance (Hu's numerical
+        // damping takes 10 %, docs/validation.md 4.5); a new warning that fires on a scene
+        // meant to be right is a false alarm
+        let expected: &[&str] = match name.as_str() {
+            "three_rings" => &["the energy balance is off"],
+            _ => &[],
+        };
+        assert_eq!(
+            summary.warnings.len(),
+            expected.len(),
+            "{name}: {:?}",
+            summary.warnings
+        );
+        for (warning, start) in summary.warnings.iter().zip(expected) {
+            assert!(warning.starts_with(start), "{name}: {warning}");
+        }
         let json: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
                 .unwrap();

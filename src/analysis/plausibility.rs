@@ -1,15 +1,28 @@
-//! Plausibility at the end of a run: what a finished run can say about its own answer. Each
-//! warning is a sentence in summary.json `warnings` and on the closing lines; a warning
-//! never changes the exit code (`impact run --strict` makes any warning exit 3).
+//! Plausibility: what the scene alone says about the run it asks for ([`setup_warnings`],
+//! printed by `impact check` and repeated by the run), and what a finished run can say about
+//! its own answer ([`warnings`]). Each warning is a sentence in summary.json `warnings` and
+//! on the closing lines; a warning never changes the exit code (`--strict` makes any warning
+//! exit 3).
+//!
+//! Legend
+//! ```text
+//! n_steps      end_time / dt, dt the fixed step or, with dt = "auto", time_step_scale times
+//!              the central-difference limit of the initial mesh (the run's first step)
+//! c            a body's dilatational wave speed (check::wave_speed)
+//! L            a body's size: the shorter side of its bounding box (a rod: its length)
+//! t_transit    L / c, the time a wave takes to cross the body once
+//! ```
 
 use super::Summary;
+use super::check::wave_speed;
+use super::explicit::critical_time_step;
 use super::record::Energies;
 use crate::assembly::{self, State};
 use crate::contact::penetration_limits;
 use crate::output::readable;
-use crate::scene::Model;
 use crate::scene::model::Analysis;
 use crate::scene::spec::{IntegratorKind, TimeStep};
+use crate::scene::{Body, BodyKind, Model};
 
 /// The energy balance error (summary.energy.max_relative_drift) above which a run warns:
 /// a conserving integrator stays within a few 1e-3 on the shipped scenes; more means
@@ -35,9 +48,135 @@ pub const PENETRATION_SHARE: f64 = 0.05;
 /// See [`IMPACT_STEP_RATIO`].
 pub const CONTACT_STEPS: f64 = 20.0;
 
+/// A dynamic run of fewer steps than this warns: a central-difference or Newmark step
+/// resolves a period of at least about ten steps (the period error of the trapezoidal rule
+/// is (omega dt)^2 / 12: 3 % at ten steps per period, 33 % at three), and an impact needs
+/// steps for the force to rise and fall. Far fewer steps than that is mostly a sign of
+/// mixed units: the step comes from the wave speed, the end time from the user.
+pub const MIN_STEPS: f64 = 10.0;
+
+/// The warnings the scene alone gives, before a step is taken: `impact check` prints them and
+/// a run repeats them in summary.json. A dynamic run of fewer than [`MIN_STEPS`] steps, and
+/// one shorter than a wave transit of its smallest body, each with the likely unit mistake.
+pub fn setup_warnings(model: &Model) -> Vec<String> {
+    let mut out = Vec::new();
+    let Analysis::Dynamic(d) = &model.analysis else {
+        return out;
+    };
+    let step = match d.step {
+        TimeStep::Fixed(dt) => Some((dt, "analysis.dt".to_string())),
+        TimeStep::Auto { scale, .. } => critical_time_step(model).ok().map(|limit| {
+            (
+                scale * limit.dt,
+                format!(
+                    "the automatic step (time_step_scale x the stability limit {})",
+                    readable(limit.dt)
+                ),
+            )
+        }),
+    };
+    if let Some((dt, what)) = step {
+        let steps = d.end_time / dt;
+        if steps < MIN_STEPS {
+            let change = match d.step {
+                TimeStep::Fixed(_) => "lower analysis.dt",
+                TimeStep::Auto { .. } => "lengthen analysis.end_time",
+            };
+            out.push(format!(
+                "analysis.end_time = {} spans {} step(s) of {what} = {}: fewer than {} \
+                steps cannot follow a wave or an impact (a step clipped to end_time or to a \
+                frame time hides it: the run still ends on time); {change}, or check the \
+                units: {}",
+                readable(d.end_time),
+                readable(steps),
+                readable(dt),
+                MIN_STEPS,
+                unit_hint(model)
+            ));
+        }
+    }
+    let transit = model
+        .bodies
+        .iter()
+        .filter_map(|b| wave_speed(b).map(|c| (b, body_size(b), c.speed)))
+        .filter(|(_, size, c)| *size > 0.0 && *c > 0.0)
+        .map(|(b, size, c)| (b, size, c, size / c))
+        .min_by(|x, y| x.3.total_cmp(&y.3));
+    if let Some((body, size, c, time)) = transit
+        && d.end_time < time
+    {
+        out.push(format!(
+            "analysis.end_time = {} is shorter than one wave transit of the smallest body, \
+                `{}` (size {} / wave speed {} = {}): no wave crosses any body in the run; lengthen \
+                analysis.end_time, or check the units: {}",
+            readable(d.end_time),
+            body.name,
+            readable(size),
+            readable(c),
+            readable(time),
+            unit_hint(model)
+        ));
+    }
+    out
+}
+
+/// The size a wave crosses: the shorter side of the body's bounding box (a rod: its length,
+/// the longer side).
+fn body_size(body: &Body) -> f64 {
+    let mut low = [f64::INFINITY; 2];
+    let mut high = [f64::NEG_INFINITY; 2];
+    for p in &body.mesh.nodes {
+        for k in 0..2 {
+            low[k] = low[k].min(p[k]);
+            high[k] = high[k].max(p[k]);
+        }
+    }
+    let sides = [high[0] - low[0], high[1] - low[1]];
+    match body.kind {
+        BodyKind::Rod { .. } => sides[0].max(sides[1]),
+        BodyKind::Continuum { .. } => sides[0].min(sides[1]),
+    }
+}
+
+/// The unit mistake the model's numbers point to, in words. Two are common: a density in
+/// kg/m^3 beside moduli in MPa (lengths in mm: the density must be in t/mm^3), which makes
+/// waves some 3e4 times slower than in any solid; and a geometry in mm beside SI material
+/// data, which makes the bodies 1000 times too large for their m/s wave speed.
+fn unit_hint(model: &Model) -> String {
+    const CONSISTENT: &str = "consistent units are m, kg, s, Pa (steel: 7850, 210e9) or mm, t, \
+                s, MPa (steel: 7.85e-9, 210e3)";
+    for body in &model.bodies {
+        let m = &body.material;
+        if m.density > 100.0 && m.elastic.young < 1e7 {
+            return format!(
+                "material `{}` has density = {} (kg/m^3?) with young = {} (MPa?): with moduli in \
+                MPa and lengths in mm the density is in t/mm^3 (7850 kg/m^3 = 7.85e-9 t/mm^3); {CONSISTENT}",
+                m.name,
+                readable(m.density),
+                readable(m.elastic.young)
+            );
+        }
+    }
+    for body in &model.bodies {
+        if let Some(c) = wave_speed(body)
+            && (1e3..=2e4).contains(&c.speed)
+            && body_size(body) >= 1.0
+        {
+            return format!(
+                "body `{}` has a wave speed of {} (a solid's in m/s) and a size of {} (m, then): \
+                a geometry meant in mm must be given in m with SI material data; {CONSISTENT}",
+                body.name,
+                readable(c.speed),
+                readable(body_size(body))
+            );
+        }
+    }
+    CONSISTENT.to_string()
+}
+
 /// The warnings of a run that ended with `summary` and the last `energies`.
 pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<String> {
-    let mut out = Vec::new();
+    let mut out = setup_warnings(model);
     if summary.step_cuts > 0 {
         out.push(format!(
             "{} step cut(s): Newton did not converge in the nominal step there; a smaller \
@@ -130,8 +269,7 @@ fn shortest_edge_at(model: &Model, coords: &[[f64; 2]], node: usize) -> f64 {
     shortest
 }
 
-/// A dynamic step longer than the run, or an implicit step far above the explicit stable
-/// step on a run with contact.
+/// An implicit step far above the explicit stable step on a run with contact.
 fn time_step_warning(model: &Model, summary: &Summary) -> Option<String> {
     let Analysis::Dynamic(d) = &model.analysis else {
         return None;
@@ -139,12 +277,9 @@ fn time_step_warning(model: &Model, summary: &Summary) -> Option<String> {
     let TimeStep::Fixed(dt) = d.step else {
         return None;
     };
+    // a step longer than the run is one of the runs of too few steps of `setup_warnings`
     if dt > d.end_time {
-        return Some(format!(
-            "analysis.dt = {} is longer than end_time = {}: the run is one shortened step",
-            readable(dt),
-            readable(d.end_time)
-        ));
+        return None;
     }
     let first = summary.contact.first_contact_time;
     if d.integrator == IntegratorKind::CentralDifference || first.is_none() {
