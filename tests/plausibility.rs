@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{impact, out_dir};
+use common::{impact, out_dir, out_dir_of};
 use impact::analysis::plausibility;
 use impact::analysis::record::Energies;
 use impact::analysis::{Status, Summary};
@@ -862,9 +862,18 @@ fn wave_transit_warning_edge_is_the_smallest_body_crossing() {
 /// `check` and `run` of models/steel_block_wall.toml with `sets`: check's output and exit
 /// code, and the run's summary.json `warnings`.
 fn check_and_run(name: &str, sets: &[String]) -> (String, Option<i32>, Vec<String>) {
+    check_and_run_scene(name, "models/steel_block_wall.toml", sets)
+}
+
+/// As `check_and_run`, for the scene file `scene`.
+fn check_and_run_scene(
+    name: &str,
+    scene: &str,
+    sets: &[String],
+) -> (String, Option<i32>, Vec<String>) {
     let dir = out_dir(name);
     let d = dir.to_str().unwrap().to_string();
-    let mut args: Vec<&str> = vec!["check", "models/steel_block_wall.toml", "--strict"];
+    let mut args: Vec<&str> = vec!["check", scene, "--strict"];
     for s in sets {
         args.extend(["--set", s.as_str()]);
     }
@@ -940,7 +949,7 @@ fn a_density_in_kg_per_m3_beside_mpa_and_mm_warns() {
 /// the 20 x 10 "m" block ran silently. Setup: models/steel_block_wall.toml as shipped
 /// (correct) and with its mesh and wall in mm (the mistake). Reference: a wave crosses the
 /// 10 "m" block in 10 / 6001 = 1.7 ms against a 12 us run, and the stable step of its
-/// 0.5 "m" elements (0.13 ms) is longer than the run.
+/// 0.5 "m" elements (0.13 ms) is longer than the run; check prints both.
 #[test]
 fn a_geometry_in_mm_beside_si_material_data_warns() {
     let (said, code, warnings) = check_and_run("units_si_ok", &[]);
@@ -957,12 +966,14 @@ fn a_geometry_in_mm_beside_si_material_data_warns() {
     .collect();
     let (said, code, warnings) = check_and_run("units_si_mm_geometry", &mm);
     assert_eq!(code, Some(3), "{said}");
-    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    // and the block never reaches the wall 0.05 "m" ahead in 12 us at 50 m/s
+    assert_eq!(warnings.len(), 3, "{warnings:?}");
     assert!(
         warnings[1].contains("size 10 / wave speed 6000.98"),
         "{warnings:?}"
     );
-    for w in &warnings {
+    assert!(warnings[2].contains("never closed"), "{warnings:?}");
+    for w in &warnings[..2] {
         assert!(
             said.contains(w.as_str()),
             "check prints what the run warns: {said}"
@@ -972,4 +983,68 @@ fn a_geometry_in_mm_beside_si_material_data_warns() {
             "{w}"
         );
     }
+}
+
+/// Goal: an obstacle that no contact pair names is reported by check and run. Before: the
+/// block flew through the wall, warnings []. Setup: models/steel_block_wall.toml (correct)
+/// and the same text without its [[contact]] table (the mistake). Reference: without a pair
+/// nothing stops the block, whose face ends past the wall (u_x[right] above the 0.05 mm
+/// gap).
+#[test]
+fn an_obstacle_no_pair_uses_warns() {
+    let text = std::fs::read_to_string("models/steel_block_wall.toml").unwrap();
+    let cut = text.find("[[contact]]").unwrap()..text.find("[analysis]").unwrap();
+    let mut without = text.clone();
+    without.replace_range(cut, "");
+    let scene = out_dir("obstacle_unused_scene").join("steel_block_wall.toml");
+    std::fs::write(&scene, without).unwrap();
+    let (said, code, warnings) =
+        check_and_run_scene("obstacle_unused", scene.to_str().unwrap(), &[]);
+    assert_eq!(code, Some(3), "{said}");
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("obstacle `wall` is used by no contact pair"),
+        "{warnings:?}"
+    );
+    assert!(
+        warnings[0].contains("[[contact]] with obstacle = \"wall\""),
+        "{warnings:?}"
+    );
+    assert!(said.contains(warnings[0].as_str()), "{said}");
+    let u = common::column(&out_dir_of("obstacle_unused"), "u_x[right]");
+    assert!(
+        *u.last().unwrap() > 0.05e-3,
+        "the block passed the wall: {u:?}"
+    );
+}
+
+/// Goal: a pair that never closes because its slaves move away from the master is reported
+/// by the run. Before: no contact, no word. Setup: models/steel_block_wall.toml as shipped
+/// (50 m/s towards the wall, silent) and with velocity = [-50, 0] (the sign mistake); and
+/// with end_time 0.5 us, before the block reaches the wall 0.05 mm ahead (1 us at 50 m/s).
+/// Reference: the gap 5e-5 m opens (closes) at the block's speed, 50 m/s.
+#[test]
+fn a_pair_that_never_closes_warns_with_the_way_its_slaves_moved() {
+    let sets = ["body.block.velocity=[-50.0, 0.0]".to_string()];
+    let (said, code, warnings) = check_and_run("never_closed_away", &sets);
+    assert_eq!(code, Some(0), "check cannot know: {said}");
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("contact `wall` never closed: at the start its slaves move away")
+            && warnings[0].contains("gap 5e-5 opening at 50")
+            && warnings[0].contains("the sign of the body's velocity"),
+        "{warnings:?}"
+    );
+    let sets = ["analysis.end_time=5e-7".to_string()];
+    let (_, _, warnings) = check_and_run("never_closed_short", &sets);
+    let closing: Vec<_> = warnings
+        .iter()
+        .filter(|w| w.contains("never closed"))
+        .collect();
+    assert_eq!(closing.len(), 1, "{warnings:?}");
+    assert!(
+        closing[0].contains("gap 5e-5 closing at 50")
+            && closing[0].contains("lengthen analysis.end_time"),
+        "{warnings:?}"
+    );
 }

@@ -18,7 +18,7 @@ use super::check::wave_speed;
 use super::explicit::critical_time_step;
 use super::record::Energies;
 use crate::assembly::{self, State};
-use crate::contact::penetration_limits;
+use crate::contact::{ContactPair, Master, penetration_limits};
 use crate::output::readable;
 use crate::scene::model::Analysis;
 use crate::scene::spec::{IntegratorKind, TimeStep};
@@ -60,6 +60,20 @@ pub const MIN_STEPS: f64 = 10.0;
 /// one shorter than a wave transit of its smallest body, each with the likely unit mistake.
 pub fn setup_warnings(model: &Model) -> Vec<String> {
     let mut out = Vec::new();
+    for obstacle in &model.obstacles {
+        let used = model
+            .contacts
+            .iter()
+            .any(|pair| matches!(&pair.master, Master::Obstacle(o) if o.name == obstacle.name));
+        if !used {
+            out.push(format!(
+                "obstacle `{0}` is used by no contact pair: it stops nothing, and bodies pass \
+                 through it; add a [[contact]] with obstacle = \"{0}\" and the slave set that \
+                 meets it (or remove the obstacle)",
+                obstacle.name
+            ));
+        }
+    }
     let Analysis::Dynamic(d) = &model.analysis else {
         return out;
     };
@@ -206,6 +220,14 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
     if let Some(problem) = time_step_warning(model, summary) {
         out.push(problem);
     }
+    let moved = summary.energy.initial > 0.0 || energies.external_work.abs() > 0.0;
+    if moved {
+        for name in &summary.contact.never_closed {
+            if let Some(pair) = model.contacts.iter().find(|p| &p.name == name) {
+                out.push(never_closed_warning(model, pair));
+            }
+        }
+    }
     if let Some(depth) = summary.contact.max_penetration {
         let coords = model.coordinates();
         let limits = penetration_limits(&model.contacts, &coords);
@@ -243,6 +265,91 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
         }
     }
     out
+}
+
+/// A pair that never closed in a run where something moved, with the way its slaves moved
+/// relative to the master at the start: the gap rate dg/dt of the slave nearest the master
+/// under the initial velocities (a small advance of every node along its velocity, master
+/// nodes included, so the rate is the relative one).
+fn never_closed_warning(model: &Model, pair: &ContactPair) -> String {
+    let coords = model.coordinates();
+    let velocity = |n: usize| {
+        [
+            model.initial_velocity[2 * n],
+            model.initial_velocity[2 * n + 1],
+        ]
+    };
+    let speed = (0..model.node_count)
+        .map(|n| velocity(n)[0].hypot(velocity(n)[1]))
+        .fold(0.0, f64::max);
+    let at = |x: &dyn Fn(usize) -> [f64; 2]| {
+        pair.slaves
+            .iter()
+            .filter_map(|s| pair.gap(*s, x).map(|g| (*s, g.gap)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    };
+    let start = at(&|n: usize| coords[n]);
+    let name = &pair.name;
+    let Some((slave, gap)) = start else {
+        return format!(
+            "contact `{name}` never closed: no slave node came within its search distance of \
+             the master at the start; check the pair's slave and master sets (or obstacle) and \
+             where the bodies are"
+        );
+    };
+    // an advance of a millionth of the gap (or of the model's size) along the velocities
+    let size = model_size(&coords);
+    let h = if speed > 0.0 {
+        1e-6 * gap.abs().max(1e-3 * size) / speed
+    } else {
+        0.0
+    };
+    let rate = if h > 0.0 {
+        pair.gap(slave, &|n: usize| {
+            let v = velocity(n);
+            [coords[n][0] + h * v[0], coords[n][1] + h * v[1]]
+        })
+        .map(|g| (g.gap - gap) / h)
+        .unwrap_or(0.0)
+    } else {
+        0.0
+    };
+    if rate > 0.0 {
+        format!(
+            "contact `{name}` never closed: at the start its slaves move away from the master \
+             (gap {} opening at {}): check the sign of the body's velocity (or which side of \
+             the master the slaves are on)",
+            readable(gap),
+            readable(rate)
+        )
+    } else if rate < 0.0 {
+        format!(
+            "contact `{name}` never closed although its slaves approach the master at the start \
+             (gap {} closing at {}): the run ended before they met (lengthen analysis.end_time) \
+             or they passed beside it (check the pair's sets and the master's extent)",
+            readable(gap),
+            readable(-rate)
+        )
+    } else {
+        format!(
+            "contact `{name}` never closed (gap {} at the start, no initial motion towards or \
+             away from the master): the loads never brought the slaves onto it; check the \
+             loads, analysis.end_time and the pair's sets",
+            readable(gap)
+        )
+    }
+}
+
+/// The larger side of the bounding box of `coords`.
+fn model_size(coords: &[[f64; 2]]) -> f64 {
+    let (mut low, mut high) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in coords {
+        for k in 0..2 {
+            low[k] = low[k].min(p[k]);
+            high[k] = high[k].max(p[k]);
+        }
+    }
+    (high[0] - low[0]).max(high[1] - low[1])
 }
 
 /// The shortest element edge that ends at global node `node`.

@@ -416,7 +416,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.timing = profile::snapshot();
         summary.energy.final_ = energies.kinetic + energies.internal;
         summary.energy.plastic_dissipation = energies.plastic_work;
-        summary.contact = s.contact().summary();
+        summary.contact = s.contact().summary(&self.model.contacts);
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
         if let Some(report) = s.time_step_report() {
             summary.dt_min = Some(report.shortest);

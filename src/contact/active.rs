@@ -38,6 +38,9 @@ pub struct ContactState {
     pub max_penetration: f64,
     /// The same after the last step alone.
     pub penetration: f64,
+    /// Per pair: closed at some step (empty in a checkpoint written before it was kept).
+    #[serde(default)]
+    pub ever_closed: Vec<bool>,
 }
 
 /// What happened in a step, for the conditions and the bookkeeping.
@@ -182,6 +185,7 @@ impl ContactState {
             min_gap: None,
             max_penetration: 0.0,
             penetration: 0.0,
+            ever_closed: vec![false; pairs.len()],
         }
     }
 
@@ -480,6 +484,9 @@ impl ContactState {
         for (i, (p, k)) in active.iter().enumerate() {
             self.active[*p][*k] = true;
             self.force[*p][*k] = forces[i];
+            if let Some(closed) = self.ever_closed.get_mut(*p) {
+                *closed = true;
+            }
         }
         if !active.is_empty() && self.first_contact_time.is_none() {
             self.first_contact_time = Some(time);
@@ -507,8 +514,22 @@ impl ContactState {
 
 impl ContactState {
     /// The contact block of summary.json.
-    pub fn summary(&self) -> ContactSummary {
+    /// The contact block of summary.json for the run's `pairs`.
+    pub fn summary(&self, pairs: &[ContactPair]) -> ContactSummary {
+        // a second pass closes nothing where its first pass holds the contact: the two
+        // passes are one contact
+        let closed = |p: usize| {
+            let first = pairs[p].covered.as_ref().map(|c| c.pair);
+            [Some(p), first]
+                .into_iter()
+                .flatten()
+                .any(|q| self.ever_closed.get(q).copied().unwrap_or(true))
+        };
         ContactSummary {
+            never_closed: (0..pairs.len().min(self.ever_closed.len()))
+                .filter(|p| !closed(*p))
+                .map(|p| pairs[p].name.clone())
+                .collect(),
             first_contact_time: self.first_contact_time,
             last_release_time: self.last_release_time,
             peak_force: self.peak_force,

@@ -128,6 +128,9 @@ pub struct ContactSummary {
     /// null without contact.
     #[serde(default)]
     pub max_penetration: Option<f64>,
+    /// The pairs (by name) that never closed in the run; empty when every pair closed.
+    #[serde(default)]
+    pub never_closed: Vec<String>,
 }
 
 #[cfg(test)]

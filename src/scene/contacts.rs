@@ -17,13 +17,13 @@ pub(super) fn contacts(
     cx: &Context,
     scene: &Scene,
     bodies: &[Body],
+    obstacles: &[Obstacle],
 ) -> Result<Vec<ContactPair>, InputError> {
-    let obstacles = obstacles(cx, scene)?;
     let contacts = scene
         .contact
         .iter()
         .enumerate()
-        .map(|(k, c)| contact(cx, bodies, &obstacles, k, c, explicit(scene)))
+        .map(|(k, c)| contact(cx, bodies, obstacles, k, c, explicit(scene)))
         .collect::<Result<Vec<_>, _>>()?;
     let mut contacts = contacts;
     for (k, spec) in scene.contact.iter().enumerate() {
@@ -45,7 +45,7 @@ pub(super) fn contacts(
 
 /// The `[[obstacle]]` polylines: unique names, at least 2 points (3 when closed), finite,
 /// no two consecutive points equal.
-fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, InputError> {
+pub(super) fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, InputError> {
     let mut out: Vec<Obstacle> = Vec::new();
     for (k, o) in scene.obstacle.iter().enumerate() {
         let key = format!("obstacle[{k}] (`{}`)", o.name);

@@ -11,7 +11,7 @@
 use super::spec::{
     BucklingSpec, DynamicSpec, OutputSpec, Quantity, ReferenceKind, StaticSpec, Statistic,
 };
-use crate::contact::ContactPair;
+use crate::contact::{ContactPair, Obstacle};
 use crate::element::{Formulation, Strain, Voigt};
 use crate::material::Material;
 use crate::mesh::Mesh;
@@ -185,6 +185,9 @@ pub struct Model {
     /// Initial velocity per DOF (bodies' `velocity`, then `[[initial_velocity]]` sets).
     pub initial_velocity: Vec<f64>,
     pub contacts: Vec<ContactPair>,
+    /// Every `[[obstacle]]` of the scene, whether a pair uses it or not (the pairs hold their
+    /// own copies): an obstacle no pair names stops nothing.
+    pub obstacles: Vec<Obstacle>,
     /// The `[reference]` solution with its numbers (None without the table).
     pub reference: Option<Reference>,
     /// `analysis.checkpoint_every`: a checkpoint every N converged steps (0: none).

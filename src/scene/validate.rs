@@ -6,7 +6,7 @@
 use super::InputError;
 use super::analysis::analysis;
 use super::bodies::{add_node_set, bodies, initial_velocity};
-use super::contacts::{check_contact_setup, contacts};
+use super::contacts::{check_contact_setup, contacts, obstacles};
 use super::context::Context;
 use super::loads::{curves, default_curve, fixed_dofs, loads};
 use super::materials::materials;
@@ -32,7 +32,8 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let loads = loads(&cx, &scene, &bodies, &curves, &default_curve)?;
     let probes = probes(&cx, &bodies, &scene.output.probe)?;
     let frame_times = frame_times(&cx, &scene.output, analysis.end_time())?;
-    let contacts = contacts(&cx, &scene, &bodies)?;
+    let obstacles = obstacles(&cx, &scene)?;
+    let contacts = contacts(&cx, &scene, &bodies, &obstacles)?;
     check_contact_setup(&cx, &scene, &bodies, &contacts)?;
     check_reaction_probes(&cx, &probes, &fixed_dofs, &loads)?;
     check_reduced_quadrature(&cx, &analysis, &bodies)?;
@@ -64,6 +65,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
         initial_velocity,
         reference,
         contacts,
+        obstacles,
         checkpoint_every: scene.analysis.checkpoint_every,
         source: SceneSource::default(),
     })
