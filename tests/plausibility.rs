@@ -1048,3 +1048,58 @@ fn a_pair_that_never_closes_warns_with_the_way_its_slaves_moved() {
         "{warnings:?}"
     );
 }
+
+/// Goal: an axisymmetric body whose axis is not held is reported by check (axis nodes free
+/// in x) and by the run (nodes that ended at r < 0). Before: the Taylor rod's axis nodes
+/// ended at r = -32 um, warnings []. Setup: models/taylor_aluminum.toml (correct, silent)
+/// and the same text without its `left` support (the mistake). Reference: the rectangle
+/// mesh's `left` set holds the 31 nodes at r = 0 (ny = 30); without a radial support the
+/// impact's radial flow takes some across the axis.
+#[test]
+fn an_axis_not_held_warns_in_check_and_run() {
+    let text = std::fs::read_to_string("models/taylor_aluminum.toml").unwrap();
+    let support = "[[support]]\nset = \"left\"\nfix = [\"x\"]\n";
+    assert!(text.contains(support));
+    let scene = out_dir("axis_free_scene").join("taylor_aluminum.toml");
+    std::fs::write(&scene, text.replace(support, "")).unwrap();
+    let (said, code, warnings) = check_and_run_scene("axis_free", scene.to_str().unwrap(), &[]);
+    assert_eq!(code, Some(3), "{said}");
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(
+        warnings[0].contains("31 node(s) on the axis (r = 0) free in x")
+            && warnings[0].contains("set = \"left\", fix = [\"x\"]"),
+        "{warnings:?}"
+    );
+    assert!(said.contains(warnings[0].as_str()), "{said}");
+    assert!(
+        warnings[1].contains("ends with") && warnings[1].contains("at r = x < 0"),
+        "{warnings:?}"
+    );
+    let (said, code, warnings) =
+        check_and_run_scene("axis_held", "models/taylor_aluminum.toml", &[]);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(warnings.is_empty(), "{warnings:?}");
+}
+
+/// Goal: nodes of an axisymmetric body at r < 0 in the initial mesh are reported, and nodes
+/// within round-off of the axis count as on it. Setup: the Taylor rod's model with its mesh
+/// moved by dx = -1e-4 (the left column at r = -1e-4) and by dx = -1e-12 (round-off: the
+/// left column stays on the axis, held). Reference: 31 nodes in the left column (ny = 30).
+#[test]
+fn nodes_at_negative_radius_warn_and_round_off_does_not() {
+    let path = Path::new("models/taylor_aluminum.toml");
+    let moved = |dx: f64| {
+        let mut model = impact::scene::load(path, &[]).unwrap();
+        for p in &mut model.bodies[0].mesh.nodes {
+            p[0] += dx;
+        }
+        plausibility::setup_warnings(&model)
+    };
+    let across = moved(-1e-4);
+    assert_eq!(across.len(), 1, "{across:?}");
+    assert!(
+        across[0].contains("31 node(s) at r = x < 0 (down to -1e-4"),
+        "{across:?}"
+    );
+    assert!(moved(-1e-12).is_empty());
+}

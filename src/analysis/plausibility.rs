@@ -19,6 +19,7 @@ use super::explicit::critical_time_step;
 use super::record::Energies;
 use crate::assembly::{self, State};
 use crate::contact::{ContactPair, Master, penetration_limits};
+use crate::element::Formulation;
 use crate::output::readable;
 use crate::scene::model::Analysis;
 use crate::scene::spec::{IntegratorKind, TimeStep};
@@ -74,6 +75,7 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
             ));
         }
     }
+    out.extend(axis_warnings(model));
     let Analysis::Dynamic(d) = &model.analysis else {
         return out;
     };
@@ -132,6 +134,134 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
         ));
     }
     out
+}
+
+/// A node of an axisymmetric body counts as on the axis, or across it, beyond this share of
+/// the body's size from r = 0: round-off of coordinates written in decimal, not geometry.
+pub const AXIS_TOLERANCE: f64 = 1e-9;
+
+/// The nodes of the axisymmetric bodies at positions `x`: per body, those at r < 0 beyond
+/// the tolerance and those on the axis, r = 0 within it.
+struct AxisNodes<'a> {
+    body: &'a Body,
+    across: Vec<usize>,
+    on_axis: Vec<usize>,
+    /// The smallest r of the body.
+    min_r: f64,
+}
+
+fn axis_nodes<'a>(model: &'a Model, x: &[[f64; 2]]) -> Vec<AxisNodes<'a>> {
+    model
+        .bodies
+        .iter()
+        .filter(|b| {
+            matches!(
+                b.kind,
+                BodyKind::Continuum {
+                    formulation: Formulation::Axisymmetric,
+                    ..
+                }
+            )
+        })
+        .map(|body| {
+            let tolerance = AXIS_TOLERANCE * body_extent(body);
+            let nodes = (0..body.mesh.nodes.len()).map(|n| body.global(n));
+            let r = |n: usize| x[n][0];
+            AxisNodes {
+                body,
+                across: nodes.clone().filter(|n| r(*n) < -tolerance).collect(),
+                on_axis: nodes.clone().filter(|n| r(*n).abs() <= tolerance).collect(),
+                min_r: nodes.map(r).fold(f64::INFINITY, f64::min),
+            }
+        })
+        .collect()
+}
+
+/// The first few of `nodes` (global ids) in words: `12, 14, 17 and 3 more`.
+fn some_nodes(nodes: &[usize]) -> String {
+    let shown: Vec<String> = nodes.iter().take(5).map(|n| n.to_string()).collect();
+    if nodes.len() > 5 {
+        format!("{} and {} more", shown.join(", "), nodes.len() - 5)
+    } else {
+        shown.join(", ")
+    }
+}
+
+/// Axisymmetric bodies in the initial mesh: nodes at r < 0, and axis nodes free in x (the
+/// hoop strain u_r / r needs u_r = 0 on the axis; nothing else keeps them there).
+fn axis_warnings(model: &Model) -> Vec<String> {
+    let coords = model.coordinates();
+    let constrained = model.constrained_dofs();
+    let mut out = Vec::new();
+    for a in axis_nodes(model, &coords) {
+        let name = &a.body.name;
+        if !a.across.is_empty() {
+            out.push(format!(
+                "axisymmetric body `{name}` has {} node(s) at r = x < 0 (down to {}; global \
+                 nodes {}): the axis is x = 0 and the body must lie at x >= 0; move its mesh",
+                a.across.len(),
+                readable(a.min_r),
+                some_nodes(&a.across)
+            ));
+        }
+        let free: Vec<usize> = a
+            .on_axis
+            .iter()
+            .copied()
+            .filter(|n| constrained.binary_search(&(2 * n)).is_err())
+            .collect();
+        if !free.is_empty() {
+            // the body's own set of exactly its axis nodes, when it has one (`axis`, `left`)
+            let mut on_axis: Vec<usize> =
+                a.on_axis.iter().map(|n| n - a.body.node_offset).collect();
+            on_axis.sort_unstable();
+            let set = a.body.mesh.node_sets.iter().find_map(|(set, nodes)| {
+                let mut nodes = nodes.clone();
+                nodes.sort_unstable();
+                nodes.dedup();
+                (nodes == on_axis).then_some(set)
+            });
+            let support = match set {
+                Some(set) => format!(
+                    "add a [[support]] with body = \"{name}\", set = \"{set}\", fix = [\"x\"]"
+                ),
+                None => "add a [[support]] with fix = [\"x\"] on a set of the axis nodes".into(),
+            };
+            out.push(format!(
+                "axisymmetric body `{name}` has {} node(s) on the axis (r = 0) free in x (global \
+                 nodes {}): nothing holds them on the axis, and they can cross it to r < 0; \
+                 {support}",
+                free.len(),
+                some_nodes(&free)
+            ));
+        }
+    }
+    out
+}
+
+/// What the final configuration of a run shows: nodes of an axisymmetric body that ended
+/// across the axis (r < 0), where the hoop strain u_r / r has no meaning.
+pub fn final_warnings(model: &Model, positions: &[[f64; 2]]) -> Vec<String> {
+    axis_nodes(model, positions)
+        .into_iter()
+        .filter(|a| !a.across.is_empty())
+        .map(|a| {
+            format!(
+                "axisymmetric body `{}` ends with {} node(s) at r = x < 0 (down to {}; global \
+                 nodes {}): they crossed the axis; hold the axis nodes in x (a [[support]] with \
+                 fix = [\"x\"] on them)",
+                a.body.name,
+                a.across.len(),
+                readable(a.min_r),
+                some_nodes(&a.across)
+            )
+        })
+        .collect()
+}
+
+/// The larger side of the body's bounding box.
+fn body_extent(body: &Body) -> f64 {
+    model_size(&body.mesh.nodes)
 }
 
 /// The size a wave crosses: the shorter side of the body's bounding box (a rod: its length,

@@ -425,6 +425,10 @@ impl<'a, S: Stepper> Run<'a, S> {
         }
         summary.max_temperature = super::record::max_temperature(self.model, s.state());
         summary.warnings = super::plausibility::warnings(self.model, summary, &energies);
+        let positions = s.state().positions(self.model.analysis.geometry());
+        summary
+            .warnings
+            .extend(super::plausibility::final_warnings(self.model, &positions));
     }
 
     /// A failed step: its frame when asked, then `fail`.
