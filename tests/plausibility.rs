@@ -1103,3 +1103,101 @@ fn nodes_at_negative_radius_warn_and_round_off_does_not() {
     );
     assert!(moved(-1e-12).is_empty());
 }
+
+/// A steel plate (100 x 20 mm, 20 x 4 one-point Quad4, plane strain) dropped at 20 m/s onto
+/// a rigid knife edge under its middle: a load concentrated on one node, the case that
+/// excites hourglass modes. Explicit, the automatic step, 100 us.
+const KNIFE_EDGE: &str = r#"
+[[material]]
+name = "steel"
+young = 210e9
+poisson = 0.3
+density = 7850.0
+
+[[body]]
+name = "plate"
+material = "steel"
+formulation = "plane_strain"
+velocity = [0.0, -20.0]
+mesh = { type = "rectangle", width = 0.1, height = 0.02, nx = 20, ny = 4 }
+
+[[obstacle]]
+name = "edge"
+points = [[0.06, -0.01], [0.05, -0.00001], [0.04, -0.01]]
+
+[[contact]]
+name = "edge"
+slave = { set = "bottom" }
+obstacle = "edge"
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+quadrature = "reduced"
+end_time = 1e-4
+
+[output]
+frame_every = 0
+"#;
+
+/// Goal: a one-point run whose hourglass energy is a large share of its internal energy
+/// warns. Before: 35 % ended with warnings []. Setup: `KNIFE_EDGE` with the default
+/// hourglass stiffness 0.1 (correct, silent) and with analysis.hourglass = 0.002 (the
+/// mistake: a coefficient lowered to soften the plate). Reference: the run's own history.csv,
+/// whose last row gives hourglass_energy / (internal_energy + plastic_work), above 10 % in
+/// the mistake and below it in the correct scene.
+#[test]
+fn hourglass_energy_above_a_tenth_of_the_internal_energy_warns() {
+    let scene = out_dir("knife_edge_scene").join("knife_edge.toml");
+    std::fs::write(&scene, KNIFE_EDGE).unwrap();
+    let scene = scene.to_str().unwrap();
+    let share = |name: &str| {
+        let dir = out_dir_of(name);
+        let last = |c: &str| *common::column(&dir, c).last().unwrap();
+        last("hourglass_energy") / (last("internal_energy") + last("plastic_work"))
+    };
+    let (said, code, warnings) = check_and_run_scene("knife_edge_ok", scene, &[]);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(share("knife_edge_ok") < 0.1);
+    let sets = ["analysis.hourglass=0.002".to_string()];
+    let (said, code, warnings) = check_and_run_scene("knife_edge_soft", scene, &sets);
+    assert_eq!(code, Some(0), "check cannot know: {said}");
+    let measured = share("knife_edge_soft");
+    assert!(measured > 0.1, "{measured}");
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    let percent = format!("is {:.1} % of the internal energy", 100.0 * measured);
+    assert!(
+        warnings[0].contains(&percent) && warnings[0].contains("analysis.hourglass"),
+        "`{percent}` in {warnings:?}"
+    );
+}
+
+/// Goal: the hourglass warning's edge is 10 % of the internal energy, stored energy plus
+/// plastic work. Setup: stored 0.9 and plastic 0.1 (base 1), hourglass 0.1 (1 -+ 1e-3);
+/// then stored 0.1, plastic 0.9, hourglass 0.09: 9 % of the base (silent), though 90 % of
+/// the stored energy alone. Reference: the user guide, section 3.2a.
+#[test]
+fn hourglass_warning_edge_is_ten_percent_of_stored_plus_plastic() {
+    let model = common::model("edge_hourglass", ROD, &[]);
+    let at = |stored: f64, plastic: f64, hourglass: f64| {
+        let energies = Energies {
+            internal: stored,
+            plastic_work: plastic,
+            ..Energies::default()
+        };
+        let positions = model.coordinates();
+        let end = plausibility::EndOfRun {
+            positions: &positions,
+            energies: &energies,
+            hourglass_energy: Some(hourglass),
+        };
+        plausibility::final_warnings(&model, &end)
+    };
+    edge(
+        &at(0.9, 0.1, 0.1 * (1.0 - 1e-3)),
+        &at(0.9, 0.1, 0.1 * (1.0 + 1e-3)),
+        "above 10 %",
+    );
+    assert!(at(0.1, 0.9, 0.09).is_empty());
+}

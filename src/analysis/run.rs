@@ -426,9 +426,14 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.max_temperature = super::record::max_temperature(self.model, s.state());
         summary.warnings = super::plausibility::warnings(self.model, summary, &energies);
         let positions = s.state().positions(self.model.analysis.geometry());
+        let end = super::plausibility::EndOfRun {
+            positions: &positions,
+            energies: &energies,
+            hourglass_energy: s.hourglass_energy(),
+        };
         summary
             .warnings
-            .extend(super::plausibility::final_warnings(self.model, &positions));
+            .extend(super::plausibility::final_warnings(self.model, &end));
     }
 
     /// A failed step: its frame when asked, then `fail`.
