@@ -1201,3 +1201,93 @@ fn hourglass_warning_edge_is_ten_percent_of_stored_plus_plastic() {
     );
     assert!(at(0.1, 0.9, 0.09).is_empty());
 }
+
+/// Goal: a scene that asks for a great many frames is warned of, with the disk they take,
+/// and lays them out in time linear in their count. Before: frame_interval = 1.2e-11 (1e6
+/// frames, the most allowed) spent 7 min 53 s in `check` (the layout compared every new
+/// frame time with all before it) and a run printed nothing for as long; now 0.01 s.
+/// Setup: models/steel_block_wall.toml as shipped (13 frames, silent) and with
+/// frame_interval = 1.2e-9 (10 000 frames over the 12 us; the mistake) and 1.2e-11.
+/// Reference: the frames of the shipped run on disk: the size the warning gives per frame is
+/// within 15 % of theirs; the 1e6 frame times are laid out in under 2 s (a quadratic
+/// layout takes minutes), and a run prints its first progress line within 10 s.
+#[test]
+fn many_frames_warn_with_their_size_and_lay_out_quickly() {
+    let (said, code, warnings) = check_and_run("frames_shipped", &[]);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let vtk = out_dir_of("frames_shipped").join("vtk");
+    let sizes: Vec<u64> = std::fs::read_dir(&vtk)
+        .unwrap()
+        .map(|e| e.unwrap().metadata().unwrap().len())
+        .collect();
+    let measured = *sizes.iter().max().unwrap() as f64;
+
+    let o = impact(&[
+        "check",
+        "models/steel_block_wall.toml",
+        "--set",
+        "output.frame_interval=1.2e-9",
+    ]);
+    let said = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{said}");
+    let warning = said
+        .lines()
+        .find(|l| l.contains("VTK frames"))
+        .unwrap_or_else(|| panic!("no frames warning in {said}"));
+    assert!(
+        warning.contains("about 10001 VTK frames") && warning.contains("output.frame_interval"),
+        "{warning}"
+    );
+    // "some 924.1 MB on disk": the estimate per frame against a frame on disk
+    let total: f64 = warning
+        .split("some ")
+        .nth(1)
+        .and_then(|t| t.split(" MB").next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no size in MB in {warning}"));
+    let per_frame = total * 1e6 / 10001.0;
+    assert!(
+        (per_frame / measured - 1.0).abs() < 0.15,
+        "estimate {per_frame} B per frame, measured {measured} B"
+    );
+
+    let path = Path::new("models/steel_block_wall.toml");
+    let start = std::time::Instant::now();
+    let model = impact::scene::load(path, &["output.frame_interval=1.2e-11".to_string()]).unwrap();
+    let layout = start.elapsed().as_secs_f64();
+    assert_eq!(model.output.frame_times.len(), 1_000_000);
+    assert!(layout < 2.0, "laying out 1e6 frames took {layout} s");
+
+    // the run's first progress line, then stop it (it would write a million frames)
+    use std::io::BufRead;
+    let out = out_dir("frames_million");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
+        .args([
+            "run",
+            "models/steel_block_wall.toml",
+            "--set",
+            "output.frame_interval=1.2e-11",
+            "--progress-every",
+            "0",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let mut first = String::new();
+    std::io::BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    let waited = start.elapsed().as_secs_f64();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(first.contains("steel_block_wall: t = 0"), "{first}");
+    assert!(
+        waited < 10.0,
+        "the first progress line came after {waited} s"
+    );
+}

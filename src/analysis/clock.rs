@@ -172,10 +172,7 @@ impl Clock {
                 }
                 let next_frame = model
                     .output
-                    .frame_times
-                    .iter()
-                    .copied()
-                    .find(|t| *t > time * (1.0 + 1e-12))
+                    .next_frame_after(time * (1.0 + 1e-12))
                     .unwrap_or(f64::INFINITY);
                 let stop = spec.end_time.min(next_frame);
                 let full = time + h;

@@ -224,10 +224,7 @@ impl<'a> Dynamics<'a> {
         let next_frame = self
             .model
             .output
-            .frame_times
-            .iter()
-            .copied()
-            .find(|t| *t > time * (1.0 + 1e-9) + 1e-12 * spec.dt())
+            .next_frame_after(time * (1.0 + 1e-9) + 1e-12 * spec.dt())
             .unwrap_or(f64::INFINITY);
         // a remainder shorter than the shortest step the control takes joins this step: a
         // step of 1e-7 dt (end_time written with a few digits) does not converge

@@ -76,6 +76,7 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
         }
     }
     out.extend(axis_warnings(model));
+    out.extend(frames_warning(model));
     let Analysis::Dynamic(d) = &model.analysis else {
         return out;
     };
@@ -308,6 +309,72 @@ fn axis_crossings(model: &Model, positions: &[[f64; 2]]) -> Vec<String> {
 /// The larger side of the body's bounding box.
 fn body_extent(body: &Body) -> f64 {
     model_size(&body.mesh.nodes)
+}
+
+/// A run that writes more frames than this warns (check and run): each frame is a file and
+/// an entry of the .pvd, which is rewritten after every frame so that a crash leaves a
+/// valid series, so the writing grows with the square of the count; and a series of
+/// thousands of frames is more than one looks at in ParaView. The shipped scenes write at
+/// most 131 (taylor_aluminum).
+pub const MANY_FRAMES: f64 = 1000.0;
+
+/// The size of an uncompressed frame per node of the model (measured: 335 to 536 bytes on
+/// the last frames of the shipped scenes, most near 370; the point fields, the cell fields
+/// and the connectivity of a Quad4 mesh). `lz4` and `zlib` compression write less.
+pub const FRAME_BYTES_PER_NODE: f64 = 400.0;
+
+/// The frames a run of `model` writes, estimated before it starts: the listed frame times
+/// (`frame_times` and the multiples of `frame_interval`), the first, and one every
+/// `frame_every` steps of the nominal step (the fixed step, or the automatic step of the
+/// initial mesh; the steps of a static analysis).
+pub fn expected_frames(model: &Model) -> f64 {
+    let output = &model.output;
+    let steps = match &model.analysis {
+        Analysis::Static(s) => s.steps as f64,
+        Analysis::Dynamic(d) => match d.step {
+            TimeStep::Fixed(dt) => d.end_time / dt,
+            TimeStep::Auto { scale, .. } => critical_time_step(model)
+                .map(|limit| d.end_time / (scale * limit.dt))
+                .unwrap_or(0.0),
+        },
+    };
+    let every = if output.frame_every > 0 {
+        (steps / output.frame_every as f64).ceil()
+    } else {
+        0.0
+    };
+    1.0 + output.frame_times.len() as f64 + every
+}
+
+/// More than [`MANY_FRAMES`] frames, with the disk they will take.
+fn frames_warning(model: &Model) -> Option<String> {
+    let frames = expected_frames(model);
+    if frames <= MANY_FRAMES {
+        return None;
+    }
+    let bytes = frames * FRAME_BYTES_PER_NODE * model.node_count as f64;
+    Some(format!(
+        "the run will write about {} VTK frames (output.frame_interval, output.frame_times and \
+         output.frame_every together), some {} on disk uncompressed ({} nodes): more than {} \
+         frames is more than ParaView shows usefully, and every frame rewrites the .pvd; \
+         lengthen output.frame_interval (or raise output.frame_every)",
+        readable(frames.round()),
+        bytes_in_words(bytes),
+        model.node_count,
+        MANY_FRAMES
+    ))
+}
+
+/// `12 kB`, `3.4 MB`, `1.2 GB`, `5 TB` (powers of 1000).
+fn bytes_in_words(bytes: f64) -> String {
+    let units = ["B", "kB", "MB", "GB", "TB", "PB"];
+    let mut value = bytes;
+    let mut unit = 0;
+    while value >= 1000.0 && unit + 1 < units.len() {
+        value /= 1000.0;
+        unit += 1;
+    }
+    format!("{value:.1} {}", units[unit])
 }
 
 /// The size a wave crosses: the shorter side of the body's bounding box (a rod: its length,

@@ -246,11 +246,12 @@ impl Recorder {
     fn frame_due(&self, model: &Model, time: f64, force_frame: bool, pending: usize) -> bool {
         let tolerance = 1e-9 * time.abs().max(1e-300);
         let previous = time - self.step_length;
-        let listed = model
-            .output
-            .frame_times
-            .iter()
-            .any(|t| (t - time).abs() <= tolerance || (*t < time && *t > previous + tolerance));
+        // the listed times within the tolerance of `time`, or inside the step just taken
+        let listed = model.output.any_frame_in(
+            (time - tolerance).min(previous + tolerance),
+            time + tolerance,
+            |t| (t - time).abs() <= tolerance || (t < time && t > previous + tolerance),
+        );
         force_frame
             || listed
             || (self.frame_every > 0 && self.steps_since_frame + pending >= self.frame_every)

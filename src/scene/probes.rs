@@ -39,9 +39,21 @@ pub(super) fn frame_times(
             )));
         }
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        // the listed times are sorted (checked above): a multiple is compared with its two
+        // neighbours among them only, so laying out n frames costs n log(listed), not n^2
+        let listed = output.frame_times.as_slice();
+        let near_listed = |t: f64| {
+            let k = listed.partition_point(|x| *x < t);
+            [k.checked_sub(1), Some(k)]
+                .into_iter()
+                .flatten()
+                .filter_map(|i| listed.get(i))
+                .any(|x| close(*x, t))
+        };
+        times.reserve(count as usize);
         for k in 1..=count as usize {
             let t = (k as f64 * interval).min(end_time);
-            if !times.iter().any(|listed| close(*listed, t)) {
+            if !near_listed(t) {
                 times.push(t);
             }
         }

@@ -52,6 +52,26 @@ impl Default for OutputSpec {
     }
 }
 
+impl OutputSpec {
+    /// The first frame time after `time` (strictly), or None. The validated `frame_times`
+    /// are sorted, so a binary search finds it: a run of many frames does not scan the list
+    /// at every step.
+    pub fn next_frame_after(&self, time: f64) -> Option<f64> {
+        let k = self.frame_times.partition_point(|t| *t <= time);
+        self.frame_times.get(k).copied()
+    }
+
+    /// Whether a listed frame time satisfies `hit` among those in [low, high] (sorted: found
+    /// by a binary search, then a walk over the few in the range).
+    pub fn any_frame_in(&self, low: f64, high: f64, hit: impl Fn(f64) -> bool) -> bool {
+        let k = self.frame_times.partition_point(|t| *t < low);
+        self.frame_times[k..]
+            .iter()
+            .take_while(|t| **t <= high)
+            .any(|t| hit(*t))
+    }
+}
+
 fn default_frame_every() -> usize {
     1
 }
