@@ -638,3 +638,66 @@ fn a_remainder_shorter_than_the_shortest_step_joins_the_last_step() {
         );
     }
 }
+
+/// A steel rod of 10 elements at 10 m/s, Newmark average, to end_time 1e-4 with frames every
+/// 3e-6: the numbers a user writes, whose multiples of dt are not those times in floating
+/// point (100 x 1e-6 = 9.999999999999999e-5, 15 x 1e-6 = 1.4999999999999999e-5).
+const ROUND_OFF_ROD: &str = r#"
+[[material]]
+name = "bar"
+young = 200e9
+poisson = 0.0
+density = 7850.0
+
+[[body]]
+name = "bar"
+material = "bar"
+formulation = "rod"
+area = 1e-4
+velocity = [10.0, 0.0]
+mesh = { type = "line", start = [0.0, 0.0], end = [0.1, 0.0], n = 10 }
+
+[[support]]
+set = "all"
+fix = ["y"]
+
+[analysis]
+type = "dynamic"
+integrator = "average"
+dt = 1e-6
+end_time = 1e-4
+
+[output]
+frame_every = 0
+frame_interval = 3e-6
+"#;
+
+/// Goal: implicit steps land exactly on end_time and on the frame times. Before: the last
+/// history row was at 9.999999999999999e-5 (100 x 1e-6) instead of 1e-4, and frames at
+/// 1.4999999999999999e-5 instead of the listed 1.5e-5. Setup: `ROUND_OFF_ROD` with dt = 1e-6
+/// and 2e-6 (both land off in floating point) and 7e-7 (a dt the frames split).
+/// Reference: the scene's own numbers: the last row's time is the text `1e-4` parsed, each
+/// frame's time is k x 3e-6 as the scene defines the frame times, and each of those times
+/// has a history row.
+#[test]
+fn implicit_steps_land_exactly_on_end_time_and_frame_times() {
+    let end_time: f64 = "1e-4".parse().unwrap();
+    let listed: Vec<f64> = (1..=33).map(|k| k as f64 * 3e-6).collect();
+    for dt in ["1e-6", "2e-6", "7e-7"] {
+        let name = format!("round_off_{dt}");
+        let model = common::model(&name, ROUND_OFF_ROD, &[&format!("analysis.dt={dt}")]);
+        common::run(&name, &model);
+        let dir = common::out_dir_of(&name);
+        let times = column(&dir, "time");
+        assert_eq!(*times.last().unwrap(), end_time, "dt {dt}");
+        let frames = impact::output::vtk::read_pvd(&dir.join(format!("{name}.pvd"))).unwrap();
+        let frame_times: Vec<f64> = frames.iter().map(|(t, _)| *t).collect();
+        let mut expected = vec![0.0];
+        expected.extend(&listed);
+        expected.push(end_time);
+        assert_eq!(frame_times, expected, "dt {dt}");
+        for t in &listed {
+            assert!(times.contains(t), "dt {dt}: no history row at {t:e}");
+        }
+    }
+}

@@ -233,7 +233,14 @@ impl<'a> Dynamics<'a> {
         if stop - end < self.control.shortest() {
             end = stop;
         }
-        let target = super::snap(end, spec.dt());
+        // a step that reaches end_time or a frame time ends on it exactly, as the scene wrote
+        // it (k dt in floating point is not always that time: 100 x 1e-6 is 9.999999999999999e-5);
+        // other steps end on the multiple of dt they are within round-off of
+        let target = if stop - end <= 1e-9 * spec.dt() {
+            stop
+        } else {
+            super::snap(end, spec.dt())
+        };
         (target, super::step_length(target - time, spec.dt()))
     }
 
