@@ -155,9 +155,12 @@ pub struct Summary {
     /// end state gives it).
     #[serde(skip)]
     pub max_temperature: Option<f64>,
-    /// What the finished run can say about its own answer (analysis::plausibility): step
-    /// cuts, the energy balance, plastic work above the energy supplied, a step too long for
-    /// the run or the impact, a contact penetration beyond TOL. Empty when none.
+    /// What the scene and the finished run say about the answer (analysis::plausibility):
+    /// the scene's own warnings (too few steps, a run shorter than a wave transit, an unused
+    /// obstacle, an axis not held, too many frames), then step cuts, the energy balance,
+    /// plastic work above the energy supplied, a step too long for the impact, a pair that
+    /// never closed, a contact penetration beyond TOL, nodes across the axis, hourglass
+    /// energy. Empty when none.
     #[serde(default)]
     pub warnings: Vec<String>,
 }
