@@ -205,17 +205,17 @@ fn pair_against_wall(
             .collect();
         all.extend(extra.iter().map(|s| s.replace("body.upper.", "body.rod.")));
         let all: Vec<&str> = all.iter().map(String::as_str).collect();
-        let (m, _, s, _) = run(&format!("{name}_{tag}"), &wall_text, &all);
-        extents(&m, &s)[0]
+        let (m, summary, s, _) = run(&format!("{name}_{tag}"), &wall_text, &all);
+        (extents(&m, &s)[0], summary.energy.max_relative_drift)
     };
     let upper_mesh: Vec<&str> = overrides
         .iter()
         .copied()
         .filter(|s| s.starts_with("body.upper."))
         .collect();
-    let upper_wall = wall_for("wall", &upper_mesh);
-    let lower_wall = match lower_wall {
-        None => upper_wall,
+    let (upper_wall, upper_drift) = wall_for("wall", &upper_mesh);
+    let (lower_wall, lower_drift) = match lower_wall {
+        None => (upper_wall, upper_drift),
         Some(mesh) => wall_for("wall_lower", mesh),
     };
     println!("{name}: pair {pair:?}, walls {upper_wall:?} {lower_wall:?}");
@@ -247,10 +247,14 @@ fn pair_against_wall(
         momentum.abs() < conserved * MOMENTUM,
         "{name}: momentum {momentum:e}"
     );
+    // the balance loses the kinetic energy of the face nodes arrested at first contact
+    // (theory 8.3: 1 / 100 of the mass on 5 x 50, 1.1 %), as the rod on the rigid wall
+    // does: the pair may lose no more than its worse wall run, and under 1.5 %
+    let drift = summary.energy.max_relative_drift;
+    let wall_drift = upper_drift.max(lower_drift);
     assert!(
-        summary.energy.max_relative_drift < 0.01,
-        "{name}: energy balance {}",
-        summary.energy.max_relative_drift
+        drift < 0.015 && drift < wall_drift + 1e-3,
+        "{name}: energy balance {drift} against the wall's {wall_drift}"
     );
     let slave_columns = if overrides.contains(&"body.upper.mesh.nx=7") {
         7.0
@@ -283,8 +287,9 @@ fn pair_against_wall(
 /// -0.03 % / +0.09 % D_f; Newmark -0.004 %, +0.01 %); non-matching within 1 % of each rod's
 /// own wall run (measured up to 0.27 % L_f, 0.38 % D_f). Total axial momentum zero to 1e-9
 /// of rho A L V on the explicit paths (equal and opposite contact forces), 1e-5 on Newmark
-/// (Hughes' impact conditions: `pair_against_wall`), energy balance within
-/// 1 % (measured 0.10 % to 0.13 %), deepest penetration of either surface below 1 % of the
+/// (Hughes' impact conditions: `pair_against_wall`), energy balance no worse than the
+/// wall's (within 1e-3; measured 1.12 % both on 2x2: the arrest of the face nodes) and below
+/// 1.5 %, deepest penetration of either surface below 1 % of the
 /// 0.64 mm face element (measured 5e-10 m on 2x2, 2.5e-6 m one-point).
 #[test]
 fn rod_pair_on_explicit_and_implicit_paths_matches_the_wall() {

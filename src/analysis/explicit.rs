@@ -225,7 +225,6 @@ impl<'a> Explicit<'a> {
                 }
             });
         self.energies.contact_work -= chunked_sum(&step.step_force, &self.du, |f, u| f * u);
-        self.energies.contact_work += step.impact_loss;
     }
 
     /// The internal force at u_{n+1} (a step of length `h`), the committed element state and
