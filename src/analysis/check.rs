@@ -93,16 +93,38 @@ pub enum StepStability {
     WilsonBelowLimit { dt: f64, dt_crit_explicit: f64 },
 }
 
-/// How many steps of `dt` the run takes to its end time: exactly for a fixed step, at least
-/// for the automatic one (the stable step falls as elements crush).
-fn step_count(spec: &DynamicSpec, dt: f64) -> String {
+/// Element updates per second per core of the explicit kernels through the whole driver,
+/// as `impact bench` measured them on the 2-core development machine (docs/performance.md:
+/// one-point 5.2-5.9e6 on the rod pair and rod, 2x2 with J2 1.9e6; Johnson-Cook is slower):
+/// a rough scale for the wall-time estimate of `check`, not a promise.
+const ONE_POINT_RATE: f64 = 5.0e6;
+const FULL_RATE: f64 = 1.5e6;
+
+/// How many steps of `dt` the run takes to its end time (exactly for a fixed step, at least
+/// for the automatic one: the stable step falls as elements crush), and a rough wall time
+/// for central difference from the kernel's element rate.
+fn step_count(model: &Model, spec: &DynamicSpec, dt: f64) -> String {
     let steps = (spec.end_time / dt).ceil();
-    match spec.step {
+    let count = match spec.step {
         crate::scene::spec::TimeStep::Fixed(_) => format!("{steps:.0} steps to end_time"),
         crate::scene::spec::TimeStep::Auto { .. } => format!(
             "at least {steps:.0} steps to end_time (the automatic step falls as elements deform)"
         ),
+    };
+    if spec.integrator != IntegratorKind::CentralDifference {
+        return count;
     }
+    let rate = match spec.quadrature {
+        crate::scene::spec::Quadrature::Reduced => ONE_POINT_RATE,
+        _ => FULL_RATE,
+    };
+    let seconds = steps * model.elements() as f64 / rate;
+    format!(
+        "{count}; about {} s of element updates for those steps on one core at {} element \
+         updates/s (impact bench measures this machine's rate)",
+        readable(seconds),
+        readable(rate)
+    )
 }
 
 /// The step of `spec` against the stability limit of its integrator; a central-difference
@@ -186,7 +208,7 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
                 readable(dt),
                 readable(dt_crit),
                 readable(dt / dt_crit),
-                step_count(spec, dt),
+                step_count(model, spec, dt),
                 if spec.mass == MassKind::Consistent {
                     " (from the lumped-mass frequency bound: the consistent mass's highest \
                      frequency is higher, sqrt 3 times for rods, so its limit is lower)"
