@@ -208,7 +208,7 @@ impl ContactState {
     fn slip_start(&self, pairs: &[ContactPair], (p, k): (usize, usize)) -> Slip {
         match pairs[p].options.friction {
             Friction::None | Friction::Return { .. } => Slip::Free,
-            Friction::Coulomb { mu } if mu == 0.0 => Slip::Free,
+            Friction::Coulomb { mu: 0.0 } => Slip::Free,
             Friction::Coulomb { .. } if self.active[p][k] && self.sliding[p][k] != 0.0 => {
                 Slip::Slide(self.sliding[p][k])
             }
