@@ -445,11 +445,11 @@ fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
         outln!("  {line}");
     }
     if model.bodies.iter().all(|b| b.material.density > 0.0) {
-        let analysis::explicit::StableStep {
+        let analysis::stable::StableStep {
             dt: dt_crit,
             body: b,
             element: e,
-        } = analysis::explicit::critical_time_step(&model)?;
+        } = analysis::stable::critical_time_step(&model)?;
         outln!(
             "  central-difference stability limit: dt_crit = {} (element eigenvalue bound; body `{}`, element {e})",
             readable(dt_crit),

@@ -143,7 +143,7 @@ fn at_fraction_of_critical(
     overrides: &[&str],
 ) -> impact::scene::Model {
     let model = common::model(name, text, overrides);
-    let dt_crit = impact::analysis::explicit::critical_time_step(&model)
+    let dt_crit = impact::analysis::stable::critical_time_step(&model)
         .unwrap()
         .dt;
     let mut all: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();

@@ -15,48 +15,12 @@
 //!              Wilson-theta: unconditionally stable for theta >= 1.37 only
 //! ```
 
-use super::explicit::{StableStep, checked_step, critical_time_step, first_step};
+use super::explicit::first_step;
+use super::stable::{StableStep, checked_step, critical_time_step, wave_speed};
 use crate::element::Formulation;
 use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind};
 use crate::scene::{BodyKind, InputError, Model};
-
-/// A body's wave speed and the modulus it comes from.
-#[derive(Debug, Clone, PartialEq)]
-pub struct WaveSpeed {
-    /// sqrt(modulus / rho).
-    pub speed: f64,
-    pub modulus: f64,
-    /// The modulus in words: `lambda + 2 mu (plane strain)`, ...
-    pub modulus_name: &'static str,
-}
-
-/// The dilatational wave speed of `body`'s material in its formulation (None without
-/// density: a static scene may leave it out).
-pub fn wave_speed(body: &crate::scene::Body) -> Option<WaveSpeed> {
-    let m = &body.material;
-    if m.density <= 0.0 {
-        return None;
-    }
-    let e = &m.elastic;
-    let (lambda, mu) = e.lame();
-    let (modulus, modulus_name) = match body.kind {
-        BodyKind::Rod { .. } => (e.young, "E (rod)"),
-        BodyKind::Continuum { formulation, .. } => match formulation {
-            Formulation::PlaneStrain => (lambda + 2.0 * mu, "lambda + 2 mu (plane strain)"),
-            Formulation::Axisymmetric => (lambda + 2.0 * mu, "lambda + 2 mu (axisymmetric)"),
-            Formulation::PlaneStress => (
-                e.young / (1.0 - e.poisson * e.poisson),
-                "E / (1 - nu^2) (plane stress)",
-            ),
-        },
-    };
-    Some(WaveSpeed {
-        speed: (modulus / m.density).sqrt(),
-        modulus,
-        modulus_name,
-    })
-}
 
 /// The body's kind in words: `plane strain, B-bar`, `plane stress, thickness 0.01`, ...
 pub fn kind_in_words(kind: BodyKind) -> String {

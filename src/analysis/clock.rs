@@ -18,7 +18,7 @@
 //! the rule set: a clipped step says where a frame or the end fell, not what the mesh needed.
 
 use super::Status;
-use super::run::StepError;
+use super::StepError;
 use crate::assembly::FrequencyBound;
 use crate::output::readable;
 use crate::scene::Model;

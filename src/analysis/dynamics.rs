@@ -14,12 +14,13 @@
 //! times in a row); a slave that touches its master at the start of a step closes with the
 //! impact conditions, and the step is split at the first contact event inside it.
 
+use super::StepError;
 use super::checkpoint::{Carry, Checkpoint, DynamicCarry};
 use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
 use super::record::{Energies, Motion};
-use super::run::{StepError, Stepper};
+use super::run::Stepper;
 use super::{StepControl, loads};
-use crate::assembly::{self, Mass, State, System};
+use crate::assembly::{self, Mass, State, System, check_mass};
 use crate::contact::{ContactResult, ContactState, Interfaces, Tangential};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
@@ -64,29 +65,6 @@ fn contact_nodes(model: &Model) -> Vec<bool> {
         }
     }
     flags
-}
-
-/// Refuses a dynamic model without mass on some free DOF (zero density).
-pub fn check_mass(model: &Model, mass: &Mass, system: &System) -> Result<(), InputError> {
-    for (dof, eq) in system.equation.iter().enumerate() {
-        if eq.is_some() && !(mass.lumped[dof] > 0.0) {
-            let node = dof / 2;
-            let body = model
-                .bodies
-                .iter()
-                .rev()
-                .find(|b| b.node_offset <= node)
-                .expect("node in a body");
-            return Err(InputError::new(
-                &model.file,
-                format!(
-                    "material `{}`.density: a dynamic analysis needs density > 0 (body `{}`)",
-                    body.material.name, body.name
-                ),
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// Implicit time stepping: the state, the motion, the solver and what the loop carries.

@@ -12,15 +12,16 @@
 //! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
+use super::StepError;
 use super::checkpoint::{Carry, Checkpoint, ExplicitCarry};
 use super::clock::Clock;
-use super::dynamics::check_mass;
 use super::newton::Counters;
 use super::record::{Energies, Motion};
-use super::run::{StepError, Stepper, TimeStepReport};
+use super::run::{Stepper, TimeStepReport};
+use super::stable::checked_step;
 use super::{DtLimit, RunError, Status, loads};
 use crate::assembly::explicit::{ExplicitKernel, Full, Reduced, StepWork};
-use crate::assembly::{self, ElementMasses, FrequencyBound, Mass, State, System};
+use crate::assembly::{self, ElementMasses, FrequencyBound, Mass, State, System, check_mass};
 use crate::contact::{ContactState, Interfaces};
 use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, MassKind, Quadrature};
@@ -29,28 +30,6 @@ use crate::solver::Solver;
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
-
-/// A central-difference stability limit and the element that sets it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StableStep {
-    /// dt_crit = 2 / omega_max.
-    pub dt: f64,
-    pub body: usize,
-    pub element: usize,
-}
-
-/// The central-difference stability limit of the model in its initial state, with the
-/// element that sets it.
-pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
-    let state = State::initial(model);
-    let bound = assembly::max_frequency_squared(model, &state, model.analysis.geometry())
-        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    Ok(StableStep {
-        dt: 2.0 / bound.omega_squared.sqrt(),
-        body: bound.body,
-        element: bound.element,
-    })
-}
 
 /// The clock of a run's first step: the element frequency bound of the kernel that will
 /// step `state` (one-point, 2x2 in rate form, or the general element loop), with the
@@ -81,30 +60,6 @@ pub fn first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, InputError> 
     let state = State::initial(model);
     let (kernel, _) = explicit_kernel(model, spec, &state, &masses);
     Ok(initial_clock(model, spec, exact, &state, &masses, kernel.as_deref())?.dt0)
-}
-
-/// The stability limit of `model`, or the refusal of a fixed dt above it (unless the scene
-/// sets `allow_unstable` to watch it blow up): the one check `impact check` and a run share.
-pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, InputError> {
-    let limit = critical_time_step(model)?;
-    if let Some(dt) = spec.fixed_dt()
-        && dt > limit.dt
-        && !spec.allow_unstable
-    {
-        return Err(InputError::new(
-            &model.file,
-            format!(
-                "analysis.dt = {} exceeds the central-difference stability limit {} (dt / dt_crit = {}; set by body `{}`, element {}); \
-                 lower dt, use dt = \"auto\", or set analysis.allow_unstable = true to watch it blow up",
-                readable(dt),
-                readable(limit.dt),
-                readable(dt / limit.dt),
-                model.bodies[limit.body].name,
-                limit.element
-            ),
-        ));
-    }
-    Ok(limit)
 }
 
 /// Central difference: the state, the motion, the one-point kernel when asked, and what the

@@ -15,6 +15,7 @@ pub mod plausibility;
 pub mod progress;
 pub mod record;
 pub mod run;
+pub mod stable;
 pub mod statics;
 
 use crate::assembly::State;
@@ -25,6 +26,25 @@ use record::Energies;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+/// A step that could not be taken: the run ends with this status and message.
+#[derive(Debug, Clone)]
+pub struct StepError {
+    pub status: Status,
+    pub message: String,
+    /// Write a frame of the state reached (the explicit blow-up shows what blew up).
+    pub frame: bool,
+}
+
+impl StepError {
+    pub fn diverged(message: String) -> StepError {
+        StepError {
+            status: Status::Diverged,
+            message,
+            frame: false,
+        }
+    }
+}
 
 /// How a run ended (summary.json `status`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -8,15 +8,14 @@
 //! ```text
 //! n_steps      end_time / dt, dt the fixed step or, with dt = "auto", time_step_scale times
 //!              the central-difference limit of the initial mesh (the run's first step)
-//! c            a body's dilatational wave speed (check::wave_speed)
+//! c            a body's dilatational wave speed (stable::wave_speed)
 //! L            a body's size: the shorter side of its bounding box (a rod: its length)
 //! t_transit    L / c, the time a wave takes to cross the body once
 //! ```
 
 use super::Summary;
-use super::check::wave_speed;
-use super::explicit::critical_time_step;
 use super::record::Energies;
+use super::stable::{critical_time_step, wave_speed};
 use crate::assembly::{self, State};
 use crate::contact::{ContactPair, Master, penetration_limits};
 use crate::element::Formulation;

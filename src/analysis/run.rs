@@ -23,7 +23,7 @@ use super::checkpoint::{self, Carry, Checkpoint};
 use super::newton::Counters;
 use super::progress::Progress;
 use super::record::{Energies, Motion, Recorder};
-use super::{DtLimit, Outcome, RunError, RunOptions, Status, Summary};
+use super::{DtLimit, Outcome, RunError, RunOptions, Status, StepError, Summary};
 use crate::assembly::State;
 use crate::contact::ContactState;
 use crate::output::readable;
@@ -32,25 +32,6 @@ use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
 use std::time::Instant;
-
-/// A step that could not be taken: the run ends with this status and message.
-#[derive(Debug, Clone)]
-pub struct StepError {
-    pub status: Status,
-    pub message: String,
-    /// Write a frame of the state reached (the explicit blow-up shows what blew up).
-    pub frame: bool,
-}
-
-impl StepError {
-    pub fn diverged(message: String) -> StepError {
-        StepError {
-            status: Status::Diverged,
-            message,
-            frame: false,
-        }
-    }
-}
 
 /// The steps a central-difference run took and what limits them at the end.
 #[derive(Debug, Clone)]

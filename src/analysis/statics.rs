@@ -11,10 +11,11 @@
 //! event inside an increment ends it early (Erklig 2.1.4: alpha brings the next node exactly
 //! into contact before the boundary conditions change).
 
+use super::StepError;
 use super::checkpoint::{Carry, Checkpoint, StaticCarry};
 use super::newton::{Constraints, Counters, Step, StepFailure};
 use super::record::{Energies, Motion};
-use super::run::{StepError, Stepper};
+use super::run::Stepper;
 use super::{StepControl, loads};
 use crate::assembly::{self, State, System};
 use crate::contact::{ContactState, Interfaces, Tangential};

@@ -4,7 +4,7 @@
 use super::{ElementFailure, Kernel, System};
 use crate::mesh::Cells;
 use crate::scene::spec::MassKind;
-use crate::scene::{Body, Model};
+use crate::scene::{Body, InputError, Model};
 
 /// The mass matrix. In the updated-Lagrangian description rho dV is invariant, so the mass
 /// is computed once on the initial configuration and never changes.
@@ -192,6 +192,29 @@ fn redistribute(m: &mut [f64], nn: usize, flagged: &[bool]) {
     for i in (0..nn).filter(|i| !flagged[*i]) {
         m[i * nn + i] += (total - kept) * rows[i] / weight;
     }
+}
+
+/// Refuses a dynamic model without mass on some free DOF (zero density).
+pub fn check_mass(model: &Model, mass: &Mass, system: &System) -> Result<(), InputError> {
+    for (dof, eq) in system.equation.iter().enumerate() {
+        if eq.is_some() && !(mass.lumped[dof] > 0.0) {
+            let node = dof / 2;
+            let body = model
+                .bodies
+                .iter()
+                .rev()
+                .find(|b| b.node_offset <= node)
+                .expect("node in a body");
+            return Err(InputError::new(
+                &model.file,
+                format!(
+                    "material `{}`.density: a dynamic analysis needs density > 0 (body `{}`)",
+                    body.material.name, body.name
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

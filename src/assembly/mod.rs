@@ -19,7 +19,7 @@ mod scatter;
 
 use kernel::ElementOut;
 pub use kernel::Kernel;
-pub use mass::Mass;
+pub use mass::{Mass, check_mass};
 use scatter::{Scatter, TRANSPOSED};
 
 use crate::element::{KernelError, Strain};
