@@ -99,32 +99,7 @@ enum Command {
     /// Run the cross product of `--vary` variations of a scene (in parallel across cases),
     /// measure each against the scene's [reference] (else the finest case), write
     /// sweep.csv and charts. A rerun skips finished cases.
-    Sweep {
-        /// The scene (not with --merge).
-        scene: Option<PathBuf>,
-        /// KEY=v1,v2,... or KEY1,KEY2=a1,a2;b1,b2 (keys varied together); repeat for a
-        /// cross product, the first outermost.
-        #[arg(long = "vary", value_name = "KEYS=VALUES")]
-        vary: Vec<String>,
-        /// Override a scene value in every case.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Cases run at once. Default: one per core.
-        #[arg(long, default_value_t = 0)]
-        jobs: usize,
-        /// Run only the cases k with k mod n = i (0 <= i < n), e.g. --shard $SLURM_ARRAY_TASK_ID/8.
-        #[arg(long, value_name = "i/n")]
-        shard: Option<String>,
-        /// Join the case folders of these sweep folders (shards) into --out.
-        #[arg(long, value_name = "DIR", num_args = 1..)]
-        merge: Vec<PathBuf>,
-        /// Output folder. Default: output/<scene name>_sweep/
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// No progress bar and no closing lines.
-        #[arg(long)]
-        quiet: bool,
-    },
+    Sweep(SweepArgs),
     /// Generated scenes of growing size (a J2 block striking a rigid wall), implicit and
     /// explicit, one child process each: a table of DOFs, steps/s, element updates/s,
     /// factorizations, back-substitutions, peak memory and the time per phase; bench.json and
@@ -214,25 +189,7 @@ fn main() -> ExitCode {
             out,
             set,
         } => buckle(&scene, modes, out, &set),
-        Command::Sweep {
-            scene,
-            vary,
-            set,
-            jobs,
-            shard,
-            merge,
-            out,
-            quiet,
-        } => sweep(
-            scene,
-            &vary,
-            &set,
-            jobs,
-            shard.as_deref(),
-            &merge,
-            out,
-            quiet,
-        ),
+        Command::Sweep(args) => sweep(args),
         Command::Bench {
             quick,
             cases,
@@ -504,18 +461,67 @@ fn buckle(
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
-fn sweep(
+/// `impact sweep`: its arguments.
+#[derive(clap::Args)]
+struct SweepArgs {
+    /// The scene (not with --merge).
     scene: Option<PathBuf>,
-    vary: &[String],
-    set: &[String],
+    /// KEY=v1,v2,... or KEY1,KEY2=a1,a2;b1,b2 (keys varied together); repeat for a
+    /// cross product, the first outermost.
+    #[arg(long = "vary", value_name = "KEYS=VALUES")]
+    vary: Vec<String>,
+    /// Override a scene value in every case.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Score each case on a history.csv column: [NAME=]COLUMN (its final value) or
+    /// [NAME=]STAT(COLUMN), STAT one of final, max, min, time_of_max, time_of_min,
+    /// integral; e.g. --measure L_f=extent_y[all]. Repeat for several. Each gets a sweep.csv
+    /// column, its error against the extrapolated value (Richardson, with the grid
+    /// convergence index) and charts.
+    #[arg(long = "measure", value_name = "MEASURE")]
+    measure: Vec<String>,
+    /// Write each case's VTK frames as its scene asks (default: none).
+    #[arg(long)]
+    frames: bool,
+    /// Cases run at once. Default: one per core.
+    #[arg(long, default_value_t = 0)]
     jobs: usize,
-    shard: Option<&str>,
-    merge: &[PathBuf],
+    /// Run only the cases k with k mod n = i (0 <= i < n), e.g. --shard $SLURM_ARRAY_TASK_ID/8.
+    #[arg(long, value_name = "i/n")]
+    shard: Option<String>,
+    /// Join the case folders of these sweep folders (shards) into --out.
+    #[arg(long, value_name = "DIR", num_args = 1..)]
+    merge: Vec<PathBuf>,
+    /// Output folder. Default: output/<scene name>_sweep/
+    #[arg(long)]
     out: Option<PathBuf>,
+    /// No progress bar and no closing lines.
+    #[arg(long)]
     quiet: bool,
-) -> Result<(), RunError> {
-    use impact::sweep::{self, Plan, SweepOptions, plan};
+}
+
+fn sweep(args: SweepArgs) -> Result<(), RunError> {
+    use impact::sweep::{self, Measure, Plan, SweepOptions, plan};
+    let SweepArgs {
+        scene,
+        vary,
+        set,
+        measure,
+        frames,
+        jobs,
+        shard,
+        merge,
+        out,
+        quiet,
+    } = args;
+    let shard = shard.as_deref();
+    let here = scene
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("impact sweep"));
+    let measures = measure
+        .iter()
+        .map(|m| Measure::parse(m).map_err(|e| InputError::new(&here, format!("--measure {e}"))))
+        .collect::<Result<Vec<_>, _>>()?;
     let report = if !merge.is_empty() {
         let here = Path::new("--merge");
         if scene.is_some() || !vary.is_empty() || !set.is_empty() || shard.is_some() {
@@ -526,7 +532,7 @@ fn sweep(
             .into());
         }
         let out = out.ok_or_else(|| InputError::new(here, "--merge needs --out DIR"))?;
-        sweep::merge(merge, &out)?
+        sweep::merge(&merge, &out, &measures)?
     } else {
         let scene = scene.ok_or_else(|| {
             InputError::new(
@@ -559,8 +565,9 @@ fn sweep(
             jobs,
             shard,
             progress: Progress::for_stderr(quiet, std::time::Duration::ZERO),
+            frames,
         };
-        sweep::run(&plan, &out, options)?
+        sweep::run(&plan, &out, options, &measures)?
     };
     if !quiet {
         outln!(
@@ -574,6 +581,11 @@ fn sweep(
         );
         for chart in &report.charts {
             outln!("  {}", chart.display());
+        }
+        for score in &report.scores {
+            for line in sweep::qoi::summary_lines(score) {
+                outln!("  {line}");
+            }
         }
         for note in &report.notes {
             outln!("  note: {note}");
@@ -643,6 +655,7 @@ fn plot_history(
         log_y: false,
         x_limits: look.x_limits,
         y_limits: look.y_limits,
+        notes: Vec::new(),
     };
     let charts = if look.panels {
         // the series of column k are the k-th of every run's group (own run, then references)

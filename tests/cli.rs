@@ -782,3 +782,23 @@ fn closed_stdout_and_stderr_cost_no_output() {
         Some(2)
     );
 }
+
+/// A probe that is one number of its set (an extent, a momentum) refuses `max` and `min`
+/// with the probe and the reason named (`p_x` took them silently and summed before).
+#[test]
+fn whole_set_probes_refuse_a_statistic() {
+    for (quantity, why) in [
+        ("extent_x", "extent of the set"),
+        ("p_x", "sum over the set"),
+    ] {
+        let text = format!(
+            "{BEAM}\n[[output.probe]]\nquantity = \"{quantity}\"\nset = \"all\"\nstatistic = \"max\"\n"
+        );
+        assert_input_error(
+            &format!("whole_set_{quantity}"),
+            &text,
+            &[],
+            &["output.probe[1].statistic", quantity, why],
+        );
+    }
+}

@@ -37,6 +37,7 @@ fn sin_cos_chart() -> Chart {
         log_y: false,
         x_limits: Default::default(),
         y_limits: Default::default(),
+        notes: Vec::new(),
     }
 }
 
@@ -169,6 +170,7 @@ fn log_log_convergence_chart_writes() {
         log_y: true,
         x_limits: Default::default(),
         y_limits: Default::default(),
+        notes: Vec::new(),
     };
     for name in ["convergence.svg", "convergence.png"] {
         plot::write(&chart, &dir.join(name)).unwrap();
@@ -312,6 +314,7 @@ fn png_curve_stays_inside_the_axes() {
         log_y: false,
         x_limits: Default::default(),
         y_limits: Default::default(),
+        notes: Vec::new(),
     };
     let path = dir.join("round_bar.png");
     plot::write(&chart, &path).unwrap();

@@ -21,6 +21,7 @@ fn options(jobs: usize, shard: Option<(usize, usize)>) -> SweepOptions {
         jobs,
         shard,
         progress: impact::analysis::progress::Mode::Off,
+        frames: false,
     }
 }
 
@@ -47,7 +48,7 @@ fn two_bars_force_error_converges_with_h_and_dt_together() {
         &[],
         &["body.bar1.mesh.n,body.bar2.mesh.n,analysis.dt=14,14,0.005;28,28,0.0025;56,56,0.00125"],
     );
-    let report = sweep::run(&p, &dir, options(2, None)).unwrap();
+    let report = sweep::run(&p, &dir, options(2, None), &[]).unwrap();
     assert_eq!(report.executed, 3);
     let mut smooth = Vec::new();
     let mut whole = Vec::new();
@@ -125,7 +126,7 @@ fn stability_map_central_difference_fails_just_above_dt_crit() {
             &format!("analysis.dt={}", dts.join(",")),
         ],
     );
-    let report = sweep::run(&p, &dir, options(2, None)).unwrap();
+    let report = sweep::run(&p, &dir, options(2, None), &[]).unwrap();
     let cell = |integrator: &str, ratio: f64| {
         let row = report
             .rows
@@ -187,19 +188,19 @@ fn rerun_does_no_work_and_merged_shards_equal_the_whole() {
         ],
     );
     let whole = common::out_dir("sweep_whole");
-    let first = sweep::run(&p, &whole, options(2, None)).unwrap();
+    let first = sweep::run(&p, &whole, options(2, None), &[]).unwrap();
     assert_eq!((first.executed, first.skipped), (4, 0));
-    let again = sweep::run(&p, &whole, options(2, None)).unwrap();
+    let again = sweep::run(&p, &whole, options(2, None), &[]).unwrap();
     assert_eq!((again.executed, again.skipped), (0, 4));
     let (a, b) = (
         common::out_dir("sweep_shard0"),
         common::out_dir("sweep_shard1"),
     );
-    let s0 = sweep::run(&p, &a, options(1, Some((0, 2)))).unwrap();
-    let s1 = sweep::run(&p, &b, options(1, Some((1, 2)))).unwrap();
+    let s0 = sweep::run(&p, &a, options(1, Some((0, 2))), &[]).unwrap();
+    let s1 = sweep::run(&p, &b, options(1, Some((1, 2))), &[]).unwrap();
     assert_eq!((s0.executed, s1.executed), (2, 2));
     let merged = common::out_dir("sweep_merged");
-    let m = sweep::merge(&[a, b], &merged).unwrap();
+    let m = sweep::merge(&[a, b], &merged, &[]).unwrap();
     assert_eq!(m.not_ok, 0);
     assert_eq!(deterministic(&m.csv), deterministic(&first.csv));
 }
@@ -210,8 +211,37 @@ fn rerun_does_no_work_and_merged_shards_equal_the_whole() {
 fn sweep_bad_input_exits_2() {
     let dir = common::out_dir("sweep_bad_input");
     let out = dir.join("out");
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 8] = [
         (&["--vary", "analysis.dtt=0.1,0.2"], "dtt"),
+        (
+            &[
+                "--vary",
+                "analysis.dt=0.01",
+                "--measure",
+                "max(nothing[all])",
+            ],
+            "nothing[all]",
+        ),
+        (
+            &[
+                "--vary",
+                "analysis.dt=0.01",
+                "--measure",
+                "mean(v_x[bar1.all])",
+            ],
+            "unknown statistic",
+        ),
+        (
+            &[
+                "--vary",
+                "analysis.dt=0.01",
+                "--measure",
+                "v=v_x[bar1.all]",
+                "--measure",
+                "v=max(v_x[bar2.all])",
+            ],
+            "two measures are named `v`",
+        ),
         (&["--vary", "analysis.dt=0.1,abc"], "analysis.dt"),
         (&["--vary", "analysis.dt"], "--vary"),
         (&["--vary", "analysis.dt=0.01", "--shard", "2/2"], "--shard"),
@@ -237,4 +267,211 @@ fn sweep_bad_input_exits_2() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
+}
+
+/// The unit oscillator of tests/dynamics.rs (one rod, m = rho A L / 2 = 1, k = E A / L = 1,
+/// omega = 1; started with v = 1: u = sin t), Newmark average by default.
+const OSCILLATOR: &str = r#"
+title = "unit oscillator"
+
+[[material]]
+name = "spring"
+young = 1.0
+poisson = 0.0
+density = 2.0
+
+[[body]]
+name = "rod"
+material = "spring"
+formulation = "rod"
+area = 1.0
+mesh = { type = "line", start = [0.0, 0.0], end = [1.0, 0.0], n = 1 }
+
+[[support]]
+set = "start"
+fix = ["x", "y"]
+
+[[support]]
+set = "end"
+fix = ["y"]
+
+[[initial_velocity]]
+set = "end"
+velocity = [1.0, 0.0]
+
+[analysis]
+type = "dynamic"
+geometry = "linear"
+mass = "lumped"
+dt = 0.1
+end_time = 10.0
+newton = { strategy = "initial", tol_displacement = 1e-12, tol_force = 1e-12 }
+
+[output]
+frame_every = 0
+
+[[output.probe]]
+quantity = "u_x"
+set = "end"
+"#;
+
+/// Lame's thick cylinder (a = 1, b = 2, p = 1, E = 1000, nu = 0.3), axisymmetric with u_z = 0,
+/// small strain, one element high (tests/statics.rs).
+const CYLINDER: &str = r#"
+title = "Lame cylinder"
+
+[[material]]
+name = "m"
+young = 1000.0
+poisson = 0.3
+
+[[body]]
+name = "cylinder"
+material = "m"
+formulation = "axisymmetric"
+bbar = false
+mesh = { type = "rectangle", origin = [1.0, 0.0], width = 1.0, height = 0.25, nx = 4, ny = 1 }
+
+[[support]]
+set = "bottom"
+fix = ["y"]
+
+[[support]]
+set = "top"
+fix = ["y"]
+
+[[load]]
+type = "pressure"
+set = "left"
+pressure = 1.0
+
+[analysis]
+type = "static"
+steps = 1
+geometry = "linear"
+newton = { strategy = "full" }
+
+[[output.probe]]
+quantity = "u_x"
+set = "left"
+"#;
+
+/// Runs a sweep of the scene `text` (written into the test's folder) with `vary` and one
+/// `--measure`; returns the measure's score of the only series and the rows.
+fn measured(
+    name: &str,
+    text: &str,
+    vary: &str,
+    measure: &str,
+) -> (
+    impact::sweep::qoi::SeriesScore,
+    Vec<impact::sweep::measure::Row>,
+) {
+    let dir = common::out_dir(name);
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let p = Plan {
+        scene,
+        sets: Vec::new(),
+        variations: vec![parse_variation(vary).unwrap()],
+    };
+    let measures = [impact::sweep::Measure::parse(measure).unwrap()];
+    let report = sweep::run(&p, &dir.join("sweep"), options(2, None), &measures).unwrap();
+    assert_eq!(report.not_ok, 0);
+    assert_eq!(report.scores[0].series.len(), 1);
+    (report.scores[0].series[0].clone(), report.rows)
+}
+
+/// Goal: the extrapolated value of a measure and its grid convergence index bracket the
+/// exact value, with the method's order observed, in dt and in h.
+/// Setup and references:
+/// - the unit oscillator with Newmark average to t = 10 at dt = 0.2, 0.1, 0.05, measure
+///   u(10), exact sin 10; the trapezoidal rule is second order (its phase error is
+///   (omega dt)^2 / 12 per radian, Hughes 1987, 9.3), and the energy it conserves keeps the
+///   amplitude exact;
+/// - Lame's cylinder with 8, 16, 32 elements through the wall, measure the bore's u_r, exact
+///   reference::lame_radial_displacement; bilinear quads converge as h^2 in displacement.
+/// Asserted: the observed order within 0.2 of 2 (Celik et al. 2008: three levels at ratio 2),
+/// the exact value inside the GCI band of the finest value, f1 (1 +- GCI), and inside
+/// f_ext +- GCI |f1|; the extrapolation closer to the exact value than the finest case.
+/// Measured: oscillator p = 2.006, f_ext 1.4e-5 from exact (finest 3.2e-3), GCI 4.0e-3;
+/// Lame p = 1.986, f_ext 1.6e-6 (finest 1.6e-4), GCI 2.0e-4.
+#[test]
+fn extrapolation_and_gci_bracket_the_exact_value() {
+    let lame = impact::reference::lame_radial_displacement(1.0, 1.0, 2.0, 1000.0, 0.3, 1.0);
+    let studies = [
+        (
+            "sweep_gci_oscillator",
+            OSCILLATOR,
+            "analysis.dt=0.2,0.1,0.05",
+            "u=u_x[end]",
+            10f64.sin(),
+        ),
+        (
+            "sweep_gci_lame",
+            CYLINDER,
+            "body.cylinder.mesh.nx=8,16,32",
+            "u=u_x[left]",
+            lame,
+        ),
+    ];
+    for (name, text, vary, measure, exact) in studies {
+        let (score, rows) = measured(name, text, vary, measure);
+        let e = score.extrapolation.expect("three levels");
+        let (order, value, gci) = (e.order.unwrap(), e.value.unwrap(), e.gci.unwrap());
+        let f1 = e.values[0];
+        println!(
+            "{name}: values {:?}, order {order:.3}, extrapolated {value:.8e} (exact {exact:.8e}), GCI {:.3e}, finest error {:.3e}",
+            e.values,
+            gci,
+            (f1 - exact).abs() / exact.abs()
+        );
+        assert!((order - 2.0).abs() <= 0.2, "{name}: order {order}");
+        assert!((f1 - exact).abs() <= gci * f1.abs(), "{name}");
+        assert!((value - exact).abs() <= gci * f1.abs(), "{name}");
+        assert!((value - exact).abs() < (f1 - exact).abs(), "{name}");
+        // every case, the finest included, has an error against the extrapolation
+        assert!(
+            rows.iter()
+                .all(|r| r.quantity_errors[0].is_some_and(|e| e != 0.0)),
+            "{name}"
+        );
+    }
+}
+
+/// Goal: without a reference, no case is scored against itself and no zero error reaches
+/// sweep.csv or a fitted slope. Setup: models/two_bars.toml with its [reference] removed,
+/// dt = 0.005 and 0.0025 (n = 14 rods per bar), and a measure of the first bar's final
+/// velocity: two levels, so nothing can be extrapolated.
+/// Asserted: the finest case (the reference history) has no force_l2 and no peak force
+/// error; every error that is reported is nonzero; the measure falls back to the finest
+/// case, which then has no error of its own.
+#[test]
+fn a_sweep_without_reference_never_scores_a_case_against_itself() {
+    let text = std::fs::read_to_string("models/two_bars.toml").unwrap();
+    let text = text.split("[reference]").next().unwrap().to_string();
+    let (score, rows) = measured(
+        "sweep_no_reference",
+        &text,
+        "analysis.dt=0.005,0.0025",
+        "v=v_x[bar1.all]",
+    );
+    let finest = rows
+        .iter()
+        .min_by(|a, b| a.dt.unwrap().total_cmp(&b.dt.unwrap()))
+        .unwrap();
+    assert!(finest.measures.force_l2.is_none());
+    assert!(finest.measures.peak_force_error.is_none());
+    for row in &rows {
+        let m = &row.measures;
+        for e in [m.force_l2, m.peak_force_error, row.quantity_errors[0]]
+            .into_iter()
+            .flatten()
+        {
+            assert!(e != 0.0, "{}: a zero error", row.folder);
+        }
+    }
+    assert_eq!(score.reference_kind, Some("finest case"));
+    assert_eq!(score.finest.as_deref(), Some(finest.folder.as_str()));
+    assert!(finest.quantity_errors[0].is_none());
 }

@@ -1022,3 +1022,105 @@ fn frames_carry_body_ids_and_fall_on_the_frame_interval() {
         assert!(*t >= e - 1e-12 && *t < e + dt, "{times:?}");
     }
 }
+
+/// The extent of a frame's points: (min x, max x, min y, max y).
+fn bounds(frame: &FrameData) -> [f64; 4] {
+    rows(frame, Section::Points, "Points").iter().fold(
+        [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ],
+        |b, p| {
+            [
+                b[0].min(p[0]),
+                b[1].max(p[0]),
+                b[2].min(p[1]),
+                b[3].max(p[1]),
+            ]
+        },
+    )
+}
+
+/// Goal: the shape probes (`extent_x`, `extent_y`, `x`/`y` with `max`/`min`) give the extent
+/// of the current configuration, the last history row and summary.json's `probes` agree, so
+/// a Taylor rod's L_f and D_f need no arithmetic.
+/// Setup: the aluminium Taylor rod (axisymmetric, models/taylor_aluminum.toml, its probes
+/// `extent_y[all]` and `extent_x[all]`, one-point kernel, 45 us) and the finite-strain
+/// cantilever above (plane stress) with the four kinds of probe over `all`.
+/// Reference: the last frame's points (the coordinates the run moved step by step; the probes
+/// sum initial coordinates and displacements): the same to the round-off of thousands of
+/// additions, 1e-12 of the body's size. Axisymmetric: the body of revolution's extent across
+/// the axis, 2 max r.
+#[test]
+fn shape_probes_are_the_extent_of_the_last_frame() {
+    let dir = common::out_dir("shape_probes_taylor");
+    let text = std::fs::read_to_string("models/taylor_aluminum.toml").unwrap();
+    let out = run_scene(
+        &dir,
+        "taylor",
+        &text,
+        &[
+            "--set",
+            "analysis.quadrature=reduced",
+            "--set",
+            "output.frame_every=100000",
+        ],
+    );
+    let last = frames(&out, "taylor").pop().unwrap();
+    let b = bounds(&last);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let probe = |name: &str| summary["probes"][name].as_f64().unwrap();
+    let size = 23.47e-3;
+    assert!((probe("extent_y[all]") - (b[3] - b[2])).abs() <= 1e-12 * size);
+    assert!((probe("extent_x[all]") - 2.0 * b[1]).abs() <= 1e-12 * size);
+    // history.csv prints 17 significant digits: the last one may differ by rounding
+    for name in ["extent_y[all]", "extent_x[all]"] {
+        let last_row = *common::column(&out, name).last().unwrap();
+        approx::assert_relative_eq!(last_row, probe(name), max_relative = 1e-15);
+    }
+
+    let dir = common::out_dir("shape_probes_beam");
+    let probes = r#"
+[[output.probe]]
+quantity = "extent_x"
+set = "all"
+
+[[output.probe]]
+quantity = "extent_y"
+set = "all"
+
+[[output.probe]]
+quantity = "y"
+set = "all"
+statistic = "max"
+
+[[output.probe]]
+quantity = "x"
+set = "all"
+statistic = "min"
+"#;
+    let out = run_scene(&dir, "beam", &format!("{CANTILEVER}{probes}"), &[]);
+    let last = frames(&out, "beam").pop().unwrap();
+    let b = bounds(&last);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let probe = |name: &str| summary["probes"][name].as_f64().unwrap();
+    let size = 4.0;
+    for (name, expected) in [
+        ("extent_x[all]", b[1] - b[0]),
+        ("extent_y[all]", b[3] - b[2]),
+        ("max_y[all]", b[3]),
+        ("min_x[all]", b[0]),
+    ] {
+        assert!(
+            (probe(name) - expected).abs() <= 1e-12 * size,
+            "{name}: {} against {expected}",
+            probe(name)
+        );
+    }
+    // the tip rises by a third of the length: the extents are not the initial ones
+    assert!(probe("max_y[all]") > 1.5);
+}

@@ -59,6 +59,8 @@ pub struct Recorder {
     pub hourglass_energy: f64,
     /// The length of the step the next row ends (column `dt`; 0 on the first row).
     pub step_length: f64,
+    /// The probes' values in the last row written (summary.json `probes`).
+    last_probes: Vec<f64>,
 }
 
 impl Recorder {
@@ -94,6 +96,7 @@ impl Recorder {
             hourglass_column: hourglass_column(model),
             hourglass_energy: 0.0,
             step_length: 0.0,
+            last_probes: Vec::new(),
         })
     }
 
@@ -109,6 +112,7 @@ impl Recorder {
             steps_since_frame: self.steps_since_frame,
             last_frame_time: self.last_frame_time,
             negative_pivots: self.negative_pivots,
+            probes: self.last_probes.clone(),
         })
     }
 
@@ -144,6 +148,7 @@ impl Recorder {
             hourglass_column: hourglass_column(model),
             hourglass_energy: 0.0,
             step_length: 0.0,
+            last_probes: position.probes,
         })
     }
 
@@ -209,12 +214,18 @@ impl Recorder {
         } else {
             None
         };
-        row.extend(
-            model
-                .probes
-                .iter()
-                .map(|p| probe_value(model, state, motion, reaction.as_deref(), p)),
-        );
+        self.last_probes.clear();
+        self.last_probes.extend(model.probes.iter().map(|p| {
+            probe_value(
+                model,
+                state,
+                motion,
+                reaction.as_deref(),
+                &self.reference,
+                p,
+            )
+        }));
+        row.extend_from_slice(&self.last_probes);
         if self.pivots_column {
             row.push(self.negative_pivots.map_or(f64::NAN, |n| n as f64));
         }
@@ -326,7 +337,9 @@ impl Recorder {
         Ok(())
     }
 
-    pub fn write_summary(&self, summary: &Summary) -> Result<(), OutputError> {
+    /// Writes summary.json: the summary, then `max_temperature` and the probes' final values
+    /// (`probes`, by column) when there are any.
+    pub fn write_summary(&self, model: &Model, summary: &Summary) -> Result<(), OutputError> {
         // every frame and row on disk (and the frames listed) before the summary says how
         // the run ended
         if let Some(series) = &self.series {
@@ -337,19 +350,50 @@ impl Recorder {
         let file = SummaryFile {
             summary,
             max_temperature: summary.max_temperature,
+            probes: FinalProbes {
+                columns: &model.probes,
+                values: &self.last_probes,
+            },
         };
         let text = serde_json::to_string_pretty(&file).expect("the summary serializes");
         write_atomic(&path, text.as_bytes())
     }
 }
 
-/// summary.json: the summary's fields, then `max_temperature` when there is one.
+/// summary.json: the summary's fields, then `max_temperature` when there is one, then the
+/// probes' last values when the scene has probes.
 #[derive(serde::Serialize)]
 struct SummaryFile<'a> {
     #[serde(flatten)]
     summary: &'a Summary,
     #[serde(skip_serializing_if = "Option::is_none")]
     max_temperature: Option<f64>,
+    #[serde(skip_serializing_if = "FinalProbes::is_empty")]
+    probes: FinalProbes<'a>,
+}
+
+/// `"probes": {"COLUMN": value, ...}` in the scene's order: the last history row's probe
+/// values (none before the first row).
+struct FinalProbes<'a> {
+    columns: &'a [crate::scene::model::Probe],
+    values: &'a [f64],
+}
+
+impl FinalProbes<'_> {
+    fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+}
+
+impl serde::Serialize for FinalProbes<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(self.values.len()))?;
+        for (probe, value) in self.columns.iter().zip(self.values) {
+            map.serialize_entry(&probe.column, value)?;
+        }
+        map.end()
+    }
 }
 
 /// The highest point temperature of the state, when some material carries one.
@@ -559,6 +603,16 @@ fn cell_fields(model: &Model, state: &State) -> CellFields {
     out
 }
 
+fn is_axisymmetric(body: &crate::scene::model::Body) -> bool {
+    matches!(
+        body.kind,
+        crate::scene::model::BodyKind::Continuum {
+            formulation: crate::element::Formulation::Axisymmetric,
+            ..
+        }
+    )
+}
+
 fn is_reaction(quantity: Quantity) -> bool {
     matches!(quantity, Quantity::ReactionX | Quantity::ReactionY)
 }
@@ -595,6 +649,7 @@ fn probe_value(
     state: &State,
     motion: &Motion,
     reaction: Option<&[f64]>,
+    initial: &[[f64; 2]],
     probe: &crate::scene::model::Probe,
 ) -> f64 {
     let combine = |values: &mut dyn Iterator<Item = f64>| -> f64 {
@@ -645,6 +700,32 @@ fn probe_value(
             let reaction = reaction.expect("computed when a reaction probe exists");
             probe.members.iter().map(|m| reaction[2 * m + c]).sum()
         }
+        Quantity::CoordinateX | Quantity::CoordinateY => {
+            let c = (probe.quantity == Quantity::CoordinateY) as usize;
+            combine(
+                &mut probe
+                    .members
+                    .iter()
+                    .map(|&m| initial[m][c] + state.displacement[2 * m + c]),
+            )
+        }
+        Quantity::ExtentX | Quantity::ExtentY => {
+            let c = (probe.quantity == Quantity::ExtentY) as usize;
+            let (low, high) =
+                probe
+                    .members
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), &m| {
+                        let x = initial[m][c] + state.displacement[2 * m + c];
+                        (low.min(x), high.max(x))
+                    });
+            if c == 0 && is_axisymmetric(&model.bodies[probe.body]) {
+                // the body of revolution spans -r_max .. r_max
+                2.0 * high
+            } else {
+                high - low
+            }
+        }
         Quantity::StressXX => points(&|p| p.stress[0]),
         Quantity::StressYY => points(&|p| p.stress[1]),
         Quantity::StressZZ => points(&|p| p.stress[2]),
@@ -653,6 +734,11 @@ fn probe_value(
         Quantity::EqPlasticStrain => points(&|p| p.eq_plastic_strain),
         Quantity::Temperature => points(&|p| p.temperature),
     }
+}
+
+/// The history.csv columns a run of `model` writes, in order.
+pub fn column_names(model: &Model) -> Vec<String> {
+    columns(model).0
 }
 
 /// The history.csv columns of a model, and whether the negative-pivot column is among them.
@@ -710,4 +796,7 @@ pub struct RecorderPosition {
     pub steps_since_frame: usize,
     pub last_frame_time: Option<f64>,
     pub negative_pivots: Option<usize>,
+    /// The probes' values in the last row (summary.json `probes`).
+    #[serde(default)]
+    pub probes: Vec<f64>,
 }

@@ -159,7 +159,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             let mut run_summary = summary;
             run_summary.status = Status::Diverged;
             run_summary.message = Some(message.clone());
-            recorder.write_summary(&run_summary)?;
+            recorder.write_summary(model, &run_summary)?;
             return Err(RunError::Numerical {
                 message,
                 summary: Box::new(run_summary),
@@ -438,7 +438,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         let mut summary = self.summary.clone();
         summary.status = status;
         summary.message = Some(message.clone());
-        match self.recorder.write_summary(&summary) {
+        match self.recorder.write_summary(self.model, &summary) {
             Ok(()) => RunError::Numerical {
                 message,
                 summary: Box::new(summary),
@@ -467,7 +467,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         let mut summary = self.summary.clone();
         summary.status = Status::Interrupted;
         summary.message = Some(message.clone());
-        match self.recorder.write_summary(&summary) {
+        match self.recorder.write_summary(self.model, &summary) {
             Ok(()) => RunError::Interrupted {
                 message,
                 summary: Box::new(summary),
@@ -493,7 +493,7 @@ impl<'a, S: Stepper> Run<'a, S> {
     fn end(&mut self) -> Result<Outcome, RunError> {
         self.stepper.sync_points();
         self.fill_summary();
-        self.recorder.write_summary(&self.summary)?;
+        self.recorder.write_summary(self.model, &self.summary)?;
         let positions = self
             .stepper
             .state()

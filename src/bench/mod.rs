@@ -536,6 +536,7 @@ fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                 log_y: true,
                 x_limits: Default::default(),
                 y_limits: Default::default(),
+                notes: Vec::new(),
             },
             &dir.join("bench_throughput.svg"),
         )?;
@@ -566,6 +567,7 @@ fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                 log_y: false,
                 x_limits: Default::default(),
                 y_limits: Default::default(),
+                notes: Vec::new(),
             },
             &dir.join("bench_time_breakdown.svg"),
         )?;

@@ -80,6 +80,16 @@ pub(super) fn probes(
                 bodies[b].name, bodies[b].material.name
             )));
         }
+        if p.quantity.is_whole_set() && p.statistic != Statistic::Mean {
+            let what = match p.quantity {
+                Quantity::ExtentX | Quantity::ExtentY => "the extent of the set",
+                _ => "the sum over the set",
+            };
+            return Err(cx.err(format!(
+                "{key}.statistic: {} is {what}; leave statistic out",
+                p.quantity.name()
+            )));
+        }
         let members = if p.quantity.is_nodal() {
             node_set(cx, bodies, p.body.as_deref(), &p.set, &key)?
                 .1

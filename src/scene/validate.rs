@@ -13,7 +13,7 @@ use super::materials::materials;
 use super::model::{Analysis, Body, BodyKind, Load, Model, Probe, SceneSource};
 use super::probes::{frame_times, probes};
 use super::reference::reference;
-use super::spec::{IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene, Statistic};
+use super::spec::{IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene};
 use crate::contact::{ContactPair, Friction};
 use std::path::Path;
 
@@ -72,8 +72,8 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
 }
 
 /// A reaction probe sums the support reactions of its set: the set needs a constrained DOF
-/// in the probe's direction (a support or a prescribed displacement), and the statistic is
-/// the sum (`mean`, the default, stands for it; `max` and `min` do not apply).
+/// in the probe's direction (a support or a prescribed displacement). (Its statistic, the
+/// sum, is checked with the probe: `scene::probes`.)
 fn check_reaction_probes(
     cx: &Context,
     probes: &[Probe],
@@ -87,12 +87,6 @@ fn check_reaction_probes(
             Quantity::ReactionY => 1,
             _ => continue,
         };
-        if probe.statistic != Statistic::Mean {
-            return Err(cx.err(format!(
-                "output.probe[{k}].statistic: {} is the sum over the set; leave statistic out",
-                probe.quantity.name()
-            )));
-        }
         let dof = |n: &usize| 2 * n + component;
         if !probe
             .members

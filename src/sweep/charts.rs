@@ -18,6 +18,7 @@
 
 use super::measure::Row;
 use super::plan::Plan;
+use super::qoi::{MeasureScore, Units, with_unit};
 use crate::analysis::RunError;
 use crate::output::plot::{self, Cell, CellKind, Chart, Map, Series, SeriesStyle};
 use std::collections::BTreeMap;
@@ -74,31 +75,47 @@ pub fn series_label(row: &Row, unlabelled: &[String]) -> String {
     label
 }
 
-fn grouped<'a>(plan: &Plan, rows: &'a [Row]) -> Vec<(String, Vec<&'a Row>)> {
+/// The series of the rows: each label with the indices of its rows, in order of appearance.
+pub fn series_indices(plan: &Plan, rows: &[Row]) -> Vec<(String, Vec<usize>)> {
     let unlabelled = unlabelled_keys(plan);
-    let mut groups: Vec<(String, Vec<&Row>)> = Vec::new();
-    for row in rows {
+    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
+    for (k, row) in rows.iter().enumerate() {
         let label = series_label(row, &unlabelled);
         match groups.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, members)) => members.push(row),
-            None => groups.push((label, vec![row])),
+            Some((_, members)) => members.push(k),
+            None => groups.push((label, vec![k])),
         }
     }
     groups
 }
 
+fn grouped<'a>(plan: &Plan, rows: &'a [Row]) -> Vec<(String, Vec<&'a Row>)> {
+    series_indices(plan, rows)
+        .into_iter()
+        .map(|(label, members)| (label, members.into_iter().map(|k| &rows[k]).collect()))
+        .collect()
+}
+
 /// The series of the charts: each label with its rows.
 type Groups<'a> = [(String, Vec<&'a Row>)];
 
-/// Writes the charts that the rows support; returns their paths.
+/// Writes the charts that the rows support; returns their paths. `units`: the scene's (for
+/// the axes), `notes`: lines shown on the force-error charts.
 pub fn write_all(
     plan: &Plan,
     rows: &[Row],
     title: &str,
+    units: Option<&Units>,
+    notes: &[String],
     out: &Path,
 ) -> Result<Vec<PathBuf>, RunError> {
     let mut written = Vec::new();
     let groups = grouped(plan, rows);
+    let look = Look {
+        title,
+        units,
+        notes,
+    };
     let primary_name = if rows.iter().any(|r| r.measures.force_l2.is_some()) {
         "contact force L2 error (relative)"
     } else {
@@ -106,7 +123,7 @@ pub fn write_all(
     };
     written.extend(error_vs_cpu(
         &groups,
-        title,
+        &look,
         primary_name,
         out,
         Accuracy::Primary,
@@ -119,15 +136,29 @@ pub fn write_all(
         };
         written.extend(error_vs_cpu(
             &groups,
-            title,
+            &look,
             name,
             out,
             Accuracy::Converged,
         )?);
     }
-    written.extend(convergence(rows, &groups, title, primary_name, out)?);
+    written.extend(convergence(rows, &groups, &look, primary_name, out)?);
     written.extend(stability_map(rows, &groups, title, out)?);
     Ok(written)
+}
+
+/// What every chart of a sweep shares: its title, the scene's units, the notes to show.
+struct Look<'a> {
+    title: &'a str,
+    units: Option<&'a Units>,
+    notes: &'a [String],
+}
+
+impl Look<'_> {
+    /// An axis label with the unit `unit` picks from the scene's units.
+    fn axis(&self, label: &str, unit: fn(&Units) -> &'static str) -> String {
+        with_unit(label, self.units.map_or("", unit))
+    }
 }
 
 /// Whether a case finished with status `ok` (the charts of errors plot only those).
@@ -140,14 +171,15 @@ fn finished(r: &&&Row) -> bool {
 /// case beats on both time and error, the cheapest way to each accuracy.
 fn error_vs_cpu(
     groups: &Groups,
-    title: &str,
+    look: &Look,
     primary_name: &str,
     out: &Path,
     accuracy: Accuracy,
 ) -> Result<Vec<PathBuf>, RunError> {
-    let error = |r: &Row| match accuracy {
+    let error = |r: &Row| match &accuracy {
         Accuracy::Primary => r.primary_error(),
         Accuracy::Converged => r.converged_error(),
+        Accuracy::Quantity(k, _) => r.quantity_errors.get(*k).copied().flatten().map(f64::abs),
     };
     let mut series: Vec<Series> = groups
         .iter()
@@ -176,7 +208,7 @@ fn error_vs_cpu(
         style: SeriesStyle::Line,
     });
     let chart = Chart {
-        title: format!("{title}: error against CPU time"),
+        title: format!("{}: error against CPU time", look.title),
         x_label: "CPU time of the case [s]".into(),
         y_label: primary_name.into(),
         series,
@@ -184,20 +216,177 @@ fn error_vs_cpu(
         log_y: true,
         x_limits: Default::default(),
         y_limits: Default::default(),
+        notes: look.notes.to_vec(),
     };
-    let name = match accuracy {
-        Accuracy::Primary => "error_vs_cpu",
-        Accuracy::Converged => "error_vs_cpu_converged",
+    let name = match &accuracy {
+        Accuracy::Primary => "error_vs_cpu".to_string(),
+        Accuracy::Converged => "error_vs_cpu_converged".to_string(),
+        Accuracy::Quantity(_, stem) => format!("error_vs_cpu_{stem}"),
     };
-    both(&chart, out, name)
+    both(&chart, out, &name)
+}
+
+/// The charts of each `--measure`: `measure_NAME` (its value against the refinement, one
+/// series per method, with each series' extrapolated value and GCI band) and
+/// `error_vs_cpu_NAME` (its error against the converged value, against CPU time, with the
+/// Pareto front). NAME: the measure's name with every character other than a letter, digit
+/// or `_` replaced by `_`.
+pub fn write_measures(
+    plan: &Plan,
+    rows: &[Row],
+    scores: &[MeasureScore],
+    title: &str,
+    units: &Units,
+    out: &Path,
+) -> Result<Vec<PathBuf>, RunError> {
+    let groups = series_indices(plan, rows);
+    let mut written = Vec::new();
+    for (k, score) in scores.iter().enumerate() {
+        let stem = slug(&score.measure.name);
+        let notes: Vec<String> = score
+            .series
+            .iter()
+            .filter_map(|s| {
+                let verdict = s.extrapolation.as_ref()?.verdict?;
+                Some(shortened(&format!("{}: {verdict}", s.series), 100))
+            })
+            .collect();
+        let look = Look {
+            title,
+            units: Some(units),
+            notes: &notes,
+        };
+        if let Some(chart) = measure_chart(k, score, rows, &groups, &look) {
+            written.extend(both(&chart, out, &format!("measure_{stem}"))?);
+        }
+        let error_groups: Vec<(String, Vec<&Row>)> = groups
+            .iter()
+            .map(|(label, members)| (label.clone(), members.iter().map(|&i| &rows[i]).collect()))
+            .collect();
+        let name = format!(
+            "|{} error| (relative, against the converged value)",
+            score.measure.name
+        );
+        written.extend(error_vs_cpu(
+            &error_groups,
+            &look,
+            &name,
+            out,
+            Accuracy::Quantity(k, stem),
+        )?);
+    }
+    Ok(written)
+}
+
+/// measure_NAME: the values of measure `k` against h or dt, a series per method, with the
+/// extrapolated value and the GCI band (a box on the finest value f1 (1 +- GCI) over the
+/// levels' span) of each series that has them.
+fn measure_chart(
+    k: usize,
+    score: &MeasureScore,
+    rows: &[Row],
+    groups: &[(String, Vec<usize>)],
+    look: &Look,
+) -> Option<Chart> {
+    let refinement = score.series.iter().find_map(|s| s.refinement)?;
+    let x_of = |r: &Row| if refinement == "h" { Some(r.h) } else { r.dt };
+    let mut series = Vec::new();
+    for ((label, members), scored) in groups.iter().zip(&score.series) {
+        let mut points: Vec<(f64, f64)> = members
+            .iter()
+            .map(|&i| &rows[i])
+            .filter(|r| r.status == "ok")
+            .filter_map(|r| Some((x_of(r)?, r.quantities[k]?)))
+            .filter(|(x, y)| *x > 0.0 && y.is_finite())
+            .collect();
+        if points.is_empty() {
+            continue;
+        }
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (low, high) = (points[0].0, points[points.len() - 1].0);
+        series.push(Series {
+            label: label.clone(),
+            points,
+            style: SeriesStyle::LineAndMarkers,
+        });
+        let Some(e) = &scored.extrapolation else {
+            continue;
+        };
+        if let (Some(value), Some(gci)) = (e.value, e.gci) {
+            series.push(Series {
+                label: format!(
+                    "{label}: extrapolated {value:.5e}, order {:.2}",
+                    e.order.unwrap_or(f64::NAN)
+                ),
+                points: vec![(low, value), (high, value)],
+                style: SeriesStyle::Line,
+            });
+            let f1 = e.values[0];
+            let (a, b) = (f1 - gci * f1.abs(), f1 + gci * f1.abs());
+            series.push(Series {
+                label: format!("{label}: GCI band, +-{:.2} %", 100.0 * gci),
+                points: vec![(low, a), (high, a), (high, b), (low, b), (low, a)],
+                style: SeriesStyle::Line,
+            });
+        }
+    }
+    if series.is_empty() {
+        return None;
+    }
+    let (x_label, unit) = if refinement == "h" {
+        (
+            "shortest element edge h",
+            look.units.map_or("", |u| u.length),
+        )
+    } else {
+        ("time step dt", look.units.map_or("", |u| u.time))
+    };
+    Some(Chart {
+        title: format!("{}: {}", look.title, score.measure.name),
+        x_label: with_unit(x_label, unit),
+        y_label: with_unit(&score.measure.name, &score.unit),
+        series,
+        log_x: true,
+        log_y: false,
+        x_limits: Default::default(),
+        y_limits: Default::default(),
+        notes: look.notes.to_vec(),
+    })
+}
+
+/// `text` cut to `width` characters, with an ellipsis when cut.
+fn shortened(text: &str, width: usize) -> String {
+    if text.chars().count() <= width {
+        text.to_string()
+    } else {
+        let cut: String = text.chars().take(width - 1).collect();
+        format!("{cut}…")
+    }
+}
+
+/// A file-name stem of a measure's name.
+fn slug(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    s.trim_matches('_').to_string()
 }
 
 /// Which error a speed chart plots: against the scene's reference (or the finest case
 /// without one), or against the converged reference beside a declared one.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 enum Accuracy {
     Primary,
     Converged,
+    /// The error of `--measure` k; the chart's file name ends with the measure's slug.
+    Quantity(usize, String),
 }
 
 /// The (time, error) points no other point beats on both, by increasing time: each has a
@@ -217,7 +406,7 @@ pub fn pareto_front(mut points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
 fn convergence(
     rows: &[Row],
     groups: &Groups,
-    title: &str,
+    look: &Look,
     primary_name: &str,
     out: &Path,
 ) -> Result<Vec<PathBuf>, RunError> {
@@ -228,9 +417,13 @@ fn convergence(
         measures.push((" away from jumps", |r: &Row| r.measures.force_l2_smooth));
     }
     type Abscissa = fn(&Row) -> Option<f64>;
-    let axes: [(&str, &str, Abscissa); 2] = [
-        ("dt", "time step dt", |r: &Row| r.dt),
-        ("h", "shortest element edge h", |r: &Row| Some(r.h)),
+    let axes: [(&str, String, Abscissa); 2] = [
+        ("dt", look.axis("time step dt", |u| u.time), |r: &Row| r.dt),
+        (
+            "h",
+            look.axis("shortest element edge h", |u| u.length),
+            |r: &Row| Some(r.h),
+        ),
     ];
     for (name, x_label, x_of) in axes {
         let mut series = Vec::new();
@@ -262,14 +455,15 @@ fn convergence(
         }
         if !series.is_empty() {
             let chart = Chart {
-                title: format!("{title}: error against {name}"),
-                x_label: x_label.into(),
+                title: format!("{}: error against {name}", look.title),
+                x_label,
                 y_label: primary_name.into(),
                 series,
                 log_x: true,
                 log_y: true,
                 x_limits: Default::default(),
                 y_limits: Default::default(),
+                notes: look.notes.to_vec(),
             };
             written.extend(both(&chart, out, &format!("error_vs_{name}"))?);
         }

@@ -82,6 +82,10 @@ pub struct Row {
     pub wall_seconds: Option<f64>,
     pub cpu_seconds: Option<f64>,
     pub measures: Measures,
+    /// The `--measure` values of the case, in the order given (qoi::score).
+    pub quantities: Vec<Option<f64>>,
+    /// Their errors against the series' converged value (qoi::score).
+    pub quantity_errors: Vec<Option<f64>>,
 }
 
 impl Row {
@@ -122,6 +126,9 @@ pub struct ReferenceUsed {
     pub richardson_order: Option<f64>,
     /// What a column measures when it is not a discretization error (printed by the sweep).
     pub notes: Vec<String>,
+    /// The same, in a line short enough for the charts of the force errors.
+    #[serde(skip)]
+    pub chart_notes: Vec<String>,
     /// Beside a declared reference: the converged one the `converged_` columns use.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub converged: Option<Box<ReferenceUsed>>,
@@ -245,6 +252,8 @@ fn row(
         wall_seconds: record.map(|r| r.wall_seconds),
         cpu_seconds: record.and_then(|r| r.cpu_seconds),
         measures,
+        quantities: Vec::new(),
+        quantity_errors: Vec::new(),
     })
 }
 
@@ -291,6 +300,7 @@ fn pulse_reference(
         finest: None,
         richardson_order: None,
         notes: vec![PULSE_PEAK_NOTE.to_string()],
+        chart_notes: Vec::new(),
         converged: None,
     }
 }
@@ -331,6 +341,7 @@ fn hertz_reference(
         finest: None,
         richardson_order: None,
         notes: Vec::new(),
+        chart_notes: Vec::new(),
         converged: None,
     }
 }
@@ -386,6 +397,7 @@ fn finest_reference(
         finest: None,
         richardson_order: None,
         notes: Vec::new(),
+        chart_notes: Vec::new(),
         converged: None,
     };
     let Some(&finest) = ok.first() else {
@@ -435,12 +447,22 @@ fn finest_reference(
         .as_ref()
         .and_then(|l| Some((l.time.clone(), l.force.clone()?)));
     for (k, row) in rows.iter_mut().enumerate() {
+        // the finest case is the reference history (and, without an extrapolation, the
+        // reference peak and release): it is not scored against itself
+        if k == finest && order.is_none() {
+            continue;
+        }
         let m = &mut row.measures;
-        if let (Some(p), Some(p_ref)) = (m.peak_force, peak) {
+        if let (Some(p), Some(p_ref)) = (m.peak_force, peak)
+            && p_ref != 0.0
+        {
             m.peak_force_error = Some(p / p_ref - 1.0);
         }
         if let (Some(t), Some(t_ref)) = (m.release_time, release) {
             m.release_error = Some(t - t_ref);
+        }
+        if k == finest {
+            continue;
         }
         if let (
             Some((t_ref, f_ref)),
@@ -455,7 +477,31 @@ fn finest_reference(
             m.force_l2 = relative_l2(time, f, &interpolate, |_| true);
         }
     }
+    if let Some(note) = not_decreasing(rows, &ok) {
+        used.notes.push(note);
+        used.chart_notes.push(
+            "force L2 against the finest case does not fall under refinement: no converging measure"
+                .into(),
+        );
+    }
     used
+}
+
+/// A note when force_l2 against the finest case does not fall as the cases get finer (by dt,
+/// then h, as the finest case is chosen): the force history is then no converging measure.
+fn not_decreasing(rows: &[Row], finest_first: &[usize]) -> Option<String> {
+    let errors: Vec<f64> = finest_first
+        .iter()
+        .filter_map(|&k| rows[k].measures.force_l2)
+        .collect();
+    let rising = errors.windows(2).any(|w| w[0] > w[1] * (1.0 + 1e-9));
+    (errors.len() >= 2 && rising).then(|| {
+        let listed: Vec<String> = errors.iter().rev().map(|e| format!("{e:.3}")).collect();
+        format!(
+            "force_l2 against the finest case does not fall as the cases get finer ({}, coarse to fine): the contact force history is not a converging measure of this scene; score the cases on a quantity with --measure",
+            listed.join(", ")
+        )
+    })
 }
 
 /// Richardson extrapolation from values on three levels f1 (finest), f2, f3 with step
@@ -569,9 +615,10 @@ pub fn shortest_edge(model: &Model) -> f64 {
     shortest
 }
 
-/// sweep.csv: one row per case; the varied values as given, then the measures. Numbers in
-/// shortest round-trip exponent form; empty where not applicable.
-pub fn csv(plan: &Plan, rows: &[Row]) -> String {
+/// sweep.csv: one row per case; the varied values as given, then the measures, then per
+/// `--measure` its value and its error (`NAME`, `NAME_error`). Numbers in shortest
+/// round-trip exponent form; empty where not applicable.
+pub fn csv(plan: &Plan, rows: &[Row], quantities: &[super::Measure]) -> String {
     let keys = plan.keys();
     let mut header: Vec<String> = vec!["case".into(), "folder".into()];
     header.extend(keys.iter().cloned());
@@ -603,6 +650,10 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
         ]
         .map(String::from),
     );
+    for q in quantities {
+        header.push(q.name.clone());
+        header.push(format!("{}_error", q.name));
+    }
     let mut text = header.join(",");
     text.push('\n');
     let num = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
@@ -636,6 +687,10 @@ pub fn csv(plan: &Plan, rows: &[Row]) -> String {
         cells.extend([m.steps, m.newton_iterations, m.factorizations].map(count));
         cells.push(num(row.wall_seconds));
         cells.push(num(row.cpu_seconds));
+        for k in 0..quantities.len() {
+            cells.push(num(row.quantities.get(k).copied().flatten()));
+            cells.push(num(row.quantity_errors.get(k).copied().flatten()));
+        }
         text.push_str(&cells.join(","));
         text.push('\n');
     }

@@ -4,10 +4,13 @@
 //!
 //! ```text
 //! DIR/sweep.json         the plan (scene, --set, --vary); a rerun must have the same plan
-//! DIR/case-HASH/         one case: history.csv, summary.json (analysis::run, no VTK frames),
+//! DIR/case-HASH/         one case: history.csv, summary.json (analysis::run; VTK frames only
+//!                        with `frames`),
 //!                        case.json written last and atomically: the case is finished
 //! DIR/sweep.csv          one row per case (measure::csv)
 //! DIR/reference.json     the reference the errors are measured against
+//! DIR/measures.json      each --measure per series: levels, observed order, extrapolated
+//!                        value and GCI, or why not (qoi.rs)
 //! DIR/*.png, DIR/*.svg   charts (charts.rs)
 //! ```
 //! A rerun skips finished cases. `--shard i/n` runs the cases k with k mod n = i; `merge`
@@ -17,6 +20,7 @@
 pub mod charts;
 pub mod measure;
 pub mod plan;
+pub mod qoi;
 
 use crate::analysis::progress::Mode;
 use crate::analysis::{self, RunError, RunOptions};
@@ -25,6 +29,7 @@ use crate::scene::{self, InputError, Model};
 use indicatif::{ProgressBar, ProgressStyle};
 use measure::CaseRecord;
 pub use plan::{Case, Plan, Variation};
+pub use qoi::Measure;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -39,6 +44,8 @@ pub struct SweepOptions {
     /// A bar over the cases (with a line per finished case above it), a line per finished
     /// case, or nothing.
     pub progress: Mode,
+    /// Write each case's VTK frames as its scene asks (off: no frames, whatever the scene).
+    pub frames: bool,
 }
 
 /// What a sweep did.
@@ -57,19 +64,23 @@ pub struct Report {
     pub rows: Vec<measure::Row>,
     pub csv: PathBuf,
     pub charts: Vec<PathBuf>,
-    /// What some columns measure (reference.json `notes`), for the closing lines.
+    /// What some columns measure (reference.json `notes`), and why a measure has no
+    /// extrapolated value, for the closing lines.
     pub notes: Vec<String>,
+    /// Each `--measure` per series (measures.json).
+    pub scores: Vec<qoi::MeasureScore>,
 }
 
 fn output_error(path: &Path, action: &'static str, e: std::io::Error) -> RunError {
     RunError::Output(OutputError::io(path, action, e))
 }
 
-/// Builds every case's model (bad keys and values are input errors before anything runs).
-fn models(plan: &Plan, cases: &[Case]) -> Result<Vec<Model>, RunError> {
+/// Builds every case's model (bad keys and values are input errors before anything runs),
+/// and checks that each measure names a column of the cases' history.
+fn models(plan: &Plan, cases: &[Case], measures: &[Measure]) -> Result<Vec<Model>, RunError> {
     plan.validate()
         .map_err(|m| InputError::new(&plan.scene, format!("--vary: {m}")))?;
-    cases
+    let models: Vec<Model> = cases
         .iter()
         .map(|case| {
             scene::load(&plan.scene, &plan.overrides(case)).map_err(|e| {
@@ -84,14 +95,23 @@ fn models(plan: &Plan, cases: &[Case]) -> Result<Vec<Model>, RunError> {
                 })
             })
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    for model in &models {
+        qoi::check(measures, model).map_err(|m| InputError::new(&plan.scene, m))?;
+    }
+    Ok(models)
 }
 
 /// Runs the plan's cases (of the shard) not finished in `dir`, then writes sweep.csv, the
 /// reference and the charts of the cases found in `dir`.
-pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, RunError> {
+pub fn run(
+    plan: &Plan,
+    dir: &Path,
+    options: SweepOptions,
+    measures: &[Measure],
+) -> Result<Report, RunError> {
     let cases = plan.cases();
-    let models = models(plan, &cases)?;
+    let models = models(plan, &cases, measures)?;
     crate::analysis::create_output_folder(dir)?;
     let plan_path = dir.join("sweep.json");
     if let Ok(text) = std::fs::read_to_string(&plan_path) {
@@ -133,7 +153,7 @@ pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, Run
     let results: Vec<Result<(), RunError>> = pool.install(|| {
         todo.par_iter()
             .map(|&k| {
-                let result = run_case(plan, &cases[k], &models[k], dir);
+                let result = run_case(plan, &cases[k], &models[k], dir, options.frames);
                 if options.progress != Mode::Off
                     && let Ok(record) = &result
                 {
@@ -157,7 +177,7 @@ pub fn run(plan: &Plan, dir: &Path, options: SweepOptions) -> Result<Report, Run
         .iter()
         .map(|c| Some(dir.join(plan.folder(c))).filter(|f| f.join("case.json").is_file()))
         .collect();
-    let mut report = write_results(plan, &cases, &models, &folders, dir)?;
+    let mut report = write_results(plan, &cases, &models, &folders, dir, measures)?;
     report.in_shard = mine.len();
     report.executed = todo.len();
     report.skipped = mine.len() - todo.len();
@@ -184,9 +204,25 @@ fn case_line(record: &CaseRecord, cases: usize) -> String {
     line
 }
 
-/// Runs one case into DIR/FOLDER (cleared first) on one thread; writes case.json last and
-/// returns it.
-fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<CaseRecord, RunError> {
+/// Runs one case into DIR/FOLDER (cleared first) on one thread, with its frames only when
+/// `frames`; writes case.json last and returns it.
+fn run_case(
+    plan: &Plan,
+    case: &Case,
+    model: &Model,
+    dir: &Path,
+    frames: bool,
+) -> Result<CaseRecord, RunError> {
+    let without_frames;
+    let model = if frames {
+        model
+    } else {
+        let mut m = model.clone();
+        m.output.frame_every = 0;
+        m.output.frame_times.clear();
+        without_frames = m;
+        &without_frames
+    };
     let folder = dir.join(plan.folder(case));
     if folder.exists() {
         std::fs::remove_dir_all(&folder).map_err(|e| output_error(&folder, "clear", e))?;
@@ -234,7 +270,7 @@ fn run_case(plan: &Plan, case: &Case, model: &Model, dir: &Path) -> Result<CaseR
 
 /// Joins the finished cases of sweeps run into `dirs` (shards of one plan) and writes the
 /// table and charts into `out`.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Report, RunError> {
+pub fn merge(dirs: &[PathBuf], out: &Path, measures: &[Measure]) -> Result<Report, RunError> {
     let mut plan: Option<Plan> = None;
     for dir in dirs {
         let path = dir.join("sweep.json");
@@ -258,7 +294,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Report, RunError> {
     }
     let plan = plan.ok_or_else(|| InputError::new(out, "--merge: name at least one folder"))?;
     let cases = plan.cases();
-    let models = models(&plan, &cases)?;
+    let models = models(&plan, &cases, measures)?;
     let folders: Vec<Option<PathBuf>> = cases
         .iter()
         .map(|c| {
@@ -270,24 +306,60 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Report, RunError> {
     crate::analysis::create_output_folder(out)?;
     let text = serde_json::to_string_pretty(&plan).expect("the plan serializes");
     write_atomic(&out.join("sweep.json"), text.as_bytes())?;
-    write_results(&plan, &cases, &models, &folders, out)
+    write_results(&plan, &cases, &models, &folders, out, measures)
 }
 
-/// Measures the cases, writes sweep.csv, reference.json and the charts into `out`.
+/// Measures the cases, writes sweep.csv, reference.json, measures.json and the charts into
+/// `out`.
 fn write_results(
     plan: &Plan,
     cases: &[Case],
     models: &[Model],
     folders: &[Option<PathBuf>],
     out: &Path,
+    measures: &[Measure],
 ) -> Result<Report, RunError> {
-    let (rows, reference) = measure::tabulate(plan, cases, models, folders)?;
+    let (mut rows, reference) = measure::tabulate(plan, cases, models, folders)?;
+    let scores = match models.first() {
+        Some(model) => {
+            let series = charts::series_indices(plan, &rows);
+            qoi::score(
+                measures,
+                &qoi::Units::of(model),
+                model,
+                &mut rows,
+                folders,
+                &series,
+            )
+        }
+        None => Vec::new(),
+    };
     let csv = out.join("sweep.csv");
-    write_atomic(&csv, measure::csv(plan, &rows).as_bytes())?;
+    write_atomic(&csv, measure::csv(plan, &rows, measures).as_bytes())?;
     let text = serde_json::to_string_pretty(&reference).expect("the reference serializes");
     write_atomic(&out.join("reference.json"), text.as_bytes())?;
-    let title = models.first().map(|m| m.name.clone()).unwrap_or_default();
-    let charts = charts::write_all(plan, &rows, &title, out)?;
+    let text = serde_json::to_string_pretty(&scores).expect("the scores serialize");
+    write_atomic(&out.join("measures.json"), text.as_bytes())?;
+    // the scene's title, else its name (the file's stem)
+    let title = models
+        .first()
+        .map(|m| {
+            if m.title.is_empty() {
+                m.name.clone()
+            } else {
+                m.title.clone()
+            }
+        })
+        .unwrap_or_default();
+    let units = models.first().map(qoi::Units::of);
+    let mut charts = charts::write_all(plan, &rows, &title, units.as_ref(), &reference.notes, out)?;
+    if let Some(units) = &units {
+        charts.extend(charts::write_measures(
+            plan, &rows, &scores, &title, units, out,
+        )?);
+    }
+    let mut notes = reference.notes;
+    notes.extend(scores.iter().flat_map(qoi::MeasureScore::notes));
     Ok(Report {
         cases: cases.len(),
         in_shard: cases.len(),
@@ -297,6 +369,7 @@ fn write_results(
         rows,
         csv,
         charts,
-        notes: reference.notes,
+        notes,
+        scores,
     })
 }

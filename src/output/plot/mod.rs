@@ -65,6 +65,9 @@ pub struct Chart {
     /// Axis ends given by the user; the others follow the data (with a margin).
     pub x_limits: Limits,
     pub y_limits: Limits,
+    /// Lines printed in the plot's upper left corner, in red: what a reader must know before
+    /// trusting the curves (e.g. that a measure does not converge).
+    pub notes: Vec<String>,
 }
 
 /// Ends of an axis fixed by the user (`--xmin` ...); None: from the data.
@@ -352,7 +355,7 @@ fn draw<DB: DrawingBackend>(
     // tick labels much smaller than a linear axis' span print as 0; log axes pass 0
     let span = |(low, high): (f64, f64), log: bool| if log { 0.0 } else { high - low };
     let (x_span, y_span) = (span(x, chart.log_x), span(y, chart.log_y));
-    match (chart.log_x, chart.log_y) {
+    let plotted = match (chart.log_x, chart.log_y) {
         (false, false) => draw_series(
             builder.build_cartesian_2d(x.0..x.1, y.0..y.1).map_err(e)?,
             chart,
@@ -383,8 +386,18 @@ fn draw<DB: DrawingBackend>(
             x_span,
             y_span,
         ),
+    };
+    plotted.map_err(e)?;
+    let note_style = TextStyle::from((FontFamily::SansSerif, 14)).color(&RGBColor(180, 0, 0));
+    for (k, note) in chart.notes.iter().enumerate() {
+        root.draw(&Text::new(
+            note.as_str(),
+            (104, 50 + 18 * k as i32),
+            note_style.clone(),
+        ))
+        .map_err(e)?;
     }
-    .map_err(e)
+    Ok(())
 }
 
 /// Colours of the series in order (the matplotlib "tab10" cycle), repeated past ten.
@@ -631,11 +644,19 @@ fn tick_label(value: f64, span: f64) -> String {
         return "0".to_string();
     }
     let magnitude = value.abs();
+    // the decimal place of a tenth of the span: neighbouring ticks must print apart
+    let resolved = if span > 0.0 {
+        -(0.1 * span).log10().floor() as i32
+    } else {
+        i32::MIN / 2
+    };
+    let order = magnitude.log10().floor() as i32;
     if (1e-3..1e5).contains(&magnitude) {
-        let decimals = (3 - magnitude.log10().floor() as i32).max(0) as usize;
+        let decimals = (3 - order).max(resolved).max(0) as usize;
         trim_zeros(&format!("{value:.decimals$}"))
     } else {
-        let text = format!("{value:.3e}");
+        let digits = 3.max(order + resolved) as usize;
+        let text = format!("{value:.digits$e}");
         let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
         format!("{}e{exponent}", trim_zeros(mantissa))
     }
@@ -676,6 +697,9 @@ mod tests {
         assert_eq!(tick_label(-0.0125, 0.1), "-0.0125");
         assert_eq!(tick_label(1e-6, 0.0), "1e-6");
         assert_eq!(tick_label(2.5e7, 1e8), "2.5e7");
+        // a narrow span about a large value: neighbouring ticks 2e-6 apart print apart
+        assert_eq!(tick_label(0.026572, 2e-5), "0.026572");
+        assert_eq!(tick_label(1.23456e7, 1e3), "1.23456e7");
     }
 
     /// Goal: log-axis ticks are exact 1-2-5 values inside the range, once each, and a range
@@ -710,6 +734,7 @@ mod tests {
             log_y: false,
             x_limits: Default::default(),
             y_limits: Default::default(),
+            notes: Vec::new(),
         };
         let path = Path::new("a.svg");
         assert_eq!(axis_range(&chart, path, Axis::X).unwrap(), (0.0, 2.0));
@@ -744,6 +769,7 @@ mod tests {
             log_y: false,
             x_limits: Limits::default(),
             y_limits: Limits::default(),
+            notes: Vec::new(),
         };
         let bounds = Bounds {
             x: (0.0, 100.0),

@@ -96,6 +96,19 @@ pub enum Quantity {
     MomentumX,
     #[serde(rename = "p_y")]
     MomentumY,
+    /// Current coordinates (initial + displacement): with `max` / `min`, where the set
+    /// reaches.
+    #[serde(rename = "x")]
+    CoordinateX,
+    #[serde(rename = "y")]
+    CoordinateY,
+    /// The set's extent in x of the current configuration, max x - min x (an axisymmetric
+    /// body's set: the body of revolution's, 2 max r, its diameter); in y, max y - min y.
+    /// A length, not a mean: the statistic does not apply.
+    #[serde(rename = "extent_x")]
+    ExtentX,
+    #[serde(rename = "extent_y")]
+    ExtentY,
     /// Support reaction summed over the set's constrained DOFs: f_int - f_ext (+ m a with
     /// the lumped mass in dynamics), the force the supports exert on the body; f_int the
     /// internal force the step converged with.
@@ -132,6 +145,10 @@ impl Quantity {
             Quantity::AccelerationY => "a_y",
             Quantity::MomentumX => "p_x",
             Quantity::MomentumY => "p_y",
+            Quantity::CoordinateX => "x",
+            Quantity::CoordinateY => "y",
+            Quantity::ExtentX => "extent_x",
+            Quantity::ExtentY => "extent_y",
             Quantity::ReactionX => "reaction_x",
             Quantity::ReactionY => "reaction_y",
             Quantity::StressXX => "s_xx",
@@ -156,8 +173,50 @@ impl Quantity {
                 | Quantity::AccelerationY
                 | Quantity::MomentumX
                 | Quantity::MomentumY
+                | Quantity::CoordinateX
+                | Quantity::CoordinateY
+                | Quantity::ExtentX
+                | Quantity::ExtentY
                 | Quantity::ReactionX
                 | Quantity::ReactionY
+        )
+    }
+
+    /// The quantity's unit in SI scenes (the scene's own units otherwise): `m`, `m/s`, ...
+    /// Per unit depth where a plane-strain body says so (section 4 of the user guide).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Quantity::DisplacementX
+            | Quantity::DisplacementY
+            | Quantity::CoordinateX
+            | Quantity::CoordinateY
+            | Quantity::ExtentX
+            | Quantity::ExtentY => "m",
+            Quantity::VelocityX | Quantity::VelocityY => "m/s",
+            Quantity::AccelerationX | Quantity::AccelerationY => "m/s^2",
+            Quantity::MomentumX | Quantity::MomentumY => "kg m/s",
+            Quantity::ReactionX | Quantity::ReactionY => "N",
+            Quantity::StressXX
+            | Quantity::StressYY
+            | Quantity::StressXY
+            | Quantity::StressZZ
+            | Quantity::VonMises => "Pa",
+            Quantity::EqPlasticStrain => "",
+            Quantity::Temperature => "K",
+        }
+    }
+
+    /// Quantities that are one number of the whole set (a sum or a length), so `max` and
+    /// `min` do not apply.
+    pub fn is_whole_set(self) -> bool {
+        matches!(
+            self,
+            Quantity::MomentumX
+                | Quantity::MomentumY
+                | Quantity::ReactionX
+                | Quantity::ReactionY
+                | Quantity::ExtentX
+                | Quantity::ExtentY
         )
     }
 }
