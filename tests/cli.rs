@@ -802,3 +802,60 @@ fn whole_set_probes_refuse_a_statistic() {
         );
     }
 }
+
+/// The keys of the implicit error-controlled step are refused where they do not apply, and
+/// `dt = "auto"` for a method without an error estimate says why.
+#[test]
+fn adaptive_step_keys_are_refused_where_they_do_not_apply() {
+    let dynamic = BEAM.replace(
+        "type = \"static\"\nsteps = 4",
+        "type = \"dynamic\"\nend_time = 1.0",
+    );
+    let cases: [(&str, &[&str], &[&str]); 6] = [
+        (
+            "tolerance_fixed_dt",
+            &["analysis.dt=0.1", "analysis.error_tolerance=1e-3"],
+            &["analysis.error_tolerance", "dt = \"auto\""],
+        ),
+        (
+            "auto_wilson",
+            &["analysis.dt=\"auto\"", "analysis.integrator=\"wilson\""],
+            &["wilson", "no error estimate"],
+        ),
+        (
+            "auto_linear",
+            &["analysis.dt=\"auto\"", "analysis.integrator=\"linear\""],
+            &["beta = 1/6"],
+        ),
+        (
+            "dt_max_explicit",
+            &[
+                "analysis.integrator=\"central_difference\"",
+                "analysis.dt_max=1e-3",
+            ],
+            &["analysis.dt_max"],
+        ),
+        (
+            "dt_min_above_max",
+            &[
+                "analysis.dt=\"auto\"",
+                "analysis.dt_min=0.1",
+                "analysis.dt_max=0.01",
+            ],
+            &["analysis.dt_min", "dt_max"],
+        ),
+        (
+            "tolerance_range",
+            &["analysis.dt=\"auto\"", "analysis.error_tolerance=2.0"],
+            &["analysis.error_tolerance", "(0, 1)"],
+        ),
+    ];
+    for (name, sets, needles) in cases {
+        let extra: Vec<String> = sets
+            .iter()
+            .flat_map(|s| ["--set".into(), s.to_string()])
+            .collect();
+        let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+        assert_input_error(name, &dynamic, &extra, needles);
+    }
+}

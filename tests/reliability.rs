@@ -320,6 +320,17 @@ fn implicit_integrators_and_damping_resume_bit_identically() {
             PLASTIC_BLOCK.to_string(),
             vec!["analysis.rayleigh=[0.5, 1.0e-4]", every],
         ),
+        // the error-controlled step: its control (step length, ladder) and the error
+        // watch (top speed, largest estimate) are carried
+        (
+            "plastic_block_adaptive",
+            PLASTIC_BLOCK.to_string(),
+            vec![
+                "analysis.dt=\"auto\"",
+                "analysis.error_tolerance=1e-2",
+                every,
+            ],
+        ),
     ] {
         let full = run_full(name, &text, &set);
         assert_in_contact_at(&full, name, 20);

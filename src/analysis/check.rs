@@ -74,6 +74,10 @@ fn step_count(model: &Model, spec: &DynamicSpec, dt: f64) -> String {
         crate::scene::spec::TimeStep::Auto { .. } => format!(
             "at least {steps:.0} steps to end_time (the automatic step falls as elements deform)"
         ),
+        crate::scene::spec::TimeStep::Adaptive { tolerance, .. } => format!(
+            "{steps:.0} steps of the first step to end_time; the error control (tolerance {}) lengthens or shortens them",
+            readable(tolerance)
+        ),
     };
     if spec.integrator != IntegratorKind::CentralDifference {
         return count;
@@ -102,7 +106,7 @@ pub fn step_stability(model: &Model, spec: &DynamicSpec) -> Result<StepStability
         let dt = Some(first_step(model, spec)?);
         return Ok(StepStability::Conditional { dt, dt_crit });
     }
-    let dt = spec.dt();
+    let dt = crate::analysis::stable::implicit_first_step(model, spec)?;
     let newmark = matches!(
         spec.integrator,
         IntegratorKind::Average | IntegratorKind::Linear | IntegratorKind::Newmark

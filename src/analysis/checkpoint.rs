@@ -83,6 +83,8 @@ pub struct DynamicCarry {
     pub contact: ContactState,
     /// The last step's mean velocity, the next step's predictor (None before the first).
     pub mean_velocity: Option<Vec<f64>>,
+    /// The local error estimates so far (the top speed, the last and largest estimate).
+    pub watch: super::dynamics::ErrorWatch,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -97,6 +97,49 @@ pub struct Dynamics<'a> {
     /// The mean velocity of the last step (its increment over its length): the next step's
     /// predictor. None before the first step.
     mean_velocity: Option<Vec<f64>>,
+    /// The fixed step, or the first of an adaptive run (`stable::implicit_first_step`).
+    nominal: f64,
+    /// `dt = "auto"`: the error tolerance and the shortest and longest step.
+    adaptive: Option<(f64, Option<f64>, Option<f64>)>,
+    /// The method's local error constant (None: no estimate, Wilson and Houbolt).
+    error_constant: Option<f64>,
+    watch: ErrorWatch,
+}
+
+/// The local error of the steps (theory 8.2a): with c the method's error constant,
+/// ```text
+/// e   = c dt^2 (a_{n+1} - a_n)                       (Zienkiewicz & Xie 1991)
+/// eta = max_i |e_i| / (dt V),   V = the run's top nodal speed so far
+/// ```
+/// the error of the step's displacement relative to the distance the fastest node covers in
+/// it. Carried through checkpoints.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
+pub struct ErrorWatch {
+    pub speed: f64,
+    /// The last accepted step's estimate, and the largest of the run.
+    pub last: f64,
+    pub largest: f64,
+}
+
+/// The growth of an adaptive step: at most doubled, at least a fifth; the estimate grows as
+/// dt^2 (eta ~ c dt |da/dt| / V and the jump of a over the step ~ dt), so the step that meets
+/// the tolerance is dt (tol / eta)^(1/2), taken with a safety factor 0.9.
+fn step_factor(tolerance: f64, estimate: f64) -> f64 {
+    if estimate <= 0.0 {
+        return 2.0;
+    }
+    (0.9 * (tolerance / estimate).sqrt()).clamp(0.2, 2.0)
+}
+
+/// The ratio of the ladder an adaptive step moves on: a proposed step is rounded down to
+/// first x LADDER^k, so steady stretches repeat one length and K*(dt) stays factored
+/// (a factorization per new length would cost more than the steps it saves).
+const LADDER: f64 = std::f64::consts::SQRT_2;
+
+/// `proposal` rounded down to the ladder through `first`.
+fn on_ladder(first: f64, proposal: f64) -> f64 {
+    let k = ((proposal / first).ln() / LADDER.ln() + 1e-9).floor();
+    first * LADDER.powf(k)
 }
 
 impl<'a> Dynamics<'a> {
@@ -124,12 +167,18 @@ impl<'a> Dynamics<'a> {
         }
         let solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
         let n = model.dofs();
+        let nominal = super::stable::implicit_first_step(model, spec)?;
+        let method = integrator(spec);
         Ok(Dynamics {
             model,
             spec,
             interfaces,
             initial: model.coordinates(),
-            method: integrator(spec),
+            error_constant: method.error_constant(),
+            method,
+            nominal,
+            adaptive: spec.adaptive(),
+            watch: ErrorWatch::default(),
             state: State::initial(model),
             kin: MotionState {
                 displacement: vec![0.0; n],
@@ -141,7 +190,7 @@ impl<'a> Dynamics<'a> {
             last_total: vec![0.0; n],
             last_internal: vec![0.0; n],
             last_contact: vec![0.0; n],
-            control: StepControl::new(spec.dt(), spec.newton.max_cuts),
+            control: StepControl::new(nominal, spec.newton.max_cuts),
             factored_for: None,
             increments: 0,
             contact: ContactState::new(&model.contacts),
@@ -162,7 +211,7 @@ impl<'a> Dynamics<'a> {
             model,
             &self.state,
             &vec![0.0; model.dofs()],
-            spec.dt(),
+            self.nominal,
             spec.geometry,
             None,
             spec.newton.tangent,
@@ -198,11 +247,16 @@ impl<'a> Dynamics<'a> {
     /// The end of the step this step attempt aims at, and its nominal length.
     fn target(&self) -> (f64, f64) {
         let (spec, time) = (self.spec, self.state.time);
+        // an adaptive run's current step (whose steps land on no grid of multiples)
+        let dt = match self.adaptive {
+            Some(_) => self.control.nominal,
+            None => self.nominal,
+        };
         // steps end at the listed frame times
         let next_frame = self
             .model
             .output
-            .next_frame_after(time * (1.0 + 1e-9) + 1e-12 * spec.dt())
+            .next_frame_after(time * (1.0 + 1e-9) + 1e-12 * dt)
             .unwrap_or(f64::INFINITY);
         // a remainder shorter than the shortest step the control takes joins this step: a
         // step of 1e-7 dt (end_time written with a few digits) does not converge
@@ -214,12 +268,14 @@ impl<'a> Dynamics<'a> {
         // a step that reaches end_time or a frame time ends on it exactly, as the scene wrote
         // it (k dt in floating point is not always that time: 100 x 1e-6 is 9.999999999999999e-5);
         // other steps end on the multiple of dt they are within round-off of
-        let target = if stop - end <= 1e-9 * spec.dt() {
+        let target = if stop - end <= 1e-9 * dt {
             stop
+        } else if self.adaptive.is_some() {
+            end
         } else {
-            super::snap(end, spec.dt())
+            super::snap(end, dt)
         };
-        (target, super::step_length(target - time, spec.dt()))
+        (target, super::step_length(target - time, dt))
     }
 
     /// One attempt at the step of nominal length `nominal` (shortened at a contact event).
@@ -243,6 +299,9 @@ impl<'a> Dynamics<'a> {
             pairs: &self.interfaces.pairs,
             persistent: self.persistent_entries(),
             mean_velocity: self.mean_velocity.as_deref(),
+            error_target: self
+                .adaptive
+                .map(|(tolerance, ..)| NEWTON_SHARE * tolerance * self.watch.speed),
         };
         let (system, solver, factored_for) =
             (&mut self.system, &mut self.solver, &mut self.factored_for);
@@ -345,6 +404,56 @@ impl<'a> Dynamics<'a> {
         self.control.accept(true);
     }
 
+    /// The largest speed of the free DOFs of `velocity`, and the run's so far.
+    fn top_speed(&self, velocity: &[f64]) -> f64 {
+        velocity
+            .iter()
+            .zip(&self.system.equation)
+            .filter(|(_, e)| e.is_some())
+            .fold(self.watch.speed, |m, (v, _)| m.max(v.abs()))
+    }
+
+    /// The local error estimate of a step of length `h` ending in `end` (ErrorWatch); 0 for a
+    /// method without one. Updates the run's top speed with the step's end velocities.
+    fn estimate(&mut self, h: f64, end: &Advance) -> f64 {
+        self.watch.speed = self.top_speed(&end.velocity);
+        let Some(c) = self.error_constant else {
+            return 0.0;
+        };
+        let jump = end
+            .acceleration
+            .iter()
+            .zip(&self.kin.acceleration)
+            .zip(&self.system.equation)
+            .filter(|(_, e)| e.is_some())
+            .fold(0.0f64, |m, ((a1, a0), _)| m.max((a1 - a0).abs()));
+        if self.watch.speed > 0.0 {
+            c * h * jump / self.watch.speed
+        } else {
+            0.0
+        }
+    }
+
+    /// dt_min of an adaptive run (0 without one).
+    fn dt_floor(&self) -> f64 {
+        self.adaptive.and_then(|(_, min, _)| min).unwrap_or(0.0)
+    }
+
+    fn adaptive_tolerance(&self) -> f64 {
+        self.adaptive
+            .map_or(f64::INFINITY, |(tolerance, ..)| tolerance)
+    }
+
+    /// Whether an adaptive run takes the step of length `h` again, shorter: its estimate is
+    /// above the tolerance, it was not ended early by a contact event (an event is a
+    /// discontinuity the estimate does not describe), and it is longer than dt_min.
+    fn refuses(&self, h: f64, nominal: f64, estimate: f64) -> bool {
+        let Some((tolerance, min, _)) = self.adaptive else {
+            return false;
+        };
+        estimate > tolerance && h >= nominal * (1.0 - 1e-9) && h > min.unwrap_or(0.0) * (1.0 + 1e-9)
+    }
+
     /// Velocity-level persistency: the (pair, slave node) entries closed at the start of the
     /// step, which keep their relative normal velocity at zero; none for the other methods.
     fn persistent_entries(&self) -> Vec<(usize, usize)> {
@@ -398,7 +507,15 @@ struct Attempt<'s> {
     /// Entries held by velocity-level persistency (see `Dynamics::persistent_entries`).
     persistent: Vec<(usize, usize)>,
     mean_velocity: Option<&'s [f64]>,
+    /// `dt = "auto"`: the Newton correction that counts as converged, per unit step length
+    /// (NEWTON_SHARE x tolerance x the top speed: a tenth of the error the step may make).
+    error_target: Option<f64>,
 }
+
+/// Under `dt = "auto"` Newton stops when its remaining correction is this share of the
+/// local error the step may make (the iteration error then stays below the step's own
+/// discretization error), unless Erklig's tests pass first.
+const NEWTON_SHARE: f64 = 0.1;
 
 impl Attempt<'_> {
     /// The end-of-step gap each active entry must have: 0 (the gap constraint), or for a
@@ -494,6 +611,7 @@ impl Attempt<'_> {
             external: &external,
             internal_start: self.last_internal,
             factor_first,
+            error_target: self.error_target.map(|fraction| fraction * h),
             contact: Some(Constraints {
                 pairs: self.pairs,
                 active,
@@ -518,7 +636,7 @@ impl Stepper for Dynamics<'_> {
         self.method.name()
     }
     fn dt(&self) -> f64 {
-        self.spec.dt()
+        self.nominal
     }
     fn end_time(&self) -> f64 {
         self.spec.end_time
@@ -535,7 +653,7 @@ impl Stepper for Dynamics<'_> {
 
     fn start(&mut self) -> Result<(), String> {
         let free: Vec<bool> = self.system.equation.iter().map(Option::is_some).collect();
-        let velocity = super::initial_velocity(self.model, &free, self.spec.dt());
+        let velocity = super::initial_velocity(self.model, &free, self.nominal);
         let (acceleration, internal) = self
             .initial_acceleration(&velocity)
             .map_err(|reason| format!("initial acceleration: {reason}"))?;
@@ -544,6 +662,7 @@ impl Stepper for Dynamics<'_> {
         self.last_internal = internal;
         self.energies.kinetic = self.mass.kinetic_energy(self.model, &self.kin.velocity);
         self.initial_kinetic = self.energies.kinetic;
+        self.watch.speed = self.top_speed(&self.kin.velocity);
         self.last_total = self.total_force(&self.last_internal.clone());
         Ok(())
     }
@@ -564,6 +683,7 @@ impl Stepper for Dynamics<'_> {
         self.increments = carry.increments;
         self.contact = carry.contact;
         self.mean_velocity = carry.mean_velocity;
+        self.watch = carry.watch;
         true
     }
 
@@ -581,6 +701,7 @@ impl Stepper for Dynamics<'_> {
             increments: self.increments,
             contact: self.contact.clone(),
             mean_velocity: self.mean_velocity.clone(),
+            watch: self.watch,
         }))
     }
 
@@ -608,7 +729,27 @@ impl Stepper for Dynamics<'_> {
                 kinetic_before_impact - self.mass.kinetic_energy(self.model, &self.kin.velocity);
             match self.attempt(nominal, &positions, counters) {
                 Ok((step, advance)) => {
+                    let h = step.length;
+                    let estimate = self.estimate(h, &advance);
+                    if self.refuses(h, nominal, estimate) {
+                        self.method.reject();
+                        counters.rejected += 1;
+                        let shorter = h * step_factor(self.adaptive_tolerance(), estimate);
+                        self.control
+                            .retry(on_ladder(self.nominal, shorter).max(self.dt_floor()));
+                        continue;
+                    }
+                    let clipped = h < self.control.length * (1.0 - 1e-9);
                     self.commit(step, advance, target, nominal);
+                    self.watch.last = estimate;
+                    self.watch.largest = self.watch.largest.max(estimate);
+                    if let Some((tolerance, min, max)) = self.adaptive
+                        && !(clipped && estimate <= tolerance)
+                    {
+                        let next = on_ladder(self.nominal, h * step_factor(tolerance, estimate));
+                        let next = next.min(max.unwrap_or(f64::INFINITY));
+                        self.control.propose(next.max(min.unwrap_or(0.0)));
+                    }
                     return Ok(());
                 }
                 Err(StepFailure(reason)) => {
@@ -650,6 +791,9 @@ impl Stepper for Dynamics<'_> {
     }
     fn last_step(&self) -> f64 {
         self.last_step
+    }
+    fn error_watch(&self) -> Option<ErrorWatch> {
+        self.error_constant.map(|_| self.watch)
     }
 }
 

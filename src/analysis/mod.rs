@@ -155,6 +155,14 @@ pub struct Summary {
     pub factorizations: usize,
     pub back_substitutions: usize,
     pub step_cuts: usize,
+    /// Implicit `dt = "auto"`: steps taken again shorter because their error estimate was
+    /// above `error_tolerance` (apart from `step_cuts`, the cuts after a failed Newton).
+    #[serde(default)]
+    pub rejected_steps: usize,
+    /// Implicit integrators with an error estimate (the Newmark family): the largest local
+    /// error estimate of an accepted step (history.csv `error_estimate`); null otherwise.
+    #[serde(default)]
+    pub max_error_estimate: Option<f64>,
     pub contact: ContactSummary,
     pub energy: EnergySummary,
     pub buckling: Option<BucklingSummary>,
@@ -212,6 +220,8 @@ impl Summary {
             factorizations: 0,
             back_substitutions: 0,
             step_cuts: 0,
+            rejected_steps: 0,
+            max_error_estimate: None,
             contact: ContactSummary::default(),
             energy: EnergySummary::default(),
             buckling: None,
@@ -262,6 +272,18 @@ impl StepControl {
         if grow {
             self.length = (2.0 * self.length).min(self.nominal);
         }
+    }
+
+    /// An adaptive run's next step: `length` (the nominal too, so the floor of the cuts
+    /// follows it).
+    fn propose(&mut self, length: f64) {
+        self.nominal = length;
+        self.length = length;
+    }
+
+    /// A step whose error estimate was too large: take it again with `length`.
+    fn retry(&mut self, length: f64) {
+        self.length = length;
     }
 
     /// A step of length `attempted` failed: halve it, or say why the run must stop.

@@ -57,6 +57,10 @@ pub struct Recorder {
     hourglass_column: bool,
     /// Its value for the next row (the reduced explicit kernel sets it before each step).
     pub hourglass_energy: f64,
+    /// Whether history.csv has the `error_estimate` column (implicit Newmark family).
+    error_column: bool,
+    /// Its value for the next row (the implicit stepper's last estimate).
+    pub error_estimate: f64,
     /// The length of the step the next row ends (column `dt`; 0 on the first row).
     pub step_length: f64,
     /// The probes' values in the last row written (summary.json `probes`).
@@ -95,6 +99,8 @@ impl Recorder {
             negative_pivots: None,
             hourglass_column: hourglass_column(model),
             hourglass_energy: 0.0,
+            error_column: error_column(model),
+            error_estimate: 0.0,
             step_length: 0.0,
             last_probes: Vec::new(),
         })
@@ -147,6 +153,8 @@ impl Recorder {
             negative_pivots: position.negative_pivots,
             hourglass_column: hourglass_column(model),
             hourglass_energy: 0.0,
+            error_column: error_column(model),
+            error_estimate: 0.0,
             step_length: 0.0,
             last_probes: position.probes,
         })
@@ -231,6 +239,9 @@ impl Recorder {
         }
         if self.hourglass_column {
             row.push(self.hourglass_energy);
+        }
+        if self.error_column {
+            row.push(self.error_estimate);
         }
         if !model.contacts.is_empty() {
             row.push(contact.map_or(0.0, |c| c.penetration));
@@ -776,11 +787,21 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
     if hourglass_column(model) {
         columns.push("hourglass_energy".to_string());
     }
+    if error_column(model) {
+        // the local error estimate of the step (theory 8.2a)
+        columns.push("error_estimate".to_string());
+    }
     if !model.contacts.is_empty() {
         // the deepest penetration of either surface into the other body after the step
         columns.push("penetration".to_string());
     }
     (columns, pivots_column)
+}
+
+fn error_column(model: &Model) -> bool {
+    matches!(&model.analysis, crate::scene::model::Analysis::Dynamic(d)
+        if d.integrator != crate::scene::spec::IntegratorKind::CentralDifference
+            && super::dynamics::integrator(d).error_constant().is_some())
 }
 
 fn hourglass_column(model: &Model) -> bool {

@@ -88,6 +88,10 @@ pub trait Stepper {
     fn hourglass_energy(&self) -> Option<f64> {
         None
     }
+    /// The local error estimates of the implicit steps (None: no estimate).
+    fn error_watch(&self) -> Option<super::dynamics::ErrorWatch> {
+        None
+    }
     /// The length of the last step (0 before the first).
     fn last_step(&self) -> f64;
     /// What the time step did (central difference): summary.json `dt_min`, `dt_max`,
@@ -339,6 +343,9 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Some(energy) = self.stepper.hourglass_energy() {
             self.recorder.hourglass_energy = energy;
         }
+        if let Some(watch) = self.stepper.error_watch() {
+            self.recorder.error_estimate = watch.last;
+        }
         let s = &self.stepper;
         let contact = (self.summary.steps > 0).then(|| s.contact());
         self.recorder.step_with_contact(
@@ -391,6 +398,8 @@ impl<'a, S: Stepper> Run<'a, S> {
         let summary = &mut self.summary;
         summary.newton_iterations = self.counters.iterations;
         summary.step_cuts = self.counters.cuts;
+        summary.rejected_steps = self.counters.rejected;
+        summary.max_error_estimate = s.error_watch().map(|w| w.largest);
         summary.factorizations = solver.map_or(0, |s| s.factorizations);
         summary.back_substitutions = solver.map_or(0, |s| s.solves);
         summary.wall_seconds = self.start.elapsed().as_secs_f64();

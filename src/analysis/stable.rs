@@ -62,6 +62,23 @@ pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, Inp
     Ok(limit)
 }
 
+/// The step an implicit run starts with: the fixed `dt`, or for `dt = "auto"` the time a
+/// dilatational wave takes to cross the smallest element (the critical step of central
+/// difference, [`critical_time_step`]): a step that resolves the fastest wave the mesh can
+/// carry, from which the error control grows or shrinks it; within `dt_min`, `dt_max`.
+pub fn implicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, InputError> {
+    match spec.adaptive() {
+        None => Ok(spec
+            .fixed_dt()
+            .expect("an implicit step is fixed or adaptive (checked by the scene)")),
+        Some((_, min, max)) => {
+            let courant = critical_time_step(model)?.dt;
+            let step = courant.min(max.unwrap_or(f64::INFINITY)).min(spec.end_time);
+            Ok(step.max(min.unwrap_or(0.0)))
+        }
+    }
+}
+
 /// A body's wave speed and the modulus it comes from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WaveSpeed {

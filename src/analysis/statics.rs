@@ -135,6 +135,7 @@ impl Increment<'_> {
             external: &external,
             internal_start: self.last_force,
             factor_first: self.factor_first,
+            error_target: None,
             contact: Some(Constraints {
                 pairs: &model.contacts,
                 active,

@@ -68,6 +68,12 @@ pub trait Integrator: Send {
     fn advance(&mut self, dt: f64, k: &MotionState, solved: &[f64]) -> Advance;
     /// Called when a step is abandoned (cut): history stays as before the step.
     fn reject(&mut self) {}
+    /// The constant c of the local error estimate e = c dt^2 (a_{n+1} - a_n) of the
+    /// displacement (Zienkiewicz & Xie 1991: c = |beta - 1/6| for the Newmark family); None
+    /// where the method has no such estimate.
+    fn error_constant(&self) -> Option<f64> {
+        None
+    }
     /// What the method carries from step to step besides u, v, a (for checkpoints).
     fn history(&self) -> MethodHistory {
         MethodHistory::default()
@@ -165,6 +171,11 @@ impl GeneralizedAlpha {
 }
 
 impl Integrator for GeneralizedAlpha {
+    fn error_constant(&self) -> Option<f64> {
+        let c = (self.beta - 1.0 / 6.0).abs();
+        (c > 1e-3).then_some(c)
+    }
+
     fn name(&self) -> String {
         match self.label {
             "hht" => format!("hht(alpha={})", -self.alpha_f),

@@ -28,6 +28,8 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
             given(spec.dt.is_some(), "dt", "static")?;
             given(spec.time_step_scale.is_some(), "time_step_scale", "static")?;
             given(spec.dt_min.is_some(), "dt_min", "static")?;
+            given(spec.dt_max.is_some(), "dt_max", "static")?;
+            given(spec.error_tolerance.is_some(), "error_tolerance", "static")?;
             given(spec.integrator.is_some(), "integrator", "static")?;
             for (present, key) in [
                 (spec.beta.is_some(), "beta"),
@@ -103,8 +105,9 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
     })
 }
 
-/// `analysis.dt` (a number, or `auto` for central difference, its default) with
-/// `time_step_scale` and `dt_min`.
+/// `analysis.dt` (a number, or `auto`: central difference's default, the stable step with
+/// `time_step_scale` and `dt_min`; for the implicit integrators the error-controlled step
+/// with `error_tolerance`, `dt_min` and `dt_max`).
 fn time_step(
     cx: &Context,
     spec: &AnalysisSpec,
@@ -118,6 +121,8 @@ fn time_step(
             for (present, key) in [
                 (spec.time_step_scale.is_some(), "time_step_scale"),
                 (spec.dt_min.is_some(), "dt_min"),
+                (spec.dt_max.is_some(), "dt_max"),
+                (spec.error_tolerance.is_some(), "error_tolerance"),
             ] {
                 if present {
                     return Err(cx.err(format!(
@@ -127,11 +132,18 @@ fn time_step(
             }
             Ok(TimeStep::Fixed(positive(cx, "analysis.dt", dt)?))
         }
-        Some(StepSpec::Auto) if !explicit => Err(cx.err(format!(
-            "analysis.dt: \"auto\" (the stable step of central difference) does not apply to integrator {}: give a time step",
-            integrator.name()
-        ))),
+        Some(StepSpec::Auto) if !explicit => adaptive(cx, spec, integrator),
         Some(StepSpec::Auto) => {
+            for (present, key) in [
+                (spec.dt_max.is_some(), "dt_max"),
+                (spec.error_tolerance.is_some(), "error_tolerance"),
+            ] {
+                if present {
+                    return Err(cx.err(format!(
+                        "analysis.{key}: applies to the implicit integrators' dt = \"auto\" (central difference takes the stable step)"
+                    )));
+                }
+            }
             let scale = spec.time_step_scale.unwrap_or(0.9);
             if !(scale > 0.0 && scale <= 1.0) {
                 return Err(cx.err(format!(
@@ -150,6 +162,67 @@ fn time_step(
             Ok(TimeStep::Auto { scale, min })
         }
     }
+}
+
+/// Implicit `dt = "auto"`: the error-controlled step (Zienkiewicz & Xie 1991), for the
+/// Newmark family (average, Hu, newmark with beta != 1/6, HHT, generalized-alpha) only.
+fn adaptive(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<TimeStep, InputError> {
+    let why = match integrator {
+        IntegratorKind::Wilson => Some(
+            "Wilson-theta solves at t + theta dt and interpolates back: the one-step estimate of Zienkiewicz & Xie (1991) is for the Newmark family",
+        ),
+        IntegratorKind::Houbolt => {
+            Some("Houbolt is a multistep method whose formulas assume equal steps")
+        }
+        IntegratorKind::Linear => Some(
+            "with beta = 1/6 the leading error term, dt^2 (beta - 1/6) (a_{n+1} - a_n), vanishes",
+        ),
+        IntegratorKind::Newmark if (spec.beta.unwrap_or(0.25) - 1.0 / 6.0).abs() < 1e-3 => Some(
+            "with beta = 1/6 the leading error term, dt^2 (beta - 1/6) (a_{n+1} - a_n), vanishes",
+        ),
+        _ => None,
+    };
+    if let Some(why) = why {
+        return Err(cx.err(format!(
+            "analysis.dt: \"auto\" for integrator {} has no error estimate ({why}); give a time step, or use average, hu, hht or generalized_alpha",
+            integrator.name()
+        )));
+    }
+    if spec.time_step_scale.is_some() {
+        return Err(cx.err(
+            "analysis.time_step_scale: applies to central difference's dt = \"auto\" (the implicit step follows error_tolerance)",
+        ));
+    }
+    let tolerance = spec
+        .error_tolerance
+        .unwrap_or(crate::scene::spec::DEFAULT_ERROR_TOLERANCE);
+    if !(tolerance > 0.0 && tolerance < 1.0) {
+        return Err(cx.err(format!(
+            "analysis.error_tolerance: must lie in (0, 1), got {tolerance}"
+        )));
+    }
+    let min = spec
+        .dt_min
+        .map(|m| positive(cx, "analysis.dt_min", m))
+        .transpose()?;
+    let max = spec
+        .dt_max
+        .map(|m| positive(cx, "analysis.dt_max", m))
+        .transpose()?;
+    if let (Some(low), Some(high)) = (min, max)
+        && low > high
+    {
+        return Err(cx.err(format!("analysis.dt_min: {low} is above dt_max {high}")));
+    }
+    Ok(TimeStep::Adaptive {
+        tolerance,
+        min,
+        max,
+    })
 }
 
 /// The keys that belong to one integrator only are absent for the others.

@@ -279,8 +279,8 @@ pub fn write_measures(
 }
 
 /// measure_NAME: the values of measure `k` against h or dt, a series per method, with the
-/// extrapolated value and the GCI band (a box on the finest value f1 (1 +- GCI) over the
-/// levels' span) of each series that has them.
+/// extrapolated value (a line over the levels' span) and the GCI band (a bar at the finest
+/// level, f1 (1 +- GCI)) of each series that has them.
 fn measure_chart(
     k: usize,
     score: &MeasureScore,
@@ -324,9 +324,9 @@ fn measure_chart(
             let f1 = e.values[0];
             let (a, b) = (f1 - gci * f1.abs(), f1 + gci * f1.abs());
             series.push(Series {
-                label: format!("{label}: GCI band, +-{:.2} %", 100.0 * gci),
-                points: vec![(low, a), (high, a), (high, b), (low, b), (low, a)],
-                style: SeriesStyle::Line,
+                label: format!("{label}: GCI band of the finest, +-{:.2} %", 100.0 * gci),
+                points: vec![(low, a), (low, b)],
+                style: SeriesStyle::LineAndMarkers,
             });
         }
     }

@@ -340,12 +340,16 @@ fn write_results(
     write_atomic(&out.join("reference.json"), text.as_bytes())?;
     let text = serde_json::to_string_pretty(&scores).expect("the scores serialize");
     write_atomic(&out.join("measures.json"), text.as_bytes())?;
-    // the scene's title, else its name (the file's stem)
+    // the scene's title (its first 60 characters: the charts add what they show), else its
+    // name (the file's stem)
     let title = models
         .first()
         .map(|m| {
             if m.title.is_empty() {
                 m.name.clone()
+            } else if m.title.chars().count() > 60 {
+                let cut: String = m.title.chars().take(59).collect();
+                format!("{}…", cut.trim_end())
             } else {
                 m.title.clone()
             }
