@@ -68,6 +68,16 @@ sweep models/sphere_wall.toml --vary 'analysis.integrator=average,hu,houbolt,wil
 copy $out/sweep_sphere_wall_methods/error_vs_cpu sweep_sphere_wall_speed
 copy $out/sweep_sphere_wall_methods/error_vs_cpu_converged sweep_sphere_wall_speed_converged
 
+# The Johnson-Cook Taylor rod's mesh study (validation 10.2): four meshes, both quadratures,
+# L_f and D_f from the shape probes, Richardson with the GCI; about three minutes on 2 cores
+sweep models/taylor_jc.toml --vary 'body.rod.mesh.nx,body.rod.mesh.ny=5,50;10,100;15,150;20,200' \
+  --vary 'analysis.quadrature=full,reduced' \
+  --measure 'L_f=extent_y[all]' --measure 'D_f=extent_x[all]' --out $out/sweep_taylor_jc_mesh
+for m in L_f D_f; do
+  copy $out/sweep_taylor_jc_mesh/measure_$m sweep_taylor_jc_$m
+  copy $out/sweep_taylor_jc_mesh/error_vs_cpu_$m sweep_taylor_jc_${m}_speed
+done
+
 # The Taylor rods (aluminium, Johnson-Cook steel): three meshes, one-point and 2x2 explicit,
 # implicit Newmark on the two coarser Johnson-Cook meshes; about four minutes
 impact bench --case taylor --out $out/bench_taylor
