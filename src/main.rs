@@ -480,6 +480,10 @@ struct SweepArgs {
     /// convergence index) and charts.
     #[arg(long = "measure", value_name = "MEASURE")]
     measure: Vec<String>,
+    /// A value a measure is scored against instead of its extrapolation: NAME=VALUE (a
+    /// published or closed-form value), e.g. --reference L_f=26.56e-3. Repeat for several.
+    #[arg(long = "reference", value_name = "NAME=VALUE")]
+    reference: Vec<String>,
     /// Write each case's VTK frames as its scene asks (default: none).
     #[arg(long)]
     frames: bool,
@@ -507,6 +511,7 @@ fn sweep(args: SweepArgs) -> Result<(), RunError> {
         vary,
         set,
         measure,
+        reference,
         frames,
         jobs,
         shard,
@@ -518,10 +523,11 @@ fn sweep(args: SweepArgs) -> Result<(), RunError> {
     let here = scene
         .clone()
         .unwrap_or_else(|| PathBuf::from("impact sweep"));
-    let measures = measure
+    let mut measures = measure
         .iter()
         .map(|m| Measure::parse(m).map_err(|e| InputError::new(&here, format!("--measure {e}"))))
         .collect::<Result<Vec<_>, _>>()?;
+    Measure::with_references(&mut measures, &reference).map_err(|e| InputError::new(&here, e))?;
     let report = if !merge.is_empty() {
         let here = Path::new("--merge");
         if scene.is_some() || !vary.is_empty() || !set.is_empty() || shard.is_some() {

@@ -555,10 +555,10 @@ fn messages_name_things_as_the_scene_does() {
         "auto_implicit",
         &BEAM.replace(
             "type = \"static\"\nsteps = 4",
-            "type = \"dynamic\"\nintegrator = \"average\"\ndt = \"auto\"\nend_time = 1.0",
+            "type = \"dynamic\"\nintegrator = \"houbolt\"\ndt = \"auto\"\nend_time = 1.0",
         ),
         &[],
-        &["integrator average"],
+        &["integrator houbolt"],
     );
     assert_input_error(
         "strain_thickness",

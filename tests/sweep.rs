@@ -211,7 +211,7 @@ fn rerun_does_no_work_and_merged_shards_equal_the_whole() {
 fn sweep_bad_input_exits_2() {
     let dir = common::out_dir("sweep_bad_input");
     let out = dir.join("out");
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 9] = [
         (&["--vary", "analysis.dtt=0.1,0.2"], "dtt"),
         (
             &[
@@ -230,6 +230,17 @@ fn sweep_bad_input_exits_2() {
                 "mean(v_x[bar1.all])",
             ],
             "unknown statistic",
+        ),
+        (
+            &[
+                "--vary",
+                "analysis.dt=0.01",
+                "--measure",
+                "v=v_x[bar1.all]",
+                "--reference",
+                "w=1",
+            ],
+            "no --measure is named `w`",
         ),
         (
             &[
@@ -357,12 +368,14 @@ set = "left"
 "#;
 
 /// Runs a sweep of the scene `text` (written into the test's folder) with `vary` and one
-/// `--measure`; returns the measure's score of the only series and the rows.
+/// `--measure` (scored against `reference` when given); returns the measure's score of the
+/// only series and the rows.
 fn measured(
     name: &str,
     text: &str,
     vary: &str,
     measure: &str,
+    reference: Option<f64>,
 ) -> (
     impact::sweep::qoi::SeriesScore,
     Vec<impact::sweep::measure::Row>,
@@ -375,7 +388,8 @@ fn measured(
         sets: Vec::new(),
         variations: vec![parse_variation(vary).unwrap()],
     };
-    let measures = [impact::sweep::Measure::parse(measure).unwrap()];
+    let mut measures = [impact::sweep::Measure::parse(measure).unwrap()];
+    measures[0].reference = reference;
     let report = sweep::run(&p, &dir.join("sweep"), options(2, None), &measures).unwrap();
     assert_eq!(report.not_ok, 0);
     assert_eq!(report.scores[0].series.len(), 1);
@@ -416,7 +430,7 @@ fn extrapolation_and_gci_bracket_the_exact_value() {
         ),
     ];
     for (name, text, vary, measure, exact) in studies {
-        let (score, rows) = measured(name, text, vary, measure);
+        let (score, rows) = measured(name, text, vary, measure, None);
         let e = score.extrapolation.expect("three levels");
         let (order, value, gci) = (e.order.unwrap(), e.value.unwrap(), e.gci.unwrap());
         let f1 = e.values[0];
@@ -455,6 +469,7 @@ fn a_sweep_without_reference_never_scores_a_case_against_itself() {
         &text,
         "analysis.dt=0.005,0.0025",
         "v=v_x[bar1.all]",
+        None,
     );
     let finest = rows
         .iter()
@@ -474,4 +489,27 @@ fn a_sweep_without_reference_never_scores_a_case_against_itself() {
     assert_eq!(score.reference_kind, Some("finest case"));
     assert_eq!(score.finest.as_deref(), Some(finest.folder.as_str()));
     assert!(finest.quantity_errors[0].is_none());
+}
+
+/// Goal: a measure with a given reference (`--reference NAME=VALUE`, a closed form or a
+/// published value) is scored against it, every case, the finest included, while the
+/// extrapolation is still reported. Setup: the oscillator at dt = 0.2, 0.1, 0.05, u(10).
+/// Reference: sin 10 (exact); each error is (u - sin 10) / |sin 10| from the case's own value.
+#[test]
+fn a_given_reference_scores_every_case() {
+    let exact = 10f64.sin();
+    let (score, rows) = measured(
+        "sweep_given_reference",
+        OSCILLATOR,
+        "analysis.dt=0.2,0.1,0.05",
+        "u=u_x[end]",
+        Some(exact),
+    );
+    assert_eq!(score.reference_kind, Some("given"));
+    assert!(score.extrapolation.is_some_and(|e| e.value.is_some()));
+    for row in &rows {
+        let u = row.quantities[0].unwrap();
+        let error = row.quantity_errors[0].unwrap();
+        approx::assert_relative_eq!(error, (u - exact) / exact.abs(), max_relative = 1e-12);
+    }
 }

@@ -84,7 +84,7 @@ pub struct DynamicCarry {
     /// The last step's mean velocity, the next step's predictor (None before the first).
     pub mean_velocity: Option<Vec<f64>>,
     /// The local error estimates so far (the top speed, the last and largest estimate).
-    pub watch: super::dynamics::ErrorWatch,
+    pub watch: super::ErrorWatch,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -19,7 +19,7 @@ use super::checkpoint::{Carry, Checkpoint, DynamicCarry};
 use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
 use super::record::{Energies, Motion};
 use super::run::Stepper;
-use super::{StepControl, loads};
+use super::{ErrorWatch, StepControl, loads};
 use crate::assembly::{self, Mass, State, System, check_mass};
 use crate::contact::{ContactResult, ContactState, Interfaces, Tangential};
 use crate::integrator::{
@@ -104,21 +104,6 @@ pub struct Dynamics<'a> {
     /// The method's local error constant (None: no estimate, Wilson and Houbolt).
     error_constant: Option<f64>,
     watch: ErrorWatch,
-}
-
-/// The local error of the steps (theory 8.2a): with c the method's error constant,
-/// ```text
-/// e   = c dt^2 (a_{n+1} - a_n)                       (Zienkiewicz & Xie 1991)
-/// eta = max_i |e_i| / (dt V),   V = the run's top nodal speed so far
-/// ```
-/// the error of the step's displacement relative to the distance the fastest node covers in
-/// it. Carried through checkpoints.
-#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
-pub struct ErrorWatch {
-    pub speed: f64,
-    /// The last accepted step's estimate, and the largest of the run.
-    pub last: f64,
-    pub largest: f64,
 }
 
 /// The growth of an adaptive step: at most doubled, at least a fifth; the estimate grows as

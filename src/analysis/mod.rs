@@ -246,6 +246,21 @@ fn snap(t: f64, dt: f64) -> f64 {
     }
 }
 
+/// The local error of the steps (theory 8.2a): with c the method's error constant,
+/// ```text
+/// e   = c dt^2 (a_{n+1} - a_n)                       (Zienkiewicz & Xie 1991)
+/// eta = max_i |e_i| / (dt V),   V = the run's top nodal speed so far
+/// ```
+/// the error of the step's displacement relative to the distance the fastest node covers in
+/// it. Carried through checkpoints.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
+pub struct ErrorWatch {
+    pub speed: f64,
+    /// The last accepted step's estimate, and the largest of the run.
+    pub last: f64,
+    pub largest: f64,
+}
+
 /// The step length of a driver: halved when a step fails (at most `max_cuts` times in a
 /// row), grown back towards the nominal length after each success.
 #[derive(Debug, Clone, Serialize, Deserialize)]

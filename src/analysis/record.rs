@@ -799,9 +799,7 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
 }
 
 fn error_column(model: &Model) -> bool {
-    matches!(&model.analysis, crate::scene::model::Analysis::Dynamic(d)
-        if d.integrator != crate::scene::spec::IntegratorKind::CentralDifference
-            && super::dynamics::integrator(d).error_constant().is_some())
+    matches!(&model.analysis, crate::scene::model::Analysis::Dynamic(d) if d.has_error_estimate())
 }
 
 fn hourglass_column(model: &Model) -> bool {

@@ -89,7 +89,7 @@ pub trait Stepper {
         None
     }
     /// The local error estimates of the implicit steps (None: no estimate).
-    fn error_watch(&self) -> Option<super::dynamics::ErrorWatch> {
+    fn error_watch(&self) -> Option<super::ErrorWatch> {
         None
     }
     /// The length of the last step (0 before the first).

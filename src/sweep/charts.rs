@@ -46,9 +46,13 @@ pub fn fitted_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
     Some((slope, mean_y - slope * mean_x))
 }
 
-/// Whether a key is a refinement or the method: dt, the integrator, a mesh parameter.
+/// Whether a key is a refinement or the method: dt, the implicit error tolerance, the
+/// integrator, a mesh parameter.
 fn is_method_or_refinement(key: &str) -> bool {
-    key == "analysis.dt" || key == "analysis.integrator" || key.contains(".mesh.")
+    key == "analysis.dt"
+        || key == "analysis.error_tolerance"
+        || key == "analysis.integrator"
+        || key.contains(".mesh.")
 }
 
 /// Keys that do not name a series: those varied together with a refinement or the method

@@ -73,12 +73,16 @@ impl Reduction {
     }
 }
 
-/// One `--measure`: a name (the sweep.csv column), a history column and its reduction.
+/// One `--measure`: a name (the sweep.csv column), a history column and its reduction, and
+/// the value it is scored against when one is given (`--reference NAME=VALUE`: a published
+/// or closed-form value).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Measure {
     pub name: String,
     pub column: String,
     pub reduction: Reduction,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference: Option<f64>,
 }
 
 impl Measure {
@@ -128,7 +132,37 @@ impl Measure {
             name,
             column,
             reduction,
+            reference: None,
         })
+    }
+
+    /// Gives the measures the values of `--reference NAME=VALUE`; an unknown name or a value
+    /// that is no finite number is an error naming it.
+    pub fn with_references(measures: &mut [Measure], given: &[String]) -> Result<(), String> {
+        for text in given {
+            let (name, value) = text
+                .split_once('=')
+                .ok_or_else(|| format!("--reference {text}: write NAME=VALUE"))?;
+            let value: f64 = value
+                .trim()
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite())
+                .ok_or_else(|| format!("--reference {text}: `{}` is not a number", value.trim()))?;
+            let names: Vec<String> = measures.iter().map(|m| m.name.clone()).collect();
+            let measure = measures
+                .iter_mut()
+                .find(|m| m.name == name.trim())
+                .ok_or_else(|| {
+                    format!(
+                        "--reference {text}: no --measure is named `{}` (measures: {})",
+                        name.trim(),
+                        names.join(", ")
+                    )
+                })?;
+            measure.reference = Some(value);
+        }
+        Ok(())
     }
 
     /// The measure of a history: `time` and the column's `values`, row by row. None when
@@ -387,7 +421,7 @@ pub struct SeriesScore {
     /// The converged value the cases are compared with: the extrapolated one, else the
     /// finest case's.
     pub reference: Option<f64>,
-    /// `extrapolated` or `finest case`.
+    /// `given` (`--reference`), `extrapolated` or `finest case`.
     pub reference_kind: Option<&'static str>,
     /// The finest case's folder when it is the reference (it has no error then).
     pub finest: Option<String>,
@@ -490,14 +524,20 @@ pub fn score(
             unit: measure.unit(&units.of_column(model, &measure.column)),
             series: series
                 .iter()
-                .map(|(label, members)| score_series(k, label, rows, members))
+                .map(|(label, members)| score_series(k, measure, label, rows, members))
                 .collect(),
         })
         .collect()
 }
 
 /// Measure `k` on one series: its levels, the extrapolation of the three finest, the errors.
-fn score_series(k: usize, label: &str, rows: &mut [Row], members: &[usize]) -> SeriesScore {
+fn score_series(
+    k: usize,
+    measure: &Measure,
+    label: &str,
+    rows: &mut [Row],
+    members: &[usize],
+) -> SeriesScore {
     let mut score = SeriesScore {
         series: label.to_string(),
         refinement: None,
@@ -519,11 +559,17 @@ fn score_series(k: usize, label: &str, rows: &mut [Row], members: &[usize]) -> S
     };
     let of_h: fn(&Row) -> Option<f64> = |r| Some(r.h);
     let of_dt: fn(&Row) -> Option<f64> = |r| r.dt;
+    let given = measure.reference;
     let (name, of) = if distinct(of_h) >= 2 {
         ("h", of_h)
     } else if distinct(of_dt) >= 2 {
         ("dt", of_dt)
     } else {
+        if let Some(reference) = given {
+            score_against(k, reference, rows, &usable, None);
+            score.reference = Some(reference);
+            score.reference_kind = Some("given");
+        }
         return score;
     };
     score.refinement = Some(name);
@@ -542,17 +588,31 @@ fn score_series(k: usize, label: &str, rows: &mut [Row], members: &[usize]) -> S
     }
     let extrapolated = score.extrapolation.as_ref().and_then(|e| e.value);
     let finest = levels[0].1;
-    let (reference, kind) = match extrapolated {
-        Some(v) => (v, "extrapolated"),
-        None => {
+    let (reference, kind, skip) = match (given, extrapolated) {
+        (Some(v), _) => (v, "given", None),
+        (None, Some(v)) => (v, "extrapolated", None),
+        (None, None) => {
             score.finest = Some(rows[finest].folder.clone());
-            (value(finest), "finest case")
+            (value(finest), "finest case", Some(finest))
         }
     };
     score.reference = Some(reference);
     score.reference_kind = Some(kind);
-    for &i in &usable {
-        if extrapolated.is_none() && i == finest {
+    score_against(k, reference, rows, &usable, skip);
+    score
+}
+
+/// The errors of measure `k` of the rows `usable` against `reference`, but for `skip` (the
+/// reference's own case): (value - reference) / |reference|, the difference where it is 0.
+fn score_against(
+    k: usize,
+    reference: f64,
+    rows: &mut [Row],
+    usable: &[usize],
+    skip: Option<usize>,
+) {
+    for &i in usable {
+        if Some(i) == skip {
             continue;
         }
         let v = rows[i].quantities[k].expect("usable rows have the value");
@@ -562,7 +622,6 @@ fn score_series(k: usize, label: &str, rows: &mut [Row], members: &[usize]) -> S
             v - reference
         });
     }
-    score
 }
 
 #[cfg(test)]

@@ -223,6 +223,22 @@ impl DynamicSpec {
         }
     }
 
+    /// Whether the integrator has a one-step local error estimate (the Newmark family with
+    /// beta != 1/6: theory 8.2a): implicit `dt = "auto"` and history.csv `error_estimate`.
+    pub fn has_error_estimate(&self) -> bool {
+        match self.integrator {
+            IntegratorKind::Average
+            | IntegratorKind::Hu
+            | IntegratorKind::Hht
+            | IntegratorKind::GeneralizedAlpha => true,
+            IntegratorKind::Newmark => (self.beta - 1.0 / 6.0).abs() > 1e-3,
+            IntegratorKind::Linear
+            | IntegratorKind::Wilson
+            | IntegratorKind::Houbolt
+            | IntegratorKind::CentralDifference => false,
+        }
+    }
+
     /// The tolerance, shortest and longest step of an adaptive implicit analysis.
     pub fn adaptive(&self) -> Option<(f64, Option<f64>, Option<f64>)> {
         match self.step {
