@@ -697,7 +697,7 @@ pub fn kernel_benchmark_run(
         crate::scene::from_str(&benchmark_scene(n), Path::new("kernel_benchmark.toml"), &[])
             .expect("the benchmark scene is valid");
     let young: f64 = 200.0;
-    let c = (model.bodies[0].material.elastic.p_wave_modulus()).sqrt();
+    let c = (model.bodies[0].p_wave_modulus()).sqrt();
     let h = 0.5 / c;
     let rate = 0.3 / young / (10.0 * h);
     let centre = 0.5 * n as f64;

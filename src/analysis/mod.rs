@@ -69,28 +69,21 @@ pub fn interfaces(model: &Model) -> crate::contact::Interfaces {
         .bodies
         .iter()
         .map(|b| {
-            let e = &b.material.elastic;
-            let (lambda, mu) = e.lame();
-            let (modulus, section) = match b.kind {
-                BodyKind::Rod { area } => (e.young, Section::Rod { area }),
+            let section = match b.kind {
+                BodyKind::Rod { area } => Section::Rod { area },
                 BodyKind::Continuum {
                     formulation,
                     thickness,
                     ..
                 } => match formulation {
-                    Formulation::PlaneStrain => {
-                        (lambda + 2.0 * mu, Section::Plane { thickness: 1.0 })
-                    }
-                    Formulation::PlaneStress => (
-                        e.young / (1.0 - e.poisson * e.poisson),
-                        Section::Plane { thickness },
-                    ),
-                    Formulation::Axisymmetric => (lambda + 2.0 * mu, Section::Axisymmetric),
+                    Formulation::PlaneStrain => Section::Plane { thickness: 1.0 },
+                    Formulation::PlaneStress => Section::Plane { thickness },
+                    Formulation::Axisymmetric => Section::Axisymmetric,
                 },
             };
             BodySurface {
                 section,
-                impedance_per_area: (modulus * b.material.density).sqrt(),
+                impedance_per_area: (b.p_wave_modulus() * b.material.density).sqrt(),
                 boundary_at_node: b
                     .boundary_at_node
                     .iter()

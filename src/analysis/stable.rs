@@ -96,17 +96,13 @@ pub fn wave_speed(body: &crate::scene::Body) -> Option<WaveSpeed> {
     if m.density <= 0.0 {
         return None;
     }
-    let e = &m.elastic;
-    let (lambda, mu) = e.lame();
-    let (modulus, modulus_name) = match body.kind {
-        BodyKind::Rod { .. } => (e.young, "E (rod)"),
+    let modulus = body.p_wave_modulus();
+    let modulus_name = match body.kind {
+        BodyKind::Rod { .. } => "E (rod)",
         BodyKind::Continuum { formulation, .. } => match formulation {
-            Formulation::PlaneStrain => (lambda + 2.0 * mu, "lambda + 2 mu (plane strain)"),
-            Formulation::Axisymmetric => (lambda + 2.0 * mu, "lambda + 2 mu (axisymmetric)"),
-            Formulation::PlaneStress => (
-                e.young / (1.0 - e.poisson * e.poisson),
-                "E / (1 - nu^2) (plane stress)",
-            ),
+            Formulation::PlaneStrain => "lambda + 2 mu (plane strain)",
+            Formulation::Axisymmetric => "lambda + 2 mu (axisymmetric)",
+            Formulation::PlaneStress => "E / (1 - nu^2) (plane stress)",
         },
     };
     Some(WaveSpeed {

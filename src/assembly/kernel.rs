@@ -141,7 +141,7 @@ impl Kernel {
                     check_orientation(&kinematics.deformation())?;
                 }
                 let strains = kinematics.strains();
-                let condition = stress_condition(formulation);
+                let condition = StressCondition::of(formulation);
                 let context = UpdateContext { condition, dt };
                 let fine = crate::profile::fine_sample(e).then(Instant::now);
                 // the algorithmic moduli only where the matrix is asked for and made of them
@@ -351,10 +351,7 @@ impl Kernel {
             Kernel::Quad4 { formulation, .. } => {
                 let x = quad_nodes(body, e, coordinates);
                 let geom = quad4::values(&x, formulation, &point_thickness(committed, e))?;
-                let (mut lambda, mu) = elastic.lame();
-                if formulation == Formulation::PlaneStress {
-                    lambda = 2.0 * lambda * mu / (lambda + 2.0 * mu);
-                }
+                let (lambda, mu) = elastic.lame_in(StressCondition::of(formulation));
                 let m = [lumped[0], lumped[1], lumped[2], lumped[3]];
                 Ok(quad4::frequency_bound(&geom, lambda, mu, &m))
             }
@@ -403,15 +400,6 @@ impl Kernel {
         let a = nalgebra::DMatrix::from_fn(n, n, |i, j| k[i * n + j] * scale[i] * scale[j]);
         let a = (&a + a.transpose()) * 0.5;
         Ok(a.symmetric_eigenvalues().max())
-    }
-}
-
-/// The stress condition of a Quad4 formulation.
-fn stress_condition(formulation: Formulation) -> StressCondition {
-    if formulation == Formulation::PlaneStress {
-        StressCondition::PlaneStress
-    } else {
-        StressCondition::General
     }
 }
 

@@ -17,7 +17,7 @@
 pub mod j2;
 pub mod johnson_cook;
 
-use crate::element::{Moduli, Voigt};
+use crate::element::{Formulation, Moduli, Voigt};
 pub use j2::{FlowStart, Hardening, J2};
 pub use johnson_cook::JohnsonCook;
 
@@ -28,6 +28,18 @@ pub enum StressCondition {
     General,
     /// sigma_zz = 0; the material decides the out-of-plane strain.
     PlaneStress,
+}
+
+impl StressCondition {
+    /// The stress condition of a continuum formulation.
+    #[inline]
+    pub fn of(formulation: Formulation) -> StressCondition {
+        if formulation == Formulation::PlaneStress {
+            StressCondition::PlaneStress
+        } else {
+            StressCondition::General
+        }
+    }
 }
 
 /// What a material update needs besides the committed state and the strain increment.
@@ -87,15 +99,24 @@ impl Elastic {
         )
     }
 
+    /// The Lame constants of the in-plane law of `condition`: those of the 3D law, or in
+    /// plane stress lambda condensed by sigma_zz = 0, 2 lambda mu / (lambda + 2 mu) (mu is
+    /// unchanged). The moduli, the P-wave modulus and the element frequency bounds all take
+    /// lambda from here.
+    #[inline]
+    pub fn lame_in(&self, condition: StressCondition) -> (f64, f64) {
+        let (lambda, mu) = self.lame();
+        match condition {
+            StressCondition::General => (lambda, mu),
+            StressCondition::PlaneStress => (2.0 * lambda * mu / (lambda + 2.0 * mu), mu),
+        }
+    }
+
     /// Elastic moduli; in plane stress the condensed in-plane moduli with the zz row and
     /// column zero.
     #[inline]
     pub fn moduli(&self, state: StressCondition) -> Moduli {
-        let (lambda, mu) = self.lame();
-        let lambda = match state {
-            StressCondition::General => lambda,
-            StressCondition::PlaneStress => 2.0 * lambda * mu / (lambda + 2.0 * mu),
-        };
+        let (lambda, mu) = self.lame_in(state);
         let mut d = Moduli::zeros();
         let normal = if state == StressCondition::General {
             3
@@ -112,9 +133,12 @@ impl Elastic {
         d
     }
 
-    /// Dilatational wave speed squared times density (the P-wave modulus); for rods E.
-    pub fn p_wave_modulus(&self) -> f64 {
-        let (lambda, mu) = self.lame();
+    /// The P-wave (constrained) modulus M = rho c^2 of the dilatational wave under
+    /// `condition`: lambda + 2 mu with the lambda of `lame_in` (plane stress: E / (1 - nu^2)).
+    /// A rod's is E.
+    #[inline]
+    pub fn p_wave_modulus(&self, condition: StressCondition) -> f64 {
+        let (lambda, mu) = self.lame_in(condition);
         lambda + 2.0 * mu
     }
 }

@@ -13,7 +13,7 @@ use super::spec::{
 };
 use crate::contact::{ContactPair, Obstacle};
 use crate::element::{Formulation, Strain, Voigt};
-use crate::material::Material;
+use crate::material::{Material, StressCondition};
 use crate::mesh::Mesh;
 use std::path::PathBuf;
 
@@ -50,6 +50,19 @@ impl Body {
 
     pub fn elements(&self) -> usize {
         self.mesh.cells.len()
+    }
+
+    /// The P-wave modulus M = rho c^2 of the body's dilatational wave: the material's under
+    /// the stress condition of its formulation (lambda + 2 mu; plane stress E / (1 - nu^2)),
+    /// E for a rod.
+    pub fn p_wave_modulus(&self) -> f64 {
+        let elastic = &self.material.elastic;
+        match self.kind {
+            BodyKind::Rod { .. } => elastic.young,
+            BodyKind::Continuum { formulation, .. } => {
+                elastic.p_wave_modulus(StressCondition::of(formulation))
+            }
+        }
     }
 
     /// Material points per element: 4 for Quad4, 1 for rods.

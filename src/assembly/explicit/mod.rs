@@ -13,7 +13,7 @@ pub use one_point::Reduced;
 
 use super::{ElementFailure, FrequencyBound, State};
 use crate::element::Formulation;
-use crate::material::Material;
+use crate::material::{Material, StressCondition};
 use crate::scene::{BodyKind, Model};
 use rayon::prelude::*;
 
@@ -119,12 +119,10 @@ impl Layout {
             else {
                 continue;
             };
-            let (lambda, mu) = spec.material.elastic.lame();
-            let wave_lambda = if formulation == Formulation::PlaneStress {
-                2.0 * lambda * mu / (lambda + 2.0 * mu)
-            } else {
-                lambda
-            };
+            let condition = StressCondition::of(formulation);
+            let elastic = &spec.material.elastic;
+            let (lambda, mu) = elastic.lame();
+            let (wave_lambda, _) = elastic.lame_in(condition);
             layout.bodies.push(BodyParameters {
                 name: spec.name.clone(),
                 material: spec.material.clone(),
@@ -132,7 +130,7 @@ impl Layout {
                 bbar,
                 lambda,
                 mu,
-                wave_modulus: wave_lambda + 2.0 * mu,
+                wave_modulus: elastic.p_wave_modulus(condition),
                 wave_lambda,
                 hourglass_modulus: kappa * (wave_lambda + 3.0 * mu) / 24.0,
                 first_element: layout.body.len(),
