@@ -167,18 +167,24 @@ impl<'a> Explicit<'a> {
             self.clock.last,
             time,
         );
-        (
-            self.du.par_chunks_mut(DOF_CHUNK),
-            self.v_half.par_chunks_mut(DOF_CHUNK),
-        )
-            .into_par_iter()
-            .zip(step.correction.par_chunks(DOF_CHUNK))
-            .for_each(|((du, v_half), correction)| {
-                for ((du, v), c) in du.iter_mut().zip(v_half).zip(correction) {
-                    *du += c;
-                    *v += c / h;
-                }
-            });
+        let apply = |du: &mut [f64], v_half: &mut [f64], correction: &[f64]| {
+            for ((du, v), c) in du.iter_mut().zip(v_half).zip(correction) {
+                *du += c;
+                *v += c / h;
+            }
+        };
+        if self.du.len() <= DOF_CHUNK {
+            // one chunk: not worth the pool's bookkeeping
+            apply(&mut self.du, &mut self.v_half, &step.correction);
+        } else {
+            (
+                self.du.par_chunks_mut(DOF_CHUNK),
+                self.v_half.par_chunks_mut(DOF_CHUNK),
+            )
+                .into_par_iter()
+                .zip(step.correction.par_chunks(DOF_CHUNK))
+                .for_each(|((du, v_half), correction)| apply(du, v_half, correction));
+        }
         self.energies.contact_work -= chunked_sum(&step.step_force, &self.du, |f, u| f * u);
     }
 
@@ -556,6 +562,13 @@ fn predict(v: &[f64], a: &[f64], h: f64, v_half: &mut [f64], du: &mut [f64]) {
 
 /// sum_i term(x_i, y_i), deterministic for any number of threads (see `DOF_CHUNK`).
 fn chunked_sum(x: &[f64], y: &[f64], term: impl Fn(f64, f64) -> f64 + Sync) -> f64 {
+    // one chunk: the same sum without handing it to the pool (whose bookkeeping cost the rod
+    // pair a tenth of its contact phase)
+    if x.len() <= DOF_CHUNK {
+        return [x.iter().zip(y).map(|(x, y)| term(*x, *y)).sum::<f64>()]
+            .into_iter()
+            .sum();
+    }
     x.par_chunks(DOF_CHUNK)
         .zip(y.par_chunks(DOF_CHUNK))
         .map(|(x, y)| x.iter().zip(y).map(|(x, y)| term(*x, *y)).sum::<f64>())

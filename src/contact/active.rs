@@ -452,6 +452,7 @@ impl ContactState {
             released,
             time,
             &|n| coords[n],
+            None,
         );
         for (i, (p, k)) in step.active.iter().enumerate() {
             self.tangential[*p][*k] = step.tangential[i];
@@ -460,7 +461,9 @@ impl ContactState {
     }
 
     /// Sets the status: the active entries and their forces after a step ending at `time`
-    /// with the nodes at `x`.
+    /// with the nodes at `x`. `lowest`: the lowest slave gap at `x` when the caller has just
+    /// computed every slave's gap there (Some(None): no slave has a master in reach); None
+    /// computes them.
     pub(super) fn set(
         &mut self,
         interfaces: &Interfaces,
@@ -469,6 +472,7 @@ impl ContactState {
         released: bool,
         time: f64,
         x: &dyn Fn(usize) -> [f64; 2],
+        lowest: Option<Option<f64>>,
     ) {
         for flags in &mut self.active {
             flags.iter_mut().for_each(|a| *a = false);
@@ -496,9 +500,13 @@ impl ContactState {
         }
         let total: f64 = forces.iter().sum();
         self.peak_force = self.peak_force.max(total);
+        let lowest = lowest.unwrap_or_else(|| {
+            slave_gaps(&interfaces.pairs, x, &|_, _| false)
+                .map(|s| s.gap.gap)
+                .reduce(f64::min)
+        });
         let mut penetration = 0.0f64;
-        for s in slave_gaps(&interfaces.pairs, x, &|_, _| false) {
-            let g = s.gap.gap;
+        if let Some(g) = lowest {
             self.min_gap = Some(self.min_gap.map_or(g, |m| m.min(g)));
             penetration = penetration.max(-g);
         }

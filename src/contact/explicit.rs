@@ -35,7 +35,7 @@
 use super::Interfaces;
 use super::active::ContactState;
 use super::geometry::{Friction, Gap};
-use super::search::penetrating;
+use super::search::{SlaveGap, penetrates, slave_gaps};
 
 /// What an explicit contact step gives the driver.
 pub struct ExplicitContact {
@@ -106,7 +106,9 @@ impl ContactState {
             .zip(&c.in_active)
             .any(|(was, is)| was.iter().zip(is).any(|(was, is)| *was && !*is));
         let end = |node: usize| step.position(&c.delta, node);
-        self.set(interfaces, &c.active, &forces, released, time, &end);
+        self.set(
+            interfaces, &c.active, &forces, released, time, &end, c.lowest,
+        );
         for (i, (p, k)) in c.active.iter().enumerate() {
             self.tangential[*p][*k] = c.friction_total[i] / (h * spans[i]);
             // a sliding entry: on the cone, with the signed coefficient of its force
@@ -149,6 +151,9 @@ struct Correction {
     in_active: Vec<Vec<bool>>,
     mu_total: Vec<f64>,
     friction_total: Vec<f64>,
+    /// When the passes settled: the lowest slave gap at the corrected positions (every
+    /// slave's gap was computed there by the last pass; None inside: no master in reach).
+    lowest: Option<Option<f64>>,
 }
 
 impl Predicted<'_> {
@@ -174,31 +179,42 @@ impl Predicted<'_> {
                 .collect(),
             mu_total: Vec::new(),
             friction_total: Vec::new(),
+            lowest: None,
         };
+        let pairs = &interfaces.pairs;
         for _ in 0..20 {
-            // gaps at the corrected positions; penetrated entries join
+            // gaps at the corrected positions: the active entries', and the others', of
+            // which the penetrated join (with the gap found)
             let delta = &c.delta;
             let x = |node: usize| self.position(delta, node);
-            let joining: Vec<(usize, usize)> =
-                penetrating(&interfaces.pairs, &x, &|p, k| c.in_active[p][k])
-                    .map(|s| (s.pair, s.index))
-                    .collect();
-            let changed = !joining.is_empty();
-            for (p, k) in joining {
-                c.active.push((p, k));
-                c.in_active[p][k] = true;
-                c.mu_total.push(0.0);
-                c.friction_total.push(0.0);
-            }
-            let gaps: Vec<Gap> = c
+            let mut gaps: Vec<Gap> = c
                 .active
                 .iter()
                 .map(|(p, k)| {
-                    interfaces.pairs[*p]
-                        .gap(interfaces.pairs[*p].slaves[*k], &x)
+                    pairs[*p]
+                        .gap(pairs[*p].slaves[*k], &x)
                         .expect("found above")
                 })
                 .collect();
+            let in_active = |p: usize, k: usize| c.in_active[p][k];
+            let others: Vec<SlaveGap> = slave_gaps(pairs, &x, &in_active).collect();
+            let lowest = others
+                .iter()
+                .map(|s| s.gap.gap)
+                .chain(gaps.iter().map(|g| g.gap))
+                .reduce(f64::min);
+            let joining: Vec<SlaveGap> = others
+                .into_iter()
+                .filter(|s| penetrates(pairs, s, &x, &in_active))
+                .collect();
+            let changed = !joining.is_empty();
+            for s in joining {
+                c.active.push((s.pair, s.index));
+                c.in_active[s.pair][s.index] = true;
+                c.mu_total.push(0.0);
+                c.friction_total.push(0.0);
+                gaps.push(s.gap);
+            }
             let tangent_rows: Vec<Option<Vec<(usize, f64)>>> = c
                 .active
                 .iter()
@@ -208,6 +224,7 @@ impl Predicted<'_> {
                 })
                 .collect();
             if !changed && self.settled(&c, &gaps, &tangent_rows) {
+                c.lowest = Some(lowest);
                 break;
             }
             self.pass(&mut c, &gaps, &tangent_rows);

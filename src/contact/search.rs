@@ -45,10 +45,18 @@ pub fn penetrating<'a>(
     x: &'a dyn Fn(usize) -> [f64; 2],
     skip: &'a dyn Fn(usize, usize) -> bool,
 ) -> impl Iterator<Item = SlaveGap> + 'a {
-    slave_gaps(pairs, x, skip).filter(|s| {
-        s.gap.gap < -pairs[s.pair].options.tolerance
-            && !pairs[s.pair].covers(pairs, &s.gap, x, skip)
-    })
+    slave_gaps(pairs, x, skip).filter(|s| penetrates(pairs, s, x, skip))
+}
+
+/// Whether a slave's gap is a penetration beyond its pair's TOL that no other pass covers
+/// (the test of [`penetrating`]).
+pub fn penetrates(
+    pairs: &[ContactPair],
+    s: &SlaveGap,
+    x: &dyn Fn(usize) -> [f64; 2],
+    skip: &dyn Fn(usize, usize) -> bool,
+) -> bool {
+    s.gap.gap < -pairs[s.pair].options.tolerance && !pairs[s.pair].covers(pairs, &s.gap, x, skip)
 }
 
 /// Per pair, the penetration beyond which a run stops: half the smallest distance between
