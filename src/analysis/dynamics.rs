@@ -103,6 +103,9 @@ pub struct Dynamics<'a> {
     adaptive: Option<(f64, Option<f64>, Option<f64>)>,
     /// The method's local error constant (None: no estimate, Wilson and Houbolt).
     error_constant: Option<f64>,
+    /// Per DOF, whether the estimate reads it: the free DOFs off the contact surfaces
+    /// (theory 8.2a).
+    estimated: Vec<bool>,
     watch: ErrorWatch,
 }
 
@@ -154,15 +157,29 @@ impl<'a> Dynamics<'a> {
         let n = model.dofs();
         let nominal = super::stable::implicit_first_step(model, spec)?;
         let method = integrator(spec);
+        let on_surface = contact_nodes(model);
+        let estimated: Vec<bool> = system
+            .equation
+            .iter()
+            .enumerate()
+            .map(|(dof, e)| e.is_some() && !on_surface[dof / 2])
+            .collect();
         Ok(Dynamics {
             model,
             spec,
             interfaces,
             initial: model.coordinates(),
             error_constant: method.error_constant(),
+            estimated,
             method,
             nominal,
-            adaptive: spec.adaptive(),
+            // with contact, dt_min defaults to the first step: shorter steps made the impact
+            // conditions' forces (a momentum over the step) run away on every contact scene
+            // (validation 10.3a)
+            adaptive: spec.adaptive().map(|(tolerance, min, max)| {
+                let min = min.or((!model.contacts.is_empty()).then_some(nominal));
+                (tolerance, min, max)
+            }),
             watch: ErrorWatch::default(),
             state: State::initial(model),
             kin: MotionState {
@@ -409,8 +426,8 @@ impl<'a> Dynamics<'a> {
             .acceleration
             .iter()
             .zip(&self.kin.acceleration)
-            .zip(&self.system.equation)
-            .filter(|(_, e)| e.is_some())
+            .zip(&self.estimated)
+            .filter(|(_, read)| **read)
             .fold(0.0f64, |m, ((a1, a0), _)| m.max((a1 - a0).abs()));
         if self.watch.speed > 0.0 {
             c * h * jump / self.watch.speed
@@ -431,12 +448,16 @@ impl<'a> Dynamics<'a> {
 
     /// Whether an adaptive run takes the step of length `h` again, shorter: its estimate is
     /// above the tolerance, it was not ended early by a contact event (an event is a
-    /// discontinuity the estimate does not describe), and it is longer than dt_min.
+    /// discontinuity the estimate does not describe), and it is longer than dt_min and than
+    /// the shortest step the control takes (the step's nominal over 2^max_cuts and a tenth).
+    /// At an impact the acceleration jumps by the velocity change over the step, so the
+    /// estimate does not shrink with the step: the floor ends the rejections there.
     fn refuses(&self, h: f64, nominal: f64, estimate: f64) -> bool {
         let Some((tolerance, min, _)) = self.adaptive else {
             return false;
         };
-        estimate > tolerance && h >= nominal * (1.0 - 1e-9) && h > min.unwrap_or(0.0) * (1.0 + 1e-9)
+        let floor = min.unwrap_or(0.0).max(self.control.shortest());
+        estimate > tolerance && h >= nominal * (1.0 - 1e-9) && h > floor * (1.0 + 1e-9)
     }
 
     /// Velocity-level persistency: the (pair, slave node) entries closed at the start of the
