@@ -7,50 +7,6 @@ use common::column;
 
 use impact::reference::{self, Recurrence};
 
-/// One rod, node `start` fixed, node `end` free along x: lumped m = rho A L / 2 = 1,
-/// k = E A / L = 1, so omega = 1 and T = 2 pi. Started with v = 1: u = sin t.
-const OSCILLATOR: &str = r#"
-[[material]]
-name = "spring"
-young = 1.0
-poisson = 0.0
-density = 2.0
-
-[[body]]
-name = "rod"
-material = "spring"
-formulation = "rod"
-area = 1.0
-mesh = { type = "line", start = [0.0, 0.0], end = [1.0, 0.0], n = 1 }
-
-[[support]]
-set = "start"
-fix = ["x", "y"]
-
-[[support]]
-set = "end"
-fix = ["y"]
-
-[[initial_velocity]]
-set = "end"
-velocity = [1.0, 0.0]
-
-[analysis]
-type = "dynamic"
-geometry = "linear"
-mass = "lumped"
-dt = 0.1
-end_time = 10.0
-newton = { strategy = "initial", tol_displacement = 1e-12, tol_force = 1e-12 }
-
-[output]
-frame_every = 0
-
-[[output.probe]]
-quantity = "u_x"
-set = "end"
-"#;
-
 fn run_oscillator(name: &str, integrator: &[&str], dt_over_t: f64, cycles: f64) -> Vec<f64> {
     let period = 2.0 * std::f64::consts::PI;
     let dt = dt_over_t * period;
@@ -58,7 +14,7 @@ fn run_oscillator(name: &str, integrator: &[&str], dt_over_t: f64, cycles: f64) 
     overrides.push(format!("analysis.dt={dt:e}"));
     overrides.push(format!("analysis.end_time={:e}", cycles * period));
     let refs: Vec<&str> = overrides.iter().map(String::as_str).collect();
-    let model = common::model("oscillator", OSCILLATOR, &refs);
+    let model = common::model("oscillator", common::UNIT_OSCILLATOR, &refs);
     let dir = common::out_dir(name);
     impact::analysis::run(&model, &dir, Default::default())
         .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -784,10 +740,12 @@ fn adaptive_error(name: &str, text: &str, tolerance: f64, exact: f64) -> (f64, u
 /// (measured 0.12 % and 0.48 %: about 1.6 periods of the oscillator, 5 of the rod).
 #[test]
 fn adaptive_step_global_error_follows_the_tolerance() {
-    let oscillator = OSCILLATOR.replace("dt = 0.1", "dt = \"auto\"").replace(
-        "newton = { strategy = \"initial\", tol_displacement = 1e-12, tol_force = 1e-12 }",
-        "newton = { strategy = \"initial\" }",
-    );
+    let oscillator = common::UNIT_OSCILLATOR
+        .replace("dt = 0.1", "dt = \"auto\"")
+        .replace(
+            "newton = { strategy = \"initial\", tol_displacement = 1e-12, tol_force = 1e-12 }",
+            "newton = { strategy = \"initial\" }",
+        );
     let (rod, omega) = rod_mode(10);
     // u_tip(t) = sin(n theta) sin(omega t) / omega, sin(n theta) = 1
     let studies = [

@@ -222,42 +222,10 @@ fn rigid_rotation_turns_stress_and_keeps_invariants() {
     }
 }
 
-const CYLINDER_AXISYMMETRIC: &str = r#"
-[[material]]
-name = "m"
-young = 1000.0
-poisson = 0.3
-
-[[body]]
-name = "cylinder"
-material = "m"
-formulation = "axisymmetric"
-mesh = { type = "rectangle", origin = [1.0, 0.0], width = 1.0, height = 0.25, nx = 4, ny = 1 }
-
-[[support]]
-set = "bottom"
-fix = ["y"]
-
-[[support]]
-set = "top"
-fix = ["y"]
-
-[[load]]
-type = "pressure"
-set = "left"
-pressure = 1.0
-
-[analysis]
-type = "static"
-steps = 1
-geometry = "linear"
-newton = { strategy = "full" }
-"#;
-
 fn bore_displacement_axisymmetric(nr: usize, bbar: bool) -> f64 {
     let model = common::model(
         "lame_axi",
-        CYLINDER_AXISYMMETRIC,
+        common::LAME_CYLINDER_AXISYMMETRIC,
         &[
             &format!("body.cylinder.mesh.nx={nr}"),
             &format!("body.cylinder.bbar={bbar}"),

@@ -280,93 +280,6 @@ fn sweep_bad_input_exits_2() {
     assert_eq!(o.status.code(), Some(2));
 }
 
-/// The unit oscillator of tests/dynamics.rs (one rod, m = rho A L / 2 = 1, k = E A / L = 1,
-/// omega = 1; started with v = 1: u = sin t), Newmark average by default.
-const OSCILLATOR: &str = r#"
-title = "unit oscillator"
-
-[[material]]
-name = "spring"
-young = 1.0
-poisson = 0.0
-density = 2.0
-
-[[body]]
-name = "rod"
-material = "spring"
-formulation = "rod"
-area = 1.0
-mesh = { type = "line", start = [0.0, 0.0], end = [1.0, 0.0], n = 1 }
-
-[[support]]
-set = "start"
-fix = ["x", "y"]
-
-[[support]]
-set = "end"
-fix = ["y"]
-
-[[initial_velocity]]
-set = "end"
-velocity = [1.0, 0.0]
-
-[analysis]
-type = "dynamic"
-geometry = "linear"
-mass = "lumped"
-dt = 0.1
-end_time = 10.0
-newton = { strategy = "initial", tol_displacement = 1e-12, tol_force = 1e-12 }
-
-[output]
-frame_every = 0
-
-[[output.probe]]
-quantity = "u_x"
-set = "end"
-"#;
-
-/// Lame's thick cylinder (a = 1, b = 2, p = 1, E = 1000, nu = 0.3), axisymmetric with u_z = 0,
-/// small strain, one element high (tests/statics.rs).
-const CYLINDER: &str = r#"
-title = "Lame cylinder"
-
-[[material]]
-name = "m"
-young = 1000.0
-poisson = 0.3
-
-[[body]]
-name = "cylinder"
-material = "m"
-formulation = "axisymmetric"
-bbar = false
-mesh = { type = "rectangle", origin = [1.0, 0.0], width = 1.0, height = 0.25, nx = 4, ny = 1 }
-
-[[support]]
-set = "bottom"
-fix = ["y"]
-
-[[support]]
-set = "top"
-fix = ["y"]
-
-[[load]]
-type = "pressure"
-set = "left"
-pressure = 1.0
-
-[analysis]
-type = "static"
-steps = 1
-geometry = "linear"
-newton = { strategy = "full" }
-
-[[output.probe]]
-quantity = "u_x"
-set = "left"
-"#;
-
 /// Runs a sweep of the scene `text` (written into the test's folder) with `vary` and one
 /// `--measure` (scored against `reference` when given); returns the measure's score of the
 /// only series and the rows.
@@ -413,17 +326,22 @@ fn measured(
 #[test]
 fn extrapolation_and_gci_bracket_the_exact_value() {
     let lame = impact::reference::lame_radial_displacement(1.0, 1.0, 2.0, 1000.0, 0.3, 1.0);
+    // the bore's mean u_r (plain Q4: B-bar is off for an elastic material by default)
+    let cylinder = format!(
+        "{}\n[[output.probe]]\nquantity = \"u_x\"\nset = \"left\"\n",
+        common::LAME_CYLINDER_AXISYMMETRIC
+    );
     let studies = [
         (
             "sweep_gci_oscillator",
-            OSCILLATOR,
+            common::UNIT_OSCILLATOR,
             "analysis.dt=0.2,0.1,0.05",
             "u=u_x[end]",
             10f64.sin(),
         ),
         (
             "sweep_gci_lame",
-            CYLINDER,
+            cylinder.as_str(),
             "body.cylinder.mesh.nx=8,16,32",
             "u=u_x[left]",
             lame,
@@ -500,7 +418,7 @@ fn a_given_reference_scores_every_case() {
     let exact = 10f64.sin();
     let (score, rows) = measured(
         "sweep_given_reference",
-        OSCILLATOR,
+        common::UNIT_OSCILLATOR,
         "analysis.dt=0.2,0.1,0.05",
         "u=u_x[end]",
         Some(exact),

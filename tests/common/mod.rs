@@ -95,3 +95,81 @@ pub fn impact(args: &[&str]) -> std::process::Output {
         .output()
         .expect("the binary runs")
 }
+
+/// One rod, node `start` fixed, node `end` free along x: lumped m = rho A L / 2 = 1,
+/// k = E A / L = 1, so omega = 1 and T = 2 pi. Started with v = 1: u = sin t.
+pub const UNIT_OSCILLATOR: &str = r#"
+[[material]]
+name = "spring"
+young = 1.0
+poisson = 0.0
+density = 2.0
+
+[[body]]
+name = "rod"
+material = "spring"
+formulation = "rod"
+area = 1.0
+mesh = { type = "line", start = [0.0, 0.0], end = [1.0, 0.0], n = 1 }
+
+[[support]]
+set = "start"
+fix = ["x", "y"]
+
+[[support]]
+set = "end"
+fix = ["y"]
+
+[[initial_velocity]]
+set = "end"
+velocity = [1.0, 0.0]
+
+[analysis]
+type = "dynamic"
+geometry = "linear"
+mass = "lumped"
+dt = 0.1
+end_time = 10.0
+newton = { strategy = "initial", tol_displacement = 1e-12, tol_force = 1e-12 }
+
+[output]
+frame_every = 0
+
+[[output.probe]]
+quantity = "u_x"
+set = "end"
+"#;
+
+/// Lame's thick cylinder (a = 1, b = 2, p = 1 on the bore, E = 1000, nu = 0.3), axisymmetric
+/// with u_z = 0 (plane strain), small strain, one element high: `nx` elements through the wall.
+pub const LAME_CYLINDER_AXISYMMETRIC: &str = r#"
+[[material]]
+name = "m"
+young = 1000.0
+poisson = 0.3
+
+[[body]]
+name = "cylinder"
+material = "m"
+formulation = "axisymmetric"
+mesh = { type = "rectangle", origin = [1.0, 0.0], width = 1.0, height = 0.25, nx = 4, ny = 1 }
+
+[[support]]
+set = "bottom"
+fix = ["y"]
+
+[[support]]
+set = "top"
+fix = ["y"]
+
+[[load]]
+type = "pressure"
+set = "left"
+pressure = 1.0
+
+[analysis]
+type = "static"
+steps = 1
+geometry = "linear"
+newton = { strategy = "full" }
+"#;

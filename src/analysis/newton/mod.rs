@@ -254,17 +254,7 @@ impl Step<'_> {
         counters: &mut Counters,
     ) -> Result<Solution, StepFailure> {
         let newton = self.newton;
-        // the multipliers: normal, then the fixed tangential rows (which start from zero)
-        let mut forces = self.contact.as_ref().map_or(Vec::new(), |c| {
-            let fixed = c
-                .tangential
-                .iter()
-                .filter(|t| matches!(t, Tangential::Fixed { .. }))
-                .count();
-            let mut f = c.forces.clone();
-            f.resize(f.len() + fixed, 0.0);
-            f
-        });
+        let mut forces = self.initial_multipliers();
         let damping = match &self.inertia {
             Some(i) if i.rayleigh[1] > 0.0 => {
                 self.evaluate(state, &vec![0.0; d.len()], Some(&mut *system))?;
@@ -370,6 +360,21 @@ impl Step<'_> {
             "no convergence in {} iterations",
             newton.max_iterations
         )))
+    }
+
+    /// The multipliers the iteration starts from: the normal ones given, then the fixed
+    /// tangential rows' (which start from zero).
+    fn initial_multipliers(&self) -> Vec<f64> {
+        self.contact.as_ref().map_or(Vec::new(), |c| {
+            let fixed = c
+                .tangential
+                .iter()
+                .filter(|t| matches!(t, Tangential::Fixed { .. }))
+                .count();
+            let mut f = c.forces.clone();
+            f.resize(f.len() + fixed, 0.0);
+            f
+        })
     }
 
     /// Factors K* from the tangent assembled in `system`.
