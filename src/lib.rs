@@ -12,7 +12,7 @@
 //! 4  contact, solver, integrator        contact on plain arrays, faer, step coefficients
 //! 5  scene                              TOML -> validated Model (owns every enum a scene names)
 //! 6  assembly                           element dispatch, scatter, parallel loops
-//! 7  stability                          inertia of K_T, linearized buckling
+//! 7  buckling                           inertia of K_T, linearized buckling
 //! 8  analysis                           the run scaffold and its steppers
 //! 9  sweep, bench                       studies and speed
 //! ```
@@ -21,6 +21,7 @@
 pub mod analysis;
 pub mod assembly;
 pub mod bench;
+pub mod buckling;
 pub mod contact;
 pub mod element;
 pub mod integrator;
@@ -32,5 +33,4 @@ pub mod profile;
 pub mod reference;
 pub mod scene;
 pub mod solver;
-pub mod stability;
 pub mod sweep;

@@ -13,7 +13,7 @@ const LAYERS: [&[&str]; 9] = [
     &["contact", "solver", "integrator"],
     &["scene"],
     &["assembly"],
-    &["stability"],
+    &["buckling"],
     &["analysis"],
     &["sweep", "bench"],
 ];

@@ -1,6 +1,6 @@
 //! The buckling check of a run (Erklig 2.1.3): the inertia of K_T after each
 //! converged state, the linearized buckling load factors of the scene's loads, and the
-//! imperfection (a buckling mode added to the coordinates). The numerics are in `stability`.
+//! imperfection (a buckling mode added to the coordinates). The numerics are in the crate's `buckling` module.
 //!
 //! Legend
 //! ```text
@@ -15,6 +15,7 @@
 use super::loads;
 use super::record;
 use crate::assembly::{self, State, System};
+use crate::buckling::{self, BucklingError, InertiaCounter, Mode};
 use crate::element::Strain;
 use crate::output::OutputError;
 use crate::output::vtk::{Fields, Series};
@@ -22,12 +23,11 @@ use crate::scene::Model;
 use crate::scene::spec::OnCritical;
 use crate::scene::spec::Tangent;
 use crate::solver::Solver;
-use crate::stability::{self, InertiaCounter, Mode, StabilityError};
 use serde::Serialize;
 use std::path::Path;
 
 /// The prebuckling state (see the legend).
-pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
+pub fn prebuckling_state(model: &Model) -> Result<State, BucklingError> {
     let end = match &model.analysis {
         crate::scene::model::Analysis::Static(s) => s.end_time,
         crate::scene::model::Analysis::Dynamic(s) => s.end_time,
@@ -55,7 +55,7 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
     let mut solver = Solver::new(&system.pattern)?;
     solver
         .factor(&system.values)
-        .map_err(|_| StabilityError::MaterialStiffness)?;
+        .map_err(|_| BucklingError::MaterialStiffness)?;
     let external = loads::external_force(model, &state, &initial, end);
     let mut residual = system.gather(&external);
     residual
@@ -72,16 +72,16 @@ pub fn prebuckling_state(model: &Model) -> Result<State, StabilityError> {
 
 /// The lowest `count` linearized buckling modes of the scene's end loads (at the prebuckling
 /// state), ascending load factors.
-pub fn linear_modes(model: &Model, count: usize) -> Result<Vec<Mode>, StabilityError> {
+pub fn linear_modes(model: &Model, count: usize) -> Result<Vec<Mode>, BucklingError> {
     let state = prebuckling_state(model)?;
     let mut system = System::new(model, &model.constrained_dofs());
-    stability::eigen_buckling(model, &state, &mut system, count)
+    buckling::eigen_buckling(model, &state, &mut system, count)
 }
 
 /// The lowest `count` buckling modes at a committed state of a run.
-pub fn modes_at(model: &Model, state: &State, count: usize) -> Result<Vec<Mode>, StabilityError> {
+pub fn modes_at(model: &Model, state: &State, count: usize) -> Result<Vec<Mode>, BucklingError> {
     let mut system = System::new(model, &model.constrained_dofs());
-    stability::eigen_buckling(model, state, &mut system, count)
+    buckling::eigen_buckling(model, state, &mut system, count)
 }
 
 /// The inertia check of a run: K_T at each committed state, its negative pivots counted.
@@ -91,7 +91,7 @@ pub struct InertiaCheck {
 }
 
 impl InertiaCheck {
-    pub fn new(model: &Model) -> Result<InertiaCheck, StabilityError> {
+    pub fn new(model: &Model) -> Result<InertiaCheck, BucklingError> {
         let system = System::new(model, &model.constrained_dofs());
         let counter = InertiaCounter::new(&system.pattern)?;
         Ok(InertiaCheck { system, counter })
@@ -102,8 +102,8 @@ impl InertiaCheck {
         &mut self,
         model: &Model,
         state: &State,
-    ) -> Result<usize, StabilityError> {
-        stability::assemble_tangent(model, state, &mut self.system)?;
+    ) -> Result<usize, BucklingError> {
+        buckling::assemble_tangent(model, state, &mut self.system)?;
         Ok(self.counter.negative_pivots(&self.system.values)?)
     }
 }
@@ -165,7 +165,7 @@ impl Monitor {
         &mut self,
         model: &Model,
         state: &State,
-    ) -> Result<(Option<usize>, bool), StabilityError> {
+    ) -> Result<(Option<usize>, bool), BucklingError> {
         let Some(check) = &mut self.check else {
             return Ok((None, false));
         };
@@ -187,7 +187,7 @@ impl Monitor {
 #[derive(Debug, thiserror::Error)]
 pub enum MonitorError {
     #[error("buckling modes: {0}")]
-    Stability(#[from] StabilityError),
+    Modes(#[from] BucklingError),
     #[error("{0}")]
     Output(#[from] OutputError),
 }
@@ -237,7 +237,7 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
 
 /// The model with `amplitude` times mode `mode` of the end loads added to its initial
 /// coordinates (`[analysis.buckling.imperfection]`); None without an imperfection.
-pub fn with_imperfection(model: &Model) -> Result<Option<Model>, StabilityError> {
+pub fn with_imperfection(model: &Model) -> Result<Option<Model>, BucklingError> {
     let Some(imperfection) = model
         .analysis
         .buckling()
@@ -248,7 +248,7 @@ pub fn with_imperfection(model: &Model) -> Result<Option<Model>, StabilityError>
     let modes = linear_modes(model, imperfection.mode)?;
     let mode = modes
         .get(imperfection.mode - 1)
-        .ok_or(StabilityError::NoMode)?;
+        .ok_or(BucklingError::NoMode)?;
     let mut imperfect = model.clone();
     for body in &mut imperfect.bodies {
         let offset = body.node_offset;

@@ -523,7 +523,7 @@ impl<'a, S: Stepper> Run<'a, S> {
 /// supports) or its frames.
 fn monitor_error(model: &Model, e: buckling::MonitorError) -> RunError {
     match e {
-        buckling::MonitorError::Stability(e) => RunError::Input(InputError::new(
+        buckling::MonitorError::Modes(e) => RunError::Input(InputError::new(
             &model.file,
             format!("analysis.buckling: {e}"),
         )),

@@ -38,7 +38,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Par, Side};
 
 #[derive(Debug, thiserror::Error)]
-pub enum StabilityError {
+pub enum BucklingError {
     #[error("{0}")]
     Element(#[from] ElementFailure),
     #[error("{0}")]
@@ -194,17 +194,17 @@ pub fn eigen_buckling(
     state: &State,
     system: &mut System,
     count: usize,
-) -> Result<Vec<Mode>, StabilityError> {
+) -> Result<Vec<Mode>, BucklingError> {
     let (k_0, k_sigma) = stiffness_parts(model, state, system)?;
     let pattern = &system.pattern;
     let n = pattern.size;
     if n == 0 || count == 0 {
-        return Err(StabilityError::NoMode);
+        return Err(BucklingError::NoMode);
     }
     let mut solver = Solver::new(pattern)?;
     solver.factor(&k_0).map_err(|e| match e {
-        SolverError::NotPositiveDefinite { .. } => StabilityError::MaterialStiffness,
-        other => StabilityError::Solver(other),
+        SolverError::NotPositiveDefinite { .. } => BucklingError::MaterialStiffness,
+        other => BucklingError::Solver(other),
     })?;
     let mut operator = Operator {
         pattern,
@@ -215,7 +215,7 @@ pub fn eigen_buckling(
     };
     let converged = lanczos(&mut operator, count);
     if converged.is_empty() {
-        return Err(StabilityError::NoMode);
+        return Err(BucklingError::NoMode);
     }
     Ok(converged
         .into_iter()
