@@ -272,6 +272,7 @@ fn run_options(progress: Progress) -> RunOptions {
         progress,
         interrupt: Some(&**flag),
         halt_after_steps: None,
+        no_frames: false,
     }
 }
 

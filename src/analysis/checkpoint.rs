@@ -31,7 +31,9 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 2: material points carry a temperature, the explicit carry its clock.
 /// 4: the implicit dynamic carry holds the last step's mean velocity (the predictor).
 /// 5: the explicit clock keeps the range of the steps it set apart from the clipped ones.
-const FORMAT: u32 = 5;
+/// 6: the implicit error watch, rejected steps, the probes' last values, the summary's
+///    error fields.
+const FORMAT: u32 = 6;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

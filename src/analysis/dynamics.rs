@@ -415,12 +415,13 @@ impl<'a> Dynamics<'a> {
             .fold(self.watch.speed, |m, (v, _)| m.max(v.abs()))
     }
 
-    /// The local error estimate of a step of length `h` ending in `end` (ErrorWatch); 0 for a
-    /// method without one. Updates the run's top speed with the step's end velocities.
-    fn estimate(&mut self, h: f64, end: &Advance) -> f64 {
-        self.watch.speed = self.top_speed(&end.velocity);
+    /// The local error estimate of a step of length `h` ending in `end` (ErrorWatch), and
+    /// the run's top speed with the step's end velocities (kept only if the step is); 0 for
+    /// a method without an estimate.
+    fn estimate(&self, h: f64, end: &Advance) -> (f64, f64) {
+        let speed = self.top_speed(&end.velocity);
         let Some(c) = self.error_constant else {
-            return 0.0;
+            return (0.0, speed);
         };
         let jump = end
             .acceleration
@@ -429,11 +430,12 @@ impl<'a> Dynamics<'a> {
             .zip(&self.estimated)
             .filter(|(_, read)| **read)
             .fold(0.0f64, |m, ((a1, a0), _)| m.max((a1 - a0).abs()));
-        if self.watch.speed > 0.0 {
-            c * h * jump / self.watch.speed
+        let estimate = if speed > 0.0 {
+            c * h * jump / speed
         } else {
             0.0
-        }
+        };
+        (estimate, speed)
     }
 
     /// dt_min of an adaptive run (0 without one).
@@ -736,7 +738,7 @@ impl Stepper for Dynamics<'_> {
             match self.attempt(nominal, &positions, counters) {
                 Ok((step, advance)) => {
                     let h = step.length;
-                    let estimate = self.estimate(h, &advance);
+                    let (estimate, speed) = self.estimate(h, &advance);
                     if self.refuses(h, nominal, estimate) {
                         self.method.reject();
                         counters.rejected += 1;
@@ -747,6 +749,7 @@ impl Stepper for Dynamics<'_> {
                     }
                     let clipped = h < self.control.length * (1.0 - 1e-9);
                     self.commit(step, advance, target, nominal);
+                    self.watch.speed = speed;
                     self.watch.last = estimate;
                     self.watch.largest = self.watch.largest.max(estimate);
                     if let Some((tolerance, min, max)) = self.adaptive

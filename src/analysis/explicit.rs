@@ -565,9 +565,7 @@ fn chunked_sum(x: &[f64], y: &[f64], term: impl Fn(f64, f64) -> f64 + Sync) -> f
     // one chunk: the same sum without handing it to the pool (whose bookkeeping cost the rod
     // pair a tenth of its contact phase)
     if x.len() <= DOF_CHUNK {
-        return [x.iter().zip(y).map(|(x, y)| term(*x, *y)).sum::<f64>()]
-            .into_iter()
-            .sum();
+        return x.iter().zip(y).map(|(x, y)| term(*x, *y)).sum::<f64>();
     }
     x.par_chunks(DOF_CHUNK)
         .zip(y.par_chunks(DOF_CHUNK))

@@ -432,6 +432,9 @@ pub struct RunOptions {
     /// For tests: stop dead after this many converged steps, writing nothing more (as a
     /// SIGKILL would), returning `RunError::Interrupted`.
     pub halt_after_steps: Option<usize>,
+    /// Write no VTK frames, whatever the scene asks (`impact sweep` without `--frames`); the
+    /// frame times still end steps, so the numbers are those of `impact run`.
+    pub no_frames: bool,
 }
 
 impl RunOptions {

@@ -69,13 +69,14 @@ pub struct Recorder {
 
 impl Recorder {
     /// Creates the output folder, the .pvd series and history.csv with its header.
-    pub fn create(model: &Model, dir: &Path) -> Result<Recorder, OutputError> {
+    pub fn create(model: &Model, dir: &Path, frames: bool) -> Result<Recorder, OutputError> {
         std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
             path: dir.to_path_buf(),
             action: "create folder",
             source,
         })?;
-        let series = if model.output.frame_every > 0 || !model.output.frame_times.is_empty() {
+        let wanted = model.output.frame_every > 0 || !model.output.frame_times.is_empty();
+        let series = if frames && wanted {
             let mut series = Series::create(dir, &model.name, model.output.compression)?;
             // frames are encoded and written off the stepping thread
             series.set_background(true);

@@ -147,7 +147,7 @@ impl<'a, S: Stepper> Run<'a, S> {
     ) -> Result<Run<'a, S>, RunError> {
         let recorder = match &resume {
             Some(c) => Recorder::resume(model, dir, c.recorder.clone())?,
-            None => Recorder::create(model, dir)?,
+            None => Recorder::create(model, dir, !options.no_frames)?,
         };
         let summary = Summary::new(
             model,

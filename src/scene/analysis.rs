@@ -181,7 +181,7 @@ fn adaptive(
         IntegratorKind::Linear => Some(
             "with beta = 1/6 the leading error term, dt^2 (beta - 1/6) (a_{n+1} - a_n), vanishes",
         ),
-        IntegratorKind::Newmark if (spec.beta.unwrap_or(0.25) - 1.0 / 6.0).abs() < 1e-3 => Some(
+        IntegratorKind::Newmark if (spec.beta.unwrap_or(0.25) - 1.0 / 6.0).abs() <= 1e-3 => Some(
             "with beta = 1/6 the leading error term, dt^2 (beta - 1/6) (a_{n+1} - a_n), vanishes",
         ),
         _ => None,

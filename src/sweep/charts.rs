@@ -13,10 +13,14 @@
 //!                 unstable or diverged), drift (energy gained: balance error > 5 % and the
 //!                 final energy above the initial), damped (bounded, more than 5 % of the
 //!                 energy lost: numerical dissipation), stable, refused
+//! measure_NAME    each --measure against h or dt, a series per method, with the
+//!                 extrapolated value and the GCI bar (qoi.rs)
+//! error_vs_cpu_NAME  its error against the converged value, against CPU time, and the
+//!                 Pareto front
 //! ```
 //! primary error: force_l2, else |peak_force_error| (measure::Row::primary_error).
 
-use super::measure::Row;
+use super::measure::{Row, series_indices};
 use super::plan::Plan;
 use super::qoi::{MeasureScore, Units, with_unit};
 use crate::analysis::RunError;
@@ -44,53 +48,6 @@ pub fn fitted_slope(points: &[(f64, f64)]) -> Option<(f64, f64)> {
     let sxy: f64 = logs.iter().map(|p| (p.0 - mean_x) * (p.1 - mean_y)).sum();
     let slope = sxy / sxx;
     Some((slope, mean_y - slope * mean_x))
-}
-
-/// Whether a key is a refinement or the method: dt, the implicit error tolerance, the
-/// integrator, a mesh parameter.
-fn is_method_or_refinement(key: &str) -> bool {
-    key == "analysis.dt"
-        || key == "analysis.error_tolerance"
-        || key == "analysis.integrator"
-        || key.contains(".mesh.")
-}
-
-/// Keys that do not name a series: those varied together with a refinement or the method
-/// (`--vary "analysis.integrator,analysis.mass=..."`).
-fn unlabelled_keys(plan: &Plan) -> Vec<String> {
-    plan.variations
-        .iter()
-        .filter(|v| v.keys.iter().any(|k| is_method_or_refinement(k)))
-        .flat_map(|v| v.keys.iter().cloned())
-        .collect()
-}
-
-/// The series a row belongs to: its integrator and the varied values that are not dt,
-/// the integrator, a mesh parameter or varied together with one of those.
-pub fn series_label(row: &Row, unlabelled: &[String]) -> String {
-    let mut label = row.integrator.clone();
-    for (key, value) in &row.case.values {
-        if unlabelled.contains(key) {
-            continue;
-        }
-        let short = key.rsplit('.').next().unwrap_or(key);
-        label.push_str(&format!(", {short}={value}"));
-    }
-    label
-}
-
-/// The series of the rows: each label with the indices of its rows, in order of appearance.
-pub fn series_indices(plan: &Plan, rows: &[Row]) -> Vec<(String, Vec<usize>)> {
-    let unlabelled = unlabelled_keys(plan);
-    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
-    for (k, row) in rows.iter().enumerate() {
-        let label = series_label(row, &unlabelled);
-        match groups.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, members)) => members.push(k),
-            None => groups.push((label, vec![k])),
-        }
-    }
-    groups
 }
 
 fn grouped<'a>(plan: &Plan, rows: &'a [Row]) -> Vec<(String, Vec<&'a Row>)> {

@@ -187,7 +187,18 @@ pub fn tabulate(
             radius,
             duration,
         }) => hertz_reference(&mut rows, &loaded, pair, *peak_force, *radius, *duration),
-        None => finest_reference(&mut rows, &loaded, pair.clone()),
+        None => {
+            let mut used = finest_reference(&mut rows, &loaded, pair.clone());
+            let series = series_indices(plan, &rows);
+            if let Some(note) = not_decreasing(&rows, &series) {
+                used.notes.push(note);
+                used.chart_notes.push(
+                    "force L2 against the finest case does not fall under refinement: no converging measure"
+                        .into(),
+                );
+            }
+            used
+        }
     };
     let used = match reference {
         Some(_) => with_converged(used, &mut rows, &loaded, pair),
@@ -477,30 +488,32 @@ fn finest_reference(
             m.force_l2 = relative_l2(time, f, &interpolate, |_| true);
         }
     }
-    if let Some(note) = not_decreasing(rows, &ok) {
-        used.notes.push(note);
-        used.chart_notes.push(
-            "force L2 against the finest case does not fall under refinement: no converging measure"
-                .into(),
-        );
-    }
     used
 }
 
-/// A note when force_l2 against the finest case does not fall as the cases get finer (by dt,
-/// then h, as the finest case is chosen): the force history is then no converging measure.
-fn not_decreasing(rows: &[Row], finest_first: &[usize]) -> Option<String> {
-    let errors: Vec<f64> = finest_first
-        .iter()
-        .filter_map(|&k| rows[k].measures.force_l2)
-        .collect();
-    let rising = errors.windows(2).any(|w| w[0] > w[1] * (1.0 + 1e-9));
-    (errors.len() >= 2 && rising).then(|| {
-        let listed: Vec<String> = errors.iter().rev().map(|e| format!("{e:.3}")).collect();
-        format!(
-            "force_l2 against the finest case does not fall as the cases get finer ({}, coarse to fine): the contact force history is not a converging measure of this scene; score the cases on a quantity with --measure",
-            listed.join(", ")
-        )
+/// A note when, in some series, force_l2 against the finest case does not fall as the cases
+/// get finer (by dt, then h, as the finest case is chosen; cases of one level compared by
+/// nothing): the force history is then no converging measure.
+fn not_decreasing(rows: &[Row], series: &[(String, Vec<usize>)]) -> Option<String> {
+    series.iter().find_map(|(label, members)| {
+        let mut levels: Vec<((f64, f64), f64)> = members
+            .iter()
+            .filter(|&&k| rows[k].status == "ok")
+            .filter_map(|&k| {
+                let r = &rows[k];
+                Some(((r.dt.unwrap_or(0.0), r.h), r.measures.force_l2?))
+            })
+            .collect();
+        levels.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
+        levels.dedup_by(|a, b| a.0 == b.0);
+        let rising = levels.windows(2).any(|w| w[0].1 > w[1].1 * (1.0 + 1e-9));
+        (levels.len() >= 2 && rising).then(|| {
+            let listed: Vec<String> = levels.iter().rev().map(|l| format!("{:.3}", l.1)).collect();
+            format!(
+                "force_l2 against the finest case does not fall as the cases of {label} get finer ({}, coarse to fine): the contact force history is not a converging measure of this scene; score the cases on a quantity with --measure",
+                listed.join(", ")
+            )
+        })
     })
 }
 
@@ -704,6 +717,53 @@ fn quote(v: &str) -> String {
     } else {
         v.to_string()
     }
+}
+
+/// Whether a key is a refinement or the method: dt, the implicit error tolerance, the
+/// integrator, a mesh parameter.
+fn is_method_or_refinement(key: &str) -> bool {
+    key == "analysis.dt"
+        || key == "analysis.error_tolerance"
+        || key == "analysis.integrator"
+        || key.contains(".mesh.")
+}
+
+/// Keys that do not name a series: those varied together with a refinement or the method
+/// (`--vary "analysis.integrator,analysis.mass=..."`).
+fn unlabelled_keys(plan: &Plan) -> Vec<String> {
+    plan.variations
+        .iter()
+        .filter(|v| v.keys.iter().any(|k| is_method_or_refinement(k)))
+        .flat_map(|v| v.keys.iter().cloned())
+        .collect()
+}
+
+/// The series a row belongs to: its integrator and the varied values that are not dt,
+/// the integrator, a mesh parameter or varied together with one of those.
+pub fn series_label(row: &Row, unlabelled: &[String]) -> String {
+    let mut label = row.integrator.clone();
+    for (key, value) in &row.case.values {
+        if unlabelled.contains(key) {
+            continue;
+        }
+        let short = key.rsplit('.').next().unwrap_or(key);
+        label.push_str(&format!(", {short}={value}"));
+    }
+    label
+}
+
+/// The series of the rows: each label with the indices of its rows, in order of appearance.
+pub fn series_indices(plan: &Plan, rows: &[Row]) -> Vec<(String, Vec<usize>)> {
+    let unlabelled = unlabelled_keys(plan);
+    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
+    for (k, row) in rows.iter().enumerate() {
+        let label = series_label(row, &unlabelled);
+        match groups.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, members)) => members.push(k),
+            None => groups.push((label, vec![k])),
+        }
+    }
+    groups
 }
 
 #[cfg(test)]

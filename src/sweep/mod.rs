@@ -213,16 +213,6 @@ fn run_case(
     dir: &Path,
     frames: bool,
 ) -> Result<CaseRecord, RunError> {
-    let without_frames;
-    let model = if frames {
-        model
-    } else {
-        let mut m = model.clone();
-        m.output.frame_every = 0;
-        m.output.frame_times.clear();
-        without_frames = m;
-        &without_frames
-    };
     let folder = dir.join(plan.folder(case));
     if folder.exists() {
         std::fs::remove_dir_all(&folder).map_err(|e| output_error(&folder, "clear", e))?;
@@ -236,7 +226,11 @@ fn run_case(
     // the case runs on the single pool's thread: its CPU time is the case's own
     let (result, cpu_seconds) = single.install(|| {
         let cpu = cpu_time::ThreadTime::now();
-        let result = analysis::run(model, &folder, RunOptions::default());
+        let options = RunOptions {
+            no_frames: !frames,
+            ..Default::default()
+        };
+        let result = analysis::run(model, &folder, options);
         (result, cpu.elapsed().as_secs_f64())
     });
     let wall = start.elapsed().as_secs_f64();
@@ -322,7 +316,7 @@ fn write_results(
     let (mut rows, reference) = measure::tabulate(plan, cases, models, folders)?;
     let scores = match models.first() {
         Some(model) => {
-            let series = charts::series_indices(plan, &rows);
+            let series = measure::series_indices(plan, &rows);
             qoi::score(
                 measures,
                 &qoi::Units::of(model),
@@ -356,13 +350,22 @@ fn write_results(
         })
         .unwrap_or_default();
     let units = models.first().map(qoi::Units::of);
-    let mut charts = charts::write_all(plan, &rows, &title, units.as_ref(), &reference.notes, out)?;
+    // the notes of the reference, and of the converged one beside a declared reference
+    let converged = reference.converged.as_deref();
+    let chart_notes: Vec<String> = reference
+        .chart_notes
+        .iter()
+        .chain(converged.map_or(&[][..], |c| &c.chart_notes[..]))
+        .cloned()
+        .collect();
+    let mut charts = charts::write_all(plan, &rows, &title, units.as_ref(), &chart_notes, out)?;
     if let Some(units) = &units {
         charts.extend(charts::write_measures(
             plan, &rows, &scores, &title, units, out,
         )?);
     }
-    let mut notes = reference.notes;
+    let mut notes = reference.notes.clone();
+    notes.extend(converged.map_or(Vec::new(), |c| c.notes.clone()));
     notes.extend(scores.iter().flat_map(qoi::MeasureScore::notes));
     Ok(Report {
         cases: cases.len(),

@@ -281,7 +281,8 @@ pub fn extrapolate(h: [f64; 3], f: [f64; 3]) -> Extrapolation {
     } else {
         let rp = r21.powf(p);
         out.value = Some((rp * f[0] - f[1]) / (rp - 1.0));
-        out.gci = Some(SAFETY_FACTOR * (e21 / f[0]).abs() / (rp - 1.0));
+        // the GCI is relative to the finest value: none when that is 0
+        out.gci = (f[0] != 0.0).then(|| SAFETY_FACTOR * (e21 / f[0]).abs() / (rp - 1.0));
         if r21 < 1.3 || r32 < 1.3 {
             out.note = Some(format!(
                 "refinement ratios {r21:.2} and {r32:.2}: below the 1.3 Celik et al. ask for, the order is sensitive to noise"
@@ -466,7 +467,7 @@ pub fn summary_lines(score: &MeasureScore) -> Vec<String> {
             let head = format!("{} ({})", score.measure.name, s.series);
             match (&s.extrapolation, s.reference, s.reference_kind) {
                 (Some(e), _, _) if e.value.is_some() => format!(
-                    "{head}: {:.6e}, {:.6e}, {:.6e}{unit} at {} = {:.3e}, {:.3e}, {:.3e}: order {:.2}, extrapolated {:.6e}{unit}, GCI {:.3} %",
+                    "{head}: {:.6e}, {:.6e}, {:.6e}{unit} at {} = {:.3e}, {:.3e}, {:.3e}: order {:.2}, extrapolated {:.6e}{unit}, GCI {}",
                     e.values[0],
                     e.values[1],
                     e.values[2],
@@ -476,7 +477,10 @@ pub fn summary_lines(score: &MeasureScore) -> Vec<String> {
                     e.levels[2],
                     e.order.unwrap_or(f64::NAN),
                     e.value.unwrap_or(f64::NAN),
-                    100.0 * e.gci.unwrap_or(f64::NAN)
+                    e.gci.map_or("none (the finest value is 0)".to_string(), |g| format!(
+                        "{:.3} %",
+                        100.0 * g
+                    ))
                 ),
                 (_, Some(reference), Some(kind)) => {
                     format!("{head}: compared with the {kind}, {reference:.6e}{unit}")

@@ -99,8 +99,10 @@ pub struct AnalysisSpec {
     pub dt: Option<StepSpec>,
     /// `dt = "auto"`: the fraction of the critical step taken, in (0, 1]. Default 0.9.
     pub time_step_scale: Option<f64>,
-    /// `dt = "auto"`: the run stops (status `diverged`) when the step would fall below this
-    /// (a time). Default: no limit.
+    /// `dt = "auto"`, central difference: the run stops (status `diverged`) when the step
+    /// would fall below this (a time); default no limit. Implicit: the shortest step the
+    /// error control takes (a step there is accepted whatever its estimate); default none,
+    /// or the first step when the scene has contact pairs.
     pub dt_min: Option<f64>,
     /// Implicit `dt = "auto"`: the longest step (a time). Default: no limit (end_time).
     pub dt_max: Option<f64>,
