@@ -74,9 +74,9 @@ fn step_count(model: &Model, spec: &DynamicSpec, dt: f64) -> String {
         crate::scene::spec::TimeStep::Auto { .. } => format!(
             "at least {steps:.0} steps to end_time (the automatic step falls as elements deform)"
         ),
-        crate::scene::spec::TimeStep::Adaptive { tolerance, .. } => format!(
+        crate::scene::spec::TimeStep::Adaptive(adaptive) => format!(
             "{steps:.0} steps of the first step to end_time; the error control (tolerance {}) lengthens or shortens them",
-            readable(tolerance)
+            readable(adaptive.tolerance)
         ),
     };
     if spec.integrator != IntegratorKind::CentralDifference {

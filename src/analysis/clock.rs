@@ -100,7 +100,7 @@ impl Clock {
                 exact / limit.dt,
             ),
             TimeStep::Auto { scale, min } => (Rule::Auto { scale, min }, scale * limit.dt, 1.0),
-            TimeStep::Adaptive { .. } => {
+            TimeStep::Adaptive(_) => {
                 unreachable!("the scene gives central difference a fixed or automatic step")
             }
         };

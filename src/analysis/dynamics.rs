@@ -26,7 +26,7 @@ use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
 };
 use crate::output::readable;
-use crate::scene::spec::{ContactDynamics, DynamicSpec, IntegratorKind, Strategy};
+use crate::scene::spec::{AdaptiveStep, ContactDynamics, DynamicSpec, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
@@ -100,7 +100,7 @@ pub struct Dynamics<'a> {
     /// The fixed step, or the first of an adaptive run (`stable::implicit_first_step`).
     nominal: f64,
     /// `dt = "auto"`: the error tolerance and the shortest and longest step.
-    adaptive: Option<(f64, Option<f64>, Option<f64>)>,
+    adaptive: Option<AdaptiveStep>,
     /// The method's local error constant (None: no estimate, Wilson and Houbolt).
     error_constant: Option<f64>,
     /// Per DOF, whether the estimate reads it: the free DOFs off the contact surfaces
@@ -176,9 +176,9 @@ impl<'a> Dynamics<'a> {
             // with contact, dt_min defaults to the first step: shorter steps made the impact
             // conditions' forces (a momentum over the step) run away on every contact scene
             // (validation 10.3a)
-            adaptive: spec.adaptive().map(|(tolerance, min, max)| {
-                let min = min.or((!model.contacts.is_empty()).then_some(nominal));
-                (tolerance, min, max)
+            adaptive: spec.adaptive().map(|a| AdaptiveStep {
+                min: a.min.or((!model.contacts.is_empty()).then_some(nominal)),
+                ..a
             }),
             watch: ErrorWatch::default(),
             state: State::initial(model),
@@ -303,7 +303,7 @@ impl<'a> Dynamics<'a> {
             mean_velocity: self.mean_velocity.as_deref(),
             error_target: self
                 .adaptive
-                .map(|(tolerance, ..)| NEWTON_SHARE * tolerance * self.watch.speed),
+                .map(|a| NEWTON_SHARE * a.tolerance * self.watch.speed),
         };
         let (system, solver, factored_for) =
             (&mut self.system, &mut self.solver, &mut self.factored_for);
@@ -440,12 +440,11 @@ impl<'a> Dynamics<'a> {
 
     /// dt_min of an adaptive run (0 without one).
     fn dt_floor(&self) -> f64 {
-        self.adaptive.and_then(|(_, min, _)| min).unwrap_or(0.0)
+        self.adaptive.and_then(|a| a.min).unwrap_or(0.0)
     }
 
     fn adaptive_tolerance(&self) -> f64 {
-        self.adaptive
-            .map_or(f64::INFINITY, |(tolerance, ..)| tolerance)
+        self.adaptive.map_or(f64::INFINITY, |a| a.tolerance)
     }
 
     /// Whether an adaptive run takes the step of length `h` again, shorter: its estimate is
@@ -455,11 +454,11 @@ impl<'a> Dynamics<'a> {
     /// At an impact the acceleration jumps by the velocity change over the step, so the
     /// estimate does not shrink with the step: the floor ends the rejections there.
     fn refuses(&self, h: f64, nominal: f64, estimate: f64) -> bool {
-        let Some((tolerance, min, _)) = self.adaptive else {
+        let Some(adaptive) = self.adaptive else {
             return false;
         };
-        let floor = min.unwrap_or(0.0).max(self.control.shortest());
-        estimate > tolerance && h >= nominal * (1.0 - 1e-9) && h > floor * (1.0 + 1e-9)
+        let floor = adaptive.min.unwrap_or(0.0).max(self.control.shortest());
+        estimate > adaptive.tolerance && h >= nominal * (1.0 - 1e-9) && h > floor * (1.0 + 1e-9)
     }
 
     /// Velocity-level persistency: the (pair, slave node) entries closed at the start of the
@@ -752,12 +751,12 @@ impl Stepper for Dynamics<'_> {
                     self.watch.speed = speed;
                     self.watch.last = estimate;
                     self.watch.largest = self.watch.largest.max(estimate);
-                    if let Some((tolerance, min, max)) = self.adaptive
-                        && !(clipped && estimate <= tolerance)
+                    if let Some(a) = self.adaptive
+                        && !(clipped && estimate <= a.tolerance)
                     {
-                        let next = on_ladder(self.nominal, h * step_factor(tolerance, estimate));
-                        let next = next.min(max.unwrap_or(f64::INFINITY));
-                        self.control.propose(next.max(min.unwrap_or(0.0)));
+                        let next = on_ladder(self.nominal, h * step_factor(a.tolerance, estimate));
+                        let next = next.min(a.max.unwrap_or(f64::INFINITY));
+                        self.control.propose(next.max(a.min.unwrap_or(0.0)));
                     }
                     return Ok(());
                 }

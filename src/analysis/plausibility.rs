@@ -91,14 +91,14 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
             )
         }),
         // the error control lengthens the steps as far as the answer allows: no count
-        TimeStep::Adaptive { .. } => None,
+        TimeStep::Adaptive(_) => None,
     };
     if let Some((dt, what)) = step {
         let steps = d.end_time / dt;
         if steps < MIN_STEPS {
             let change = match d.step {
                 TimeStep::Fixed(_) => "lower analysis.dt",
-                TimeStep::Auto { .. } | TimeStep::Adaptive { .. } => "lengthen analysis.end_time",
+                TimeStep::Auto { .. } | TimeStep::Adaptive(_) => "lengthen analysis.end_time",
             };
             out.push(format!(
                 "analysis.end_time = {} spans {} step(s) of {what} = {}: fewer than {} \
@@ -338,7 +338,7 @@ pub fn expected_frames(model: &Model) -> f64 {
                 .map(|limit| d.end_time / (scale * limit.dt))
                 .unwrap_or(0.0),
             // the first step's count: the error control may lengthen them
-            TimeStep::Adaptive { .. } => super::stable::implicit_first_step(model, d)
+            TimeStep::Adaptive(_) => super::stable::implicit_first_step(model, d)
                 .map(|dt| d.end_time / dt)
                 .unwrap_or(0.0),
         },

@@ -13,7 +13,7 @@
 use crate::assembly::{self, State};
 use crate::element::Formulation;
 use crate::output::readable;
-use crate::scene::spec::DynamicSpec;
+use crate::scene::spec::{AdaptiveStep, DynamicSpec};
 use crate::scene::{BodyKind, InputError, Model};
 
 /// A central-difference stability limit and the element that sets it.
@@ -71,7 +71,7 @@ pub fn implicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, Inp
         None => Ok(spec
             .fixed_dt()
             .expect("an implicit step is fixed or adaptive (checked by the scene)")),
-        Some((_, min, max)) => {
+        Some(AdaptiveStep { min, max, .. }) => {
             let courant = critical_time_step(model)?.dt;
             let step = courant.min(max.unwrap_or(f64::INFINITY)).min(spec.end_time);
             Ok(step.max(min.unwrap_or(0.0)))

@@ -5,8 +5,8 @@ use super::InputError;
 use super::context::{Context, positive};
 use super::model::Analysis;
 use super::spec::{
-    AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics, DynamicSpec, IntegratorKind,
-    MassKind, NewtonSpec, Quadrature, StaticSpec, StepSpec, TimeStep,
+    AdaptiveStep, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics, DynamicSpec,
+    IntegratorKind, MassKind, NewtonSpec, Quadrature, StaticSpec, StepSpec, TimeStep,
 };
 use crate::element::Strain;
 
@@ -218,11 +218,11 @@ fn adaptive(
     {
         return Err(cx.err(format!("analysis.dt_min: {low} is above dt_max {high}")));
     }
-    Ok(TimeStep::Adaptive {
+    Ok(TimeStep::Adaptive(AdaptiveStep {
         tolerance,
         min,
         max,
-    })
+    }))
 }
 
 /// The keys that belong to one integrator only are absent for the others.

@@ -206,13 +206,18 @@ pub enum TimeStep {
     /// `scale` times the critical step of the current configuration, every step; the run
     /// stops when it would fall below `min`.
     Auto { scale: f64, min: Option<f64> },
-    /// Implicit: each step as long as the local error estimate allows (`tolerance`), within
-    /// [`min`, `max`]; the first from the wave speed and the smallest element.
-    Adaptive {
-        tolerance: f64,
-        min: Option<f64>,
-        max: Option<f64>,
-    },
+    /// Implicit: each step as long as the local error estimate allows; the first from the
+    /// wave speed and the smallest element.
+    Adaptive(AdaptiveStep),
+}
+
+/// The implicit error-controlled step (`dt = "auto"`): the tolerance of the local error
+/// estimate and the shortest and longest step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdaptiveStep {
+    pub tolerance: f64,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
 }
 
 impl DynamicSpec {
@@ -221,7 +226,7 @@ impl DynamicSpec {
     pub fn fixed_dt(&self) -> Option<f64> {
         match self.step {
             TimeStep::Fixed(dt) => Some(dt),
-            TimeStep::Auto { .. } | TimeStep::Adaptive { .. } => None,
+            TimeStep::Auto { .. } | TimeStep::Adaptive(_) => None,
         }
     }
 
@@ -241,14 +246,10 @@ impl DynamicSpec {
         }
     }
 
-    /// The tolerance, shortest and longest step of an adaptive implicit analysis.
-    pub fn adaptive(&self) -> Option<(f64, Option<f64>, Option<f64>)> {
+    /// The error-controlled step of an adaptive implicit analysis.
+    pub fn adaptive(&self) -> Option<AdaptiveStep> {
         match self.step {
-            TimeStep::Adaptive {
-                tolerance,
-                min,
-                max,
-            } => Some((tolerance, min, max)),
+            TimeStep::Adaptive(adaptive) => Some(adaptive),
             _ => None,
         }
     }
