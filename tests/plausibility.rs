@@ -267,6 +267,39 @@ fn steps_too_long_for_the_run_or_the_impact_warn() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 }
 
+/// Goal: the set-up check counts an automatic explicit step as the run takes it. Before: it
+/// counted time_step_scale x the element-eigenvalue limit (taylor_jc: 3.47 steps in 3e-7 s),
+/// while the run scales the kernel's conservative bound, 0.46 of that limit (8 steps).
+/// Reference: the run's own step count; over 3e-7 s (a twentieth of a wave transit of the
+/// rod's radius) the mesh barely deforms, so the steps keep their first length and the run
+/// takes the warned count rounded up (the last step clipped to end_time).
+#[test]
+fn the_few_steps_warning_counts_the_steps_the_run_takes() {
+    let dir = out_dir("few_steps_taylor");
+    let d = dir.to_str().unwrap().to_string();
+    let o = impact(&[
+        "run",
+        "models/taylor_jc.toml",
+        "--quiet",
+        "--out",
+        &d,
+        "--set",
+        "analysis.end_time=3e-7",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let summary: Summary =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let warning = saying(&summary, "spans");
+    assert_eq!(warning.len(), 1, "{:?}", summary.warnings);
+    let count: f64 = warning[0]
+        .split("spans ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .expect("a step count after `spans`");
+    assert_eq!(count.ceil() as usize, summary.steps, "{}", warning[0]);
+}
+
 const ROUND_BAR_SWAP: [&str; 5] = [
     "contact.tip.slave.body=block",
     "contact.tip.slave.set=top",

@@ -470,10 +470,12 @@ proptest! {
             .lumped;
         let lumped: [f64; 4] = std::array::from_fn(|a| lumped_all[2 * cell[a]]);
         let exact = max_frequency_squared(&k, &lumped);
-        let bound = explicit_kernel(&model, quadrature, kappa)
-            .frequency_bound(&positions)
+        let step = explicit_kernel(&model, quadrature, kappa)
+            .stable_step(&positions)
             .unwrap()
-            .omega_squared;
+            .dt;
+        // the bound's omega^2 = (2 / dt)^2 (a round-off of 1e-16 against the 1e-6 below)
+        let bound = (2.0 / step).powi(2);
         prop_assert!(bound >= exact * (1.0 - 1e-6), "{formulation} {quadrature}: bound {bound} below {exact}");
         prop_assert!(bound <= 16.0 * exact, "{formulation} {quadrature}: bound {bound} far above {exact}");
     }

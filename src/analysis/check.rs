@@ -15,8 +15,10 @@
 //!              Wilson-theta: unconditionally stable for theta >= 1.37 only
 //! ```
 
-use super::explicit::first_step;
-use super::stable::{StableStep, checked_step, critical_time_step, wave_speed};
+use super::stable::{
+    StableStep, checked_step, critical_time_step, explicit_first_step, implicit_first_step,
+    wave_speed,
+};
 use crate::element::Formulation;
 use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind};
@@ -103,10 +105,10 @@ pub fn step_stability(model: &Model, spec: &DynamicSpec) -> Result<StepStability
         // the element-eigenvalue limit, and the step the run will take (the automatic step
         // scales the explicit kernel's conservative bound, below the limit)
         let StableStep { dt: dt_crit, .. } = checked_step(model, spec)?;
-        let dt = Some(first_step(model, spec)?);
+        let dt = Some(explicit_first_step(model, spec)?);
         return Ok(StepStability::Conditional { dt, dt_crit });
     }
-    let dt = crate::analysis::stable::implicit_first_step(model, spec)?;
+    let dt = implicit_first_step(model, spec)?;
     let newmark = matches!(
         spec.integrator,
         IntegratorKind::Average | IntegratorKind::Linear | IntegratorKind::Newmark

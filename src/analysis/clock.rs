@@ -19,29 +19,11 @@
 
 use super::Status;
 use super::StepError;
-use crate::assembly::FrequencyBound;
+use crate::assembly::StableStep;
 use crate::output::readable;
 use crate::scene::Model;
 use crate::scene::spec::{DynamicSpec, TimeStep};
 use serde::{Deserialize, Serialize};
-
-/// The stable step of a configuration and the element that sets it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Limit {
-    pub dt: f64,
-    pub body: usize,
-    pub element: usize,
-}
-
-impl Limit {
-    fn of(bound: FrequencyBound) -> Limit {
-        Limit {
-            dt: 2.0 / bound.omega_squared.sqrt(),
-            body: bound.body,
-            element: bound.element,
-        }
-    }
-}
 
 /// The step rule of a central-difference run and what it has seen.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -52,7 +34,7 @@ pub struct Clock {
     /// Fixed: the initial element-eigenvalue limit over the initial dt_bound; auto: 1.
     calibration: f64,
     /// The stable step of the committed configuration (the bound's, unscaled).
-    pub limit: Limit,
+    pub limit: StableStep,
     /// The last step taken (0 before the first).
     pub last: f64,
     /// The shortest and the longest step the rule set (clipped steps not counted).
@@ -87,9 +69,8 @@ enum Rule {
 
 impl Clock {
     /// The clock of `spec`, with the initial element-eigenvalue limit `exact` and the initial
-    /// bound `first`.
-    pub fn new(spec: &DynamicSpec, exact: f64, first: FrequencyBound) -> Clock {
-        let limit = Limit::of(first);
+    /// bound `limit` (`stable::explicit_clock` makes it).
+    pub fn new(spec: &DynamicSpec, exact: f64, limit: StableStep) -> Clock {
         let (rule, dt0, calibration) = match spec.step {
             TimeStep::Fixed(dt) => (
                 Rule::Fixed {
@@ -189,8 +170,8 @@ impl Clock {
         }
     }
 
-    /// `step` was taken; `bound` is that of the new configuration.
-    pub fn took(&mut self, step: Step, bound: FrequencyBound) {
+    /// `step` was taken; `limit` is the stable step of the new configuration.
+    pub fn took(&mut self, step: Step, limit: StableStep) {
         let h = step.length;
         self.last = h;
         if !step.clipped {
@@ -199,7 +180,7 @@ impl Clock {
         }
         self.shortest_taken = self.shortest_taken.min(h);
         self.longest_taken = self.longest_taken.max(h);
-        self.limit = Limit::of(bound);
+        self.limit = limit;
     }
 
     /// The shortest and the longest step the rule set; the steps taken when every step was

@@ -18,49 +18,18 @@ use super::clock::Clock;
 use super::newton::Counters;
 use super::record::{Energies, Motion};
 use super::run::{Stepper, TimeStepReport};
-use super::stable::checked_step;
+use super::stable::{checked_step, explicit_clock};
 use super::{DtLimit, RunError, Status, loads};
-use crate::assembly::explicit::{ExplicitKernel, Full, Reduced, StepWork};
-use crate::assembly::{self, ElementMasses, FrequencyBound, Mass, State, System, check_mass};
+use crate::assembly::explicit::{ExplicitKernel, StepWork, kernel_for};
+use crate::assembly::{self, ElementMasses, Mass, StableStep, State, System, check_mass};
 use crate::contact::{ContactState, Interfaces};
 use crate::output::readable;
-use crate::scene::spec::{DynamicSpec, MassKind, Quadrature};
+use crate::scene::spec::{DynamicSpec, MassKind};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
-
-/// The clock of a run's first step: the element frequency bound of the kernel that will
-/// step `state` (one-point, 2x2 in rate form, or the general element loop), with the
-/// element-eigenvalue limit `exact` for a fixed step's check.
-fn initial_clock(
-    model: &Model,
-    spec: &DynamicSpec,
-    exact: f64,
-    state: &State,
-    masses: &ElementMasses,
-    kernel: Option<&dyn ExplicitKernel>,
-) -> Result<Clock, InputError> {
-    let first = match kernel {
-        Some(kernel) => kernel.frequency_bound(&state.coordinates),
-        None => assembly::frequency_bound(model, state, masses),
-    }
-    .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    Ok(Clock::new(spec, exact, first))
-}
-
-/// The first step a central-difference run of `model` takes (a fixed dt, or the automatic
-/// step of the kernel that will run), computed as the run computes it: what `impact check`
-/// prints.
-pub fn first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, InputError> {
-    let exact = checked_step(model, spec)?.dt;
-    let masses =
-        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    let state = State::initial(model);
-    let (kernel, _) = explicit_kernel(model, spec, &state, &masses);
-    Ok(initial_clock(model, spec, exact, &state, &masses, kernel.as_deref())?.dt0)
-}
 
 /// Central difference: the state, the motion, the one-point kernel when asked, and what the
 /// loop carries.
@@ -120,8 +89,8 @@ impl<'a> Explicit<'a> {
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
         let state = State::initial(model);
-        let (kernel, kernel_has_own_state) = explicit_kernel(model, spec, &state, &masses);
-        let clock = initial_clock(model, spec, dt_crit, &state, &masses, kernel.as_deref())?;
+        let (kernel, kernel_has_own_state) = kernel_for(model, spec, &state, &masses);
+        let clock = explicit_clock(model, spec, dt_crit, &state, &masses, kernel.as_deref())?;
         let dofs = model.dofs();
         Ok(Explicit {
             model,
@@ -189,8 +158,8 @@ impl<'a> Explicit<'a> {
     }
 
     /// The internal force at u_{n+1} (a step of length `h`), the committed element state and
-    /// the frequency bound of the new configuration; the message of an element that failed.
-    fn internal_force(&mut self, h: f64) -> Result<FrequencyBound, String> {
+    /// the stable step of the new configuration; the message of an element that failed.
+    fn internal_force(&mut self, h: f64) -> Result<StableStep, String> {
         let du = &self.du;
         match self.kernel.as_mut() {
             Some(kernel) => {
@@ -201,11 +170,7 @@ impl<'a> Explicit<'a> {
                 .map_err(|e| e.to_string())?;
                 commit_kernel_step(&mut self.state, du, work);
                 let (body, element) = kernel.locate(work.critical_element);
-                Ok(FrequencyBound {
-                    omega_squared: work.omega_squared,
-                    body,
-                    element,
-                })
+                Ok(StableStep::of_frequency(work.omega_squared, body, element))
             }
             None => {
                 let spec = self.spec;
@@ -221,7 +186,7 @@ impl<'a> Explicit<'a> {
                 .map_err(|e| e.to_string())?;
                 self.internal = evaluation.force.clone();
                 assembly::commit(self.model, &mut self.state, du, evaluation, spec.geometry);
-                assembly::frequency_bound(self.model, &self.state, &self.masses)
+                assembly::bound_stable_step(self.model, &self.state, &self.masses)
                     .map_err(|e| e.to_string())
             }
         }
@@ -317,7 +282,7 @@ impl Stepper for Explicit<'_> {
         // a kernel with its own arrays starts again from the restored points
         if self.kernel.is_some() {
             (self.kernel, self.kernel_has_own_state) =
-                explicit_kernel(self.model, self.spec, &self.state, &self.masses);
+                kernel_for(self.model, self.spec, &self.state, &self.masses);
         }
         true
     }
@@ -478,38 +443,8 @@ impl Stepper for Explicit<'_> {
         Some(TimeStepReport {
             shortest: range.shortest,
             longest: range.longest,
-            limit: DtLimit {
-                dt: c.limit.dt,
-                body: self.model.bodies[c.limit.body].name.clone(),
-                element: c.limit.element,
-            },
+            limit: DtLimit::of(c.limit, self.model),
         })
-    }
-}
-
-/// The element loop of a central-difference run: the one-point kernel (`reduced`), the 2x2
-/// rate-form kernel on finite-strain Quad4 models, or none (rods, small strain: the general
-/// assembly); and whether the kernel keeps state that `State` does not.
-fn explicit_kernel(
-    model: &Model,
-    spec: &DynamicSpec,
-    state: &State,
-    masses: &ElementMasses,
-) -> (Option<Box<dyn ExplicitKernel>>, bool) {
-    use crate::scene::BodyKind;
-    let quads_only = model
-        .bodies
-        .iter()
-        .all(|b| matches!(b.kind, BodyKind::Continuum { .. }));
-    match spec.quadrature {
-        Quadrature::Reduced => (
-            Some(Box::new(Reduced::new(model, state, spec.hourglass, masses))),
-            true,
-        ),
-        Quadrature::Full if quads_only && spec.geometry == crate::element::Strain::Finite => {
-            (Some(Box::new(Full::new(model, state, masses))), false)
-        }
-        Quadrature::Full => (None, false),
     }
 }
 

@@ -18,7 +18,7 @@ pub mod run;
 pub mod stable;
 pub mod statics;
 
-use crate::assembly::State;
+use crate::assembly::{StableStep, State};
 use crate::output::{OutputError, readable};
 use crate::scene::{InputError, Model};
 use newton::Counters;
@@ -115,13 +115,23 @@ pub struct EnergySummary {
 
 pub use buckling::BucklingSummary;
 
-/// The stable step of a configuration (from the element bound, before the scale) and the
-/// body and element that set it.
+/// summary.json's form of a [`StableStep`] (the stable step of the last
+/// configuration, from the element bound, before the scale): the body by name.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DtLimit {
     pub dt: f64,
     pub body: String,
     pub element: usize,
+}
+
+impl DtLimit {
+    pub fn of(step: StableStep, model: &Model) -> DtLimit {
+        DtLimit {
+            dt: step.dt,
+            body: model.bodies[step.body].name.clone(),
+            element: step.element,
+        }
+    }
 }
 
 /// summary.json (the output contract of docs/user-guide.md): other tools read it; fields

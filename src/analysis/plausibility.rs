@@ -15,7 +15,7 @@
 
 use super::Summary;
 use super::record::Energies;
-use super::stable::{critical_time_step, wave_speed};
+use super::stable::{explicit_first_step, implicit_first_step, wave_speed};
 use crate::assembly::{self, State};
 use crate::contact::{ContactPair, Master, penetration_limits};
 use crate::element::Formulation;
@@ -81,12 +81,12 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
     };
     let step = match d.step {
         TimeStep::Fixed(dt) => Some((dt, "analysis.dt".to_string())),
-        TimeStep::Auto { scale, .. } => critical_time_step(model).ok().map(|limit| {
+        TimeStep::Auto { scale, .. } => explicit_first_step(model, d).ok().map(|dt| {
             (
-                scale * limit.dt,
+                dt,
                 format!(
-                    "the automatic step (time_step_scale x the stability limit {})",
-                    readable(limit.dt)
+                    "the automatic step (time_step_scale = {} x the stable step of the initial mesh)",
+                    readable(scale)
                 ),
             )
         }),
@@ -334,11 +334,11 @@ pub fn expected_frames(model: &Model) -> f64 {
         Analysis::Static(s) => s.steps as f64,
         Analysis::Dynamic(d) => match d.step {
             TimeStep::Fixed(dt) => d.end_time / dt,
-            TimeStep::Auto { scale, .. } => critical_time_step(model)
-                .map(|limit| d.end_time / (scale * limit.dt))
+            TimeStep::Auto { .. } => explicit_first_step(model, d)
+                .map(|dt| d.end_time / dt)
                 .unwrap_or(0.0),
             // the first step's count: the error control may lengthen them
-            TimeStep::Adaptive(_) => super::stable::implicit_first_step(model, d)
+            TimeStep::Adaptive(_) => implicit_first_step(model, d)
                 .map(|dt| d.end_time / dt)
                 .unwrap_or(0.0),
         },
@@ -662,15 +662,16 @@ fn time_step_warning(model: &Model, summary: &Summary) -> Option<String> {
     })
 }
 
-/// The central-difference stable step 2 / omega of the median element of the initial mesh.
+/// The central-difference stable step 2 / omega of the median element of the initial mesh
+/// (of n elements the one at n / 2 in ascending omega, so at n - 1 - n / 2 in ascending dt).
 fn median_stable_step(model: &Model) -> Option<f64> {
     let state = State::initial(model);
-    let bounds = assembly::frequency_bounds(model, &state, model.analysis.geometry()).ok()?;
-    let mut omega_squared: Vec<f64> = bounds.iter().map(|b| b.omega_squared).collect();
-    if omega_squared.is_empty() {
+    let steps = assembly::element_stable_steps(model, &state, model.analysis.geometry()).ok()?;
+    let mut dt: Vec<f64> = steps.iter().map(|s| s.dt).collect();
+    if dt.is_empty() {
         return None;
     }
-    let middle = omega_squared.len() / 2;
-    let (_, median, _) = omega_squared.select_nth_unstable_by(middle, f64::total_cmp);
-    (*median > 0.0).then(|| 2.0 / median.sqrt())
+    let middle = dt.len() - 1 - dt.len() / 2;
+    let (_, median, _) = dt.select_nth_unstable_by(middle, f64::total_cmp);
+    median.is_finite().then_some(*median)
 }

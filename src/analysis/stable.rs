@@ -1,5 +1,6 @@
-//! The stability limit of central difference and the wave speeds it comes from: one place
-//! that the run, `impact check` and the end-of-run warnings read (docs/theory.md 8.7).
+//! The stable step of central difference and the wave speeds it comes from: one place that
+//! the run, its clock, `impact check`, the set-up warnings and the sweep read
+//! (docs/theory.md 8.7). Its one type is [`StableStep`] (dt, body, element).
 //!
 //! Legend
 //! ```text
@@ -7,35 +8,59 @@
 //!            formulation: lambda + 2 mu (plane strain, axisymmetric), E / (1 - nu^2) (plane
 //!            stress), E (rod)
 //! dt_crit    2 / omega_max, omega_max^2 the largest element eigenvalue of M_e^-1 K_e of the
-//!            initial configuration
+//!            initial configuration (the limit a fixed dt is checked against)
+//! dt_bound   2 / sqrt(max_e omega^2_e), omega^2_e the closed-form frequency bound of the
+//!            kernel that steps the run (<= dt_crit): the run's automatic step is
+//!            time_step_scale dt_bound, re-evaluated every step (clock.rs)
 //! ```
 
-use crate::assembly::{self, State};
+use super::clock::Clock;
+use crate::assembly::explicit::{ExplicitKernel, kernel_for};
+use crate::assembly::{self, ElementMasses, State};
 use crate::element::Formulation;
 use crate::output::readable;
 use crate::scene::spec::{AdaptiveStep, DynamicSpec};
 use crate::scene::{BodyKind, InputError, Model};
 
-/// A central-difference stability limit and the element that sets it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StableStep {
-    /// dt_crit = 2 / omega_max.
-    pub dt: f64,
-    pub body: usize,
-    pub element: usize,
-}
+pub use crate::assembly::StableStep;
 
-/// The central-difference stability limit of the model in its initial state, with the
-/// element that sets it.
+/// The central-difference stability limit dt_crit of the model in its initial state, with
+/// the element that sets it.
 pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
     let state = State::initial(model);
-    let bound = assembly::max_frequency_squared(model, &state, model.analysis.geometry())
-        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    Ok(StableStep {
-        dt: 2.0 / bound.omega_squared.sqrt(),
-        body: bound.body,
-        element: bound.element,
-    })
+    assembly::eigenvalue_stable_step(model, &state, model.analysis.geometry())
+        .map_err(|err| InputError::new(&model.file, err.to_string()))
+}
+
+/// The clock of a central-difference run that starts from `state`: dt_crit `exact` (from
+/// [`checked_step`]) for a fixed step's check, and the stable step of `kernel` (the one-point
+/// or the 2x2 kernel; none: the general element loop) that an automatic step scales.
+pub fn explicit_clock(
+    model: &Model,
+    spec: &DynamicSpec,
+    exact: f64,
+    state: &State,
+    masses: &ElementMasses,
+    kernel: Option<&dyn ExplicitKernel>,
+) -> Result<Clock, InputError> {
+    let limit = match kernel {
+        Some(kernel) => kernel.stable_step(&state.coordinates),
+        None => assembly::bound_stable_step(model, state, masses),
+    }
+    .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    Ok(Clock::new(spec, exact, limit))
+}
+
+/// The first step a central-difference run of `model` takes (the fixed dt, or the automatic
+/// step of the kernel that will run), computed as the run computes it ([`explicit_clock`]):
+/// what `impact check` prints and the set-up warnings count steps with.
+pub fn explicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, InputError> {
+    let exact = checked_step(model, spec)?.dt;
+    let masses =
+        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    let state = State::initial(model);
+    let (kernel, _) = kernel_for(model, spec, &state, &masses);
+    Ok(explicit_clock(model, spec, exact, &state, &masses, kernel.as_deref())?.dt0)
 }
 
 /// The stability limit of `model`, or the refusal of a fixed dt above it (unless the scene

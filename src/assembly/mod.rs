@@ -445,21 +445,38 @@ impl ElementMasses {
     }
 }
 
-/// An upper bound of the highest frequency squared of the model at the committed state,
-/// element by element (Irons' theorem: the assembled model's highest frequency is at most
-/// the elements' highest), from the closed-form bounds of the kernels (`Kernel::
-/// frequency_bound`); with the element that sets it (the lowest index among equals, so the
-/// result does not depend on the thread count).
-pub fn frequency_bound(
+/// A stable step of central difference, dt = 2 / omega, and the element that sets it: the
+/// one type of the stable step. The explicit kernels' bounds, the run's clock, `impact check`
+/// and summary.json `dt_limit` (the body by name) all carry it (docs/theory.md 8.7).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StableStep {
+    pub dt: f64,
+    pub body: usize,
+    pub element: usize,
+}
+
+impl StableStep {
+    /// The step 2 / omega of an element whose highest frequency squared is `omega_squared`
+    /// (infinite for an element that does not vibrate).
+    pub fn of_frequency(omega_squared: f64, body: usize, element: usize) -> StableStep {
+        StableStep {
+            dt: 2.0 / omega_squared.sqrt(),
+            body,
+            element,
+        }
+    }
+}
+
+/// A stable step of the model at the committed state from the closed-form element frequency
+/// bounds of the kernels (`Kernel::frequency_bound`; Irons' theorem: the assembled model's
+/// highest frequency is at most the elements' highest); with the element that sets it (the
+/// lowest index among equals, so the result does not depend on the thread count).
+pub fn bound_stable_step(
     model: &Model,
     state: &State,
     masses: &ElementMasses,
-) -> Result<FrequencyBound, ElementFailure> {
-    let mut best = FrequencyBound {
-        omega_squared: 0.0,
-        body: 0,
-        element: 0,
-    };
+) -> Result<StableStep, ElementFailure> {
+    let mut best = (0.0, 0, 0);
     for (b, body) in model.bodies.iter().enumerate() {
         let kernel = Kernel::of(body);
         let committed = &state.bodies[b];
@@ -492,57 +509,53 @@ pub fn frequency_bound(
                 element,
                 error,
             })?;
-        if worst.0 > best.omega_squared {
-            best = FrequencyBound {
-                omega_squared: worst.0,
-                body: b,
-                element: worst.1,
-            };
+        if worst.0 > best.0 {
+            best = (worst.0, b, worst.1);
         }
     }
-    Ok(best)
+    Ok(StableStep::of_frequency(best.0, best.1, best.2))
 }
 
-/// The highest element frequency squared and the element that has it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrequencyBound {
-    /// max_e lambda_max(M_e^-1 K_e).
-    pub omega_squared: f64,
-    pub body: usize,
-    pub element: usize,
-}
-
-/// The largest element eigenvalue max_e lambda_max(M_e^-1 K_e) with the lumped element mass:
-/// an upper bound of the highest natural frequency squared of the assembled model (Irons'
-/// element eigenvalue theorem), so 2 / sqrt(it) is a safe central-difference step.
-pub fn max_frequency_squared(
+/// The stability limit of central difference from the element eigenvalues: 2 / sqrt of the
+/// largest lambda_max(M_e^-1 K_e) with the lumped element mass (an upper bound of the
+/// assembled model's highest frequency squared, Irons' element eigenvalue theorem), and the
+/// element that has it (the first among equals).
+pub fn eigenvalue_stable_step(
     model: &Model,
     state: &State,
     geometry: Strain,
-) -> Result<FrequencyBound, ElementFailure> {
-    let mut best = FrequencyBound {
-        omega_squared: 0.0,
-        body: 0,
-        element: 0,
-    };
-    for bound in frequency_bounds(model, state, geometry)? {
-        if bound.omega_squared > best.omega_squared {
-            best = bound;
+) -> Result<StableStep, ElementFailure> {
+    let mut best = (0.0, 0, 0);
+    for (b, e, omega_squared) in element_eigenvalues(model, state, geometry)? {
+        if omega_squared > best.0 {
+            best = (omega_squared, b, e);
         }
     }
-    Ok(best)
+    Ok(StableStep::of_frequency(best.0, best.1, best.2))
 }
 
-/// Every element's frequency bound (as `max_frequency_squared` takes the largest of them),
-/// body by body in element order.
-pub fn frequency_bounds(
+/// Every element's eigenvalue stable step (as `eigenvalue_stable_step` takes the shortest of
+/// them), body by body in element order.
+pub fn element_stable_steps(
     model: &Model,
     state: &State,
     geometry: Strain,
-) -> Result<Vec<FrequencyBound>, ElementFailure> {
+) -> Result<Vec<StableStep>, ElementFailure> {
+    Ok(element_eigenvalues(model, state, geometry)?
+        .into_iter()
+        .map(|(b, e, omega_squared)| StableStep::of_frequency(omega_squared, b, e))
+        .collect())
+}
+
+/// Every element's largest eigenvalue lambda_max(M_e^-1 K_e): (body, element, lambda).
+fn element_eigenvalues(
+    model: &Model,
+    state: &State,
+    geometry: Strain,
+) -> Result<Vec<(usize, usize, f64)>, ElementFailure> {
     let zero = vec![0.0; model.dofs()];
     let coords = model.coordinates();
-    let mut bounds = Vec::new();
+    let mut eigenvalues = Vec::new();
     for (b, body) in model.bodies.iter().enumerate() {
         let kernel = Kernel::of(body);
         for e in 0..body.elements() {
@@ -562,12 +575,8 @@ pub fn frequency_bounds(
                     geometry,
                 )
                 .map_err(failure)?;
-            bounds.push(FrequencyBound {
-                omega_squared: lambda,
-                body: b,
-                element: e,
-            });
+            eigenvalues.push((b, e, lambda));
         }
     }
-    Ok(bounds)
+    Ok(eigenvalues)
 }

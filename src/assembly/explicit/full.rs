@@ -17,8 +17,8 @@
 //! W_int                 sum_q W_q,mid 1/2 (R sigma_n R^T + sigma_{n+1}) . d_q
 //! ```
 
-use super::{CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, bound_of};
-use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
+use super::{CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, stable_step_of};
+use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
@@ -344,7 +344,7 @@ impl ExplicitKernel for Full {
         Ok(())
     }
 
-    fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<FrequencyBound, ElementFailure> {
+    fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure> {
         let mut worst = StepWork::default();
         for e in 0..self.elements() {
             let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
@@ -354,7 +354,7 @@ impl ExplicitKernel for Full {
             let w = quad4::frequency_bound(&values, p.wave_lambda, p.mu, &self.lumped[e]);
             worst.observe(w, e);
         }
-        Ok(bound_of(&self.layout, &worst))
+        Ok(stable_step_of(&self.layout, &worst))
     }
 
     fn step(

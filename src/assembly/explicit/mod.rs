@@ -11,9 +11,11 @@ pub mod one_point;
 pub use full::Full;
 pub use one_point::Reduced;
 
-use super::{ElementFailure, FrequencyBound, State};
+use super::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::Formulation;
+use crate::element::Strain;
 use crate::material::{Material, StressCondition};
+use crate::scene::spec::{DynamicSpec, Quadrature};
 use crate::scene::{BodyKind, Model};
 use rayon::prelude::*;
 
@@ -233,8 +235,9 @@ pub trait ExplicitKernel: Send {
         dt: f64,
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure>;
-    /// The largest element frequency bound on the positions `x` from the stored state.
-    fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<FrequencyBound, ElementFailure>;
+    /// The stable step of the positions `x` from the stored state: 2 / sqrt of the largest
+    /// element frequency bound.
+    fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure>;
     /// Copies the element state into the points of `state` (what output reads).
     fn write_points(&self, model: &Model, state: &mut State);
     /// The accumulated hourglass work (the one-point kernel).
@@ -245,16 +248,37 @@ pub trait ExplicitKernel: Send {
     fn eq_plastic_strain(&self) -> &[f64];
 }
 
-/// The frequency bound of kernel element `critical` as the model names it.
-pub(super) fn bound_of(layout: &Layout, work: &StepWork) -> FrequencyBound {
+/// The stable step of a step's sums, its element as the model names it.
+pub(super) fn stable_step_of(layout: &Layout, work: &StepWork) -> StableStep {
     let (body, element) = layout
         .origin
         .get(work.critical_element)
         .copied()
         .unwrap_or((0, 0));
-    FrequencyBound {
-        omega_squared: work.omega_squared,
-        body,
-        element,
+    StableStep::of_frequency(work.omega_squared, body, element)
+}
+
+/// The element loop of a central-difference run: the one-point kernel (`reduced`), the 2x2
+/// rate-form kernel on finite-strain Quad4 models, or none (rods, small strain: the general
+/// assembly); and whether the kernel keeps state that `State` does not.
+pub fn kernel_for(
+    model: &Model,
+    spec: &DynamicSpec,
+    state: &State,
+    masses: &ElementMasses,
+) -> (Option<Box<dyn ExplicitKernel>>, bool) {
+    let quads_only = model
+        .bodies
+        .iter()
+        .all(|b| matches!(b.kind, BodyKind::Continuum { .. }));
+    match spec.quadrature {
+        Quadrature::Reduced => (
+            Some(Box::new(Reduced::new(model, state, spec.hourglass, masses))),
+            true,
+        ),
+        Quadrature::Full if quads_only && spec.geometry == Strain::Finite => {
+            (Some(Box::new(Full::new(model, state, masses))), false)
+        }
+        Quadrature::Full => (None, false),
     }
 }

@@ -13,8 +13,8 @@
 //! the chunk sums of the work are added in chunk order. The bits do not depend on the thread
 //! count.
 
-use super::{BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, bound_of};
-use crate::assembly::{ElementFailure, ElementMasses, FrequencyBound, State};
+use super::{BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, stable_step_of};
+use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
 use crate::material::{
@@ -365,7 +365,7 @@ impl ExplicitKernel for Reduced {
         Ok(())
     }
 
-    fn frequency_bound(&self, x: &[[f64; 2]]) -> Result<FrequencyBound, ElementFailure> {
+    fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure> {
         let mut worst = StepWork::default();
         for e in 0..self.elements() {
             let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
@@ -385,7 +385,7 @@ impl ExplicitKernel for Reduced {
             );
             worst.observe(omega_squared, e);
         }
-        Ok(bound_of(&self.layout, &worst))
+        Ok(stable_step_of(&self.layout, &worst))
     }
 
     fn step(
