@@ -403,11 +403,11 @@ fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
         outln!("  {line}");
     }
     if model.bodies.iter().all(|b| b.material.density > 0.0) {
-        let analysis::stable::StableStep {
+        let analysis::steppers::stable::StableStep {
             dt: dt_crit,
             body: b,
             element: e,
-        } = analysis::stable::critical_time_step(&model)?;
+        } = analysis::steppers::stable::critical_time_step(&model)?;
         outln!(
             "  central-difference stability limit: dt_crit = {} (element eigenvalue bound; body `{}`, element {e})",
             readable(dt_crit),
@@ -440,9 +440,9 @@ fn buckle(
     }
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
     analysis::create_output_folder(&dir)?;
-    let found = analysis::buckling::linear_modes(&model, count)
+    let found = analysis::run::buckling::linear_modes(&model, count)
         .map_err(|e| InputError::new(path, format!("linearized buckling: {e}")))?;
-    analysis::buckling::write_modes(&model, &found, &dir)?;
+    analysis::run::buckling::write_modes(&model, &found, &dir)?;
     outln!(
         "{}: linearized buckling of the loads at t = {} ({} free DOFs)",
         model.name,

@@ -46,7 +46,7 @@ fn code(path: &Path) -> String {
         .join("\n")
 }
 
-/// The top-level module of a file under src/ (`analysis` for src/analysis/run.rs).
+/// The top-level module of a file under src/ (`analysis` for src/analysis/run/mod.rs).
 fn module_of(path: &Path) -> String {
     let rel = path.strip_prefix("src").unwrap();
     let first = rel
@@ -199,4 +199,71 @@ fn find_cycles(
     }
     path.pop();
     finished.insert(node.clone());
+}
+
+/// Goal: the analyses' rooms stand on each other one way: the summary (summary.json, the
+/// status, the errors) on the ground, the steppers on it, the set-up checks (`check`,
+/// `plausibility`) on those, the run scaffold above them, the entry (analysis/mod.rs) on
+/// top; no stepper knows the scaffold that drives it. Setup: every file of src/analysis.
+/// Reference: that order; a file may name only rooms below its own (its own room too).
+#[test]
+fn the_analysis_rooms_are_layered() {
+    let room = |path: &Path| -> usize {
+        let rel = path.strip_prefix("src/analysis").unwrap();
+        let first = rel
+            .components()
+            .next()
+            .unwrap()
+            .as_os_str()
+            .to_string_lossy();
+        match first.trim_end_matches(".rs") {
+            "summary" => 0,
+            "steppers" => 1,
+            "check" | "plausibility" => 2,
+            "run" => 3,
+            "mod" => 4,
+            other => panic!("src/analysis/{other} is in no room of this test"),
+        }
+    };
+    let named = |code: &str, path: &Path| -> BTreeSet<usize> {
+        let mut out = BTreeSet::new();
+        for (name, level) in [
+            ("summary", 0),
+            ("steppers", 1),
+            ("check", 2),
+            ("plausibility", 2),
+            ("run", 3),
+        ] {
+            let absolute = format!("crate::analysis::{name}");
+            // `super::NAME` from a file directly under src/analysis or a folder's mod.rs,
+            // `super::super::NAME` from another file of a folder
+            let below = path.components().count() - 3;
+            let depth = if path.file_stem().is_some_and(|s| s == "mod") {
+                below.saturating_sub(1)
+            } else {
+                below
+            };
+            let relative = format!("{}{name}", "super::".repeat(depth + 1));
+            let top_mod = path == Path::new("src/analysis/mod.rs");
+            if code.contains(&absolute) || (!top_mod && code.contains(&relative)) {
+                out.insert(level);
+            }
+        }
+        out
+    };
+    let mut files = Vec::new();
+    sources(Path::new("src/analysis"), &mut files);
+    let mut violations = Vec::new();
+    for path in &files {
+        let own = room(path);
+        for level in named(&code(path), path) {
+            if level > own {
+                violations.push(format!(
+                    "{} (room {own}) names room {level}",
+                    path.display()
+                ));
+            }
+        }
+    }
+    assert!(violations.is_empty(), "{violations:#?}");
 }

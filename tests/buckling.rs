@@ -9,7 +9,7 @@
 
 mod common;
 
-use impact::analysis::buckling;
+use impact::analysis::run::buckling;
 use impact::reference;
 
 const YOUNG: f64 = 1.2e6;

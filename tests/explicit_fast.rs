@@ -8,14 +8,15 @@ use common::{column, mean};
 
 /// Goal: the micro-benchmark of the reduced kernel (run by hand, no timing assertion):
 /// `cargo test --release -j 1 --test explicit_fast -- --ignored --nocapture`.
-/// Setup: impact::analysis::explicit::kernel_benchmark_run on a 316 x 316 plane-strain J2
+/// Setup: impact::analysis::steppers::explicit::kernel_benchmark_run on a 316 x 316 plane-strain J2
 /// block, 200 steps, 1 and 2 threads.
 #[test]
 #[ignore]
 fn kernel_benchmark_element_updates_per_second() {
     for threads in [1, 2] {
         let run =
-            impact::analysis::explicit::kernel_benchmark_run(316 * 316, 200, threads).unwrap();
+            impact::analysis::steppers::explicit::kernel_benchmark_run(316 * 316, 200, threads)
+                .unwrap();
         println!(
             "threads {threads}: {:.3e} element-updates/s ({:.1} % of the elements plastic)",
             run.element_updates_per_second,
@@ -143,7 +144,7 @@ fn at_fraction_of_critical(
     overrides: &[&str],
 ) -> impact::scene::Model {
     let model = common::model(name, text, overrides);
-    let dt_crit = impact::analysis::stable::critical_time_step(&model)
+    let dt_crit = impact::analysis::steppers::stable::critical_time_step(&model)
         .unwrap()
         .dt;
     let mut all: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();

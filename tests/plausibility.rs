@@ -7,7 +7,7 @@ mod common;
 
 use common::{impact, out_dir, out_dir_of};
 use impact::analysis::plausibility;
-use impact::analysis::record::Energies;
+use impact::analysis::steppers::energies::Energies;
 use impact::analysis::{Status, Summary};
 use impact::scene::Model;
 use std::path::Path;

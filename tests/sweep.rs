@@ -105,7 +105,7 @@ fn two_bars_force_error_converges_with_h_and_dt_together() {
 fn stability_map_central_difference_fails_just_above_dt_crit() {
     let dt_crit = 10.0 / 14.0 / 100.0;
     approx::assert_relative_eq!(
-        impact::analysis::stable::critical_time_step(
+        impact::analysis::steppers::stable::critical_time_step(
             &impact::scene::load(Path::new("models/bar_wall.toml"), &[]).unwrap()
         )
         .unwrap()

@@ -15,7 +15,7 @@
 //!              Wilson-theta: unconditionally stable for theta >= 1.37 only
 //! ```
 
-use super::stable::{
+use super::steppers::stable::{
     StableStep, checked_step, critical_time_step, explicit_first_step, implicit_first_step,
     wave_speed,
 };

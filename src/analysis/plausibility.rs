@@ -14,8 +14,8 @@
 //! ```
 
 use super::Summary;
-use super::record::Energies;
-use super::stable::{explicit_first_step, implicit_first_step, wave_speed};
+use super::steppers::energies::Energies;
+use super::steppers::stable::{explicit_first_step, implicit_first_step, wave_speed};
 use crate::assembly::{self, State};
 use crate::contact::{ContactPair, Master, penetration_limits};
 use crate::element::Formulation;

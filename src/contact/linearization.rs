@@ -12,7 +12,7 @@
 //! on round_bar, where the rows against a rigid wall converge quadratically). Here both
 //! derivatives are formed exactly, by forward-mode dual numbers through the same formulas:
 //! the gradient dg/dx for the linearized constraint and dC/dx for the force's stiffness
-//! tau dC/dx (see `analysis::newton::exact_solve`).
+//! tau dC/dx (see `analysis::steppers::newton::exact_solve`).
 
 use super::geometry::{ContactPair, Gap, Master};
 use nalgebra::{Const, SVector};

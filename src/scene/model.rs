@@ -11,7 +11,7 @@
 use super::spec::{
     BucklingSpec, DynamicSpec, OutputSpec, Quantity, ReferenceKind, StaticSpec, Statistic,
 };
-use crate::contact::{ContactPair, Obstacle};
+use crate::contact::{BodySurface, ContactPair, Interfaces, Obstacle, Section};
 use crate::element::{Formulation, Strain, Voigt};
 use crate::material::{Material, StressCondition};
 use crate::mesh::Mesh;
@@ -299,5 +299,46 @@ impl Model {
     /// Whether some body's material carries a temperature (Johnson-Cook).
     pub fn carries_temperature(&self) -> bool {
         self.bodies.iter().any(|b| b.material.carries_temperature())
+    }
+
+    /// The contact problem of the model as contact sees it: the pairs, and per body its
+    /// section, its plane-wave impedance for the impact and release conditions and its
+    /// boundary (every stepper's contact set-up).
+    pub fn interfaces(&self) -> Interfaces {
+        let bodies = self
+            .bodies
+            .iter()
+            .map(|b| {
+                let section = match b.kind {
+                    BodyKind::Rod { area } => Section::Rod { area },
+                    BodyKind::Continuum {
+                        formulation,
+                        thickness,
+                        ..
+                    } => match formulation {
+                        Formulation::PlaneStrain => Section::Plane { thickness: 1.0 },
+                        Formulation::PlaneStress => Section::Plane { thickness },
+                        Formulation::Axisymmetric => Section::Axisymmetric,
+                    },
+                };
+                BodySurface {
+                    section,
+                    impedance_per_area: (b.p_wave_modulus() * b.material.density).sqrt(),
+                    boundary_at_node: b
+                        .boundary_at_node
+                        .iter()
+                        .map(|edges| edges.iter().map(|e| e.map(|n| b.global(n))).collect())
+                        .collect(),
+                    boundary: (b.mesh.boundary_edges().iter())
+                        .map(|e| e.map(|n| b.global(n)))
+                        .collect(),
+                    node_offset: b.node_offset,
+                }
+            })
+            .collect();
+        Interfaces {
+            pairs: self.contacts.clone(),
+            bodies,
+        }
     }
 }

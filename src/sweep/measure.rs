@@ -19,7 +19,7 @@
 //! force_l2_smooth shows the order of the scheme away from the jumps (docs/validation.md 6).
 
 use super::plan::{Case, Plan};
-use crate::analysis::stable::critical_time_step;
+use crate::analysis::steppers::stable::critical_time_step;
 use crate::mesh::Cells;
 use crate::scene::model::{Analysis, Reference};
 use crate::scene::spec::ReferenceKind;

@@ -1,7 +1,9 @@
 //! What a run writes: VTK frames (every `frame_every` steps, and the last), one history.csv
 //! row per converged step, summary.json at the end (also after a failure).
 
-use super::Summary;
+use crate::analysis::steppers::energies::{Energies, Motion};
+use crate::analysis::steppers::loads;
+use crate::analysis::summary::Summary;
 use crate::assembly::State;
 use crate::contact::ContactState;
 use crate::contact::Friction;
@@ -14,27 +16,6 @@ use crate::scene::Model;
 use crate::scene::spec::{FramePoints, Quantity, Statistic};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-
-/// Energies of one step (history.csv columns 2-6).
-#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
-pub struct Energies {
-    pub kinetic: f64,
-    pub internal: f64,
-    pub plastic_work: f64,
-    pub external_work: f64,
-    pub contact_work: f64,
-}
-
-/// Nodal kinematic fields beyond the displacement (zero in statics).
-pub struct Motion<'a> {
-    pub velocity: &'a [f64],
-    pub acceleration: &'a [f64],
-    /// Lumped mass per DOF (for the momentum probes); empty in statics.
-    pub mass: &'a [f64],
-    /// The internal force of the committed state, all DOFs (for the reaction probes): the
-    /// one the step converged with, so the reactions balance the loads as the solution does.
-    pub internal_force: &'a [f64],
-}
 
 pub struct Recorder {
     dir: PathBuf,
@@ -638,7 +619,7 @@ fn is_reaction(quantity: Quantity) -> bool {
 /// Rayleigh damping are not part of it.
 fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
     let mut external = vec![0.0; model.dofs()];
-    super::loads::add_external_force(
+    loads::add_external_force(
         model,
         state,
         &model.coordinates(),

@@ -18,87 +18,75 @@
 //! finish: summary.json, the outcome
 //! ```
 
-use super::buckling::{self, Monitor};
-use super::checkpoint::{self, Carry, Checkpoint};
-use super::newton::Counters;
-use super::progress::Progress;
-use super::record::{Energies, Motion, Recorder};
-use super::{DtLimit, Outcome, RunError, RunOptions, Status, StepError, Summary};
+pub mod buckling;
+pub mod checkpoint;
+pub mod progress;
+pub mod record;
+
+use super::plausibility;
+use super::steppers::Stepper;
+use super::steppers::energies::balance_error;
+use super::steppers::newton::Counters;
+use super::summary::{DtLimit, RunError, Status, StepError, Summary};
 use crate::assembly::State;
-use crate::contact::ContactState;
 use crate::output::readable;
 use crate::profile::{self, Phase};
 use crate::scene::{InputError, Model};
-use crate::solver::Solver;
+use buckling::Monitor;
+use checkpoint::Checkpoint;
+use progress::Progress;
+use record::Recorder;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-/// The steps a central-difference run took and what limits them at the end.
-#[derive(Debug, Clone)]
-pub struct TimeStepReport {
-    /// The shortest and the longest step the step rule set (`Clock::range`: steps clipped to
-    /// a frame time or the end time are not counted).
-    pub shortest: f64,
-    pub longest: f64,
-    pub limit: DtLimit,
+/// Options of a run that are not part of the scene.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions {
+    /// How the run shows its progress (a bar, plain lines, nothing).
+    pub progress: progress::Mode,
+    /// Set (by a signal handler) to stop the run after the step in progress.
+    pub interrupt: Option<&'static AtomicBool>,
+    /// For tests: stop dead after this many converged steps, writing nothing more (as a
+    /// SIGKILL would), returning `RunError::Interrupted`.
+    pub halt_after_steps: Option<usize>,
+    /// Write no VTK frames, whatever the scene asks (`impact sweep` without `--frames`); the
+    /// frame times still end steps, so the numbers are those of `impact run`.
+    pub no_frames: bool,
 }
 
-/// One kind of analysis: it advances the state and says what it holds; the scaffold
-/// records, checkpoints and ends the run.
-pub trait Stepper {
-    /// The integrator's name in summary.json.
-    fn integrator(&self) -> String;
-    /// The nominal step and the end time.
-    fn dt(&self) -> f64;
-    fn end_time(&self) -> f64;
-    fn free_dofs(&self) -> usize;
-    /// Whether the run carries the buckling check of `[analysis.buckling]`.
-    fn checks_buckling(&self) -> bool;
-    /// What the stepper computes at t = 0 before the first row (a numerical failure here
-    /// ends the run `diverged` with the message).
-    fn start(&mut self) -> Result<(), String>;
-    /// Takes over the carry of a checkpoint; false when it is another analysis' carry.
-    fn restore(&mut self, carry: Carry, checkpoint: &Checkpoint) -> bool;
-    /// What a checkpoint stores of the stepper; None when it writes none, with the reason.
-    fn carry(&self) -> Result<Carry, &'static str>;
-    /// The analysis' name in the message of a wrong carry.
-    fn kind(&self) -> &'static str;
-    /// Called after a checkpoint is written (the step after it factors afresh, as the
-    /// resumed run must).
-    fn after_checkpoint(&mut self) {}
-    fn done(&self) -> bool;
-    /// One converged step, cutting and retrying inside as the analysis allows.
-    fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError>;
-    /// A judgement of the step just counted (explicit: the energy has not blown up).
-    fn verdict(&self) -> Result<(), StepError> {
+impl RunOptions {
+    fn interrupted(&self) -> bool {
+        self.interrupt.is_some_and(|f| f.load(Ordering::SeqCst))
+    }
+
+    /// The test hook `halt_after_steps`: the error to return after `steps` steps.
+    fn halt(&self, summary: &Summary) -> Result<(), RunError> {
+        if self.halt_after_steps == Some(summary.steps) {
+            return Err(RunError::Interrupted {
+                message: format!("halted after {} steps (test hook)", summary.steps),
+                summary: Box::new(summary.clone()),
+            });
+        }
         Ok(())
     }
-    fn state(&self) -> &State;
-    fn motion(&self) -> Motion<'_>;
-    fn energies(&self) -> &Energies;
-    /// The kinetic energy at t = 0: summary.json `energy.initial` and the drift's reference.
-    fn initial_kinetic(&self) -> f64;
-    fn contact(&self) -> &ContactState;
-    fn solver(&self) -> Option<&Solver>;
-    fn solver_mut(&mut self) -> Option<&mut Solver>;
-    /// Makes the state's material points current before output reads them (the one-point
-    /// kernel keeps its own arrays).
-    fn sync_points(&mut self) {}
-    /// The accumulated hourglass work, for the history column of the one-point kernel.
-    fn hourglass_energy(&self) -> Option<f64> {
-        None
-    }
-    /// The local error estimates of the implicit steps (None: no estimate).
-    fn error_watch(&self) -> Option<super::ErrorWatch> {
-        None
-    }
-    /// The length of the last step (0 before the first).
-    fn last_step(&self) -> f64;
-    /// What the time step did (central difference): summary.json `dt_min`, `dt_max`,
-    /// `dt_limit`.
-    fn time_step_report(&self) -> Option<TimeStepReport> {
-        None
-    }
+}
+
+/// What a run leaves besides its files: the summary, the final committed state and the
+/// final nodal contact forces (all DOFs; zero without contact).
+pub struct Outcome {
+    pub summary: Summary,
+    pub state: State,
+    pub contact_force: Vec<f64>,
+}
+
+/// What the run does after a step that went well.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Next {
+    Continue,
+    /// The buckling check asked to stop (`on_critical = "stop"`): the run ends here, its
+    /// output complete.
+    Stop,
 }
 
 /// A run in progress: the stepper and its bookkeeping.
@@ -127,8 +115,8 @@ pub fn execute<S: Stepper>(
     let mut run = Run::open(model, dir, options, resume, stepper, start)?;
     profile::add(Phase::Setup, start);
     while !run.stepper.done() {
-        if let Some(end) = run.step()? {
-            return end;
+        if run.step()? == Next::Stop {
+            break;
         }
     }
     run.finish()
@@ -216,7 +204,7 @@ impl<'a, S: Stepper> Run<'a, S> {
 
     /// Takes a checkpoint's bookkeeping and the stepper's carry.
     fn restore(&mut self, checkpoint: Checkpoint, dir: &Path) -> Result<(), RunError> {
-        if !self.stepper.restore(checkpoint.carry.clone(), &checkpoint) {
+        if !self.stepper.restore(checkpoint.carry.clone()) {
             return Err(RunError::Input(InputError::new(
                 &checkpoint::path(dir),
                 format!(
@@ -238,13 +226,13 @@ impl<'a, S: Stepper> Run<'a, S> {
         Ok(())
     }
 
-    /// One step and its bookkeeping; Some(result) when the run ends here.
-    fn step(&mut self) -> Result<Option<Result<Outcome, RunError>>, RunError> {
+    /// One step and its bookkeeping, and whether the run goes on.
+    fn step(&mut self) -> Result<Next, RunError> {
         if let Err(e) = self.stepper.advance(&mut self.counters) {
             return Err(self.fail_step(e));
         }
         self.summary.steps += 1;
-        let drift = super::balance_error(self.stepper.energies(), self.stepper.initial_kinetic());
+        let drift = balance_error(self.stepper.energies(), self.stepper.initial_kinetic());
         self.summary.energy.max_relative_drift = self.summary.energy.max_relative_drift.max(drift);
         if let Err(e) = self.stepper.verdict() {
             return Err(self.fail_step(e));
@@ -288,7 +276,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         self.progress.update(time, self.summary.steps);
         if stop {
             self.summary.message = Some(stop_message(time, &self.recorder));
-            return Ok(Some(self.finish_early()));
+            return Ok(Next::Stop);
         }
         let interrupted = !last && self.options.interrupted();
         if interrupted {
@@ -310,7 +298,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         if interrupted {
             return Err(self.interrupted(time));
         }
-        Ok(None)
+        Ok(Next::Continue)
     }
 
     /// The buckling check of the committed state: whether the run must stop here.
@@ -411,19 +399,19 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Some(report) = s.time_step_report() {
             summary.dt_min = Some(report.shortest);
             summary.dt_max = Some(report.longest);
-            summary.dt_limit = Some(report.limit);
+            summary.dt_limit = Some(DtLimit::of(report.limit, self.model));
         }
-        summary.max_temperature = super::record::max_temperature(self.model, s.state());
-        summary.warnings = super::plausibility::warnings(self.model, summary, &energies);
+        summary.max_temperature = record::max_temperature(self.model, s.state());
+        summary.warnings = plausibility::warnings(self.model, summary, &energies);
         let positions = s.state().positions(self.model.analysis.geometry());
-        let end = super::plausibility::EndOfRun {
+        let end = plausibility::EndOfRun {
             positions: &positions,
             energies: &energies,
             hourglass_energy: s.hourglass_energy(),
         };
         summary
             .warnings
-            .extend(super::plausibility::final_warnings(self.model, &end));
+            .extend(plausibility::final_warnings(self.model, &end));
     }
 
     /// A failed step: its frame when asked, then `fail`.
@@ -486,12 +474,6 @@ impl<'a, S: Stepper> Run<'a, S> {
     }
 
     /// A run stopped before its end time on purpose (the buckling check's `stop`).
-    fn finish_early(&mut self) -> Result<Outcome, RunError> {
-        self.progress
-            .finish(self.stepper.state().time, self.summary.steps);
-        self.end()
-    }
-
     fn finish(mut self) -> Result<Outcome, RunError> {
         self.progress
             .finish(self.stepper.state().time, self.summary.steps);

@@ -13,12 +13,10 @@
 //! not stored: the step after a checkpoint refactors K* in the run that wrote it and in the
 //! resumed one alike, so both take the same path (one extra factorization per checkpoint).
 
-use super::newton::Counters;
-use super::record::{Energies, RecorderPosition};
-use super::{StepControl, Summary};
-use crate::assembly::State;
-use crate::contact::ContactState;
-use crate::integrator::{MethodHistory, MotionState};
+use super::record::RecorderPosition;
+use crate::analysis::steppers::carry::Carry;
+use crate::analysis::steppers::newton::Counters;
+use crate::analysis::summary::{BucklingSummary, Summary};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::{InputError, SceneSource};
 use serde::{Deserialize, Serialize};
@@ -48,60 +46,8 @@ pub struct Checkpoint {
     pub back_substitutions: usize,
     pub wall_seconds: f64,
     pub recorder: RecorderPosition,
-    pub buckling: Option<super::BucklingSummary>,
+    pub buckling: Option<BucklingSummary>,
     pub carry: Carry,
-}
-
-/// What each driver's loop carries from step to step.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub enum Carry {
-    Static(StaticCarry),
-    Dynamic(DynamicCarry),
-    Explicit(ExplicitCarry),
-}
-
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct StaticCarry {
-    pub state: State,
-    pub energies: Energies,
-    pub last_force: Vec<f64>,
-    pub control: StepControl,
-    pub increments: usize,
-    pub contact: ContactState,
-}
-
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct DynamicCarry {
-    pub state: State,
-    pub kinematics: MotionState,
-    pub method: MethodHistory,
-    pub energies: Energies,
-    pub initial_kinetic: f64,
-    pub last_total: Vec<f64>,
-    pub last_internal: Vec<f64>,
-    pub last_contact: Vec<f64>,
-    pub control: StepControl,
-    pub increments: usize,
-    pub contact: ContactState,
-    /// The last step's mean velocity, the next step's predictor (None before the first).
-    pub mean_velocity: Option<Vec<f64>>,
-    /// The local error estimates so far (the top speed, the last and largest estimate).
-    pub watch: super::ErrorWatch,
-}
-
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct ExplicitCarry {
-    pub state: State,
-    pub velocity: Vec<f64>,
-    pub acceleration: Vec<f64>,
-    pub energies: Energies,
-    pub initial_kinetic: f64,
-    pub last_total: Vec<f64>,
-    pub energy_reference: f64,
-    /// The last step taken (the loop goes on with step + 1).
-    pub step: usize,
-    pub contact: ContactState,
-    pub clock: super::clock::Clock,
 }
 
 pub fn path(dir: &Path) -> PathBuf {

@@ -12,21 +12,19 @@
 //! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
-use super::StepError;
-use super::checkpoint::{Carry, Checkpoint, ExplicitCarry};
+use super::carry::{Carry, ExplicitCarry};
 use super::clock::Clock;
+use super::energies::{Energies, Motion};
 use super::newton::Counters;
-use super::record::{Energies, Motion};
-use super::run::{Stepper, TimeStepReport};
 use super::stable::{checked_step, explicit_clock};
-use super::{DtLimit, RunError, Status, loads};
+use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
+use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, StepWork, kernel_for};
 use crate::assembly::{self, ElementMasses, Mass, StableStep, State, System, check_mass};
 use crate::contact::{ContactState, Interfaces};
 use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, MassKind};
 use crate::scene::{InputError, Model};
-use crate::solver::Solver;
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
@@ -95,7 +93,7 @@ impl<'a> Explicit<'a> {
         Ok(Explicit {
             model,
             spec,
-            interfaces: super::interfaces(model),
+            interfaces: model.interfaces(),
             initial: model.coordinates(),
             free,
             mass: m,
@@ -194,25 +192,6 @@ impl<'a> Explicit<'a> {
 }
 
 impl Stepper for Explicit<'_> {
-    fn integrator(&self) -> String {
-        "central_difference".into()
-    }
-    fn dt(&self) -> f64 {
-        self.clock.dt0
-    }
-    fn end_time(&self) -> f64 {
-        self.spec.end_time
-    }
-    fn free_dofs(&self) -> usize {
-        self.free.iter().filter(|f| **f).count()
-    }
-    fn checks_buckling(&self) -> bool {
-        false
-    }
-    fn kind(&self) -> &'static str {
-        "explicit"
-    }
-
     fn start(&mut self) -> Result<(), String> {
         let model = self.model;
         let zero = vec![0.0; model.dofs()];
@@ -263,53 +242,6 @@ impl Stepper for Explicit<'_> {
         );
         self.energy_reference = self.initial_kinetic;
         Ok(())
-    }
-
-    fn restore(&mut self, carry: Carry, _: &Checkpoint) -> bool {
-        let Carry::Explicit(carry) = carry else {
-            return false;
-        };
-        self.state = carry.state;
-        self.v = carry.velocity;
-        self.a = carry.acceleration;
-        self.energies = carry.energies;
-        self.initial_kinetic = carry.initial_kinetic;
-        self.last_total = carry.last_total;
-        self.energy_reference = carry.energy_reference;
-        self.contact = carry.contact;
-        self.step = carry.step;
-        self.clock = carry.clock;
-        // a kernel with its own arrays starts again from the restored points
-        if self.kernel.is_some() {
-            (self.kernel, self.kernel_has_own_state) =
-                kernel_for(self.model, self.spec, &self.state, &self.masses);
-        }
-        true
-    }
-
-    fn carry(&self) -> Result<Carry, &'static str> {
-        if self.kernel_has_own_state {
-            // its hourglass forces are not in `State`; the scene refuses checkpoint_every
-            return Err(
-                "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
-            );
-        }
-        let mut state = self.state.clone();
-        if let Some(kernel) = &self.kernel {
-            kernel.write_points(self.model, &mut state);
-        }
-        Ok(Carry::Explicit(ExplicitCarry {
-            state,
-            velocity: self.v.clone(),
-            acceleration: self.a.clone(),
-            energies: self.energies,
-            initial_kinetic: self.initial_kinetic,
-            last_total: self.last_total.clone(),
-            energy_reference: self.energy_reference,
-            step: self.step,
-            contact: self.contact.clone(),
-            clock: self.clock.clone(),
-        }))
     }
 
     fn done(&self) -> bool {
@@ -396,6 +328,32 @@ impl Stepper for Explicit<'_> {
         }
         Ok(())
     }
+    fn sync_points(&mut self) {
+        if let Some(kernel) = &self.kernel
+            && !self.synced
+        {
+            kernel.write_points(self.model, &mut self.state);
+            self.synced = true;
+        }
+    }
+}
+
+impl Report for Explicit<'_> {
+    fn integrator(&self) -> String {
+        "central_difference".into()
+    }
+    fn dt(&self) -> f64 {
+        self.clock.dt0
+    }
+    fn end_time(&self) -> f64 {
+        self.spec.end_time
+    }
+    fn free_dofs(&self) -> usize {
+        self.free.iter().filter(|f| **f).count()
+    }
+    fn checks_buckling(&self) -> bool {
+        false
+    }
 
     fn state(&self) -> &State {
         &self.state
@@ -417,20 +375,6 @@ impl Stepper for Explicit<'_> {
     fn contact(&self) -> &ContactState {
         &self.contact
     }
-    fn solver(&self) -> Option<&Solver> {
-        None
-    }
-    fn solver_mut(&mut self) -> Option<&mut Solver> {
-        None
-    }
-    fn sync_points(&mut self) {
-        if let Some(kernel) = &self.kernel
-            && !self.synced
-        {
-            kernel.write_points(self.model, &mut self.state);
-            self.synced = true;
-        }
-    }
     fn hourglass_energy(&self) -> Option<f64> {
         self.kernel.as_ref().and_then(|k| k.hourglass_energy())
     }
@@ -443,8 +387,61 @@ impl Stepper for Explicit<'_> {
         Some(TimeStepReport {
             shortest: range.shortest,
             longest: range.longest,
-            limit: DtLimit::of(c.limit, self.model),
+            limit: c.limit,
         })
+    }
+}
+
+impl Resume for Explicit<'_> {
+    fn kind(&self) -> &'static str {
+        "explicit"
+    }
+
+    fn restore(&mut self, carry: Carry) -> bool {
+        let Carry::Explicit(carry) = carry else {
+            return false;
+        };
+        self.state = carry.state;
+        self.v = carry.velocity;
+        self.a = carry.acceleration;
+        self.energies = carry.energies;
+        self.initial_kinetic = carry.initial_kinetic;
+        self.last_total = carry.last_total;
+        self.energy_reference = carry.energy_reference;
+        self.contact = carry.contact;
+        self.step = carry.step;
+        self.clock = carry.clock;
+        // a kernel with its own arrays starts again from the restored points
+        if self.kernel.is_some() {
+            (self.kernel, self.kernel_has_own_state) =
+                kernel_for(self.model, self.spec, &self.state, &self.masses);
+        }
+        true
+    }
+
+    fn carry(&self) -> Result<Carry, &'static str> {
+        if self.kernel_has_own_state {
+            // its hourglass forces are not in `State`; the scene refuses checkpoint_every
+            return Err(
+                "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
+            );
+        }
+        let mut state = self.state.clone();
+        if let Some(kernel) = &self.kernel {
+            kernel.write_points(self.model, &mut state);
+        }
+        Ok(Carry::Explicit(ExplicitCarry {
+            state,
+            velocity: self.v.clone(),
+            acceleration: self.a.clone(),
+            energies: self.energies,
+            initial_kinetic: self.initial_kinetic,
+            last_total: self.last_total.clone(),
+            energy_reference: self.energy_reference,
+            step: self.step,
+            contact: self.contact.clone(),
+            clock: self.clock.clone(),
+        }))
     }
 }
 

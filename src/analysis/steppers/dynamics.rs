@@ -14,12 +14,12 @@
 //! times in a row); a slave that touches its master at the start of a step closes with the
 //! impact conditions, and the step is split at the first contact event inside it.
 
-use super::StepError;
-use super::checkpoint::{Carry, Checkpoint, DynamicCarry};
+use super::carry::{Carry, DynamicCarry};
+use super::control::{ErrorWatch, StepControl, snap, step_length};
+use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
-use super::record::{Energies, Motion};
-use super::run::Stepper;
-use super::{ErrorWatch, StepControl, loads};
+use super::{Report, Resume, StepError, Stepper, loads};
+use crate::analysis::summary::RunError;
 use crate::assembly::{self, Mass, State, System, check_mass};
 use crate::contact::{ContactResult, ContactState, Interfaces, Tangential};
 use crate::integrator::{
@@ -135,12 +135,12 @@ impl<'a> Dynamics<'a> {
         model: &'a Model,
         spec: &'a DynamicSpec,
         dir: &Path,
-    ) -> Result<Dynamics<'a>, super::RunError> {
+    ) -> Result<Dynamics<'a>, RunError> {
         let system = System::new(model, &model.constrained_dofs());
         let mut mass =
             Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
         check_mass(model, &mass, &system)?;
-        let mut interfaces = super::interfaces(model);
+        let mut interfaces = model.interfaces();
         if spec.contact_dynamics != ContactDynamics::Hughes {
             // no velocity jumps; a pair releases when its multiplier turns to tension
             for pair in &mut interfaces.pairs {
@@ -153,7 +153,7 @@ impl<'a> Dynamics<'a> {
         if spec.contact_dynamics == ContactDynamics::MassRedistribution {
             mass = mass.redistributed(model, &contact_nodes(model));
         }
-        let solver = Solver::new(&system.pattern).map_err(|e| super::setup_error(dir, e))?;
+        let solver = Solver::new(&system.pattern).map_err(|e| RunError::setup(dir, e))?;
         let n = model.dofs();
         let nominal = super::stable::implicit_first_step(model, spec)?;
         let method = integrator(spec);
@@ -275,9 +275,9 @@ impl<'a> Dynamics<'a> {
         } else if self.adaptive.is_some() {
             end
         } else {
-            super::snap(end, dt)
+            snap(end, dt)
         };
-        (target, super::step_length(target - time, dt))
+        (target, step_length(target - time, dt))
     }
 
     /// One attempt at the step of nominal length `nominal` (shortened at a contact event).
@@ -639,25 +639,6 @@ impl Attempt<'_> {
 }
 
 impl Stepper for Dynamics<'_> {
-    fn integrator(&self) -> String {
-        self.method.name()
-    }
-    fn dt(&self) -> f64 {
-        self.nominal
-    }
-    fn end_time(&self) -> f64 {
-        self.spec.end_time
-    }
-    fn free_dofs(&self) -> usize {
-        self.system.free
-    }
-    fn checks_buckling(&self) -> bool {
-        true
-    }
-    fn kind(&self) -> &'static str {
-        "implicit dynamic"
-    }
-
     fn start(&mut self) -> Result<(), String> {
         let free: Vec<bool> = self.system.equation.iter().map(Option::is_some).collect();
         let velocity = super::initial_velocity(self.model, &free, self.nominal);
@@ -672,48 +653,6 @@ impl Stepper for Dynamics<'_> {
         self.watch.speed = self.top_speed(&self.kin.velocity);
         self.last_total = self.total_force(&self.last_internal.clone());
         Ok(())
-    }
-
-    fn restore(&mut self, carry: Carry, _: &Checkpoint) -> bool {
-        let Carry::Dynamic(carry) = carry else {
-            return false;
-        };
-        self.state = carry.state;
-        self.kin = carry.kinematics;
-        self.method.restore(carry.method);
-        self.energies = carry.energies;
-        self.initial_kinetic = carry.initial_kinetic;
-        self.last_total = carry.last_total;
-        self.last_internal = carry.last_internal;
-        self.last_contact = carry.last_contact;
-        self.control = carry.control;
-        self.increments = carry.increments;
-        self.contact = carry.contact;
-        self.mean_velocity = carry.mean_velocity;
-        self.watch = carry.watch;
-        true
-    }
-
-    fn carry(&self) -> Result<Carry, &'static str> {
-        Ok(Carry::Dynamic(DynamicCarry {
-            state: self.state.clone(),
-            kinematics: self.kin.clone(),
-            method: self.method.history(),
-            energies: self.energies,
-            initial_kinetic: self.initial_kinetic,
-            last_total: self.last_total.clone(),
-            last_internal: self.last_internal.clone(),
-            last_contact: self.last_contact.clone(),
-            control: self.control.clone(),
-            increments: self.increments,
-            contact: self.contact.clone(),
-            mean_velocity: self.mean_velocity.clone(),
-            watch: self.watch,
-        }))
-    }
-
-    fn after_checkpoint(&mut self) {
-        self.factored_for = None;
     }
 
     fn done(&self) -> bool {
@@ -770,6 +709,24 @@ impl Stepper for Dynamics<'_> {
             }
         }
     }
+}
+
+impl Report for Dynamics<'_> {
+    fn integrator(&self) -> String {
+        self.method.name()
+    }
+    fn dt(&self) -> f64 {
+        self.nominal
+    }
+    fn end_time(&self) -> f64 {
+        self.spec.end_time
+    }
+    fn free_dofs(&self) -> usize {
+        self.system.free
+    }
+    fn checks_buckling(&self) -> bool {
+        true
+    }
 
     fn state(&self) -> &State {
         &self.state
@@ -794,14 +751,62 @@ impl Stepper for Dynamics<'_> {
     fn solver(&self) -> Option<&Solver> {
         Some(&self.solver)
     }
-    fn solver_mut(&mut self) -> Option<&mut Solver> {
-        Some(&mut self.solver)
-    }
     fn last_step(&self) -> f64 {
         self.last_step
     }
     fn error_watch(&self) -> Option<ErrorWatch> {
         self.error_constant.map(|_| self.watch)
+    }
+}
+
+impl Resume for Dynamics<'_> {
+    fn kind(&self) -> &'static str {
+        "implicit dynamic"
+    }
+
+    fn restore(&mut self, carry: Carry) -> bool {
+        let Carry::Dynamic(carry) = carry else {
+            return false;
+        };
+        self.state = carry.state;
+        self.kin = carry.kinematics;
+        self.method.restore(carry.method);
+        self.energies = carry.energies;
+        self.initial_kinetic = carry.initial_kinetic;
+        self.last_total = carry.last_total;
+        self.last_internal = carry.last_internal;
+        self.last_contact = carry.last_contact;
+        self.control = carry.control;
+        self.increments = carry.increments;
+        self.contact = carry.contact;
+        self.mean_velocity = carry.mean_velocity;
+        self.watch = carry.watch;
+        true
+    }
+
+    fn carry(&self) -> Result<Carry, &'static str> {
+        Ok(Carry::Dynamic(DynamicCarry {
+            state: self.state.clone(),
+            kinematics: self.kin.clone(),
+            method: self.method.history(),
+            energies: self.energies,
+            initial_kinetic: self.initial_kinetic,
+            last_total: self.last_total.clone(),
+            last_internal: self.last_internal.clone(),
+            last_contact: self.last_contact.clone(),
+            control: self.control.clone(),
+            increments: self.increments,
+            contact: self.contact.clone(),
+            mean_velocity: self.mean_velocity.clone(),
+            watch: self.watch,
+        }))
+    }
+
+    fn after_checkpoint(&mut self) {
+        self.factored_for = None;
+    }
+    fn solver_mut(&mut self) -> Option<&mut Solver> {
+        Some(&mut self.solver)
     }
 }
 

@@ -17,8 +17,8 @@
 //! The shortest and the longest step (summary.json `dt_min`, `dt_max`) are over the steps
 //! the rule set: a clipped step says where a frame or the end fell, not what the mesh needed.
 
-use super::Status;
-use super::StepError;
+use super::control::{snap, step_length};
+use crate::analysis::summary::{Status, StepError};
 use crate::assembly::StableStep;
 use crate::output::readable;
 use crate::scene::Model;
@@ -129,8 +129,8 @@ impl Clock {
                         frame: true,
                     });
                 }
-                let end = super::snap(step as f64 * dt, dt).min(spec.end_time);
-                let length = super::step_length(end - time, dt);
+                let end = snap(step as f64 * dt, dt).min(spec.end_time);
+                let length = step_length(end - time, dt);
                 Ok(Step {
                     end,
                     length,

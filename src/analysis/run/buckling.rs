@@ -12,8 +12,9 @@
 //! Contact constraints are not part of the checked tangent (the check sees the bodies with
 //! their supports and prescribed displacements only).
 
-use super::loads;
 use super::record;
+use crate::analysis::steppers::loads;
+use crate::analysis::summary::BucklingSummary;
 use crate::assembly::{self, State, System};
 use crate::buckling::{self, BucklingError, InertiaCounter, Mode};
 use crate::element::Strain;
@@ -23,7 +24,6 @@ use crate::scene::Model;
 use crate::scene::spec::OnCritical;
 use crate::scene::spec::Tangent;
 use crate::solver::Solver;
-use serde::Serialize;
 use std::path::Path;
 
 /// The prebuckling state (see the legend).
@@ -106,24 +106,6 @@ impl InertiaCheck {
         buckling::assemble_tangent(model, state, &mut self.system)?;
         Ok(self.counter.negative_pivots(&self.system.values)?)
     }
-}
-
-/// summary.json `buckling` (present when the scene has `[analysis.buckling]`).
-#[derive(Debug, Clone, Default, Serialize, serde::Deserialize)]
-pub struct BucklingSummary {
-    /// lambda_1 of the end loads at the prebuckling state (`modes` > 0), else null.
-    pub critical_load_factor: Option<f64>,
-    /// lambda_1 .. lambda_modes, ascending.
-    pub load_factors: Vec<f64>,
-    /// Negative pivots of K_T at the start and after the last converged state (`check`).
-    pub initial_negative_pivots: Option<usize>,
-    pub final_negative_pivots: Option<usize>,
-    /// The first time (load factor in statics with the default ramp) at which the count
-    /// differed from the initial one, and the count then.
-    pub inertia_change_time: Option<f64>,
-    pub negative_pivots_at_change: Option<usize>,
-    /// The run stopped there (`on_critical = "stop"`).
-    pub stopped: bool,
 }
 
 /// The check of a run: set up from `[analysis.buckling]`, fed every committed state.

@@ -11,12 +11,11 @@
 //! event inside an increment ends it early (Erklig 2.1.4: alpha brings the next node exactly
 //! into contact before the boundary conditions change).
 
-use super::StepError;
-use super::checkpoint::{Carry, Checkpoint, StaticCarry};
+use super::carry::{Carry, StaticCarry};
+use super::control::{StepControl, snap};
+use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Step, StepFailure};
-use super::record::{Energies, Motion};
-use super::run::Stepper;
-use super::{StepControl, loads};
+use super::{Report, Resume, StepError, Stepper, loads};
 use crate::assembly::{self, State, System};
 use crate::contact::{ContactState, Interfaces, Tangential};
 use crate::integrator::StepForm;
@@ -70,7 +69,7 @@ impl<'a> Statics<'a> {
         Ok(Statics {
             model,
             spec,
-            interfaces: super::interfaces(model),
+            interfaces: model.interfaces(),
             initial: model.coordinates(),
             form: static_form(model.dofs()),
             zeros: vec![0.0; model.dofs()],
@@ -150,54 +149,8 @@ impl Increment<'_> {
 }
 
 impl Stepper for Statics<'_> {
-    fn integrator(&self) -> String {
-        "static".into()
-    }
-    fn dt(&self) -> f64 {
-        self.dt
-    }
-    fn end_time(&self) -> f64 {
-        self.spec.end_time
-    }
-    fn free_dofs(&self) -> usize {
-        self.system.free
-    }
-    fn checks_buckling(&self) -> bool {
-        true
-    }
     fn start(&mut self) -> Result<(), String> {
         Ok(())
-    }
-    fn kind(&self) -> &'static str {
-        "static"
-    }
-
-    fn restore(&mut self, carry: Carry, _: &Checkpoint) -> bool {
-        let Carry::Static(carry) = carry else {
-            return false;
-        };
-        self.state = carry.state;
-        self.energies = carry.energies;
-        self.last_force = carry.last_force;
-        self.control = carry.control;
-        self.increments = carry.increments;
-        self.contact = carry.contact;
-        true
-    }
-
-    fn carry(&self) -> Result<Carry, &'static str> {
-        Ok(Carry::Static(StaticCarry {
-            state: self.state.clone(),
-            energies: self.energies,
-            last_force: self.last_force.clone(),
-            control: self.control.clone(),
-            increments: self.increments,
-            contact: self.contact.clone(),
-        }))
-    }
-
-    fn after_checkpoint(&mut self) {
-        self.refresh = true;
     }
 
     fn done(&self) -> bool {
@@ -207,7 +160,7 @@ impl Stepper for Statics<'_> {
     fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError> {
         loop {
             let spec = self.spec;
-            let target = super::snap(
+            let target = snap(
                 (self.state.time + self.control.length).min(spec.end_time),
                 self.dt,
             );
@@ -281,6 +234,24 @@ impl Stepper for Statics<'_> {
             }
         }
     }
+}
+
+impl Report for Statics<'_> {
+    fn integrator(&self) -> String {
+        "static".into()
+    }
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+    fn end_time(&self) -> f64 {
+        self.spec.end_time
+    }
+    fn free_dofs(&self) -> usize {
+        self.system.free
+    }
+    fn checks_buckling(&self) -> bool {
+        true
+    }
 
     fn state(&self) -> &State {
         &self.state
@@ -305,10 +276,44 @@ impl Stepper for Statics<'_> {
     fn solver(&self) -> Option<&Solver> {
         Some(&self.solver)
     }
-    fn solver_mut(&mut self) -> Option<&mut Solver> {
-        Some(&mut self.solver)
-    }
     fn last_step(&self) -> f64 {
         self.last_step
+    }
+}
+
+impl Resume for Statics<'_> {
+    fn kind(&self) -> &'static str {
+        "static"
+    }
+
+    fn restore(&mut self, carry: Carry) -> bool {
+        let Carry::Static(carry) = carry else {
+            return false;
+        };
+        self.state = carry.state;
+        self.energies = carry.energies;
+        self.last_force = carry.last_force;
+        self.control = carry.control;
+        self.increments = carry.increments;
+        self.contact = carry.contact;
+        true
+    }
+
+    fn carry(&self) -> Result<Carry, &'static str> {
+        Ok(Carry::Static(StaticCarry {
+            state: self.state.clone(),
+            energies: self.energies,
+            last_force: self.last_force.clone(),
+            control: self.control.clone(),
+            increments: self.increments,
+            contact: self.contact.clone(),
+        }))
+    }
+
+    fn after_checkpoint(&mut self) {
+        self.refresh = true;
+    }
+    fn solver_mut(&mut self) -> Option<&mut Solver> {
+        Some(&mut self.solver)
     }
 }

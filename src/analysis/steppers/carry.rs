@@ -1,0 +1,62 @@
+//! What each stepper carries from step to step, and so what a checkpoint stores of it
+//! (run/checkpoint.rs writes it whole; a resumed stepper takes it back).
+
+use super::clock::Clock;
+use super::control::{ErrorWatch, StepControl};
+use super::energies::Energies;
+use crate::assembly::State;
+use crate::contact::ContactState;
+use crate::integrator::{MethodHistory, MotionState};
+use serde::{Deserialize, Serialize};
+
+/// What each driver's loop carries from step to step.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub enum Carry {
+    Static(StaticCarry),
+    Dynamic(DynamicCarry),
+    Explicit(ExplicitCarry),
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct StaticCarry {
+    pub state: State,
+    pub energies: Energies,
+    pub last_force: Vec<f64>,
+    pub control: StepControl,
+    pub increments: usize,
+    pub contact: ContactState,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DynamicCarry {
+    pub state: State,
+    pub kinematics: MotionState,
+    pub method: MethodHistory,
+    pub energies: Energies,
+    pub initial_kinetic: f64,
+    pub last_total: Vec<f64>,
+    pub last_internal: Vec<f64>,
+    pub last_contact: Vec<f64>,
+    pub control: StepControl,
+    pub increments: usize,
+    pub contact: ContactState,
+    /// The last step's mean velocity, the next step's predictor (None before the first).
+    pub mean_velocity: Option<Vec<f64>>,
+    /// The local error estimates so far (the top speed, the last and largest estimate).
+    pub watch: ErrorWatch,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ExplicitCarry {
+    pub state: State,
+    pub velocity: Vec<f64>,
+    pub acceleration: Vec<f64>,
+    pub energies: Energies,
+    pub initial_kinetic: f64,
+    pub last_total: Vec<f64>,
+    pub energy_reference: f64,
+    /// The last step taken (the loop goes on with step + 1).
+    pub step: usize,
+    pub contact: ContactState,
+    pub clock: Clock,
+}

@@ -1,0 +1,149 @@
+//! The step length of the implicit steppers and what they share of the time line: cuts
+//! after a failed Newton, growth back to the nominal step, the local error watch of
+//! `dt = "auto"`, steps snapped onto multiples of the nominal step.
+
+use super::newton::Counters;
+use crate::output::readable;
+use serde::{Deserialize, Serialize};
+
+/// Rounds a time that is a whole number of nominal steps up to round-off onto that multiple,
+/// so history rows fall on k dt exactly.
+pub(super) fn snap(t: f64, dt: f64) -> f64 {
+    let k = (t / dt).round();
+    if (t - k * dt).abs() <= 1e-9 * dt {
+        k * dt
+    } else {
+        t
+    }
+}
+
+/// The local error of the steps (theory 8.2a): with c the method's error constant,
+/// ```text
+/// e   = c dt^2 (a_{n+1} - a_n)                       (Zienkiewicz & Xie 1991)
+/// eta = max_i |e_i| / (dt V),   V = the run's top nodal speed so far
+/// ```
+/// the error of the step's displacement relative to the distance the fastest node covers in
+/// it. Carried through checkpoints.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
+pub struct ErrorWatch {
+    pub speed: f64,
+    /// The last accepted step's estimate, and the largest of the run.
+    pub last: f64,
+    pub largest: f64,
+}
+
+/// The step length of a driver: halved when a step fails (at most `max_cuts` times in a
+/// row), grown back towards the nominal length after each success.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct StepControl {
+    pub(super) nominal: f64,
+    pub(super) length: f64,
+    cuts_in_a_row: usize,
+    max_cuts: usize,
+}
+
+impl StepControl {
+    pub(super) fn new(nominal: f64, max_cuts: usize) -> StepControl {
+        StepControl {
+            nominal,
+            length: nominal,
+            cuts_in_a_row: 0,
+            max_cuts,
+        }
+    }
+
+    /// A step ending at its target succeeded (`grow`: it was not ended early by an event).
+    pub(super) fn accept(&mut self, grow: bool) {
+        self.cuts_in_a_row = 0;
+        if grow {
+            self.length = (2.0 * self.length).min(self.nominal);
+        }
+    }
+
+    /// An adaptive run's next step: `length` (the nominal too, so the floor of the cuts
+    /// follows it).
+    pub(super) fn propose(&mut self, length: f64) {
+        self.nominal = length;
+        self.length = length;
+    }
+
+    /// A step whose error estimate was too large: take it again with `length`.
+    pub(super) fn retry(&mut self, length: f64) {
+        self.length = length;
+    }
+
+    /// A step of length `attempted` failed: halve it, or say why the run must stop.
+    ///
+    /// Besides `max_cuts` cuts in a row, the length may not fall below the nominal step over
+    /// 2^max_cuts and a tenth (the shortest event split of such a step): cuts and successes
+    /// that alternate would otherwise shrink it without end (to 1e-17 and then 0, which
+    /// Wilson-theta met on a crushed contact tip).
+    pub(super) fn reject(&mut self, attempted: f64, counters: &mut Counters) -> Result<(), String> {
+        if self.cuts_in_a_row >= self.max_cuts {
+            return Err(format!(
+                "did not converge after {} cuts (dt = {})",
+                self.cuts_in_a_row,
+                readable(attempted)
+            ));
+        }
+        let floor = self.shortest();
+        if 0.5 * attempted < floor {
+            return Err(format!(
+                "did not converge: repeated cuts brought the step to {}, and halving it would go below dt / 2^{} / 10 = {}",
+                readable(attempted),
+                self.max_cuts,
+                readable(floor)
+            ));
+        }
+        self.length = 0.5 * attempted;
+        self.cuts_in_a_row += 1;
+        counters.cuts += 1;
+        Ok(())
+    }
+
+    /// The shortest step the control takes: the nominal over 2^max_cuts and a tenth.
+    pub(super) fn shortest(&self) -> f64 {
+        self.nominal * 0.5f64.powi(self.max_cuts as i32) * 0.1
+    }
+
+    pub(super) fn after_cut(&self) -> bool {
+        self.cuts_in_a_row > 0
+    }
+}
+
+/// A step of nominal length up to round-off is given exactly the nominal length, so methods
+/// that keep history (Houbolt) or a factorization of K*(dt) see one dt.
+pub(super) fn step_length(h: f64, dt: f64) -> f64 {
+    if (h - dt).abs() <= 1e-9 * dt { dt } else { h }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Goal: cuts that alternate with successes cannot shrink the step without end (the
+    /// cuts-in-a-row limit never trips then). Reference: the floor dt / 2^max_cuts / 10.
+    #[test]
+    fn alternating_cuts_stop_at_the_floor() {
+        let mut control = StepControl::new(1e-3, 6);
+        let mut counters = Counters::default();
+        let floor = 1e-3 / 64.0 / 10.0;
+        let mut error = None;
+        // two cuts, one success (which doubles back once): the length halves per round
+        for _ in 0..100 {
+            let mut round = || -> Result<(), String> {
+                control.reject(control.length, &mut counters)?;
+                control.reject(control.length, &mut counters)?;
+                control.accept(true);
+                Ok(())
+            };
+            if let Err(e) = round() {
+                error = Some(e);
+                break;
+            }
+            assert!(control.length >= floor, "length {}", control.length);
+        }
+        let error = error.expect("the floor stops the run");
+        assert!(error.contains("below dt / 2^6 / 10"), "{error}");
+    }
+}

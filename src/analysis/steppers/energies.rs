@@ -1,0 +1,37 @@
+//! What a stepper reports of its state besides the state itself: the energies of the step
+//! and the nodal motion (velocity, acceleration, mass, internal force), and the energy
+//! balance they close (docs/theory.md section 7).
+
+/// Energies of one step (history.csv columns 2-6).
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
+pub struct Energies {
+    pub kinetic: f64,
+    pub internal: f64,
+    pub plastic_work: f64,
+    pub external_work: f64,
+    pub contact_work: f64,
+}
+
+/// Nodal kinematic fields beyond the displacement (zero in statics).
+pub struct Motion<'a> {
+    pub velocity: &'a [f64],
+    pub acceleration: &'a [f64],
+    /// Lumped mass per DOF (for the momentum probes); empty in statics.
+    pub mass: &'a [f64],
+    /// The internal force of the committed state, all DOFs (for the reaction probes): the
+    /// one the step converged with, so the reactions balance the loads as the solution does.
+    pub internal_force: &'a [f64],
+}
+
+/// Relative energy balance error |KE + W_int - W_ext - KE_0| / max(KE_0, |W_ext|, W_int).
+pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
+    let scale = initial_kinetic
+        .max(energies.external_work.abs())
+        .max(energies.internal.abs())
+        .max(f64::MIN_POSITIVE);
+    (energies.kinetic + energies.internal + energies.plastic_work + energies.contact_work
+        - energies.external_work
+        - initial_kinetic)
+        .abs()
+        / scale
+}

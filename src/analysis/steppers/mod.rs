@@ -1,0 +1,145 @@
+//! The steppers: what advances a model's state by one converged step. Static load stepping
+//! (`statics`), implicit time stepping (`dynamics`, with Newton in `newton`) and explicit
+//! central difference (`explicit`, its step rule in `clock`, the stable step in `stable`);
+//! the loads and prescribed motions they apply (`loads`); the step control of the implicit
+//! steppers (`control`). The run scaffold (`analysis::run`) drives a [`Stepper`], reads
+//! its [`Report`] and checkpoints it through [`Resume`]; no stepper knows the scaffold.
+
+pub mod carry;
+pub mod clock;
+pub mod control;
+pub mod dynamics;
+pub mod energies;
+pub mod explicit;
+pub mod loads;
+pub mod newton;
+pub mod stable;
+pub mod statics;
+
+use crate::assembly::{StableStep, State};
+use crate::contact::ContactState;
+use crate::scene::Model;
+use crate::solver::Solver;
+use carry::Carry;
+use control::ErrorWatch;
+use energies::{Energies, Motion};
+use newton::Counters;
+
+pub use crate::analysis::summary::StepError;
+
+/// One kind of analysis as the run drives it: it advances the state by converged steps.
+/// What it says of itself is its [`Report`]; what a checkpoint keeps of it, its [`Resume`].
+pub trait Stepper: Report + Resume {
+    /// What the stepper computes at t = 0 before the first row (a numerical failure here
+    /// ends the run `diverged` with the message).
+    fn start(&mut self) -> Result<(), String>;
+    fn done(&self) -> bool;
+    /// One converged step, cutting and retrying inside as the analysis allows.
+    fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError>;
+    /// A judgement of the step just counted (explicit: the energy has not blown up).
+    fn verdict(&self) -> Result<(), StepError> {
+        Ok(())
+    }
+    /// Makes the state's material points current before output reads them (the one-point
+    /// kernel keeps its own arrays).
+    fn sync_points(&mut self) {}
+}
+
+/// What a stepper says of its run and its state: summary.json, history.csv and the frames
+/// read it.
+pub trait Report {
+    /// The integrator's name in summary.json.
+    fn integrator(&self) -> String;
+    /// The nominal step and the end time.
+    fn dt(&self) -> f64;
+    fn end_time(&self) -> f64;
+    fn free_dofs(&self) -> usize;
+    /// Whether the run carries the buckling check of `[analysis.buckling]`.
+    fn checks_buckling(&self) -> bool;
+    fn state(&self) -> &State;
+    fn motion(&self) -> Motion<'_>;
+    fn energies(&self) -> &Energies;
+    /// The kinetic energy at t = 0: summary.json `energy.initial` and the drift's reference.
+    fn initial_kinetic(&self) -> f64;
+    fn contact(&self) -> &ContactState;
+    /// The linear solver, for its counters (None: explicit, no solver).
+    fn solver(&self) -> Option<&Solver> {
+        None
+    }
+    /// The accumulated hourglass work, for the history column of the one-point kernel.
+    fn hourglass_energy(&self) -> Option<f64> {
+        None
+    }
+    /// The local error estimates of the implicit steps (None: no estimate).
+    fn error_watch(&self) -> Option<ErrorWatch> {
+        None
+    }
+    /// The length of the last step (0 before the first).
+    fn last_step(&self) -> f64;
+    /// What the time step did (central difference): summary.json `dt_min`, `dt_max`,
+    /// `dt_limit`.
+    fn time_step_report(&self) -> Option<TimeStepReport> {
+        None
+    }
+}
+
+/// What a checkpoint keeps of a stepper, and how a resumed stepper takes it back.
+pub trait Resume {
+    /// What a checkpoint stores of the stepper; an error when it writes none, the reason.
+    fn carry(&self) -> Result<Carry, &'static str>;
+    /// Takes over the carry of a checkpoint; false when it is another analysis' carry.
+    fn restore(&mut self, carry: Carry) -> bool;
+    /// The analysis' name in the message of a wrong carry.
+    fn kind(&self) -> &'static str;
+    /// Called after a checkpoint is written (the step after it factors afresh, as the
+    /// resumed run must).
+    fn after_checkpoint(&mut self) {}
+    /// The linear solver, whose counters a checkpoint carries (None: no solver).
+    fn solver_mut(&mut self) -> Option<&mut Solver> {
+        None
+    }
+}
+
+/// The steps a central-difference run took and what limits them at the end.
+#[derive(Debug, Clone)]
+pub struct TimeStepReport {
+    /// The shortest and the longest step the step rule set (`Clock::range`: steps clipped to
+    /// a frame time or the end time are not counted).
+    pub shortest: f64,
+    pub longest: f64,
+    /// The stable step of the last configuration.
+    pub limit: StableStep,
+}
+
+/// The scene's initial velocity, with the constrained DOFs (`free` false) moving as their
+/// prescriptions do at t = 0 (the slope of the first curve segment; supports at rest): a
+/// prescribed motion then starts without a velocity jump the trapezoidal rule would carry as
+/// an oscillation.
+pub(super) fn initial_velocity(model: &Model, free: &[bool], dt: f64) -> Vec<f64> {
+    let mut v = model.initial_velocity.clone();
+    let initial = model.coordinates();
+    let eps = 1e-6 * dt;
+    let at = |t: f64| {
+        let mut u = vec![0.0; model.dofs()];
+        for (dof, value) in loads::prescribed(model, &initial, t) {
+            u[dof] = value;
+        }
+        u
+    };
+    let (u0, u1) = (at(0.0), at(eps));
+    for (dof, free) in free.iter().enumerate() {
+        if !free {
+            v[dof] = (u1[dof] - u0[dof]) / eps;
+        }
+    }
+    v
+}
+
+/// Work of the nodal forces over an increment by the trapezoid rule, 1/2 (f_0 + f_1) . d.
+pub(super) fn trapezoid_work(d: &[f64], f1: &[f64], f0: &[f64]) -> f64 {
+    0.5 * d
+        .iter()
+        .zip(f1.iter().zip(f0))
+        .map(|(u, (a, b))| u * (a + b))
+        .sum::<f64>()
+}

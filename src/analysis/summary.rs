@@ -1,0 +1,239 @@
+//! How a run ended and what it says of itself: summary.json (the output contract of
+//! docs/user-guide.md, read by other tools: fields are only ever added), the status, the
+//! error of a step that could not be taken and the error of a run. The ground floor of the
+//! analyses: the steppers and the run scaffold both speak it.
+
+use crate::assembly::StableStep;
+use crate::output::OutputError;
+use crate::scene::{InputError, Model};
+use serde::{Deserialize, Serialize};
+
+pub use crate::contact::ContactSummary;
+
+/// A step that could not be taken: the run ends with this status and message.
+#[derive(Debug, Clone)]
+pub struct StepError {
+    pub status: Status,
+    pub message: String,
+    /// Write a frame of the state reached (the explicit blow-up shows what blew up).
+    pub frame: bool,
+}
+
+impl StepError {
+    pub fn diverged(message: String) -> StepError {
+        StepError {
+            status: Status::Diverged,
+            message,
+            frame: false,
+        }
+    }
+}
+
+/// How a run ended (summary.json `status`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    Ok,
+    Diverged,
+    Unstable,
+    /// Stopped by SIGINT or SIGTERM after a whole step; `impact resume DIR` continues it.
+    Interrupted,
+}
+
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct EnergySummary {
+    pub initial: f64,
+    #[serde(rename = "final")]
+    pub final_: f64,
+    /// max over the steps of |KE + W_elastic + W_plastic + W_contact - KE_0 - W_ext| /
+    /// max(KE_0, |W_ext|, |W_elastic|).
+    pub max_relative_drift: f64,
+    pub plastic_dissipation: f64,
+}
+
+/// summary.json's form of a [`StableStep`] (the stable step of the last
+/// configuration, from the element bound, before the scale): the body by name.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DtLimit {
+    pub dt: f64,
+    pub body: String,
+    pub element: usize,
+}
+
+impl DtLimit {
+    pub fn of(step: StableStep, model: &Model) -> DtLimit {
+        DtLimit {
+            dt: step.dt,
+            body: model.bodies[step.body].name.clone(),
+            element: step.element,
+        }
+    }
+}
+
+/// summary.json (the output contract of docs/user-guide.md): other tools read it; fields
+/// are only ever added.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Summary {
+    pub scene: String,
+    pub title: String,
+    pub status: Status,
+    /// Set when status is not `ok`: what failed, where and when.
+    pub message: Option<String>,
+    pub integrator: String,
+    /// The (nominal) time or pseudo-time step.
+    pub dt: f64,
+    /// Converged increments (sub-increments count one each).
+    pub steps: usize,
+    pub end_time: f64,
+    pub nodes: usize,
+    pub elements: usize,
+    pub dofs: usize,
+    pub free_dofs: usize,
+    pub wall_seconds: f64,
+    pub newton_iterations: usize,
+    pub factorizations: usize,
+    pub back_substitutions: usize,
+    pub step_cuts: usize,
+    /// Implicit `dt = "auto"`: steps taken again shorter because their error estimate was
+    /// above `error_tolerance` (apart from `step_cuts`, the cuts after a failed Newton).
+    #[serde(default)]
+    pub rejected_steps: usize,
+    /// Implicit integrators with an error estimate (the Newmark family): the largest local
+    /// error estimate of an accepted step (history.csv `error_estimate`); null otherwise.
+    #[serde(default)]
+    pub max_error_estimate: Option<f64>,
+    pub contact: ContactSummary,
+    pub energy: EnergySummary,
+    pub buckling: Option<BucklingSummary>,
+    /// Central difference: the shortest and the longest step the step rule set (steps
+    /// clipped to a frame time or the end time not counted).
+    pub dt_min: Option<f64>,
+    pub dt_max: Option<f64>,
+    /// Central difference: the stable step of the final configuration and the element that
+    /// sets it.
+    pub dt_limit: Option<DtLimit>,
+    /// Seconds per phase and element updates (see `profile`); process-wide counters, so
+    /// only meaningful for one run per process (as `impact run` and `impact bench` do).
+    #[serde(default)]
+    pub timing: crate::profile::Timing,
+    /// The highest point temperature at the end (the run's highest: adiabatic heating never
+    /// cools), when some material carries a temperature. summary.json writes it last and
+    /// only then (`record::Recorder::write_summary`); a checkpoint does not store it (the
+    /// end state gives it).
+    #[serde(skip)]
+    pub max_temperature: Option<f64>,
+    /// What the scene and the finished run say about the answer (analysis::plausibility):
+    /// the scene's own warnings (too few steps, a run shorter than a wave transit, an unused
+    /// obstacle, an axis not held, too many frames), then step cuts, the energy balance,
+    /// plastic work above the energy supplied, a step too long for the impact, a pair that
+    /// never closed, a contact penetration beyond TOL, nodes across the axis, hourglass
+    /// energy. Empty when none.
+    #[serde(default)]
+    pub warnings: Vec<String>,
+}
+
+impl Summary {
+    /// A summary before the run: status `ok`, counters zero.
+    pub fn new(
+        model: &Model,
+        integrator: &str,
+        dt: f64,
+        end_time: f64,
+        free_dofs: usize,
+    ) -> Summary {
+        Summary {
+            scene: model.file.display().to_string(),
+            title: model.title.clone(),
+            status: Status::Ok,
+            message: None,
+            integrator: integrator.to_string(),
+            dt,
+            steps: 0,
+            end_time,
+            nodes: model.node_count,
+            elements: model.elements(),
+            dofs: model.dofs(),
+            free_dofs,
+            wall_seconds: 0.0,
+            newton_iterations: 0,
+            factorizations: 0,
+            back_substitutions: 0,
+            step_cuts: 0,
+            rejected_steps: 0,
+            max_error_estimate: None,
+            contact: ContactSummary::default(),
+            energy: EnergySummary::default(),
+            buckling: None,
+            dt_min: None,
+            dt_max: None,
+            dt_limit: None,
+            timing: Default::default(),
+            max_temperature: None,
+            warnings: Vec::new(),
+        }
+    }
+}
+
+/// summary.json `buckling` (present when the scene has `[analysis.buckling]`).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct BucklingSummary {
+    /// lambda_1 of the end loads at the prebuckling state (`modes` > 0), else null.
+    pub critical_load_factor: Option<f64>,
+    /// lambda_1 .. lambda_modes, ascending.
+    pub load_factors: Vec<f64>,
+    /// Negative pivots of K_T at the start and after the last converged state (`check`).
+    pub initial_negative_pivots: Option<usize>,
+    pub final_negative_pivots: Option<usize>,
+    /// The first time (load factor in statics with the default ramp) at which the count
+    /// differed from the initial one, and the count then.
+    pub inertia_change_time: Option<f64>,
+    pub negative_pivots_at_change: Option<usize>,
+    /// The run stopped there (`on_critical = "stop"`).
+    pub stopped: bool,
+}
+
+/// Why a run failed; `exit_code` maps it to the CLI's contract.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("{0}")]
+    Input(#[from] InputError),
+    /// Divergence, an inverted element, NaN: the partial output and summary.json are kept.
+    #[error("numerical failure: {message}")]
+    Numerical {
+        message: String,
+        summary: Box<Summary>,
+    },
+    #[error("{0}")]
+    Output(#[from] OutputError),
+    /// SIGINT or SIGTERM: the step in progress was finished and written, with a frame, a
+    /// checkpoint and summary.json (status `interrupted`).
+    #[error("interrupted: {message}")]
+    Interrupted {
+        message: String,
+        summary: Box<Summary>,
+    },
+    /// `--strict`: the run finished (status ok, its output complete) with warnings.
+    #[error("{count} warning(s) with --strict (summary.json `warnings`)")]
+    Warnings { count: usize, summary: Box<Summary> },
+}
+
+impl RunError {
+    /// The linear solver could not be set up for the model's pattern (the output folder
+    /// `dir` named).
+    pub fn setup(dir: &std::path::Path, e: impl std::fmt::Display) -> RunError {
+        RunError::Output(OutputError::Invalid {
+            path: dir.to_path_buf(),
+            reason: e.to_string(),
+        })
+    }
+
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            RunError::Input(_) => 2,
+            RunError::Numerical { .. } => 3,
+            RunError::Output(_) => 1,
+            RunError::Interrupted { .. } => 130,
+            RunError::Warnings { .. } => 3,
+        }
+    }
+}
