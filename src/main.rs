@@ -389,7 +389,7 @@ fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
             body.name,
             body.mesh.nodes.len(),
             body.elements(),
-            analysis::check::kind_in_words(body.kind),
+            body.kind.in_words(),
             body.material.name
         );
     }

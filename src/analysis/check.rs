@@ -19,31 +19,9 @@ use super::steppers::stable::{
     StableStep, checked_step, critical_time_step, explicit_first_step, implicit_first_step,
     wave_speed,
 };
-use crate::element::Formulation;
 use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind};
-use crate::scene::{BodyKind, InputError, Model};
-
-/// The body's kind in words: `plane strain, B-bar`, `plane stress, thickness 0.01`, ...
-pub fn kind_in_words(kind: BodyKind) -> String {
-    match kind {
-        BodyKind::Rod { area } => format!("rod, area {}", readable(area)),
-        BodyKind::Continuum {
-            formulation,
-            bbar,
-            thickness,
-        } => {
-            let name = match formulation {
-                Formulation::PlaneStrain => "plane strain (per unit depth)".to_string(),
-                Formulation::PlaneStress => {
-                    format!("plane stress, thickness {}", readable(thickness))
-                }
-                Formulation::Axisymmetric => "axisymmetric (full ring)".to_string(),
-            };
-            if bbar { format!("{name}, B-bar") } else { name }
-        }
-    }
-}
+use crate::scene::{InputError, Model};
 
 /// How the time step of a dynamic analysis stands against its integrator's limit.
 #[derive(Debug, Clone, PartialEq)]

@@ -18,11 +18,10 @@ use super::steppers::energies::Energies;
 use super::steppers::stable::{explicit_first_step, implicit_first_step, wave_speed};
 use crate::assembly::{self, State};
 use crate::contact::{ContactPair, Master, penetration_limits};
-use crate::element::Formulation;
 use crate::output::readable;
 use crate::scene::model::Analysis;
 use crate::scene::spec::{IntegratorKind, TimeStep};
-use crate::scene::{Body, BodyKind, Model};
+use crate::scene::{Body, Model};
 
 /// The energy balance error (summary.energy.max_relative_drift) above which a run warns:
 /// a conserving integrator stays within a few 1e-3 on the shipped scenes; more means
@@ -156,15 +155,7 @@ fn axis_nodes<'a>(model: &'a Model, x: &[[f64; 2]]) -> Vec<AxisNodes<'a>> {
     model
         .bodies
         .iter()
-        .filter(|b| {
-            matches!(
-                b.kind,
-                BodyKind::Continuum {
-                    formulation: Formulation::Axisymmetric,
-                    ..
-                }
-            )
-        })
+        .filter(|b| b.is_axisymmetric())
         .map(|body| {
             let tolerance = AXIS_TOLERANCE * body_extent(body);
             let nodes = (0..body.mesh.nodes.len()).map(|n| body.global(n));
@@ -394,9 +385,10 @@ fn body_size(body: &Body) -> f64 {
         }
     }
     let sides = [high[0] - low[0], high[1] - low[1]];
-    match body.kind {
-        BodyKind::Rod { .. } => sides[0].max(sides[1]),
-        BodyKind::Continuum { .. } => sides[0].min(sides[1]),
+    if body.kind.is_rod() {
+        sides[0].max(sides[1])
+    } else {
+        sides[0].min(sides[1])
     }
 }
 

@@ -539,6 +539,38 @@ pub fn mass(geom: &QuadValues) -> Mat4 {
     }
     m
 }
+/// The Green-Lagrange strain (E_XX, E_YY, E_XY, tensor shear) at the centre (xi = eta = 0) of
+/// a quad with nodes at `reference` (initial) and `current`, counter-clockwise: H = grad_X u
+/// there, E = (H + H^T + H^T H) / 2 (the frames' cell strain; the out-of-plane part is the
+/// formulation's).
+pub fn centre_green_strain(reference: &[[f64; 2]; 4], current: &[[f64; 2]; 4]) -> [f64; 3] {
+    // dN/dxi and dN/deta at the centre, nodes counter-clockwise
+    let dxi = [-0.25, 0.25, 0.25, -0.25];
+    let deta = [-0.25, -0.25, 0.25, 0.25];
+    let mut jacobian = [[0.0; 2]; 2]; // dX_i / d(xi, eta)_j
+    let mut du = [[0.0; 2]; 2]; // du_i / d(xi, eta)_j
+    for (a, (x0, x)) in reference.iter().zip(current).enumerate() {
+        for i in 0..2 {
+            let displacement = x[i] - x0[i];
+            jacobian[i][0] += x0[i] * dxi[a];
+            jacobian[i][1] += x0[i] * deta[a];
+            du[i][0] += displacement * dxi[a];
+            du[i][1] += displacement * deta[a];
+        }
+    }
+    let det = jacobian[0][0] * jacobian[1][1] - jacobian[0][1] * jacobian[1][0];
+    // d(xi, eta) / dX = J^-1
+    let inverse = [
+        [jacobian[1][1] / det, -jacobian[0][1] / det],
+        [-jacobian[1][0] / det, jacobian[0][0] / det],
+    ];
+    let h: [[f64; 2]; 2] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| du[i][0] * inverse[0][j] + du[i][1] * inverse[1][j])
+    });
+    let green =
+        |i: usize, j: usize| 0.5 * (h[i][j] + h[j][i] + h[0][i] * h[0][j] + h[1][i] * h[1][j]);
+    [green(0, 0), green(1, 1), green(0, 1)]
+}
 
 /// Consistent nodal forces [fa_x fa_y fb_x fb_y] of a constant traction `t` (force per unit
 /// reference length; per unit area in plane stress with `thickness`, per unit area of the

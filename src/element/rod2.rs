@@ -12,6 +12,12 @@
 //! Linear kinematics keeps B = [-e, e] / L with e the reference direction and no K_sigma.
 
 use super::{GeometricStiffness, KernelError, Mat4, Strain, Vec4};
+/// The Green-Lagrange strain along a rod with ends at `reference` (initial) and `current`:
+/// (l^2 / L^2 - 1) / 2 (the frames' cell strain).
+pub fn green_strain(reference: &[[f64; 2]; 2], current: &[[f64; 2]; 2]) -> f64 {
+    let length2 = |p: [f64; 2], q: [f64; 2]| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+    0.5 * (length2(current[0], current[1]) / length2(reference[0], reference[1]) - 1.0)
+}
 
 /// Reference length and unit direction of the rod X1 -> X2.
 pub fn length(x: &[[f64; 2]; 2]) -> Result<f64, KernelError> {

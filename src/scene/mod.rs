@@ -17,7 +17,7 @@ mod reference;
 pub mod spec;
 pub mod validate;
 
-pub use model::{Body, BodyKind, Curve, Load, Model, SceneSource};
+pub use model::{Body, BodyKind, Continuum, Curve, Load, Model, SceneSource};
 pub use spec::Scene;
 
 use std::path::{Path, PathBuf};

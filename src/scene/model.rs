@@ -15,6 +15,7 @@ use crate::contact::{BodySurface, ContactPair, Interfaces, Obstacle, Section};
 use crate::element::{Formulation, Strain, Voigt};
 use crate::material::{Material, StressCondition};
 use crate::mesh::Mesh;
+use crate::output::readable;
 use std::path::PathBuf;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,6 +28,73 @@ pub enum BodyKind {
     Rod {
         area: f64,
     },
+}
+
+/// What a continuum body is besides its mesh: its formulation, B-bar and thickness (plane
+/// stress).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Continuum {
+    pub formulation: Formulation,
+    pub bbar: bool,
+    pub thickness: f64,
+}
+
+impl BodyKind {
+    /// The continuum's formulation, B-bar and thickness; None for a rod.
+    pub fn continuum(self) -> Option<Continuum> {
+        match self {
+            BodyKind::Continuum {
+                formulation,
+                bbar,
+                thickness,
+            } => Some(Continuum {
+                formulation,
+                bbar,
+                thickness,
+            }),
+            BodyKind::Rod { .. } => None,
+        }
+    }
+
+    /// The formulation of a continuum; None for a rod.
+    pub fn formulation(self) -> Option<Formulation> {
+        self.continuum().map(|c| c.formulation)
+    }
+
+    pub fn is_rod(self) -> bool {
+        matches!(self, BodyKind::Rod { .. })
+    }
+
+    /// The kind in words: `plane strain, B-bar`, `plane stress, thickness 0.01`, ...
+    pub fn in_words(self) -> String {
+        match self {
+            BodyKind::Rod { area } => format!("rod, area {}", readable(area)),
+            BodyKind::Continuum {
+                formulation,
+                bbar,
+                thickness,
+            } => {
+                let name = match formulation {
+                    Formulation::PlaneStrain => "plane strain (per unit depth)".to_string(),
+                    Formulation::PlaneStress => {
+                        format!("plane stress, thickness {}", readable(thickness))
+                    }
+                    Formulation::Axisymmetric => "axisymmetric (full ring)".to_string(),
+                };
+                if bbar { format!("{name}, B-bar") } else { name }
+            }
+        }
+    }
+
+    /// The modulus of the dilatational wave ([`Body::p_wave_modulus`]) in words.
+    pub fn modulus_name(self) -> &'static str {
+        match self.formulation() {
+            None => "E (rod)",
+            Some(Formulation::PlaneStrain) => "lambda + 2 mu (plane strain)",
+            Some(Formulation::Axisymmetric) => "lambda + 2 mu (axisymmetric)",
+            Some(Formulation::PlaneStress) => "E / (1 - nu^2) (plane stress)",
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -63,6 +131,11 @@ impl Body {
                 elastic.p_wave_modulus(StressCondition::of(formulation))
             }
         }
+    }
+
+    /// Whether the body is an axisymmetric continuum (x the radius).
+    pub fn is_axisymmetric(&self) -> bool {
+        self.kind.formulation() == Some(Formulation::Axisymmetric)
     }
 
     /// Material points per element: 4 for Quad4, 1 for rods.

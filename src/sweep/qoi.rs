@@ -29,7 +29,6 @@
 use super::measure::Row;
 use crate::element::Formulation;
 use crate::scene::Model;
-use crate::scene::model::BodyKind;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -331,15 +330,10 @@ impl Units {
                 .johnson_cook()
                 .is_some_and(|law| law.room_temperature < 150.0)
         });
-        let plane_strain = model.bodies.iter().any(|b| {
-            matches!(
-                b.kind,
-                BodyKind::Continuum {
-                    formulation: Formulation::PlaneStrain,
-                    ..
-                }
-            )
-        });
+        let plane_strain = model
+            .bodies
+            .iter()
+            .any(|b| b.kind.formulation() == Some(Formulation::PlaneStrain));
         Units {
             length,
             time,

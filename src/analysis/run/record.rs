@@ -413,8 +413,8 @@ pub fn max_temperature(model: &Model, state: &State) -> Option<f64> {
 /// rods    XX = (l^2 / L^2 - 1) / 2 along the rod, the rest 0
 /// ```
 pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -> Vec<[f64; 6]> {
-    use crate::element::Formulation;
-    use crate::scene::BodyKind;
+    use crate::element::{Formulation, quad4, rod2};
+    use crate::scene::Continuum;
     let u = &state.displacement;
     let at = |n: usize| {
         (
@@ -429,51 +429,27 @@ pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -
         };
         for (e, q) in quads.iter().enumerate() {
             let nodes = q.map(|n| at(body.global(n)));
-            // dN/dxi and dN/deta at the centre, nodes counter-clockwise
-            let dxi = [-0.25, 0.25, 0.25, -0.25];
-            let deta = [-0.25, -0.25, 0.25, 0.25];
-            let mut jacobian = [[0.0; 2]; 2]; // dX_i / d(xi, eta)_j
-            let mut du = [[0.0; 2]; 2]; // du_i / d(xi, eta)_j
-            for (a, (reference, current)) in nodes.iter().enumerate() {
-                for i in 0..2 {
-                    let displacement = current[i] - reference[i];
-                    jacobian[i][0] += reference[i] * dxi[a];
-                    jacobian[i][1] += reference[i] * deta[a];
-                    du[i][0] += displacement * dxi[a];
-                    du[i][1] += displacement * deta[a];
-                }
-            }
-            let det = jacobian[0][0] * jacobian[1][1] - jacobian[0][1] * jacobian[1][0];
-            // d(xi, eta) / dX = J^-1
-            let inverse = [
-                [jacobian[1][1] / det, -jacobian[0][1] / det],
-                [-jacobian[1][0] / det, jacobian[0][0] / det],
-            ];
-            let h: [[f64; 2]; 2] = std::array::from_fn(|i| {
-                std::array::from_fn(|j| du[i][0] * inverse[0][j] + du[i][1] * inverse[1][j])
-            });
-            let green = |i: usize, j: usize| {
-                0.5 * (h[i][j] + h[j][i] + h[0][i] * h[0][j] + h[1][i] * h[1][j])
-            };
-            let zz = match body.kind {
-                BodyKind::Continuum {
+            let reference = nodes.map(|n| n.0);
+            let current = nodes.map(|n| n.1);
+            let [xx, yy, xy] = quad4::centre_green_strain(&reference, &current);
+            let zz = match body.kind.continuum() {
+                Some(Continuum {
                     formulation: Formulation::Axisymmetric,
                     ..
-                } => {
-                    let radius =
-                        |k: usize| nodes.iter().map(|n| [n.0, n.1][k][0]).sum::<f64>() / 4.0;
-                    let (initial_r, current_r) = (radius(0), radius(1));
+                }) => {
+                    let radius = |x: &[[f64; 2]; 4]| x.iter().map(|p| p[0]).sum::<f64>() / 4.0;
+                    let (initial_r, current_r) = (radius(&reference), radius(&current));
                     if initial_r > 0.0 {
                         0.5 * ((current_r / initial_r).powi(2) - 1.0)
                     } else {
                         0.0
                     }
                 }
-                BodyKind::Continuum {
+                Some(Continuum {
                     formulation: Formulation::PlaneStress,
                     thickness,
                     ..
-                } => {
+                }) => {
                     let ppe = body.points_per_element();
                     let now = &state.bodies[b].thickness[e * ppe..(e + 1) * ppe];
                     let stretch = now.iter().sum::<f64>() / ppe as f64 / thickness;
@@ -481,7 +457,7 @@ pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -
                 }
                 _ => 0.0,
             };
-            out.push([green(0, 0), green(1, 1), zz, green(0, 1), 0.0, 0.0]);
+            out.push([xx, yy, zz, xy, 0.0, 0.0]);
         }
     }
     for body in &model.bodies {
@@ -490,8 +466,7 @@ pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -
         };
         for r in rods {
             let [(a0, a1), (b0, b1)] = r.map(|n| at(body.global(n)));
-            let length2 = |p: [f64; 2], q: [f64; 2]| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
-            let xx = 0.5 * (length2(a1, b1) / length2(a0, b0) - 1.0);
+            let xx = rod2::green_strain(&[a0, b0], &[a1, b1]);
             out.push([xx, 0.0, 0.0, 0.0, 0.0, 0.0]);
         }
     }
@@ -594,16 +569,6 @@ fn cell_fields(model: &Model, state: &State) -> CellFields {
         first = last;
     }
     out
-}
-
-fn is_axisymmetric(body: &crate::scene::model::Body) -> bool {
-    matches!(
-        body.kind,
-        crate::scene::model::BodyKind::Continuum {
-            formulation: crate::element::Formulation::Axisymmetric,
-            ..
-        }
-    )
 }
 
 fn is_reaction(quantity: Quantity) -> bool {
@@ -712,7 +677,7 @@ fn probe_value(
                         let x = initial[m][c] + state.displacement[2 * m + c];
                         (low.min(x), high.max(x))
                     });
-            if c == 0 && is_axisymmetric(&model.bodies[probe.body]) {
+            if c == 0 && model.bodies[probe.body].is_axisymmetric() {
                 // the body of revolution spans -r_max .. r_max
                 2.0 * high
             } else {

@@ -2,7 +2,7 @@
 
 use crate::assembly::State;
 use crate::element::quad4;
-use crate::scene::{BodyKind, Load, Model};
+use crate::scene::{Continuum, Load, Model};
 
 /// Prescribed total displacements (DOF, value) at time t: supports give 0; a DOF named by
 /// several loads takes the last one's value.
@@ -135,11 +135,11 @@ fn add_edge_forces(
     traction: impl Fn([f64; 2], [f64; 2]) -> [f64; 2],
     f: &mut [f64],
 ) {
-    let BodyKind::Continuum {
+    let Some(Continuum {
         formulation,
         thickness,
         ..
-    } = model.bodies[body].kind
+    }) = model.bodies[body].kind.continuum()
     else {
         return;
     };

@@ -17,10 +17,9 @@
 use super::clock::Clock;
 use crate::assembly::explicit::{ExplicitKernel, kernel_for};
 use crate::assembly::{self, ElementMasses, State};
-use crate::element::Formulation;
 use crate::output::readable;
 use crate::scene::spec::{AdaptiveStep, DynamicSpec};
-use crate::scene::{BodyKind, InputError, Model};
+use crate::scene::{InputError, Model};
 
 pub use crate::assembly::StableStep;
 
@@ -122,14 +121,7 @@ pub fn wave_speed(body: &crate::scene::Body) -> Option<WaveSpeed> {
         return None;
     }
     let modulus = body.p_wave_modulus();
-    let modulus_name = match body.kind {
-        BodyKind::Rod { .. } => "E (rod)",
-        BodyKind::Continuum { formulation, .. } => match formulation {
-            Formulation::PlaneStrain => "lambda + 2 mu (plane strain)",
-            Formulation::Axisymmetric => "lambda + 2 mu (axisymmetric)",
-            Formulation::PlaneStress => "E / (1 - nu^2) (plane stress)",
-        },
-    };
+    let modulus_name = body.kind.modulus_name();
     Some(WaveSpeed {
         speed: (modulus / m.density).sqrt(),
         modulus,

@@ -16,7 +16,7 @@ use crate::element::Formulation;
 use crate::element::Strain;
 use crate::material::{Material, StressCondition};
 use crate::scene::spec::{DynamicSpec, Quadrature};
-use crate::scene::{BodyKind, Model};
+use crate::scene::{Continuum, Model};
 use rayon::prelude::*;
 
 /// Elements per parallel task (fixed, so the work sums do not depend on the thread count).
@@ -115,9 +115,9 @@ impl Layout {
             origin: Vec::new(),
         };
         for (b, spec) in model.bodies.iter().enumerate() {
-            let BodyKind::Continuum {
+            let Some(Continuum {
                 formulation, bbar, ..
-            } = spec.kind
+            }) = spec.kind.continuum()
             else {
                 continue;
             };
@@ -267,10 +267,7 @@ pub fn kernel_for(
     state: &State,
     masses: &ElementMasses,
 ) -> (Option<Box<dyn ExplicitKernel>>, bool) {
-    let quads_only = model
-        .bodies
-        .iter()
-        .all(|b| matches!(b.kind, BodyKind::Continuum { .. }));
+    let quads_only = model.bodies.iter().all(|b| !b.kind.is_rod());
     match spec.quadrature {
         Quadrature::Reduced => (
             Some(Box::new(Reduced::new(model, state, spec.hourglass, masses))),
