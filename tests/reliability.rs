@@ -245,6 +245,28 @@ fn explicit_automatic_step_resume_is_bit_identical() {
     assert!(a["dt_min"].as_f64().unwrap() > 0.0);
 }
 
+/// Goal: the bulk viscosity resumes bit-identically: its pressures of the last step (which
+/// the next step's work needs) are in the checkpoint, its work in the energies. Setup:
+/// PLASTIC_BLOCK, frictionless, central difference with dt = "auto" and
+/// `bulk_viscosity = {}`, checkpoints every 15 steps, killed at 40. Reference: the
+/// uninterrupted run, byte for byte (history.csv with its `bulk_viscosity_work` column).
+#[test]
+fn explicit_bulk_viscosity_resume_is_bit_identical() {
+    let name = "plastic_block_bulk_viscosity";
+    let set = [
+        "analysis.integrator=central_difference",
+        "analysis.dt=auto",
+        "analysis.end_time=0.3",
+        "analysis.checkpoint_every=15",
+        "analysis.bulk_viscosity={}",
+    ];
+    let text = frictionless();
+    let full = run_full(name, &text, &set);
+    assert!(*common::column(&full, "bulk_viscosity_work").last().unwrap() > 0.0);
+    let resumed = run_killed_and_resumed(name, &text, &set, 40);
+    assert_same_output(&full, &resumed, name);
+}
+
 /// Goal: static load stepping resumes bit-identically (modified Newton every 3 increments).
 #[test]
 fn static_plastic_resume_is_bit_identical() {
@@ -434,7 +456,7 @@ fn resume_without_checkpoint_is_bad_input() {
     assert!(stderr.contains("checkpoint.bin"), "{stderr}");
     assert!(stderr.contains("checkpoint_every"), "{stderr}");
     // an older format is refused as such; the current format with a damaged body as damaged
-    for (version, needle) in [(5u32, "checkpoint format 5"), (6, "damaged checkpoint")] {
+    for (version, needle) in [(6u32, "checkpoint format 6"), (7, "damaged checkpoint")] {
         let mut bytes = b"IMPACTCP".to_vec();
         bytes.extend(version.to_le_bytes());
         bytes.extend(b"garbage");

@@ -40,15 +40,41 @@ pub enum Status {
     Interrupted,
 }
 
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize)]
 pub struct EnergySummary {
     pub initial: f64,
     #[serde(rename = "final")]
     pub final_: f64,
-    /// max over the steps of |KE + W_elastic + W_plastic + W_contact - KE_0 - W_ext| /
-    /// max(KE_0, |W_ext|, |W_elastic|).
+    /// max over the steps of |KE + W_elastic + W_plastic + W_contact + W_visc - KE_0 - W_ext|
+    /// / max(KE_0, |W_ext|, |W_elastic|).
     pub max_relative_drift: f64,
     pub plastic_dissipation: f64,
+    /// The work of the bulk viscosity's pressure over the run (history.csv
+    /// `bulk_viscosity_work`); only with `analysis.bulk_viscosity`, and summary.json has the
+    /// field only then.
+    #[serde(default)]
+    pub bulk_viscosity_work: Option<f64>,
+}
+
+/// summary.json (a human-readable format) leaves `bulk_viscosity_work` out when there is
+/// none, so the scenes without bulk viscosity keep their file as it was; a checkpoint (a
+/// binary format whose fields are positional) always stores it.
+impl Serialize for EnergySummary {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let present = self.bulk_viscosity_work.is_some() || !serializer.is_human_readable();
+        let mut s = serializer.serialize_struct("EnergySummary", 4 + usize::from(present))?;
+        s.serialize_field("initial", &self.initial)?;
+        s.serialize_field("final", &self.final_)?;
+        s.serialize_field("max_relative_drift", &self.max_relative_drift)?;
+        s.serialize_field("plastic_dissipation", &self.plastic_dissipation)?;
+        if present {
+            s.serialize_field("bulk_viscosity_work", &self.bulk_viscosity_work)?;
+        } else {
+            s.skip_field("bulk_viscosity_work")?;
+        }
+        s.end()
+    }
 }
 
 /// summary.json's form of a [`StableStep`] (the stable step of the last

@@ -8,6 +8,7 @@
 //! engineering value `2 E_xy` (so `stress . strain` is the work density). For axisymmetric
 //! bodies x = r, y = z and zz is the hoop (theta theta) component.
 
+pub mod bulk_viscosity;
 pub mod quad4;
 pub mod quad4_one_point;
 pub mod rod2;

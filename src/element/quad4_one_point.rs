@@ -70,8 +70,7 @@ pub struct Gradient {
 /// Area, b_x, b_y (see the legend).
 #[inline(always)]
 pub fn centroid_gradient(x: &Nodes) -> Gradient {
-    let area = 0.5
-        * ((x[2][0] - x[0][0]) * (x[3][1] - x[1][1]) - (x[3][0] - x[1][0]) * (x[2][1] - x[0][1]));
+    let area = area(x);
     let s = 0.5 / area;
     let bx = [
         s * (x[1][1] - x[3][1]),
@@ -86,6 +85,13 @@ pub fn centroid_gradient(x: &Nodes) -> Gradient {
         s * (x[2][0] - x[0][0]),
     ];
     Gradient { area, bx, by }
+}
+
+/// The area of the quadrilateral x (half the cross product of its diagonals; negative when
+/// inverted).
+#[inline(always)]
+pub fn area(x: &Nodes) -> f64 {
+    0.5 * ((x[2][0] - x[0][0]) * (x[3][1] - x[1][1]) - (x[3][0] - x[1][0]) * (x[2][1] - x[0][1]))
 }
 
 /// FB's gamma vector (see the legend).

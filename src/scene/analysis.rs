@@ -9,6 +9,7 @@ use super::spec::{
     IntegratorKind, MassKind, NewtonSpec, Quadrature, StaticSpec, StepSpec, TimeStep,
 };
 use crate::element::Strain;
+use crate::element::bulk_viscosity::{self, BulkViscosity};
 
 /// `[analysis]`: a static analysis (load steps) or a dynamic one (time steps), checked
 /// against the keys that apply to it.
@@ -43,6 +44,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 (spec.allow_unstable, "allow_unstable"),
                 (spec.quadrature.is_some(), "quadrature"),
                 (spec.hourglass.is_some(), "hourglass"),
+                (spec.bulk_viscosity.is_some(), "bulk_viscosity"),
             ] {
                 given(present, key, "static")?;
             }
@@ -87,6 +89,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
     Ok(DynamicSpec {
         quadrature,
         hourglass,
+        bulk_viscosity: bulk_viscosity(cx, spec, integrator)?,
         step,
         end_time,
         integrator,
@@ -395,6 +398,49 @@ fn quadrature(
         (_, k) => k.unwrap_or(0.1),
     };
     Ok((quadrature, hourglass))
+}
+
+/// `analysis.bulk_viscosity`: central difference at finite strain only (it acts in the
+/// explicit Quad4 kernels; the scene's checks refuse it with rod bodies), coefficients >= 0.
+fn bulk_viscosity(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<Option<BulkViscosity>, InputError> {
+    let Some(given) = spec.bulk_viscosity else {
+        return Ok(None);
+    };
+    if integrator != IntegratorKind::CentralDifference {
+        return Err(cx.err(format!(
+            "analysis.bulk_viscosity: applies to integrator central_difference (it acts in the explicit Quad4 kernels); \
+             integrator {} is implicit (for numerical damping there use hht or generalized_alpha): \
+             remove bulk_viscosity or use integrator = \"central_difference\"",
+            integrator.name()
+        )));
+    }
+    if spec.geometry == Strain::Small {
+        return Err(cx.err(
+            "analysis.bulk_viscosity: acts in the finite-strain explicit Quad4 kernels; use geometry = \"nonlinear\" or remove bulk_viscosity",
+        ));
+    }
+    let coefficient = |key: &str, value: Option<f64>, default: f64| {
+        let value = value.unwrap_or(default);
+        if value >= 0.0 && value.is_finite() {
+            Ok(value)
+        } else {
+            Err(cx.err(format!(
+                "analysis.bulk_viscosity.{key}: a coefficient >= 0, got {value}"
+            )))
+        }
+    };
+    Ok(Some(BulkViscosity {
+        linear: coefficient("linear", given.linear, bulk_viscosity::DEFAULT_LINEAR)?,
+        quadratic: coefficient(
+            "quadratic",
+            given.quadratic,
+            bulk_viscosity::DEFAULT_QUADRATIC,
+        )?,
+    }))
 }
 
 /// `[analysis.buckling]`, which needs an implicit tangent.

@@ -252,6 +252,14 @@ impl Analysis {
             Analysis::Dynamic(s) => s.buckling.as_ref(),
         }
     }
+
+    /// The bulk viscosity of a central-difference analysis (None: off, or not dynamic).
+    pub fn bulk_viscosity(&self) -> Option<&crate::element::bulk_viscosity::BulkViscosity> {
+        match self {
+            Analysis::Static(_) => None,
+            Analysis::Dynamic(s) => s.bulk_viscosity.as_ref(),
+        }
+    }
 }
 
 #[derive(Debug, Clone)]

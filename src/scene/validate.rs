@@ -37,6 +37,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     check_contact_setup(&cx, &scene, &bodies, &contacts)?;
     check_reaction_probes(&cx, &probes, &fixed_dofs, &loads)?;
     check_reduced_quadrature(&cx, &analysis, &bodies)?;
+    check_bulk_viscosity(&cx, &analysis, &bodies)?;
     check_dispersion_free(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
@@ -118,6 +119,26 @@ fn check_reduced_quadrature(
     {
         return Err(cx.err(format!(
             "analysis.quadrature: `reduced` covers Quad4 bodies (plane strain, plane stress, axisymmetric); body `{}` is a rod: use quadrature = \"full\"",
+            body.name
+        )));
+    }
+    Ok(())
+}
+
+/// The bulk viscosity acts in the explicit Quad4 kernels, which run on Quad4 bodies only.
+fn check_bulk_viscosity(
+    cx: &Context,
+    analysis: &Analysis,
+    bodies: &[Body],
+) -> Result<(), InputError> {
+    if let Analysis::Dynamic(d) = analysis
+        && d.bulk_viscosity.is_some()
+        && let Some(body) = bodies
+            .iter()
+            .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
+    {
+        return Err(cx.err(format!(
+            "analysis.bulk_viscosity: acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric); body `{}` is a rod: remove bulk_viscosity",
             body.name
         )));
     }

@@ -367,8 +367,13 @@ impl Units {
         let name = column.split('[').next().unwrap_or(column);
         match name {
             "time" | "dt" => self.time.to_string(),
-            "kinetic_energy" | "internal_energy" | "plastic_work" | "external_work"
-            | "contact_work" | "hourglass_energy" => per(self.energy),
+            "kinetic_energy"
+            | "internal_energy"
+            | "plastic_work"
+            | "external_work"
+            | "contact_work"
+            | "hourglass_energy"
+            | "bulk_viscosity_work" => per(self.energy),
             "contact_force" | "tangential_force" => per(self.force),
             "penetration" => self.length.to_string(),
             _ => String::new(),

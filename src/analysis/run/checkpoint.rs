@@ -31,7 +31,9 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 5: the explicit clock keeps the range of the steps it set apart from the clipped ones.
 /// 6: the implicit error watch, rejected steps, the probes' last values, the summary's
 ///    error fields.
-const FORMAT: u32 = 6;
+/// 7: the bulk viscosity's work in the energies and the summary, its pressures in the
+///    explicit carry.
+const FORMAT: u32 = 7;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -394,6 +394,11 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.timing = profile::snapshot();
         summary.energy.final_ = energies.kinetic + energies.internal;
         summary.energy.plastic_dissipation = energies.plastic_work;
+        summary.energy.bulk_viscosity_work = self
+            .model
+            .analysis
+            .bulk_viscosity()
+            .map(|_| energies.bulk_viscosity_work);
         summary.contact = s.contact().summary(&self.model.contacts);
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
         if let Some(report) = s.time_step_report() {

@@ -228,6 +228,9 @@ impl Recorder {
         if !model.contacts.is_empty() {
             row.push(contact.map_or(0.0, |c| c.penetration));
         }
+        if bulk_viscosity_column(model) {
+            row.push(energies.bulk_viscosity_work);
+        }
         self.history.append(&row)?;
         crate::profile::add(crate::profile::Phase::Output, start);
         self.steps_since_frame += 1;
@@ -742,7 +745,15 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
         // the deepest penetration of either surface into the other body after the step
         columns.push("penetration".to_string());
     }
+    if bulk_viscosity_column(model) {
+        // the cumulative work of the bulk viscosity's pressure
+        columns.push("bulk_viscosity_work".to_string());
+    }
     (columns, pivots_column)
+}
+
+fn bulk_viscosity_column(model: &Model) -> bool {
+    model.analysis.bulk_viscosity().is_some()
 }
 
 fn error_column(model: &Model) -> bool {

@@ -59,4 +59,7 @@ pub struct ExplicitCarry {
     pub step: usize,
     pub contact: ContactState,
     pub clock: Clock,
+    /// The bulk viscosity's pressure of the last step at the kernel's points (empty without
+    /// it).
+    pub viscous_pressure: Vec<f64>,
 }

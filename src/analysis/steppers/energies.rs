@@ -2,7 +2,8 @@
 //! and the nodal motion (velocity, acceleration, mass, internal force), and the energy
 //! balance they close (docs/theory.md section 7).
 
-/// Energies of one step (history.csv columns 2-6).
+/// Energies of one step (history.csv columns 2-6, and `bulk_viscosity_work` last when the
+/// scene has the bulk viscosity).
 #[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     pub kinetic: f64,
@@ -10,6 +11,8 @@ pub struct Energies {
     pub plastic_work: f64,
     pub external_work: f64,
     pub contact_work: f64,
+    /// The work of the bulk viscosity's pressure (central difference; 0 without it).
+    pub bulk_viscosity_work: f64,
 }
 
 /// Nodal kinematic fields beyond the displacement (zero in statics).
@@ -23,13 +26,18 @@ pub struct Motion<'a> {
     pub internal_force: &'a [f64],
 }
 
-/// Relative energy balance error |KE + W_int - W_ext - KE_0| / max(KE_0, |W_ext|, W_int).
+/// Relative energy balance error |KE + W_int + W_contact + W_visc - W_ext - KE_0| /
+/// max(KE_0, |W_ext|, W_int), W_int = W_elastic + W_plastic, W_visc the bulk viscosity's work.
 pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
     let scale = initial_kinetic
         .max(energies.external_work.abs())
         .max(energies.internal.abs())
         .max(f64::MIN_POSITIVE);
-    (energies.kinetic + energies.internal + energies.plastic_work + energies.contact_work
+    (energies.kinetic
+        + energies.internal
+        + energies.plastic_work
+        + energies.contact_work
+        + energies.bulk_viscosity_work
         - energies.external_work
         - initial_kinetic)
         .abs()

@@ -167,6 +167,7 @@ impl<'a> Explicit<'a> {
                 })
                 .map_err(|e| e.to_string())?;
                 commit_kernel_step(&mut self.state, du, work);
+                self.energies.bulk_viscosity_work += work.viscous;
                 let (body, element) = kernel.locate(work.critical_element);
                 Ok(StableStep::of_frequency(work.omega_squared, body, element))
             }
@@ -411,10 +412,16 @@ impl Resume for Explicit<'_> {
         self.contact = carry.contact;
         self.step = carry.step;
         self.clock = carry.clock;
-        // a kernel with its own arrays starts again from the restored points
+        // a kernel with its own arrays starts again from the restored points (and the viscous
+        // pressures of the last step, which the next step's work needs)
         if self.kernel.is_some() {
             (self.kernel, self.kernel_has_own_state) =
                 kernel_for(self.model, self.spec, &self.state, &self.masses);
+            if let Some(kernel) = self.kernel.as_mut()
+                && !carry.viscous_pressure.is_empty()
+            {
+                kernel.restore_viscous_pressure(&carry.viscous_pressure);
+            }
         }
         true
     }
@@ -441,6 +448,10 @@ impl Resume for Explicit<'_> {
             step: self.step,
             contact: self.contact.clone(),
             clock: self.clock.clone(),
+            viscous_pressure: match (&self.kernel, &self.spec.bulk_viscosity) {
+                (Some(kernel), Some(_)) => kernel.viscous_pressure().to_vec(),
+                _ => Vec::new(),
+            },
         }))
     }
 }

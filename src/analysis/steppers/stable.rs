@@ -8,7 +8,9 @@
 //!            formulation: lambda + 2 mu (plane strain, axisymmetric), E / (1 - nu^2) (plane
 //!            stress), E (rod)
 //! dt_crit    2 / omega_max, omega_max^2 the largest element eigenvalue of M_e^-1 K_e of the
-//!            initial configuration (the limit a fixed dt is checked against)
+//!            initial configuration (the limit a fixed dt is checked against); with the
+//!            bulk viscosity of central difference times sqrt(1 + xi^2) - xi, xi = b_1 its
+//!            damping at rest (element::bulk_viscosity::damped_step_factor)
 //! dt_bound   2 / sqrt(max_e omega^2_e), omega^2_e the closed-form frequency bound of the
 //!            kernel that steps the run (<= dt_crit): the run's automatic step is
 //!            time_step_scale dt_bound, re-evaluated every step (clock.rs)
@@ -17,6 +19,7 @@
 use super::clock::Clock;
 use crate::assembly::explicit::{ExplicitKernel, kernel_for};
 use crate::assembly::{self, ElementMasses, State};
+use crate::element::bulk_viscosity::damped_step_factor;
 use crate::output::readable;
 use crate::scene::spec::{AdaptiveStep, DynamicSpec};
 use crate::scene::{InputError, Model};
@@ -62,10 +65,11 @@ pub fn explicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, Inp
     Ok(explicit_clock(model, spec, exact, &state, &masses, kernel.as_deref())?.dt0)
 }
 
-/// The stability limit of `model`, or the refusal of a fixed dt above it (unless the scene
-/// sets `allow_unstable` to watch it blow up): the one check `impact check` and a run share.
+/// The stability limit of `model` under `spec` (the bulk viscosity's damping at rest taken
+/// into account), or the refusal of a fixed dt above it (unless the scene sets
+/// `allow_unstable` to watch it blow up): the one check `impact check` and a run share.
 pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, InputError> {
-    let limit = critical_time_step(model)?;
+    let limit = damped_at_rest(critical_time_step(model)?, spec);
     if let Some(dt) = spec.fixed_dt()
         && dt > limit.dt
         && !spec.allow_unstable
@@ -73,10 +77,15 @@ pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, Inp
         return Err(InputError::new(
             &model.file,
             format!(
-                "analysis.dt = {} exceeds the central-difference stability limit {} (dt / dt_crit = {}; set by body `{}`, element {}); \
+                "analysis.dt = {} exceeds the central-difference stability limit {}{} (dt / dt_crit = {}; set by body `{}`, element {}); \
                  lower dt, use dt = \"auto\", or set analysis.allow_unstable = true to watch it blow up",
                 readable(dt),
                 readable(limit.dt),
+                if spec.bulk_viscosity.is_some() {
+                    " with the bulk viscosity's damping"
+                } else {
+                    ""
+                },
                 readable(dt / limit.dt),
                 model.bodies[limit.body].name,
                 limit.element
@@ -84,6 +93,18 @@ pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, Inp
         ));
     }
     Ok(limit)
+}
+
+/// The stability limit `limit` shortened by the damping of `spec`'s bulk viscosity at rest
+/// (every element has the same, b_1: element::bulk_viscosity); unchanged without it.
+fn damped_at_rest(limit: StableStep, spec: &DynamicSpec) -> StableStep {
+    match &spec.bulk_viscosity {
+        Some(viscosity) => StableStep {
+            dt: limit.dt * damped_step_factor(viscosity.damping_fraction_at_rest()),
+            ..limit
+        },
+        None => limit,
+    }
 }
 
 /// The step an implicit run starts with: the fixed `dt`, or for `dt = "auto"` the time a

@@ -15,10 +15,17 @@
 //! sigma_q               material(R_q sigma_q,n R_q^T, d_q)
 //! f_a                   sum_q W_q (B_q^T sigma_q) on the end configuration (B-bar likewise)
 //! W_int                 sum_q W_q,mid 1/2 (R sigma_n R^T + sigma_{n+1}) . d_q
+//! q_q                   the bulk viscosity's pressure at q from tr d_q / dt (by option;
+//!                       element::bulk_viscosity), the element's rho, c_d, L_e on the mid
+//!                       configuration; f_a then sums B_q^T (sigma_q - q_q I)
+//! W_visc                -sum_q W_q,mid 1/2 (q_q,n + q_q,n+1) tr d_q
 //! ```
 
 use super::{CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, stable_step_of};
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
+use crate::element::bulk_viscosity::{
+    BulkViscosity, ElementScale, damped_frequency_squared, loaded_stress, volumetric_increment,
+};
 use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
@@ -37,6 +44,8 @@ struct PointsState {
     /// Temperature (0 for materials that carry none).
     temperature: [f64; 4],
     thickness: [f64; 4],
+    /// The bulk viscosity's pressure of the step that ended here (0 without it).
+    viscous_pressure: [f64; 4],
 }
 
 /// One element after a step.
@@ -45,6 +54,7 @@ struct ElementStep {
     force: [f64; 8],
     work: f64,
     plastic_work: f64,
+    viscous_work: f64,
     omega_squared: f64,
 }
 
@@ -60,6 +70,9 @@ pub struct Full {
     eq_plastic_strain: Vec<f64>,
     temperature: Vec<f64>,
     thickness: Vec<f64>,
+    /// The bulk viscosity (None: off) and its pressure per element, per point (4 each).
+    viscosity: Option<BulkViscosity>,
+    viscous_pressure: Vec<f64>,
     element_forces: Vec<f64>,
     gather: NodeGather,
 }
@@ -122,8 +135,8 @@ fn forces(values: &QuadValues, stress: &[[f64; 4]; 4], bbar: bool) -> [f64; 8] {
     f
 }
 
-/// One element over one step of length dt: positions x at the start, increment u (see the
-/// legend).
+/// One element over one step of length dt: positions x at the start, increment u, with the
+/// bulk viscosity `viscosity` when on (see the legend).
 fn element_step(
     p: &super::BodyParameters,
     x: &Nodes,
@@ -131,6 +144,7 @@ fn element_step(
     committed: &PointsState,
     lumped: &[f64; 4],
     dt: f64,
+    viscosity: Option<&BulkViscosity>,
 ) -> Result<ElementStep, KernelError> {
     let axisymmetric = p.axisymmetric();
     let mid: Nodes = std::array::from_fn(|a| [x[a][0] + 0.5 * u[a][0], x[a][1] + 0.5 * u[a][1]]);
@@ -155,6 +169,14 @@ fn element_step(
             }
         }
     }
+    // the volumetric increments the viscous pressures follow (before plane stress writes the
+    // thickness strain into the increments)
+    let viscous = viscosity.map(|viscosity| {
+        let scale = ElementScale::new(&mid, lumped.iter().sum(), at_mid.volume(), p.wave_modulus);
+        let volumetric: [f64; 4] =
+            std::array::from_fn(|q| volumetric_increment(&strain[q], p.formulation));
+        (viscosity, scale, volumetric)
+    });
     let mut state = *committed;
     let (mut work, mut plastic_work) = (0.0, 0.0);
     for q in 0..4 {
@@ -192,12 +214,41 @@ fn element_step(
         state.stress[q] = stress;
     }
     let at_end = quad4::values(&end, p.formulation, &state.thickness)?;
+    let omega_squared = quad4::frequency_bound(&at_end, p.wave_lambda, p.mu, lumped);
+    let Some((viscosity, scale, volumetric)) = viscous else {
+        return Ok(ElementStep {
+            force: forces(&at_end, &state.stress, p.bbar),
+            omega_squared,
+            state,
+            work,
+            plastic_work,
+            viscous_work: 0.0,
+        });
+    };
+    let mut loaded = state.stress;
+    let (mut viscous_work, mut damping_fraction) = (0.0, 0.0);
+    for q in 0..4 {
+        let weight = at_mid.points[q].weight;
+        let v = viscosity.step(
+            &scale,
+            volumetric[q],
+            dt,
+            weight,
+            committed.viscous_pressure[q],
+        );
+        viscous_work += v.work;
+        // the most compressed point sets the element's damping
+        damping_fraction = f64::max(damping_fraction, v.damping_fraction);
+        state.viscous_pressure[q] = v.pressure;
+        loaded[q] = loaded_stress(&state.stress[q], v.pressure, p.formulation);
+    }
     Ok(ElementStep {
-        force: forces(&at_end, &state.stress, p.bbar),
-        omega_squared: quad4::frequency_bound(&at_end, p.wave_lambda, p.mu, lumped),
+        force: forces(&at_end, &loaded, p.bbar),
+        omega_squared: damped_frequency_squared(omega_squared, damping_fraction),
         state,
         work,
         plastic_work,
+        viscous_work,
     })
 }
 
@@ -281,6 +332,8 @@ impl Full {
             eq_plastic_strain: Vec::with_capacity(4 * count),
             temperature: Vec::with_capacity(4 * count),
             thickness: Vec::with_capacity(4 * count),
+            viscosity: None,
+            viscous_pressure: vec![0.0; 4 * count],
             element_forces: vec![0.0; 8 * count],
             gather: NodeGather::new(&layout.nodes, state.coordinates.len()),
             layout,
@@ -302,6 +355,11 @@ impl Full {
         kernel
     }
 
+    /// The kernel with the bulk viscosity `viscosity` (None: off).
+    pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Full {
+        Full { viscosity, ..self }
+    }
+
     fn state_of(&self, e: usize) -> PointsState {
         PointsState {
             stress: std::array::from_fn(|q| {
@@ -313,6 +371,22 @@ impl Full {
             eq_plastic_strain: std::array::from_fn(|q| self.eq_plastic_strain[4 * e + q]),
             temperature: std::array::from_fn(|q| self.temperature[4 * e + q]),
             thickness: std::array::from_fn(|q| self.thickness[4 * e + q]),
+            viscous_pressure: std::array::from_fn(|q| self.viscous_pressure[4 * e + q]),
+        }
+    }
+
+    /// The stress the forces of element `e` see in `state` (the stored viscous pressure taken
+    /// off when the bulk viscosity is on).
+    fn loaded(&self, e: usize, state: &PointsState) -> [[f64; 4]; 4] {
+        match self.viscosity {
+            Some(_) => std::array::from_fn(|q| {
+                loaded_stress(
+                    &state.stress[q],
+                    state.viscous_pressure[q],
+                    self.parameters(e).formulation,
+                )
+            }),
+            None => state.stress,
         }
     }
 
@@ -337,7 +411,7 @@ impl ExplicitKernel for Full {
             let p = self.parameters(e);
             let values = quad4::values(&xe, p.formulation, &state.thickness)
                 .map_err(|err| self.layout.failure(e, err))?;
-            let f = forces(&values, &state.stress, p.bbar);
+            let f = forces(&values, &self.loaded(e, &state), p.bbar);
             self.element_forces[8 * e..8 * e + 8].copy_from_slice(&f);
         }
         self.gather.gather(&self.element_forces, force);
@@ -352,6 +426,11 @@ impl ExplicitKernel for Full {
             let values = quad4::values(&xe, p.formulation, &self.state_of(e).thickness)
                 .map_err(|err| self.layout.failure(e, err))?;
             let w = quad4::frequency_bound(&values, p.wave_lambda, p.mu, &self.lumped[e]);
+            // at rest (no step yet): the damping of the linear term alone
+            let w = match &self.viscosity {
+                Some(v) => damped_frequency_squared(w, v.damping_fraction_at_rest()),
+                None => w,
+            };
             worst.observe(w, e);
         }
         Ok(stable_step_of(&self.layout, &worst))
@@ -366,18 +445,20 @@ impl ExplicitKernel for Full {
     ) -> Result<StepWork, ElementFailure> {
         let layout = &self.layout;
         let lumped = &self.lumped;
+        let viscosity = self.viscosity.as_ref();
         let results: Vec<(StepWork, Option<(usize, KernelError)>)> = (
             self.stress.par_chunks_mut(16 * CHUNK),
             self.back_stress.par_chunks_mut(16 * CHUNK),
             self.eq_plastic_strain.par_chunks_mut(4 * CHUNK),
             self.temperature.par_chunks_mut(4 * CHUNK),
             self.thickness.par_chunks_mut(4 * CHUNK),
+            self.viscous_pressure.par_chunks_mut(4 * CHUNK),
             self.element_forces.par_chunks_mut(8 * CHUNK),
         )
             .into_par_iter()
             .enumerate()
             .map(
-                |(k, (stress, back, eps_p, temperature, thickness, forces))| {
+                |(k, (stress, back, eps_p, temperature, thickness, viscous, forces))| {
                     let mut sums = StepWork::default();
                     for i in 0..forces.len() / 8 {
                         let e = k * CHUNK + i;
@@ -395,9 +476,12 @@ impl ExplicitKernel for Full {
                             eq_plastic_strain: std::array::from_fn(|q| eps_p[4 * i + q]),
                             temperature: std::array::from_fn(|q| temperature[4 * i + q]),
                             thickness: std::array::from_fn(|q| thickness[4 * i + q]),
+                            viscous_pressure: std::array::from_fn(|q| viscous[4 * i + q]),
                         };
                         let p = &layout.bodies[layout.body[e] as usize];
-                        let r = match element_step(p, &xe, &ue, &committed, &lumped[e], dt) {
+                        let r = match element_step(
+                            p, &xe, &ue, &committed, &lumped[e], dt, viscosity,
+                        ) {
                             Ok(r) => r,
                             Err(err) => return (sums, Some((e, err))),
                         };
@@ -411,9 +495,11 @@ impl ExplicitKernel for Full {
                         eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
                         temperature[4 * i..4 * i + 4].copy_from_slice(&r.state.temperature);
                         thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
+                        viscous[4 * i..4 * i + 4].copy_from_slice(&r.state.viscous_pressure);
                         forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
                         sums.internal += r.work;
                         sums.plastic += r.plastic_work;
+                        sums.viscous += r.viscous_work;
                     }
                     (sums, None)
                 },
@@ -448,5 +534,13 @@ impl ExplicitKernel for Full {
 
     fn eq_plastic_strain(&self) -> &[f64] {
         &self.eq_plastic_strain
+    }
+
+    fn viscous_pressure(&self) -> &[f64] {
+        &self.viscous_pressure
+    }
+
+    fn restore_viscous_pressure(&mut self, values: &[f64]) {
+        self.viscous_pressure.copy_from_slice(values);
     }
 }

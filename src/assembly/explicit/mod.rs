@@ -3,7 +3,8 @@
 //! depend on the thread count). Two kernels: the one-point Quad4 with hourglass control
 //! (`one_point`, `quadrature = "reduced"`) and the 2x2 Quad4 in the same rate form (`full`,
 //! `quadrature = "full"` on finite-strain Quad4 models); both give the element frequency
-//! bound of the end configuration for the stable step.
+//! bound of the end configuration for the stable step, and both carry the optional bulk
+//! viscosity (`element::bulk_viscosity`), whose damping they fold into that bound.
 
 pub mod full;
 pub mod one_point;
@@ -25,10 +26,13 @@ pub(super) const CHUNK: usize = 256;
 /// The sums of one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepWork {
-    /// Work of the stresses and the hourglass forces (includes both below).
+    /// Work of the stresses and the hourglass forces (includes plastic and hourglass below,
+    /// not the bulk viscosity).
     pub internal: f64,
     pub plastic: f64,
     pub hourglass: f64,
+    /// Work of the bulk viscosity's pressure (0 without it).
+    pub viscous: f64,
     /// The largest element frequency bound squared on the end configuration, and its
     /// element (index over the kernel's elements; the lowest among equals).
     pub omega_squared: f64,
@@ -41,6 +45,7 @@ impl Default for StepWork {
             internal: 0.0,
             plastic: 0.0,
             hourglass: 0.0,
+            viscous: 0.0,
             omega_squared: 0.0,
             critical_element: usize::MAX,
         }
@@ -63,6 +68,7 @@ impl StepWork {
         self.internal += other.internal;
         self.plastic += other.plastic;
         self.hourglass += other.hourglass;
+        self.viscous += other.viscous;
         self.observe(other.omega_squared, other.critical_element);
     }
 }
@@ -244,6 +250,11 @@ pub trait ExplicitKernel: Send {
     fn hourglass_energy(&self) -> Option<f64> {
         None
     }
+    /// The bulk viscosity's pressure q of the last step at every point the kernel keeps
+    /// (zeros without it): what a checkpoint carries, since the next step's work needs it.
+    fn viscous_pressure(&self) -> &[f64];
+    /// Takes the viscous pressures of a checkpoint (as `viscous_pressure` gave them).
+    fn restore_viscous_pressure(&mut self, values: &[f64]);
     /// The equivalent plastic strain of every point the kernel keeps (for studies).
     fn eq_plastic_strain(&self) -> &[f64];
 }
@@ -270,12 +281,18 @@ pub fn kernel_for(
     let quads_only = model.bodies.iter().all(|b| !b.kind.is_rod());
     match spec.quadrature {
         Quadrature::Reduced => (
-            Some(Box::new(Reduced::new(model, state, spec.hourglass, masses))),
+            Some(Box::new(
+                Reduced::new(model, state, spec.hourglass, masses)
+                    .with_bulk_viscosity(spec.bulk_viscosity),
+            )),
             true,
         ),
-        Quadrature::Full if quads_only && spec.geometry == Strain::Finite => {
-            (Some(Box::new(Full::new(model, state, masses))), false)
-        }
+        Quadrature::Full if quads_only && spec.geometry == Strain::Finite => (
+            Some(Box::new(
+                Full::new(model, state, masses).with_bulk_viscosity(spec.bulk_viscosity),
+            )),
+            false,
+        ),
         Quadrature::Full => (None, false),
     }
 }

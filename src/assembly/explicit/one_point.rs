@@ -7,6 +7,9 @@
 //! ```text
 //! sigma      sigma_{n+1} = material(R sigma_n R^T, d)   (back stress rotated alike)
 //! W_int      t A_mid 1/2 (R sigma_n R^T + sigma_{n+1}) . d;  W_hg = 1/2 (R Q_n + Q_{n+1}) . q
+//! q          the bulk viscosity's pressure from tr d / dt (by option; element::bulk_viscosity),
+//!            rho, c_d, L_e on the mid configuration; the forces see sigma - q I
+//! W_visc     -t A_mid 1/2 (q_n + q_{n+1}) tr d
 //! ```
 //! Parallel and deterministic: elements are processed in fixed chunks (rayon), each writes
 //! its own 8 force entries; nodes then gather their elements' entries in element order, and
@@ -15,6 +18,9 @@
 
 use super::{BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, stable_step_of};
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
+use crate::element::bulk_viscosity::{
+    BulkViscosity, ElementScale, damped_frequency_squared, loaded_stress, volumetric_increment,
+};
 use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
 use crate::material::{
@@ -36,6 +42,8 @@ pub struct ElementState {
     pub thickness: f64,
     /// Hourglass forces Q [x y].
     pub hourglass: [f64; 2],
+    /// The bulk viscosity's pressure of the step that ended here (0 without it).
+    pub viscous_pressure: f64,
 }
 
 /// The new state of one element after a step, with its forces and work.
@@ -48,20 +56,32 @@ pub struct ElementStep {
     pub work: f64,
     pub plastic_work: f64,
     pub hourglass_work: f64,
-    /// The bound of the element's highest frequency squared on the end configuration.
+    /// Work of the bulk viscosity's pressure.
+    pub viscous_work: f64,
+    /// The bound of the element's highest frequency squared on the end configuration (with
+    /// the bulk viscosity: the damped bound, `damped_frequency_squared`).
     pub omega_squared: f64,
 }
 
-/// One element over one step of length dt: positions x at the start, increment u (see the
-/// legend).
+/// What the one-point kernel knows of an element's mass: the smallest of its lumped nodal
+/// masses (the stable-step bound) and their sum (its density, for the bulk viscosity).
+#[derive(Debug, Clone, Copy)]
+struct ElementMass {
+    smallest: f64,
+    total: f64,
+}
+
+/// One element over one step of length dt: positions x at the start, increment u, with the
+/// bulk viscosity `viscosity` when on (see the legend).
 #[inline(always)]
 fn element_step(
     p: &BodyParameters,
     x: &Nodes,
     u: &Nodes,
     committed: &ElementState,
-    smallest_mass: f64,
+    mass: ElementMass,
     dt: f64,
+    viscosity: Option<&BulkViscosity>,
 ) -> Result<ElementStep, KernelError> {
     let t = committed.thickness;
     let section = if p.axisymmetric() {
@@ -74,6 +94,9 @@ fn element_step(
     let stress_n = rotate(&committed.stress, c, s);
     let back_n = rotate(&committed.back_stress, c, s);
     let mut strain = step.strain;
+    // the volumetric increment the viscous pressure follows (before plane stress writes the
+    // thickness strain into it)
+    let volumetric = volumetric_increment(&strain, p.formulation);
     let MaterialStep {
         stress,
         back_stress,
@@ -96,6 +119,10 @@ fn element_step(
         p.hourglass_modulus,
         section.weight(&step.mid),
     );
+    let viscous = viscosity.map(|viscosity| {
+        let scale = ElementScale::new(&step.mid, mass.total, volume, p.wave_modulus);
+        viscosity.step(&scale, volumetric, dt, volume, committed.viscous_pressure)
+    });
     let state = ElementState {
         stress,
         back_stress,
@@ -103,6 +130,7 @@ fn element_step(
         temperature,
         thickness,
         hourglass: hourglass.forces,
+        viscous_pressure: viscous.map_or(committed.viscous_pressure, |v| v.pressure),
     };
     let section = match section {
         Section::Plane { .. } => Section::Plane {
@@ -110,7 +138,13 @@ fn element_step(
         },
         axisymmetric => axisymmetric,
     };
-    let end = one_point::force(&step.end, &state.stress, section, &state.hourglass)?;
+    let end = match viscous {
+        Some(v) => {
+            let loaded = loaded_stress(&state.stress, v.pressure, p.formulation);
+            one_point::force(&step.end, &loaded, section, &state.hourglass)?
+        }
+        None => one_point::force(&step.end, &state.stress, section, &state.hourglass)?,
+    };
     let omega_squared = one_point::frequency_bound(
         &end.gradient,
         &end.gamma,
@@ -119,8 +153,15 @@ fn element_step(
         p.axisymmetric()
             .then(|| one_point::centroid_radius(&step.end)),
         p.hourglass_modulus,
-        smallest_mass,
+        mass.smallest,
     );
+    let (omega_squared, viscous_work) = match viscous {
+        Some(v) => (
+            damped_frequency_squared(omega_squared, v.damping_fraction),
+            v.work,
+        ),
+        None => (omega_squared, 0.0),
+    };
     Ok(ElementStep {
         state,
         force: end.force,
@@ -134,6 +175,7 @@ fn element_step(
                 plastic_density,
             ),
         hourglass_work: hourglass.work,
+        viscous_work,
         omega_squared,
     })
 }
@@ -236,8 +278,8 @@ fn material_step(
 /// over the bodies in order).
 pub struct Reduced {
     layout: Layout,
-    /// The smallest lumped nodal mass of each element (for its stable-step bound).
-    smallest_mass: Vec<f64>,
+    /// The smallest and the total lumped nodal mass of each element.
+    mass: Vec<ElementMass>,
     /// Cauchy stress, 4 per element [xx yy zz xy].
     pub stress: Vec<f64>,
     /// Back stress, 4 per element.
@@ -249,6 +291,9 @@ pub struct Reduced {
     pub thickness: Vec<f64>,
     /// Hourglass forces Q, 2 per element.
     pub hourglass: Vec<f64>,
+    /// The bulk viscosity (None: off) and its pressure per element.
+    viscosity: Option<BulkViscosity>,
+    viscous_pressure: Vec<f64>,
     /// Element forces of the last evaluation, 8 per element.
     element_forces: Vec<f64>,
     gather: NodeGather,
@@ -264,7 +309,7 @@ impl Reduced {
         let count = layout.body.len();
         let (mut stress, mut back_stress) =
             (Vec::with_capacity(4 * count), Vec::with_capacity(4 * count));
-        let (mut eq_plastic_strain, mut temperature, mut thickness, mut smallest_mass) = (
+        let (mut eq_plastic_strain, mut temperature, mut thickness, mut mass) = (
             Vec::with_capacity(count),
             Vec::with_capacity(count),
             Vec::with_capacity(count),
@@ -278,27 +323,44 @@ impl Reduced {
             eq_plastic_strain.push(p.eq_plastic_strain);
             temperature.push(p.temperature);
             thickness.push(committed.thickness[4 * e]);
-            smallest_mass.push(
-                masses
-                    .of(model, b, e)
-                    .iter()
-                    .copied()
-                    .fold(f64::INFINITY, f64::min),
-            );
+            let nodal = masses.of(model, b, e);
+            mass.push(ElementMass {
+                smallest: nodal.iter().copied().fold(f64::INFINITY, f64::min),
+                total: nodal.iter().sum(),
+            });
         }
         let gather = NodeGather::new(&layout.nodes, state.coordinates.len());
         Reduced {
             layout,
-            smallest_mass,
+            mass,
             stress,
             back_stress,
             eq_plastic_strain,
             temperature,
             thickness,
             hourglass: vec![0.0; 2 * count],
+            viscosity: None,
+            viscous_pressure: vec![0.0; count],
             element_forces: vec![0.0; 8 * count],
             gather,
             hourglass_energy: 0.0,
+        }
+    }
+
+    /// The kernel with the bulk viscosity `viscosity` (None: off).
+    pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Reduced {
+        Reduced { viscosity, ..self }
+    }
+
+    /// The stress the forces of element `e` see in `state` (the stored viscous pressure taken
+    /// off when the bulk viscosity is on).
+    fn loaded(&self, e: usize, state: &ElementState) -> [f64; 4] {
+        match self.viscosity {
+            Some(_) => {
+                let p = &self.layout.bodies[self.layout.body[e] as usize];
+                loaded_stress(&state.stress, state.viscous_pressure, p.formulation)
+            }
+            None => state.stress,
         }
     }
 
@@ -321,6 +383,7 @@ impl Reduced {
             temperature: self.temperature[e],
             thickness: self.thickness[e],
             hourglass: [self.hourglass[2 * e], self.hourglass[2 * e + 1]],
+            viscous_pressure: self.viscous_pressure[e],
         }
     }
 }
@@ -346,7 +409,8 @@ impl ExplicitKernel for Reduced {
                     let xe: Nodes = this.layout.nodes[e].map(|n| x[n as usize]);
                     let state = this.state_of(e);
                     let section = this.section(e, &state);
-                    match one_point::force(&xe, &state.stress, section, &state.hourglass) {
+                    let stress = this.loaded(e, &state);
+                    match one_point::force(&xe, &stress, section, &state.hourglass) {
                         Ok(v) => f.copy_from_slice(&v.force),
                         Err(err) => return Some((e, err)),
                     }
@@ -381,8 +445,13 @@ impl ExplicitKernel for Reduced {
                 end.gradient.area * section.weight(&xe),
                 p.axisymmetric().then(|| one_point::centroid_radius(&xe)),
                 p.hourglass_modulus,
-                self.smallest_mass[e],
+                self.mass[e].smallest,
             );
+            // at rest (no step yet): the damping of the linear term alone
+            let omega_squared = match &self.viscosity {
+                Some(v) => damped_frequency_squared(omega_squared, v.damping_fraction_at_rest()),
+                None => omega_squared,
+            };
             worst.observe(omega_squared, e);
         }
         Ok(stable_step_of(&self.layout, &worst))
@@ -396,7 +465,8 @@ impl ExplicitKernel for Reduced {
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
         let layout = &self.layout;
-        let smallest_mass = &self.smallest_mass;
+        let mass = &self.mass;
+        let viscosity = self.viscosity.as_ref();
         let results: Vec<(StepWork, Option<(usize, KernelError)>)> = (
             self.stress.par_chunks_mut(4 * CHUNK),
             self.back_stress.par_chunks_mut(4 * CHUNK),
@@ -404,12 +474,14 @@ impl ExplicitKernel for Reduced {
             self.temperature.par_chunks_mut(CHUNK),
             self.thickness.par_chunks_mut(CHUNK),
             self.hourglass.par_chunks_mut(2 * CHUNK),
+            self.viscous_pressure.par_chunks_mut(CHUNK),
             self.element_forces.par_chunks_mut(8 * CHUNK),
         )
             .into_par_iter()
             .enumerate()
             .map(|(k, chunks)| {
-                let (stress, back, eps_p, temperature, thickness, hourglass, forces) = chunks;
+                let (stress, back, eps_p, temperature, thickness, hourglass, viscous, forces) =
+                    chunks;
                 let mut sums = StepWork::default();
                 for i in 0..eps_p.len() {
                     let e = k * CHUNK + i;
@@ -423,9 +495,10 @@ impl ExplicitKernel for Reduced {
                         temperature: temperature[i],
                         thickness: thickness[i],
                         hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
+                        viscous_pressure: viscous[i],
                     };
                     let p = &layout.bodies[layout.body[e] as usize];
-                    let r = match element_step(p, &xe, &ue, &committed, smallest_mass[e], dt) {
+                    let r = match element_step(p, &xe, &ue, &committed, mass[e], dt, viscosity) {
                         Ok(r) => r,
                         Err(err) => return (sums, Some((e, err))),
                     };
@@ -436,10 +509,12 @@ impl ExplicitKernel for Reduced {
                     temperature[i] = r.state.temperature;
                     thickness[i] = r.state.thickness;
                     hourglass[2 * i..2 * i + 2].copy_from_slice(&r.state.hourglass);
+                    viscous[i] = r.state.viscous_pressure;
                     forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
                     sums.internal += r.work + r.hourglass_work;
                     sums.plastic += r.plastic_work;
                     sums.hourglass += r.hourglass_work;
+                    sums.viscous += r.viscous_work;
                 }
                 (sums, None)
             })
@@ -487,6 +562,14 @@ impl ExplicitKernel for Reduced {
 
     fn hourglass_energy(&self) -> Option<f64> {
         Some(self.hourglass_energy)
+    }
+
+    fn viscous_pressure(&self) -> &[f64] {
+        &self.viscous_pressure
+    }
+
+    fn restore_viscous_pressure(&mut self, values: &[f64]) {
+        self.viscous_pressure.copy_from_slice(values);
     }
 
     fn eq_plastic_strain(&self) -> &[f64] {
@@ -541,6 +624,7 @@ mod tests {
             temperature: 0.0,
             thickness: 1.0,
             hourglass: [0.0; 2],
+            viscous_pressure: 0.0,
         };
         let step: f64 = 0.003;
         let (c, s) = (step.cos(), step.sin());
@@ -549,7 +633,13 @@ mod tests {
                 let [px, py] = x[a];
                 [c * px - s * py - px, s * px + c * py - py]
             });
-            state = element_step(&p, &x, &u, &state, 1.0, 1.0).unwrap().state;
+            let mass = ElementMass {
+                smallest: 1.0,
+                total: 4.0,
+            };
+            state = element_step(&p, &x, &u, &state, mass, 1.0, None)
+                .unwrap()
+                .state;
             x = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);
         }
         // round-off: E ~ 200 times strains of ~1e-16 per step

@@ -3,6 +3,7 @@
 
 use super::yes;
 use crate::element::Strain;
+use crate::element::bulk_viscosity::BulkViscosity;
 use serde::Deserialize;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -154,6 +155,19 @@ pub struct AnalysisSpec {
     /// `quadrature = "reduced"`: the hourglass stiffness coefficient kappa in [0, 1]: kappa = 1
     /// gives a square element the hourglass stiffness of the fully integrated one. Default 0.1.
     pub hourglass: Option<f64>,
+    /// Central difference on Quad4 bodies at finite strain: the bulk viscosity, an artificial
+    /// pressure on the volumetric strain rate (docs/theory.md 8.7a). Default: none (off).
+    pub bulk_viscosity: Option<BulkViscositySpec>,
+}
+
+/// `analysis.bulk_viscosity = { linear = 0.06, quadratic = 1.2 }`: the coefficients b_1 and
+/// b_2 of Abaqus/Explicit's bulk viscosity, each >= 0 and defaulting to those values (so
+/// `bulk_viscosity = {}` turns it on with the defaults).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BulkViscositySpec {
+    pub linear: Option<f64>,
+    pub quadratic: Option<f64>,
 }
 
 /// `analysis.dt` as written: a step length or the word `auto`.
@@ -335,6 +349,8 @@ pub struct DynamicSpec {
     pub quadrature: Quadrature,
     /// The hourglass coefficient kappa of the reduced kernel (0.1 unless given).
     pub hourglass: f64,
+    /// Central difference: the bulk viscosity of the explicit Quad4 kernels (None: off).
+    pub bulk_viscosity: Option<BulkViscosity>,
 }
 
 /// The validated static analysis.
