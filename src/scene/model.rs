@@ -13,7 +13,7 @@ use super::spec::{
 };
 use crate::contact::{BodySurface, ContactPair, Interfaces, Obstacle, Section};
 use crate::element::{Formulation, Strain, Voigt};
-use crate::material::{Material, StressCondition};
+use crate::material::{Material, PointState, StressCondition};
 use crate::mesh::Mesh;
 use crate::output::readable;
 use std::path::PathBuf;
@@ -222,6 +222,38 @@ pub struct Probe {
     /// Node ids (nodal quantities, global) or element ids of the body.
     pub members: Vec<usize>,
     pub column: String,
+}
+
+impl Probe {
+    /// The probe's statistic (mean, max, min) of `values`.
+    pub fn combine(&self, values: &mut dyn Iterator<Item = f64>) -> f64 {
+        match self.statistic {
+            Statistic::Mean => {
+                let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
+                sum / count.max(1) as f64
+            }
+            Statistic::Max => values.fold(f64::NEG_INFINITY, f64::max),
+            Statistic::Min => values.fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// The statistic of `f` over the material points of the probe's elements, `points` the
+    /// points of its body (`points_per_element` each).
+    pub fn of_points(
+        &self,
+        points: &[PointState],
+        points_per_element: usize,
+        f: &dyn Fn(&PointState) -> f64,
+    ) -> f64 {
+        let ppe = points_per_element;
+        self.combine(
+            &mut self
+                .members
+                .iter()
+                .flat_map(|e| &points[e * ppe..(e + 1) * ppe])
+                .map(f),
+        )
+    }
 }
 
 #[derive(Debug, Clone)]

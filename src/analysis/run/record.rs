@@ -13,7 +13,7 @@ use crate::output::history::History;
 use crate::output::vtk::{Fields, Grid, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
-use crate::scene::spec::{FramePoints, Quantity, Statistic};
+use crate::scene::spec::{FramePoints, Quantity};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -613,28 +613,11 @@ fn probe_value(
     initial: &[[f64; 2]],
     probe: &crate::scene::model::Probe,
 ) -> f64 {
-    let combine = |values: &mut dyn Iterator<Item = f64>| -> f64 {
-        match probe.statistic {
-            Statistic::Mean => {
-                let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
-                sum / count.max(1) as f64
-            }
-            Statistic::Max => values.fold(f64::NEG_INFINITY, f64::max),
-            Statistic::Min => values.fold(f64::INFINITY, f64::min),
-        }
-    };
+    let combine = |values: &mut dyn Iterator<Item = f64>| probe.combine(values);
     let nodal = |v: &[f64], c: usize| combine(&mut probe.members.iter().map(|m| v[2 * m + c]));
     let points = |f: &dyn Fn(&crate::material::PointState) -> f64| {
-        let body = &model.bodies[probe.body];
-        let ppe = body.points_per_element();
-        let pts = &state.bodies[probe.body].points;
-        combine(
-            &mut probe
-                .members
-                .iter()
-                .flat_map(|e| &pts[e * ppe..(e + 1) * ppe])
-                .map(f),
-        )
+        let ppe = model.bodies[probe.body].points_per_element();
+        probe.of_points(&state.bodies[probe.body].points, ppe, f)
     };
     match probe.quantity {
         Quantity::DisplacementX => nodal(&state.displacement, 0),
