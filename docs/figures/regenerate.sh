@@ -78,6 +78,35 @@ for m in L_f D_f; do
   copy $out/sweep_taylor_jc_mesh/error_vs_cpu_$m sweep_taylor_jc_${m}_speed
 done
 
+# The implicit step: fixed dt against dt = "auto" at a sweep of tolerances (validation
+# 10.3a). taylor_jc with the lumped mass, scored against its explicit 2x2 run (the same
+# semi-discretization: L_f, D_f, T, eps_p of `impact run models/taylor_jc.toml`); sphere_wall
+# against Hertz (peak force 60.2) and 2 m V (the impulse of an elastic rebound, 8.37758).
+# About a minute on 2 cores.
+jc='--set analysis.integrator=average --set analysis.mass=lumped
+  --measure L_f=extent_y[all] --measure D_f=extent_x[all]
+  --measure T=temperature[face_centre] --measure eps_p=eq_plastic_strain[face_centre]
+  --reference L_f=0.026531158 --reference D_f=0.011147658 --reference T=589.845
+  --reference eps_p=1.80725'
+# shellcheck disable=SC2086
+sweep models/taylor_jc.toml --vary 'analysis.dt=2e-7,1e-7,5e-8,2.5e-8' $jc \
+  --out $out/sweep_taylor_jc_fixed
+# shellcheck disable=SC2086
+sweep models/taylor_jc.toml --set analysis.dt=auto \
+  --vary 'analysis.error_tolerance=3e-2,1e-2,3e-3,1e-3,3e-4' $jc --out $out/sweep_taylor_jc_tolerance
+hz='--measure peak=max(contact_force[wall]) --measure impulse=integral(contact_force[wall])
+  --reference peak=60.2 --reference impulse=8.37758'
+# shellcheck disable=SC2086
+sweep models/sphere_wall.toml --vary 'analysis.dt=0.02,0.01,0.005,0.0025' $hz \
+  --out $out/sweep_sphere_wall_fixed
+# shellcheck disable=SC2086
+sweep models/sphere_wall.toml --set analysis.dt=auto \
+  --vary 'analysis.error_tolerance=1e-1,3e-2,1e-2,3e-3,1e-3' $hz --out $out/sweep_sphere_wall_tolerance
+for s in fixed tolerance; do
+  for m in D_f T; do copy $out/sweep_taylor_jc_$s/error_vs_cpu_$m sweep_taylor_jc_${s}_$m; done
+  for m in peak impulse; do copy $out/sweep_sphere_wall_$s/error_vs_cpu_$m sweep_sphere_wall_${s}_$m; done
+done
+
 # The Taylor rods (aluminium, Johnson-Cook steel): three meshes, one-point and 2x2 explicit,
 # implicit Newmark on the two coarser Johnson-Cook meshes; about four minutes
 impact bench --case taylor --out $out/bench_taylor

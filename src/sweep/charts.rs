@@ -224,8 +224,12 @@ pub fn write_measures(
             .iter()
             .map(|(label, members)| (label.clone(), members.iter().map(|&i| &rows[i]).collect()))
             .collect();
+        let against = match score.measure.reference {
+            Some(value) => format!("the reference {value}"),
+            None => "the converged value".to_string(),
+        };
         let name = format!(
-            "|{} error| (relative, against the converged value)",
+            "|{} error| (relative, against {against})",
             score.measure.name
         );
         written.extend(error_vs_cpu(

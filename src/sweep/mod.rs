@@ -262,6 +262,10 @@ fn run_case(
     Ok(record)
 }
 
+/// The characters of a scene's title the charts keep: an 800-pixel chart holds about 78 of
+/// the title font, and the charts add up to 30 (": error against CPU time").
+const TITLE_CHARACTERS: usize = 48;
+
 /// Joins the finished cases of sweeps run into `dirs` (shards of one plan) and writes the
 /// table and charts into `out`.
 pub fn merge(dirs: &[PathBuf], out: &Path, measures: &[Measure]) -> Result<Report, RunError> {
@@ -334,15 +338,15 @@ fn write_results(
     write_atomic(&out.join("reference.json"), text.as_bytes())?;
     let text = serde_json::to_string_pretty(&scores).expect("the scores serialize");
     write_atomic(&out.join("measures.json"), text.as_bytes())?;
-    // the scene's title (its first 60 characters: the charts add what they show), else its
-    // name (the file's stem)
+    // the scene's title (its first TITLE_CHARACTERS: the charts add what they show, up to 30
+    // more, and a title wider than the chart is cut at both ends), else its name (the stem)
     let title = models
         .first()
         .map(|m| {
             if m.title.is_empty() {
                 m.name.clone()
-            } else if m.title.chars().count() > 60 {
-                let cut: String = m.title.chars().take(59).collect();
+            } else if m.title.chars().count() > TITLE_CHARACTERS {
+                let cut: String = m.title.chars().take(TITLE_CHARACTERS - 1).collect();
                 format!("{}…", cut.trim_end())
             } else {
                 m.title.clone()
