@@ -21,6 +21,16 @@ use crate::scene::{Body, BodyKind};
 use nalgebra::Matrix2;
 use std::time::Instant;
 
+/// Element `element` of `body` at its committed state (`committed`, the configuration
+/// `coordinates`): what every kernel call reads.
+#[derive(Clone, Copy)]
+pub struct ElementAt<'a> {
+    pub body: &'a Body,
+    pub committed: &'a BodyState,
+    pub coordinates: &'a [[f64; 2]],
+    pub element: usize,
+}
+
 /// Where a kernel writes one element's results: slices of the caller's arrays, so a result
 /// is written once, in place, and never moved (a whole-result struct sized for a Quad4 was
 /// ~1 kB a rod, copied three times an evaluation).
@@ -98,25 +108,28 @@ impl Kernel {
         }
     }
 
-    /// Internal force, trial point states and work of element `e` at the increment `d` over
-    /// the time step `dt` from the committed state, into `out`; with `tangent`, its matrix.
-    #[allow(clippy::too_many_arguments)]
+    /// Internal force, trial point states and work of the element `at` at the increment `d`
+    /// over the time step `dt` from the committed state, into `out`; with `tangent`, its
+    /// matrix.
     // inlined into the assembly's element loop, whose kernel is fixed for a body: the rod
     // loop then runs without the Quad4 arm's frame (the 224-rod bars 0.90x, the Quad4
     // scenes 0.97-1.0x)
     #[inline(always)]
     pub fn evaluate(
         &self,
-        body: &Body,
-        committed: &BodyState,
-        coordinates: &[[f64; 2]],
+        at: ElementAt<'_>,
         d: &[f64],
         dt: f64,
-        e: usize,
         geometry: Strain,
         tangent: Option<Tangent>,
         out: ElementOut<'_>,
     ) -> Result<ElementWork, KernelError> {
+        let ElementAt {
+            body,
+            committed,
+            coordinates,
+            element: e,
+        } = at;
         // the material's tangent, or D_e (Erklig's modified Newton); K_sigma unless `elastic`
         let elastic_moduli = tangent.is_some_and(|t| t != Tangent::Consistent);
         let geometric = if tangent == Some(Tangent::Elastic) {
@@ -222,19 +235,21 @@ impl Kernel {
         }
     }
 
-    /// Pushes the trial stresses of element `e` (second Piola-Kirchhoff of the increment `d`)
-    /// forward to Cauchy stresses on the new configuration (finite strain).
-    #[allow(clippy::too_many_arguments)]
+    /// Pushes the trial stresses of the element `at` (second Piola-Kirchhoff of the
+    /// increment `d`) forward to Cauchy stresses on the new configuration (finite strain).
     pub fn push_forward(
         &self,
-        body: &Body,
-        committed: &BodyState,
-        coordinates: &[[f64; 2]],
+        at: ElementAt<'_>,
         d: &[f64],
         strain_zz: &[f64],
-        e: usize,
         points: &mut [PointState],
     ) {
+        let ElementAt {
+            body,
+            committed,
+            coordinates,
+            element: e,
+        } = at;
         match *self {
             Kernel::Quad4 { formulation, .. } => {
                 let x = quad_nodes(body, e, coordinates);
@@ -362,31 +377,28 @@ impl Kernel {
         }
     }
 
-    /// The largest eigenvalue of M_e^-1 K_e of element `e` (lumped M_e) at the committed
-    /// state, its frequency squared; `zero` is a zero increment over all DOFs.
-    #[allow(clippy::too_many_arguments)]
+    /// The largest eigenvalue of M_e^-1 K_e of the element `at` (lumped M_e, from the
+    /// `initial` coordinates) at the committed state, its frequency squared; `zero` is a zero
+    /// increment over all DOFs.
     pub fn max_frequency_squared(
         &self,
-        body: &Body,
-        committed: &BodyState,
-        coordinates: &[[f64; 2]],
+        at: ElementAt<'_>,
         initial: &[[f64; 2]],
         zero: &[f64],
-        e: usize,
         geometry: Strain,
     ) -> Result<f64, KernelError> {
+        let ElementAt {
+            body, element: e, ..
+        } = at;
         let lumped = self.lumped_mass(body, initial, e)?;
         let n = 2 * lumped.len();
         let (mut force, mut k) = ([0.0; 8], [0.0; 64]);
         let mut trial = [PointState::default(); 4];
         // a zero increment: no step, no rate
         self.evaluate(
-            body,
-            committed,
-            coordinates,
+            at,
             zero,
             f64::INFINITY,
-            e,
             geometry,
             Some(Tangent::Consistent),
             ElementOut {

@@ -18,7 +18,7 @@ mod mass;
 mod scatter;
 
 use kernel::ElementOut;
-pub use kernel::Kernel;
+pub use kernel::{ElementAt, Kernel};
 pub use mass::{Mass, check_mass};
 use scatter::{Scatter, TRANSPOSED};
 
@@ -286,13 +286,16 @@ pub fn evaluate(
             let element = |(k, (o, t)): (usize, (&mut [f64], &mut [PointState]))| {
                 let (f, rest) = o.split_at_mut(n);
                 let (m, z) = rest.split_at_mut(matrix);
-                kernel.evaluate(
+                let at = ElementAt {
                     body,
-                    &state.bodies[b],
-                    &state.coordinates,
+                    committed: &state.bodies[b],
+                    coordinates: &state.coordinates,
+                    element: first + k,
+                };
+                kernel.evaluate(
+                    at,
                     d,
                     dt,
-                    first + k,
                     geometry,
                     want_tangent.then_some(tangent),
                     ElementOut {
@@ -373,15 +376,13 @@ pub fn commit(
         if geometry == Strain::Finite {
             let kernel = Kernel::of(body);
             for e in 0..body.elements() {
-                kernel.push_forward(
+                let at = ElementAt {
                     body,
-                    &state.bodies[b],
-                    &state.coordinates,
-                    d,
-                    &strain_zz[b],
-                    e,
-                    &mut points,
-                );
+                    committed: &state.bodies[b],
+                    coordinates: &state.coordinates,
+                    element: e,
+                };
+                kernel.push_forward(at, d, &strain_zz[b], &mut points);
             }
             if kernel.thins() {
                 let bs = &mut state.bodies[b];
@@ -566,12 +567,14 @@ fn element_eigenvalues(
             };
             let lambda = kernel
                 .max_frequency_squared(
-                    body,
-                    &state.bodies[b],
-                    &state.coordinates,
+                    ElementAt {
+                        body,
+                        committed: &state.bodies[b],
+                        coordinates: &state.coordinates,
+                        element: e,
+                    },
                     &coords,
                     &zero,
-                    e,
                     geometry,
                 )
                 .map_err(failure)?;
