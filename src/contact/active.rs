@@ -165,6 +165,18 @@ fn first_event(
     crate::profile::add(crate::profile::Phase::Contact, search);
     (penetrating, alpha)
 }
+/// One pass of a contact step, what the solver is asked to solve: the step's `length`, the
+/// `active` entries as (pair, slave node), their `forces` (the multipliers' start), the
+/// `tangential` conditions, and `warm`: after a change of the active set at the same length
+/// the last pass's increment (Newton then starts at the solution it had, not at the predictor
+/// again), after a split or a change of a slip status none.
+pub struct Pass<'a> {
+    pub length: f64,
+    pub active: &'a [(usize, usize)],
+    pub forces: Vec<f64>,
+    pub tangential: &'a [Tangential],
+    pub warm: Option<&'a [f64]>,
+}
 
 impl ContactState {
     /// Every pair starts open: slaves touching at the start (|g| <= TOL) close in the first
@@ -216,23 +228,14 @@ impl ContactState {
         }
     }
 
-    /// Runs one step with contact from the positions `start`. `solve(length, active (pair,
-    /// slave node), forces, tangential conditions, warm start)` solves the step for a given
-    /// active set; after a change of the active set at the same length, the last pass's
-    /// increment is handed over as the warm start (Newton then starts at the solution it had,
-    /// not at the predictor again); after a split or a change of a slip status none.
+    /// Runs one step with contact from the positions `start`: `solve` solves the step for
+    /// each [`Pass`] (a length and an active set) until the active set settles.
     pub fn step<S: ConstrainedSolution, E: From<Unsettled>>(
         &self,
         pairs: &[ContactPair],
         start: &[[f64; 2]],
         length: f64,
-        mut solve: impl FnMut(
-            f64,
-            &[(usize, usize)],
-            Vec<f64>,
-            &[Tangential],
-            Option<&[f64]>,
-        ) -> Result<S, E>,
+        mut solve: impl FnMut(Pass<'_>) -> Result<S, E>,
     ) -> Result<ContactResult<S>, E> {
         let (mut entries, mut forces) = self.entries();
         let mut slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(pairs, *e)).collect();
@@ -246,7 +249,13 @@ impl ContactState {
                 .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
                 .collect();
             let tangential = tangential_conditions(&slips);
-            let solution = solve(length, &nodes, forces.clone(), &tangential, warm.as_deref())?;
+            let solution = solve(Pass {
+                length,
+                active: &nodes,
+                forces: forces.clone(),
+                tangential: &tangential,
+                warm: warm.as_deref(),
+            })?;
             let (normal, d) = (solution.normal_forces(), solution.increment());
             warm = Some(d.to_vec());
             // release entries in tension, most negative first, and solve again

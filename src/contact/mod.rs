@@ -35,8 +35,8 @@ pub mod search;
 pub mod setup;
 
 pub use active::{
-    ConstrainedSolution, ContactResult, ContactState, Events, NodalStatus, Tangential, Unsettled,
-    apply_conditions,
+    ConstrainedSolution, ContactResult, ContactState, Events, NodalStatus, Pass, Tangential,
+    Unsettled, apply_conditions,
 };
 pub use geometry::{
     ContactPair, Covered, Friction, Gap, Master, Obstacle, PairOptions, winding_number,

@@ -21,7 +21,7 @@ use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure}
 use super::{Report, Resume, StepError, Stepper, loads};
 use crate::analysis::summary::RunError;
 use crate::assembly::{self, Evaluation, Mass, State, System, check_mass};
-use crate::contact::{ContactResult, ContactState, Interfaces, Tangential};
+use crate::contact::{ContactResult, ContactState, Interfaces, Pass};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
 };
@@ -380,15 +380,11 @@ impl<'a> Dynamics<'a> {
         };
         let (system, solver, factored_for) =
             (&mut self.system, &mut self.solver, &mut self.factored_for);
-        let mut step = self.contact.step(
-            &self.interfaces.pairs,
-            positions,
-            nominal,
-            |h, active, forces, tangential, warm| {
-                let constraints = (h, active, forces, tangential);
-                attempt.solve(constraints, warm, system, solver, factored_for, counters)
-            },
-        )?;
+        let mut step = self
+            .contact
+            .step(&self.interfaces.pairs, positions, nominal, |pass| {
+                attempt.solve(pass, system, solver, factored_for, counters)
+            })?;
         let h = step.length;
         let form = self.method.form(h, &self.kin);
         let advance = self.method.advance(h, &self.kin, &step.solution.d);
@@ -638,14 +634,19 @@ impl Attempt<'_> {
     /// when its coefficients changed or the strategy asks.
     fn solve(
         &self,
-        constraints: (f64, &[(usize, usize)], Vec<f64>, &[Tangential]),
-        warm: Option<&[f64]>,
+        pass: Pass<'_>,
         system: &mut System,
         solver: &mut Solver,
         factored_for: &mut Option<[f64; 3]>,
         counters: &mut Counters,
     ) -> Result<Solution, StepFailure> {
-        let (h, active, forces, tangential) = constraints;
+        let Pass {
+            length: h,
+            active,
+            forces,
+            tangential,
+            warm,
+        } = pass;
         let (model, spec, state) = (self.model, self.spec, self.state);
         let form = self.method.form(h, self.kin);
         let solve_time = state.time + form.solve_fraction * h;

@@ -17,7 +17,7 @@ use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Step, StepFailure};
 use super::{Report, Resume, StepError, Stepper, loads};
 use crate::assembly::{self, State, System};
-use crate::contact::{ContactState, Interfaces, Tangential};
+use crate::contact::{ContactState, Interfaces, Pass};
 use crate::integrator::StepForm;
 use crate::output::readable;
 use crate::scene::Model;
@@ -105,13 +105,18 @@ impl Increment<'_> {
     /// Solves the increment with a given length and active contact set.
     fn attempt(
         &self,
-        constraints: (f64, &[(usize, usize)], Vec<f64>, &[Tangential]),
-        warm: Option<&[f64]>,
+        pass: Pass<'_>,
         system: &mut System,
         solver: &mut Solver,
         counters: &mut Counters,
     ) -> Result<super::newton::Solution, StepFailure> {
-        let (h, active, forces, tangential) = constraints;
+        let Pass {
+            length: h,
+            active,
+            forces,
+            tangential,
+            warm,
+        } = pass;
         let (model, state, target) = (self.model, self.state, self.target);
         let end = if state.time + h >= target {
             target
@@ -193,10 +198,7 @@ impl Stepper for Statics<'_> {
                 &self.model.contacts,
                 &positions,
                 target - self.state.time,
-                |h, active, forces, tangential, warm| {
-                    let constraints = (h, active, forces, tangential);
-                    increment.attempt(constraints, warm, system, solver, counters)
-                },
+                |pass| increment.attempt(pass, system, solver, counters),
             );
             match outcome {
                 Ok(mut step) => {
