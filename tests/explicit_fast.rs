@@ -160,12 +160,12 @@ fn at_fraction_of_critical(
 /// 0.1125 dt_crit (dt_crit of the full kernel, an upper bound for the reduced one with
 /// kappa <= 1). Reference: a free elastic body keeps KE + W_int (hourglass work included) =
 /// KE_0. The recorded energy of the central difference (velocities at whole steps)
-/// oscillates by O(dt^2) in each excited mode, whatever the kernel: measured on this scene
-/// (at 10 times the speed) 6.8 % (full) and 6.0 % (reduced) at 0.9 dt_crit, 1.5 % and 1.3 %
-/// at 0.45 dt_crit. Asserted: the drift falls as dt^2 (ratio of the two runs in [3.5, 4.6],
-/// measured 4.1, 4.2, 4.2; a kernel that lost or made energy would leave a floor), and is
-/// below 1.2e-3 at 0.1125 dt_crit (measured 0.88e-3 plane strain, 1.02e-3 plane stress,
-/// 0.93e-3 axisymmetric), while the hourglass energy peaks at more than 1 % of KE_0
+/// oscillates by O(dt^2) in each excited mode, whatever the kernel (6.8 % full, 6.0 %
+/// reduced at 0.9 dt_crit on this scene at 10 times the speed); the balance subtracts that
+/// kinetic shadow, h^2 / 8 a.M a (theory 7), which took the drift from 3.6e-3 and 0.88e-3
+/// (plane strain at 0.225 and 0.1125, a ratio of 4.1: the dt^2 of the shadow) to 7.6e-4 and
+/// 2.8e-4. Asserted: the drift falls with the step (a kernel that lost or made energy would
+/// leave a floor) and is below 1.2e-3 at 0.1125 dt_crit, while the hourglass energy peaks at more than 1 % of KE_0
 /// (measured 5.6 %, 5.6 %, 1.7 %: leaving the hourglass work out of W_int would break the
 /// balance 15 to 60 times over). The speed is small so that the hypoelastic rate form, which
 /// is not exactly conservative at finite strain, stays below that: at 10 times the speed the
@@ -195,10 +195,14 @@ fn free_block_conserves_energy_with_hourglass_stiffness() {
             assert!(peak > 0.01 * initial, "the hourglass control was exercised");
             drift.push(summary.energy.max_relative_drift);
         }
-        let ratio = drift[0] / drift[1];
+        // with the kinetic shadow the balance holds the energy central difference conserves
+        // (exactly for a linear system): what is left is the rate form's finite-strain
+        // error and higher orders, and it still falls with the step
         assert!(
-            (3.5..=4.6).contains(&ratio),
-            "{formulation}: drift ratio {ratio}"
+            drift[1] < drift[0],
+            "{formulation}: drift {} at 0.1125 against {} at 0.225",
+            drift[1],
+            drift[0]
         );
         assert!(
             drift[1] < 1.2e-3,

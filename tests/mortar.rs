@@ -247,13 +247,15 @@ fn pair_against_wall(
         momentum.abs() < conserved * MOMENTUM,
         "{name}: momentum {momentum:e}"
     );
-    // the balance loses the kinetic energy of the face nodes arrested at first contact
-    // (theory 8.3: 1 / 100 of the mass on 5 x 50, 1.1 %), as the rod on the rigid wall
-    // does: the pair may lose no more than its worse wall run, and under 1.5 %
+    // energy is conserved (the kinetic energy the correction takes from the face nodes
+    // arrested at first contact is booked as contact work, theory 7): the 1 %,
+    // asserted at 1e-3 (measured 3.2e-5 on 2x2 explicit, the wall runs alike), and no
+    // worse than the pair's wall runs
     let drift = summary.energy.max_relative_drift;
     let wall_drift = upper_drift.max(lower_drift);
+    println!("{name}: energy balance {drift:.3e}, wall runs {wall_drift:.3e}");
     assert!(
-        drift < 0.015 && drift < wall_drift + 1e-3,
+        drift < 1e-3 && drift < wall_drift + 1e-3,
         "{name}: energy balance {drift} against the wall's {wall_drift}"
     );
     let slave_columns = if overrides.contains(&"body.upper.mesh.nx=7") {

@@ -341,9 +341,9 @@ fn taylor_jc_on_a_contact_wall_runs_implicit_through_the_release() {
 /// the lumped mass, the Schur complement on K*) and must agree on D_f within the 1 % of the
 /// implicit-against-explicit tests above, widened to 1.5 % for the sliding face (measured
 /// 0.59, 0.47 and 0.92 %); the summed friction force never exceeds mu times the summed
-/// normal force; every run completes with its energy balance within 1.5 % (the explicit
-/// runs lose the arrested face nodes' 1.1 %, theory 8.3; measured 1.06 to 1.12 % explicit,
-/// 0.057 to 0.072 % implicit).
+/// normal force; every run completes with its energy balance within 0.2 % (theory 7: the
+/// friction's dissipation and the arrest of the face nodes are in the contact work;
+/// measured 0.002 to 0.003 % explicit, 0.057 to 0.072 % implicit).
 #[test]
 fn taylor_jc_wall_friction_narrows_the_foot_on_both_paths() {
     let mut diameters = Vec::new();
@@ -382,7 +382,7 @@ fn taylor_jc_wall_friction_narrows_the_foot_on_both_paths() {
             // first touch (1 / 100 of the mass: 1.1 % on the explicit path, theory 8.3); friction
             // work is counted in contact_work, so friction must not add to the loss
             assert!(
-                summary.energy.max_relative_drift < 0.015,
+                summary.energy.max_relative_drift < 0.002,
                 "{name}: {}",
                 summary.energy.max_relative_drift
             );

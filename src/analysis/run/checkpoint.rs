@@ -33,7 +33,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///    error fields.
 /// 7: the bulk viscosity's work in the energies and the summary, its pressures in the
 ///    explicit carry.
-const FORMAT: u32 = 7;
+/// 8: the energies hold central difference's kinetic shadow.
+const FORMAT: u32 = 8;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]
