@@ -2,8 +2,8 @@
 //! and the nodal motion (velocity, acceleration, mass, internal force), and the energy
 //! balance they close (docs/theory.md section 7).
 
-/// Energies of one step (history.csv columns 2-6, and `bulk_viscosity_work` last when the
-/// scene has the bulk viscosity).
+/// Energies of one step (history.csv columns 2-6; `bulk_viscosity_work` when the scene has
+/// the bulk viscosity, `mass_scaling_loss` when it has the mass scaling).
 #[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     pub kinetic: f64,
@@ -13,6 +13,9 @@ pub struct Energies {
     pub contact_work: f64,
     /// The work of the bulk viscosity's pressure (central difference; 0 without it).
     pub bulk_viscosity_work: f64,
+    /// The kinetic energy lost as the mass scaling's added mass joined the moving nodes at
+    /// rest (central difference; 0 without it; docs/theory.md 8.7b).
+    pub mass_scaling_loss: f64,
 }
 
 /// Nodal kinematic fields beyond the displacement (zero in statics).
@@ -26,8 +29,9 @@ pub struct Motion<'a> {
     pub internal_force: &'a [f64],
 }
 
-/// Relative energy balance error |KE + W_int + W_contact + W_visc - W_ext - KE_0| /
-/// max(KE_0, |W_ext|, W_int), W_int = W_elastic + W_plastic, W_visc the bulk viscosity's work.
+/// Relative energy balance error |KE + W_int + W_contact + W_visc + L_ms - W_ext - KE_0| /
+/// max(KE_0, |W_ext|, W_int), W_int = W_elastic + W_plastic, W_visc the bulk viscosity's work,
+/// L_ms the mass scaling's loss.
 pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
     let scale = initial_kinetic
         .max(energies.external_work.abs())
@@ -38,6 +42,7 @@ pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
         + energies.plastic_work
         + energies.contact_work
         + energies.bulk_viscosity_work
+        + energies.mass_scaling_loss
         - energies.external_work
         - initial_kinetic)
         .abs()
