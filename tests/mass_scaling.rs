@@ -623,3 +623,187 @@ fn mass_scaling_is_refused_off_the_explicit_quad4_kernels() {
         "{stderr}"
     );
 }
+
+/// One rod of the Taylor study: its scene, the overrides that set the mesh and the
+/// one-point kernel, and the two targets (s; the unscaled run's stable step falls to 7e-10
+/// s on the aluminium rod and to 3.5e-9 s on the steel one as their feet crush).
+struct StudyRod {
+    label: &'static str,
+    scene: &'static str,
+    overrides: &'static [&'static str],
+    targets: [f64; 2],
+}
+
+/// What the study keeps of a run: the shortest wall time of its repetitions, and the rest
+/// (the same every time).
+#[derive(Debug, Clone, serde::Serialize)]
+struct StudyRow {
+    rod: &'static str,
+    target: Option<f64>,
+    steps: u64,
+    wall_seconds: f64,
+    /// The shape probes extent_y[all], extent_x[all] (m).
+    length: f64,
+    diameter: f64,
+    added_mass_percent: f64,
+    warnings: usize,
+}
+
+/// The Taylor study of docs/validation.md 10.6 (not run by default: about five minutes):
+/// models/taylor_aluminum.toml at 20 x 120 and models/taylor_jc.toml at 20 x 200, one-point
+/// kernel, frames off, without mass scaling and at two targets each; three repetitions,
+/// interleaved, the shortest wall time (summary.json `wall_seconds`) kept. Writes the table
+/// (DIR/mass_scaling_taylor.json) and the chart of the added mass and the changes of L_f
+/// and D_f against the wall time saved (DIR/mass_scaling_taylor.svg, .png), DIR from
+/// IMPACT_STUDY_OUT or output/mass_scaling_study.
+/// `cargo test --release --test mass_scaling -- --ignored mass_scaling_taylor_study --nocapture`
+#[test]
+#[ignore]
+fn mass_scaling_taylor_study() {
+    use impact::output::plot::{self, Chart, Limits, Series, SeriesStyle};
+    let rods = [
+        StudyRod {
+            label: "aluminium, 20 x 120",
+            scene: "models/taylor_aluminum.toml",
+            overrides: &["body.rod.mesh.nx=20", "body.rod.mesh.ny=120"],
+            targets: [2e-9, 4e-9],
+        },
+        StudyRod {
+            label: "42CrMo4 Johnson-Cook, 20 x 200",
+            scene: "models/taylor_jc.toml",
+            overrides: &[
+                "body.rod.mesh.nx=20",
+                "body.rod.mesh.ny=200",
+                "analysis.quadrature=reduced",
+            ],
+            targets: [5e-9, 8e-9],
+        },
+    ];
+    let out = std::env::var("IMPACT_STUDY_OUT")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|_| std::path::PathBuf::from("output/mass_scaling_study"));
+    std::fs::create_dir_all(&out).unwrap();
+    let cases: Vec<(&StudyRod, Option<f64>)> = rods
+        .iter()
+        .flat_map(|rod| [None, Some(rod.targets[0]), Some(rod.targets[1])].map(|t| (rod, t)))
+        .collect();
+    let mut rows: Vec<Option<StudyRow>> = vec![None; cases.len()];
+    for repetition in 0..3 {
+        for (k, (rod, target)) in cases.iter().enumerate() {
+            let dir = out.join(format!("case_{k}"));
+            let mut args = vec![
+                "run".to_string(),
+                rod.scene.to_string(),
+                "--quiet".into(),
+                "--out".into(),
+                dir.display().to_string(),
+                "--set".into(),
+                "output.frame_every=0".into(),
+            ];
+            for set in rod.overrides {
+                args.extend(["--set".into(), set.to_string()]);
+            }
+            if let Some(target) = target {
+                args.extend([
+                    "--set".into(),
+                    format!("analysis.mass_scaling.target={target:e}"),
+                ]);
+            }
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let output = impact(&args);
+            assert_eq!(output.status.code(), Some(0), "{args:?}");
+            let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+            let s: serde_json::Value = serde_json::from_str(&text).unwrap();
+            let row = StudyRow {
+                rod: rod.label,
+                target: *target,
+                steps: s["steps"].as_u64().unwrap(),
+                wall_seconds: s["wall_seconds"].as_f64().unwrap(),
+                length: s["probes"]["extent_y[all]"].as_f64().unwrap(),
+                diameter: s["probes"]["extent_x[all]"].as_f64().unwrap(),
+                added_mass_percent: s["mass_scaling"]["added_mass_percent"]
+                    .as_f64()
+                    .unwrap_or(0.0),
+                warnings: s["warnings"].as_array().unwrap().len(),
+            };
+            println!("repetition {repetition}: {row:?}");
+            rows[k] = Some(match rows[k].take() {
+                Some(kept) if kept.wall_seconds <= row.wall_seconds => kept,
+                _ => row,
+            });
+        }
+    }
+    let rows: Vec<StudyRow> = rows.into_iter().map(Option::unwrap).collect();
+    let json = serde_json::to_string_pretty(&rows).unwrap();
+    std::fs::write(out.join("mass_scaling_taylor.json"), json).unwrap();
+    println!(
+        "| rod | target (s) | steps | wall (s) | saved | L_f (mm) | change | D_f (mm) | change | added mass |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let mut panels: [Vec<Series>; 3] = Default::default();
+    for chunk in rows.chunks(3) {
+        let plain = &chunk[0];
+        let mut points: [Vec<(f64, f64)>; 3] = Default::default();
+        for row in chunk {
+            let saved = 100.0 * (1.0 - row.wall_seconds / plain.wall_seconds);
+            let length = 100.0 * (row.length / plain.length - 1.0);
+            let diameter = 100.0 * (row.diameter / plain.diameter - 1.0);
+            println!(
+                "| {} | {} | {} | {:.2} | {:.0} % | {:.3} | {:+.2} % | {:.3} | {:+.2} % | {:.2} % |",
+                row.rod,
+                row.target.map_or("off".to_string(), |t| format!("{t:e}")),
+                row.steps,
+                row.wall_seconds,
+                saved,
+                1e3 * row.length,
+                length,
+                1e3 * row.diameter,
+                diameter,
+                row.added_mass_percent
+            );
+            for (p, y) in points
+                .iter_mut()
+                .zip([row.added_mass_percent, length, diameter])
+            {
+                p.push((saved, y));
+            }
+        }
+        for (panel, p) in panels.iter_mut().zip(points) {
+            panel.push(Series {
+                label: chunk[0].rod.to_string(),
+                points: p,
+                style: SeriesStyle::LineAndMarkers,
+            });
+        }
+        // the unscaled run took longest: scaling saved time
+        assert!(chunk[1].steps < plain.steps && chunk[2].steps < chunk[1].steps);
+    }
+    let y_labels = [
+        "added mass (% of the rod's)",
+        "change of L_f (%)",
+        "change of D_f (%)",
+    ];
+    let titles = [
+        "Taylor rods, one-point: added mass (unscaled, then two targets)",
+        "final length L_f against the unscaled run",
+        "impact-face diameter D_f against the unscaled run",
+    ];
+    let charts: Vec<Chart> = panels
+        .into_iter()
+        .zip(y_labels.iter().zip(titles))
+        .map(|(series, (y_label, title))| Chart {
+            title: title.to_string(),
+            x_label: "wall time saved (% of the unscaled run's)".into(),
+            y_label: y_label.to_string(),
+            series,
+            log_x: false,
+            log_y: false,
+            x_limits: Limits::default(),
+            y_limits: Limits::default(),
+            notes: Vec::new(),
+        })
+        .collect();
+    for ext in ["svg", "png"] {
+        plot::write_panels(&charts, &out.join(format!("mass_scaling_taylor.{ext}"))).unwrap();
+    }
+}
