@@ -1224,6 +1224,7 @@ fn hourglass_warning_edge_is_ten_percent_of_stored_plus_plastic() {
             positions: &positions,
             energies: &energies,
             hourglass_energy: Some(hourglass),
+            mass_scaling: None,
         };
         plausibility::final_warnings(&model, &end)
     };

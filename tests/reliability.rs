@@ -267,6 +267,36 @@ fn explicit_bulk_viscosity_resume_is_bit_identical() {
     assert_same_output(&full, &resumed, name);
 }
 
+/// Goal: the mass scaling resumes bit-identically: its factors, the mass added and the nodal
+/// masses as the run summed them are in the checkpoint, its loss in the energies. Setup:
+/// PLASTIC_BLOCK, frictionless, central difference (2x2 kernel) with dt = "auto" and
+/// `mass_scaling = { target = 0.006 }`, below the initial stable step (6.2e-3) and above
+/// the later ones, so elements are scaled from step 10 to 36: checkpoints every 15 steps,
+/// killed at 40 (resumed from step 30). Reference: the uninterrupted run, byte for byte
+/// (history.csv with its `mass_scaling_loss` and `added_mass` columns, summary.json's
+/// `mass_scaling`).
+#[test]
+fn explicit_mass_scaling_resume_is_bit_identical() {
+    let name = "plastic_block_mass_scaling";
+    let set = [
+        "analysis.integrator=central_difference",
+        "analysis.dt=auto",
+        "analysis.end_time=0.3",
+        "analysis.checkpoint_every=15",
+        "analysis.mass_scaling={target=0.006}",
+    ];
+    let text = frictionless();
+    let full = run_full(name, &text, &set);
+    let added = common::column(&full, "added_mass");
+    assert_eq!(added[0], 0.0);
+    assert!(
+        added[30] > 0.0 && added[30] < *added.last().unwrap(),
+        "{added:?}"
+    );
+    let resumed = run_killed_and_resumed(name, &text, &set, 40);
+    assert_same_output(&full, &resumed, name);
+}
+
 /// Goal: static load stepping resumes bit-identically (modified Newton every 3 increments).
 #[test]
 fn static_plastic_resume_is_bit_identical() {

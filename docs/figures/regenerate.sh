@@ -112,3 +112,10 @@ done
 impact bench --case taylor --out $out/bench_taylor
 cp $out/bench_taylor/taylor_*.svg $fig/
 cp $out/bench_taylor/bench.json $fig/taylor_bench.json
+
+# The mass scaling study (validation 10.6): the Taylor rods at 20 x 120 and 20 x 200, one-point,
+# without scaling and at two targets each, three repetitions; about three minutes
+IMPACT_STUDY_OUT=$out/mass_scaling_study cargo test --release --quiet --test mass_scaling -- \
+  --ignored mass_scaling_taylor_study --nocapture
+copy $out/mass_scaling_study/mass_scaling_taylor mass_scaling_taylor
+cp $out/mass_scaling_study/mass_scaling_taylor.json $fig/

@@ -16,8 +16,8 @@
 //! ```
 
 use super::steppers::stable::{
-    StableStep, checked_step, critical_time_step, explicit_first_step, implicit_first_step,
-    wave_speed,
+    StableStep, checked_step, critical_time_step, explicit_first_step, explicit_start_scaling,
+    implicit_first_step, wave_speed,
 };
 use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind};
@@ -195,6 +195,20 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
                 readable(spec.gamma)
             ),
         });
+        if let Some(report) = explicit_start_scaling(model, spec)? {
+            let model_mass = report.model_mass();
+            lines.push(format!(
+                "mass scaling: target stable step {}; {} element(s) below it on the initial mesh \
+                 scaled, adding {} ({} % of the model's mass {}), so dt above is the scaled \
+                 model's (dt_crit the unscaled one's); elements that fall below the target as \
+                 they deform gain mass during the run (summary.json `mass_scaling`)",
+                readable(report.target),
+                report.scaled.len(),
+                readable(report.added_mass),
+                readable(100.0 * report.added_mass / model_mass),
+                readable(model_mass)
+            ));
+        }
     }
     Ok(lines)
 }

@@ -16,6 +16,7 @@
 use super::Summary;
 use super::steppers::energies::Energies;
 use super::steppers::stable::{explicit_first_step, implicit_first_step, wave_speed};
+use crate::assembly::mass_scaling::MassScalingReport;
 use crate::assembly::{self, State};
 use crate::contact::{ContactPair, Master, penetration_limits};
 use crate::output::readable;
@@ -170,7 +171,8 @@ fn axis_nodes<'a>(model: &'a Model, x: &[[f64; 2]]) -> Vec<AxisNodes<'a>> {
         .collect()
 }
 
-/// The first few of `nodes` (global ids) in words: `12, 14, 17 and 3 more`.
+/// The first few of `nodes` (global node ids, or element numbers) in words: `12, 14, 17 and
+/// 3 more`.
 fn some_nodes(nodes: &[usize]) -> String {
     let shown: Vec<String> = nodes.iter().take(5).map(|n| n.to_string()).collect();
     if nodes.len() > 5 {
@@ -245,6 +247,14 @@ fn axis_warnings(model: &Model) -> Vec<String> {
 /// (2.3 % of the internal energy).
 pub const HOURGLASS_SHARE: f64 = 0.10;
 
+/// A body to which the mass scaling added more than this share of its mass warns: the
+/// added inertia then carries a visible part of its answer (the wave speed in a scaled
+/// element falls by sqrt(s), its kinetic energy grows by s). LS-DYNA users hold the added
+/// mass of a part below about 5 % in dynamic runs; an impact whose answer is a shape (the
+/// Taylor rods) moves by more than its tolerance well before that (docs/validation.md
+/// 10.6), so the warning comes at 1 %.
+pub const ADDED_MASS_SHARE: f64 = 0.01;
+
 /// What a run has at its end, for [`final_warnings`].
 pub struct EndOfRun<'a> {
     /// Node positions of the final configuration.
@@ -253,13 +263,19 @@ pub struct EndOfRun<'a> {
     pub energies: &'a Energies,
     /// The hourglass work of the one-point kernel (None without it).
     pub hourglass_energy: Option<f64>,
+    /// The mass scaling per body (None without it).
+    pub mass_scaling: Option<&'a MassScalingReport>,
 }
 
 /// What the end of a run shows: nodes of an axisymmetric body that ended across the axis
-/// (r < 0), where the hoop strain u_r / r has no meaning; and hourglass energy above
-/// [`HOURGLASS_SHARE`] of the internal energy.
+/// (r < 0), where the hoop strain u_r / r has no meaning; hourglass energy above
+/// [`HOURGLASS_SHARE`] of the internal energy; mass scaling that added more than
+/// [`ADDED_MASS_SHARE`] of a body's mass or scaled an element on a contact surface.
 pub fn final_warnings(model: &Model, end: &EndOfRun) -> Vec<String> {
     let mut out = axis_crossings(model, end.positions);
+    if let Some(report) = end.mass_scaling {
+        out.extend(mass_scaling_warnings(model, report));
+    }
     let internal = end.energies.internal + end.energies.plastic_work;
     if let Some(hourglass) = end.hourglass_energy
         && internal > 0.0
@@ -275,6 +291,72 @@ pub fn final_warnings(model: &Model, end: &EndOfRun) -> Vec<String> {
             readable(internal),
             100.0 * HOURGLASS_SHARE
         ));
+    }
+    out
+}
+
+/// The mass scaling's warnings: per body, added mass above [`ADDED_MASS_SHARE`] of its
+/// mass; per contact pair, scaled elements with a node on its surfaces (its slave nodes or
+/// its master segments and nodes), whose added mass the contact then stops and throws.
+fn mass_scaling_warnings(model: &Model, report: &MassScalingReport) -> Vec<String> {
+    let mut out = Vec::new();
+    for (body, scaled) in model.bodies.iter().zip(&report.bodies) {
+        if scaled.mass > 0.0 && scaled.added_mass > ADDED_MASS_SHARE * scaled.mass {
+            out.push(format!(
+                "mass scaling (analysis.mass_scaling.target = {}) added {} to body `{}`, {:.2} % \
+                 of its mass {} ({} element(s) scaled), above {} %: the added inertia changes \
+                 the answer (waves cross a scaled element sqrt(s) times slower); lower the \
+                 target, or compare with a run without it",
+                readable(report.target),
+                readable(scaled.added_mass),
+                body.name,
+                100.0 * scaled.added_mass / scaled.mass,
+                readable(scaled.mass),
+                scaled.elements_scaled,
+                100.0 * ADDED_MASS_SHARE
+            ));
+        }
+    }
+    for pair in &model.contacts {
+        let mut surface = pair.slaves.clone();
+        match &pair.master {
+            Master::Segments { edges, .. } => surface.extend(edges.iter().flatten()),
+            Master::Nodes { nodes, .. } => surface.extend(nodes),
+            Master::Obstacle(_) => {}
+        }
+        surface.sort_unstable();
+        let touching: Vec<(usize, usize)> = report
+            .scaled
+            .iter()
+            .copied()
+            .filter(|&(b, e)| {
+                let body = &model.bodies[b];
+                body.mesh
+                    .cells
+                    .nodes_of(e)
+                    .iter()
+                    .any(|n| surface.binary_search(&body.global(*n)).is_ok())
+            })
+            .collect();
+        if let Some(&(first_body, _)) = touching.first() {
+            let elements: Vec<usize> = touching
+                .iter()
+                .filter(|(b, _)| *b == first_body)
+                .map(|(_, e)| *e)
+                .collect();
+            out.push(format!(
+                "mass scaling (analysis.mass_scaling.target = {}) scaled {} element(s) with a \
+                 node on the surface of contact pair `{}` (body `{}`, elements {}): the \
+                 contact stops and throws their added mass with the body, so the impact \
+                 force and the rebound see it; lower the target below these elements' \
+                 stable step, or compare with a run without it",
+                readable(report.target),
+                touching.len(),
+                pair.name,
+                model.bodies[first_body].name,
+                some_nodes(&elements)
+            ));
+        }
     }
     out
 }

@@ -4,6 +4,7 @@
 //! analyses: the steppers and the run scaffold both speak it.
 
 use crate::assembly::StableStep;
+use crate::assembly::mass_scaling::MassScalingReport;
 use crate::output::OutputError;
 use crate::scene::{InputError, Model};
 use serde::{Deserialize, Serialize};
@@ -54,26 +55,107 @@ pub struct EnergySummary {
     /// field only then.
     #[serde(default)]
     pub bulk_viscosity_work: Option<f64>,
+    /// The kinetic energy lost as the mass scaling's added mass joined the moving nodes
+    /// (history.csv `mass_scaling_loss`); only with `analysis.mass_scaling`, and summary.json
+    /// has the field only then.
+    #[serde(default)]
+    pub mass_scaling_loss: Option<f64>,
 }
 
-/// summary.json (a human-readable format) leaves `bulk_viscosity_work` out when there is
-/// none, so the scenes without bulk viscosity keep their file as it was; a checkpoint (a
-/// binary format whose fields are positional) always stores it.
+/// summary.json (a human-readable format) leaves `bulk_viscosity_work` and
+/// `mass_scaling_loss` out when there are none, so the scenes without them keep their file
+/// as it was; a checkpoint (a binary format whose fields are positional) always stores them.
 impl Serialize for EnergySummary {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
-        let present = self.bulk_viscosity_work.is_some() || !serializer.is_human_readable();
-        let mut s = serializer.serialize_struct("EnergySummary", 4 + usize::from(present))?;
+        let binary = !serializer.is_human_readable();
+        let viscosity = self.bulk_viscosity_work.is_some() || binary;
+        let scaling = self.mass_scaling_loss.is_some() || binary;
+        let fields = 4 + usize::from(viscosity) + usize::from(scaling);
+        let mut s = serializer.serialize_struct("EnergySummary", fields)?;
         s.serialize_field("initial", &self.initial)?;
         s.serialize_field("final", &self.final_)?;
         s.serialize_field("max_relative_drift", &self.max_relative_drift)?;
         s.serialize_field("plastic_dissipation", &self.plastic_dissipation)?;
-        if present {
+        if viscosity {
             s.serialize_field("bulk_viscosity_work", &self.bulk_viscosity_work)?;
         } else {
             s.skip_field("bulk_viscosity_work")?;
         }
+        if scaling {
+            s.serialize_field("mass_scaling_loss", &self.mass_scaling_loss)?;
+        } else {
+            s.skip_field("mass_scaling_loss")?;
+        }
         s.end()
+    }
+}
+
+/// summary.json `mass_scaling` (only with `analysis.mass_scaling`): the target, the mass
+/// added over the run and its share of the model's mass, the elements scaled, and per body
+/// the same (docs/theory.md 8.7b).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MassScalingSummary {
+    pub target: f64,
+    pub added_mass: f64,
+    /// 100 added_mass / the model's unscaled mass.
+    pub added_mass_percent: f64,
+    pub elements_scaled: usize,
+    /// The largest of the bodies' `added_mass_percent`, and its body.
+    pub max_body_added_mass_percent: f64,
+    pub max_body: String,
+    pub bodies: Vec<BodyMassScaling>,
+}
+
+/// One body in summary.json `mass_scaling.bodies`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodyMassScaling {
+    pub body: String,
+    /// The body's unscaled mass and the mass added to it.
+    pub mass: f64,
+    pub added_mass: f64,
+    /// 100 added_mass / mass.
+    pub added_mass_percent: f64,
+    pub elements_scaled: usize,
+}
+
+impl MassScalingSummary {
+    pub fn of(report: &MassScalingReport, model: &Model) -> MassScalingSummary {
+        let percent = |added: f64, mass: f64| {
+            if mass > 0.0 {
+                100.0 * added / mass
+            } else {
+                0.0
+            }
+        };
+        let bodies: Vec<BodyMassScaling> = report
+            .bodies
+            .iter()
+            .zip(&model.bodies)
+            .map(|(b, body)| BodyMassScaling {
+                body: body.name.clone(),
+                mass: b.mass,
+                added_mass: b.added_mass,
+                added_mass_percent: percent(b.added_mass, b.mass),
+                elements_scaled: b.elements_scaled,
+            })
+            .collect();
+        // the first of the largest
+        let max = bodies
+            .iter()
+            .fold(None::<&BodyMassScaling>, |best, b| match best {
+                Some(best) if best.added_mass_percent >= b.added_mass_percent => Some(best),
+                _ => Some(b),
+            });
+        MassScalingSummary {
+            target: report.target,
+            added_mass: report.added_mass,
+            added_mass_percent: percent(report.added_mass, report.model_mass()),
+            elements_scaled: report.scaled.len(),
+            max_body_added_mass_percent: max.map_or(0.0, |b| b.added_mass_percent),
+            max_body: max.map_or_else(String::new, |b| b.body.clone()),
+            bodies,
+        }
     }
 }
 
@@ -148,12 +230,18 @@ pub struct Summary {
     /// end state gives it).
     #[serde(skip)]
     pub max_temperature: Option<f64>,
+    /// The mass scaling at the end (with `analysis.mass_scaling`): summary.json writes it
+    /// after `max_temperature` and only then; a checkpoint does not store it (the end state
+    /// gives it).
+    #[serde(skip)]
+    pub mass_scaling: Option<MassScalingSummary>,
     /// What the scene and the finished run say about the answer (analysis::plausibility):
     /// the scene's own warnings (too few steps, a run shorter than a wave transit, an unused
     /// obstacle, an axis not held, too many frames), then step cuts, the energy balance,
     /// plastic work above the energy supplied, a step too long for the impact, a pair that
     /// never closed, a contact penetration beyond TOL, nodes across the axis, hourglass
-    /// energy. Empty when none.
+    /// energy, mass scaling above 1 % of a body's mass or on a contact surface. Empty when
+    /// none.
     #[serde(default)]
     pub warnings: Vec<String>,
 }
@@ -195,6 +283,7 @@ impl Summary {
             dt_limit: None,
             timing: Default::default(),
             max_temperature: None,
+            mass_scaling: None,
             warnings: Vec::new(),
         }
     }

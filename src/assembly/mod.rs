@@ -2,7 +2,8 @@
 //! every element's scatter positions computed once per topology (`scatter`), the element loop
 //! (in chunks; a chunk's elements in parallel where it pays, their results written in place
 //! and scattered serially in element order, so the sums do not depend on the thread count),
-//! and the mass matrix (`mass`).
+//! and the mass matrix (`mass`); the explicit element loops (`explicit`) and their mass
+//! scaling (`mass_scaling`).
 //!
 //! Legend
 //! ```text
@@ -15,6 +16,7 @@
 pub mod explicit;
 mod kernel;
 mod mass;
+pub mod mass_scaling;
 mod scatter;
 
 use kernel::ElementOut;

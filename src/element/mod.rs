@@ -9,6 +9,7 @@
 //! bodies x = r, y = z and zz is the hoop (theta theta) component.
 
 pub mod bulk_viscosity;
+pub mod mass_scaling;
 pub mod quad4;
 pub mod quad4_one_point;
 pub mod rod2;

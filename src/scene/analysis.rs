@@ -10,6 +10,7 @@ use super::spec::{
 };
 use crate::element::Strain;
 use crate::element::bulk_viscosity::{self, BulkViscosity};
+use crate::element::mass_scaling::MassScaling;
 
 /// `[analysis]`: a static analysis (load steps) or a dynamic one (time steps), checked
 /// against the keys that apply to it.
@@ -45,6 +46,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 (spec.quadrature.is_some(), "quadrature"),
                 (spec.hourglass.is_some(), "hourglass"),
                 (spec.bulk_viscosity.is_some(), "bulk_viscosity"),
+                (spec.mass_scaling.is_some(), "mass_scaling"),
             ] {
                 given(present, key, "static")?;
             }
@@ -90,6 +92,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
         quadrature,
         hourglass,
         bulk_viscosity: bulk_viscosity(cx, spec, integrator)?,
+        mass_scaling: mass_scaling(cx, spec, integrator, &step)?,
         step,
         end_time,
         integrator,
@@ -441,6 +444,47 @@ fn bulk_viscosity(
             bulk_viscosity::DEFAULT_QUADRATIC,
         )?,
     }))
+}
+
+/// `analysis.mass_scaling`: central difference at finite strain with the automatic step (it
+/// acts in the explicit Quad4 kernels; the scene's checks refuse it with rod bodies), a
+/// target step > 0.
+fn mass_scaling(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+    step: &TimeStep,
+) -> Result<Option<MassScaling>, InputError> {
+    let Some(given) = spec.mass_scaling else {
+        return Ok(None);
+    };
+    if integrator != IntegratorKind::CentralDifference {
+        return Err(cx.err(format!(
+            "analysis.mass_scaling: applies to integrator central_difference (it raises the masses of the elements that \
+             limit the explicit stable step); integrator {} is implicit and has no such limit: remove mass_scaling or use \
+             integrator = \"central_difference\"",
+            integrator.name()
+        )));
+    }
+    if spec.geometry == Strain::Small {
+        return Err(cx.err(
+            "analysis.mass_scaling: acts in the finite-strain explicit Quad4 kernels; use geometry = \"nonlinear\" or remove mass_scaling",
+        ));
+    }
+    if let TimeStep::Fixed(dt) = step {
+        return Err(cx.err(format!(
+            "analysis.mass_scaling: scales the elements below its target so that the automatic step can be longer; \
+             with the fixed analysis.dt = {dt} nothing would use the added mass: set dt = \"auto\" (central \
+             difference's default) or remove mass_scaling"
+        )));
+    }
+    let target = given.target;
+    if !(target > 0.0 && target.is_finite()) {
+        return Err(cx.err(format!(
+            "analysis.mass_scaling.target: a stable step (a time) > 0, got {target}"
+        )));
+    }
+    Ok(Some(MassScaling { target }))
 }
 
 /// `[analysis.buckling]`, which needs an implicit tangent.

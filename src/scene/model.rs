@@ -292,6 +292,14 @@ impl Analysis {
             Analysis::Dynamic(s) => s.bulk_viscosity.as_ref(),
         }
     }
+
+    /// The mass scaling of a central-difference analysis (None: off, or not dynamic).
+    pub fn mass_scaling(&self) -> Option<&crate::element::mass_scaling::MassScaling> {
+        match self {
+            Analysis::Static(_) => None,
+            Analysis::Dynamic(s) => s.mass_scaling.as_ref(),
+        }
+    }
 }
 
 #[derive(Debug, Clone)]

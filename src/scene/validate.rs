@@ -38,6 +38,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     check_reaction_probes(&cx, &probes, &fixed_dofs, &loads)?;
     check_reduced_quadrature(&cx, &analysis, &bodies)?;
     check_bulk_viscosity(&cx, &analysis, &bodies)?;
+    check_mass_scaling(&cx, &analysis, &bodies)?;
     check_dispersion_free(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
@@ -139,6 +140,26 @@ fn check_bulk_viscosity(
     {
         return Err(cx.err(format!(
             "analysis.bulk_viscosity: acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric); body `{}` is a rod: remove bulk_viscosity",
+            body.name
+        )));
+    }
+    Ok(())
+}
+
+/// The mass scaling acts in the explicit Quad4 kernels, which run on Quad4 bodies only.
+fn check_mass_scaling(
+    cx: &Context,
+    analysis: &Analysis,
+    bodies: &[Body],
+) -> Result<(), InputError> {
+    if let Analysis::Dynamic(d) = analysis
+        && d.mass_scaling.is_some()
+        && let Some(body) = bodies
+            .iter()
+            .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
+    {
+        return Err(cx.err(format!(
+            "analysis.mass_scaling: acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric); body `{}` is a rod: remove mass_scaling",
             body.name
         )));
     }

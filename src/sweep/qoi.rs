@@ -304,6 +304,7 @@ pub struct Units {
     pub force: &'static str,
     pub energy: &'static str,
     pub stress: &'static str,
+    pub mass: &'static str,
     pub temperature: &'static str,
     /// `/m`, `/mm` (or `/[length]`) for forces and energies of a plane-strain body: per unit
     /// depth; empty otherwise.
@@ -318,12 +319,14 @@ impl Units {
                 (density.0..=density.1).contains(&rho) && (young.0..=young.1).contains(&e)
             })
         };
-        let (length, time, force, energy, stress) = if all((100.0, 3e4), (1e7, 1e13)) {
-            ("m", "s", "N", "J", "Pa")
+        let (length, time, force, energy, stress, mass) = if all((100.0, 3e4), (1e7, 1e13)) {
+            ("m", "s", "N", "J", "Pa", "kg")
         } else if all((1e-10, 1e-7), (1e2, 1e7)) {
-            ("mm", "s", "N", "mJ", "MPa")
+            ("mm", "s", "N", "mJ", "MPa", "t")
         } else {
-            ("[length]", "[time]", "[force]", "[energy]", "[stress]")
+            (
+                "[length]", "[time]", "[force]", "[energy]", "[stress]", "[mass]",
+            )
         };
         let celsius = model.bodies.iter().any(|b| {
             b.material
@@ -340,6 +343,7 @@ impl Units {
             force,
             energy,
             stress,
+            mass,
             temperature: if celsius { "C" } else { "K" },
             per_depth: if plane_strain {
                 format!("/{length}")
@@ -373,7 +377,9 @@ impl Units {
             | "external_work"
             | "contact_work"
             | "hourglass_energy"
-            | "bulk_viscosity_work" => per(self.energy),
+            | "bulk_viscosity_work"
+            | "mass_scaling_loss" => per(self.energy),
+            "added_mass" => per(self.mass),
             "contact_force" | "tangential_force" => per(self.force),
             "penetration" => self.length.to_string(),
             _ => String::new(),

@@ -33,7 +33,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///    error fields.
 /// 7: the bulk viscosity's work in the energies and the summary, its pressures in the
 ///    explicit carry.
-/// 8: the energies hold central difference's kinetic shadow.
+/// 8: the mass scaling's loss in the energies and the summary, its factors and the nodal
+///    masses in the explicit carry; central difference's kinetic shadow in the energies.
 const FORMAT: u32 = 8;
 
 /// A whole run at the end of a converged step.

@@ -27,7 +27,7 @@ use super::plausibility;
 use super::steppers::Stepper;
 use super::steppers::energies::balance_error;
 use super::steppers::newton::Counters;
-use super::summary::{DtLimit, RunError, Status, StepError, Summary};
+use super::summary::{DtLimit, MassScalingSummary, RunError, Status, StepError, Summary};
 use crate::assembly::State;
 use crate::output::readable;
 use crate::profile::{self, Phase};
@@ -334,6 +334,9 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Some(watch) = self.stepper.error_watch() {
             self.recorder.error_estimate = watch.last;
         }
+        if let Some(added) = self.stepper.added_mass() {
+            self.recorder.added_mass = added;
+        }
         let s = &self.stepper;
         let contact = (self.summary.steps > 0).then(|| s.contact());
         self.recorder.step_with_contact(
@@ -399,6 +402,15 @@ impl<'a, S: Stepper> Run<'a, S> {
             .analysis
             .bulk_viscosity()
             .map(|_| energies.bulk_viscosity_work);
+        summary.energy.mass_scaling_loss = self
+            .model
+            .analysis
+            .mass_scaling()
+            .map(|_| energies.mass_scaling_loss);
+        let mass_scaling = s.mass_scaling();
+        summary.mass_scaling = mass_scaling
+            .as_ref()
+            .map(|r| MassScalingSummary::of(r, self.model));
         summary.contact = s.contact().summary(&self.model.contacts);
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
         if let Some(report) = s.time_step_report() {
@@ -413,6 +425,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             positions: &positions,
             energies: &energies,
             hourglass_energy: s.hourglass_energy(),
+            mass_scaling: mass_scaling.as_ref(),
         };
         summary
             .warnings

@@ -42,6 +42,9 @@ pub struct Recorder {
     error_column: bool,
     /// Its value for the next row (the implicit stepper's last estimate).
     pub error_estimate: f64,
+    /// The mass the mass scaling has added, for the next row's `added_mass` (the column is
+    /// there with `analysis.mass_scaling`).
+    pub added_mass: f64,
     /// The length of the step the next row ends (column `dt`; 0 on the first row).
     pub step_length: f64,
     /// The probes' values in the last row written (summary.json `probes`).
@@ -83,6 +86,7 @@ impl Recorder {
             hourglass_energy: 0.0,
             error_column: error_column(model),
             error_estimate: 0.0,
+            added_mass: 0.0,
             step_length: 0.0,
             last_probes: Vec::new(),
         })
@@ -137,6 +141,7 @@ impl Recorder {
             hourglass_energy: 0.0,
             error_column: error_column(model),
             error_estimate: 0.0,
+            added_mass: 0.0,
             step_length: 0.0,
             last_probes: position.probes,
         })
@@ -230,6 +235,10 @@ impl Recorder {
         }
         if bulk_viscosity_column(model) {
             row.push(energies.bulk_viscosity_work);
+        }
+        if mass_scaling_columns(model) {
+            row.push(energies.mass_scaling_loss);
+            row.push(self.added_mass);
         }
         self.history.append(&row)?;
         crate::profile::add(crate::profile::Phase::Output, start);
@@ -346,6 +355,7 @@ impl Recorder {
         let file = SummaryFile {
             summary,
             max_temperature: summary.max_temperature,
+            mass_scaling: summary.mass_scaling.as_ref(),
             probes: FinalProbes {
                 columns: &model.probes,
                 values: &self.last_probes,
@@ -356,14 +366,17 @@ impl Recorder {
     }
 }
 
-/// summary.json: the summary's fields, then `max_temperature` when there is one, then the
-/// probes' last values when the scene has probes.
+/// summary.json: the summary's fields, then `max_temperature` when there is one, then
+/// `mass_scaling` with the mass scaling, then the probes' last values when the scene has
+/// probes.
 #[derive(serde::Serialize)]
 struct SummaryFile<'a> {
     #[serde(flatten)]
     summary: &'a Summary,
     #[serde(skip_serializing_if = "Option::is_none")]
     max_temperature: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mass_scaling: Option<&'a crate::analysis::summary::MassScalingSummary>,
     #[serde(skip_serializing_if = "FinalProbes::is_empty")]
     probes: FinalProbes<'a>,
 }
@@ -732,11 +745,20 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
         // the cumulative work of the bulk viscosity's pressure
         columns.push("bulk_viscosity_work".to_string());
     }
+    if mass_scaling_columns(model) {
+        // the kinetic energy lost as added mass joined the nodes, and the mass added so far
+        columns.push("mass_scaling_loss".to_string());
+        columns.push("added_mass".to_string());
+    }
     (columns, pivots_column)
 }
 
 fn bulk_viscosity_column(model: &Model) -> bool {
     model.analysis.bulk_viscosity().is_some()
+}
+
+fn mass_scaling_columns(model: &Model) -> bool {
+    model.analysis.mass_scaling().is_some()
 }
 
 fn error_column(model: &Model) -> bool {

@@ -5,6 +5,7 @@ use super::clock::Clock;
 use super::control::{ErrorWatch, StepControl};
 use super::energies::Energies;
 use crate::assembly::State;
+use crate::assembly::mass_scaling::ScalingCarry;
 use crate::contact::ContactState;
 use crate::integrator::{MethodHistory, MotionState};
 use serde::{Deserialize, Serialize};
@@ -62,4 +63,6 @@ pub struct ExplicitCarry {
     /// The bulk viscosity's pressure of the last step at the kernel's points (empty without
     /// it).
     pub viscous_pressure: Vec<f64>,
+    /// The mass scaling's factors, added mass and the nodal masses (None without it).
+    pub mass_scaling: Option<ScalingCarry>,
 }

@@ -2,8 +2,8 @@
 //! and the nodal motion (velocity, acceleration, mass, internal force), and the energy
 //! balance they close (docs/theory.md section 7).
 
-/// Energies of one step (history.csv columns 2-6, and `bulk_viscosity_work` last when the
-/// scene has the bulk viscosity).
+/// Energies of one step (history.csv columns 2-6; `bulk_viscosity_work` when the scene has
+/// the bulk viscosity, `mass_scaling_loss` when it has the mass scaling).
 #[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     pub kinetic: f64,
@@ -16,6 +16,9 @@ pub struct Energies {
     /// Central difference: h^2 / 8 a.M a, the part of 1/2 v.M v at the full steps that the
     /// scheme's conserved energy does not hold (theory 7); 0 for the other integrators.
     pub kinetic_shadow: f64,
+    /// The kinetic energy lost as the mass scaling's added mass joined the moving nodes at
+    /// rest (central difference; 0 without it; docs/theory.md 8.7b).
+    pub mass_scaling_loss: f64,
 }
 
 /// Nodal kinematic fields beyond the displacement (zero in statics).
@@ -29,8 +32,9 @@ pub struct Motion<'a> {
     pub internal_force: &'a [f64],
 }
 
-/// Relative energy balance error |KE + W_int + W_contact + W_visc - W_ext - KE_0| /
-/// max(KE_0, |W_ext|, W_int), W_int = W_elastic + W_plastic, W_visc the bulk viscosity's work.
+/// Relative energy balance error |KE + W_int + W_contact + W_visc + L_ms - W_ext - KE_0| /
+/// max(KE_0, |W_ext|, W_int), W_int = W_elastic + W_plastic, W_visc the bulk viscosity's work,
+/// L_ms the mass scaling's loss.
 pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
     let scale = initial_kinetic
         .max(energies.external_work.abs())
@@ -41,6 +45,7 @@ pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
         + energies.plastic_work
         + energies.contact_work
         + energies.bulk_viscosity_work
+        + energies.mass_scaling_loss
         - energies.external_work
         - initial_kinetic)
         .abs()

@@ -20,6 +20,7 @@ use super::stable::{checked_step, explicit_clock};
 use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
 use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, StepWork, kernel_for};
+use crate::assembly::mass_scaling::{AddedAtRest, MassScalingReport, NodalMotion};
 use crate::assembly::{self, ElementMasses, Mass, StableStep, State, System, check_mass};
 use crate::contact::{ContactState, Interfaces};
 use crate::output::readable;
@@ -82,12 +83,16 @@ impl<'a> Explicit<'a> {
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
         check_mass(model, &mass, &system)?;
         let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
-        let m = mass.lumped;
+        let state = State::initial(model);
+        let (mut kernel, kernel_has_own_state) = kernel_for(model, spec, &state, &masses);
+        let mut m = mass.lumped;
+        if let Some(scaling) = kernel.as_mut().and_then(|k| k.mass_scaling_mut()) {
+            // the elements below the target at the start: the initial velocities move them
+            scaling.add_pending(&mut m);
+        }
         let inverse_mass = (0..model.dofs())
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
-        let state = State::initial(model);
-        let (kernel, kernel_has_own_state) = kernel_for(model, spec, &state, &masses);
         let clock = explicit_clock(model, spec, dt_crit, &state, &masses, kernel.as_deref())?;
         let dofs = model.dofs();
         Ok(Explicit {
@@ -170,6 +175,22 @@ impl<'a> Explicit<'a> {
                 .for_each(|((du, v_half), correction)| apply(du, v_half, correction));
         }
         self.energies.contact_work -= work;
+    }
+
+    /// The mass the mass scaling added in the step just taken joins the nodes at rest
+    /// (docs/theory.md 8.7b): the nodal masses, velocities and accelerations of the end of
+    /// the step change with it.
+    fn add_scaled_mass(&mut self) -> AddedAtRest {
+        match self.kernel.as_mut().and_then(|k| k.mass_scaling_mut()) {
+            Some(scaling) => scaling.add_pending_at_rest(NodalMotion {
+                mass: &mut self.mass,
+                inverse_mass: &mut self.inverse_mass,
+                free: &self.free,
+                velocity: &mut self.v,
+                acceleration: &mut self.a,
+            }),
+            None => AddedAtRest::default(),
+        }
     }
 
     /// The internal force at u_{n+1} (a step of length `h`), the committed element state and
@@ -313,10 +334,12 @@ impl Stepper for Explicit<'_> {
             a_r: spec.rayleigh[0],
         }
         .apply(&mut self.a, &mut self.v, &mut self.total);
+        let added = self.add_scaled_mass();
         let energies = &mut self.energies;
-        energies.external_work += work;
+        energies.external_work += work + added.support_work;
+        energies.mass_scaling_loss += added.loss;
         std::mem::swap(&mut self.last_total, &mut self.total);
-        energies.kinetic = kinetic_energy;
+        energies.kinetic = kinetic_energy + added.kinetic_energy_change;
         energies.kinetic_shadow = shadow;
         energies.internal = self.state.internal_work - self.state.plastic_work;
         energies.plastic_work = self.state.plastic_work;
@@ -400,6 +423,17 @@ impl Report for Explicit<'_> {
     fn last_step(&self) -> f64 {
         self.clock.last
     }
+    fn added_mass(&self) -> Option<f64> {
+        self.kernel
+            .as_ref()
+            .and_then(|k| k.mass_scaling())
+            .map(|s| s.added())
+    }
+    fn mass_scaling(&self) -> Option<MassScalingReport> {
+        let kernel = self.kernel.as_ref()?;
+        let scaling = kernel.mass_scaling()?;
+        Some(scaling.report(self.model.bodies.len(), |e| kernel.locate(e)))
+    }
     fn time_step_report(&self) -> Option<TimeStepReport> {
         let c = &self.clock;
         let range = c.range()?;
@@ -440,6 +474,12 @@ impl Resume for Explicit<'_> {
             {
                 kernel.restore_viscous_pressure(&carry.viscous_pressure);
             }
+            // the factors and the nodal masses as the run had grown them
+            if let Some(scaling) = self.kernel.as_mut().and_then(|k| k.mass_scaling_mut())
+                && let Some(carried) = &carry.mass_scaling
+            {
+                scaling.restore(carried, &mut self.mass, &mut self.inverse_mass, &self.free);
+            }
         }
         true
     }
@@ -470,6 +510,11 @@ impl Resume for Explicit<'_> {
                 (Some(kernel), Some(_)) => kernel.viscous_pressure().to_vec(),
                 _ => Vec::new(),
             },
+            mass_scaling: self
+                .kernel
+                .as_ref()
+                .and_then(|k| k.mass_scaling())
+                .map(|s| s.carry(&self.mass)),
         }))
     }
 }

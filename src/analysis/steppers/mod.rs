@@ -81,6 +81,15 @@ pub trait Report {
     fn time_step_report(&self) -> Option<TimeStepReport> {
         None
     }
+    /// The mass the mass scaling has added so far, for the history column (None: off).
+    fn added_mass(&self) -> Option<f64> {
+        None
+    }
+    /// The mass scaling per body at the end: summary.json `mass_scaling` and its warnings
+    /// (None: off).
+    fn mass_scaling(&self) -> Option<crate::assembly::mass_scaling::MassScalingReport> {
+        None
+    }
 }
 
 /// What a checkpoint keeps of a stepper, and how a resumed stepper takes it back.

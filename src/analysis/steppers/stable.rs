@@ -18,6 +18,7 @@
 
 use super::clock::Clock;
 use crate::assembly::explicit::{ExplicitKernel, kernel_for};
+use crate::assembly::mass_scaling::MassScalingReport;
 use crate::assembly::{self, ElementMasses, State};
 use crate::element::bulk_viscosity::damped_step_factor;
 use crate::output::readable;
@@ -63,6 +64,27 @@ pub fn explicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, Inp
     let state = State::initial(model);
     let (kernel, _) = kernel_for(model, spec, &state, &masses);
     Ok(explicit_clock(model, spec, exact, &state, &masses, kernel.as_deref())?.dt0)
+}
+
+/// The mass scaling a central-difference run of `model` starts with (None: off): the
+/// elements below the target on the initial mesh, scaled as the run scales them
+/// ([`kernel_for`]); what `impact check` reports beside the first step.
+pub fn explicit_start_scaling(
+    model: &Model,
+    spec: &DynamicSpec,
+) -> Result<Option<MassScalingReport>, InputError> {
+    if spec.mass_scaling.is_none() {
+        return Ok(None);
+    }
+    let masses =
+        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    let state = State::initial(model);
+    let (kernel, _) = kernel_for(model, spec, &state, &masses);
+    Ok(kernel.as_deref().and_then(|kernel| {
+        kernel
+            .mass_scaling()
+            .map(|s| s.report(model.bodies.len(), |e| kernel.locate(e)))
+    }))
 }
 
 /// The stability limit of `model` under `spec` (the bulk viscosity's damping at rest taken

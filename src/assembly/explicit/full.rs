@@ -19,13 +19,19 @@
 //!                       element::bulk_viscosity), the element's rho, c_d, L_e on the mid
 //!                       configuration; f_a then sums B_q^T (sigma_q - q_q I)
 //! W_visc                -sum_q W_q,mid 1/2 (q_q,n + q_q,n+1) tr d_q
+//! s                     the element's mass factor of the mass scaling (by option; 1
+//!                       without it): its lumped masses are s m_a in the frequency bound and
+//!                       the viscous density, and an element whose bound is below the target
+//!                       gets a larger s (mass_scaling.rs)
 //! ```
 
-use super::{CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, stable_step_of};
+use super::{CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling, stable_step_of};
+use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::bulk_viscosity::{
     BulkViscosity, ElementScale, damped_frequency_squared, loaded_stress, volumetric_increment,
 };
+use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
@@ -75,6 +81,8 @@ pub struct Full {
     viscous_pressure: Vec<f64>,
     element_forces: Vec<f64>,
     gather: NodeGather,
+    /// The mass scaling (None: off).
+    scaling: Option<ElementScaling>,
 }
 
 /// The increment gradient, strain and spin at one point.
@@ -337,6 +345,7 @@ impl Full {
             element_forces: vec![0.0; 8 * count],
             gather: NodeGather::new(&layout.nodes, state.coordinates.len()),
             layout,
+            scaling: None,
         };
         for &(b, e) in &kernel.layout.origin {
             let committed = &state.bodies[b];
@@ -358,6 +367,44 @@ impl Full {
     /// The kernel with the bulk viscosity `viscosity` (None: off).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Full {
         Full { viscosity, ..self }
+    }
+
+    /// The kernel with the mass scaling `rule` (None: off), the elements below its target
+    /// on the positions `x` scaled (`masses`: the lumped masses the kernel was made with).
+    pub fn with_mass_scaling(
+        mut self,
+        rule: Option<MassScaling>,
+        model: &Model,
+        masses: &ElementMasses,
+        x: &[[f64; 2]],
+    ) -> Full {
+        if let Some(rule) = rule {
+            let mut scaling = element_scaling(rule, model, &self.layout, masses);
+            scaling.scale_at_start(|e| self.frequency(x, e).ok());
+            self.scaling = Some(scaling);
+        }
+        self
+    }
+
+    /// The lumped masses of element `e` (scaled by its factor with the mass scaling).
+    #[inline(always)]
+    fn lumped_of(&self, e: usize) -> [f64; 4] {
+        scaled(&self.lumped[e], self.scaling.as_ref().map(|s| s.factor(e)))
+    }
+
+    /// The frequency bound squared of element `e` on the positions `x` from the stored
+    /// state, with its masses and (at rest: no step yet) the damping of the bulk
+    /// viscosity's linear term.
+    fn frequency(&self, x: &[[f64; 2]], e: usize) -> Result<f64, ElementFailure> {
+        let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
+        let p = self.parameters(e);
+        let values = quad4::values(&xe, p.formulation, &self.state_of(e).thickness)
+            .map_err(|err| self.layout.failure(e, err))?;
+        let w = quad4::frequency_bound(&values, p.wave_lambda, p.mu, &self.lumped_of(e));
+        Ok(match &self.viscosity {
+            Some(v) => damped_frequency_squared(w, v.damping_fraction_at_rest()),
+            None => w,
+        })
     }
 
     fn state_of(&self, e: usize) -> PointsState {
@@ -421,17 +468,7 @@ impl ExplicitKernel for Full {
     fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure> {
         let mut worst = StepWork::default();
         for e in 0..self.elements() {
-            let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
-            let p = self.parameters(e);
-            let values = quad4::values(&xe, p.formulation, &self.state_of(e).thickness)
-                .map_err(|err| self.layout.failure(e, err))?;
-            let w = quad4::frequency_bound(&values, p.wave_lambda, p.mu, &self.lumped[e]);
-            // at rest (no step yet): the damping of the linear term alone
-            let w = match &self.viscosity {
-                Some(v) => damped_frequency_squared(w, v.damping_fraction_at_rest()),
-                None => w,
-            };
-            worst.observe(w, e);
+            worst.observe(self.frequency(x, e)?, e);
         }
         Ok(stable_step_of(&self.layout, &worst))
     }
@@ -446,7 +483,8 @@ impl ExplicitKernel for Full {
         let layout = &self.layout;
         let lumped = &self.lumped;
         let viscosity = self.viscosity.as_ref();
-        let results: Vec<(StepWork, Option<(usize, KernelError)>)> = (
+        let scaling = self.scaling.as_ref();
+        let results: Vec<ChunkResult> = (
             self.stress.par_chunks_mut(16 * CHUNK),
             self.back_stress.par_chunks_mut(16 * CHUNK),
             self.eq_plastic_strain.par_chunks_mut(4 * CHUNK),
@@ -460,6 +498,7 @@ impl ExplicitKernel for Full {
             .map(
                 |(k, (stress, back, eps_p, temperature, thickness, viscous, forces))| {
                     let mut sums = StepWork::default();
+                    let mut grown = Vec::new();
                     for i in 0..forces.len() / 8 {
                         let e = k * CHUNK + i;
                         let element = layout.nodes[e];
@@ -479,13 +518,30 @@ impl ExplicitKernel for Full {
                             viscous_pressure: std::array::from_fn(|q| viscous[4 * i + q]),
                         };
                         let p = &layout.bodies[layout.body[e] as usize];
+                        let factor = scaling.map(|s| s.factor(e));
+                        let element_lumped = scaled(&lumped[e], factor);
                         let r = match element_step(
-                            p, &xe, &ue, &committed, &lumped[e], dt, viscosity,
+                            p,
+                            &xe,
+                            &ue,
+                            &committed,
+                            &element_lumped,
+                            dt,
+                            viscosity,
                         ) {
                             Ok(r) => r,
-                            Err(err) => return (sums, Some((e, err))),
+                            Err(err) => return (sums, Some((e, err)), grown),
                         };
-                        sums.observe(r.omega_squared, e);
+                        let omega_squared = match scaling
+                            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
+                        {
+                            Some(rescaled) => {
+                                grown.push((e, rescaled.factor));
+                                rescaled.omega_squared
+                            }
+                            None => r.omega_squared,
+                        };
+                        sums.observe(omega_squared, e);
                         for q in 0..4 {
                             stress[16 * i + 4 * q..16 * i + 4 * q + 4]
                                 .copy_from_slice(&r.state.stress[q]);
@@ -501,16 +557,21 @@ impl ExplicitKernel for Full {
                         sums.plastic += r.plastic_work;
                         sums.viscous += r.viscous_work;
                     }
-                    (sums, None)
+                    (sums, None, grown)
                 },
             )
             .collect();
         let mut total = StepWork::default();
-        for (sums, error) in results {
+        for (sums, error, grown) in results {
             if let Some((e, err)) = error {
                 return Err(self.layout.failure(e, err));
             }
             total.add(&sums);
+            if let Some(scaling) = self.scaling.as_mut() {
+                for (e, factor) in grown {
+                    scaling.grow(e, factor);
+                }
+            }
         }
         self.gather.gather(&self.element_forces, force);
         Ok(total)
@@ -542,5 +603,26 @@ impl ExplicitKernel for Full {
 
     fn restore_viscous_pressure(&mut self, values: &[f64]) {
         self.viscous_pressure.copy_from_slice(values);
+    }
+
+    fn mass_scaling(&self) -> Option<&ElementScaling> {
+        self.scaling.as_ref()
+    }
+
+    fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling> {
+        self.scaling.as_mut()
+    }
+}
+
+/// A chunk's sums, its failed element, and the elements whose mass factor grew (with the
+/// new factor), in element order.
+type ChunkResult = (StepWork, Option<(usize, KernelError)>, Vec<(usize, f64)>);
+
+/// An element's lumped masses `lumped` times its mass factor (as they are without one).
+#[inline(always)]
+fn scaled(lumped: &[f64; 4], factor: Option<f64>) -> [f64; 4] {
+    match factor {
+        Some(s) => lumped.map(|m| m * s),
+        None => *lumped,
     }
 }

@@ -4,7 +4,9 @@
 //! (`one_point`, `quadrature = "reduced"`) and the 2x2 Quad4 in the same rate form (`full`,
 //! `quadrature = "full"` on finite-strain Quad4 models); both give the element frequency
 //! bound of the end configuration for the stable step, and both carry the optional bulk
-//! viscosity (`element::bulk_viscosity`), whose damping they fold into that bound.
+//! viscosity (`element::bulk_viscosity`), whose damping they fold into that bound, and the
+//! optional mass scaling (`element::mass_scaling`, `assembly::mass_scaling`), which raises
+//! the masses of the elements whose bound is below its target as they deform.
 
 pub mod full;
 pub mod one_point;
@@ -12,9 +14,11 @@ pub mod one_point;
 pub use full::Full;
 pub use one_point::Reduced;
 
+use super::mass_scaling::ElementScaling;
 use super::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::Formulation;
 use crate::element::Strain;
+use crate::element::mass_scaling::MassScaling;
 use crate::material::{Material, StressCondition};
 use crate::scene::spec::{DynamicSpec, Quadrature};
 use crate::scene::{Continuum, Model};
@@ -257,6 +261,29 @@ pub trait ExplicitKernel: Send {
     fn restore_viscous_pressure(&mut self, values: &[f64]);
     /// The equivalent plastic strain of every point the kernel keeps (for studies).
     fn eq_plastic_strain(&self) -> &[f64];
+    /// The mass scaling of the kernel's elements (None: off): their factors, the mass they
+    /// added, and the nodal masses the run has still to take.
+    fn mass_scaling(&self) -> Option<&ElementScaling>;
+    fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling>;
+}
+
+/// The mass scaling `rule` of `layout`'s elements with their lumped masses `masses`, every
+/// element unscaled.
+pub(super) fn element_scaling(
+    rule: MassScaling,
+    model: &Model,
+    layout: &Layout,
+    masses: &ElementMasses,
+) -> ElementScaling {
+    let nodal = layout
+        .origin
+        .iter()
+        .map(|&(b, e)| {
+            let m = masses.of(model, b, e);
+            [m[0], m[1], m[2], m[3]]
+        })
+        .collect();
+    ElementScaling::new(rule, nodal, layout.nodes.clone())
 }
 
 /// The stable step of a step's sums, its element as the model names it.
@@ -271,7 +298,9 @@ pub(super) fn stable_step_of(layout: &Layout, work: &StepWork) -> StableStep {
 
 /// The element loop of a central-difference run: the one-point kernel (`reduced`), the 2x2
 /// rate-form kernel on finite-strain Quad4 models, or none (rods, small strain: the general
-/// assembly); and whether the kernel keeps state that `State` does not.
+/// assembly); and whether the kernel keeps state that `State` does not. With the mass
+/// scaling of `spec` the elements below its target on the configuration of `state` are
+/// scaled (their added mass pending for the run's nodal masses).
 pub fn kernel_for(
     model: &Model,
     spec: &DynamicSpec,
@@ -283,13 +312,16 @@ pub fn kernel_for(
         Quadrature::Reduced => (
             Some(Box::new(
                 Reduced::new(model, state, spec.hourglass, masses)
-                    .with_bulk_viscosity(spec.bulk_viscosity),
+                    .with_bulk_viscosity(spec.bulk_viscosity)
+                    .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
             )),
             true,
         ),
         Quadrature::Full if quads_only && spec.geometry == Strain::Finite => (
             Some(Box::new(
-                Full::new(model, state, masses).with_bulk_viscosity(spec.bulk_viscosity),
+                Full::new(model, state, masses)
+                    .with_bulk_viscosity(spec.bulk_viscosity)
+                    .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
             )),
             false,
         ),

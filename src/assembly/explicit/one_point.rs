@@ -10,17 +10,25 @@
 //! q          the bulk viscosity's pressure from tr d / dt (by option; element::bulk_viscosity),
 //!            rho, c_d, L_e on the mid configuration; the forces see sigma - q I
 //! W_visc     -t A_mid 1/2 (q_n + q_{n+1}) tr d
+//! s          the element's mass factor of the mass scaling (by option; 1 without it): its
+//!            lumped masses are s m_a in the frequency bound and the viscous density, and
+//!            an element whose bound is below the target gets a larger s (mass_scaling.rs)
 //! ```
 //! Parallel and deterministic: elements are processed in fixed chunks (rayon), each writes
 //! its own 8 force entries; nodes then gather their elements' entries in element order, and
 //! the chunk sums of the work are added in chunk order. The bits do not depend on the thread
 //! count.
 
-use super::{BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, stable_step_of};
+use super::{
+    BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling,
+    stable_step_of,
+};
+use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::bulk_viscosity::{
     BulkViscosity, ElementScale, damped_frequency_squared, loaded_stress, volumetric_increment,
 };
+use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
 use crate::material::{
@@ -69,6 +77,17 @@ pub struct ElementStep {
 struct ElementMass {
     smallest: f64,
     total: f64,
+}
+
+impl ElementMass {
+    /// The element's masses times the factor `factor`.
+    #[inline(always)]
+    fn scaled(self, factor: f64) -> ElementMass {
+        ElementMass {
+            smallest: self.smallest * factor,
+            total: self.total * factor,
+        }
+    }
 }
 
 /// One element over one step of length dt: positions x at the start, increment u, with the
@@ -299,6 +318,8 @@ pub struct Reduced {
     gather: NodeGather,
     /// Accumulated hourglass work.
     pub hourglass_energy: f64,
+    /// The mass scaling (None: off).
+    scaling: Option<ElementScaling>,
 }
 
 impl Reduced {
@@ -344,12 +365,64 @@ impl Reduced {
             element_forces: vec![0.0; 8 * count],
             gather,
             hourglass_energy: 0.0,
+            scaling: None,
         }
     }
 
     /// The kernel with the bulk viscosity `viscosity` (None: off).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Reduced {
         Reduced { viscosity, ..self }
+    }
+
+    /// The kernel with the mass scaling `rule` (None: off), the elements below its target
+    /// on the positions `x` scaled (`masses`: the lumped masses the kernel was made with).
+    pub fn with_mass_scaling(
+        mut self,
+        rule: Option<MassScaling>,
+        model: &Model,
+        masses: &ElementMasses,
+        x: &[[f64; 2]],
+    ) -> Reduced {
+        if let Some(rule) = rule {
+            let mut scaling = element_scaling(rule, model, &self.layout, masses);
+            scaling.scale_at_start(|e| self.frequency(x, e).ok());
+            self.scaling = Some(scaling);
+        }
+        self
+    }
+
+    /// The masses of element `e` (scaled by its factor with the mass scaling).
+    #[inline(always)]
+    fn mass_of(&self, e: usize) -> ElementMass {
+        match &self.scaling {
+            Some(scaling) => self.mass[e].scaled(scaling.factor(e)),
+            None => self.mass[e],
+        }
+    }
+
+    /// The frequency bound squared of element `e` on the positions `x` from the stored
+    /// state, with its masses and (at rest: no step yet) the damping of the bulk
+    /// viscosity's linear term.
+    fn frequency(&self, x: &[[f64; 2]], e: usize) -> Result<f64, ElementFailure> {
+        let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
+        let state = self.state_of(e);
+        let p = &self.layout.bodies[self.layout.body[e] as usize];
+        let section = self.section(e, &state);
+        let end = one_point::force(&xe, &state.stress, section, &state.hourglass)
+            .map_err(|err| self.layout.failure(e, err))?;
+        let omega_squared = one_point::frequency_bound(
+            &end.gradient,
+            &end.gamma,
+            p.wave_modulus,
+            end.gradient.area * section.weight(&xe),
+            p.axisymmetric().then(|| one_point::centroid_radius(&xe)),
+            p.hourglass_modulus,
+            self.mass_of(e).smallest,
+        );
+        Ok(match &self.viscosity {
+            Some(v) => damped_frequency_squared(omega_squared, v.damping_fraction_at_rest()),
+            None => omega_squared,
+        })
     }
 
     /// The stress the forces of element `e` see in `state` (the stored viscous pressure taken
@@ -432,27 +505,7 @@ impl ExplicitKernel for Reduced {
     fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure> {
         let mut worst = StepWork::default();
         for e in 0..self.elements() {
-            let xe: Nodes = self.layout.nodes[e].map(|n| x[n as usize]);
-            let state = self.state_of(e);
-            let p = &self.layout.bodies[self.layout.body[e] as usize];
-            let section = self.section(e, &state);
-            let end = one_point::force(&xe, &state.stress, section, &state.hourglass)
-                .map_err(|err| self.layout.failure(e, err))?;
-            let omega_squared = one_point::frequency_bound(
-                &end.gradient,
-                &end.gamma,
-                p.wave_modulus,
-                end.gradient.area * section.weight(&xe),
-                p.axisymmetric().then(|| one_point::centroid_radius(&xe)),
-                p.hourglass_modulus,
-                self.mass[e].smallest,
-            );
-            // at rest (no step yet): the damping of the linear term alone
-            let omega_squared = match &self.viscosity {
-                Some(v) => damped_frequency_squared(omega_squared, v.damping_fraction_at_rest()),
-                None => omega_squared,
-            };
-            worst.observe(omega_squared, e);
+            worst.observe(self.frequency(x, e)?, e);
         }
         Ok(stable_step_of(&self.layout, &worst))
     }
@@ -467,7 +520,8 @@ impl ExplicitKernel for Reduced {
         let layout = &self.layout;
         let mass = &self.mass;
         let viscosity = self.viscosity.as_ref();
-        let results: Vec<(StepWork, Option<(usize, KernelError)>)> = (
+        let scaling = self.scaling.as_ref();
+        let results: Vec<ChunkResult> = (
             self.stress.par_chunks_mut(4 * CHUNK),
             self.back_stress.par_chunks_mut(4 * CHUNK),
             self.eq_plastic_strain.par_chunks_mut(CHUNK),
@@ -483,6 +537,7 @@ impl ExplicitKernel for Reduced {
                 let (stress, back, eps_p, temperature, thickness, hourglass, viscous, forces) =
                     chunks;
                 let mut sums = StepWork::default();
+                let mut grown = Vec::new();
                 for i in 0..eps_p.len() {
                     let e = k * CHUNK + i;
                     let element = layout.nodes[e];
@@ -498,11 +553,25 @@ impl ExplicitKernel for Reduced {
                         viscous_pressure: viscous[i],
                     };
                     let p = &layout.bodies[layout.body[e] as usize];
-                    let r = match element_step(p, &xe, &ue, &committed, mass[e], dt, viscosity) {
-                        Ok(r) => r,
-                        Err(err) => return (sums, Some((e, err))),
+                    let element_mass = match scaling {
+                        Some(scaling) => mass[e].scaled(scaling.factor(e)),
+                        None => mass[e],
                     };
-                    sums.observe(r.omega_squared, e);
+                    let r = match element_step(p, &xe, &ue, &committed, element_mass, dt, viscosity)
+                    {
+                        Ok(r) => r,
+                        Err(err) => return (sums, Some((e, err)), grown),
+                    };
+                    let omega_squared = match scaling
+                        .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
+                    {
+                        Some(rescaled) => {
+                            grown.push((e, rescaled.factor));
+                            rescaled.omega_squared
+                        }
+                        None => r.omega_squared,
+                    };
+                    sums.observe(omega_squared, e);
                     stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
                     back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
                     eps_p[i] = r.state.eq_plastic_strain;
@@ -516,15 +585,20 @@ impl ExplicitKernel for Reduced {
                     sums.hourglass += r.hourglass_work;
                     sums.viscous += r.viscous_work;
                 }
-                (sums, None)
+                (sums, None, grown)
             })
             .collect();
         let mut total = StepWork::default();
-        for (sums, error) in results {
+        for (sums, error, grown) in results {
             if let Some((e, err)) = error {
                 return Err(self.layout.failure(e, err));
             }
             total.add(&sums);
+            if let Some(scaling) = self.scaling.as_mut() {
+                for (e, factor) in grown {
+                    scaling.grow(e, factor);
+                }
+            }
         }
         self.gather.gather(&self.element_forces, force);
         self.hourglass_energy += total.hourglass;
@@ -575,7 +649,19 @@ impl ExplicitKernel for Reduced {
     fn eq_plastic_strain(&self) -> &[f64] {
         &self.eq_plastic_strain
     }
+
+    fn mass_scaling(&self) -> Option<&ElementScaling> {
+        self.scaling.as_ref()
+    }
+
+    fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling> {
+        self.scaling.as_mut()
+    }
 }
+
+/// A chunk's sums, its failed element, and the elements whose mass factor grew (with the
+/// new factor), in element order.
+type ChunkResult = (StepWork, Option<(usize, KernelError)>, Vec<(usize, f64)>);
 
 #[cfg(test)]
 mod tests {

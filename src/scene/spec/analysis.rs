@@ -4,6 +4,7 @@
 use super::yes;
 use crate::element::Strain;
 use crate::element::bulk_viscosity::BulkViscosity;
+use crate::element::mass_scaling::MassScaling;
 use serde::Deserialize;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -158,6 +159,18 @@ pub struct AnalysisSpec {
     /// Central difference on Quad4 bodies at finite strain: the bulk viscosity, an artificial
     /// pressure on the volumetric strain rate (docs/theory.md 8.7a). Default: none (off).
     pub bulk_viscosity: Option<BulkViscositySpec>,
+    /// Central difference on Quad4 bodies at finite strain with dt = "auto": selective mass
+    /// scaling, the elements whose stable step falls below `target` made heavier until it is
+    /// the target (docs/theory.md 8.7b). Default: none (off).
+    pub mass_scaling: Option<MassScalingSpec>,
+}
+
+/// `analysis.mass_scaling = { target = 2e-9 }`: the stable step (a time, > 0) below which an
+/// element's density is raised, re-evaluated every step.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassScalingSpec {
+    pub target: f64,
 }
 
 /// `analysis.bulk_viscosity = { linear = 0.06, quadratic = 1.2 }`: the coefficients b_1 and
@@ -351,6 +364,8 @@ pub struct DynamicSpec {
     pub hourglass: f64,
     /// Central difference: the bulk viscosity of the explicit Quad4 kernels (None: off).
     pub bulk_viscosity: Option<BulkViscosity>,
+    /// Central difference: the mass scaling of the explicit Quad4 kernels (None: off).
+    pub mass_scaling: Option<MassScaling>,
 }
 
 /// The validated static analysis.
