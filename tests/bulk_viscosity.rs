@@ -304,12 +304,7 @@ fn bad_bulk_viscosity_is_refused_naming_the_key() {
             "analysis.bulk_viscosity: does not apply to a static analysis",
         ),
     ];
-    for (scene, set, expected) in cases {
-        let output = impact(&["check", scene, "--set", set]);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert_eq!(output.status.code(), Some(2), "{scene} {set}: {stderr}");
-        assert!(stderr.contains(expected), "{scene} {set}: {stderr}");
-    }
+    common::check_refuses(&cases);
 }
 
 /// Goal: the bulk viscosity is refused where the explicit Quad4 kernels do not run: rods

@@ -578,12 +578,7 @@ fn bad_mass_scaling_is_refused_naming_the_key() {
             "analysis.mass_scaling: does not apply to a static analysis",
         ),
     ];
-    for (scene, set, expected) in cases {
-        let output = impact(&["check", scene, "--set", set]);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert_eq!(output.status.code(), Some(2), "{scene} {set}: {stderr}");
-        assert!(stderr.contains(expected), "{scene} {set}: {stderr}");
-    }
+    common::check_refuses(&cases);
 }
 
 /// Goal: the mass scaling is refused where the explicit Quad4 kernels do not run: rods and

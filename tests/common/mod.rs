@@ -173,3 +173,14 @@ steps = 1
 geometry = "linear"
 newton = { strategy = "full" }
 "#;
+
+/// `impact check SCENE --set SET` of each (scene, set, words) exits 2 (bad input) with
+/// `words` in its message.
+pub fn check_refuses(cases: &[(&str, &str, &str)]) {
+    for (scene, set, expected) in cases {
+        let output = impact(&["check", scene, "--set", set]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{scene} {set}: {stderr}");
+        assert!(stderr.contains(expected), "{scene} {set}: {stderr}");
+    }
+}
