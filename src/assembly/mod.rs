@@ -250,11 +250,24 @@ pub fn evaluate(
     d: &[f64],
     dt: f64,
     geometry: Strain,
-    mut system: Option<&mut System>,
+    system: Option<&mut System>,
     tangent: Tangent,
 ) -> Result<Evaluation, ElementFailure> {
     let _timer = crate::profile::Timer::new(crate::profile::Phase::Assembly);
     crate::profile::count_elements(model.elements());
+    evaluate_elements(model, state, d, dt, geometry, system, tangent)
+}
+
+/// [`evaluate`] without its timing (for a caller that times the element loop itself).
+pub(crate) fn evaluate_elements(
+    model: &Model,
+    state: &State,
+    d: &[f64],
+    dt: f64,
+    geometry: Strain,
+    mut system: Option<&mut System>,
+    tangent: Tangent,
+) -> Result<Evaluation, ElementFailure> {
     let want_tangent = system.is_some();
     if let Some(s) = system.as_deref_mut() {
         s.values.iter_mut().for_each(|v| *v = 0.0);
@@ -479,6 +492,17 @@ pub fn bound_stable_step(
     state: &State,
     masses: &ElementMasses,
 ) -> Result<StableStep, ElementFailure> {
+    let (omega_squared, body, element) = largest_frequency_bound(model, state, masses)?;
+    Ok(StableStep::of_frequency(omega_squared, body, element))
+}
+
+/// The largest closed-form element frequency bound squared of the model at the committed
+/// state (`bound_stable_step`), with its body and element.
+pub(crate) fn largest_frequency_bound(
+    model: &Model,
+    state: &State,
+    masses: &ElementMasses,
+) -> Result<(f64, usize, usize), ElementFailure> {
     let mut best = (0.0, 0, 0);
     for (b, body) in model.bodies.iter().enumerate() {
         let kernel = Kernel::of(body);
@@ -516,7 +540,7 @@ pub fn bound_stable_step(
             best = (worst.0, b, worst.1);
         }
     }
-    Ok(StableStep::of_frequency(best.0, best.1, best.2))
+    Ok(best)
 }
 
 /// The stability limit of central difference from the element eigenvalues: 2 / sqrt of the

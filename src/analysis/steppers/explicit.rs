@@ -21,8 +21,9 @@ use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
 use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, StepWork, kernel_for};
 use crate::assembly::mass_scaling::{AddedAtRest, MassScalingReport, NodalMotion};
-use crate::assembly::{self, ElementMasses, Mass, StableStep, State, System, check_mass};
+use crate::assembly::{ElementMasses, Mass, StableStep, State, System, check_mass};
 use crate::contact::{ContactState, Interfaces};
+use crate::element::Strain;
 use crate::output::readable;
 use crate::scene::spec::{DynamicSpec, MassKind};
 use crate::scene::{InputError, Model};
@@ -45,7 +46,7 @@ pub struct Explicit<'a> {
     dt_crit: f64,
     /// The one-point kernel keeps its element state in its own arrays (copied into `state`
     /// only when output reads stresses).
-    kernel: Option<Box<dyn ExplicitKernel>>,
+    kernel: Box<dyn ExplicitKernel + 'a>,
     /// Whether the kernel keeps state that `State` does not (the one-point hourglass forces).
     kernel_has_own_state: bool,
     synced: bool,
@@ -86,14 +87,14 @@ impl<'a> Explicit<'a> {
         let state = State::initial(model);
         let (mut kernel, kernel_has_own_state) = kernel_for(model, spec, &state, &masses);
         let mut m = mass.lumped;
-        if let Some(scaling) = kernel.as_mut().and_then(|k| k.mass_scaling_mut()) {
+        if let Some(scaling) = kernel.mass_scaling_mut() {
             // the elements below the target at the start: the initial velocities move them
             scaling.add_pending(&mut m);
         }
         let inverse_mass = (0..model.dofs())
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
-        let clock = explicit_clock(model, spec, dt_crit, &state, &masses, kernel.as_deref())?;
+        let clock = explicit_clock(model, spec, dt_crit, &state, kernel.as_ref())?;
         let dofs = model.dofs();
         Ok(Explicit {
             model,
@@ -181,7 +182,7 @@ impl<'a> Explicit<'a> {
     /// (docs/theory.md 8.7b): the nodal masses, velocities and accelerations of the end of
     /// the step change with it.
     fn add_scaled_mass(&mut self) -> AddedAtRest {
-        match self.kernel.as_mut().and_then(|k| k.mass_scaling_mut()) {
+        match self.kernel.mass_scaling_mut() {
             Some(scaling) => scaling.add_pending_at_rest(NodalMotion {
                 mass: &mut self.mass,
                 inverse_mass: &mut self.inverse_mass,
@@ -196,37 +197,16 @@ impl<'a> Explicit<'a> {
     /// The internal force at u_{n+1} (a step of length `h`), the committed element state and
     /// the stable step of the new configuration; the message of an element that failed.
     fn internal_force(&mut self, h: f64) -> Result<StableStep, String> {
-        let du = &self.du;
-        match self.kernel.as_mut() {
-            Some(kernel) => {
-                let work = crate::profile::time(crate::profile::Phase::Assembly, || {
-                    crate::profile::count_elements(kernel.elements());
-                    kernel.step(&self.state.coordinates, du, h, &mut self.internal)
-                })
-                .map_err(|e| e.to_string())?;
-                commit_kernel_step(&mut self.state, du, work);
-                self.energies.bulk_viscosity_work += work.viscous;
-                let (body, element) = kernel.locate(work.critical_element);
-                Ok(StableStep::of_frequency(work.omega_squared, body, element))
-            }
-            None => {
-                let spec = self.spec;
-                let evaluation = assembly::evaluate(
-                    self.model,
-                    &self.state,
-                    du,
-                    h,
-                    spec.geometry,
-                    None,
-                    spec.newton.tangent,
-                )
-                .map_err(|e| e.to_string())?;
-                self.internal = evaluation.force.clone();
-                assembly::commit(self.model, &mut self.state, du, evaluation, spec.geometry);
-                assembly::bound_stable_step(self.model, &self.state, &self.masses)
-                    .map_err(|e| e.to_string())
-            }
-        }
+        let (du, kernel) = (&self.du, &mut self.kernel);
+        let work = crate::profile::time(crate::profile::Phase::Assembly, || {
+            crate::profile::count_elements(kernel.elements());
+            kernel.step(&self.state.coordinates, du, h, &mut self.internal)
+        })
+        .map_err(|e| e.to_string())?;
+        commit_kernel_step(&mut self.state, du, work, self.spec.geometry);
+        self.energies.bulk_viscosity_work += work.viscous;
+        let (body, element) = kernel.locate(work.critical_element);
+        Ok(StableStep::of_frequency(work.omega_squared, body, element))
     }
 }
 
@@ -234,25 +214,10 @@ impl Stepper for Explicit<'_> {
     fn start(&mut self) -> Result<(), String> {
         let model = self.model;
         let zero = vec![0.0; model.dofs()];
-        let first = match self.kernel.as_mut() {
-            Some(kernel) => {
-                let mut force = zero.clone();
-                kernel
-                    .internal_force(&self.state.coordinates, &mut force)
-                    .map(|_| force)
-            }
-            None => assembly::evaluate(
-                model,
-                &self.state,
-                &zero,
-                self.clock.dt0,
-                self.spec.geometry,
-                None,
-                self.spec.newton.tangent,
-            )
-            .map(|e| e.force),
-        }
-        .map_err(|err| err.to_string())?;
+        let mut first = zero.clone();
+        self.kernel
+            .internal_force(&self.state.coordinates, &mut first)
+            .map_err(|err| err.to_string())?;
         self.internal = first;
         let system_free = &self.free;
         let (m, a_r) = (&self.mass, self.spec.rayleigh[0]);
@@ -371,10 +336,8 @@ impl Stepper for Explicit<'_> {
         Ok(())
     }
     fn sync_points(&mut self) {
-        if let Some(kernel) = &self.kernel
-            && !self.synced
-        {
-            kernel.write_points(self.model, &mut self.state);
+        if !self.synced {
+            self.kernel.write_points(self.model, &mut self.state);
             self.synced = true;
         }
     }
@@ -418,19 +381,16 @@ impl Report for Explicit<'_> {
         &self.contact
     }
     fn hourglass_energy(&self) -> Option<f64> {
-        self.kernel.as_ref().and_then(|k| k.hourglass_energy())
+        self.kernel.hourglass_energy()
     }
     fn last_step(&self) -> f64 {
         self.clock.last
     }
     fn added_mass(&self) -> Option<f64> {
-        self.kernel
-            .as_ref()
-            .and_then(|k| k.mass_scaling())
-            .map(|s| s.added())
+        self.kernel.mass_scaling().map(|s| s.added())
     }
     fn mass_scaling(&self) -> Option<MassScalingReport> {
-        let kernel = self.kernel.as_ref()?;
+        let kernel = &self.kernel;
         let scaling = kernel.mass_scaling()?;
         Some(scaling.report(self.model.bodies.len(), |e| kernel.locate(e)))
     }
@@ -466,20 +426,17 @@ impl Resume for Explicit<'_> {
         self.clock = carry.clock;
         // a kernel with its own arrays starts again from the restored points (and the viscous
         // pressures of the last step, which the next step's work needs)
-        if self.kernel.is_some() {
-            (self.kernel, self.kernel_has_own_state) =
-                kernel_for(self.model, self.spec, &self.state, &self.masses);
-            if let Some(kernel) = self.kernel.as_mut()
-                && !carry.viscous_pressure.is_empty()
-            {
-                kernel.restore_viscous_pressure(&carry.viscous_pressure);
-            }
-            // the factors and the nodal masses as the run had grown them
-            if let Some(scaling) = self.kernel.as_mut().and_then(|k| k.mass_scaling_mut())
-                && let Some(carried) = &carry.mass_scaling
-            {
-                scaling.restore(carried, &mut self.mass, &mut self.inverse_mass, &self.free);
-            }
+        (self.kernel, self.kernel_has_own_state) =
+            kernel_for(self.model, self.spec, &self.state, &self.masses);
+        if !carry.viscous_pressure.is_empty() {
+            self.kernel
+                .restore_viscous_pressure(&carry.viscous_pressure);
+        }
+        // the factors and the nodal masses as the run had grown them
+        if let Some(scaling) = self.kernel.mass_scaling_mut()
+            && let Some(carried) = &carry.mass_scaling
+        {
+            scaling.restore(carried, &mut self.mass, &mut self.inverse_mass, &self.free);
         }
         true
     }
@@ -492,9 +449,7 @@ impl Resume for Explicit<'_> {
             );
         }
         let mut state = self.state.clone();
-        if let Some(kernel) = &self.kernel {
-            kernel.write_points(self.model, &mut state);
-        }
+        self.kernel.write_points(self.model, &mut state);
         Ok(Carry::Explicit(ExplicitCarry {
             state,
             velocity: self.v.clone(),
@@ -506,32 +461,31 @@ impl Resume for Explicit<'_> {
             step: self.step,
             contact: self.contact.clone(),
             clock: self.clock.clone(),
-            viscous_pressure: match (&self.kernel, &self.spec.bulk_viscosity) {
-                (Some(kernel), Some(_)) => kernel.viscous_pressure().to_vec(),
-                _ => Vec::new(),
+            viscous_pressure: match &self.spec.bulk_viscosity {
+                Some(_) => self.kernel.viscous_pressure().to_vec(),
+                None => Vec::new(),
             },
-            mass_scaling: self
-                .kernel
-                .as_ref()
-                .and_then(|k| k.mass_scaling())
-                .map(|s| s.carry(&self.mass)),
+            mass_scaling: self.kernel.mass_scaling().map(|s| s.carry(&self.mass)),
         }))
     }
 }
 
 /// Commits a step of an explicit kernel (whose element state is already updated): the
-/// configuration moves by du, the work accumulates.
-fn commit_kernel_step(state: &mut State, du: &[f64], work: StepWork) {
-    state
-        .coordinates
-        .par_chunks_mut(DOF_CHUNK / 2)
-        .zip(du.par_chunks(DOF_CHUNK))
-        .for_each(|(x, du)| {
-            for (x, d) in x.iter_mut().zip(du.chunks_exact(2)) {
-                x[0] += d[0];
-                x[1] += d[1];
-            }
-        });
+/// configuration moves by du (finite strain; at small strain it stays the initial one), the
+/// work accumulates.
+fn commit_kernel_step(state: &mut State, du: &[f64], work: StepWork, geometry: Strain) {
+    if geometry == Strain::Finite {
+        state
+            .coordinates
+            .par_chunks_mut(DOF_CHUNK / 2)
+            .zip(du.par_chunks(DOF_CHUNK))
+            .for_each(|(x, du)| {
+                for (x, d) in x.iter_mut().zip(du.chunks_exact(2)) {
+                    x[0] += d[0];
+                    x[1] += d[1];
+                }
+            });
+    }
     state
         .displacement
         .par_chunks_mut(DOF_CHUNK)
@@ -744,7 +698,7 @@ pub fn kernel_benchmark_run(
             stepper.advance(&mut counters).ok()?;
         }
         let seconds = start.elapsed().as_secs_f64();
-        let kernel = stepper.kernel.as_ref()?;
+        let kernel = &stepper.kernel;
         let plastic = kernel
             .eq_plastic_strain()
             .iter()

@@ -37,20 +37,17 @@ pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
 
 /// The clock of a central-difference run that starts from `state`: dt_crit `exact` (from
 /// [`checked_step`]) for a fixed step's check, and the stable step of `kernel` (the one-point
-/// or the 2x2 kernel; none: the general element loop) that an automatic step scales.
+/// or the 2x2 kernel, or the general element loop) that an automatic step scales.
 pub fn explicit_clock(
     model: &Model,
     spec: &DynamicSpec,
     exact: f64,
     state: &State,
-    masses: &ElementMasses,
-    kernel: Option<&dyn ExplicitKernel>,
+    kernel: &dyn ExplicitKernel,
 ) -> Result<Clock, InputError> {
-    let limit = match kernel {
-        Some(kernel) => kernel.stable_step(&state.coordinates),
-        None => assembly::bound_stable_step(model, state, masses),
-    }
-    .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    let limit = kernel
+        .stable_step(&state.coordinates)
+        .map_err(|err| InputError::new(&model.file, err.to_string()))?;
     Ok(Clock::new(spec, exact, limit))
 }
 
@@ -63,7 +60,7 @@ pub fn explicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, Inp
         ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
     let state = State::initial(model);
     let (kernel, _) = kernel_for(model, spec, &state, &masses);
-    Ok(explicit_clock(model, spec, exact, &state, &masses, kernel.as_deref())?.dt0)
+    Ok(explicit_clock(model, spec, exact, &state, kernel.as_ref())?.dt0)
 }
 
 /// The mass scaling a central-difference run of `model` starts with (None: off): the
@@ -80,11 +77,9 @@ pub fn explicit_start_scaling(
         ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
     let state = State::initial(model);
     let (kernel, _) = kernel_for(model, spec, &state, &masses);
-    Ok(kernel.as_deref().and_then(|kernel| {
-        kernel
-            .mass_scaling()
-            .map(|s| s.report(model.bodies.len(), |e| kernel.locate(e)))
-    }))
+    Ok(kernel
+        .mass_scaling()
+        .map(|s| s.report(model.bodies.len(), |e| kernel.locate(e))))
 }
 
 /// The stability limit of `model` under `spec` (the bulk viscosity's damping at rest taken

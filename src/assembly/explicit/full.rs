@@ -593,8 +593,8 @@ impl ExplicitKernel for Full {
         }
     }
 
-    fn eq_plastic_strain(&self) -> &[f64] {
-        &self.eq_plastic_strain
+    fn eq_plastic_strain(&self) -> Vec<f64> {
+        self.eq_plastic_strain.clone()
     }
 
     fn viscous_pressure(&self) -> &[f64] {

@@ -9,9 +9,11 @@
 //! the masses of the elements whose bound is below its target as they deform.
 
 pub mod full;
+pub mod general;
 pub mod one_point;
 
 pub use full::Full;
+pub use general::General;
 pub use one_point::Reduced;
 
 use super::mass_scaling::ElementScaling;
@@ -260,7 +262,7 @@ pub trait ExplicitKernel: Send {
     /// Takes the viscous pressures of a checkpoint (as `viscous_pressure` gave them).
     fn restore_viscous_pressure(&mut self, values: &[f64]);
     /// The equivalent plastic strain of every point the kernel keeps (for studies).
-    fn eq_plastic_strain(&self) -> &[f64];
+    fn eq_plastic_strain(&self) -> Vec<f64>;
     /// The mass scaling of the kernel's elements (None: off): their factors, the mass they
     /// added, and the nodal masses the run has still to take.
     fn mass_scaling(&self) -> Option<&ElementScaling>;
@@ -301,30 +303,39 @@ pub(super) fn stable_step_of(layout: &Layout, work: &StepWork) -> StableStep {
 /// assembly); and whether the kernel keeps state that `State` does not. With the mass
 /// scaling of `spec` the elements below its target on the configuration of `state` are
 /// scaled (their added mass pending for the run's nodal masses).
-pub fn kernel_for(
-    model: &Model,
+pub fn kernel_for<'a>(
+    model: &'a Model,
     spec: &DynamicSpec,
     state: &State,
     masses: &ElementMasses,
-) -> (Option<Box<dyn ExplicitKernel>>, bool) {
+) -> (Box<dyn ExplicitKernel + 'a>, bool) {
     let quads_only = model.bodies.iter().all(|b| !b.kind.is_rod());
     match spec.quadrature {
         Quadrature::Reduced => (
-            Some(Box::new(
+            Box::new(
                 Reduced::new(model, state, spec.hourglass, masses)
                     .with_bulk_viscosity(spec.bulk_viscosity)
                     .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
-            )),
+            ),
             true,
         ),
         Quadrature::Full if quads_only && spec.geometry == Strain::Finite => (
-            Some(Box::new(
+            Box::new(
                 Full::new(model, state, masses)
                     .with_bulk_viscosity(spec.bulk_viscosity)
                     .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
+            ),
+            false,
+        ),
+        Quadrature::Full => (
+            Box::new(General::new(
+                model,
+                state,
+                masses,
+                spec.geometry,
+                spec.newton.tangent,
             )),
             false,
         ),
-        Quadrature::Full => (None, false),
     }
 }

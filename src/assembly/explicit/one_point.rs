@@ -646,8 +646,8 @@ impl ExplicitKernel for Reduced {
         self.viscous_pressure.copy_from_slice(values);
     }
 
-    fn eq_plastic_strain(&self) -> &[f64] {
-        &self.eq_plastic_strain
+    fn eq_plastic_strain(&self) -> Vec<f64> {
+        self.eq_plastic_strain.clone()
     }
 
     fn mass_scaling(&self) -> Option<&ElementScaling> {
