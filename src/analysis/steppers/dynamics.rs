@@ -27,8 +27,9 @@ use crate::integrator::{
 };
 use crate::material::PointState;
 use crate::output::readable;
-use crate::scene::spec::Quantity;
-use crate::scene::spec::{AdaptiveStep, ContactDynamics, DynamicSpec, IntegratorKind, Strategy};
+use crate::scene::spec::{
+    AdaptiveStep, ContactDynamics, DynamicSpec, IntegratorKind, Quantity, Strategy,
+};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
