@@ -313,29 +313,15 @@ fn bad_bulk_viscosity_is_refused_naming_the_key() {
 #[test]
 fn bulk_viscosity_is_refused_off_the_explicit_quad4_kernels() {
     let explicit = [
-        "--set",
         "analysis.integrator=central_difference",
-        "--set",
         "analysis.mass=lumped",
-        "--set",
         "analysis.dt=auto",
-        "--set",
         "analysis.bulk_viscosity={}",
     ];
-    let run = |extra: &[&str]| {
-        let mut args = vec!["check", "models/bar_wall.toml"];
-        args.extend_from_slice(&explicit);
-        args.extend_from_slice(extra);
-        impact(&args)
-    };
-    let small = run(&[]);
-    let stderr = String::from_utf8_lossy(&small.stderr);
-    assert_eq!(small.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("geometry = \"nonlinear\""), "{stderr}");
-    let rods = run(&["--set", "analysis.geometry=nonlinear"]);
-    let stderr = String::from_utf8_lossy(&rods.stderr);
-    assert_eq!(rods.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("body `bar` is a rod"), "{stderr}");
+    let finite = [&explicit[..], &["analysis.geometry=nonlinear"]].concat();
+    let bar = "models/bar_wall.toml";
+    common::check_refuses_with(bar, &explicit, &["geometry = \"nonlinear\""]);
+    common::check_refuses_with(bar, &finite, &["body `bar` is a rod"]);
 }
 
 /// Goal: a fixed step between the damped and the undamped stability limit is refused before

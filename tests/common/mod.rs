@@ -178,9 +178,24 @@ newton = { strategy = "full" }
 /// `words` in its message.
 pub fn check_refuses(cases: &[(&str, &str, &str)]) {
     for (scene, set, expected) in cases {
-        let output = impact(&["check", scene, "--set", set]);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert_eq!(output.status.code(), Some(2), "{scene} {set}: {stderr}");
-        assert!(stderr.contains(expected), "{scene} {set}: {stderr}");
+        check_refuses_with(scene, &[set], &[expected]);
+    }
+}
+
+/// `impact check SCENE --set S` for every S of `sets` exits 2 (bad input) with each of
+/// `words` in its message.
+pub fn check_refuses_with(scene: &str, sets: &[&str], words: &[&str]) {
+    let mut args = vec!["check", scene];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    let output = impact(&args);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{scene} {sets:?}: {stderr}");
+    for word in words {
+        assert!(
+            stderr.contains(word),
+            "{scene} {sets:?}: `{word}` not in {stderr}"
+        );
     }
 }
