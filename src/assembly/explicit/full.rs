@@ -298,9 +298,9 @@ fn update(
     let (lambda, mu) = (p.lambda, p.mu);
     let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
     let trial = [
-        stress_n[0] + volumetric + 2.0 * mu * strain[0],
-        stress_n[1] + volumetric + 2.0 * mu * strain[1],
-        stress_n[2] + volumetric + 2.0 * mu * strain[2],
+        stress_n[0] + (volumetric + 2.0 * mu * strain[0]),
+        stress_n[1] + (volumetric + 2.0 * mu * strain[1]),
+        stress_n[2] + (volumetric + 2.0 * mu * strain[2]),
         stress_n[3] + mu * strain[3],
     ];
     let plastic = p.material.plasticity.as_ref().and_then(|j2| {

@@ -250,16 +250,16 @@ fn material_step(
         let trial = if p.axisymmetric() {
             let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
             [
-                stress_n[0] + volumetric + 2.0 * mu * strain[0],
-                stress_n[1] + volumetric + 2.0 * mu * strain[1],
-                stress_n[2] + volumetric + 2.0 * mu * strain[2],
+                stress_n[0] + (volumetric + 2.0 * mu * strain[0]),
+                stress_n[1] + (volumetric + 2.0 * mu * strain[1]),
+                stress_n[2] + (volumetric + 2.0 * mu * strain[2]),
                 stress_n[3] + mu * strain[3],
             ]
         } else {
             let volumetric = lambda * (strain[0] + strain[1]);
             [
-                stress_n[0] + volumetric + 2.0 * mu * strain[0],
-                stress_n[1] + volumetric + 2.0 * mu * strain[1],
+                stress_n[0] + (volumetric + 2.0 * mu * strain[0]),
+                stress_n[1] + (volumetric + 2.0 * mu * strain[1]),
                 stress_n[2] + volumetric,
                 stress_n[3] + mu * strain[3],
             ]
