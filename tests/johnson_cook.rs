@@ -16,7 +16,7 @@ fn material(young: f64, poisson: f64, density: f64, a: f64, law: JohnsonCook) ->
     Material {
         name: "jc".into(),
         density,
-        elastic: Elastic { young, poisson },
+        elastic: Elastic::new(young, poisson),
         plasticity: Some(J2 {
             yield_stress: a,
             hardening: Hardening::JohnsonCook(law),

@@ -9,11 +9,7 @@ use impact::material::{Elastic, StressCondition};
 use proptest::prelude::*;
 
 fn moduli() -> Moduli {
-    Elastic {
-        young: 210.0,
-        poisson: 0.3,
-    }
-    .moduli(StressCondition::General)
+    Elastic::new(210.0, 0.3).moduli(StressCondition::General)
 }
 
 /// A convex counter-clockwise quad: the unit square's corners moved by up to 0.3, scaled,
@@ -207,7 +203,7 @@ proptest! {
         form in 0usize..3,
     ) {
         let formulation = [Formulation::PlaneStrain, Formulation::PlaneStress, Formulation::Axisymmetric][form];
-        let elastic = Elastic { young: 1.0, poisson: nu };
+        let elastic = Elastic::new(1.0, nu);
         let condition = if formulation == Formulation::PlaneStress {
             StressCondition::PlaneStress
         } else {

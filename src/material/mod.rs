@@ -18,6 +18,7 @@ pub mod j2;
 pub mod johnson_cook;
 
 use crate::element::{Formulation, Moduli, Voigt};
+use j2::Radial;
 pub use j2::{FlowStart, Hardening, J2};
 pub use johnson_cook::JohnsonCook;
 
@@ -87,16 +88,28 @@ pub struct Response {
 pub struct Elastic {
     pub young: f64,
     pub poisson: f64,
+    /// (lambda, mu) of young and poisson, computed once by `new`: the explicit kernels read
+    /// them at every point of every step.
+    lame: (f64, f64),
 }
 
 impl Elastic {
+    pub fn new(young: f64, poisson: f64) -> Elastic {
+        let (e, nu) = (young, poisson);
+        Elastic {
+            young,
+            poisson,
+            lame: (
+                e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+                e / (2.0 * (1.0 + nu)),
+            ),
+        }
+    }
+
+    /// The Lame constants (lambda, mu) of the 3D law.
     #[inline]
     pub fn lame(&self) -> (f64, f64) {
-        let (e, nu) = (self.young, self.poisson);
-        (
-            e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
-            e / (2.0 * (1.0 + nu)),
-        )
+        self.lame
     }
 
     /// The Lame constants of the in-plane law of `condition`: those of the 3D law, or in
@@ -174,31 +187,56 @@ impl Material {
     }
 
     /// The temperature after the plastic work `plastic_work` per unit volume at `temperature`
-    /// (adiabatic heating; unchanged for materials that carry no temperature).
-    pub fn heated(&self, temperature: f64, plastic_work: f64) -> f64 {
+    /// (adiabatic heating; unchanged for materials that carry no temperature). Inside the
+    /// updates only: a point heats in the step that does the work.
+    fn heated(&self, temperature: f64, plastic_work: f64) -> f64 {
         match self.johnson_cook() {
             Some(law) => temperature + law.temperature_rise(plastic_work, self.density),
             None => temperature,
         }
     }
 
-    /// Response of a continuum point (Quad4): elastic predictor, then the return to the yield
-    /// surface when the material is plastic.
+    /// The one update of a continuum point, which the implicit kernel (through `update`) and
+    /// both explicit kernels call: the committed state in the frame of the increment (pushed
+    /// to the reference configuration, or rotated by the step's spin), the strain increment
+    /// and the time step in; the new state out, after the elastic predictor, the return to
+    /// the yield surface and the adiabatic heating of the step. No tangent.
+    #[inline(always)]
+    pub fn step(
+        &self,
+        committed: &PointState,
+        strain: &Voigt,
+        context: UpdateContext,
+    ) -> PointStep {
+        match context.condition {
+            StressCondition::General => {
+                self.general_step(committed, strain, context.dt, |_, _, _| ())
+                    .0
+            }
+            StressCondition::PlaneStress => {
+                let r = self.update_plane_stress(committed, strain, context.dt);
+                PointStep {
+                    state: r.state,
+                    plastic_work: r.plastic_work,
+                    strain_zz: r.strain_zz,
+                }
+            }
+        }
+    }
+
+    /// Response of a continuum point (Quad4): `step` with the algorithmic tangent.
     pub fn update(
         &self,
         committed: &PointState,
         strain: &Voigt,
         context: UpdateContext,
     ) -> Response {
-        match context.condition {
-            StressCondition::General => self.update_general(committed, strain, context.dt),
-            StressCondition::PlaneStress => self.update_plane_stress(committed, strain, context.dt),
-        }
+        self.update_with(committed, strain, context, true)
     }
 
     /// `update`, or (`tangent` false) for a caller that reads no tangent (a residual): a
     /// plastic point of the general condition then skips its algorithmic moduli and carries
-    /// the elastic ones in their place. Stress and state are those of `update`, bit for bit.
+    /// the elastic ones in their place. Stress and state are those of `step`, bit for bit.
     /// (Plane stress solves for its out-of-plane strain with the tangent, so it keeps it.)
     pub fn update_with(
         &self,
@@ -213,15 +251,19 @@ impl Material {
         }
     }
 
-    fn update_general(&self, committed: &PointState, strain: &Voigt, dt: f64) -> Response {
-        self.general(committed, strain, dt, true)
-    }
-
-    /// The 3D update (plane strain, axisymmetric), with the algorithmic tangent or not.
+    /// The elastic predictor S = sigma_n + D_e dE (from the Lame constants: the same moduli,
+    /// fewer products than D_e's 16), the J2 return and the heating of the general condition
+    /// (plane strain, axisymmetric). A plastic point also hands its return to `returned`
+    /// (the implicit kernel's tangent; the explicit kernels take nothing, so the return's
+    /// record is never copied out of the update).
     #[inline(always)]
-    fn general(&self, committed: &PointState, strain: &Voigt, dt: f64, tangent: bool) -> Response {
-        let moduli = self.elastic.moduli(StressCondition::General);
-        // D_e dE from the Lame constants (the same moduli, fewer products than D_e's 16)
+    fn general_step<T>(
+        &self,
+        committed: &PointState,
+        strain: &Voigt,
+        dt: f64,
+        returned: impl FnOnce(&J2, &Radial, f64) -> T,
+    ) -> (PointStep, Option<T>) {
         let (lambda, mu) = self.elastic.lame();
         let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
         let trial = committed.stress
@@ -231,54 +273,57 @@ impl Material {
                 volumetric + 2.0 * mu * strain[2],
                 mu * strain[3],
             );
+        let start = FlowStart {
+            eq_plastic_strain: committed.eq_plastic_strain,
+            temperature: committed.temperature,
+            dt,
+        };
         let plastic = self.plasticity.as_ref().and_then(|j2| {
-            j2.radial(
-                &trial,
-                mu,
-                &committed.back_stress,
-                FlowStart {
-                    eq_plastic_strain: committed.eq_plastic_strain,
-                    temperature: committed.temperature,
-                    dt,
-                },
-            )
-            .map(|r| {
-                (
-                    if tangent {
-                        j2.tangent(&r, &moduli, mu)
-                    } else {
-                        moduli
-                    },
-                    r,
-                )
-            })
+            j2.radial(&trial, mu, &committed.back_stress, start)
+                .map(|r| (j2, r))
         });
-        match plastic {
-            None => Response {
-                stress: trial,
-                moduli,
-                strain_zz: strain[2],
+        let Some((j2, r)) = plastic else {
+            let elastic = PointStep {
                 state: PointState {
                     stress: trial,
                     ..*committed
                 },
                 plastic_work: 0.0,
+                strain_zz: strain[2],
+            };
+            return (elastic, None);
+        };
+        let plastic_work = r.plastic_work();
+        let step = PointStep {
+            state: PointState {
+                stress: r.stress,
+                eq_plastic_strain: r.eq_plastic_strain,
+                back_stress: r.back_stress,
+                temperature: self.heated(committed.temperature, plastic_work),
             },
-            Some((tangent, r)) => {
-                let plastic_work = r.plastic_work();
-                Response {
-                    stress: r.stress,
-                    moduli: tangent,
-                    strain_zz: strain[2],
-                    state: PointState {
-                        stress: r.stress,
-                        eq_plastic_strain: r.eq_plastic_strain,
-                        back_stress: r.back_stress,
-                        temperature: self.heated(committed.temperature, plastic_work),
-                    },
-                    plastic_work,
-                }
+            plastic_work,
+            strain_zz: strain[2],
+        };
+        (step, Some(returned(j2, &r, mu)))
+    }
+
+    /// The general update with the algorithmic tangent (`tangent`) or the elastic moduli.
+    #[inline(always)]
+    fn general(&self, committed: &PointState, strain: &Voigt, dt: f64, tangent: bool) -> Response {
+        let elastic = self.elastic.moduli(StressCondition::General);
+        let (step, moduli) = self.general_step(committed, strain, dt, |j2, r, mu| {
+            if tangent {
+                j2.tangent(r, &elastic, mu)
+            } else {
+                elastic
             }
+        });
+        Response {
+            stress: step.state.stress,
+            moduli: moduli.unwrap_or(elastic),
+            strain_zz: step.strain_zz,
+            state: step.state,
+            plastic_work: step.plastic_work,
         }
     }
 
@@ -296,7 +341,7 @@ impl Material {
             .map_or(0.0, |j| j.yield_stress)
             .max(committed.stress.norm());
         let tolerance = 1e-15 * scale.max(self.elastic.young * strain.norm());
-        let mut response = self.update_general(committed, &trial, dt);
+        let mut response = self.general(committed, &trial, dt, true);
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         for _ in 0..200 {
             let szz = response.stress[2];
@@ -321,7 +366,7 @@ impl Material {
                 break;
             }
             trial[2] = next;
-            response = self.update_general(committed, &trial, dt);
+            response = self.general(committed, &trial, dt, true);
         }
         let d = response.moduli;
         let mut condensed = Moduli::zeros();
@@ -385,6 +430,17 @@ impl Material {
             }
         }
     }
+}
+
+/// A point after one increment: the one update's output (no tangent).
+#[derive(Debug, Clone, Copy)]
+pub struct PointStep {
+    /// The new state, its stress in the frame of the increment.
+    pub state: PointState,
+    /// Plastic work per unit volume of the increment, S_{n+1} : d eps_p.
+    pub plastic_work: f64,
+    /// The out-of-plane strain increment: the material's in plane stress, else the input's.
+    pub strain_zz: f64,
 }
 
 /// The response of a rod point.
@@ -459,10 +515,7 @@ mod tests {
         let m = Material {
             name: "m".into(),
             density: 1.0,
-            elastic: Elastic {
-                young: 200.0,
-                poisson: 0.3,
-            },
+            elastic: Elastic::new(200.0, 0.3),
             plasticity: None,
         };
         let r = m.update(
@@ -499,10 +552,7 @@ mod plasticity_tests {
         Material {
             name: "steel".into(),
             density: 1.0,
-            elastic: Elastic {
-                young: 200.0,
-                poisson: 0.3,
-            },
+            elastic: Elastic::new(200.0, 0.3),
             plasticity: Some(J2 {
                 yield_stress: 0.5,
                 hardening,

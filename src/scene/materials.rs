@@ -28,10 +28,7 @@ pub(super) fn materials(
         let material = Material {
             name: m.name.clone(),
             density: m.density,
-            elastic: Elastic {
-                young: m.young,
-                poisson: m.poisson,
-            },
+            elastic: Elastic::new(m.young, m.poisson),
             plasticity: plasticity(cx, &key, m)?,
         };
         if out.insert(m.name.clone(), material).is_some() {

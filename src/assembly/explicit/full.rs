@@ -25,7 +25,10 @@
 //!                       gets a larger s (mass_scaling.rs)
 //! ```
 
-use super::{CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling, stable_step_of};
+use super::{
+    CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling, point_step,
+    stable_step_of,
+};
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::bulk_viscosity::{
@@ -35,9 +38,7 @@ use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{
-    FlowStart, PointState, StressCondition, UpdateContext, trapezoid_dissipation,
-};
+use crate::material::{PointState, trapezoid_dissipation};
 use crate::scene::Model;
 use rayon::prelude::*;
 
@@ -191,35 +192,35 @@ fn element_step(
         let w = spin[q];
         let scale = 1.0 / (1.0 + 0.25 * w * w);
         let (c, s) = ((1.0 - 0.25 * w * w) * scale, w * scale);
-        let stress_n = rotate(&committed.stress[q], c, s);
-        let back_n = rotate(&committed.back_stress[q], c, s);
-        let (stress, plastic) = update(
-            p,
-            &stress_n,
-            &back_n,
-            committed,
-            q,
-            &mut strain[q],
-            dt,
-            &mut state,
-        );
-        // adiabatic heating by the step's plastic work (Johnson-Cook; the others keep theirs)
-        state.temperature[q] = p.material.heated(committed.temperature[q], plastic);
+        let start = PointState {
+            stress: Voigt::from(rotate(&committed.stress[q], c, s)),
+            eq_plastic_strain: committed.eq_plastic_strain[q],
+            back_stress: Voigt::from(rotate(&committed.back_stress[q], c, s)),
+            temperature: committed.temperature[q],
+        };
+        let step = point_step(p, &start, &mut strain[q], dt);
+        if p.plane_stress() {
+            state.thickness[q] = committed.thickness[q] * step.strain_zz.exp();
+        }
+        let end = &step.state;
         let weight = at_mid.points[q].weight;
         work += weight
             * 0.5
             * (0..4)
-                .map(|k| (stress_n[k] + stress[k]) * strain[q][k])
+                .map(|k| (start.stress[k] + end.stress[k]) * strain[q][k])
                 .sum::<f64>();
         // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
         plastic_work += weight
             * trapezoid_dissipation(
-                &Voigt::from(stress_n),
-                &Voigt::from(stress),
-                &Voigt::from(state.back_stress[q]),
-                plastic,
+                &start.stress,
+                &end.stress,
+                &end.back_stress,
+                step.plastic_work,
             );
-        state.stress[q] = stress;
+        state.stress[q] = end.stress.into();
+        state.back_stress[q] = end.back_stress.into();
+        state.eq_plastic_strain[q] = end.eq_plastic_strain;
+        state.temperature[q] = end.temperature;
     }
     let at_end = quad4::values(&end, p.formulation, &state.thickness)?;
     let omega_squared = quad4::frequency_bound(&at_end, p.wave_lambda, p.mu, lumped);
@@ -258,74 +259,6 @@ fn element_step(
         plastic_work,
         viscous_work,
     })
-}
-
-/// The material update of point q from its rotated stress and back stress and the strain
-/// increment (plane stress: the material's out-of-plane strain written into it and the
-/// thickness updated); returns the new stress and the plastic work density. `dt` is the
-/// step's length (the strain rate of rate-dependent materials).
-#[allow(clippy::too_many_arguments)]
-fn update(
-    p: &super::BodyParameters,
-    stress_n: &[f64; 4],
-    back_n: &[f64; 4],
-    committed: &PointsState,
-    q: usize,
-    strain: &mut [f64; 4],
-    dt: f64,
-    state: &mut PointsState,
-) -> ([f64; 4], f64) {
-    if p.plane_stress() {
-        let r = p.material.update(
-            &PointState {
-                stress: Voigt::from(*stress_n),
-                eq_plastic_strain: committed.eq_plastic_strain[q],
-                back_stress: Voigt::from(*back_n),
-                temperature: committed.temperature[q],
-            },
-            &Voigt::from(*strain),
-            UpdateContext {
-                condition: StressCondition::PlaneStress,
-                dt,
-            },
-        );
-        strain[2] = r.strain_zz;
-        state.back_stress[q] = r.state.back_stress.into();
-        state.eq_plastic_strain[q] = r.state.eq_plastic_strain;
-        state.thickness[q] = committed.thickness[q] * r.strain_zz.exp();
-        return (r.state.stress.into(), r.plastic_work);
-    }
-    let (lambda, mu) = (p.lambda, p.mu);
-    let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
-    let trial = [
-        stress_n[0] + (volumetric + 2.0 * mu * strain[0]),
-        stress_n[1] + (volumetric + 2.0 * mu * strain[1]),
-        stress_n[2] + (volumetric + 2.0 * mu * strain[2]),
-        stress_n[3] + mu * strain[3],
-    ];
-    let plastic = p.material.plasticity.as_ref().and_then(|j2| {
-        j2.radial(
-            &Voigt::from(trial),
-            mu,
-            &Voigt::from(*back_n),
-            FlowStart {
-                eq_plastic_strain: committed.eq_plastic_strain[q],
-                temperature: committed.temperature[q],
-                dt,
-            },
-        )
-    });
-    match plastic {
-        None => {
-            state.back_stress[q] = *back_n;
-            (trial, 0.0)
-        }
-        Some(r) => {
-            state.back_stress[q] = r.back_stress.into();
-            state.eq_plastic_strain[q] = r.eq_plastic_strain;
-            (r.stress.into(), r.plastic_work())
-        }
-    }
 }
 
 impl Full {

@@ -20,8 +20,9 @@ use super::mass_scaling::ElementScaling;
 use super::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::Formulation;
 use crate::element::Strain;
+use crate::element::Voigt;
 use crate::element::mass_scaling::MassScaling;
-use crate::material::{Material, StressCondition};
+use crate::material::{Material, PointState, PointStep, StressCondition, UpdateContext};
 use crate::scene::spec::{DynamicSpec, Quadrature};
 use crate::scene::{Continuum, Model};
 use rayon::prelude::*;
@@ -86,8 +87,7 @@ pub(super) struct BodyParameters {
     pub material: Material,
     pub formulation: Formulation,
     pub bbar: bool,
-    /// The Lame constants (lambda of the 3D law; plane stress condenses it itself).
-    pub lambda: f64,
+    /// The shear modulus.
     pub mu: f64,
     /// The plane-wave modulus of the stable-step bound: lambda + 2 mu (plane stress:
     /// E / (1 - nu^2)), and the lambda that goes with it.
@@ -105,6 +105,32 @@ impl BodyParameters {
     }
     pub(super) fn axisymmetric(&self) -> bool {
         self.formulation == Formulation::Axisymmetric
+    }
+}
+
+/// The material's one update (`Material::step`) of a point of body `p` from its committed
+/// state rotated by the step's spin: the new state, heating inside; in plane stress the
+/// material's out-of-plane strain is written into `strain[2]`. Each arm calls the update
+/// with its stress condition fixed, so the inlined update keeps one path.
+#[inline(always)]
+pub(super) fn point_step(
+    p: &BodyParameters,
+    start: &PointState,
+    strain: &mut [f64; 4],
+    dt: f64,
+) -> PointStep {
+    let increment = Voigt::from(*strain);
+    if p.plane_stress() {
+        let condition = StressCondition::PlaneStress;
+        let step = p
+            .material
+            .step(start, &increment, UpdateContext { condition, dt });
+        strain[2] = step.strain_zz;
+        step
+    } else {
+        let condition = StressCondition::General;
+        p.material
+            .step(start, &increment, UpdateContext { condition, dt })
     }
 }
 
@@ -135,14 +161,13 @@ impl Layout {
             };
             let condition = StressCondition::of(formulation);
             let elastic = &spec.material.elastic;
-            let (lambda, mu) = elastic.lame();
+            let (_, mu) = elastic.lame();
             let (wave_lambda, _) = elastic.lame_in(condition);
             layout.bodies.push(BodyParameters {
                 name: spec.name.clone(),
                 material: spec.material.clone(),
                 formulation,
                 bbar,
-                lambda,
                 mu,
                 wave_modulus: elastic.p_wave_modulus(condition),
                 wave_lambda,

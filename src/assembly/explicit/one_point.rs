@@ -21,7 +21,7 @@
 
 use super::{
     BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling,
-    stable_step_of,
+    point_step, stable_step_of,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -31,9 +31,7 @@ use crate::element::bulk_viscosity::{
 use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
-use crate::material::{
-    FlowStart, PointState, StressCondition, UpdateContext, trapezoid_dissipation,
-};
+use crate::material::{PointState, trapezoid_dissipation};
 use crate::scene::Model;
 use rayon::prelude::*;
 
@@ -110,26 +108,28 @@ fn element_step(
     };
     let step = one_point::increment(x, u, section)?;
     let (c, s) = (step.cos, step.sin);
-    let stress_n = rotate(&committed.stress, c, s);
-    let back_n = rotate(&committed.back_stress, c, s);
+    let start = PointState {
+        stress: Voigt::from(rotate(&committed.stress, c, s)),
+        eq_plastic_strain: committed.eq_plastic_strain,
+        back_stress: Voigt::from(rotate(&committed.back_stress, c, s)),
+        temperature: committed.temperature,
+    };
     let mut strain = step.strain;
     // the volumetric increment the viscous pressure follows (before plane stress writes the
     // thickness strain into it)
     let volumetric = volumetric_increment(&strain, p.formulation);
-    let MaterialStep {
-        stress,
-        back_stress,
-        eq_plastic_strain,
-        plastic_density,
-        thickness,
-    } = material_step(p, committed, &stress_n, &back_n, &mut strain, dt);
-    // adiabatic heating by the step's plastic work (Johnson-Cook; the others keep theirs)
-    let temperature = p.material.heated(committed.temperature, plastic_density);
+    let point = point_step(p, &start, &mut strain, dt);
+    let thickness = if p.plane_stress() {
+        t * point.strain_zz.exp()
+    } else {
+        t
+    };
+    let after = &point.state;
     let volume = step.gradient.area * section.weight(&step.mid);
     let work = volume
         * 0.5
         * (0..4)
-            .map(|k| (stress_n[k] + stress[k]) * strain[k])
+            .map(|k| (start.stress[k] + after.stress[k]) * strain[k])
             .sum::<f64>();
     let hourglass = one_point::hourglass(
         &step,
@@ -143,10 +143,10 @@ fn element_step(
         viscosity.step(&scale, volumetric, dt, volume, committed.viscous_pressure)
     });
     let state = ElementState {
-        stress,
-        back_stress,
-        eq_plastic_strain,
-        temperature,
+        stress: after.stress.into(),
+        back_stress: after.back_stress.into(),
+        eq_plastic_strain: after.eq_plastic_strain,
+        temperature: after.temperature,
         thickness,
         hourglass: hourglass.forces,
         viscous_pressure: viscous.map_or(committed.viscous_pressure, |v| v.pressure),
@@ -188,109 +188,15 @@ fn element_step(
         // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
         plastic_work: volume
             * trapezoid_dissipation(
-                &Voigt::from(stress_n),
-                &Voigt::from(stress),
-                &Voigt::from(back_stress),
-                plastic_density,
+                &start.stress,
+                &after.stress,
+                &after.back_stress,
+                point.plastic_work,
             ),
         hourglass_work: hourglass.work,
         viscous_work,
         omega_squared,
     })
-}
-
-/// The element's stress after the material update of one step, from the rotated start stress.
-struct MaterialStep {
-    stress: [f64; 4],
-    back_stress: [f64; 4],
-    eq_plastic_strain: f64,
-    /// Plastic work per unit volume.
-    plastic_density: f64,
-    /// The thickness at the end of the step (plane stress), else the committed one.
-    thickness: f64,
-}
-
-/// The material update of one element at its centroid: the general update for plane stress
-/// (which also gives the thickness strain, written into `strain[2]`), else the isotropic
-/// elastic trial and the one J2 return.
-#[inline(always)]
-fn material_step(
-    p: &BodyParameters,
-    committed: &ElementState,
-    stress_n: &[f64; 4],
-    back_n: &[f64; 4],
-    strain: &mut [f64; 4],
-    dt: f64,
-) -> MaterialStep {
-    let t = committed.thickness;
-    if p.plane_stress() {
-        let r = p.material.update(
-            &PointState {
-                stress: Voigt::from(*stress_n),
-                eq_plastic_strain: committed.eq_plastic_strain,
-                back_stress: Voigt::from(*back_n),
-                temperature: committed.temperature,
-            },
-            &Voigt::from(*strain),
-            UpdateContext {
-                condition: StressCondition::PlaneStress,
-                dt,
-            },
-        );
-        strain[2] = r.strain_zz;
-        MaterialStep {
-            stress: r.state.stress.into(),
-            back_stress: r.state.back_stress.into(),
-            eq_plastic_strain: r.state.eq_plastic_strain,
-            plastic_density: r.plastic_work,
-            thickness: t * r.strain_zz.exp(),
-        }
-    } else {
-        let (lambda, mu) = (p.lambda, p.mu);
-        let trial = if p.axisymmetric() {
-            let volumetric = lambda * (strain[0] + strain[1] + strain[2]);
-            [
-                stress_n[0] + (volumetric + 2.0 * mu * strain[0]),
-                stress_n[1] + (volumetric + 2.0 * mu * strain[1]),
-                stress_n[2] + (volumetric + 2.0 * mu * strain[2]),
-                stress_n[3] + mu * strain[3],
-            ]
-        } else {
-            let volumetric = lambda * (strain[0] + strain[1]);
-            [
-                stress_n[0] + (volumetric + 2.0 * mu * strain[0]),
-                stress_n[1] + (volumetric + 2.0 * mu * strain[1]),
-                stress_n[2] + volumetric,
-                stress_n[3] + mu * strain[3],
-            ]
-        };
-        let plastic = p.material.plasticity.as_ref().and_then(|j2| {
-            j2.radial(
-                &Voigt::from(trial),
-                mu,
-                &Voigt::from(*back_n),
-                FlowStart {
-                    eq_plastic_strain: committed.eq_plastic_strain,
-                    temperature: committed.temperature,
-                    dt,
-                },
-            )
-            .map(|r| MaterialStep {
-                stress: r.stress.into(),
-                back_stress: r.back_stress.into(),
-                eq_plastic_strain: r.eq_plastic_strain,
-                plastic_density: r.plastic_work(),
-                thickness: t,
-            })
-        });
-        plastic.unwrap_or(MaterialStep {
-            stress: trial,
-            back_stress: *back_n,
-            eq_plastic_strain: committed.eq_plastic_strain,
-            plastic_density: 0.0,
-            thickness: t,
-        })
-    }
 }
 
 /// Element data of all Quad4 bodies as flat arrays (element-major, kernel element index
@@ -673,10 +579,7 @@ mod tests {
         let material = Material {
             name: "m".into(),
             density: 1.0,
-            elastic: Elastic {
-                young: 200.0,
-                poisson: 0.3,
-            },
+            elastic: Elastic::new(200.0, 0.3),
             plasticity: None,
         };
         let (lambda, mu) = material.elastic.lame();
@@ -685,7 +588,6 @@ mod tests {
             material,
             formulation: Formulation::PlaneStrain,
             bbar: false,
-            lambda,
             mu,
             hourglass_modulus: 0.1 * (lambda + 3.0 * mu) / 24.0,
             wave_modulus: lambda + 2.0 * mu,
