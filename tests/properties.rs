@@ -264,7 +264,7 @@ proptest! {
         let lumped: [f64; 4] = std::array::from_fn(|i| rho * m.row(i).sum());
         let exact = max_frequency_squared(&k, &lumped);
         let smallest = lumped.iter().copied().fold(f64::INFINITY, f64::min);
-        let bound = one_point::frequency_bound(&g, &gamma, lambda + 2.0 * mu, g.area, None, hourglass, smallest);
+        let bound = one_point::frequency_bound(one_point::BoundShape { gradient: &g, gamma: &gamma, volume: g.area, hoop_radius: None }, lambda + 2.0 * mu, hourglass, smallest);
         prop_assert!(bound >= exact * (1.0 - 1e-9), "bound {bound} below {exact}");
         prop_assert!(bound <= 16.0 * exact, "bound {bound} far above {exact}");
     }
@@ -337,7 +337,7 @@ proptest! {
         let lumped: [f64; 4] = std::array::from_fn(|i| m.row(i).sum());
         let exact = max_frequency_squared(&k, &lumped);
         let smallest = lumped.iter().copied().fold(f64::INFINITY, f64::min);
-        let bound = one_point::frequency_bound(&g, &gamma, lambda + 2.0 * mu, volume, Some(r), hourglass, smallest);
+        let bound = one_point::frequency_bound(one_point::BoundShape { gradient: &g, gamma: &gamma, volume, hoop_radius: Some(r) }, lambda + 2.0 * mu, hourglass, smallest);
         prop_assert!(bound >= exact * (1.0 - 1e-9), "bound {bound} below {exact}");
         prop_assert!(bound <= 16.0 * exact, "bound {bound} far above {exact}");
     }

@@ -203,6 +203,18 @@ pub fn hourglass(
     Hourglass { forces, work }
 }
 
+/// What the frequency bound reads of an element's shape.
+#[derive(Debug, Clone, Copy)]
+pub struct BoundShape<'a> {
+    /// The centroid gradient.
+    pub gradient: &'a Gradient,
+    pub gamma: &'a [f64; 4],
+    /// The element's volume (thickness or 2 pi r included).
+    pub volume: f64,
+    /// The centroid radius of an axisymmetric element.
+    pub hoop_radius: Option<f64>,
+}
+
 /// An element's nodal forces on a configuration, with the gradient and gamma they used.
 #[derive(Debug, Clone, Copy)]
 pub struct Forces {
@@ -257,20 +269,21 @@ pub fn force(
 /// semi-definite matrices is at most the sum of theirs: the hourglass stiffness k gamma
 /// gamma^T has the one eigenvalue k |gamma|^2 per direction), over the smallest lumped nodal
 /// mass. `modulus` is lambda + 2 mu (plane stress: E / (1 - nu^2)), `volume` the element's
-/// (thickness or 2 pi r included), `hoop_radius` the centroid radius of an axisymmetric
-/// element, `hourglass_modulus` kappa (lambda + 3 mu) / 24 (k = it V b.b).
-#[allow(clippy::too_many_arguments)]
+/// (`shape`), `hourglass_modulus` kappa (lambda + 3 mu) / 24 (k = it V b.b).
 #[inline(always)]
 pub fn frequency_bound(
-    grad: &Gradient,
-    gamma: &[f64; 4],
+    shape: BoundShape,
     modulus: f64,
-    volume: f64,
-    hoop_radius: Option<f64>,
     hourglass_modulus: f64,
     smallest_mass: f64,
 ) -> f64 {
-    let (bx, by) = (&grad.bx, &grad.by);
+    let BoundShape {
+        gradient,
+        gamma,
+        volume,
+        hoop_radius,
+    } = shape;
+    let (bx, by) = (&gradient.bx, &gradient.by);
     let bb: f64 = (0..4).map(|a| bx[a] * bx[a] + by[a] * by[a]).sum();
     let hoop = hoop_radius.map_or(0.0, |r| 0.25 / (r * r));
     let gg: f64 = gamma.iter().map(|g| g * g).sum();

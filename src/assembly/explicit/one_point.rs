@@ -29,7 +29,7 @@ use crate::element::bulk_viscosity::{
     BulkViscosity, ElementScale, damped_frequency_squared, loaded_stress, volumetric_increment,
 };
 use crate::element::mass_scaling::MassScaling;
-use crate::element::quad4_one_point::{self as one_point, Nodes, Section, rotate};
+use crate::element::quad4_one_point::{self as one_point, BoundShape, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
 use crate::material::{PointState, trapezoid_dissipation};
 use crate::scene::Model;
@@ -164,16 +164,16 @@ fn element_step(
         }
         None => one_point::force(&step.end, &state.stress, section, &state.hourglass)?,
     };
-    let omega_squared = one_point::frequency_bound(
-        &end.gradient,
-        &end.gamma,
-        p.wave_modulus,
-        end.gradient.area * section.weight(&step.end),
-        p.axisymmetric()
+    let shape = BoundShape {
+        gradient: &end.gradient,
+        gamma: &end.gamma,
+        volume: end.gradient.area * section.weight(&step.end),
+        hoop_radius: p
+            .axisymmetric()
             .then(|| one_point::centroid_radius(&step.end)),
-        p.hourglass_modulus,
-        mass.smallest,
-    );
+    };
+    let omega_squared =
+        one_point::frequency_bound(shape, p.wave_modulus, p.hourglass_modulus, mass.smallest);
     let (omega_squared, viscous_work) = match viscous {
         Some(v) => (
             damped_frequency_squared(omega_squared, v.damping_fraction),
@@ -316,15 +316,15 @@ impl Reduced {
         let section = self.section(e, &state);
         let end = one_point::force(&xe, &state.stress, section, &state.hourglass)
             .map_err(|err| self.layout.failure(e, err))?;
-        let omega_squared = one_point::frequency_bound(
-            &end.gradient,
-            &end.gamma,
-            p.wave_modulus,
-            end.gradient.area * section.weight(&xe),
-            p.axisymmetric().then(|| one_point::centroid_radius(&xe)),
-            p.hourglass_modulus,
-            self.mass_of(e).smallest,
-        );
+        let shape = BoundShape {
+            gradient: &end.gradient,
+            gamma: &end.gamma,
+            volume: end.gradient.area * section.weight(&xe),
+            hoop_radius: p.axisymmetric().then(|| one_point::centroid_radius(&xe)),
+        };
+        let smallest = self.mass_of(e).smallest;
+        let omega_squared =
+            one_point::frequency_bound(shape, p.wave_modulus, p.hourglass_modulus, smallest);
         Ok(match &self.viscosity {
             Some(v) => damped_frequency_squared(omega_squared, v.damping_fraction_at_rest()),
             None => omega_squared,
