@@ -20,7 +20,8 @@ use super::steppers::stable::{
     implicit_first_step, wave_speed,
 };
 use crate::output::readable;
-use crate::scene::spec::{DynamicSpec, IntegratorKind, MassKind};
+use crate::scene::DynamicAnalysis;
+use crate::scene::spec::{IntegratorKind, MassKind};
 use crate::scene::{InputError, Model};
 
 /// How the time step of a dynamic analysis stands against its integrator's limit.
@@ -47,7 +48,7 @@ const FULL_RATE: f64 = 1.5e6;
 /// How many steps of `dt` the run takes to its end time (exactly for a fixed step, at least
 /// for the automatic one: the stable step falls as elements crush), and a rough wall time
 /// for central difference from the kernel's element rate.
-fn step_count(model: &Model, spec: &DynamicSpec, dt: f64) -> String {
+fn step_count(model: &Model, spec: &DynamicAnalysis, dt: f64) -> String {
     let steps = (spec.end_time / dt).ceil();
     let count = match spec.step {
         crate::scene::spec::TimeStep::Fixed(_) => format!("{steps:.0} steps to end_time"),
@@ -77,7 +78,7 @@ fn step_count(model: &Model, spec: &DynamicSpec, dt: f64) -> String {
 
 /// The step of `spec` against the stability limit of its integrator; a central-difference
 /// fixed dt above its limit is refused exactly as a run refuses it.
-pub fn step_stability(model: &Model, spec: &DynamicSpec) -> Result<StepStability, InputError> {
+pub fn step_stability(model: &Model, spec: &DynamicAnalysis) -> Result<StepStability, InputError> {
     let has_mass = model.bodies.iter().all(|b| b.material.density > 0.0);
     if spec.integrator == IntegratorKind::CentralDifference {
         // the element-eigenvalue limit, and the step the run will take (the automatic step

@@ -4,9 +4,10 @@
 use super::InputError;
 use super::context::{Context, positive};
 use super::model::Analysis;
+use super::model::{DynamicAnalysis, StaticAnalysis};
 use super::spec::{
-    AdaptiveStep, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics, DynamicSpec,
-    IntegratorKind, MassKind, NewtonSpec, Quadrature, StaticSpec, StepSpec, TimeStep,
+    AdaptiveStep, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics, IntegratorKind,
+    MassKind, NewtonSpec, Quadrature, StepSpec, TimeStep,
 };
 use crate::element::Strain;
 use crate::element::bulk_viscosity::{self, BulkViscosity};
@@ -57,7 +58,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 return Err(cx.err("analysis.steps: must be at least 1"));
             }
             let end_time = positive(cx, "analysis.end_time", spec.end_time.unwrap_or(1.0))?;
-            Ok(Analysis::Static(StaticSpec {
+            Ok(Analysis::Static(StaticAnalysis {
                 steps,
                 end_time,
                 geometry: spec.geometry,
@@ -71,7 +72,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
 
 /// A dynamic analysis: its time step, end time and integrator with that integrator's
 /// parameters, mass, damping and quadrature.
-fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError> {
+fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicAnalysis, InputError> {
     if spec.steps.is_some() {
         return Err(cx.err("analysis.steps: a dynamic analysis takes `dt` and `end_time`"));
     }
@@ -88,7 +89,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicSpec, InputError>
     let (theta, alpha, rho_infinity) = integrator_parameters(cx, spec)?;
     let (mass, rayleigh) = mass_and_damping(cx, spec, integrator)?;
     let (quadrature, hourglass) = quadrature(cx, spec, integrator)?;
-    Ok(DynamicSpec {
+    Ok(DynamicAnalysis {
         quadrature,
         hourglass,
         bulk_viscosity: bulk_viscosity(cx, spec, integrator)?,

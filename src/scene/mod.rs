@@ -17,7 +17,9 @@ mod reference;
 pub mod spec;
 pub mod validate;
 
-pub use model::{Body, BodyKind, Continuum, Curve, Load, Model, SceneSource};
+pub use model::{
+    Body, BodyKind, Continuum, Curve, DynamicAnalysis, Load, Model, SceneSource, StaticAnalysis,
+};
 pub use spec::Scene;
 
 use std::path::{Path, PathBuf};

@@ -9,9 +9,12 @@
 //! reference.rs, with the look-ups they share in context.rs.
 
 use super::spec::{
-    BucklingSpec, DynamicSpec, OutputSpec, Quantity, ReferenceKind, StaticSpec, Statistic,
+    AdaptiveStep, BucklingSpec, ContactDynamics, IntegratorKind, MassKind, NewtonSpec, OutputSpec,
+    Quadrature, Quantity, ReferenceKind, Statistic, TimeStep,
 };
 use crate::contact::{BodySurface, ContactPair, Interfaces, Obstacle, Section};
+use crate::element::bulk_viscosity::BulkViscosity;
+use crate::element::mass_scaling::MassScaling;
 use crate::element::{Formulation, Strain, Voigt};
 use crate::material::{Material, PointState, StressCondition};
 use crate::mesh::Mesh;
@@ -258,8 +261,81 @@ impl Probe {
 
 #[derive(Debug, Clone)]
 pub enum Analysis {
-    Static(StaticSpec),
-    Dynamic(DynamicSpec),
+    Static(StaticAnalysis),
+    Dynamic(DynamicAnalysis),
+}
+
+/// The validated dynamic analysis.
+#[derive(Debug, Clone)]
+pub struct DynamicAnalysis {
+    pub step: TimeStep,
+    pub end_time: f64,
+    pub integrator: IntegratorKind,
+    pub beta: f64,
+    pub gamma: f64,
+    pub theta: f64,
+    pub alpha: f64,
+    pub rho_infinity: f64,
+    pub mass: MassKind,
+    pub contact_dynamics: ContactDynamics,
+    pub rayleigh: [f64; 2],
+    pub allow_unstable: bool,
+    pub geometry: Strain,
+    pub newton: NewtonSpec,
+    pub buckling: Option<BucklingSpec>,
+    /// Central difference's Quad4 kernel (always `full` for the implicit integrators).
+    pub quadrature: Quadrature,
+    /// The hourglass coefficient kappa of the reduced kernel (0.1 unless given).
+    pub hourglass: f64,
+    /// Central difference: the bulk viscosity of the explicit Quad4 kernels (None: off).
+    pub bulk_viscosity: Option<BulkViscosity>,
+    /// Central difference: the mass scaling of the explicit Quad4 kernels (None: off).
+    pub mass_scaling: Option<MassScaling>,
+}
+
+/// The validated static analysis.
+#[derive(Debug, Clone)]
+pub struct StaticAnalysis {
+    pub steps: usize,
+    pub end_time: f64,
+    pub geometry: Strain,
+    pub newton: NewtonSpec,
+    pub buckling: Option<BucklingSpec>,
+}
+
+impl DynamicAnalysis {
+    /// The fixed step (every implicit analysis has one; scene validation refuses `auto`
+    /// for them).
+    pub fn fixed_dt(&self) -> Option<f64> {
+        match self.step {
+            TimeStep::Fixed(dt) => Some(dt),
+            TimeStep::Auto { .. } | TimeStep::Adaptive(_) => None,
+        }
+    }
+
+    /// Whether the integrator has a one-step local error estimate (the Newmark family with
+    /// beta != 1/6: theory 8.2a): implicit `dt = "auto"` and history.csv `error_estimate`.
+    pub fn has_error_estimate(&self) -> bool {
+        match self.integrator {
+            IntegratorKind::Average
+            | IntegratorKind::Hu
+            | IntegratorKind::Hht
+            | IntegratorKind::GeneralizedAlpha => true,
+            IntegratorKind::Newmark => (self.beta - 1.0 / 6.0).abs() > 1e-3,
+            IntegratorKind::Linear
+            | IntegratorKind::Wilson
+            | IntegratorKind::Houbolt
+            | IntegratorKind::CentralDifference => false,
+        }
+    }
+
+    /// The error-controlled step of an adaptive implicit analysis.
+    pub fn adaptive(&self) -> Option<AdaptiveStep> {
+        match self.step {
+            TimeStep::Adaptive(adaptive) => Some(adaptive),
+            _ => None,
+        }
+    }
 }
 
 impl Analysis {

@@ -21,8 +21,9 @@ use super::control::{snap, step_length};
 use crate::analysis::summary::{Status, StepError};
 use crate::assembly::StableStep;
 use crate::output::readable;
+use crate::scene::DynamicAnalysis;
 use crate::scene::Model;
-use crate::scene::spec::{DynamicSpec, TimeStep};
+use crate::scene::spec::TimeStep;
 use serde::{Deserialize, Serialize};
 
 /// The step rule of a central-difference run and what it has seen.
@@ -70,7 +71,7 @@ enum Rule {
 impl Clock {
     /// The clock of `spec`, with the initial element-eigenvalue limit `exact` and the initial
     /// bound `limit` (`stable::explicit_clock` makes it).
-    pub fn new(spec: &DynamicSpec, exact: f64, limit: StableStep) -> Clock {
+    pub fn new(spec: &DynamicAnalysis, exact: f64, limit: StableStep) -> Clock {
         let (rule, dt0, calibration) = match spec.step {
             TimeStep::Fixed(dt) => (
                 Rule::Fixed {
@@ -102,7 +103,7 @@ impl Clock {
     pub fn next(
         &self,
         model: &Model,
-        spec: &DynamicSpec,
+        spec: &DynamicAnalysis,
         time: f64,
         step: usize,
     ) -> Result<Step, StepError> {

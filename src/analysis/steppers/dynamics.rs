@@ -27,16 +27,15 @@ use crate::integrator::{
 };
 use crate::material::PointState;
 use crate::output::readable;
-use crate::scene::spec::{
-    AdaptiveStep, ContactDynamics, DynamicSpec, IntegratorKind, Quantity, Strategy,
-};
+use crate::scene::DynamicAnalysis;
+use crate::scene::spec::{AdaptiveStep, ContactDynamics, IntegratorKind, Quantity, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
 
 /// The integrator a scene asks for (implicit ones); the Newmark family's beta and gamma are
 /// the scene's (its presets for `average`, `linear` and `hu`).
-pub fn integrator(spec: &DynamicSpec) -> Box<dyn Integrator> {
+pub fn integrator(spec: &DynamicAnalysis) -> Box<dyn Integrator> {
     let newmark = |label| Box::new(GeneralizedAlpha::newmark(label, spec.beta, spec.gamma));
     match spec.integrator {
         IntegratorKind::Average => newmark("average"),
@@ -73,7 +72,7 @@ fn contact_nodes(model: &Model) -> Vec<bool> {
 /// Implicit time stepping: the state, the motion, the solver and what the loop carries.
 pub struct Dynamics<'a> {
     model: &'a Model,
-    spec: &'a DynamicSpec,
+    spec: &'a DynamicAnalysis,
     /// The contact pairs and surfaces; under `persistency` and `mass_redistribution` the
     /// pairs' impact and release conditions and fraction rule are off (see `new`).
     interfaces: Interfaces,
@@ -203,7 +202,7 @@ fn on_ladder(first: f64, proposal: f64) -> f64 {
 impl<'a> Dynamics<'a> {
     pub fn new(
         model: &'a Model,
-        spec: &'a DynamicSpec,
+        spec: &'a DynamicAnalysis,
         dir: &Path,
     ) -> Result<Dynamics<'a>, RunError> {
         let system = System::new(model, &model.constrained_dofs());
@@ -579,7 +578,7 @@ impl<'a> Dynamics<'a> {
 /// What the attempts of one step share.
 struct Attempt<'s> {
     model: &'s Model,
-    spec: &'s DynamicSpec,
+    spec: &'s DynamicAnalysis,
     method: &'s dyn Integrator,
     kin: &'s MotionState,
     state: &'s State,

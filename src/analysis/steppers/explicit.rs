@@ -25,7 +25,8 @@ use crate::assembly::{ElementMasses, Mass, StableStep, State, System, check_mass
 use crate::contact::{ContactState, Interfaces};
 use crate::element::Strain;
 use crate::output::readable;
-use crate::scene::spec::{DynamicSpec, MassKind};
+use crate::scene::DynamicAnalysis;
+use crate::scene::spec::MassKind;
 use crate::scene::{InputError, Model};
 use rayon::prelude::*;
 use std::path::Path;
@@ -35,7 +36,7 @@ use std::time::Instant;
 /// loop carries.
 pub struct Explicit<'a> {
     model: &'a Model,
-    spec: &'a DynamicSpec,
+    spec: &'a DynamicAnalysis,
     interfaces: Interfaces,
     initial: Vec<[f64; 2]>,
     free: Vec<bool>,
@@ -75,7 +76,7 @@ pub struct Explicit<'a> {
 impl<'a> Explicit<'a> {
     /// Refuses a fixed dt above the stability limit of the initial configuration (the
     /// element eigenvalues), unless the scene asks to watch it blow up.
-    pub fn new(model: &'a Model, spec: &'a DynamicSpec) -> Result<Explicit<'a>, RunError> {
+    pub fn new(model: &'a Model, spec: &'a DynamicAnalysis) -> Result<Explicit<'a>, RunError> {
         let dt_crit = checked_step(model, spec)?.dt;
         let masses = ElementMasses::new(model)
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
@@ -684,7 +685,7 @@ pub fn kernel_benchmark_run(
     let crate::scene::model::Analysis::Dynamic(spec) = &model.analysis else {
         unreachable!("the benchmark scene is dynamic")
     };
-    let spec = DynamicSpec {
+    let spec = DynamicAnalysis {
         step: crate::scene::spec::TimeStep::Fixed(h),
         end_time: h * steps as f64,
         ..spec.clone()

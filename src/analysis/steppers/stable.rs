@@ -22,7 +22,8 @@ use crate::assembly::mass_scaling::MassScalingReport;
 use crate::assembly::{self, ElementMasses, State};
 use crate::element::bulk_viscosity::damped_step_factor;
 use crate::output::readable;
-use crate::scene::spec::{AdaptiveStep, DynamicSpec};
+use crate::scene::DynamicAnalysis;
+use crate::scene::spec::AdaptiveStep;
 use crate::scene::{InputError, Model};
 
 pub use crate::assembly::StableStep;
@@ -40,7 +41,7 @@ pub fn critical_time_step(model: &Model) -> Result<StableStep, InputError> {
 /// or the 2x2 kernel, or the general element loop) that an automatic step scales.
 pub fn explicit_clock(
     model: &Model,
-    spec: &DynamicSpec,
+    spec: &DynamicAnalysis,
     exact: f64,
     state: &State,
     kernel: &dyn ExplicitKernel,
@@ -54,7 +55,7 @@ pub fn explicit_clock(
 /// The first step a central-difference run of `model` takes (the fixed dt, or the automatic
 /// step of the kernel that will run), computed as the run computes it ([`explicit_clock`]):
 /// what `impact check` prints and the set-up warnings count steps with.
-pub fn explicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, InputError> {
+pub fn explicit_first_step(model: &Model, spec: &DynamicAnalysis) -> Result<f64, InputError> {
     let exact = checked_step(model, spec)?.dt;
     let masses =
         ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
@@ -68,7 +69,7 @@ pub fn explicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, Inp
 /// ([`kernel_for`]); what `impact check` reports beside the first step.
 pub fn explicit_start_scaling(
     model: &Model,
-    spec: &DynamicSpec,
+    spec: &DynamicAnalysis,
 ) -> Result<Option<MassScalingReport>, InputError> {
     if spec.mass_scaling.is_none() {
         return Ok(None);
@@ -85,7 +86,7 @@ pub fn explicit_start_scaling(
 /// The stability limit of `model` under `spec` (the bulk viscosity's damping at rest taken
 /// into account), or the refusal of a fixed dt above it (unless the scene sets
 /// `allow_unstable` to watch it blow up): the one check `impact check` and a run share.
-pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, InputError> {
+pub fn checked_step(model: &Model, spec: &DynamicAnalysis) -> Result<StableStep, InputError> {
     let limit = damped_at_rest(critical_time_step(model)?, spec);
     if let Some(dt) = spec.fixed_dt()
         && dt > limit.dt
@@ -114,7 +115,7 @@ pub fn checked_step(model: &Model, spec: &DynamicSpec) -> Result<StableStep, Inp
 
 /// The stability limit `limit` shortened by the damping of `spec`'s bulk viscosity at rest
 /// (every element has the same, b_1: element::bulk_viscosity); unchanged without it.
-fn damped_at_rest(limit: StableStep, spec: &DynamicSpec) -> StableStep {
+fn damped_at_rest(limit: StableStep, spec: &DynamicAnalysis) -> StableStep {
     match &spec.bulk_viscosity {
         Some(viscosity) => StableStep {
             dt: limit.dt * damped_step_factor(viscosity.damping_fraction_at_rest()),
@@ -128,7 +129,7 @@ fn damped_at_rest(limit: StableStep, spec: &DynamicSpec) -> StableStep {
 /// dilatational wave takes to cross the smallest element (the critical step of central
 /// difference, [`critical_time_step`]): a step that resolves the fastest wave the mesh can
 /// carry, from which the error control grows or shrinks it; within `dt_min`, `dt_max`.
-pub fn implicit_first_step(model: &Model, spec: &DynamicSpec) -> Result<f64, InputError> {
+pub fn implicit_first_step(model: &Model, spec: &DynamicAnalysis) -> Result<f64, InputError> {
     match spec.adaptive() {
         None => Ok(spec
             .fixed_dt()

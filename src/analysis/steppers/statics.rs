@@ -21,7 +21,8 @@ use crate::contact::{ContactState, Interfaces, Pass};
 use crate::integrator::StepForm;
 use crate::output::readable;
 use crate::scene::Model;
-use crate::scene::spec::{StaticSpec, Strategy};
+use crate::scene::StaticAnalysis;
+use crate::scene::spec::Strategy;
 use crate::solver::Solver;
 
 /// The step form of statics: no inertia, equilibrium at the end of the increment.
@@ -40,7 +41,7 @@ fn static_form(n: usize) -> StepForm {
 /// Static load stepping: the state, the solver and what the loop carries.
 pub struct Statics<'a> {
     model: &'a Model,
-    spec: &'a StaticSpec,
+    spec: &'a StaticAnalysis,
     interfaces: Interfaces,
     initial: Vec<[f64; 2]>,
     system: System,
@@ -62,7 +63,7 @@ pub struct Statics<'a> {
 }
 
 impl<'a> Statics<'a> {
-    pub fn new(model: &'a Model, spec: &'a StaticSpec) -> Result<Statics<'a>, String> {
+    pub fn new(model: &'a Model, spec: &'a StaticAnalysis) -> Result<Statics<'a>, String> {
         let system = System::new(model, &model.constrained_dofs());
         let solver = Solver::new(&system.pattern).map_err(|e| e.to_string())?;
         let dt = spec.end_time / spec.steps as f64;
@@ -91,7 +92,7 @@ impl<'a> Statics<'a> {
 /// What an increment's attempts share: the committed state and the increment's settings.
 struct Increment<'s> {
     model: &'s Model,
-    spec: &'s StaticSpec,
+    spec: &'s StaticAnalysis,
     form: &'s StepForm,
     initial: &'s [[f64; 2]],
     state: &'s State,

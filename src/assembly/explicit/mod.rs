@@ -23,7 +23,8 @@ use crate::element::Strain;
 use crate::element::Voigt;
 use crate::element::mass_scaling::MassScaling;
 use crate::material::{Material, PointState, PointStep, StressCondition, UpdateContext};
-use crate::scene::spec::{DynamicSpec, Quadrature};
+use crate::scene::DynamicAnalysis;
+use crate::scene::spec::Quadrature;
 use crate::scene::{Continuum, Model};
 use rayon::prelude::*;
 
@@ -330,7 +331,7 @@ pub(super) fn stable_step_of(layout: &Layout, work: &StepWork) -> StableStep {
 /// scaled (their added mass pending for the run's nodal masses).
 pub fn kernel_for<'a>(
     model: &'a Model,
-    spec: &DynamicSpec,
+    spec: &DynamicAnalysis,
     state: &State,
     masses: &ElementMasses,
 ) -> (Box<dyn ExplicitKernel + 'a>, bool) {

@@ -3,8 +3,6 @@
 
 use super::yes;
 use crate::element::Strain;
-use crate::element::bulk_viscosity::BulkViscosity;
-use crate::element::mass_scaling::MassScaling;
 use serde::Deserialize;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -247,41 +245,6 @@ pub struct AdaptiveStep {
     pub max: Option<f64>,
 }
 
-impl DynamicSpec {
-    /// The fixed step (every implicit analysis has one; scene validation refuses `auto`
-    /// for them).
-    pub fn fixed_dt(&self) -> Option<f64> {
-        match self.step {
-            TimeStep::Fixed(dt) => Some(dt),
-            TimeStep::Auto { .. } | TimeStep::Adaptive(_) => None,
-        }
-    }
-
-    /// Whether the integrator has a one-step local error estimate (the Newmark family with
-    /// beta != 1/6: theory 8.2a): implicit `dt = "auto"` and history.csv `error_estimate`.
-    pub fn has_error_estimate(&self) -> bool {
-        match self.integrator {
-            IntegratorKind::Average
-            | IntegratorKind::Hu
-            | IntegratorKind::Hht
-            | IntegratorKind::GeneralizedAlpha => true,
-            IntegratorKind::Newmark => (self.beta - 1.0 / 6.0).abs() > 1e-3,
-            IntegratorKind::Linear
-            | IntegratorKind::Wilson
-            | IntegratorKind::Houbolt
-            | IntegratorKind::CentralDifference => false,
-        }
-    }
-
-    /// The error-controlled step of an adaptive implicit analysis.
-    pub fn adaptive(&self) -> Option<AdaptiveStep> {
-        match self.step {
-            TimeStep::Adaptive(adaptive) => Some(adaptive),
-            _ => None,
-        }
-    }
-}
-
 /// Quadrature of the explicit Quad4 kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -338,44 +301,6 @@ pub struct ImperfectionSpec {
 
 fn one() -> usize {
     1
-}
-
-/// The validated dynamic analysis.
-#[derive(Debug, Clone)]
-pub struct DynamicSpec {
-    pub step: TimeStep,
-    pub end_time: f64,
-    pub integrator: IntegratorKind,
-    pub beta: f64,
-    pub gamma: f64,
-    pub theta: f64,
-    pub alpha: f64,
-    pub rho_infinity: f64,
-    pub mass: MassKind,
-    pub contact_dynamics: ContactDynamics,
-    pub rayleigh: [f64; 2],
-    pub allow_unstable: bool,
-    pub geometry: Strain,
-    pub newton: NewtonSpec,
-    pub buckling: Option<BucklingSpec>,
-    /// Central difference's Quad4 kernel (always `full` for the implicit integrators).
-    pub quadrature: Quadrature,
-    /// The hourglass coefficient kappa of the reduced kernel (0.1 unless given).
-    pub hourglass: f64,
-    /// Central difference: the bulk viscosity of the explicit Quad4 kernels (None: off).
-    pub bulk_viscosity: Option<BulkViscosity>,
-    /// Central difference: the mass scaling of the explicit Quad4 kernels (None: off).
-    pub mass_scaling: Option<MassScaling>,
-}
-
-/// The validated static analysis.
-#[derive(Debug, Clone)]
-pub struct StaticSpec {
-    pub steps: usize,
-    pub end_time: f64,
-    pub geometry: Strain,
-    pub newton: NewtonSpec,
-    pub buckling: Option<BucklingSpec>,
 }
 
 /// How often K_T is factored.
