@@ -58,23 +58,16 @@ impl ContactState {
     /// the passes go on until a sticking entry's slip is within TOL too. The status takes the
     /// reported forces mu / (h span) and lambda / (h span) (module legend; `previous` is the
     /// length of the step before, 0 before the first).
-    #[allow(clippy::too_many_arguments)]
     pub fn explicit_step(
         &mut self,
-        interfaces: &Interfaces,
-        start: &[[f64; 2]],
-        du: &[f64],
-        inverse_mass: &[f64],
+        step: &Predicted,
         h: f64,
         previous: f64,
         time: f64,
     ) -> ExplicitContact {
-        let step = Predicted {
-            interfaces,
-            start,
-            du,
-            inverse_mass,
-        };
+        let Predicted {
+            interfaces, start, ..
+        } = *step;
         let c = step.correct();
         let coulomb = |p: usize| coulomb(interfaces, p);
         // entries closed at the start of the step (their multiplier is the step's force)
@@ -134,12 +127,14 @@ fn coulomb(interfaces: &Interfaces, p: usize) -> Option<f64> {
     }
 }
 
-/// The predicted step that the contact corrects: positions `start + du`.
-struct Predicted<'a> {
-    interfaces: &'a Interfaces,
-    start: &'a [[f64; 2]],
-    du: &'a [f64],
-    inverse_mass: &'a [f64],
+/// The predicted step that the contact corrects: positions `start + du`, the contact
+/// pairs and the inverse lumped mass of every DOF.
+#[derive(Clone, Copy)]
+pub struct Predicted<'a> {
+    pub interfaces: &'a Interfaces,
+    pub start: &'a [[f64; 2]],
+    pub du: &'a [f64],
+    pub inverse_mass: &'a [f64],
 }
 
 /// The correction of a step: delta, the active entries and their accumulated normal (mu)

@@ -22,6 +22,7 @@ use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, StepWork, kernel_for};
 use crate::assembly::mass_scaling::{AddedAtRest, MassScalingReport, NodalMotion};
 use crate::assembly::{ElementMasses, Mass, StableStep, State, System, check_mass};
+use crate::contact::explicit::Predicted;
 use crate::contact::{ContactState, Interfaces};
 use crate::element::Strain;
 use crate::output::readable;
@@ -132,15 +133,15 @@ impl<'a> Explicit<'a> {
     /// The contact correction of the predicted increment (forward-increment multipliers).
     fn contact_correction(&mut self, h: f64, time: f64) {
         let positions = self.state.positions(self.spec.geometry);
-        let step = self.contact.explicit_step(
-            &self.interfaces,
-            &positions,
-            &self.du,
-            &self.inverse_mass,
-            h,
-            self.clock.last,
-            time,
-        );
+        let predicted = Predicted {
+            interfaces: &self.interfaces,
+            start: &positions,
+            du: &self.du,
+            inverse_mass: &self.inverse_mass,
+        };
+        let step = self
+            .contact
+            .explicit_step(&predicted, h, self.clock.last, time);
         // the contact work that closes the discrete balance of the step (theory 7): with f =
         // M delta / h^2, du the predicted increment and F_n = M a_n the other forces at its
         // start, f . (du + delta / 2) - delta . F_n / 2. A node the correction stops loses
