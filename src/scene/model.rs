@@ -229,7 +229,8 @@ pub struct Probe {
 
 impl Probe {
     /// The probe's statistic (mean, max, min) of `values`.
-    pub fn combine(&self, values: &mut dyn Iterator<Item = f64>) -> f64 {
+    #[inline]
+    pub fn combine(&self, values: impl Iterator<Item = f64>) -> f64 {
         match self.statistic {
             Statistic::Mean => {
                 let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
@@ -242,16 +243,16 @@ impl Probe {
 
     /// The statistic of `f` over the material points of the probe's elements, `points` the
     /// points of its body (`points_per_element` each).
+    #[inline]
     pub fn of_points(
         &self,
         points: &[PointState],
         points_per_element: usize,
-        f: &dyn Fn(&PointState) -> f64,
+        f: impl Fn(&PointState) -> f64,
     ) -> f64 {
         let ppe = points_per_element;
         self.combine(
-            &mut self
-                .members
+            self.members
                 .iter()
                 .flat_map(|e| &points[e * ppe..(e + 1) * ppe])
                 .map(f),

@@ -626,12 +626,9 @@ fn probe_value(
     initial: &[[f64; 2]],
     probe: &crate::scene::model::Probe,
 ) -> f64 {
-    let combine = |values: &mut dyn Iterator<Item = f64>| probe.combine(values);
-    let nodal = |v: &[f64], c: usize| combine(&mut probe.members.iter().map(|m| v[2 * m + c]));
-    let points = |f: &dyn Fn(&crate::material::PointState) -> f64| {
-        let ppe = model.bodies[probe.body].points_per_element();
-        probe.of_points(&state.bodies[probe.body].points, ppe, f)
-    };
+    let nodal = |v: &[f64], c: usize| probe.combine(probe.members.iter().map(|m| v[2 * m + c]));
+    let ppe = model.bodies[probe.body].points_per_element();
+    let body_points = &state.bodies[probe.body].points;
     match probe.quantity {
         Quantity::DisplacementX => nodal(&state.displacement, 0),
         Quantity::DisplacementY => nodal(&state.displacement, 1),
@@ -659,8 +656,8 @@ fn probe_value(
         }
         Quantity::CoordinateX | Quantity::CoordinateY => {
             let c = (probe.quantity == Quantity::CoordinateY) as usize;
-            combine(
-                &mut probe
+            probe.combine(
+                probe
                     .members
                     .iter()
                     .map(|&m| initial[m][c] + state.displacement[2 * m + c]),
@@ -683,13 +680,13 @@ fn probe_value(
                 high - low
             }
         }
-        Quantity::StressXX => points(&|p| p.stress[0]),
-        Quantity::StressYY => points(&|p| p.stress[1]),
-        Quantity::StressZZ => points(&|p| p.stress[2]),
-        Quantity::StressXY => points(&|p| p.stress[3]),
-        Quantity::VonMises => points(&|p| von_mises(&p.stress)),
-        Quantity::EqPlasticStrain => points(&|p| p.eq_plastic_strain),
-        Quantity::Temperature => points(&|p| p.temperature),
+        Quantity::StressXX => probe.of_points(body_points, ppe, |p| p.stress[0]),
+        Quantity::StressYY => probe.of_points(body_points, ppe, |p| p.stress[1]),
+        Quantity::StressZZ => probe.of_points(body_points, ppe, |p| p.stress[2]),
+        Quantity::StressXY => probe.of_points(body_points, ppe, |p| p.stress[3]),
+        Quantity::VonMises => probe.of_points(body_points, ppe, |p| von_mises(&p.stress)),
+        Quantity::EqPlasticStrain => probe.of_points(body_points, ppe, |p| p.eq_plastic_strain),
+        Quantity::Temperature => probe.of_points(body_points, ppe, |p| p.temperature),
     }
 }
 
