@@ -16,7 +16,7 @@ use crate::contact::{BodySurface, ContactPair, Interfaces, Obstacle, Section};
 use crate::element::bulk_viscosity::BulkViscosity;
 use crate::element::mass_scaling::MassScaling;
 use crate::element::{Formulation, Strain, Voigt};
-use crate::material::{Material, PointState, StressCondition};
+use crate::material::{Material, PointState, StressCondition, von_mises};
 use crate::mesh::Mesh;
 use crate::output::readable;
 use std::path::PathBuf;
@@ -227,6 +227,12 @@ pub struct Probe {
     pub column: String,
 }
 
+/// A probe's statistic over material points, given what it reads of a point
+/// ([`Probe::fold_points`]).
+pub trait PointFold {
+    fn fold(self, value: impl Fn(&PointState) -> f64) -> f64;
+}
+
 impl Probe {
     /// The probe's statistic (mean, max, min) of `values`.
     #[inline]
@@ -239,6 +245,22 @@ impl Probe {
             Statistic::Max => values.fold(f64::NEG_INFINITY, f64::max),
             Statistic::Min => values.fold(f64::INFINITY, f64::min),
         }
+    }
+
+    /// `fold` of what the probe reads of a material point (one closure per quantity, so the
+    /// fold is compiled for each); None for a nodal quantity.
+    #[inline]
+    pub fn fold_points<F: PointFold>(&self, fold: F) -> Option<f64> {
+        Some(match self.quantity {
+            Quantity::StressXX => fold.fold(|p: &PointState| p.stress[0]),
+            Quantity::StressYY => fold.fold(|p: &PointState| p.stress[1]),
+            Quantity::StressZZ => fold.fold(|p: &PointState| p.stress[2]),
+            Quantity::StressXY => fold.fold(|p: &PointState| p.stress[3]),
+            Quantity::VonMises => fold.fold(|p: &PointState| von_mises(&p.stress)),
+            Quantity::EqPlasticStrain => fold.fold(|p: &PointState| p.eq_plastic_strain),
+            Quantity::Temperature => fold.fold(|p: &PointState| p.temperature),
+            _ => return None,
+        })
     }
 
     /// The statistic of `f` over the material points of the probe's elements, `points` the

@@ -325,6 +325,8 @@ impl<'a, S: Stepper> Run<'a, S> {
     fn record(&mut self, last: bool) -> Result<(), RunError> {
         let time = self.stepper.state().time;
         self.recorder.step_length = self.stepper.last_step();
+        let s = &self.stepper;
+        self.recorder.point_probes = self.model.probes.iter().map(|p| s.point_probe(p)).collect();
         if self.recorder.reads_stresses(self.model, time, last) {
             self.stepper.sync_points();
         }

@@ -7,12 +7,14 @@ use crate::analysis::summary::Summary;
 use crate::assembly::State;
 use crate::contact::ContactState;
 use crate::contact::Friction;
+use crate::material::PointState;
 use crate::material::{pressure, von_mises};
 use crate::mesh::Cells;
 use crate::output::history::History;
 use crate::output::vtk::{Fields, Grid, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
+use crate::scene::model::{PointFold, Probe};
 use crate::scene::spec::{FramePoints, Quantity};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -49,6 +51,10 @@ pub struct Recorder {
     pub step_length: f64,
     /// The probes' values in the last row written (summary.json `probes`).
     last_probes: Vec<f64>,
+    /// Point probes the stepper has answered from its own point values for the next row (an
+    /// explicit kernel's arrays, so the state's points need no copy), by probe; None (or
+    /// missing): read from the state.
+    pub point_probes: Vec<Option<f64>>,
 }
 
 impl Recorder {
@@ -89,6 +95,7 @@ impl Recorder {
             added_mass: 0.0,
             step_length: 0.0,
             last_probes: Vec::new(),
+            point_probes: Vec::new(),
         })
     }
 
@@ -144,6 +151,7 @@ impl Recorder {
             added_mass: 0.0,
             step_length: 0.0,
             last_probes: position.probes,
+            point_probes: Vec::new(),
         })
     }
 
@@ -210,16 +218,21 @@ impl Recorder {
             None
         };
         self.last_probes.clear();
-        self.last_probes.extend(model.probes.iter().map(|p| {
-            probe_value(
-                model,
-                state,
-                motion,
-                reaction.as_deref(),
-                &self.reference,
-                p,
-            )
-        }));
+        let answered = &self.point_probes;
+        self.last_probes
+            .extend(model.probes.iter().enumerate().map(|(i, p)| {
+                match answered.get(i).copied().flatten() {
+                    Some(value) => value,
+                    None => probe_value(
+                        model,
+                        state,
+                        motion,
+                        reaction.as_deref(),
+                        &self.reference,
+                        p,
+                    ),
+                }
+            }));
         row.extend_from_slice(&self.last_probes);
         if self.pivots_column {
             row.push(self.negative_pivots.map_or(f64::NAN, |n| n as f64));
@@ -252,7 +265,10 @@ impl Recorder {
     /// Whether recording the step that ends at `time` reads the element stresses: a stress
     /// probe, or a frame due. Call it before `step_with_contact`.
     pub fn reads_stresses(&self, model: &Model, time: f64, force_frame: bool) -> bool {
-        model.probes.iter().any(|p| !p.quantity.is_nodal())
+        let unanswered = |(i, p): (usize, &Probe)| {
+            !p.quantity.is_nodal() && self.point_probes.get(i).copied().flatten().is_none()
+        };
+        model.probes.iter().enumerate().any(unanswered)
             || (self.series.is_some() && self.frame_due(model, time, force_frame, 1))
     }
 
@@ -618,6 +634,20 @@ fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
     reaction
 }
 
+/// A probe's statistic over the state's points.
+struct StatePoints<'a> {
+    probe: &'a Probe,
+    points: &'a [PointState],
+    points_per_element: usize,
+}
+
+impl PointFold for StatePoints<'_> {
+    #[inline]
+    fn fold(self, value: impl Fn(&PointState) -> f64) -> f64 {
+        (self.probe).of_points(self.points, self.points_per_element, value)
+    }
+}
+
 fn probe_value(
     model: &Model,
     state: &State,
@@ -680,13 +710,15 @@ fn probe_value(
                 high - low
             }
         }
-        Quantity::StressXX => probe.of_points(body_points, ppe, |p| p.stress[0]),
-        Quantity::StressYY => probe.of_points(body_points, ppe, |p| p.stress[1]),
-        Quantity::StressZZ => probe.of_points(body_points, ppe, |p| p.stress[2]),
-        Quantity::StressXY => probe.of_points(body_points, ppe, |p| p.stress[3]),
-        Quantity::VonMises => probe.of_points(body_points, ppe, |p| von_mises(&p.stress)),
-        Quantity::EqPlasticStrain => probe.of_points(body_points, ppe, |p| p.eq_plastic_strain),
-        Quantity::Temperature => probe.of_points(body_points, ppe, |p| p.temperature),
+        _ => {
+            // every other quantity is a point's
+            let points = StatePoints {
+                probe,
+                points: body_points,
+                points_per_element: ppe,
+            };
+            probe.fold_points(points).unwrap_or(f64::NAN)
+        }
     }
 }
 

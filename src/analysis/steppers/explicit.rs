@@ -27,6 +27,7 @@ use crate::contact::{ContactState, Interfaces};
 use crate::element::Strain;
 use crate::output::readable;
 use crate::scene::DynamicAnalysis;
+use crate::scene::model::Probe;
 use crate::scene::spec::MassKind;
 use crate::scene::{InputError, Model};
 use rayon::prelude::*;
@@ -381,6 +382,12 @@ impl Report for Explicit<'_> {
     }
     fn contact(&self) -> &ContactState {
         &self.contact
+    }
+    fn point_probe(&self, probe: &Probe) -> Option<f64> {
+        if self.synced {
+            return None;
+        }
+        self.kernel.point_probe(self.model, probe)
     }
     fn hourglass_energy(&self) -> Option<f64> {
         self.kernel.hourglass_energy()

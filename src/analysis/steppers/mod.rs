@@ -19,6 +19,7 @@ pub mod statics;
 use crate::assembly::{StableStep, State};
 use crate::contact::ContactState;
 use crate::scene::Model;
+use crate::scene::model::Probe;
 use crate::solver::Solver;
 use carry::Carry;
 use control::ErrorWatch;
@@ -64,6 +65,12 @@ pub trait Report {
     fn contact(&self) -> &ContactState;
     /// The linear solver, for its counters (None: explicit, no solver).
     fn solver(&self) -> Option<&Solver> {
+        None
+    }
+    /// The statistic of the point probe `probe` from the stepper's own point values, where
+    /// they are newer than the state's points (an explicit kernel between copies): spares the
+    /// copy of every point for a history row. None: read the state's points.
+    fn point_probe(&self, _probe: &Probe) -> Option<f64> {
         None
     }
     /// The accumulated hourglass work, for the history column of the one-point kernel.

@@ -26,8 +26,8 @@
 //! ```
 
 use super::{
-    CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling, point_step,
-    stable_step_of,
+    CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling, point_statistic,
+    point_step, stable_step_of,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -40,6 +40,7 @@ use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
 use crate::material::{PointState, trapezoid_dissipation};
 use crate::scene::Model;
+use crate::scene::model::Probe;
 use rayon::prelude::*;
 
 /// The committed state of the four points of one element.
@@ -524,6 +525,17 @@ impl ExplicitKernel for Full {
                 bs.thickness[4 * e + q] = s.thickness[q];
             }
         }
+    }
+
+    fn point_probe(&self, model: &Model, probe: &Probe) -> Option<f64> {
+        point_statistic(&self.layout, model, probe, 4, |e, q| PointState {
+            stress: Voigt::from(std::array::from_fn(|k| self.stress[16 * e + 4 * q + k])),
+            eq_plastic_strain: self.eq_plastic_strain[4 * e + q],
+            back_stress: Voigt::from(std::array::from_fn(|k| {
+                self.back_stress[16 * e + 4 * q + k]
+            })),
+            temperature: self.temperature[4 * e + q],
+        })
     }
 
     fn eq_plastic_strain(&self) -> Vec<f64> {

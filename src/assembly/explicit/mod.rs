@@ -24,6 +24,7 @@ use crate::element::Voigt;
 use crate::element::mass_scaling::MassScaling;
 use crate::material::{Material, PointState, PointStep, StressCondition, UpdateContext};
 use crate::scene::DynamicAnalysis;
+use crate::scene::model::{PointFold, Probe};
 use crate::scene::spec::Quadrature;
 use crate::scene::{Continuum, Model};
 use rayon::prelude::*;
@@ -143,6 +144,8 @@ pub(super) struct Layout {
     pub nodes: Vec<[u32; 4]>,
     /// (model body, element in it) of each kernel element.
     pub origin: Vec<(usize, usize)>,
+    /// The kernel element of each model body's first element (None: not a Quad4 body).
+    pub first_of_body: Vec<Option<usize>>,
 }
 
 impl Layout {
@@ -152,14 +155,17 @@ impl Layout {
             body: Vec::new(),
             nodes: Vec::new(),
             origin: Vec::new(),
+            first_of_body: Vec::new(),
         };
         for (b, spec) in model.bodies.iter().enumerate() {
             let Some(Continuum {
                 formulation, bbar, ..
             }) = spec.kind.continuum()
             else {
+                layout.first_of_body.push(None);
                 continue;
             };
+            layout.first_of_body.push(Some(layout.body.len()));
             let condition = StressCondition::of(formulation);
             let elastic = &spec.material.elastic;
             let (_, mu) = elastic.lame();
@@ -287,12 +293,69 @@ pub trait ExplicitKernel: Send {
     fn viscous_pressure(&self) -> &[f64];
     /// Takes the viscous pressures of a checkpoint (as `viscous_pressure` gave them).
     fn restore_viscous_pressure(&mut self, values: &[f64]);
+    /// The statistic of point probe `probe` over the kernel's own point values, as
+    /// `write_points` and the probe over the state's points would give it (None: a body the
+    /// kernel does not hold, or a nodal quantity).
+    fn point_probe(&self, _model: &Model, _probe: &Probe) -> Option<f64> {
+        None
+    }
     /// The equivalent plastic strain of every point the kernel keeps (for studies).
     fn eq_plastic_strain(&self) -> Vec<f64>;
     /// The mass scaling of the kernel's elements (None: off): their factors, the mass they
     /// added, and the nodal masses the run has still to take.
     fn mass_scaling(&self) -> Option<&ElementScaling>;
     fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling>;
+}
+
+/// A point probe's statistic over the points of a kernel's elements: `point(e, q)` the state of
+/// point q of kernel element e, `distinct` points per element (a one-point element's one
+/// state stands for all its points, as `write_points` copies it); the fold over the probe's
+/// elements' points in the state's order, `points_per_element` each.
+pub(super) struct KernelPoints<'a, P> {
+    pub probe: &'a Probe,
+    /// The kernel element of the body's first element.
+    pub first: usize,
+    pub points_per_element: usize,
+    pub distinct: usize,
+    pub point: P,
+}
+
+impl<P: Fn(usize, usize) -> PointState> PointFold for KernelPoints<'_, P> {
+    #[inline]
+    fn fold(self, value: impl Fn(&PointState) -> f64) -> f64 {
+        let KernelPoints {
+            probe,
+            first,
+            points_per_element,
+            distinct,
+            point,
+        } = self;
+        let (point, value) = (&point, &value);
+        let values = probe.members.iter().flat_map(|&e| {
+            let one = (distinct == 1).then(|| value(&point(first + e, 0)));
+            (0..points_per_element).map(move |q| one.unwrap_or_else(|| value(&point(first + e, q))))
+        });
+        probe.combine(values)
+    }
+}
+
+/// The statistic of point probe `probe` over `layout`'s elements (see `KernelPoints`); None
+/// for a body the kernel does not hold or a nodal quantity.
+pub(super) fn point_statistic<P: Fn(usize, usize) -> PointState>(
+    layout: &Layout,
+    model: &Model,
+    probe: &Probe,
+    distinct: usize,
+    point: P,
+) -> Option<f64> {
+    let first = layout.first_of_body.get(probe.body).copied().flatten()?;
+    probe.fold_points(KernelPoints {
+        probe,
+        first,
+        points_per_element: model.bodies[probe.body].points_per_element(),
+        distinct,
+        point,
+    })
 }
 
 /// The mass scaling `rule` of `layout`'s elements with their lumped masses `masses`, every

@@ -21,7 +21,7 @@
 
 use super::{
     BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling,
-    point_step, stable_step_of,
+    point_statistic, point_step, stable_step_of,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -33,6 +33,7 @@ use crate::element::quad4_one_point::{self as one_point, BoundShape, Nodes, Sect
 use crate::element::{KernelError, Voigt};
 use crate::material::{PointState, trapezoid_dissipation};
 use crate::scene::Model;
+use crate::scene::model::Probe;
 use rayon::prelude::*;
 
 /// The committed state of one element as the kernel reads it.
@@ -550,6 +551,15 @@ impl ExplicitKernel for Reduced {
 
     fn restore_viscous_pressure(&mut self, values: &[f64]) {
         self.viscous_pressure.copy_from_slice(values);
+    }
+
+    fn point_probe(&self, model: &Model, probe: &Probe) -> Option<f64> {
+        point_statistic(&self.layout, model, probe, 1, |e, _| PointState {
+            stress: Voigt::from(std::array::from_fn(|k| self.stress[4 * e + k])),
+            eq_plastic_strain: self.eq_plastic_strain[e],
+            back_stress: Voigt::from(std::array::from_fn(|k| self.back_stress[4 * e + k])),
+            temperature: self.temperature[e],
+        })
     }
 
     fn eq_plastic_strain(&self) -> Vec<f64> {
