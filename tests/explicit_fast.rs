@@ -973,3 +973,45 @@ fn time_step_scale_scales_the_automatic_step() {
     impact::analysis::run(&model, &dir, Default::default()).unwrap();
     assert_eq!(column(&dir, "dt")[1], first_steps[0]);
 }
+
+/// Goal: an explicit run answers point probes from its kernel's own arrays (no copy of every
+/// point for a history row) with the values the model's points give.
+/// Setup: models/taylor_jc.toml (Johnson-Cook, so the points carry a temperature) to 10 us
+/// with one probe of every point quantity and statistic over all elements, on both explicit
+/// kernels; run once with a frame every step (the kernel's state copied into the model's
+/// points before every row, the probes folded over those) and once without frames (the
+/// probes folded over the kernel's arrays).
+/// Reference: the run with frames. The two histories must agree to the byte: the same values
+/// folded in the same order (a one-point element's one state standing for its four points,
+/// as the copy writes it).
+#[test]
+fn point_probes_from_the_kernel_match_the_copied_points() {
+    let mut text = std::fs::read_to_string("models/taylor_jc.toml").unwrap();
+    for (quantity, statistic) in [
+        ("s_xx", "min"),
+        ("s_yy", "mean"),
+        ("s_zz", "max"),
+        ("s_xy", "max"),
+        ("von_mises", "mean"),
+        ("eq_plastic_strain", "mean"),
+        ("temperature", "max"),
+        ("temperature", "min"),
+    ] {
+        text.push_str(&format!(
+            "\n[[output.probe]]\nquantity = \"{quantity}\"\nset = \"all\"\nstatistic = \"{statistic}\"\n"
+        ));
+    }
+    for quadrature in ["full", "reduced"] {
+        let q = format!("analysis.quadrature={quadrature}");
+        let history = |frames: &str| {
+            let name = format!("point_probes_{quadrature}_{frames}");
+            let every = format!("output.frame_every={frames}");
+            let model = common::model(&name, &text, &[&q, &every, "analysis.end_time=1.0e-5"]);
+            common::run(&name, &model);
+            std::fs::read_to_string(common::out_dir_of(&name).join("history.csv")).unwrap()
+        };
+        let (copied, own) = (history("1"), history("0"));
+        assert!(copied.lines().count() > 50, "{quadrature}: too few rows");
+        assert_eq!(copied, own, "{quadrature}: the probes differ");
+    }
+}
