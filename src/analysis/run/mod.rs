@@ -325,9 +325,12 @@ impl<'a, S: Stepper> Run<'a, S> {
     fn record(&mut self, last: bool) -> Result<(), RunError> {
         let time = self.stepper.state().time;
         self.recorder.step_length = self.stepper.last_step();
+        // point probes from the stepper's own values, unless the points are copied anyway
+        // (a frame, or a probe it cannot answer): then all fold over the copied points
         let s = &self.stepper;
         self.recorder.point_probes = self.model.probes.iter().map(|p| s.point_probe(p)).collect();
         if self.recorder.reads_stresses(self.model, time, last) {
+            self.recorder.point_probes.clear();
             self.stepper.sync_points();
         }
         if let Some(energy) = self.stepper.hourglass_energy() {
