@@ -634,6 +634,31 @@ fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
     reaction
 }
 
+/// The smallest and the largest of `x` over `members`, in four independent lanes (min and
+/// max are exact, so the lanes give the one fold's answer; the lanes let the comparisons of
+/// a long set overlap instead of waiting each on the last).
+fn span(members: &[usize], x: impl Fn(usize) -> f64) -> (f64, f64) {
+    let mut low = [f64::INFINITY; 4];
+    let mut high = [f64::NEG_INFINITY; 4];
+    let chunks = members.chunks_exact(4);
+    let rest = chunks.remainder();
+    for chunk in chunks {
+        for lane in 0..4 {
+            let v = x(chunk[lane]);
+            low[lane] = low[lane].min(v);
+            high[lane] = high[lane].max(v);
+        }
+    }
+    for (lane, &m) in rest.iter().enumerate() {
+        let v = x(m);
+        low[lane] = low[lane].min(v);
+        high[lane] = high[lane].max(v);
+    }
+    let low = low.into_iter().fold(f64::INFINITY, f64::min);
+    let high = high.into_iter().fold(f64::NEG_INFINITY, f64::max);
+    (low, high)
+}
+
 /// A probe's statistic over the state's points.
 struct StatePoints<'a> {
     probe: &'a Probe,
@@ -695,14 +720,9 @@ fn probe_value(
         }
         Quantity::ExtentX | Quantity::ExtentY => {
             let c = (probe.quantity == Quantity::ExtentY) as usize;
-            let (low, high) =
-                probe
-                    .members
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), &m| {
-                        let x = initial[m][c] + state.displacement[2 * m + c];
-                        (low.min(x), high.max(x))
-                    });
+            let (low, high) = span(&probe.members, |m| {
+                initial[m][c] + state.displacement[2 * m + c]
+            });
             if c == 0 && model.bodies[probe.body].is_axisymmetric() {
                 // the body of revolution spans -r_max .. r_max
                 2.0 * high
