@@ -412,3 +412,97 @@ fn taylor_jc_wall_friction_narrows_the_foot_on_both_paths() {
         );
     }
 }
+
+/// Goal (a study, by hand: `cargo test --release --test taylor subcycling -- --ignored
+/// --nocapture`): what multi-time-step (subcycled) central difference could buy on the Taylor
+/// rods at their finest meshes, before building it.
+/// Setup: each rod run with the one-point kernel to ten times over its run; at each, every
+/// element's own stable step dt_e (the eigenvalue bound of the element on that state,
+/// `element_stable_steps`), the shortest dt_min, and the elements grouped by powers of two,
+/// k_e = floor(log2(dt_e / dt_min)) (at most 10); a node takes the finest group of its
+/// elements and an element the finest of its nodes (Belytschko, Yen & Mullen 1979: an element
+/// between groups steps with the smaller step). Subcycled, an element costs 2^-k of its
+/// single-step cost per dt_min.
+/// Reference: the single-step cost (every element at dt_min). The speed-up bound is the ratio
+/// of the two costs integrated over the run (trapezoid over the snapshots); the bookkeeping
+/// of the groups, the interface interpolation and the rest of the driver are not in it, so
+/// it bounds the real gain from above. Prints; asserts nothing.
+#[test]
+#[ignore]
+fn subcycling_cost_model_on_the_taylor_rods() {
+    for (scene, nx, ny, end) in [
+        ("taylor_aluminum", 20, 120, 45e-6),
+        ("taylor_jc", 20, 200, 80e-6),
+    ] {
+        let mut rows = Vec::new();
+        for k in 0..=10 {
+            let time = end * (k as f64 / 10.0).max(0.01);
+            let overrides = [
+                format!("body.rod.mesh.nx={nx}"),
+                format!("body.rod.mesh.ny={ny}"),
+                "analysis.quadrature=reduced".to_string(),
+                format!("analysis.end_time={time:e}"),
+                "output.frame_every=0".to_string(),
+            ];
+            let path = format!("models/{scene}.toml");
+            let model = impact::scene::load(Path::new(&path), &overrides).unwrap();
+            let dir = common::out_dir(&format!("subcycling_{scene}_{k}"));
+            let (_, state) =
+                impact::analysis::run_to_state(&model, &dir, Default::default()).unwrap();
+            let steps = impact::assembly::element_stable_steps(
+                &model,
+                &state,
+                impact::element::Strain::Finite,
+            )
+            .unwrap();
+            let dt: Vec<f64> = steps.iter().map(|s| s.dt).collect();
+            let dt_min = dt.iter().copied().fold(f64::INFINITY, f64::min);
+            let own: Vec<u32> = dt
+                .iter()
+                .map(|d| ((d / dt_min).log2().floor() as u32).min(10))
+                .collect();
+            let body = &model.bodies[0];
+            let mut node = vec![u32::MAX; body.mesh.nodes.len()];
+            for (e, k) in own.iter().enumerate() {
+                for &n in body.mesh.cells.nodes_of(e) {
+                    node[n] = node[n].min(*k);
+                }
+            }
+            let group: Vec<u32> = (0..own.len())
+                .map(|e| {
+                    body.mesh
+                        .cells
+                        .nodes_of(e)
+                        .iter()
+                        .map(|&n| node[n])
+                        .min()
+                        .unwrap()
+                })
+                .collect();
+            let single = dt.len() as f64 / dt_min;
+            let cost = |groups: &[u32]| {
+                groups.iter().map(|k| 0.5f64.powi(*k as i32)).sum::<f64>() / dt_min
+            };
+            let (subcycled, own_groups) = (cost(&group), cost(&own));
+            let finest = group.iter().filter(|k| **k == 0).count();
+            println!(
+                "{scene} {nx}x{ny} t = {time:.2e}: dt_min {dt_min:.3e}, largest dt_e / dt_min {:.1}, finest group {finest} of {} elements, cost ratio {:.2} ({:.2} on the elements' own groups)",
+                dt.iter().copied().fold(0.0, f64::max) / dt_min,
+                dt.len(),
+                single / subcycled,
+                single / own_groups
+            );
+            rows.push([time, single, subcycled, own_groups]);
+        }
+        let integral = |c: usize| {
+            rows.windows(2)
+                .map(|w| 0.5 * (w[0][c] + w[1][c]) * (w[1][0] - w[0][0]))
+                .sum::<f64>()
+        };
+        println!(
+            "{scene} {nx}x{ny}: speed-up bound of subcycling over the run {:.2} ({:.2} on the elements' own groups)",
+            integral(1) / integral(2),
+            integral(1) / integral(3)
+        );
+    }
+}
