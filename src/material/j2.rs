@@ -145,7 +145,8 @@ impl J2 {
     /// the logarithm, it can fall back to 0.) Returns dl and the hardening slope at the
     /// solution.
     #[inline]
-    fn plastic_multiplier(&self, a: f64, b: f64, start: &FlowStart) -> (f64, f64) {
+    fn plastic_multiplier(&self, a: f64, b: f64, flow: &Flow) -> (f64, f64) {
+        let start = &flow.start;
         if let Hardening::Linear { modulus } = self.hardening {
             let yield_stress = self.yield_stress + modulus * start.eq_plastic_strain;
             let dl = (a - SQRT_2_3 * yield_stress) / (b + 2.0 / 3.0 * modulus);
@@ -155,7 +156,7 @@ impl J2 {
         let mut dl = 0.0;
         let mut slope = 0.0;
         for _ in 0..200 {
-            let (sy, h) = self.flow_stress(start, SQRT_2_3 * dl);
+            let (sy, h) = flow.stress(SQRT_2_3 * dl);
             slope = h;
             let g = a - b * dl - SQRT_2_3 * sy;
             if g > 0.0 {
@@ -217,14 +218,15 @@ impl J2 {
         // dev of the difference: the pushed-forward back stress need not stay traceless
         let eta = deviator(&(trial - back));
         let eta_squared = squared_norm(&eta);
-        let (sy, _) = self.flow_stress(&start, 0.0);
+        let flow = Flow::new(self, start);
+        let sy = flow.at_start();
         // f = sqrt(3/2) ||eta|| - sigma_y <= 0 without the root (most points are elastic)
         if sy >= 0.0 && 1.5 * eta_squared <= sy * sy {
             return None;
         }
         let eta_norm = eta_squared.sqrt();
         let h_kin = self.kinematic_modulus;
-        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, &start);
+        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, &flow);
         let n = eta / eta_norm;
         Some(Radial {
             stress: trial - n * (2.0 * mu * dl),
@@ -246,7 +248,8 @@ impl J2 {
         start: FlowStart,
     ) -> Option<UniaxialReturn> {
         let xi = trial - back;
-        let (sy, _) = self.flow_stress(&start, 0.0);
+        let flow = Flow::new(self, start);
+        let sy = flow.at_start();
         if xi.abs() - sy <= 0.0 {
             return None;
         }
@@ -255,7 +258,7 @@ impl J2 {
         // dl = sqrt(3/2) de_p: a = sqrt(2/3)|xi|, b = 2/3 (E + H_kin)
         let h_kin = self.kinematic_modulus;
         let (dl, h_iso) =
-            self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), &start);
+            self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), &flow);
         let dep = SQRT_2_3 * dl;
         let h = h_iso + h_kin;
         Some(UniaxialReturn {
@@ -270,6 +273,55 @@ impl J2 {
             },
             plastic_strain: sign * dep,
         })
+    }
+}
+
+/// The flow stress of one return: what does not change with the increment (Johnson-Cook's
+/// thermal factor of the step's temperature) computed once for the elastic check and every
+/// iterate. The same values as `J2::flow_stress`, bit for bit.
+struct Flow<'a> {
+    j2: &'a J2,
+    start: FlowStart,
+    /// Johnson-Cook's 1 - T*^m (1 for the other laws, unused).
+    thermal: f64,
+}
+
+impl<'a> Flow<'a> {
+    #[inline]
+    fn new(j2: &'a J2, start: FlowStart) -> Flow<'a> {
+        let thermal = match &j2.hardening {
+            Hardening::JohnsonCook(law) => law.thermal_factor(start.temperature),
+            _ => 1.0,
+        };
+        Flow { j2, start, thermal }
+    }
+
+    /// The flow stress of a zero increment (no slope: the elastic check).
+    #[inline]
+    fn at_start(&self) -> f64 {
+        match &self.j2.hardening {
+            Hardening::JohnsonCook(law) => law.start_flow_stress(
+                self.j2.yield_stress,
+                self.start.eq_plastic_strain,
+                self.thermal,
+            ),
+            _ => self.j2.flow_stress(&self.start, 0.0).0,
+        }
+    }
+
+    /// The flow stress of the increment `dep` and its slope.
+    #[inline]
+    fn stress(&self, dep: f64) -> (f64, f64) {
+        match &self.j2.hardening {
+            Hardening::JohnsonCook(law) => law.flow_stress_at(
+                self.j2.yield_stress,
+                self.start.eq_plastic_strain,
+                self.thermal,
+                dep,
+                self.start.dt,
+            ),
+            _ => self.j2.flow_stress(&self.start, dep),
+        }
     }
 }
 

@@ -65,6 +65,35 @@ impl JohnsonCook {
         dep: f64,
         dt: f64,
     ) -> (f64, f64) {
+        let thermal = self.thermal_factor(temperature);
+        self.flow_stress_at(a, eq_plastic_strain, thermal, dep, dt)
+    }
+
+    /// The thermal softening factor 1 - T*^m of `temperature`.
+    #[inline]
+    pub fn thermal_factor(&self, temperature: f64) -> f64 {
+        1.0 - self.homologous_temperature(temperature).powf(self.m)
+    }
+
+    /// The flow stress of a zero increment, without its slope (the elastic check of every
+    /// point): (A + B eps_p^n) thermal.
+    #[inline]
+    pub fn start_flow_stress(&self, a: f64, eq_plastic_strain: f64, thermal: f64) -> f64 {
+        // the rate factor of a zero increment is 1 (as flow_stress takes it)
+        (a + self.b * eq_plastic_strain.powf(self.n)) * 1.0 * thermal
+    }
+
+    /// `flow_stress` with the thermal factor of the step's temperature given (it is the same
+    /// at every iterate of a return).
+    #[inline]
+    pub fn flow_stress_at(
+        &self,
+        a: f64,
+        eq_plastic_strain: f64,
+        thermal: f64,
+        dep: f64,
+        dt: f64,
+    ) -> (f64, f64) {
         let eps_p = eq_plastic_strain + dep;
         let power = eps_p.powf(self.n);
         let hardening = a + self.b * power;
@@ -80,7 +109,6 @@ impl JohnsonCook {
         } else {
             (1.0, 0.0)
         };
-        let thermal = 1.0 - self.homologous_temperature(temperature).powf(self.m);
         (
             hardening * rate_factor * thermal,
             (hardening_slope * rate_factor + hardening * rate_slope) * thermal,
