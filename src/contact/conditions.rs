@@ -217,3 +217,55 @@ pub(super) fn impact(
         );
     }
 }
+
+/// Hughes II-8 for the active rows `rows` of a mortar pair together, `forces` their
+/// multipliers: the velocities and accelerations are made compatible on every row at once,
+/// C v = 0 and C a = 0, by the multipliers of the lumped mass,
+/// ```text
+/// (C M^-1 C^T) mu = -C v,   v += M^-1 C^T mu
+/// ```
+/// (and the same for a, whose mu is added to the forces). A row shares master nodes with its
+/// neighbours, so one slave's condition at a time would undo the last one's; together they
+/// take no momentum from the pair (each row's weights sum to zero), and the kinetic energy
+/// they take is that of the relative normal motion. A row whose force would turn to a pull
+/// only loses its present force and is left out of the accelerations' condition.
+pub(super) fn impact_together(
+    rows: &[Vec<(usize, f64)>],
+    inverse_mass: &[f64],
+    velocity: &mut [f64],
+    acceleration: &mut [f64],
+    forces: &mut [f64],
+) {
+    let along =
+        |row: &[(usize, f64)], v: &[f64]| -> f64 { row.iter().map(|(d, c)| c * v[*d]).sum() };
+    let push = |v: &mut [f64], row: &[(usize, f64)], mu: f64| {
+        for (d, c) in row {
+            v[*d] += inverse_mass[*d] * c * mu;
+        }
+    };
+    let rates: Vec<f64> = rows.iter().map(|r| along(r, velocity)).collect();
+    let mu = super::explicit::lumped_multipliers(rows, &rates, inverse_mass);
+    for (row, m) in rows.iter().zip(&mu) {
+        push(velocity, row, *m);
+    }
+    let mut kept: Vec<usize> = (0..rows.len()).collect();
+    loop {
+        let subset: Vec<Vec<(usize, f64)>> = kept.iter().map(|i| rows[*i].clone()).collect();
+        let rates: Vec<f64> = subset.iter().map(|r| along(r, acceleration)).collect();
+        let mu = super::explicit::lumped_multipliers(&subset, &rates, inverse_mass);
+        let worst = (0..kept.len())
+            .filter(|a| forces[kept[*a]] + mu[*a] < 0.0)
+            .min_by(|a, b| (forces[kept[*a]] + mu[*a]).total_cmp(&(forces[kept[*b]] + mu[*b])));
+        if let Some(a) = worst {
+            let i = kept.remove(a);
+            push(acceleration, &rows[i], -forces[i]);
+            forces[i] = 0.0;
+            continue;
+        }
+        for (a, i) in kept.iter().enumerate() {
+            push(acceleration, &rows[*i], mu[a]);
+            forces[*i] += mu[a];
+        }
+        break;
+    }
+}

@@ -393,7 +393,7 @@ fn moves(row: &[(usize, f64)], inverse_mass: &[f64]) -> bool {
 /// m x m matrix. A singular group (redundant rows, or rows on prescribed DOFs only, which no
 /// multiplier can move) gets mu = 0 and is left to the penetration check; the others are
 /// solved.
-fn lumped_multipliers(
+pub(super) fn lumped_multipliers(
     rows: &[Vec<(usize, f64)>],
     violations: &[f64],
     inverse_mass: &[f64],
