@@ -779,6 +779,24 @@ pub fn apply_conditions<S>(
         let (ms, zs) = entry.slave_mass_and_impedance();
         // the impedance is positive for any node with a contact area (an axis node included)
         debug_assert!(zs > 0.0, "slave {s}: impedance {zs}");
+        if pair.mortar.is_some() {
+            let zm = entry.master().map_or(0.0, |side| side.impedance);
+            let compliance = 1.0 / zs + if zm > 0.0 { 1.0 / zm } else { 0.0 };
+            let rows = conditions::Released {
+                normal: gap.row(s),
+                tangential: gap.tangent_row(s),
+            };
+            conditions::release_along(
+                &rows,
+                inverse_mass,
+                velocity,
+                acceleration,
+                tau,
+                friction,
+                compliance,
+            );
+            continue;
+        }
         conditions::add_normal(velocity, s, n, tau / zs);
         conditions::add_normal(acceleration, s, n, -tau / ms);
         // the friction force goes with the normal one (its acceleration, as in II-12)
