@@ -400,6 +400,7 @@ impl ContactState {
         interfaces: &Interfaces,
         coords: &[[f64; 2]],
         lumped: &[f64],
+        inverse_mass: &[f64],
         velocity: &mut [f64],
         acceleration: &mut [f64],
     ) -> Vec<(usize, usize)> {
@@ -434,12 +435,36 @@ impl ContactState {
             self.active[p][k] = true;
             self.force[p][k] = 0.0;
             closed.push((p, k));
-            if pair.options.impact_conditions {
+            if pair.options.impact_conditions && pair.mortar.is_none() {
                 // the velocities before the impact are the previous step's
                 let previous = velocity.to_vec();
                 let mut force = 0.0;
                 conditions::impact(&entry, &previous, velocity, acceleration, &mut force);
                 self.force[p][k] = force.max(0.0);
+            }
+        }
+        // a mortar pair's rows share master nodes: their conditions are met together
+        for (p, pair) in interfaces.pairs.iter().enumerate() {
+            if !(pair.options.impact_conditions
+                && pair.mortar.is_some()
+                && closed.iter().any(|(q, _)| *q == p))
+            {
+                continue;
+            }
+            let entries: Vec<usize> = (0..pair.slaves.len())
+                .filter(|k| self.active[p][*k])
+                .collect();
+            let rows: Vec<Vec<(usize, f64)>> = entries
+                .iter()
+                .map(|k| {
+                    let s = pair.slaves[*k];
+                    pair.gap(s, &x).map_or_else(Vec::new, |g| g.row(s))
+                })
+                .collect();
+            let mut forces: Vec<f64> = entries.iter().map(|k| self.force[p][*k]).collect();
+            conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+            for (k, f) in entries.iter().zip(forces) {
+                self.force[p][*k] = f;
             }
         }
         closed
@@ -656,14 +681,39 @@ pub fn apply_conditions<S>(
     step: &mut ContactResult<S>,
     coords: &[[f64; 2]],
     lumped: &[f64],
+    inverse_mass: &[f64],
     previous_velocity: &[f64],
     velocity: &mut [f64],
     acceleration: &mut [f64],
 ) {
     let x = |n: usize| coords[n];
+    for (p, pair) in interfaces.pairs.iter().enumerate() {
+        if !(pair.options.impact_conditions
+            && pair.mortar.is_some()
+            && step.events.closed.iter().any(|(q, _)| *q == p))
+        {
+            continue;
+        }
+        // a mortar pair's rows share master nodes: their conditions are met together
+        let entries: Vec<usize> = (0..step.active.len())
+            .filter(|i| step.active[*i].0 == p)
+            .collect();
+        let rows: Vec<Vec<(usize, f64)>> = entries
+            .iter()
+            .map(|i| {
+                let s = pair.slaves[step.active[*i].1];
+                pair.gap(s, &x).map_or_else(Vec::new, |g| g.row(s))
+            })
+            .collect();
+        let mut forces: Vec<f64> = entries.iter().map(|i| step.forces[*i]).collect();
+        conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+        for (i, f) in entries.iter().zip(forces) {
+            step.forces[*i] = f;
+        }
+    }
     for &(p, k) in &step.events.closed {
         let pair = &interfaces.pairs[p];
-        if !pair.options.impact_conditions {
+        if !pair.options.impact_conditions || pair.mortar.is_some() {
             continue;
         }
         let s = pair.slaves[k];
@@ -729,6 +779,24 @@ pub fn apply_conditions<S>(
         let (ms, zs) = entry.slave_mass_and_impedance();
         // the impedance is positive for any node with a contact area (an axis node included)
         debug_assert!(zs > 0.0, "slave {s}: impedance {zs}");
+        if pair.mortar.is_some() {
+            let zm = entry.master().map_or(0.0, |side| side.impedance);
+            let compliance = 1.0 / zs + if zm > 0.0 { 1.0 / zm } else { 0.0 };
+            let rows = conditions::Released {
+                normal: gap.row(s),
+                tangential: gap.tangent_row(s),
+            };
+            conditions::release_along(
+                &rows,
+                inverse_mass,
+                velocity,
+                acceleration,
+                tau,
+                friction,
+                compliance,
+            );
+            continue;
+        }
         conditions::add_normal(velocity, s, n, tau / zs);
         conditions::add_normal(acceleration, s, n, -tau / ms);
         // the friction force goes with the normal one (its acceleration, as in II-12)

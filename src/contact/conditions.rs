@@ -217,3 +217,99 @@ pub(super) fn impact(
         );
     }
 }
+
+/// Hughes II-8 for the active rows `rows` of a mortar pair together, `forces` their
+/// multipliers: the velocities and accelerations are made compatible on every row at once,
+/// C v = 0 and C a = 0, by the multipliers of the lumped mass,
+/// ```text
+/// (C M^-1 C^T) mu = -C v,   v += M^-1 C^T mu
+/// ```
+/// (and the same for a, whose mu is added to the forces). A row shares master nodes with its
+/// neighbours, so one slave's condition at a time would undo the last one's; together they
+/// take no momentum from the pair (each row's weights sum to zero), and the kinetic energy
+/// they take is that of the relative normal motion. A row whose force would turn to a pull
+/// only loses its present force and is left out of the accelerations' condition.
+pub(super) fn impact_together(
+    rows: &[Vec<(usize, f64)>],
+    inverse_mass: &[f64],
+    velocity: &mut [f64],
+    acceleration: &mut [f64],
+    forces: &mut [f64],
+) {
+    let along =
+        |row: &[(usize, f64)], v: &[f64]| -> f64 { row.iter().map(|(d, c)| c * v[*d]).sum() };
+    let push = |v: &mut [f64], row: &[(usize, f64)], mu: f64| {
+        for (d, c) in row {
+            v[*d] += inverse_mass[*d] * c * mu;
+        }
+    };
+    let rates: Vec<f64> = rows.iter().map(|r| along(r, velocity)).collect();
+    let mu = super::multipliers::lumped_multipliers(rows, &rates, inverse_mass);
+    for (row, m) in rows.iter().zip(&mu) {
+        push(velocity, row, *m);
+    }
+    let mut kept: Vec<usize> = (0..rows.len()).collect();
+    loop {
+        let subset: Vec<Vec<(usize, f64)>> = kept.iter().map(|i| rows[*i].clone()).collect();
+        let rates: Vec<f64> = subset.iter().map(|r| along(r, acceleration)).collect();
+        let mu = super::multipliers::lumped_multipliers(&subset, &rates, inverse_mass);
+        let worst = (0..kept.len())
+            .filter(|a| forces[kept[*a]] + mu[*a] < 0.0)
+            .min_by(|a, b| (forces[kept[*a]] + mu[*a]).total_cmp(&(forces[kept[*b]] + mu[*b])));
+        if let Some(a) = worst {
+            let i = kept.remove(a);
+            push(acceleration, &rows[i], -forces[i]);
+            forces[i] = 0.0;
+            continue;
+        }
+        for (a, i) in kept.iter().enumerate() {
+            push(acceleration, &rows[*i], mu[a]);
+            forces[*i] += mu[a];
+        }
+        break;
+    }
+}
+
+/// The rows of a released mortar entry: the normal row C and the tangential row T.
+pub(super) struct Released {
+    pub normal: Vec<(usize, f64)>,
+    pub tangential: Vec<(usize, f64)>,
+}
+
+/// Hughes II-11, II-12 for an entry of a mortar pair released by the fraction rule: the
+/// forces it carried (`tau` along C, `friction` along T) leave the accelerations, and the
+/// relative normal velocity jumps by II-11's `tau (1 / Z_s + 1 / Z_m)` (`compliance` the
+/// bracket) through an impulse along the row,
+/// ```text
+/// a <- a - M^-1 (C^T tau + T^T friction),   v <- v + M^-1 C^T mu,   (C M^-1 C^T) mu = tau compliance
+/// ```
+/// Both are equal and opposite on the two surfaces (the row's weights sum to zero), where
+/// II-11's jumps of the slave and of the master point, spread over master nodes that other
+/// rows share, are not.
+pub(super) fn release_along(
+    rows: &Released,
+    inverse_mass: &[f64],
+    velocity: &mut [f64],
+    acceleration: &mut [f64],
+    tau: f64,
+    friction: f64,
+    compliance: f64,
+) {
+    let stiffness: f64 = rows
+        .normal
+        .iter()
+        .map(|(d, c)| c * c * inverse_mass[*d])
+        .sum();
+    let mu = if stiffness > 0.0 {
+        tau * compliance / stiffness
+    } else {
+        0.0
+    };
+    for (d, c) in &rows.normal {
+        velocity[*d] += inverse_mass[*d] * c * mu;
+        acceleration[*d] -= inverse_mass[*d] * c * tau;
+    }
+    for (d, c) in &rows.tangential {
+        acceleration[*d] -= inverse_mass[*d] * c * friction;
+    }
+}

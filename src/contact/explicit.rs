@@ -277,7 +277,7 @@ impl Predicted<'_> {
             .map(|((p, k), g)| g.row(interfaces.pairs[*p].slaves[*k]))
             .collect();
         let violations: Vec<f64> = gaps.iter().map(|g| g.gap).collect();
-        let mu = lumped_multipliers(&rows, &violations, inverse_mass);
+        let mu = super::multipliers::lumped_multipliers(&rows, &violations, inverse_mass);
         for (i, row) in rows.iter().enumerate() {
             for (dof, coefficient) in row {
                 c.delta[*dof] += inverse_mass[*dof] * coefficient * mu[i];
@@ -360,7 +360,7 @@ fn friction_correction(
                 .sum()
         })
         .collect();
-    let stick = lumped_multipliers(&rows, &slips, inverse_mass);
+    let stick = super::multipliers::lumped_multipliers(&rows, &slips, inverse_mass);
     for (a, &i) in entries.iter().enumerate() {
         let limit = coefficients[i] * mu_total[i].max(0.0);
         let total = (friction_total[i] + stick[a]).clamp(-limit, limit);
@@ -377,74 +377,4 @@ fn friction_correction(
 fn moves(row: &[(usize, f64)], inverse_mass: &[f64]) -> bool {
     row.iter()
         .any(|(dof, c)| *c != 0.0 && inverse_mass[*dof] > 0.0)
-}
-
-/// The multipliers mu of (C M^-1 C^T) mu = -g for the rows C of the explicit contact step
-/// (lumped M), g the rows' `violations` (the gaps of normal rows, the slips of tangential
-/// ones). C M^-1 C^T couples two rows only through a shared DOF, so it is solved per
-/// group of rows linked by shared DOFs (one row each on a rigid wall; a run of slaves on a
-/// shared master segment otherwise; on a deformable master a continuous contact zone is one
-/// group, so the gain is on rigid obstacles): dense LU of the groups instead of the whole
-/// m x m matrix. A singular group (redundant rows, or rows on prescribed DOFs only, which no
-/// multiplier can move) gets mu = 0 and is left to the penetration check; the others are
-/// solved.
-fn lumped_multipliers(
-    rows: &[Vec<(usize, f64)>],
-    violations: &[f64],
-    inverse_mass: &[f64],
-) -> Vec<f64> {
-    let m = rows.len();
-    // union-find of the rows over their DOFs
-    let mut parent: Vec<usize> = (0..m).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
-    let mut owner: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
-    for (i, row) in rows.iter().enumerate() {
-        for (dof, c) in row {
-            if *c == 0.0 {
-                continue;
-            }
-            if let Some(&j) = owner.get(dof) {
-                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-                parent[a] = b;
-            } else {
-                owner.insert(*dof, i);
-            }
-        }
-    }
-    let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
-    for i in 0..m {
-        let r = root(&mut parent, i);
-        groups.entry(r).or_default().push(i);
-    }
-    let mut mu = vec![0.0; m];
-    for members in groups.values() {
-        let w = |i: usize, j: usize| -> f64 {
-            rows[i]
-                .iter()
-                .map(|(a, ca)| {
-                    rows[j]
-                        .iter()
-                        .filter(|(b, _)| b == a)
-                        .map(|(_, cb)| ca * cb * inverse_mass[*a])
-                        .sum::<f64>()
-                })
-                .sum()
-        };
-        let k = members.len();
-        let matrix = nalgebra::DMatrix::from_fn(k, k, |a, b| w(members[a], members[b]));
-        let rhs = nalgebra::DVector::from_fn(k, |a, _| -violations[members[a]]);
-        let Some(solution) = matrix.lu().solve(&rhs) else {
-            continue;
-        };
-        for (a, &i) in members.iter().enumerate() {
-            mu[i] = solution[a];
-        }
-    }
-    mu
 }

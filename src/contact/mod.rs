@@ -31,6 +31,7 @@ pub mod gap;
 pub mod geometry;
 pub mod linearization;
 pub mod mortar;
+mod multipliers;
 pub mod search;
 pub mod setup;
 

@@ -80,6 +80,9 @@ pub struct Dynamics<'a> {
     system: System,
     solver: Solver,
     mass: Mass,
+    /// 1 / the lumped mass on the free DOFs, 0 on prescribed ones (the impact conditions of
+    /// mortar pairs move only free DOFs).
+    inverse_mass: Vec<f64>,
     method: Box<dyn Integrator>,
     state: State,
     kin: MotionState,
@@ -222,6 +225,18 @@ impl<'a> Dynamics<'a> {
         if spec.contact_dynamics == ContactDynamics::MassRedistribution {
             mass = mass.redistributed(model, &contact_nodes(model));
         }
+        let inverse_mass = mass
+            .lumped
+            .iter()
+            .zip(&system.equation)
+            .map(|(m, e)| {
+                if e.is_some() && *m > 0.0 {
+                    1.0 / m
+                } else {
+                    0.0
+                }
+            })
+            .collect();
         let solver = Solver::new(&system.pattern).map_err(|e| RunError::setup(dir, e))?;
         let n = model.dofs();
         let nominal = super::stable::implicit_first_step(model, spec)?;
@@ -274,6 +289,7 @@ impl<'a> Dynamics<'a> {
             system,
             solver,
             mass,
+            inverse_mass,
         })
     }
 
@@ -448,6 +464,7 @@ impl<'a> Dynamics<'a> {
             &mut step,
             &positions,
             &self.mass.lumped,
+            &self.inverse_mass,
             &previous_velocity,
             &mut kin.velocity,
             &mut kin.acceleration,
@@ -750,6 +767,7 @@ impl Stepper for Dynamics<'_> {
                 &self.interfaces,
                 &positions,
                 &self.mass.lumped,
+                &self.inverse_mass,
                 &mut self.kin.velocity,
                 &mut self.kin.acceleration,
             );
