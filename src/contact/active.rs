@@ -313,7 +313,13 @@ impl ContactState {
                         _ => 0.0,
                     })
                     .collect();
-                return Ok(self.finish(pairs, solution, length, entries, forces, forces_t, sliding));
+                let rows = ConvergedRows {
+                    entries,
+                    forces,
+                    tangential: forces_t,
+                    sliding,
+                };
+                return Ok(self.finish(pairs, solution, length, rows));
             }
             if !split && alpha > MIN_SPLIT && alpha < 1.0 {
                 // Erklig 2.1.4: end the step where the first slave touches
@@ -338,17 +344,19 @@ impl ContactState {
     }
 
     /// The fraction release rule and the event lists of a converged step.
-    #[allow(clippy::too_many_arguments)]
     fn finish<S>(
         &self,
         pairs: &[ContactPair],
         solution: S,
         length: f64,
-        mut entries: Vec<(usize, usize)>,
-        mut forces: Vec<f64>,
-        mut tangential: Vec<f64>,
-        mut sliding: Vec<f64>,
+        rows: ConvergedRows,
     ) -> ContactResult<S> {
+        let ConvergedRows {
+            mut entries,
+            mut forces,
+            mut tangential,
+            mut sliding,
+        } = rows;
         let mut events = Events::default();
         let mut i = 0;
         while i < entries.len() {
@@ -672,20 +680,50 @@ fn extent(
     best
 }
 
+/// The rows of a converged contact iteration: the active entries (pair, slave) and their
+/// normal and tangential forces, and each entry's sliding coefficient (0: sticking or
+/// frictionless).
+struct ConvergedRows {
+    entries: Vec<(usize, usize)>,
+    forces: Vec<f64>,
+    tangential: Vec<f64>,
+    sliding: Vec<f64>,
+}
+
+/// The nodal motion the impact and release conditions correct: the velocity at the start of
+/// the step, and the step's velocity and acceleration (all DOFs), corrected in place.
+pub struct ImpactMotion<'a> {
+    pub previous_velocity: &'a [f64],
+    pub velocity: &'a mut [f64],
+    pub acceleration: &'a mut [f64],
+}
+
+/// The lumped mass of every DOF and its inverse (0 on prescribed DOFs).
+#[derive(Clone, Copy)]
+pub struct LumpedMass<'a> {
+    pub mass: &'a [f64],
+    pub inverse: &'a [f64],
+}
+
 /// Hughes II-8 for the entries that closed and II-11, II-12 for those released by the
 /// fraction rule: corrects `velocity` and `acceleration` (all DOFs) in place, and the forces
 /// of closed entries. `previous_velocity` is the velocity at the start of the step.
-#[allow(clippy::too_many_arguments)]
 pub fn apply_conditions<S>(
     interfaces: &Interfaces,
     step: &mut ContactResult<S>,
     coords: &[[f64; 2]],
-    lumped: &[f64],
-    inverse_mass: &[f64],
-    previous_velocity: &[f64],
-    velocity: &mut [f64],
-    acceleration: &mut [f64],
+    mass: LumpedMass,
+    motion: ImpactMotion,
 ) {
+    let LumpedMass {
+        mass: lumped,
+        inverse: inverse_mass,
+    } = mass;
+    let ImpactMotion {
+        previous_velocity,
+        velocity,
+        acceleration,
+    } = motion;
     let x = |n: usize| coords[n];
     for (p, pair) in interfaces.pairs.iter().enumerate() {
         if !(pair.options.impact_conditions

@@ -36,8 +36,8 @@ pub mod search;
 pub mod setup;
 
 pub use active::{
-    ConstrainedSolution, ContactResult, ContactState, Events, NodalStatus, Pass, Tangential,
-    Unsettled, apply_conditions,
+    ConstrainedSolution, ContactResult, ContactState, Events, ImpactMotion, LumpedMass,
+    NodalStatus, Pass, Tangential, Unsettled, apply_conditions,
 };
 pub use geometry::{
     ContactPair, Covered, Friction, Gap, Master, Obstacle, PairOptions, winding_number,

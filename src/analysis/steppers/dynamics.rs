@@ -21,7 +21,7 @@ use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure}
 use super::{Report, Resume, StepError, Stepper, loads};
 use crate::analysis::summary::RunError;
 use crate::assembly::{self, Evaluation, Mass, State, System, check_mass};
-use crate::contact::{ContactResult, ContactState, Interfaces, Pass};
+use crate::contact::{ContactResult, ContactState, ImpactMotion, Interfaces, LumpedMass, Pass};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
 };
@@ -459,16 +459,16 @@ impl<'a> Dynamics<'a> {
         let conditions = !events.closed.is_empty() || !events.released.is_empty();
         let kinetic_before = conditions.then(|| self.mass.kinetic_energy(model, &kin.velocity));
         let positions = self.state.positions(spec.geometry);
-        crate::contact::apply_conditions(
-            &self.interfaces,
-            &mut step,
-            &positions,
-            &self.mass.lumped,
-            &self.inverse_mass,
-            &previous_velocity,
-            &mut kin.velocity,
-            &mut kin.acceleration,
-        );
+        let mass = LumpedMass {
+            mass: &self.mass.lumped,
+            inverse: &self.inverse_mass,
+        };
+        let motion = ImpactMotion {
+            previous_velocity: &previous_velocity,
+            velocity: &mut kin.velocity,
+            acceleration: &mut kin.acceleration,
+        };
+        crate::contact::apply_conditions(&self.interfaces, &mut step, &positions, mass, motion);
         self.contact
             .commit(&self.interfaces, &step, self.state.time, &positions);
         let contact_force = self
