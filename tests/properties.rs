@@ -47,8 +47,7 @@ fn stiffness(x: &Coords, bbar: bool, stress: [f64; 4]) -> Mat8 {
     quad4::tangent(
         &geom,
         &quad4::Kinematics::new(&geom, &Vec8::zeros(), op(bbar)),
-        &[s; 4],
-        &[moduli(); 4],
+        (&[s; 4], &[moduli(); 4]),
         op(bbar),
         GeometricStiffness::Included,
     )
@@ -212,8 +211,8 @@ proptest! {
         let geom = quad4::values(&x, formulation, &[1.0; 4]).unwrap();
         let op = quad4::Operator { strain: Strain::Small, bbar };
         let kin = quad4::Kinematics::new(&geom, &Vec8::zeros(), op);
-        let k = quad4::tangent(&geom, &kin, &[impact::element::Voigt::zeros(); 4],
-            &[elastic.moduli(condition); 4], op, GeometricStiffness::Omitted);
+        let k = quad4::tangent(&geom, &kin, (&[impact::element::Voigt::zeros(); 4],
+            &[elastic.moduli(condition); 4]), op, GeometricStiffness::Omitted);
         let m = quad4::mass(&geom);
         let lumped: [f64; 4] = std::array::from_fn(|i| m.row(i).sum());
         let exact = max_frequency_squared(&k, &lumped);

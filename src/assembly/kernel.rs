@@ -8,7 +8,7 @@
 //! push-forward of its stresses at commit, its consistent and lumped mass, and its element
 //! frequency bound for the central-difference stable step.
 
-use super::BodyState;
+use super::{BodyState, StepIncrement};
 use crate::element::{
     Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
 };
@@ -118,12 +118,11 @@ impl Kernel {
     pub fn evaluate(
         &self,
         at: ElementAt<'_>,
-        d: &[f64],
-        dt: f64,
-        geometry: Strain,
+        step: StepIncrement<'_>,
         tangent: Option<Tangent>,
         out: ElementOut<'_>,
     ) -> Result<ElementWork, KernelError> {
+        let StepIncrement { d, dt, geometry } = step;
         let ElementAt {
             body,
             committed,
@@ -182,7 +181,7 @@ impl Kernel {
                     } else {
                         responses.map(|r| r.moduli)
                     };
-                    let k = quad4::tangent(&geom, kinematics, &stress, &moduli, op, geometric);
+                    let k = quad4::tangent(&geom, kinematics, (&stress, &moduli), op, geometric);
                     m.copy_from_slice(k.transpose().as_slice()); // row-major
                 }
                 for (t, r) in out.trial.iter_mut().zip(&responses) {
@@ -221,8 +220,8 @@ impl Kernel {
                     } else {
                         response.tangent
                     };
-                    let k: Mat4 =
-                        rod2::tangent(&x, &de, stress, modulus, area, geometry, geometric)?;
+                    let axial = rod2::Axial { stress, modulus };
+                    let k: Mat4 = rod2::tangent(&x, &de, axial, area, (geometry, geometric))?;
                     m.copy_from_slice(k.transpose().as_slice());
                 }
                 out.force.copy_from_slice(f4.as_slice());
@@ -395,11 +394,14 @@ impl Kernel {
         let (mut force, mut k) = ([0.0; 8], [0.0; 64]);
         let mut trial = [PointState::default(); 4];
         // a zero increment: no step, no rate
+        let increment = StepIncrement {
+            d: zero,
+            dt: f64::INFINITY,
+            geometry,
+        };
         self.evaluate(
             at,
-            zero,
-            f64::INFINITY,
-            geometry,
+            increment,
             Some(Tangent::Consistent),
             ElementOut {
                 force: &mut force[..n],

@@ -129,9 +129,9 @@ pub struct Evaluation {
     /// follows it); empty for the other bodies, where it is not read (16 MB an evaluation
     /// at 1e6 DOFs).
     pub strain_zz: Vec<Vec<f64>>,
-    /// Increment of the internal work.
+    /// StepIncrement of the internal work.
     pub work: f64,
-    /// Increment of the plastic work.
+    /// StepIncrement of the plastic work.
     pub plastic_work: f64,
 }
 
@@ -247,24 +247,29 @@ const CHUNK: usize = 8192;
 pub fn evaluate(
     model: &Model,
     state: &State,
-    d: &[f64],
-    dt: f64,
-    geometry: Strain,
+    increment: StepIncrement,
     system: Option<&mut System>,
     tangent: Tangent,
 ) -> Result<Evaluation, ElementFailure> {
     let _timer = crate::profile::Timer::new(crate::profile::Phase::Assembly);
     crate::profile::count_elements(model.elements());
-    evaluate_elements(model, state, d, dt, geometry, system, tangent)
+    evaluate_elements(model, state, increment, system, tangent)
+}
+
+/// The increment an evaluation takes from the committed state: the displacement increment
+/// `d` (all DOFs) over the step `dt` (infinity: no rate), under small or finite strain.
+#[derive(Debug, Clone, Copy)]
+pub struct StepIncrement<'a> {
+    pub d: &'a [f64],
+    pub dt: f64,
+    pub geometry: Strain,
 }
 
 /// [`evaluate`] without its timing (for a caller that times the element loop itself).
 pub(crate) fn evaluate_elements(
     model: &Model,
     state: &State,
-    d: &[f64],
-    dt: f64,
-    geometry: Strain,
+    increment: StepIncrement,
     mut system: Option<&mut System>,
     tangent: Tangent,
 ) -> Result<Evaluation, ElementFailure> {
@@ -309,9 +314,7 @@ pub(crate) fn evaluate_elements(
                 };
                 kernel.evaluate(
                     at,
-                    d,
-                    dt,
-                    geometry,
+                    increment,
                     want_tangent.then_some(tangent),
                     ElementOut {
                         force: f,

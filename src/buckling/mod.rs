@@ -22,7 +22,7 @@
 //! finds first), the Ritz values of the tridiagonal matrix accepted when their residual
 //! estimate beta_m |s_m,i| is below 1e-10 mu_i.
 
-use crate::assembly::{self, ElementFailure, State, System};
+use crate::assembly::{self, ElementFailure, State, StepIncrement, System};
 use crate::element::Strain;
 use crate::scene::Model;
 use crate::scene::spec::Tangent;
@@ -138,9 +138,11 @@ pub fn assemble_tangent(
     assembly::evaluate(
         model,
         state,
-        &zero,
-        f64::INFINITY,
-        Strain::Finite,
+        StepIncrement {
+            d: &zero,
+            dt: f64::INFINITY,
+            geometry: Strain::Finite,
+        },
         Some(system),
         Tangent::Consistent,
     )?;
@@ -158,9 +160,11 @@ pub fn stiffness_parts(
         assembly::evaluate(
             model,
             state,
-            &zero,
-            f64::INFINITY,
-            Strain::Finite,
+            StepIncrement {
+                d: &zero,
+                dt: f64::INFINITY,
+                geometry: Strain::Finite,
+            },
             Some(&mut *system),
             tangent,
         )

@@ -408,12 +408,12 @@ pub fn internal_force(geom: &QuadValues, kin: &Kinematics, stress: &[Voigt; 4]) 
 }
 
 /// Tangent K_T = K_0 + K_sigma (Erklig eqs 32-34), the exact derivative of `internal_force`
-/// for the given material moduli dS/dE; K_sigma only when `geometric` includes it.
+/// for the points' stresses and material moduli dS/dE (`points`); K_sigma only when
+/// `geometric` includes it.
 pub fn tangent(
     geom: &QuadValues,
     kin: &Kinematics,
-    stress: &[Voigt; 4],
-    moduli: &[Moduli; 4],
+    (stress, moduli): (&[Voigt; 4], &[Moduli; 4]),
     op: Operator,
     geometric: GeometricStiffness,
 ) -> Mat8 {
@@ -712,8 +712,7 @@ mod tests {
                 let kt = tangent(
                     &geom,
                     &Kinematics::new(&geom, &d, op),
-                    &e.map(|e| stress_of(&e, &s0)),
-                    &[moduli(); 4],
+                    (&e.map(|e| stress_of(&e, &s0)), &[moduli(); 4]),
                     op,
                     GeometricStiffness::Included,
                 );

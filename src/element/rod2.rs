@@ -78,17 +78,24 @@ pub fn internal_force(
     Ok(b_vector(x, d, l, geometry) * (area * l * stress))
 }
 
-/// Tangent: the exact derivative of `internal_force` for dS/dE = `modulus`; the geometric
-/// term only when `geometric` includes it.
+/// The axial state a rod's tangent reads: the second Piola-Kirchhoff stress S and the
+/// modulus dS/dE.
+#[derive(Debug, Clone, Copy)]
+pub struct Axial {
+    pub stress: f64,
+    pub modulus: f64,
+}
+
+/// Tangent: the exact derivative of `internal_force` for dS/dE = `axial.modulus`; the
+/// geometric term (finite strain) only when `geometric` includes it.
 pub fn tangent(
     x: &[[f64; 2]; 2],
     d: &Vec4,
-    stress: f64,
-    modulus: f64,
+    axial: Axial,
     area: f64,
-    geometry: Strain,
-    geometric: GeometricStiffness,
+    (geometry, geometric): (Strain, GeometricStiffness),
 ) -> Result<Mat4, KernelError> {
+    let Axial { stress, modulus } = axial;
     let l = length(x)?;
     let b = b_vector(x, d, l, geometry);
     let mut k = b * b.transpose() * (area * l * modulus);
@@ -137,16 +144,12 @@ mod tests {
             internal_force(&x, d, s0 + modulus * e, area, Strain::Finite).unwrap()
         };
         let e = strain(&x, &d, Strain::Finite).unwrap();
-        let k = tangent(
-            &x,
-            &d,
-            s0 + modulus * e,
+        let axial = Axial {
+            stress: s0 + modulus * e,
             modulus,
-            area,
-            Strain::Finite,
-            GeometricStiffness::Included,
-        )
-        .unwrap();
+        };
+        let terms = (Strain::Finite, GeometricStiffness::Included);
+        let k = tangent(&x, &d, axial, area, terms).unwrap();
         // central differences: truncation O(h^2) ~ 1e-12 and round-off eps |f| / h ~ 1e-10
         // against entries ~ EA / L ~ 2; 1e-8 bounds both with a margin of 100
         let h = 1e-6;

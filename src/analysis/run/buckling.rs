@@ -15,7 +15,7 @@
 use super::record;
 use crate::analysis::steppers::loads;
 use crate::analysis::summary::BucklingSummary;
-use crate::assembly::{self, State, System};
+use crate::assembly::{self, State, StepIncrement, System};
 use crate::buckling::{self, BucklingError, InertiaCounter, Mode};
 use crate::element::Strain;
 use crate::output::OutputError;
@@ -44,9 +44,11 @@ pub fn prebuckling_state(model: &Model) -> Result<State, BucklingError> {
         assembly::evaluate(
             model,
             &state,
-            d,
-            f64::INFINITY,
-            Strain::Small,
+            StepIncrement {
+                d: d,
+                dt: f64::INFINITY,
+                geometry: Strain::Small,
+            },
             system,
             Tangent::Elastic,
         )

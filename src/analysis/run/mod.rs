@@ -35,7 +35,7 @@ use crate::scene::{InputError, Model};
 use buckling::Monitor;
 use checkpoint::Checkpoint;
 use progress::Progress;
-use record::Recorder;
+use record::{Recorder, Snapshot};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -112,7 +112,7 @@ pub fn execute<S: Stepper>(
     resume: Option<Checkpoint>,
     (stepper, start): (S, Instant),
 ) -> Result<Outcome, RunError> {
-    let mut run = Run::open(model, dir, options, resume, stepper, start)?;
+    let mut run = Run::open(model, dir, options, resume, (stepper, start))?;
     profile::add(Phase::Setup, start);
     while !run.stepper.done() {
         if run.step()? == Next::Stop {
@@ -130,8 +130,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         dir: &Path,
         options: RunOptions,
         resume: Option<Checkpoint>,
-        mut stepper: S,
-        start: Instant,
+        (mut stepper, start): (S, Instant),
     ) -> Result<Run<'a, S>, RunError> {
         let recorder = match &resume {
             Some(c) => Recorder::resume(model, dir, c.recorder.clone())?,
@@ -344,14 +343,14 @@ impl<'a, S: Stepper> Run<'a, S> {
         }
         let s = &self.stepper;
         let contact = (self.summary.steps > 0).then(|| s.contact());
-        self.recorder.step_with_contact(
-            self.model,
-            s.state(),
-            &s.motion(),
-            s.energies(),
+        let motion = s.motion();
+        let snapshot = Snapshot {
+            state: s.state(),
+            motion: &motion,
+            energies: s.energies(),
             contact,
-            last,
-        )?;
+        };
+        self.recorder.step(self.model, snapshot, last)?;
         Ok(())
     }
 

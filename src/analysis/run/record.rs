@@ -160,28 +160,20 @@ impl Recorder {
     }
 
     /// Records a converged step: a history row, and a frame when due (`force_frame` for the
-    /// first and last).
+    /// first and last); the contact status (None before the first step) fills the contact
+    /// columns and fields.
     pub fn step(
         &mut self,
         model: &Model,
-        state: &State,
-        motion: &Motion,
-        energies: &Energies,
+        snapshot: Snapshot,
         force_frame: bool,
     ) -> Result<(), OutputError> {
-        self.step_with_contact(model, state, motion, energies, None, force_frame)
-    }
-
-    /// As `step`, with the contact status for the contact columns and fields.
-    pub fn step_with_contact(
-        &mut self,
-        model: &Model,
-        state: &State,
-        motion: &Motion,
-        energies: &Energies,
-        contact: Option<&ContactState>,
-        force_frame: bool,
-    ) -> Result<(), OutputError> {
+        let Snapshot {
+            state,
+            motion,
+            energies,
+            contact,
+        } = snapshot;
         let start = std::time::Instant::now();
         let mut row = vec![
             state.time,
@@ -223,14 +215,7 @@ impl Recorder {
             .extend(model.probes.iter().enumerate().map(|(i, p)| {
                 match answered.get(i).copied().flatten() {
                     Some(value) => value,
-                    None => probe_value(
-                        model,
-                        state,
-                        motion,
-                        reaction.as_deref(),
-                        &self.reference,
-                        p,
-                    ),
+                    None => probe_value(model, &snapshot, reaction.as_deref(), &self.reference, p),
                 }
             }));
         row.extend_from_slice(&self.last_probes);
@@ -263,7 +248,7 @@ impl Recorder {
     }
 
     /// Whether recording the step that ends at `time` reads the element stresses: a stress
-    /// probe, or a frame due. Call it before `step_with_contact`.
+    /// probe, or a frame due. Call it before `step`.
     pub fn reads_stresses(&self, model: &Model, time: f64, force_frame: bool) -> bool {
         let unanswered = |(i, p): (usize, &Probe)| {
             !p.quantity.is_nodal() && self.point_probes.get(i).copied().flatten().is_none()
@@ -659,6 +644,16 @@ fn span(members: &[usize], x: impl Fn(usize) -> f64) -> (f64, f64) {
     (low, high)
 }
 
+/// What a history row and a frame read of the run at a converged step.
+#[derive(Clone, Copy)]
+pub struct Snapshot<'a> {
+    pub state: &'a State,
+    pub motion: &'a Motion<'a>,
+    pub energies: &'a Energies,
+    /// The contact status (None before the first step).
+    pub contact: Option<&'a ContactState>,
+}
+
 /// A probe's statistic over the state's points.
 struct StatePoints<'a> {
     probe: &'a Probe,
@@ -675,12 +670,12 @@ impl PointFold for StatePoints<'_> {
 
 fn probe_value(
     model: &Model,
-    state: &State,
-    motion: &Motion,
+    snapshot: &Snapshot,
     reaction: Option<&[f64]>,
     initial: &[[f64; 2]],
     probe: &crate::scene::model::Probe,
 ) -> f64 {
+    let (state, motion) = (snapshot.state, snapshot.motion);
     let nodal = |v: &[f64], c: usize| probe.combine(probe.members.iter().map(|m| v[2 * m + c]));
     let ppe = model.bodies[probe.body].points_per_element();
     let body_points = &state.bodies[probe.body].points;

@@ -20,7 +20,7 @@ use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
 use super::{Report, Resume, StepError, Stepper, loads};
 use crate::analysis::summary::RunError;
-use crate::assembly::{self, Evaluation, Mass, State, System, check_mass};
+use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System, check_mass};
 use crate::contact::{ContactResult, ContactState, ImpactMotion, Interfaces, LumpedMass, Pass};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
@@ -301,9 +301,11 @@ impl<'a> Dynamics<'a> {
         let evaluation = assembly::evaluate(
             model,
             &self.state,
-            &vec![0.0; model.dofs()],
-            self.nominal,
-            spec.geometry,
+            StepIncrement {
+                d: &vec![0.0; model.dofs()],
+                dt: self.nominal,
+                geometry: spec.geometry,
+            },
             None,
             spec.newton.tangent,
         )
@@ -413,9 +415,11 @@ impl<'a> Dynamics<'a> {
             step.solution.evaluation = assembly::evaluate(
                 self.model,
                 &self.state,
-                &du,
-                h,
-                self.spec.geometry,
+                StepIncrement {
+                    d: &du,
+                    dt: h,
+                    geometry: self.spec.geometry,
+                },
                 None,
                 self.spec.newton.tangent,
             )

@@ -238,15 +238,15 @@ impl Stepper for Explicit<'_> {
         self.v = v;
         self.energies.kinetic = 0.5 * self.v.iter().zip(m).map(|(v, m)| m * v * v).sum::<f64>();
         self.initial_kinetic = self.energies.kinetic;
-        self.last_total = total_force(
-            &self.free,
-            &external,
-            &self.internal,
+        let dofs = DofArrays {
+            free: &self.free,
+            external: &external,
+            internal: &self.internal,
             m,
-            &self.a,
-            &self.v,
-            a_r,
-        );
+            a: &self.a,
+            v: &self.v,
+        };
+        self.last_total = total_force(&dofs, a_r);
         self.energy_reference = self.initial_kinetic;
         Ok(())
     }
@@ -585,8 +585,15 @@ impl StepEnd<'_> {
                         *a = (self.du[i] / h - *v) * 2.0 / h;
                         *v = self.du[i] / h;
                     }
-                    let (external, internal) = (self.external[i], self.internal[i]);
-                    *total = total_at(self.free[i], external, internal, m, *a, *v, a_r);
+                    let dof = Dof {
+                        free: self.free[i],
+                        external: self.external[i],
+                        internal: self.internal[i],
+                        m,
+                        a: *a,
+                        v: *v,
+                    };
+                    *total = total_at(dof, a_r);
                     work += self.du[i] * (*total + self.last_total[i]);
                     kinetic += m * *v * *v;
                 }
@@ -602,27 +609,52 @@ impl StepEnd<'_> {
     }
 }
 
+/// What F reads at one DOF: whether it is free, its external and internal force, lumped
+/// mass, acceleration and velocity.
+#[derive(Clone, Copy)]
+struct Dof {
+    free: bool,
+    external: f64,
+    internal: f64,
+    m: f64,
+    a: f64,
+    v: f64,
+}
+
+/// The same over all DOFs.
+struct DofArrays<'a> {
+    free: &'a [bool],
+    external: &'a [f64],
+    internal: &'a [f64],
+    m: &'a [f64],
+    a: &'a [f64],
+    v: &'a [f64],
+}
+
 /// F: f_ext on the free DOFs, the reaction m a + a_R m v + f_int on the prescribed ones.
-fn total_force(
-    free: &[bool],
-    external: &[f64],
-    internal: &[f64],
-    m: &[f64],
-    a: &[f64],
-    v: &[f64],
-    a_r: f64,
-) -> Vec<f64> {
-    (0..free.len())
-        .map(|i| total_at(free[i], external[i], internal[i], m[i], a[i], v[i], a_r))
+fn total_force(dofs: &DofArrays, a_r: f64) -> Vec<f64> {
+    (0..dofs.free.len())
+        .map(|i| {
+            let dof = Dof {
+                free: dofs.free[i],
+                external: dofs.external[i],
+                internal: dofs.internal[i],
+                m: dofs.m[i],
+                a: dofs.a[i],
+                v: dofs.v[i],
+            };
+            total_at(dof, a_r)
+        })
         .collect()
 }
 
 /// F at one DOF (see `total_force`).
-fn total_at(free: bool, external: f64, internal: f64, m: f64, a: f64, v: f64, a_r: f64) -> f64 {
-    if free {
-        external
+#[inline]
+fn total_at(dof: Dof, a_r: f64) -> f64 {
+    if dof.free {
+        dof.external
     } else {
-        m * a + a_r * m * v + internal
+        dof.m * dof.a + a_r * dof.m * dof.v + dof.internal
     }
 }
 

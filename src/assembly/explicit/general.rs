@@ -7,7 +7,7 @@
 use super::{ExplicitKernel, StepWork};
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{
-    self, ElementFailure, ElementMasses, StableStep, State, evaluate_elements,
+    self, ElementFailure, ElementMasses, StableStep, State, StepIncrement, evaluate_elements,
     largest_frequency_bound,
 };
 use crate::element::Strain;
@@ -71,9 +71,11 @@ impl ExplicitKernel for General<'_> {
         let evaluation = evaluate_elements(
             self.model,
             &self.state,
-            &zero,
-            f64::INFINITY,
-            self.geometry,
+            StepIncrement {
+                d: &zero,
+                dt: f64::INFINITY,
+                geometry: self.geometry,
+            },
             None,
             self.tangent,
         )?;
@@ -91,9 +93,11 @@ impl ExplicitKernel for General<'_> {
         let evaluation = evaluate_elements(
             self.model,
             &self.state,
-            du,
-            dt,
-            self.geometry,
+            StepIncrement {
+                d: du,
+                dt: dt,
+                geometry: self.geometry,
+            },
             None,
             self.tangent,
         )?;

@@ -20,7 +20,7 @@
 mod constrained;
 mod secant;
 
-use crate::assembly::{self, Evaluation, Mass, State, System};
+use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System};
 use crate::contact::{ConstrainedSolution, ContactPair, Tangential, Unsettled};
 use crate::element::Strain;
 use crate::integrator::StepForm;
@@ -235,9 +235,11 @@ impl Step<'_> {
         assembly::evaluate(
             self.model,
             state,
-            d,
-            self.dt,
-            self.geometry,
+            StepIncrement {
+                d: d,
+                dt: self.dt,
+                geometry: self.geometry,
+            },
             system,
             self.newton.tangent,
         )
