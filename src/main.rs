@@ -210,8 +210,7 @@ fn main() -> ExitCode {
             ymax,
         } => plot_history(
             &history,
-            &x,
-            &y,
+            (&x, &y),
             out,
             PlotLook {
                 title,
@@ -611,8 +610,7 @@ struct PlotLook {
 
 fn plot_history(
     history: &Path,
-    x: &str,
-    y: &[String],
+    (x, y): (&str, &[String]),
     out: Option<PathBuf>,
     look: PlotLook,
     references: &[PathBuf],

@@ -325,7 +325,7 @@ fn measured(
 /// Lame p = 1.986, f_ext 1.6e-6 (finest 1.6e-4), GCI 2.0e-4.
 #[test]
 fn extrapolation_and_gci_bracket_the_exact_value() {
-    let lame = impact::reference::lame_radial_displacement(1.0, 1.0, 2.0, 1000.0, 0.3, 1.0);
+    let lame = impact::reference::lame_radial_displacement(1.0, (1.0, 2.0), (1000.0, 0.3), 1.0);
     // the bore's mean u_r (plain Q4: B-bar is off for an elastic material by default)
     let cylinder = format!(
         "{}\n[[output.probe]]\nquantity = \"u_x\"\nset = \"left\"\n",

@@ -310,7 +310,7 @@ fn lanczos(operator: &mut Operator, count: usize) -> Vec<(f64, Vec<f64>)> {
             || step + 1 == max_steps;
         if check {
             let done = b == 0.0 || step + 1 == max_steps || m == n;
-            if let Some(converged) = ritz_pairs(&alpha, &beta, b, &basis, count, done) {
+            if let Some(converged) = ritz_pairs((&alpha, &beta, b), &basis, count, done) {
                 return converged;
             }
         }
@@ -325,12 +325,11 @@ fn lanczos(operator: &mut Operator, count: usize) -> Vec<(f64, Vec<f64>)> {
 }
 
 /// The Ritz pairs of the tridiagonal T = tridiag(beta, alpha, beta) whose next off-diagonal
-/// would be `b`: once the `count` largest positive mu have residual estimates b |s_m,i| below
-/// 1e-10 mu (or `done`), those below 1e-6 mu with their shapes; None to go on.
+/// would be `b` (the three given as `(alpha, beta, b)`): once the `count` largest positive mu
+/// have residual estimates b |s_m,i| below 1e-10 mu (or `done`), those below 1e-6 mu with
+/// their shapes; None to go on.
 fn ritz_pairs(
-    alpha: &[f64],
-    beta: &[f64],
-    b: f64,
+    (alpha, beta, b): (&[f64], &[f64], f64),
     basis: &[Vec<f64>],
     count: usize,
     done: bool,

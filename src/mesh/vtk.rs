@@ -191,7 +191,7 @@ fn collect(vtk: Vtk, sets: &[String]) -> Result<TaggedMesh, String> {
     };
     let typed = cells.into_iter().zip(piece.cells.types);
     for (k, ((nodes, kind), groups)) in typed.zip(tags.cell_groups).enumerate() {
-        add_cell(&mut tagged, k, nodes, kind, groups, points)?;
+        add_cell(&mut tagged, k, (nodes, kind, groups), points)?;
     }
     Ok(tagged)
 }
@@ -272,13 +272,12 @@ fn set_tags(
     Ok(tags)
 }
 
-/// Cell `k` as a quad, line or vertex of the mesh; its points must exist and match its type.
+/// Cell `k` (its points, VTK type and groups) as a quad, line or vertex of the mesh; its
+/// points must exist (`points` of them) and match its type.
 fn add_cell(
     tagged: &mut TaggedMesh,
     k: usize,
-    nodes: Vec<u64>,
-    kind: CellType,
-    groups: Vec<usize>,
+    (nodes, kind, groups): (Vec<u64>, CellType, Vec<usize>),
     points: usize,
 ) -> Result<(), String> {
     if let Some(&node) = nodes.iter().find(|&&n| n as usize >= points) {

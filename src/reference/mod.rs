@@ -1,10 +1,15 @@
 //! Closed-form and independently computed reference solutions, shared by the tests, the
 //! validation report and `impact sweep`.
 
-/// Lame's thick-walled cylinder under internal pressure `p` (inner radius a, outer b), in
-/// plane strain (eps_zz = 0): the radial displacement at radius r,
-/// u_r = (1 + nu) p a^2 / (E (b^2 - a^2)) ((1 - 2 nu) r + b^2 / r).
-pub fn lame_radial_displacement(p: f64, a: f64, b: f64, young: f64, poisson: f64, r: f64) -> f64 {
+/// Lame's thick-walled cylinder under internal pressure `p` (radii (a, b): inner, outer) of
+/// an elastic material (E, nu), in plane strain (eps_zz = 0): the radial displacement at
+/// radius r, u_r = (1 + nu) p a^2 / (E (b^2 - a^2)) ((1 - 2 nu) r + b^2 / r).
+pub fn lame_radial_displacement(
+    p: f64,
+    (a, b): (f64, f64),
+    (young, poisson): (f64, f64),
+    r: f64,
+) -> f64 {
     (1.0 + poisson) * p * a * a / (young * (b * b - a * a))
         * ((1.0 - 2.0 * poisson) * r + b * b / r)
 }

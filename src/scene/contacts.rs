@@ -23,7 +23,7 @@ pub(super) fn contacts(
         .contact
         .iter()
         .enumerate()
-        .map(|(k, c)| contact(cx, bodies, obstacles, k, c, explicit(scene)))
+        .map(|entry| contact(cx, bodies, obstacles, entry, explicit(scene)))
         .collect::<Result<Vec<_>, _>>()?;
     let mut contacts = contacts;
     for (k, spec) in scene.contact.iter().enumerate() {
@@ -74,13 +74,13 @@ pub(super) fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, In
     Ok(out)
 }
 
-/// One `[[contact]]` pair: its slave nodes (global), its master and its options.
+/// One `[[contact]]` pair (the k-th, `spec`): its slave nodes (global), its master and its
+/// options.
 fn contact(
     cx: &Context,
     bodies: &[Body],
     obstacles: &[Obstacle],
-    k: usize,
-    spec: &ContactSpec,
+    (k, spec): (usize, &ContactSpec),
     explicit: bool,
 ) -> Result<ContactPair, InputError> {
     let key = format!("contact[{k}] (`{}`)", spec.name);
@@ -129,7 +129,7 @@ fn contact(
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
         None => f64::INFINITY,
     };
-    let mortar = mortar_surface(cx, bodies, &key, spec, slave_body, &master, explicit)?;
+    let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), explicit)?;
     Ok(ContactPair {
         name: spec.name.clone(),
         slave_body,
@@ -150,15 +150,13 @@ fn contact(
     })
 }
 
-/// The slave surface of a `discretization = "mortar"` pair: the slave set's edges, against a
-/// master edge set of another body.
+/// The slave surface of a `discretization = "mortar"` pair (`key`, `spec`): the slave set's
+/// edges of `slave_body`, against a master edge set of another body.
 fn mortar_surface(
     cx: &Context,
     bodies: &[Body],
-    key: &str,
-    spec: &ContactSpec,
-    slave_body: usize,
-    master: &Master,
+    (key, spec): (&str, &ContactSpec),
+    (slave_body, master): (usize, &Master),
     explicit: bool,
 ) -> Result<Option<MortarSurface>, InputError> {
     let slave_edges = bodies[slave_body]

@@ -56,7 +56,7 @@ pub(super) fn loads(
         .load
         .iter()
         .enumerate()
-        .map(|(k, l)| load(cx, bodies, curves, default, k, l))
+        .map(|entry| load(cx, bodies, (curves, default), entry))
         .collect()
 }
 
@@ -110,14 +110,13 @@ fn curve(
     }
 }
 
-/// One `[[load]]`, resolved to global nodes (or a body's edges) and its curve.
+/// One `[[load]]` (the k-th, `spec`), resolved to global nodes (or a body's edges) and its
+/// curve among the named `curves` (`default` when it names none).
 fn load(
     cx: &Context,
     bodies: &[Body],
-    curves: &BTreeMap<String, Curve>,
-    default: &Curve,
-    k: usize,
-    spec: &LoadSpec,
+    (curves, default): (&BTreeMap<String, Curve>, &Curve),
+    (k, spec): (usize, &LoadSpec),
 ) -> Result<Load, InputError> {
     let key = format!("load[{k}]");
     let globals =

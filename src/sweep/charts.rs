@@ -63,8 +63,7 @@ type Groups<'a> = [(String, Vec<&'a Row>)];
 /// Writes the charts that the rows support; returns their paths. `units`: the scene's (for
 /// the axes), `notes`: lines shown on the force-error charts.
 pub fn write_all(
-    plan: &Plan,
-    rows: &[Row],
+    (plan, rows): (&Plan, &[Row]),
     title: &str,
     units: Option<&Units>,
     notes: &[String],
@@ -193,8 +192,7 @@ fn error_vs_cpu(
 /// Pareto front). NAME: the measure's name with every character other than a letter, digit
 /// or `_` replaced by `_`.
 pub fn write_measures(
-    plan: &Plan,
-    rows: &[Row],
+    (plan, rows): (&Plan, &[Row]),
     scores: &[MeasureScore],
     title: &str,
     units: &Units,

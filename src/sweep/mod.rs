@@ -177,7 +177,7 @@ pub fn run(
         .iter()
         .map(|c| Some(dir.join(plan.folder(c))).filter(|f| f.join("case.json").is_file()))
         .collect();
-    let mut report = write_results(plan, &cases, &models, &folders, dir, measures)?;
+    let mut report = write_results(plan, (&cases, &models, &folders), dir, measures)?;
     report.in_shard = mine.len();
     report.executed = todo.len();
     report.skipped = mine.len() - todo.len();
@@ -304,16 +304,14 @@ pub fn merge(dirs: &[PathBuf], out: &Path, measures: &[Measure]) -> Result<Repor
     crate::analysis::create_output_folder(out)?;
     let text = serde_json::to_string_pretty(&plan).expect("the plan serializes");
     write_atomic(&out.join("sweep.json"), text.as_bytes())?;
-    write_results(&plan, &cases, &models, &folders, out, measures)
+    write_results(&plan, (&cases, &models, &folders), out, measures)
 }
 
 /// Measures the cases, writes sweep.csv, reference.json, measures.json and the charts into
 /// `out`.
 fn write_results(
     plan: &Plan,
-    cases: &[Case],
-    models: &[Model],
-    folders: &[Option<PathBuf>],
+    (cases, models, folders): (&[Case], &[Model], &[Option<PathBuf>]),
     out: &Path,
     measures: &[Measure],
 ) -> Result<Report, RunError> {
@@ -325,8 +323,7 @@ fn write_results(
                 measures,
                 &qoi::Units::of(model),
                 model,
-                &mut rows,
-                folders,
+                (&mut rows, folders),
                 &series,
             )
         }
@@ -362,11 +359,10 @@ fn write_results(
         .chain(converged.map_or(&[][..], |c| &c.chart_notes[..]))
         .cloned()
         .collect();
-    let mut charts = charts::write_all(plan, &rows, &title, units.as_ref(), &chart_notes, out)?;
+    let table = (plan, &rows[..]);
+    let mut charts = charts::write_all(table, &title, units.as_ref(), &chart_notes, out)?;
     if let Some(units) = &units {
-        charts.extend(charts::write_measures(
-            plan, &rows, &scores, &title, units, out,
-        )?);
+        charts.extend(charts::write_measures(table, &scores, &title, units, out)?);
     }
     let mut notes = reference.notes.clone();
     notes.extend(converged.map_or(Vec::new(), |c| c.notes.clone()));

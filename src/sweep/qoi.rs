@@ -504,8 +504,7 @@ pub fn score(
     measures: &[Measure],
     units: &Units,
     model: &Model,
-    rows: &mut [Row],
-    folders: &[Option<PathBuf>],
+    (rows, folders): (&mut [Row], &[Option<PathBuf>]),
     series: &[(String, Vec<usize>)],
 ) -> Vec<MeasureScore> {
     let columns: Vec<&str> = measures.iter().map(|m| m.column.as_str()).collect();

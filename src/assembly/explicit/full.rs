@@ -145,16 +145,14 @@ fn forces(values: &QuadValues, stress: &[[f64; 4]; 4], bbar: bool) -> [f64; 8] {
     f
 }
 
-/// One element over one step of length dt: positions x at the start, increment u, with the
-/// bulk viscosity `viscosity` when on (see the legend).
+/// One element over one step of length dt: positions x at the start, increment u (`(x, u)`),
+/// with the bulk viscosity `viscosity` when on (see the legend).
 fn element_step(
     p: &super::BodyParameters,
-    x: &Nodes,
-    u: &Nodes,
+    (x, u): (&Nodes, &Nodes),
     committed: &PointsState,
     lumped: &[f64; 4],
-    dt: f64,
-    viscosity: Option<&BulkViscosity>,
+    (dt, viscosity): (f64, Option<&BulkViscosity>),
 ) -> Result<ElementStep, KernelError> {
     let axisymmetric = p.axisymmetric();
     let mid: Nodes = std::array::from_fn(|a| [x[a][0] + 0.5 * u[a][0], x[a][1] + 0.5 * u[a][1]]);
@@ -454,15 +452,9 @@ impl ExplicitKernel for Full {
                         let p = &layout.bodies[layout.body[e] as usize];
                         let factor = scaling.map(|s| s.factor(e));
                         let element_lumped = scaled(&lumped[e], factor);
-                        let r = match element_step(
-                            p,
-                            &xe,
-                            &ue,
-                            &committed,
-                            &element_lumped,
-                            dt,
-                            viscosity,
-                        ) {
+                        let motion = (&xe, &ue);
+                        let step = (dt, viscosity);
+                        let r = match element_step(p, motion, &committed, &element_lumped, step) {
                             Ok(r) => r,
                             Err(err) => return (sums, Some((e, err)), grown),
                         };

@@ -89,17 +89,15 @@ impl ElementMass {
     }
 }
 
-/// One element over one step of length dt: positions x at the start, increment u, with the
-/// bulk viscosity `viscosity` when on (see the legend).
+/// One element over one step of length dt: positions x at the start, increment u (`(x, u)`),
+/// with the bulk viscosity `viscosity` when on (see the legend).
 #[inline(always)]
 fn element_step(
     p: &BodyParameters,
-    x: &Nodes,
-    u: &Nodes,
+    (x, u): (&Nodes, &Nodes),
     committed: &ElementState,
     mass: ElementMass,
-    dt: f64,
-    viscosity: Option<&BulkViscosity>,
+    (dt, viscosity): (f64, Option<&BulkViscosity>),
 ) -> Result<ElementStep, KernelError> {
     let t = committed.thickness;
     let section = if p.axisymmetric() {
@@ -464,8 +462,13 @@ impl ExplicitKernel for Reduced {
                         Some(scaling) => mass[e].scaled(scaling.factor(e)),
                         None => mass[e],
                     };
-                    let r = match element_step(p, &xe, &ue, &committed, element_mass, dt, viscosity)
-                    {
+                    let r = match element_step(
+                        p,
+                        (&xe, &ue),
+                        &committed,
+                        element_mass,
+                        (dt, viscosity),
+                    ) {
                         Ok(r) => r,
                         Err(err) => return (sums, Some((e, err)), grown),
                     };
@@ -635,7 +638,7 @@ mod tests {
                 smallest: 1.0,
                 total: 4.0,
             };
-            state = element_step(&p, &x, &u, &state, mass, 1.0, None)
+            state = element_step(&p, (&x, &u), &state, mass, (1.0, None))
                 .unwrap()
                 .state;
             x = std::array::from_fn(|a| [x[a][0] + u[a][0], x[a][1] + u[a][1]]);

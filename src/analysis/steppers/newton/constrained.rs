@@ -280,27 +280,20 @@ pub(super) fn constrained_solve(
         }
     }
     profile::add(Phase::Contact, schur_start);
-    let delta = backward(
-        solver,
-        w,
-        secant,
-        projected_residual,
-        &projected_rows,
-        tau.iter(),
-    );
+    let unit_loads = (&projected_rows[..], tau.iter());
+    let delta = backward(solver, w, secant, projected_residual, unit_loads);
     Ok((delta, tau.iter().copied().collect()))
 }
 
 /// The backward half of a constrained solve, plus the BFGS correction W M W^T of the whole
 /// load: `projected_residual` = W^T R (None without pairs) and `projected[i]` = W^T of the
-/// unit load that `loads[i]` scales.
+/// unit load that `loads[i]` scales (the two given as `(projected, loads)`).
 fn backward<'a>(
     solver: &mut Solver,
     w: Forward,
     secant: &Secant,
     projected_residual: Option<DVector<f64>>,
-    projected: &[DVector<f64>],
-    loads: impl Iterator<Item = &'a f64>,
+    (projected, loads): (&[DVector<f64>], impl Iterator<Item = &'a f64>),
 ) -> Vec<f64> {
     let mut delta = solver.backward(w);
     if let Some(mut p) = projected_residual {
@@ -438,6 +431,6 @@ fn exact_solve(
         solver.add_unit(&mut w, *eq, *f);
     }
     profile::add(Phase::Contact, schur_start);
-    let delta = backward(solver, w, secant, projected_residual, &w_at, load.iter());
+    let delta = backward(solver, w, secant, projected_residual, (&w_at, load.iter()));
     Ok((delta, tau.iter().copied().collect()))
 }
