@@ -180,13 +180,13 @@ pub fn tabulate(
             pair,
             force,
             duration,
-        }) => pulse_reference(&mut rows, &loaded, kind, pair, *force, *duration),
+        }) => pulse_reference(&mut rows, &loaded, kind, pair, (*force, *duration)),
         Some(Reference::Hertz {
             pair,
             peak_force,
             radius,
             duration,
-        }) => hertz_reference(&mut rows, &loaded, pair, *peak_force, *radius, *duration),
+        }) => hertz_reference(&mut rows, &loaded, pair, (*peak_force, *radius, *duration)),
         None => {
             let mut used = finest_reference(&mut rows, &loaded, pair.clone());
             let series = series_indices(plan, &rows);
@@ -268,15 +268,14 @@ fn row(
     })
 }
 
-/// Against a force pulse F_0 on 0 < t < T (rod impacts): the force history's L2 errors, the
-/// release time against T and the peak force against F_0.
+/// Against a force pulse F_0 on 0 < t < T (rod impacts; `(F_0, T)`): the force history's L2
+/// errors, the release time against T and the peak force against F_0.
 fn pulse_reference(
     rows: &mut [Row],
     loaded: &[(Option<Loaded>, Option<CaseRecord>)],
     kind: &ReferenceKind,
     pair: &str,
-    force: f64,
-    duration: f64,
+    (force, duration): (f64, f64),
 ) -> ReferenceUsed {
     for (row, (files, _)) in rows.iter_mut().zip(loaded) {
         let m = &mut row.measures;
@@ -316,15 +315,13 @@ fn pulse_reference(
     }
 }
 
-/// Against the Hertz impact: peak force, contact duration (first contact to last release)
-/// and largest contact radius.
+/// Against the Hertz impact (`(peak force, contact radius, duration)`): peak force, contact
+/// duration (first contact to last release) and largest contact radius.
 fn hertz_reference(
     rows: &mut [Row],
     loaded: &[(Option<Loaded>, Option<CaseRecord>)],
     pair: &str,
-    peak_force: f64,
-    radius: f64,
-    duration: f64,
+    (peak_force, radius, duration): (f64, f64, f64),
 ) -> ReferenceUsed {
     for (row, (files, _)) in rows.iter_mut().zip(loaded) {
         let m = &mut row.measures;
