@@ -296,7 +296,7 @@ impl ContactState {
                     }
                 }
                 changed |=
-                    coulomb_switches(pairs, &entries, &mut slips, normal, &forces_t, &slip_of);
+                    coulomb_switches(pairs, &entries, &mut slips, (normal, &forces_t), &slip_of);
                 if changed && pass < 50 {
                     // a new slip status starts from the predictor: from the last increment
                     // the sliding equality |t| = mu tau lands at the Newton tolerance, not
@@ -407,11 +407,13 @@ impl ContactState {
         &mut self,
         interfaces: &Interfaces,
         coords: &[[f64; 2]],
-        lumped: &[f64],
-        inverse_mass: &[f64],
-        velocity: &mut [f64],
-        acceleration: &mut [f64],
+        mass: LumpedMass,
+        (velocity, acceleration): (&mut [f64], &mut [f64]),
     ) -> Vec<(usize, usize)> {
+        let LumpedMass {
+            mass: lumped,
+            inverse: inverse_mass,
+        } = mass;
         let x = |n: usize| coords[n];
         let touching: Vec<SlaveGap> = slave_gaps(&interfaces.pairs, &x, &|p, k| self.active[p][k])
             .filter(|s| {
@@ -487,32 +489,23 @@ impl ContactState {
         coords: &[[f64; 2]],
     ) {
         let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
-        self.set(
-            interfaces,
-            &step.active,
-            &step.forces,
-            released,
-            time,
-            &|n| coords[n],
-            None,
-        );
+        let rows = (&step.active[..], &step.forces[..]);
+        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
         for (i, (p, k)) in step.active.iter().enumerate() {
             self.tangential[*p][*k] = step.tangential[i];
             self.sliding[*p][*k] = step.sliding[i];
         }
     }
 
-    /// Sets the status: the active entries and their forces after a step ending at `time`
-    /// with the nodes at `x`. `lowest`: the lowest slave gap at `x` when the caller has just
-    /// computed every slave's gap there (Some(None): no slave has a master in reach); None
-    /// computes them.
+    /// Sets the status: the active entries and their forces (`(active, forces)`) after a step
+    /// ending at `time` (`released`: some entry let go in it) with the nodes at `x`.
+    /// `lowest`: the lowest slave gap at `x` when the caller has just computed every slave's
+    /// gap there (Some(None): no slave has a master in reach); None computes them.
     pub(super) fn set(
         &mut self,
         interfaces: &Interfaces,
-        active: &[(usize, usize)],
-        forces: &[f64],
-        released: bool,
-        time: f64,
+        (active, forces): (&[(usize, usize)], &[f64]),
+        (time, released): (f64, bool),
         x: &dyn Fn(usize) -> [f64; 2],
         lowest: Option<Option<f64>>,
     ) {
@@ -824,15 +817,8 @@ pub fn apply_conditions<S>(
                 normal: gap.row(s),
                 tangential: gap.tangent_row(s),
             };
-            conditions::release_along(
-                &rows,
-                inverse_mass,
-                velocity,
-                acceleration,
-                tau,
-                friction,
-                compliance,
-            );
+            let forces = (tau, friction, compliance);
+            conditions::release_along(&rows, inverse_mass, (velocity, acceleration), forces);
             continue;
         }
         conditions::add_normal(velocity, s, n, tau / zs);
@@ -855,8 +841,7 @@ fn coulomb_switches(
     pairs: &[ContactPair],
     entries: &[(usize, usize)],
     slips: &mut [Slip],
-    normal: &[f64],
-    forces_t: &[f64],
+    (normal, forces_t): (&[f64], &[f64]),
     slip_of: &dyn Fn(usize) -> f64,
 ) -> bool {
     let mut changed = false;

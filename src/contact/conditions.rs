@@ -289,11 +289,8 @@ pub(super) struct Released {
 pub(super) fn release_along(
     rows: &Released,
     inverse_mass: &[f64],
-    velocity: &mut [f64],
-    acceleration: &mut [f64],
-    tau: f64,
-    friction: f64,
-    compliance: f64,
+    (velocity, acceleration): (&mut [f64], &mut [f64]),
+    (tau, friction, compliance): (f64, f64, f64),
 ) {
     let stiffness: f64 = rows
         .normal

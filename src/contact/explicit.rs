@@ -99,9 +99,8 @@ impl ContactState {
             .zip(&c.in_active)
             .any(|(was, is)| was.iter().zip(is).any(|(was, is)| *was && !*is));
         let end = |node: usize| step.position(&c.delta, node);
-        self.set(
-            interfaces, &c.active, &forces, released, time, &end, c.lowest,
-        );
+        let rows = (&c.active[..], &forces[..]);
+        self.set(interfaces, rows, (time, released), &end, c.lowest);
         for (i, (p, k)) in c.active.iter().enumerate() {
             self.tangential[*p][*k] = c.friction_total[i] / (h * spans[i]);
             // a sliding entry: on the cone, with the signed coefficient of its force
@@ -291,13 +290,13 @@ impl Predicted<'_> {
             .iter()
             .map(|(p, _)| coulomb(interfaces, *p).unwrap_or(0.0))
             .collect();
+        let cones = (&coefficients[..], &c.mu_total[..]);
+        let increment = (self.du, &mut c.delta[..]);
         friction_correction(
             tangent_rows,
-            &coefficients,
-            &c.mu_total,
+            cones,
             &mut c.friction_total,
-            self.du,
-            &mut c.delta,
+            increment,
             inverse_mass,
         );
         // entries pulled (total multiplier negative) leave and give back their correction
@@ -331,11 +330,9 @@ impl Predicted<'_> {
 /// rows it shares DOFs with singular.
 fn friction_correction(
     tangent_rows: &[Option<Vec<(usize, f64)>>],
-    coefficients: &[f64],
-    mu_total: &[f64],
+    (coefficients, mu_total): (&[f64], &[f64]),
     friction_total: &mut [f64],
-    du: &[f64],
-    delta: &mut [f64],
+    (du, delta): (&[f64], &mut [f64]),
     inverse_mass: &[f64],
 ) {
     let entries: Vec<usize> = (0..tangent_rows.len())

@@ -117,7 +117,8 @@ pub fn weighted_gap(
             );
             let low = eta_p.min(eta_q).max(0.0);
             let high = eta_p.max(eta_q).min(1.0);
-            if !(high > low) || !within_reach(xa, ab, facing, [xp, xq], [eta_p, eta_q], [low, high])
+            if !(high > low)
+                || !within_reach((xa, ab, facing), [xp, xq], [eta_p, eta_q], [low, high])
             {
                 continue;
             }
@@ -172,14 +173,12 @@ pub fn weighted_gap(
 }
 
 /// Whether the master segment `master` (its end points' projections `etas` on the slave
-/// segment from `xa` along `ab`, outward normal `facing`) lies across the slave segment
-/// rather than behind it: at the overlap `[low, high]` it is not deeper inside the slave
-/// body than one slave segment length. A closed master (a ring) faces a slave segment from
-/// its far side too, where the "gap" is the body's thickness.
+/// segment from `xa` along `ab`, outward normal `facing`: `slave = (xa, ab, facing)`) lies
+/// across the slave segment rather than behind it: at the overlap `[low, high]` it is not
+/// deeper inside the slave body than one slave segment length. A closed master (a ring)
+/// faces a slave segment from its far side too, where the "gap" is the body's thickness.
 fn within_reach(
-    xa: [f64; 2],
-    ab: [f64; 2],
-    facing: [f64; 2],
+    (xa, ab, facing): ([f64; 2], [f64; 2], [f64; 2]),
     master: [[f64; 2]; 2],
     etas: [f64; 2],
     overlap: [f64; 2],

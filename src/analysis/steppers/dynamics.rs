@@ -767,14 +767,13 @@ impl Stepper for Dynamics<'_> {
             let (target, nominal) = self.target();
             let positions = self.state.positions(self.spec.geometry).into_owned();
             let kinetic_before_impact = self.mass.kinetic_energy(self.model, &self.kin.velocity);
-            self.contact.close_touching(
-                &self.interfaces,
-                &positions,
-                &self.mass.lumped,
-                &self.inverse_mass,
-                &mut self.kin.velocity,
-                &mut self.kin.acceleration,
-            );
+            let mass = LumpedMass {
+                mass: &self.mass.lumped,
+                inverse: &self.inverse_mass,
+            };
+            let motion = (&mut self.kin.velocity[..], &mut self.kin.acceleration[..]);
+            self.contact
+                .close_touching(&self.interfaces, &positions, mass, motion);
             self.energies.contact_work +=
                 kinetic_before_impact - self.mass.kinetic_energy(self.model, &self.kin.velocity);
             match self.attempt(nominal, &positions, counters) {
