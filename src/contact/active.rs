@@ -706,17 +706,23 @@ pub fn apply_conditions<S>(
     step: &mut ContactResult<S>,
     coords: &[[f64; 2]],
     mass: LumpedMass,
-    motion: ImpactMotion,
+    mut motion: ImpactMotion,
 ) {
-    let LumpedMass {
-        mass: lumped,
-        inverse: inverse_mass,
-    } = mass;
-    let ImpactMotion {
-        previous_velocity,
-        velocity,
-        acceleration,
-    } = motion;
+    impact_mortar_pairs(interfaces, step, coords, mass.inverse, &mut motion);
+    impact_slaves(interfaces, step, coords, mass.mass, &mut motion);
+    release_slaves(interfaces, step, coords, mass, &mut motion);
+}
+
+/// II-8 on the mortar pairs where an entry closed: all the pair's active rows at once (they
+/// share master nodes), their forces corrected.
+fn impact_mortar_pairs<S>(
+    interfaces: &Interfaces,
+    step: &mut ContactResult<S>,
+    coords: &[[f64; 2]],
+    inverse_mass: &[f64],
+    motion: &mut ImpactMotion,
+) {
+    let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
     let x = |n: usize| coords[n];
     for (p, pair) in interfaces.pairs.iter().enumerate() {
         if !(pair.options.impact_conditions
@@ -742,6 +748,20 @@ pub fn apply_conditions<S>(
             step.forces[*i] = f;
         }
     }
+}
+
+/// II-8 on each closed entry of the other pairs, its force kept compressive and its
+/// friction force following it.
+fn impact_slaves<S>(
+    interfaces: &Interfaces,
+    step: &mut ContactResult<S>,
+    coords: &[[f64; 2]],
+    lumped: &[f64],
+    motion: &mut ImpactMotion,
+) {
+    let previous_velocity = motion.previous_velocity;
+    let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
+    let x = |n: usize| coords[n];
     for &(p, k) in &step.events.closed {
         let pair = &interfaces.pairs[p];
         if !pair.options.impact_conditions || pair.mortar.is_some() {
@@ -791,6 +811,23 @@ pub fn apply_conditions<S>(
             }
         }
     }
+}
+
+/// II-11, II-12 on the entries released by the fraction rule (along the released row on a
+/// mortar pair).
+fn release_slaves<S>(
+    interfaces: &Interfaces,
+    step: &ContactResult<S>,
+    coords: &[[f64; 2]],
+    mass: LumpedMass,
+    motion: &mut ImpactMotion,
+) {
+    let LumpedMass {
+        mass: lumped,
+        inverse: inverse_mass,
+    } = mass;
+    let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
+    let x = |n: usize| coords[n];
     for &(p, k, tau, friction) in &step.events.released {
         let pair = &interfaces.pairs[p];
         if !pair.options.release_conditions {

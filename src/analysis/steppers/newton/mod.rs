@@ -135,6 +135,52 @@ fn cycling(norms: &[f64]) -> bool {
         && norms[k - 2] > 0.5 * norms[k - 1]
 }
 
+/// The share of each Newton correction taken: 1, halved at each two-iterate cycle of the
+/// residual norms (`cycling`, theory 8.1-1).
+struct Relaxation {
+    /// The residual norms of the iterates.
+    norms: Vec<f64>,
+    share: f64,
+    /// The iterate from which the next cycle is looked for (the last halving's).
+    since: usize,
+}
+
+impl Relaxation {
+    fn new() -> Relaxation {
+        Relaxation {
+            norms: Vec::new(),
+            share: 1.0,
+            since: 0,
+        }
+    }
+
+    /// Takes an iterate's residual norm; halves the share when the norms since the last
+    /// halving cycle.
+    fn observe(&mut self, residual_norm: f64) {
+        self.norms.push(residual_norm);
+        if cycling(&self.norms[self.since..]) {
+            self.share *= 0.5;
+            self.since = self.norms.len();
+        }
+    }
+
+    /// A solve's correction `delta` (scaled in place) and multipliers `tau`, relaxed: the
+    /// multipliers moved the share of the way from `forces`, the ones before the solve.
+    fn relax(&self, delta: &mut [f64], forces: &[f64], tau: Vec<f64>) -> Vec<f64> {
+        if self.share >= 1.0 {
+            return tau;
+        }
+        delta.iter_mut().for_each(|v| *v *= self.share);
+        tau.iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let old = forces.get(i).copied().unwrap_or(0.0);
+                old + self.share * (t - old)
+            })
+            .collect()
+    }
+}
+
 /// A residual this share of the force tolerance is round-off: the step has converged.
 const ROUND_OFF: f64 = 1e-4;
 
@@ -294,11 +340,7 @@ impl Step<'_> {
         let mut eps_displacement = f64::INFINITY;
         // the remaining correction in absolute terms, for the error target
         let mut correction = f64::INFINITY;
-        // the residual norms of the iterates, and the share of each correction taken (1,
-        // halved at each two-iterate cycle: `cycling`)
-        let mut norms: Vec<f64> = Vec::new();
-        let mut relaxation = 1.0;
-        let mut relaxed_at = 0;
+        let mut relaxation = Relaxation::new();
         for iteration in 0..=newton.max_iterations {
             let refactor =
                 newton.strategy == Strategy::Full || (iteration == 0 && self.factor_first);
@@ -368,25 +410,9 @@ impl Step<'_> {
             } else if let (Some((s, start)), Some(now)) = (last.take(), &own) {
                 secant.learn(solver, s, &start, now);
             }
-            norms.push(residual_norm);
-            if cycling(&norms[relaxed_at..]) {
-                relaxation *= 0.5;
-                relaxed_at = norms.len();
-            }
+            relaxation.observe(residual_norm);
             let (mut delta, tau) = constrained_solve(solver, &rows, residual, &forces, &secant)?;
-            if relaxation < 1.0 {
-                delta.iter_mut().for_each(|v| *v *= relaxation);
-                forces = tau
-                    .iter()
-                    .enumerate()
-                    .map(|(i, t)| {
-                        let old = forces.get(i).copied().unwrap_or(0.0);
-                        old + relaxation * (t - old)
-                    })
-                    .collect();
-            } else {
-                forces = tau;
-            }
+            forces = relaxation.relax(&mut delta, &forces, tau);
             counters.iterations += 1;
             system.scatter_add(&delta, &mut d);
             let d_norm = norm(&d);
