@@ -45,7 +45,7 @@ pub fn prebuckling_state(model: &Model) -> Result<State, BucklingError> {
             model,
             &state,
             StepIncrement {
-                d: d,
+                d,
                 dt: f64::INFINITY,
                 geometry: Strain::Small,
             },

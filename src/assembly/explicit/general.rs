@@ -95,7 +95,7 @@ impl ExplicitKernel for General<'_> {
             &self.state,
             StepIncrement {
                 d: du,
-                dt: dt,
+                dt,
                 geometry: self.geometry,
             },
             None,

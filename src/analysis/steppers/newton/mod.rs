@@ -282,7 +282,7 @@ impl Step<'_> {
             self.model,
             state,
             StepIncrement {
-                d: d,
+                d,
                 dt: self.dt,
                 geometry: self.geometry,
             },
