@@ -485,7 +485,7 @@ impl ContactState {
             &step.forces,
             released,
             time,
-            &|n| coords[n],
+            coords,
             None,
         );
         for (i, (p, k)) in step.active.iter().enumerate() {
@@ -495,9 +495,9 @@ impl ContactState {
     }
 
     /// Sets the status: the active entries and their forces after a step ending at `time`
-    /// with the nodes at `x`. `lowest`: the lowest slave gap at `x` when the caller has just
-    /// computed every slave's gap there (Some(None): no slave has a master in reach); None
-    /// computes them.
+    /// with the nodes at `positions`. `lowest`: the lowest slave gap there when the caller
+    /// has just computed every slave's gap there (Some(None): no slave has a master in
+    /// reach); None computes them.
     pub(super) fn set(
         &mut self,
         interfaces: &Interfaces,
@@ -505,9 +505,10 @@ impl ContactState {
         forces: &[f64],
         released: bool,
         time: f64,
-        x: &dyn Fn(usize) -> [f64; 2],
+        positions: &[[f64; 2]],
         lowest: Option<Option<f64>>,
     ) {
+        let x = &|n: usize| positions[n];
         for flags in &mut self.active {
             flags.iter_mut().for_each(|a| *a = false);
         }
@@ -546,7 +547,8 @@ impl ContactState {
         }
         for pair in &interfaces.pairs {
             let boundary = &interfaces.bodies[pair.slave_body].boundary;
-            penetration = penetration.max(super::setup::master_penetration(pair, x, boundary));
+            penetration =
+                penetration.max(super::setup::master_penetration(pair, positions, boundary));
         }
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);

@@ -110,13 +110,14 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
     })
 }
 
-/// The deepest penetration of a deformable master's nodes into the slave body, whose
-/// boundary edges are `slave_boundary` (global ids): for each master node inside that
+/// The deepest penetration of a deformable master's nodes into the slave body at the node
+/// positions `x` (global numbering), whose boundary edges are `slave_boundary` (global
+/// ids): for each master node inside that
 /// boundary (an odd number of crossings of a ray), its distance to the nearest boundary edge.
 /// Zero when none is inside. Only master nodes within the slave boundary's bounding box are tested.
 pub fn master_penetration(
     pair: &ContactPair,
-    x: &dyn Fn(usize) -> [f64; 2],
+    x: &[[f64; 2]],
     slave_boundary: &[[usize; 2]],
 ) -> f64 {
     let Master::Segments { edges, .. } = &pair.master else {
@@ -125,27 +126,45 @@ pub fn master_penetration(
     if slave_boundary.is_empty() {
         return 0.0;
     }
-    let segments: Vec<[[f64; 2]; 2]> = slave_boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
-    // the bounding box by plain comparisons (a chain of `f64::min` is several instructions a
-    // point; the two differ only in the sign of a zero bound, which the tests below ignore)
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in segments.iter().flatten() {
-        for c in 0..2 {
-            if p[c] < lo[c] {
-                lo[c] = p[c];
-            }
-            if p[c] > hi[c] {
-                hi[c] = p[c];
-            }
+    let segments: Vec<[[f64; 2]; 2]> = slave_boundary.iter().map(|[a, b]| [x[*a], x[*b]]).collect();
+    // the bounding box by plain comparisons, the edges' start and end points in separate
+    // lanes (independent chains of minima; they differ from `f64::min` only in the sign of
+    // a zero bound, which the tests below ignore)
+    let (mut low, mut high) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
+    for [a, b] in &segments {
+        let lanes = [a[0], a[1], b[0], b[1]];
+        for j in 0..4 {
+            low[j] = if lanes[j] < low[j] { lanes[j] } else { low[j] };
+            high[j] = if lanes[j] > high[j] {
+                lanes[j]
+            } else {
+                high[j]
+            };
         }
     }
-    let scale = (0..2).map(|c| lo[c].abs().max(hi[c].abs())).fold(0.0, f64::max);
+    let lo: [f64; 2] = std::array::from_fn(|c| {
+        if low[c + 2] < low[c] {
+            low[c + 2]
+        } else {
+            low[c]
+        }
+    });
+    let hi: [f64; 2] = std::array::from_fn(|c| {
+        if high[c + 2] > high[c] {
+            high[c + 2]
+        } else {
+            high[c]
+        }
+    });
+    let scale = (0..2)
+        .map(|c| lo[c].abs().max(hi[c].abs()))
+        .fold(0.0, f64::max);
     let mut nodes: Vec<usize> = edges.iter().flatten().copied().collect();
     nodes.sort_unstable();
     nodes.dedup();
     let mut deepest = 0.0f64;
     for m in nodes {
-        let p = x(m);
+        let p = x[m];
         let boxed = (0..2).all(|c| p[c] > lo[c] && p[c] < hi[c]);
         if !boxed || !inside_by_crossings(p, segments.iter().copied()) {
             continue;
