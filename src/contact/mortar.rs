@@ -107,14 +107,18 @@ pub fn weighted_gap(
         let facing = outward(xa, xb);
         for [p, q] in master {
             let (xp, xq) = (x(*p), x(*q));
+            // the master's end points both before the slave segment's start (eta < 0) or
+            // both past its end (eta > 1): no overlap, told before a normal and the
+            // divisions (the overlap test below finds none either)
+            let (along_p, along_q) = (dot(sub(xp, xa), ab), dot(sub(xq, xa), ab));
+            if (along_p < 0.0 && along_q < 0.0) || (along_p > length2 && along_q > length2) {
+                continue;
+            }
             let across = outward(xp, xq);
             if dot(across, facing) >= 0.0 {
                 continue;
             }
-            let (eta_p, eta_q) = (
-                dot(sub(xp, xa), ab) / length2,
-                dot(sub(xq, xa), ab) / length2,
-            );
+            let (eta_p, eta_q) = (along_p / length2, along_q / length2);
             let low = eta_p.min(eta_q).max(0.0);
             let high = eta_p.max(eta_q).min(1.0);
             if !(high > low) || !within_reach(xa, ab, facing, [xp, xq], [eta_p, eta_q], [low, high])
