@@ -490,7 +490,7 @@ impl ContactState {
     ) {
         let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
         let rows = (&step.active[..], &step.forces[..]);
-        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
+        self.set(interfaces, rows, (time, released), coords, None);
         for (i, (p, k)) in step.active.iter().enumerate() {
             self.tangential[*p][*k] = step.tangential[i];
             self.sliding[*p][*k] = step.sliding[i];
@@ -498,17 +498,18 @@ impl ContactState {
     }
 
     /// Sets the status: the active entries and their forces (`(active, forces)`) after a step
-    /// ending at `time` (`released`: some entry let go in it) with the nodes at `x`.
-    /// `lowest`: the lowest slave gap at `x` when the caller has just computed every slave's
+    /// ending at `time` (`released`: some entry let go in it) with the nodes at `positions`.
+    /// `lowest`: the lowest slave gap there when the caller has just computed every slave's
     /// gap there (Some(None): no slave has a master in reach); None computes them.
     pub(super) fn set(
         &mut self,
         interfaces: &Interfaces,
         (active, forces): (&[(usize, usize)], &[f64]),
         (time, released): (f64, bool),
-        x: &dyn Fn(usize) -> [f64; 2],
+        positions: &[[f64; 2]],
         lowest: Option<Option<f64>>,
     ) {
+        let x = &|n: usize| positions[n];
         for flags in &mut self.active {
             flags.iter_mut().for_each(|a| *a = false);
         }
@@ -547,7 +548,8 @@ impl ContactState {
         }
         for pair in &interfaces.pairs {
             let boundary = &interfaces.bodies[pair.slave_body].boundary;
-            penetration = penetration.max(super::setup::master_penetration(pair, x, boundary));
+            penetration =
+                penetration.max(super::setup::master_penetration(pair, positions, boundary));
         }
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);

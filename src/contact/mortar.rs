@@ -59,27 +59,8 @@ pub fn weighted_gap(
     slave: usize,
     x: &dyn Fn(usize) -> [f64; 2],
 ) -> Option<Gap> {
-    // a surface node has at most two segments
-    let mut own = [[0usize; 2]; 2];
-    let mut count = 0;
-    for e in surface.edges.iter().filter(|e| e.contains(&slave)) {
-        if count == own.len() {
-            return None;
-        }
-        own[count] = *e;
-        count += 1;
-    }
+    let (own, count, slave_normal) = slave_side(surface, slave, x)?;
     let own = &own[..count];
-    let mut sum = [0.0; 2];
-    for [a, b] in own {
-        let n = outward(x(*a), x(*b));
-        sum = [sum[0] + n[0], sum[1] + n[1]];
-    }
-    let l = dot(sum, sum).sqrt();
-    if !(l > 0.0) {
-        return None;
-    }
-    let slave_normal = [-sum[0] / l, -sum[1] / l];
     let mut master_normal = [0.0; 2];
     let mut masters: Vec<(usize, f64)> = Vec::with_capacity(4);
     // D_jj over the whole support, and int Phi_j dA over the overlaps
@@ -107,14 +88,18 @@ pub fn weighted_gap(
         let facing = outward(xa, xb);
         for [p, q] in master {
             let (xp, xq) = (x(*p), x(*q));
+            // the master's end points both before the slave segment's start (eta < 0) or
+            // both past its end (eta > 1): no overlap, told before a normal and the
+            // divisions (the overlap test below finds none either)
+            let (along_p, along_q) = (dot(sub(xp, xa), ab), dot(sub(xq, xa), ab));
+            if (along_p < 0.0 && along_q < 0.0) || (along_p > length2 && along_q > length2) {
+                continue;
+            }
             let across = outward(xp, xq);
             if dot(across, facing) >= 0.0 {
                 continue;
             }
-            let (eta_p, eta_q) = (
-                dot(sub(xp, xa), ab) / length2,
-                dot(sub(xq, xa), ab) / length2,
-            );
+            let (eta_p, eta_q) = (along_p / length2, along_q / length2);
             let low = eta_p.min(eta_q).max(0.0);
             let high = eta_p.max(eta_q).min(1.0);
             if !(high > low)
@@ -170,6 +155,35 @@ pub fn weighted_gap(
         masters,
         weight: share,
     })
+}
+
+/// The slave node's segments (at most two: a surface node has no more) and their count, and
+/// the node's normal: minus the mean of its segments' outward normals. None for a node of
+/// more than two segments or of degenerate ones.
+fn slave_side(
+    surface: &MortarSurface,
+    slave: usize,
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> Option<([[usize; 2]; 2], usize, [f64; 2])> {
+    let mut own = [[0usize; 2]; 2];
+    let mut count = 0;
+    for e in surface.edges.iter().filter(|e| e.contains(&slave)) {
+        if count == own.len() {
+            return None;
+        }
+        own[count] = *e;
+        count += 1;
+    }
+    let mut sum = [0.0; 2];
+    for [a, b] in &own[..count] {
+        let n = outward(x(*a), x(*b));
+        sum = [sum[0] + n[0], sum[1] + n[1]];
+    }
+    let l = dot(sum, sum).sqrt();
+    if !(l > 0.0) {
+        return None;
+    }
+    Some((own, count, [-sum[0] / l, -sum[1] / l]))
 }
 
 /// Whether the master segment `master` (its end points' projections `etas` on the slave

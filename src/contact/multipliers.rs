@@ -26,18 +26,25 @@ pub(super) fn lumped_multipliers(
         }
         i
     }
-    let mut owner: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
-    for (i, row) in rows.iter().enumerate() {
-        for (dof, c) in row {
-            if *c == 0.0 {
-                continue;
-            }
-            if let Some(&j) = owner.get(dof) {
+    // (DOF, row) of the nonzero coefficients, sorted: each row joins the first row of its DOFs
+    let mut uses: Vec<(usize, usize)> = rows
+        .iter()
+        .enumerate()
+        .flat_map(|(i, row)| {
+            row.iter()
+                .filter(|(_, c)| *c != 0.0)
+                .map(move |(dof, _)| (*dof, i))
+        })
+        .collect();
+    uses.sort_unstable();
+    let mut owner: Option<(usize, usize)> = None;
+    for (dof, i) in uses {
+        match owner {
+            Some((d, j)) if d == dof => {
                 let (a, b) = (root(&mut parent, i), root(&mut parent, j));
                 parent[a] = b;
-            } else {
-                owner.insert(*dof, i);
             }
+            _ => owner = Some((dof, i)),
         }
     }
     let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();

@@ -110,13 +110,14 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
     })
 }
 
-/// The deepest penetration of a deformable master's nodes into the slave body, whose
-/// boundary edges are `slave_boundary` (global ids): for each master node inside that
+/// The deepest penetration of a deformable master's nodes into the slave body at the node
+/// positions `x` (global numbering), whose boundary edges are `slave_boundary` (global
+/// ids): for each master node inside that
 /// boundary (an odd number of crossings of a ray), its distance to the nearest boundary edge.
 /// Zero when none is inside. Only master nodes within the slave boundary's bounding box are tested.
 pub fn master_penetration(
     pair: &ContactPair,
-    x: &dyn Fn(usize) -> [f64; 2],
+    x: &[[f64; 2]],
     slave_boundary: &[[usize; 2]],
 ) -> f64 {
     let Master::Segments { edges, .. } = &pair.master else {
@@ -125,29 +126,71 @@ pub fn master_penetration(
     if slave_boundary.is_empty() {
         return 0.0;
     }
-    let segments: Vec<[[f64; 2]; 2]> = slave_boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in segments.iter().flatten() {
-        for c in 0..2 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
+    let segments: Vec<[[f64; 2]; 2]> = slave_boundary.iter().map(|[a, b]| [x[*a], x[*b]]).collect();
+    // the bounding box by plain comparisons, the edges' start and end points in separate
+    // lanes (independent chains of minima; they differ from `f64::min` only in the sign of
+    // a zero bound, which the tests below ignore)
+    let (mut low, mut high) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
+    for [a, b] in &segments {
+        let lanes = [a[0], a[1], b[0], b[1]];
+        for j in 0..4 {
+            low[j] = if lanes[j] < low[j] { lanes[j] } else { low[j] };
+            high[j] = if lanes[j] > high[j] {
+                lanes[j]
+            } else {
+                high[j]
+            };
         }
     }
+    let lo: [f64; 2] = std::array::from_fn(|c| {
+        if low[c + 2] < low[c] {
+            low[c + 2]
+        } else {
+            low[c]
+        }
+    });
+    let hi: [f64; 2] = std::array::from_fn(|c| {
+        if high[c + 2] > high[c] {
+            high[c + 2]
+        } else {
+            high[c]
+        }
+    });
+    let scale = (0..2)
+        .map(|c| lo[c].abs().max(hi[c].abs()))
+        .fold(0.0, f64::max);
     let mut nodes: Vec<usize> = edges.iter().flatten().copied().collect();
     nodes.sort_unstable();
     nodes.dedup();
     let mut deepest = 0.0f64;
     for m in nodes {
-        let p = x(m);
+        let p = x[m];
         let boxed = (0..2).all(|c| p[c] > lo[c] && p[c] < hi[c]);
         if !boxed || !inside_by_crossings(p, segments.iter().copied()) {
             continue;
         }
-        let depth = segments
-            .iter()
-            .map(|[a, b]| project(p, *a, *b).1)
-            .fold(f64::INFINITY, f64::min);
-        deepest = deepest.max(depth);
+        deepest = deepest.max(distance_to_nearest(p, &segments, scale));
     }
     deepest
+}
+
+/// The distance from `p` to the nearest of `segments` (coordinates up to `scale` in
+/// magnitude): the least `project` distance. A segment whose bounding box lies farther from
+/// `p` than the nearest distance so far cannot be nearer and is not projected; the margin
+/// of the skip covers the rounding of the projection (a few ulps of `scale`, far below
+/// 1e-12 of it), so the least distance is the one the projection of every segment gives.
+fn distance_to_nearest(p: [f64; 2], segments: &[[[f64; 2]; 2]], scale: f64) -> f64 {
+    let margin = 1e-12 * scale;
+    let mut nearest = f64::INFINITY;
+    for [a, b] in segments {
+        let outside = |lo: f64, hi: f64, v: f64| (lo - v).max(v - hi).max(0.0);
+        let bx = outside(a[0].min(b[0]), a[0].max(b[0]), p[0]);
+        let by = outside(a[1].min(b[1]), a[1].max(b[1]), p[1]);
+        let reach = nearest * (1.0 + 1e-9) + margin;
+        if bx * bx + by * by > reach * reach {
+            continue;
+        }
+        nearest = nearest.min(project(p, *a, *b).1);
+    }
+    nearest
 }
