@@ -46,7 +46,7 @@ fn stiffness(x: &Coords, bbar: bool, stress: [f64; 4]) -> Mat8 {
     let s = impact::element::Voigt::new(stress[0], stress[1], stress[2], stress[3]);
     quad4::tangent(
         &geom,
-        &quad4::Kinematics::new(&geom, &Vec8::zeros(), op(bbar)),
+        &quad4::StrainOperators::new(&geom, &Vec8::zeros(), op(bbar)),
         (&[s; 4], &[moduli(); 4]),
         op(bbar),
         GeometricStiffness::Included,
@@ -129,7 +129,7 @@ proptest! {
         let s_moved = impact::element::Voigt::new(r[0], r[1], r[2], r[3]);
         let geom_moved = quad4::values(&moved, Formulation::PlaneStrain, &[1.0; 4]).unwrap();
         let force = |geom: &quad4::QuadValues, d: &Vec8, s: impact::element::Voigt| {
-            quad4::internal_force(geom, &quad4::Kinematics::new(geom, d, op(bbar)), &[s; 4])
+            quad4::internal_force(geom, &quad4::StrainOperators::new(geom, d, op(bbar)), &[s; 4])
         };
         let f0 = force(&geom, &Vec8::zeros(), s0);
         let f_rigid = force(&geom, &d, s0);
@@ -210,7 +210,7 @@ proptest! {
         };
         let geom = quad4::values(&x, formulation, &[1.0; 4]).unwrap();
         let op = quad4::Operator { strain: Strain::Small, bbar };
-        let kin = quad4::Kinematics::new(&geom, &Vec8::zeros(), op);
+        let kin = quad4::StrainOperators::new(&geom, &Vec8::zeros(), op);
         let k = quad4::tangent(&geom, &kin, (&[impact::element::Voigt::zeros(); 4],
             &[elastic.moduli(condition); 4]), op, GeometricStiffness::Omitted);
         let m = quad4::mass(&geom);

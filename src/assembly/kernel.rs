@@ -148,11 +148,11 @@ impl Kernel {
                     strain: geometry,
                     bbar,
                 };
-                let kinematics = Points::new(&geom, &de, op, out.matrix.is_some());
+                let points = Points::new(&geom, &de, op, out.matrix.is_some());
                 if geometry == Strain::Finite {
-                    check_orientation(&kinematics.deformation())?;
+                    check_orientation(&points.deformation())?;
                 }
-                let strains = kinematics.strains();
+                let strains = points.strains();
                 let condition = StressCondition::of(formulation);
                 let context = UpdateContext { condition, dt };
                 let fine = crate::profile::fine_sample(e).then(Instant::now);
@@ -173,15 +173,15 @@ impl Kernel {
                 let stress = responses.map(|r| r.stress);
                 let start = &committed.points[4 * e..4 * e + 4];
                 let (work, plastic_work) = quad_work(&geom, start, &strains, &responses);
-                let force = kinematics.internal_force(&geom, &stress);
+                let force = points.internal_force(&geom, &stress);
                 out.force.copy_from_slice(force.as_slice());
-                if let (Some(m), Points::Operators(kinematics)) = (out.matrix, &kinematics) {
+                if let (Some(m), Points::Operators(operators)) = (out.matrix, &points) {
                     let moduli = if elastic_moduli {
                         [body.material.elastic.moduli(condition); 4]
                     } else {
                         responses.map(|r| r.moduli)
                     };
-                    let k = quad4::tangent(&geom, kinematics, (&stress, &moduli), op, geometric);
+                    let k = quad4::tangent(&geom, operators, (&stress, &moduli), op, geometric);
                     m.copy_from_slice(k.transpose().as_slice()); // row-major
                 }
                 for (t, r) in out.trial.iter_mut().zip(&responses) {
@@ -433,7 +433,7 @@ fn check_orientation(deformation: &[(Matrix2<f64>, f64); 4]) -> Result<(), Kerne
 /// boxed (a heap allocation an element would cost more than the unused bytes).
 #[allow(clippy::large_enum_variant)]
 enum Points {
-    Operators(quad4::Kinematics),
+    Operators(quad4::StrainOperators),
     Gradients(quad4::Gradients),
 }
 
@@ -443,7 +443,7 @@ impl Points {
     #[inline(always)]
     fn new(geom: &quad4::QuadValues, de: &Vec8, op: quad4::Operator, matrix: bool) -> Points {
         if matrix || op.bbar {
-            Points::Operators(quad4::Kinematics::new(geom, de, op))
+            Points::Operators(quad4::StrainOperators::new(geom, de, op))
         } else {
             Points::Gradients(quad4::Gradients::new(geom, de, op.strain))
         }

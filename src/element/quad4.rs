@@ -142,7 +142,7 @@ pub fn values(
     })
 }
 
-/// Kinematics of one point for a given increment d.
+/// The strains and strain operators of one point for a given increment d.
 struct PointStrain {
     /// [u,x u,y v,x v,y]
     theta: [f64; 4],
@@ -322,14 +322,14 @@ pub struct Operator {
 /// The four points' strains and strain operators of an increment, B-bar applied when the
 /// operator asks: computed once per element evaluation and shared by the strains, the
 /// internal force and the tangent.
-pub struct Kinematics {
+pub struct StrainOperators {
     points: [PointStrain; 4],
 }
 
-impl Kinematics {
+impl StrainOperators {
     #[inline]
-    pub fn new(geom: &QuadValues, d: &Vec8, op: Operator) -> Kinematics {
-        let mut kin = Kinematics {
+    pub fn new(geom: &QuadValues, d: &Vec8, op: Operator) -> StrainOperators {
+        let mut kin = StrainOperators {
             points: [PointStrain::ZERO; 4],
         };
         // filled in place: a map over the points copied the 1.3 kB array several times
@@ -384,7 +384,7 @@ fn trace(v: &Voigt) -> f64 {
 /// Green-Lagrange strain increments at the four Gauss points (zz = 0 in plane stress: the
 /// material decides it).
 pub fn strains(geom: &QuadValues, d: &Vec8, op: Operator) -> [Voigt; 4] {
-    Kinematics::new(geom, d, op).strains()
+    StrainOperators::new(geom, d, op).strains()
 }
 
 /// In-plane deformation gradient F = I + [[u,x u,y] [v,x v,y]] and the hoop stretch 1 + u/r
@@ -394,11 +394,11 @@ pub fn deformation(geom: &QuadValues, d: &Vec8) -> [(Matrix2<f64>, f64); 4] {
         strain: Strain::Finite,
         bbar: false,
     };
-    Kinematics::new(geom, d, op).deformation()
+    StrainOperators::new(geom, d, op).deformation()
 }
 
 /// Internal force f = sum_q w_q B_q^T S_q (Erklig eq 25).
-pub fn internal_force(geom: &QuadValues, kin: &Kinematics, stress: &[Voigt; 4]) -> Vec8 {
+pub fn internal_force(geom: &QuadValues, kin: &StrainOperators, stress: &[Voigt; 4]) -> Vec8 {
     let k = &kin.points;
     let mut f = Vec8::zeros();
     for q in 0..4 {
@@ -412,7 +412,7 @@ pub fn internal_force(geom: &QuadValues, kin: &Kinematics, stress: &[Voigt; 4]) 
 /// `geometric` includes it.
 pub fn tangent(
     geom: &QuadValues,
-    kin: &Kinematics,
+    kin: &StrainOperators,
     (stress, moduli): (&[Voigt; 4], &[Moduli; 4]),
     op: Operator,
     geometric: GeometricStiffness,
@@ -659,7 +659,7 @@ mod tests {
                 };
                 let stress = strains(&geom, &d, op).map(|e| stress_of(&e, &s0));
                 let with_operators =
-                    internal_force(&geom, &Kinematics::new(&geom, &d, op), &stress);
+                    internal_force(&geom, &StrainOperators::new(&geom, &d, op), &stress);
                 let from_gradients =
                     Gradients::new(&geom, &d, strain).internal_force(&geom, &stress);
                 let h = 1e-6;
@@ -705,13 +705,13 @@ mod tests {
                 let geom = values(&distorted(), form, &[0.7; 4]).unwrap();
                 let force = |d: &Vec8| {
                     let e = strains(&geom, d, op);
-                    let kin = Kinematics::new(&geom, d, op);
+                    let kin = StrainOperators::new(&geom, d, op);
                     internal_force(&geom, &kin, &e.map(|e| stress_of(&e, &s0)))
                 };
                 let e = strains(&geom, &d, op);
                 let kt = tangent(
                     &geom,
-                    &Kinematics::new(&geom, &d, op),
+                    &StrainOperators::new(&geom, &d, op),
                     (&e.map(|e| stress_of(&e, &s0)), &[moduli(); 4]),
                     op,
                     GeometricStiffness::Included,
