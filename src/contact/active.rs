@@ -8,7 +8,7 @@
 //! impact and release conditions (`conditions`).
 
 use super::conditions;
-use super::geometry::{ContactPair, Friction};
+use super::geometry::{ContactPair, Friction, Master};
 use super::search::{self, SlaveGap, slave_gaps};
 use super::{ContactSummary, Interfaces, Section};
 
@@ -41,6 +41,20 @@ pub struct ContactState {
     /// Per pair: closed at some step (empty in a checkpoint written before it was kept).
     #[serde(default)]
     pub ever_closed: Vec<bool>,
+    /// The explicit correction's master block after the last step: the master nodes of
+    /// mortar pairs held out of the slave body by a row of their own, and their normal
+    /// forces (`contact::explicit`). Empty on every other path.
+    #[serde(default)]
+    pub master_block: Vec<MasterEntry>,
+}
+
+/// A master node of a mortar pair held out of the slave body by its own row (the explicit
+/// correction's master block), with its reported normal force.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MasterEntry {
+    pub pair: usize,
+    pub node: usize,
+    pub force: f64,
 }
 
 /// What happened in a step, for the conditions and the bookkeeping.
@@ -198,6 +212,7 @@ impl ContactState {
             max_penetration: 0.0,
             penetration: 0.0,
             ever_closed: vec![false; pairs.len()],
+            master_block: Vec::new(),
         }
     }
 
@@ -534,7 +549,8 @@ impl ContactState {
         if released {
             self.last_release_time = Some(time);
         }
-        let total: f64 = forces.iter().sum();
+        let total: f64 =
+            forces.iter().sum::<f64>() + self.master_block.iter().map(|e| e.force).sum::<f64>();
         self.peak_force = self.peak_force.max(total);
         let lowest = lowest.unwrap_or_else(|| {
             slave_gaps(&interfaces.pairs, x, &|_, _| false)
@@ -584,9 +600,13 @@ impl ContactState {
         }
     }
 
-    /// Total normal force per pair.
+    /// Total normal force per pair (the slave entries' and the master block's).
     pub fn pair_forces(&self) -> Vec<f64> {
-        self.force.iter().map(|f| f.iter().sum()).collect()
+        let mut totals: Vec<f64> = self.force.iter().map(|f| f.iter().sum()).collect();
+        for entry in &self.master_block {
+            totals[entry.pair] += entry.force;
+        }
+        totals
     }
 
     /// Total tangential (friction) force along t per pair.
@@ -597,7 +617,21 @@ impl ContactState {
     /// Nodal contact forces (all DOFs) at positions `coords`: +tau n on slaves, -w tau n on
     /// master nodes.
     pub fn nodal_forces(&self, pairs: &[ContactPair], coords: &[[f64; 2]]) -> Vec<f64> {
-        self.nodal_forces_of(pairs, coords, &self.force, &self.tangential)
+        let mut f = self.nodal_forces_of(pairs, coords, &self.force, &self.tangential);
+        let x = |n: usize| coords[n];
+        for entry in &self.master_block {
+            let pair = &pairs[entry.pair];
+            let (Some(surface), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master)
+            else {
+                continue;
+            };
+            if let Some(gap) = super::mortar::master_node_gap(surface, edges, entry.node, &x) {
+                for (dof, c) in gap.row(entry.node) {
+                    f[dof] += entry.force * c;
+                }
+            }
+        }
+        f
     }
 
     /// As `nodal_forces`, with the normal forces `normal` and the tangential ones

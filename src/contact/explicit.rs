@@ -30,11 +30,17 @@
 //!             slide   lambda = -mu_f mu sign(T du)    where the stick value exceeds it
 //!           i.e. lambda = clamp(lambda_stick, -mu_f mu, mu_f mu), applied as M^-1 T^T lambda;
 //!           mu_f the pair's Coulomb coefficient
+//! C_m, nu   the master block of a mortar pair (`hold_master_nodes`, theory 8.3a-4): a master
+//!           node the weighted gaps let into the slave body beyond the allowance gets a row
+//!           of its own against the slave segment it faces (`mortar::master_node_gap`),
+//!           looked at once the slave rows have settled and then solved with them,
+//!           (C M^-1 C^T) [mu; nu] = -[g; g_m] over both; its impulse C_m^T nu joins J
 //! ```
 
 use super::Interfaces;
-use super::active::ContactState;
-use super::geometry::{Friction, Gap};
+use super::active::{ContactState, MasterEntry};
+use super::geometry::{COVERED, Friction, Gap, Master};
+use super::mortar::master_node_gap;
 use super::search::{SlaveGap, penetrates, slave_gaps};
 
 /// What an explicit contact step gives the driver.
@@ -99,6 +105,24 @@ impl ContactState {
             .zip(&c.in_active)
             .any(|(was, is)| was.iter().zip(is).any(|(was, is)| *was && !*is));
         let end = step.positions(&c.delta);
+        self.master_block = c
+            .masters
+            .iter()
+            .zip(&c.nu_total)
+            .map(|(&(pair, node), nu)| {
+                let closed = previous > 0.0
+                    && self
+                        .master_block
+                        .iter()
+                        .any(|e| (e.pair, e.node) == (pair, node));
+                let span = if closed { 0.5 * (previous + h) } else { h };
+                MasterEntry {
+                    pair,
+                    node,
+                    force: nu / (h * span),
+                }
+            })
+            .collect();
         let rows = (&c.active[..], &forces[..]);
         self.set(interfaces, rows, (time, released), &end, c.lowest);
         for (i, (p, k)) in c.active.iter().enumerate() {
@@ -109,8 +133,11 @@ impl ContactState {
                 self.sliding[*p][*k] = coulomb(*p).unwrap_or(0.0) * c.friction_total[i].signum();
             }
         }
-        let step_force =
+        let mut step_force =
             self.nodal_forces_of(&interfaces.pairs, start, &step_forces, &step_friction);
+        for (dof, impulse) in &c.master_impulse {
+            step_force[*dof] += impulse / (h * h);
+        }
         ExplicitContact {
             correction: c.delta,
             step_force,
@@ -148,6 +175,12 @@ struct Correction {
     /// When the passes settled: the lowest slave gap at the corrected positions (every
     /// slave's gap was computed there by the last pass; None inside: no master in reach).
     lowest: Option<Option<f64>>,
+    /// The master block of the mortar pairs: (pair, master node) entries held out of the
+    /// slave body, their accumulated multipliers, and the impulse C^T nu they applied as
+    /// (DOF, value) terms.
+    masters: Vec<(usize, usize)>,
+    nu_total: Vec<f64>,
+    master_impulse: Vec<(usize, f64)>,
 }
 
 impl Predicted<'_> {
@@ -183,22 +216,18 @@ impl Predicted<'_> {
             mu_total: Vec::new(),
             friction_total: Vec::new(),
             lowest: None,
+            masters: Vec::new(),
+            nu_total: Vec::new(),
+            master_impulse: Vec::new(),
         };
         let pairs = &interfaces.pairs;
+        let candidates = master_candidates(interfaces);
         for _ in 0..20 {
             // gaps at the corrected positions: the active entries', and the others', of
             // which the penetrated join (with the gap found)
+            let mut gaps = self.active_gaps(&mut c);
             let delta = &c.delta;
             let x = |node: usize| self.position(delta, node);
-            let mut gaps: Vec<Gap> = c
-                .active
-                .iter()
-                .map(|(p, k)| {
-                    pairs[*p]
-                        .gap(pairs[*p].slaves[*k], &x)
-                        .expect("found above")
-                })
-                .collect();
             let in_active = |p: usize, k: usize| c.in_active[p][k];
             let others: Vec<SlaveGap> = slave_gaps(pairs, &x, &in_active).collect();
             let lowest = others
@@ -226,13 +255,113 @@ impl Predicted<'_> {
                     coulomb(interfaces, *p).map(|_| g.tangent_row(interfaces.pairs[*p].slaves[*k]))
                 })
                 .collect();
-            if !changed && self.settled(&c, &gaps, &tangent_rows) {
+            // the master nodes are looked at once the slaves have settled: before, the
+            // pass is about to move them anyway
+            let slaves_settled = !changed && self.settled(&c, &gaps, &tangent_rows);
+            let looked_at = if slaves_settled { &candidates[..] } else { &[] };
+            let (master_gaps, masters_joined) = self.look_at_masters(&mut c, looked_at, &gaps);
+            if slaves_settled && !masters_joined && self.masters_settled(&c, &master_gaps) {
                 c.lowest = Some(lowest);
                 break;
             }
-            self.pass(&mut c, &gaps, &tangent_rows);
+            self.pass(&mut c, (&gaps, &master_gaps), &tangent_rows);
         }
         c
+    }
+
+    /// The gaps of the active entries at the corrected positions. An entry whose slave no
+    /// longer faces a master segment there (the master block moved it past a master's end)
+    /// leaves; its correction so far stays applied (there is no row to give it back along).
+    fn active_gaps(&self, c: &mut Correction) -> Vec<Gap> {
+        let pairs = &self.interfaces.pairs;
+        let delta = &c.delta;
+        let x = |node: usize| self.position(delta, node);
+        let gap = |(p, k): &(usize, usize)| pairs[*p].gap(pairs[*p].slaves[*k], &x);
+        if let Some(gaps) = c.active.iter().map(gap).collect::<Option<Vec<Gap>>>() {
+            return gaps;
+        }
+        let gaps: Vec<Option<Gap>> = c.active.iter().map(gap).collect();
+        for ((p, k), gap) in c.active.iter().zip(&gaps) {
+            if gap.is_none() {
+                c.in_active[*p][*k] = false;
+            }
+        }
+        let mut kept = gaps.iter().map(Option::is_some);
+        c.active.retain(|_| kept.next().expect("one gap per entry"));
+        let mut kept = gaps.iter().map(Option::is_some);
+        c.mu_total
+            .retain(|_| kept.next().expect("one gap per entry"));
+        let mut kept = gaps.iter().map(Option::is_some);
+        c.friction_total
+            .retain(|_| kept.next().expect("one gap per entry"));
+        gaps.into_iter().flatten().collect()
+    }
+
+    /// The master block at the corrected positions: the gaps of its entries (None: the
+    /// node faces no slave segment any more), and whether master nodes of the mortar pairs
+    /// (`candidates`, (pair, node)) found inside the slave body by more than TOL joined it.
+    /// A master node that an active slave row ties to itself (weight >= COVERED of the
+    /// slave's, `gaps` the active slaves' gaps: facing nodes of matching meshes) stays out:
+    /// its row would be that slave's row again.
+    fn look_at_masters(
+        &self,
+        c: &mut Correction,
+        candidates: &[(usize, usize)],
+        gaps: &[Gap],
+    ) -> (Vec<Option<Gap>>, bool) {
+        if candidates.is_empty() && c.masters.is_empty() {
+            return (Vec::new(), false);
+        }
+        let x = |node: usize| self.position(&c.delta, node);
+        let surface = |p: usize| {
+            let pair = &self.interfaces.pairs[p];
+            match (&pair.mortar, &pair.master) {
+                (Some(surface), Master::Segments { edges, .. }) => Some((surface, &edges[..])),
+                _ => None,
+            }
+        };
+        let mut master_gaps: Vec<Option<Gap>> = c
+            .masters
+            .iter()
+            .map(|(p, m)| {
+                let (surface, edges) = surface(*p)?;
+                master_node_gap(surface, edges, *m, &x)
+            })
+            .collect();
+        let tied = |p: usize, m: usize| {
+            c.active.iter().zip(gaps).any(|((q, _), g)| {
+                *q == p
+                    && g.masters
+                        .iter()
+                        .any(|(n, w)| *n == m && *w >= COVERED * g.weight)
+            })
+        };
+        let mut joined = false;
+        for &(p, m) in candidates {
+            if c.masters.contains(&(p, m)) || tied(p, m) {
+                continue;
+            }
+            let Some(gap) = surface(p).and_then(|(s, edges)| master_node_gap(s, edges, m, &x))
+            else {
+                continue;
+            };
+            if gap.gap < -self.interfaces.pairs[p].options.tolerance {
+                c.masters.push((p, m));
+                c.nu_total.push(0.0);
+                master_gaps.push(Some(gap));
+                joined = true;
+            }
+        }
+        (master_gaps, joined)
+    }
+
+    /// Whether the master block's gaps are within TOL.
+    fn masters_settled(&self, c: &Correction, master_gaps: &[Option<Gap>]) -> bool {
+        c.masters.iter().zip(master_gaps).all(|((p, _), g)| {
+            let tolerance = self.interfaces.pairs[*p].options.tolerance;
+            g.as_ref()
+                .is_some_and(|g| g.gap.abs() <= tolerance.max(f64::MIN_POSITIVE))
+        })
     }
 
     /// Whether the active entries' gaps are within TOL and the sticking entries' slips too
@@ -274,24 +403,39 @@ impl Predicted<'_> {
         worst <= 1.0 && slip_left <= 1.0
     }
 
-    /// One pass: the normal multipliers that close `gaps`, the friction return, and the
-    /// release of the entries left in tension (they give back their correction).
-    fn pass(&self, c: &mut Correction, gaps: &[Gap], tangent_rows: &[Option<Vec<(usize, f64)>>]) {
+    /// One pass: the normal multipliers that close `gaps` (the slaves', then the master
+    /// block's, solved together), the friction return, and the release of the entries left
+    /// in tension (they give back their correction).
+    fn pass(
+        &self,
+        c: &mut Correction,
+        (gaps, master_gaps): (&[Gap], &[Option<Gap>]),
+        tangent_rows: &[Option<Vec<(usize, f64)>>],
+    ) {
         let (interfaces, inverse_mass) = (self.interfaces, self.inverse_mass);
-        let rows: Vec<Vec<(usize, f64)>> = c
+        let master_gaps = self.drop_lost_masters(c, master_gaps);
+        let mut rows: Vec<Vec<(usize, f64)>> = c
             .active
             .iter()
             .zip(gaps)
             .map(|((p, k), g)| g.row(interfaces.pairs[*p].slaves[*k]))
             .collect();
-        let violations: Vec<f64> = gaps.iter().map(|g| g.gap).collect();
+        rows.extend(
+            c.masters
+                .iter()
+                .zip(&master_gaps)
+                .map(|((_, m), g)| g.row(*m)),
+        );
+        let violations: Vec<f64> = gaps.iter().chain(&master_gaps).map(|g| g.gap).collect();
         let mu = super::multipliers::lumped_multipliers(&rows, &violations, inverse_mass);
+        let (master_rows, master_mu) = (rows.split_off(gaps.len()), &mu[gaps.len()..]);
         for (i, row) in rows.iter().enumerate() {
             for (dof, coefficient) in row {
                 c.delta[*dof] += inverse_mass[*dof] * coefficient * mu[i];
             }
             c.mu_total[i] += mu[i];
         }
+        self.apply_masters(c, &master_rows, master_mu);
         // before the release below: an entry pulled off gets the cone of a zero normal
         // multiplier, so its friction is gone with it
         let coefficients: Vec<f64> = c
@@ -327,6 +471,62 @@ impl Predicted<'_> {
             .retain(|_| *flags.next().expect("one flag per entry"));
         c.mu_total.retain(|mu| *mu >= 0.0);
     }
+
+    /// The master block's entries that face no slave segment any more leave it (their
+    /// impulse so far stays applied: there is no row to give it back along); the gaps of the
+    /// others.
+    fn drop_lost_masters(&self, c: &mut Correction, master_gaps: &[Option<Gap>]) -> Vec<Gap> {
+        let mut flags = master_gaps.iter();
+        c.nu_total
+            .retain(|_| flags.next().expect("one gap per entry").is_some());
+        let mut flags = master_gaps.iter();
+        c.masters
+            .retain(|_| flags.next().expect("one gap per entry").is_some());
+        master_gaps.iter().flatten().cloned().collect()
+    }
+
+    /// The master block's share of a pass: the multipliers `nu` on its `rows` applied (the
+    /// impulse kept for the step force), then the entries pulled leave and give back their
+    /// correction.
+    fn apply_masters(&self, c: &mut Correction, rows: &[Vec<(usize, f64)>], nu: &[f64]) {
+        let inverse_mass = self.inverse_mass;
+        let mut apply = |row: &[(usize, f64)], value: f64| {
+            for (dof, coefficient) in row {
+                c.delta[*dof] += inverse_mass[*dof] * coefficient * value;
+                c.master_impulse.push((*dof, coefficient * value));
+            }
+        };
+        for (i, row) in rows.iter().enumerate() {
+            apply(row, nu[i]);
+            c.nu_total[i] += nu[i];
+        }
+        for (i, row) in rows.iter().enumerate() {
+            if c.nu_total[i] < 0.0 {
+                apply(row, -c.nu_total[i]);
+            }
+        }
+        let mut flags = c.nu_total.iter().map(|nu| *nu >= 0.0);
+        c.masters
+            .retain(|_| flags.next().expect("one multiplier per entry"));
+        c.nu_total.retain(|nu| *nu >= 0.0);
+    }
+}
+
+/// The master nodes of the mortar pairs on deformable masters, as (pair, node).
+fn master_candidates(interfaces: &Interfaces) -> Vec<(usize, usize)> {
+    let mut candidates = Vec::new();
+    for (p, pair) in interfaces.pairs.iter().enumerate() {
+        let (Some(surface), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master) else {
+            continue;
+        };
+        if surface.hold_master_nodes {
+            let start = candidates.len();
+            candidates.extend(edges.iter().flatten().map(|m| (p, *m)));
+            candidates[start..].sort_unstable();
+            candidates.dedup();
+        }
+    }
+    candidates
 }
 
 /// Coulomb's return of the tangential multipliers of the entries with friction (those with

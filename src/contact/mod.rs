@@ -37,7 +37,7 @@ pub mod setup;
 
 pub use active::{
     ConstrainedSolution, ContactResult, ContactState, Events, ImpactMotion, LumpedMass,
-    NodalStatus, Pass, Tangential, Unsettled, apply_conditions,
+    MasterEntry, NodalStatus, Pass, Tangential, Unsettled, apply_conditions,
 };
 pub use geometry::{
     ContactPair, Covered, Friction, Gap, Master, Obstacle, PairOptions, winding_number,

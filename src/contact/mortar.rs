@@ -43,6 +43,8 @@ pub struct MortarSurface {
     pub edges: Vec<[usize; 2]>,
     /// Surface integrals over the surface of revolution (weight 2 pi r).
     pub axisymmetric: bool,
+    /// The explicit correction holds the master nodes too (`master_node_gap`).
+    pub hold_master_nodes: bool,
 }
 
 /// The two-point Gauss rule on [0, 1]: positions and weights.
@@ -157,6 +159,89 @@ pub fn weighted_gap(
     })
 }
 
+/// How deep a master node may sit inside the slave body before its own row holds it, as a
+/// fraction of the length of the slave segment it faces: a quarter of the 1 % of a face
+/// element that a contact between two bodies is held to, so that a segment stretched twice
+/// (a Taylor foot's rim) still holds it within half. The mortar's weighted gaps are the
+/// discretization's constraint (stable, patch test passed); a row on every master node as
+/// well over-constrains a master finer than its slave (a steel block's 0.33 mm bottom on a
+/// 0.5 mm plate edge: an element of the plate inverted at 2.8 us with the allowance 0), so
+/// the master rows only cap how far the weighted sense lets a master node in.
+pub const MASTER_ALLOWANCE: f64 = 0.0025;
+
+/// The pointwise gap of master node `node` (its master edges among `master`) against the
+/// slave surface at positions `x`: its distance from the nearest slave segment it projects
+/// onto (positive outside the slave body) plus the allowance, `MASTER_ALLOWANCE` of that
+/// segment's length, as a `Gap` whose "masters" are that segment's two
+/// nodes, so that its row is n on the master node and -(1 - xi) n, -xi n on the segment's
+/// ends (equal and opposite). The normal n is the mean of the segment's outward normal and
+/// the master node's own inward one, as in the slave nodes' weighted gaps (on a plane of
+/// symmetry the plane's normal: either surface's own would push the bodies apart sideways
+/// where the surfaces curl). None when the node projects onto no slave segment within one
+/// segment length. The dual mortar holds the slave nodes' weighted gaps, not the master
+/// nodes: where the two surfaces fold at the rim of a contact zone a master node can sit
+/// inside the slave body while every weighted gap is closed (the explicit correction's
+/// master block, `explicit`).
+pub fn master_node_gap(
+    surface: &MortarSurface,
+    master: &[[usize; 2]],
+    node: usize,
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> Option<Gap> {
+    let p = x(node);
+    let mut nearest: Option<(f64, usize, f64)> = None;
+    for (e, [a, b]) in surface.edges.iter().enumerate() {
+        if *a == node || *b == node {
+            continue;
+        }
+        let (xa, xb) = (x(*a), x(*b));
+        let ab = sub(xb, xa);
+        let length2 = dot(ab, ab);
+        let along = dot(sub(p, xa), ab);
+        if !(length2 > 0.0 && along >= 0.0 && along <= length2) {
+            continue;
+        }
+        let xi = along / length2;
+        let on = [xa[0] + xi * ab[0], xa[1] + xi * ab[1]];
+        let distance = dot(sub(p, on), outward(xa, xb));
+        if distance * distance >= length2
+            || nearest.is_some_and(|(d, _, _)| d.abs() <= distance.abs())
+        {
+            continue;
+        }
+        nearest = Some((distance, e, xi));
+    }
+    let (_, e, xi) = nearest?;
+    let [a, b] = surface.edges[e];
+    let (xa, xb) = (x(a), x(b));
+    let slave_normal = outward(xa, xb);
+    let mut own = [0.0; 2];
+    for [q, r] in master.iter().filter(|edge| edge.contains(&node)) {
+        let n = outward(x(*q), x(*r));
+        own = [own[0] - n[0], own[1] - n[1]];
+    }
+    let lo = dot(own, own).sqrt();
+    let both = if lo > 0.0 {
+        [slave_normal[0] + own[0] / lo, slave_normal[1] + own[1] / lo]
+    } else {
+        slave_normal
+    };
+    let lb = dot(both, both).sqrt();
+    let normal = if lb > 0.0 {
+        [both[0] / lb, both[1] / lb]
+    } else {
+        slave_normal
+    };
+    let on = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
+    let allowance = MASTER_ALLOWANCE * dot(sub(xb, xa), sub(xb, xa)).sqrt();
+    Some(Gap {
+        gap: dot(sub(p, on), normal) + allowance,
+        normal,
+        masters: vec![(a, 1.0 - xi), (b, xi)],
+        weight: 1.0,
+    })
+}
+
 /// The slave node's segments (at most two: a surface node has no more) and their count, and
 /// the node's normal: minus the mean of its segments' outward normals. None for a node of
 /// more than two segments or of degenerate ones.
@@ -245,4 +330,55 @@ fn dual_shape(length: f64, area: &dyn Fn(f64) -> f64, local: usize) -> Option<([
         [-m[1][0] / det, m[0][0] / det],
     ][local];
     Some(([d * inverse_row[0], d * inverse_row[1]], d))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// Goal: a master node's own gap against the slave surface: the distance along the
+    /// slave segment's outward normal, negative inside the slave body, with the segment's
+    /// ends weighted by the projection (equal and opposite).
+    /// Reference: plane geometry (a flat slave surface along x, solid above).
+    #[test]
+    fn master_node_gap_is_the_distance_to_the_slave_segment() {
+        // slave edges 0 -> 1 -> 2 along +x: the solid is on their left (above), outward -y
+        let surface = MortarSurface {
+            edges: vec![[0, 1], [1, 2]],
+            axisymmetric: false,
+            hold_master_nodes: true,
+        };
+        // master node 3 on a master edge 4 -> 3 (solid below it: its own normal +y, the
+        // slave's outward -y, so their mean is the slave's)
+        let mut nodes = vec![
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [2.0, 0.0],
+            [0.25, 0.01],
+            [-0.75, 0.01],
+        ];
+        let master = [[3, 4]];
+        let x = |nodes: &Vec<[f64; 2]>| {
+            let nodes = nodes.clone();
+            move |n: usize| nodes[n]
+        };
+        let inside = master_node_gap(&surface, &master, 3, &x(&nodes)).expect("faces edge 0-1");
+        // 0.01 inside a segment of length 1, less the allowance
+        assert_relative_eq!(inside.gap, -0.01 + MASTER_ALLOWANCE, max_relative = 1e-12);
+        assert_eq!(inside.masters, vec![(0, 0.75), (1, 0.25)]);
+        let row = inside.row(3);
+        let sum_y: f64 = row.iter().filter(|(d, _)| d % 2 == 1).map(|(_, c)| c).sum();
+        assert!(sum_y.abs() < 1e-15, "equal and opposite: {row:?}");
+        nodes[3] = [1.5, -0.02];
+        nodes[4] = [0.5, -0.02];
+        let outside = master_node_gap(&surface, &master, 3, &x(&nodes)).expect("faces edge 1-2");
+        assert_relative_eq!(outside.gap, 0.02 + MASTER_ALLOWANCE, max_relative = 1e-12);
+        assert_eq!(outside.masters, vec![(1, 0.5), (2, 0.5)]);
+        // past the surface's end, or deeper than a segment length: no gap
+        nodes[3] = [2.5, 0.01];
+        assert!(master_node_gap(&surface, &master, 3, &x(&nodes)).is_none());
+        nodes[3] = [0.5, 1.5];
+        assert!(master_node_gap(&surface, &master, 3, &x(&nodes)).is_none());
+    }
 }

@@ -170,7 +170,17 @@ fn mortar_surface(
         ContactDiscretization::NodeToSegment
     };
     if spec.discretization.unwrap_or(default) != ContactDiscretization::Mortar {
+        if spec.hold_master_nodes.is_some() {
+            return Err(cx.err(format!(
+                "{key}.hold_master_nodes: only a mortar pair holds its master nodes (this pair is node-to-segment)"
+            )));
+        }
         return Ok(None);
+    }
+    if !explicit && spec.hold_master_nodes == Some(true) {
+        return Err(cx.err(format!(
+            "{key}.hold_master_nodes: the master nodes are held by the explicit correction (central difference) only; implicit mortar holds the weighted gaps"
+        )));
     }
     if !matches!(master, Master::Segments { .. }) {
         return Err(cx.err(format!(
@@ -200,6 +210,7 @@ fn mortar_surface(
     Ok(Some(MortarSurface {
         edges,
         axisymmetric,
+        hold_master_nodes: explicit && spec.hold_master_nodes.unwrap_or(true),
     }))
 }
 

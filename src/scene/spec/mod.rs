@@ -328,6 +328,11 @@ pub struct ContactSpec {
     /// node-to-segment crushes the master's corners at large strain), `node_to_segment`
     /// otherwise (implicit and static runs, obstacles, node-to-node, `two_pass`).
     pub discretization: Option<ContactDiscretization>,
+    /// Mortar pairs under central difference: a master node that the weighted gaps let into
+    /// the slave body deeper than 0.5 % of the slave segment it faces is held there by a row
+    /// of its own (where the surfaces fold at the rim of a contact zone). Default true under
+    /// central difference; implicit mortar holds the weighted gaps alone.
+    pub hold_master_nodes: Option<bool>,
 }
 
 /// How a contact pair's constraints are discretized.
