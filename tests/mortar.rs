@@ -309,7 +309,8 @@ fn pair_against_wall(
 /// `pair_against_wall`), energy balance no worse than the
 /// wall's (within 1e-3; measured 1.12 % both on 2x2: the arrest of the face nodes) and below
 /// 1.5 %, deepest penetration of either surface below 1 % of the
-/// 0.64 mm face element (measured 5e-10 m on 2x2, 2.5e-6 m one-point).
+/// 0.64 mm face element, pointwise (measured 5e-10 m on 2x2, 3.3e-6 m one-point: a slave
+/// node, `setup::slave_penetration`).
 #[test]
 fn rod_pair_on_explicit_and_implicit_paths_matches_the_wall() {
     pair_against_wall("pair_full", &[], None, 0.005, 0.01, 0);

@@ -566,6 +566,7 @@ impl ContactState {
             let boundary = &interfaces.bodies[pair.slave_body].boundary;
             penetration =
                 penetration.max(super::setup::master_penetration(pair, positions, boundary));
+            penetration = penetration.max(super::setup::slave_penetration(pair, positions));
         }
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);

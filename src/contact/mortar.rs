@@ -188,30 +188,8 @@ pub fn master_node_gap(
     node: usize,
     x: &dyn Fn(usize) -> [f64; 2],
 ) -> Option<Gap> {
+    let (_, e, xi) = nearest_projection(&surface.edges, node, x)?;
     let p = x(node);
-    let mut nearest: Option<(f64, usize, f64)> = None;
-    for (e, [a, b]) in surface.edges.iter().enumerate() {
-        if *a == node || *b == node {
-            continue;
-        }
-        let (xa, xb) = (x(*a), x(*b));
-        let ab = sub(xb, xa);
-        let length2 = dot(ab, ab);
-        let along = dot(sub(p, xa), ab);
-        if !(length2 > 0.0 && along >= 0.0 && along <= length2) {
-            continue;
-        }
-        let xi = along / length2;
-        let on = [xa[0] + xi * ab[0], xa[1] + xi * ab[1]];
-        let distance = dot(sub(p, on), outward(xa, xb));
-        if distance * distance >= length2
-            || nearest.is_some_and(|(d, _, _)| d.abs() <= distance.abs())
-        {
-            continue;
-        }
-        nearest = Some((distance, e, xi));
-    }
-    let (_, e, xi) = nearest?;
     let [a, b] = surface.edges[e];
     let (xa, xb) = (x(a), x(b));
     let slave_normal = outward(xa, xb);
@@ -240,6 +218,41 @@ pub fn master_node_gap(
         masters: vec![(a, 1.0 - xi), (b, xi)],
         weight: 1.0,
     })
+}
+
+/// The nearest of `edges` (solid on their left) that node `node` projects onto at positions
+/// `x`, within one edge length of it: (the node's signed distance along the edge's outward
+/// normal, negative inside; the edge's index; the projection's xi along it). None when it
+/// projects onto none (an edge through the node itself is skipped).
+pub fn nearest_projection(
+    edges: &[[usize; 2]],
+    node: usize,
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> Option<(f64, usize, f64)> {
+    let p = x(node);
+    let mut nearest: Option<(f64, usize, f64)> = None;
+    for (e, [a, b]) in edges.iter().enumerate() {
+        if *a == node || *b == node {
+            continue;
+        }
+        let (xa, xb) = (x(*a), x(*b));
+        let ab = sub(xb, xa);
+        let length2 = dot(ab, ab);
+        let along = dot(sub(p, xa), ab);
+        if !(length2 > 0.0 && along >= 0.0 && along <= length2) {
+            continue;
+        }
+        let xi = along / length2;
+        let on = [xa[0] + xi * ab[0], xa[1] + xi * ab[1]];
+        let distance = dot(sub(p, on), outward(xa, xb));
+        if distance * distance >= length2
+            || nearest.is_some_and(|(d, _, _)| d.abs() <= distance.abs())
+        {
+            continue;
+        }
+        nearest = Some((distance, e, xi));
+    }
+    nearest
 }
 
 /// The slave node's segments (at most two: a surface node has no more) and their count, and

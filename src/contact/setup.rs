@@ -123,6 +123,34 @@ pub fn master_penetration(
     let Master::Segments { edges, .. } = &pair.master else {
         return 0.0;
     };
+    let mut nodes: Vec<usize> = edges.iter().flatten().copied().collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    deepest_inside(&nodes, x, slave_boundary)
+}
+
+/// The deepest pointwise penetration of a mortar pair's slave nodes into the master body at
+/// the node positions `x`: each slave node's distance inside the nearest master segment it
+/// projects onto (`mortar::nearest_projection`), which the weighted gaps hold only on
+/// average over the slave segments. Zero for other pairs, whose slave gaps are pointwise
+/// already.
+pub fn slave_penetration(pair: &ContactPair, x: &[[f64; 2]]) -> f64 {
+    let (Some(_), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master) else {
+        return 0.0;
+    };
+    let x = |n: usize| x[n];
+    pair.slaves
+        .iter()
+        .filter_map(|s| super::mortar::nearest_projection(edges, *s, &x))
+        .fold(0.0, |deepest, (distance, _, _)| deepest.max(-distance))
+}
+
+/// The deepest of `nodes` inside the body of boundary edges `boundary` (global ids, at
+/// positions `x`): for each node inside (an odd number of crossings of a ray), its distance
+/// to the nearest boundary edge; zero when none is inside. Only nodes within the boundary's
+/// bounding box are tested.
+fn deepest_inside(nodes: &[usize], x: &[[f64; 2]], boundary: &[[usize; 2]]) -> f64 {
+    let slave_boundary = boundary;
     if slave_boundary.is_empty() {
         return 0.0;
     }
@@ -159,11 +187,8 @@ pub fn master_penetration(
     let scale = (0..2)
         .map(|c| lo[c].abs().max(hi[c].abs()))
         .fold(0.0, f64::max);
-    let mut nodes: Vec<usize> = edges.iter().flatten().copied().collect();
-    nodes.sort_unstable();
-    nodes.dedup();
     let mut deepest = 0.0f64;
-    for m in nodes {
+    for &m in nodes {
         let p = x[m];
         let boxed = (0..2).all(|c| p[c] > lo[c] && p[c] < hi[c]);
         if !boxed || !inside_by_crossings(p, segments.iter().copied()) {
