@@ -460,7 +460,7 @@ impl ContactState {
             self.active[p][k] = true;
             self.force[p][k] = 0.0;
             closed.push((p, k));
-            if pair.options.impact_conditions && pair.mortar.is_none() {
+            if pair.options.impact_conditions && !pair.joint_conditions() {
                 // the velocities before the impact are the previous step's
                 let previous = velocity.to_vec();
                 let mut force = 0.0;
@@ -468,28 +468,27 @@ impl ContactState {
                 self.force[p][k] = force.max(0.0);
             }
         }
-        // a mortar pair's rows share master nodes: their conditions are met together
-        for (p, pair) in interfaces.pairs.iter().enumerate() {
-            if !(pair.options.impact_conditions
-                && pair.mortar.is_some()
-                && closed.iter().any(|(q, _)| *q == p))
-            {
-                continue;
-            }
-            let entries: Vec<usize> = (0..pair.slaves.len())
-                .filter(|k| self.active[p][*k])
-                .collect();
-            let rows: Vec<Vec<(usize, f64)>> = entries
-                .iter()
-                .map(|k| {
-                    let s = pair.slaves[*k];
-                    pair.gap(s, &x).map_or_else(Vec::new, |g| g.row(s))
+        // the rows of the mortar pairs and their hold pairs share nodes: their conditions are
+        // met together
+        let joint = |p: usize| {
+            let pair = &interfaces.pairs[p];
+            pair.options.impact_conditions && pair.joint_conditions()
+        };
+        if closed.iter().any(|(q, _)| joint(*q)) {
+            let active = &self.active;
+            let entries: Vec<(usize, usize)> = (0..interfaces.pairs.len())
+                .filter(|p| joint(*p))
+                .flat_map(|p| {
+                    (0..interfaces.pairs[p].slaves.len())
+                        .filter(move |k| active[p][*k])
+                        .map(move |k| (p, k))
                 })
                 .collect();
-            let mut forces: Vec<f64> = entries.iter().map(|k| self.force[p][*k]).collect();
+            let rows = joint_rows(interfaces, &entries, &x);
+            let mut forces: Vec<f64> = entries.iter().map(|(p, k)| self.force[*p][*k]).collect();
             conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
-            for (k, f) in entries.iter().zip(forces) {
-                self.force[p][*k] = f;
+            for ((p, k), f) in entries.iter().zip(forces) {
+                self.force[*p][*k] = f;
             }
         }
         closed
@@ -626,7 +625,14 @@ impl ContactState {
             else {
                 continue;
             };
-            if let Some(gap) = super::mortar::master_node_gap(surface, edges, entry.node, &x) {
+            let gap = super::mortar::master_node_gap(
+                &surface.edges,
+                edges,
+                entry.node,
+                super::mortar::MASTER_ALLOWANCE,
+                &x,
+            );
+            if let Some(gap) = gap {
                 for (dof, c) in gap.row(entry.node) {
                     f[dof] += entry.force * c;
                 }
@@ -750,8 +756,8 @@ pub fn apply_conditions<S>(
     release_slaves(interfaces, step, coords, mass, &mut motion);
 }
 
-/// II-8 on the mortar pairs where an entry closed: all the pair's active rows at once (they
-/// share master nodes), their forces corrected.
+/// II-8 on the mortar pairs and their hold pairs where an entry closed: all their active
+/// rows at once (they share nodes), their forces corrected.
 fn impact_mortar_pairs<S>(
     interfaces: &Interfaces,
     step: &mut ContactResult<S>,
@@ -761,30 +767,40 @@ fn impact_mortar_pairs<S>(
 ) {
     let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
     let x = |n: usize| coords[n];
-    for (p, pair) in interfaces.pairs.iter().enumerate() {
-        if !(pair.options.impact_conditions
-            && pair.mortar.is_some()
-            && step.events.closed.iter().any(|(q, _)| *q == p))
-        {
-            continue;
-        }
-        // a mortar pair's rows share master nodes: their conditions are met together
-        let entries: Vec<usize> = (0..step.active.len())
-            .filter(|i| step.active[*i].0 == p)
-            .collect();
-        let rows: Vec<Vec<(usize, f64)>> = entries
-            .iter()
-            .map(|i| {
-                let s = pair.slaves[step.active[*i].1];
-                pair.gap(s, &x).map_or_else(Vec::new, |g| g.row(s))
-            })
-            .collect();
-        let mut forces: Vec<f64> = entries.iter().map(|i| step.forces[*i]).collect();
-        conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
-        for (i, f) in entries.iter().zip(forces) {
-            step.forces[*i] = f;
-        }
+    let joint = |p: usize| {
+        let pair = &interfaces.pairs[p];
+        pair.options.impact_conditions && pair.joint_conditions()
+    };
+    if !step.events.closed.iter().any(|(q, _)| joint(*q)) {
+        return;
     }
+    let entries: Vec<usize> = (0..step.active.len())
+        .filter(|i| joint(step.active[*i].0))
+        .collect();
+    let pairs: Vec<(usize, usize)> = entries.iter().map(|i| step.active[*i]).collect();
+    let rows = joint_rows(interfaces, &pairs, &x);
+    let mut forces: Vec<f64> = entries.iter().map(|i| step.forces[*i]).collect();
+    conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+    for (i, f) in entries.iter().zip(forces) {
+        step.forces[*i] = f;
+    }
+}
+
+/// The constraint rows of `entries` (pair, slave index) at positions `x` (an entry whose gap
+/// is gone: an empty row).
+fn joint_rows(
+    interfaces: &Interfaces,
+    entries: &[(usize, usize)],
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> Vec<Vec<(usize, f64)>> {
+    entries
+        .iter()
+        .map(|(p, k)| {
+            let pair = &interfaces.pairs[*p];
+            let s = pair.slaves[*k];
+            pair.gap(s, x).map_or_else(Vec::new, |g| g.row(s))
+        })
+        .collect()
 }
 
 /// II-8 on each closed entry of the other pairs, its force kept compressive and its
@@ -801,7 +817,7 @@ fn impact_slaves<S>(
     let x = |n: usize| coords[n];
     for &(p, k) in &step.events.closed {
         let pair = &interfaces.pairs[p];
-        if !pair.options.impact_conditions || pair.mortar.is_some() {
+        if !pair.options.impact_conditions || pair.joint_conditions() {
             continue;
         }
         let s = pair.slaves[k];
@@ -884,7 +900,7 @@ fn release_slaves<S>(
         let (ms, zs) = entry.slave_mass_and_impedance();
         // the impedance is positive for any node with a contact area (an axis node included)
         debug_assert!(zs > 0.0, "slave {s}: impedance {zs}");
-        if pair.mortar.is_some() {
+        if pair.joint_conditions() {
             let zm = entry.master().map_or(0.0, |side| side.impedance);
             let compliance = 1.0 / zs + if zm > 0.0 { 1.0 / zm } else { 0.0 };
             let rows = conditions::Released {

@@ -40,7 +40,7 @@
 use super::Interfaces;
 use super::active::{ContactState, MasterEntry};
 use super::geometry::{COVERED, Friction, Gap, Master};
-use super::mortar::master_node_gap;
+use super::mortar::{MASTER_ALLOWANCE, master_node_gap};
 use super::search::{SlaveGap, penetrates, slave_gaps};
 
 /// What an explicit contact step gives the driver.
@@ -325,7 +325,7 @@ impl Predicted<'_> {
             .iter()
             .map(|(p, m)| {
                 let (surface, edges) = surface(*p)?;
-                master_node_gap(surface, edges, *m, &x)
+                master_node_gap(&surface.edges, edges, *m, MASTER_ALLOWANCE, &x)
             })
             .collect();
         let tied = |p: usize, m: usize| {
@@ -341,7 +341,8 @@ impl Predicted<'_> {
             if c.masters.contains(&(p, m)) || tied(p, m) {
                 continue;
             }
-            let Some(gap) = surface(p).and_then(|(s, edges)| master_node_gap(s, edges, m, &x))
+            let Some(gap) = surface(p)
+                .and_then(|(s, edges)| master_node_gap(&s.edges, edges, m, MASTER_ALLOWANCE, &x))
             else {
                 continue;
             };

@@ -2,7 +2,7 @@
 //! Greco & Coda 2003, section 2). The solver owns the system; this file only says where the
 //! slaves are, how far from their masters, and along which direction (legend in `contact`).
 
-use super::mortar::{MortarSurface, weighted_gap};
+use super::mortar::{MortarSurface, master_node_gap, weighted_gap};
 use crate::mesh::plane::{dot, outward, sub};
 
 pub use super::gap::Gap;
@@ -113,6 +113,19 @@ pub struct ContactPair {
     /// Segment-to-segment (mortar) contact: the slave surface whose segments carry the
     /// weighted gaps (`mortar`); None: node-to-segment, the slave node against the master.
     pub mortar: Option<MortarSurface>,
+    /// The hold pair of a mortar pair on the implicit paths (`NAME:held`): its slaves are
+    /// the mortar pair's master nodes and its master the mortar pair's slave surface, and a
+    /// slave's gap is `mortar::master_node_gap` (docs/theory.md 8.3a-4). None otherwise.
+    pub holds: Option<Holds>,
+}
+
+/// See [`ContactPair::holds`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Holds {
+    /// The mortar pair held.
+    pub pair: usize,
+    /// Its master edges (the nodes' own normals).
+    pub master_edges: Vec<[usize; 2]>,
 }
 
 /// See [`ContactPair::covered`].
@@ -249,6 +262,13 @@ fn gap_to_segments(
 }
 
 impl ContactPair {
+    /// Whether the pair's impact and release conditions act along its rows, all of them
+    /// together (a mortar pair and its hold pair: rows that share master nodes), rather than
+    /// node by node (Hughes II-8, II-11).
+    pub fn joint_conditions(&self) -> bool {
+        self.mortar.is_some() || self.holds.is_some()
+    }
+
     /// Whether a slave at `gap` is left to the first pass of a two-pass contact (see
     /// [`ContactPair::covered`]): its nearest master point lies on a first-pass slave that
     /// is closed (`closed(pair, index)`) or touches or penetrates its own master at `x`. Such
@@ -281,8 +301,12 @@ impl ContactPair {
     /// The gap of slave node `slave` at positions `x` (global node -> position), or None
     /// when there is no master within the search distance.
     pub fn gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
-        match (&self.mortar, &self.master) {
-            (Some(surface), Master::Segments { edges, .. }) => {
+        match (&self.mortar, &self.holds, &self.master) {
+            (_, Some(holds), Master::Segments { edges, .. }) => {
+                master_node_gap(edges, &holds.master_edges, slave, 0.0, x)
+                    .filter(|g| g.gap <= self.options.search_distance)
+            }
+            (Some(surface), _, Master::Segments { edges, .. }) => {
                 weighted_gap(surface, edges, slave, x)
                     .filter(|g| g.gap <= self.options.search_distance)
             }
@@ -508,6 +532,7 @@ pub(super) mod tests {
             options: options(),
             covered: None,
             mortar: None,
+            holds: None,
         }
     }
 

@@ -160,8 +160,9 @@ impl ContactPair {
         let Master::Segments { edges, .. } = &self.master else {
             return None;
         };
-        if self.mortar.is_some() {
-            // a weighted gap: its row is the frozen-geometry derivative
+        if self.joint_conditions() {
+            // a weighted gap, or a held master node's: its row is the frozen-geometry
+            // derivative
             return None;
         }
         let [(a, _), (b, xi)] = gap.masters[..] else {

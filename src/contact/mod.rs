@@ -40,7 +40,7 @@ pub use active::{
     MasterEntry, NodalStatus, Pass, Tangential, Unsettled, apply_conditions,
 };
 pub use geometry::{
-    ContactPair, Covered, Friction, Gap, Master, Obstacle, PairOptions, winding_number,
+    ContactPair, Covered, Friction, Gap, Holds, Master, Obstacle, PairOptions, winding_number,
 };
 pub use mortar::MortarSurface;
 pub use search::{SlaveGap, penetration_limits, runaway_penetration, slave_gaps};

@@ -170,9 +170,9 @@ pub fn weighted_gap(
 pub const MASTER_ALLOWANCE: f64 = 0.0025;
 
 /// The pointwise gap of master node `node` (its master edges among `master`) against the
-/// slave surface at positions `x`: its distance from the nearest slave segment it projects
-/// onto (positive outside the slave body) plus the allowance, `MASTER_ALLOWANCE` of that
-/// segment's length, as a `Gap` whose "masters" are that segment's two
+/// slave surface `slave_edges` at positions `x`: its distance from the nearest slave segment
+/// it projects onto (positive outside the slave body) plus `allowance` times that segment's
+/// length (`MASTER_ALLOWANCE` on the explicit path, 0 on the implicit), as a `Gap` whose "masters" are that segment's two
 /// nodes, so that its row is n on the master node and -(1 - xi) n, -xi n on the segment's
 /// ends (equal and opposite). The normal n is the mean of the segment's outward normal and
 /// the master node's own inward one, as in the slave nodes' weighted gaps (on a plane of
@@ -183,14 +183,15 @@ pub const MASTER_ALLOWANCE: f64 = 0.0025;
 /// inside the slave body while every weighted gap is closed (the explicit correction's
 /// master block, `explicit`).
 pub fn master_node_gap(
-    surface: &MortarSurface,
+    slave_edges: &[[usize; 2]],
     master: &[[usize; 2]],
     node: usize,
+    allowance: f64,
     x: &dyn Fn(usize) -> [f64; 2],
 ) -> Option<Gap> {
-    let (_, e, xi) = nearest_projection(&surface.edges, node, x)?;
+    let (_, e, xi) = nearest_projection(slave_edges, node, x)?;
     let p = x(node);
-    let [a, b] = surface.edges[e];
+    let [a, b] = slave_edges[e];
     let (xa, xb) = (x(a), x(b));
     let slave_normal = outward(xa, xb);
     let mut own = [0.0; 2];
@@ -211,7 +212,7 @@ pub fn master_node_gap(
         slave_normal
     };
     let on = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
-    let allowance = MASTER_ALLOWANCE * dot(sub(xb, xa), sub(xb, xa)).sqrt();
+    let allowance = allowance * dot(sub(xb, xa), sub(xb, xa)).sqrt();
     Some(Gap {
         gap: dot(sub(p, on), normal) + allowance,
         normal,
@@ -376,7 +377,8 @@ mod tests {
             let nodes = nodes.clone();
             move |n: usize| nodes[n]
         };
-        let inside = master_node_gap(&surface, &master, 3, &x(&nodes)).expect("faces edge 0-1");
+        let inside = master_node_gap(&surface.edges, &master, 3, MASTER_ALLOWANCE, &x(&nodes))
+            .expect("faces edge 0-1");
         // 0.01 inside a segment of length 1, less the allowance
         assert_relative_eq!(inside.gap, -0.01 + MASTER_ALLOWANCE, max_relative = 1e-12);
         assert_eq!(inside.masters, vec![(0, 0.75), (1, 0.25)]);
@@ -385,13 +387,18 @@ mod tests {
         assert!(sum_y.abs() < 1e-15, "equal and opposite: {row:?}");
         nodes[3] = [1.5, -0.02];
         nodes[4] = [0.5, -0.02];
-        let outside = master_node_gap(&surface, &master, 3, &x(&nodes)).expect("faces edge 1-2");
+        let outside = master_node_gap(&surface.edges, &master, 3, MASTER_ALLOWANCE, &x(&nodes))
+            .expect("faces edge 1-2");
         assert_relative_eq!(outside.gap, 0.02 + MASTER_ALLOWANCE, max_relative = 1e-12);
         assert_eq!(outside.masters, vec![(1, 0.5), (2, 0.5)]);
         // past the surface's end, or deeper than a segment length: no gap
         nodes[3] = [2.5, 0.01];
-        assert!(master_node_gap(&surface, &master, 3, &x(&nodes)).is_none());
+        assert!(
+            master_node_gap(&surface.edges, &master, 3, MASTER_ALLOWANCE, &x(&nodes)).is_none()
+        );
         nodes[3] = [0.5, 1.5];
-        assert!(master_node_gap(&surface, &master, 3, &x(&nodes)).is_none());
+        assert!(
+            master_node_gap(&surface.edges, &master, 3, MASTER_ALLOWANCE, &x(&nodes)).is_none()
+        );
     }
 }

@@ -5,9 +5,11 @@
 use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
 use super::model::{Body, BodyKind};
-use super::spec::{ContactDiscretization, ContactSpec, IntegratorKind, Scene, SurfaceSpec};
+use super::spec::{
+    AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Scene, SurfaceSpec,
+};
 use crate::contact::{
-    ContactPair, Covered, Friction, Master, MortarSurface, Obstacle, PairOptions, setup,
+    ContactPair, Covered, Friction, Holds, Master, MortarSurface, Obstacle, PairOptions, setup,
 };
 use crate::element::Formulation;
 use crate::mesh::Cells;
@@ -30,6 +32,14 @@ pub(super) fn contacts(
         if spec.two_pass {
             let reverse = reverse_pair(cx, bodies, k, spec, &contacts[k])?;
             contacts.push(reverse);
+        }
+        let held = contacts[k]
+            .mortar
+            .as_ref()
+            .is_some_and(|surface| surface.hold_master_nodes);
+        if held && implicit_dynamics(scene) {
+            let hold = hold_pair(cx, bodies, k, spec, &contacts[k])?;
+            contacts.push(hold);
         }
     }
     if let Some(k) =
@@ -147,6 +157,7 @@ fn contact(
         },
         covered: None,
         mortar,
+        holds: None,
     })
 }
 
@@ -177,11 +188,6 @@ fn mortar_surface(
         }
         return Ok(None);
     }
-    if !explicit && spec.hold_master_nodes == Some(true) {
-        return Err(cx.err(format!(
-            "{key}.hold_master_nodes: the master nodes are held by the explicit correction (central difference) only; implicit mortar holds the weighted gaps"
-        )));
-    }
     if !matches!(master, Master::Segments { .. }) {
         return Err(cx.err(format!(
             "{key}.discretization: mortar contact needs a master edge set on a body (an obstacle or a node-to-node master has no segments to weigh against); use node_to_segment"
@@ -210,7 +216,7 @@ fn mortar_surface(
     Ok(Some(MortarSurface {
         edges,
         axisymmetric,
-        hold_master_nodes: explicit && spec.hold_master_nodes.unwrap_or(true),
+        hold_master_nodes: spec.hold_master_nodes.unwrap_or(true),
     }))
 }
 
@@ -218,6 +224,42 @@ fn mortar_surface(
 /// between two bodies depends on it).
 fn explicit(scene: &Scene) -> bool {
     scene.analysis.integrator == Some(IntegratorKind::CentralDifference)
+}
+
+/// Whether the scene steps with an implicit integrator (where a mortar pair's master nodes
+/// are held by a hold pair; under central difference the explicit correction holds them,
+/// and statics does not: on a block dragged across another with friction the hold of the
+/// base's nodes the slider's corner passes over stopped Newton's iteration at t = 1.29).
+fn implicit_dynamics(scene: &Scene) -> bool {
+    scene.analysis.kind == AnalysisKind::Dynamic && !explicit(scene)
+}
+
+/// The hold pair of mortar pair `k` on the implicit paths (docs/theory.md 8.3a-4), named
+/// `NAME:held`: the mortar pair's master nodes as slaves of its slave surface, each with the
+/// gap of `mortar::master_node_gap`, so that a master node cannot sink into the slave body
+/// where the weighted gaps let it. A master node whose nearest slave point is a slave node in
+/// contact is left to the mortar pair (two-pass's `covered` rule: the two rows would be one).
+/// Frictionless, with the mortar pair's other options.
+fn hold_pair(
+    cx: &Context,
+    bodies: &[Body],
+    k: usize,
+    spec: &ContactSpec,
+    pair: &ContactPair,
+) -> Result<ContactPair, InputError> {
+    let mut hold = reverse_pair(cx, bodies, k, spec, pair)?;
+    let Master::Segments { edges, .. } = &pair.master else {
+        unreachable!("a mortar pair's master is an edge set");
+    };
+    hold.name = format!("{}:held", pair.name);
+    // frictionless: the mortar pair's rows carry the friction; a second tangential row at
+    // the same nodes would count it twice
+    hold.options.friction = Friction::None;
+    hold.holds = Some(Holds {
+        pair: k,
+        master_edges: edges.clone(),
+    });
+    Ok(hold)
 }
 
 /// The second pair of a two-pass contact: the master surface's nodes as slaves of the slave
@@ -263,6 +305,7 @@ fn reverse_pair(
         },
         options: pair.options.clone(),
         mortar: None,
+        holds: None,
         covered: Some(Covered {
             pair: k,
             slaves: {

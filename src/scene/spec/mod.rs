@@ -328,10 +328,11 @@ pub struct ContactSpec {
     /// node-to-segment crushes the master's corners at large strain), `node_to_segment`
     /// otherwise (implicit and static runs, obstacles, node-to-node, `two_pass`).
     pub discretization: Option<ContactDiscretization>,
-    /// Mortar pairs under central difference: a master node that the weighted gaps let into
-    /// the slave body deeper than 0.5 % of the slave segment it faces is held there by a row
-    /// of its own (where the surfaces fold at the rim of a contact zone). Default true under
-    /// central difference; implicit mortar holds the weighted gaps alone.
+    /// Mortar pairs in dynamics: a master node that the weighted gaps let into the slave body
+    /// is held out by a row of its own (where the surfaces fold at the rim of a contact zone):
+    /// under central difference in the explicit correction, beyond 0.25 % of the slave
+    /// segment it faces; with the implicit integrators by a hold pair `NAME:held` (its own
+    /// history column). Statics holds the weighted gaps alone. Default true.
     pub hold_master_nodes: Option<bool>,
 }
 
