@@ -339,8 +339,12 @@ fn rod_pair_on_explicit_and_implicit_paths_matches_the_wall() {
 /// on 2x2, 3.5e-6 m one-point: 0.74 % and 0.77 %; 7.1e-6 and 2.0e-5 m, 1.6 % and 4.3 %,
 /// before the explicit correction held the master nodes too: where the faces fold at the
 /// rim a master node sat inside the slave body with every weighted gap closed). With the
-/// coarser surface as the slave the master's extra nodes zigzag into it (6.8e-5 m on 2x2
-/// before the master block) and the run warns. Implicit Newmark: `rod_pair_with_non_matching_meshes_on_newmark_matches_the_wall`.
+/// coarser surface as the slave (the lower rod 7 x 70, the master) the master's extra nodes
+/// zigzagged into it before the master block (6.8e-5 m on 2x2) and the run warned; held,
+/// 7.1e-6 m on 2x2 (1.11 % of its 0.64 mm face element) and on one-point 3.8e-6 m (0.59 %)
+/// with L_f +0.26 / -0.10 % and D_f -0.45 / +0.04 %: on the one-point kernel that role order
+/// meets every one of the 1 % bands (the last case, asserted at them). Implicit
+/// Newmark: `rod_pair_with_non_matching_meshes_on_newmark_matches_the_wall`.
 #[test]
 fn rod_pair_with_non_matching_meshes_matches_the_wall() {
     let upper = ["body.upper.mesh.nx=7", "body.upper.mesh.ny=70"];
@@ -366,6 +370,18 @@ fn rod_pair_with_non_matching_meshes_matches_the_wall() {
             0,
         );
     }
+    pair_against_wall(
+        "pair_nonmatching_reduced_coarse_slave",
+        &[
+            "analysis.quadrature=reduced",
+            "body.lower.mesh.nx=7",
+            "body.lower.mesh.ny=70",
+        ],
+        Some(&["body.upper.mesh.nx=7", "body.upper.mesh.ny=70"]),
+        0.01,
+        0.01,
+        0,
+    );
 }
 
 /// Goal: the rod pair with non-matching meshes on implicit Newmark (average acceleration,
