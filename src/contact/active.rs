@@ -470,10 +470,7 @@ impl ContactState {
         }
         // the rows of the mortar pairs and their hold pairs share nodes: their conditions are
         // met together
-        let joint = |p: usize| {
-            let pair = &interfaces.pairs[p];
-            pair.options.impact_conditions && pair.joint_conditions()
-        };
+        let joint = |p: usize| met_together(interfaces, p);
         if closed.iter().any(|(q, _)| joint(*q)) {
             let active = &self.active;
             let entries: Vec<(usize, usize)> = (0..interfaces.pairs.len())
@@ -767,10 +764,7 @@ fn impact_mortar_pairs<S>(
 ) {
     let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
     let x = |n: usize| coords[n];
-    let joint = |p: usize| {
-        let pair = &interfaces.pairs[p];
-        pair.options.impact_conditions && pair.joint_conditions()
-    };
+    let joint = |p: usize| met_together(interfaces, p);
     if !step.events.closed.iter().any(|(q, _)| joint(*q)) {
         return;
     }
@@ -784,6 +778,13 @@ fn impact_mortar_pairs<S>(
     for (i, f) in entries.iter().zip(forces) {
         step.forces[*i] = f;
     }
+}
+
+/// Whether pair `p` takes impact conditions, met together with the other such pairs' rows
+/// (`ContactPair::joint_conditions`).
+fn met_together(interfaces: &Interfaces, p: usize) -> bool {
+    let pair = &interfaces.pairs[p];
+    pair.options.impact_conditions && pair.joint_conditions()
 }
 
 /// The constraint rows of `entries` (pair, slave index) at positions `x` (an entry whose gap

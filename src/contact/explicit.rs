@@ -48,8 +48,9 @@ pub struct ExplicitContact {
     /// The correction delta of the predicted increment (all DOFs).
     pub correction: Vec<f64>,
     /// The nodal forces f_step = (C^T mu + T^T lambda) / h^2 on the rows at the start
-    /// positions (all DOFs): what does the step's contact work on its corrected increment
-    /// (the friction's share is the work it dissipates).
+    /// positions, plus the master block's impulse C_m^T nu / h^2 as it was applied (all
+    /// DOFs): what does the step's contact work on its corrected increment (the friction's
+    /// share is the work it dissipates).
     pub step_force: Vec<f64>,
 }
 

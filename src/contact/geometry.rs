@@ -122,9 +122,8 @@ pub struct ContactPair {
 /// See [`ContactPair::holds`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Holds {
-    /// The mortar pair held.
-    pub pair: usize,
-    /// Its master edges (the nodes' own normals).
+    /// The held mortar pair's master edges (the nodes' own normals); the pair itself is the
+    /// first pass of `ContactPair::covered`.
     pub master_edges: Vec<[usize; 2]>,
 }
 

@@ -256,7 +256,6 @@ fn hold_pair(
     // the same nodes would count it twice
     hold.options.friction = Friction::None;
     hold.holds = Some(Holds {
-        pair: k,
         master_edges: edges.clone(),
     });
     Ok(hold)
