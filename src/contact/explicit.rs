@@ -287,14 +287,10 @@ impl Predicted<'_> {
                 c.in_active[*p][*k] = false;
             }
         }
-        let mut kept = gaps.iter().map(Option::is_some);
-        c.active.retain(|_| kept.next().expect("one gap per entry"));
-        let mut kept = gaps.iter().map(Option::is_some);
-        c.mu_total
-            .retain(|_| kept.next().expect("one gap per entry"));
-        let mut kept = gaps.iter().map(Option::is_some);
-        c.friction_total
-            .retain(|_| kept.next().expect("one gap per entry"));
+        let kept: Vec<bool> = gaps.iter().map(Option::is_some).collect();
+        keep(&mut c.active, &kept);
+        keep(&mut c.mu_total, &kept);
+        keep(&mut c.friction_total, &kept);
         gaps.into_iter().flatten().collect()
     }
 
@@ -465,25 +461,18 @@ impl Predicted<'_> {
             }
         }
         let kept: Vec<bool> = c.mu_total.iter().map(|mu| *mu >= 0.0).collect();
-        let mut flags = kept.iter();
-        c.active
-            .retain(|_| *flags.next().expect("one flag per entry"));
-        let mut flags = kept.iter();
-        c.friction_total
-            .retain(|_| *flags.next().expect("one flag per entry"));
-        c.mu_total.retain(|mu| *mu >= 0.0);
+        keep(&mut c.active, &kept);
+        keep(&mut c.friction_total, &kept);
+        keep(&mut c.mu_total, &kept);
     }
 
     /// The master block's entries that face no slave segment any more leave it (their
     /// impulse so far stays applied: there is no row to give it back along); the gaps of the
     /// others.
     fn drop_lost_masters(&self, c: &mut Correction, master_gaps: &[Option<Gap>]) -> Vec<Gap> {
-        let mut flags = master_gaps.iter();
-        c.nu_total
-            .retain(|_| flags.next().expect("one gap per entry").is_some());
-        let mut flags = master_gaps.iter();
-        c.masters
-            .retain(|_| flags.next().expect("one gap per entry").is_some());
+        let kept: Vec<bool> = master_gaps.iter().map(Option::is_some).collect();
+        keep(&mut c.nu_total, &kept);
+        keep(&mut c.masters, &kept);
         master_gaps.iter().flatten().cloned().collect()
     }
 
@@ -507,11 +496,16 @@ impl Predicted<'_> {
                 apply(row, -c.nu_total[i]);
             }
         }
-        let mut flags = c.nu_total.iter().map(|nu| *nu >= 0.0);
-        c.masters
-            .retain(|_| flags.next().expect("one multiplier per entry"));
-        c.nu_total.retain(|nu| *nu >= 0.0);
+        let kept: Vec<bool> = c.nu_total.iter().map(|nu| *nu >= 0.0).collect();
+        keep(&mut c.masters, &kept);
+        keep(&mut c.nu_total, &kept);
     }
+}
+
+/// Keeps the entries of `items` whose flag in `kept` (one per entry, in order) is set.
+fn keep<T>(items: &mut Vec<T>, kept: &[bool]) {
+    let mut flags = kept.iter();
+    items.retain(|_| *flags.next().expect("one flag per entry"));
 }
 
 /// The master nodes of the mortar pairs on deformable masters, as (pair, node).
