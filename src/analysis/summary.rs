@@ -107,6 +107,21 @@ pub struct MassScalingSummary {
     pub bodies: Vec<BodyMassScaling>,
 }
 
+/// summary.json `subcycling` (only with `analysis.subcycling`; docs/theory.md 8.7c): the
+/// substeps of the finest level, the element steps taken and what stepping every element at
+/// every substep would have taken, the levels of the last major step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SubcyclingSummary {
+    pub substeps: u64,
+    pub element_updates: u64,
+    /// elements x substeps.
+    pub single_step_updates: u64,
+    /// The largest level of the last major step (its step 2^levels substeps).
+    pub levels: u32,
+    /// Elements per level in the last major step, finest first.
+    pub elements_per_level: Vec<usize>,
+}
+
 /// One body in summary.json `mass_scaling.bodies`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BodyMassScaling {
@@ -235,6 +250,10 @@ pub struct Summary {
     /// gives it).
     #[serde(skip)]
     pub mass_scaling: Option<MassScalingSummary>,
+    /// The subcycling (with `analysis.subcycling`): summary.json writes it after
+    /// `mass_scaling` and only then.
+    #[serde(skip)]
+    pub subcycling: Option<SubcyclingSummary>,
     /// What the scene and the finished run say about the answer (analysis::plausibility):
     /// the scene's own warnings (too few steps, a run shorter than a wave transit, an unused
     /// obstacle, an axis not held, too many frames), then step cuts, the energy balance,
@@ -284,6 +303,7 @@ impl Summary {
             timing: Default::default(),
             max_temperature: None,
             mass_scaling: None,
+            subcycling: None,
             warnings: Vec::new(),
         }
     }

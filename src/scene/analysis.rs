@@ -4,10 +4,11 @@
 use super::InputError;
 use super::context::{Context, positive};
 use super::model::Analysis;
-use super::model::{DynamicAnalysis, StaticAnalysis};
+use super::model::{DynamicAnalysis, StaticAnalysis, Subcycling};
 use super::spec::{
-    AdaptiveStep, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics, IntegratorKind,
-    MassKind, NewtonSpec, Quadrature, StepSpec, TimeStep,
+    AdaptiveStep, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics,
+    DEFAULT_SUBCYCLING_LEVELS, IntegratorKind, MassKind, NewtonSpec, Quadrature, StepSpec,
+    TimeStep,
 };
 use crate::element::Strain;
 use crate::element::bulk_viscosity::{self, BulkViscosity};
@@ -48,6 +49,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 (spec.hourglass.is_some(), "hourglass"),
                 (spec.bulk_viscosity.is_some(), "bulk_viscosity"),
                 (spec.mass_scaling.is_some(), "mass_scaling"),
+                (spec.subcycling.is_some(), "subcycling"),
             ] {
                 given(present, key, "static")?;
             }
@@ -94,6 +96,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicAnalysis, InputEr
         hourglass,
         bulk_viscosity: bulk_viscosity(cx, spec, integrator)?,
         mass_scaling: mass_scaling(cx, spec, integrator, &step)?,
+        subcycling: subcycling(cx, spec, (integrator, quadrature), &step)?,
         step,
         end_time,
         integrator,
@@ -487,6 +490,56 @@ fn mass_scaling(
     }
     Ok(Some(MassScaling { target }))
 }
+
+/// `analysis.subcycling`: central difference with the one-point kernel (its element loop
+/// steps a subset of the elements), the automatic step (the levels follow the elements'
+/// own stable steps), no mass scaling (the two answer the same short elements: one at a
+/// time), at most 10 levels (steps up to 1024 times the shortest).
+fn subcycling(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    (integrator, quadrature): (IntegratorKind, Quadrature),
+    step: &TimeStep,
+) -> Result<Option<Subcycling>, InputError> {
+    let Some(given) = spec.subcycling else {
+        return Ok(None);
+    };
+    if integrator != IntegratorKind::CentralDifference {
+        return Err(cx.err(format!(
+            "analysis.subcycling: steps each element of central_difference with its own stable step; integrator {} \
+             is implicit and has no stable step: remove subcycling or use integrator = \"central_difference\"",
+            integrator.name()
+        )));
+    }
+    if quadrature != Quadrature::Reduced {
+        return Err(cx.err(
+            "analysis.subcycling: runs in the one-point kernel; set quadrature = \"reduced\" or remove subcycling",
+        ));
+    }
+    if let TimeStep::Fixed(dt) = step {
+        return Err(cx.err(format!(
+            "analysis.subcycling: groups the elements by their own stable steps, which the automatic step follows; \
+             with the fixed analysis.dt = {dt} set dt = \"auto\" (central difference's default) or remove subcycling"
+        )));
+    }
+    if spec.mass_scaling.is_some() {
+        return Err(cx.err(
+            "analysis.subcycling: and analysis.mass_scaling both answer the elements with the shortest steps; \
+             use one of them",
+        ));
+    }
+    let levels = given.levels.unwrap_or(DEFAULT_SUBCYCLING_LEVELS);
+    if levels > MAX_SUBCYCLING_LEVELS {
+        return Err(cx.err(format!(
+            "analysis.subcycling.levels: at most {MAX_SUBCYCLING_LEVELS} (steps up to {} times the shortest), got {levels}",
+            1u32 << MAX_SUBCYCLING_LEVELS
+        )));
+    }
+    Ok(Some(Subcycling { levels }))
+}
+
+/// The most subcycling levels a scene may ask for.
+const MAX_SUBCYCLING_LEVELS: u32 = 10;
 
 /// `[analysis.buckling]`, which needs an implicit tangent.
 fn buckling(cx: &Context, spec: &AnalysisSpec) -> Result<Option<BucklingSpec>, InputError> {

@@ -314,6 +314,15 @@ pub struct DynamicAnalysis {
     pub bulk_viscosity: Option<BulkViscosity>,
     /// Central difference: the mass scaling of the explicit Quad4 kernels (None: off).
     pub mass_scaling: Option<MassScaling>,
+    /// Central difference: the subcycling of the one-point kernel (None: off).
+    pub subcycling: Option<Subcycling>,
+}
+
+/// Multi-time-step central difference (docs/theory.md 8.7c): each element steps with its
+/// own stable step rounded down to 2^k times the shortest, k <= `levels`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Subcycling {
+    pub levels: u32,
 }
 
 /// The validated static analysis.

@@ -415,6 +415,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.mass_scaling = mass_scaling
             .as_ref()
             .map(|r| MassScalingSummary::of(r, self.model));
+        summary.subcycling = s.subcycling();
         summary.contact = s.contact().summary(&self.model.contacts);
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
         if let Some(report) = s.time_step_report() {

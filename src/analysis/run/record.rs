@@ -357,6 +357,7 @@ impl Recorder {
             summary,
             max_temperature: summary.max_temperature,
             mass_scaling: summary.mass_scaling.as_ref(),
+            subcycling: summary.subcycling.as_ref(),
             probes: FinalProbes {
                 columns: &model.probes,
                 values: &self.last_probes,
@@ -368,7 +369,7 @@ impl Recorder {
 }
 
 /// summary.json: the summary's fields, then `max_temperature` when there is one, then
-/// `mass_scaling` with the mass scaling, then the probes' last values when the scene has
+/// `mass_scaling` with the mass scaling, `subcycling` with the subcycling, then the probes' last values when the scene has
 /// probes.
 #[derive(serde::Serialize)]
 struct SummaryFile<'a> {
@@ -378,6 +379,8 @@ struct SummaryFile<'a> {
     max_temperature: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     mass_scaling: Option<&'a crate::analysis::summary::MassScalingSummary>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    subcycling: Option<&'a crate::analysis::summary::SubcyclingSummary>,
     #[serde(skip_serializing_if = "FinalProbes::is_empty")]
     probes: FinalProbes<'a>,
 }

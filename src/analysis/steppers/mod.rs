@@ -97,6 +97,10 @@ pub trait Report {
     fn mass_scaling(&self) -> Option<crate::assembly::mass_scaling::MassScalingReport> {
         None
     }
+    /// The subcycling's counts at the end: summary.json `subcycling` (None: off).
+    fn subcycling(&self) -> Option<crate::analysis::summary::SubcyclingSummary> {
+        None
+    }
 }
 
 /// What a checkpoint keeps of a stepper, and how a resumed stepper takes it back.

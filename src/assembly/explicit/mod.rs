@@ -63,7 +63,7 @@ impl Default for StepWork {
 
 impl StepWork {
     /// Takes an element's frequency bound into the maximum.
-    pub(super) fn observe(&mut self, omega_squared: f64, element: usize) {
+    pub fn observe(&mut self, omega_squared: f64, element: usize) {
         if omega_squared > self.omega_squared
             || (omega_squared == self.omega_squared && element < self.critical_element)
         {
@@ -260,6 +260,22 @@ impl NodeGather {
     }
 }
 
+impl NodeGather {
+    /// Sums the element forces into the nodes `nodes` only (`force` elsewhere untouched).
+    pub(super) fn gather_nodes(&self, nodes: &[u32], element_forces: &[f64], force: &mut [f64]) {
+        for &n in nodes {
+            let n = n as usize;
+            let (mut fx, mut fy) = (0.0, 0.0);
+            for entry in &self.entries[self.start[n]..self.start[n + 1]] {
+                fx += element_forces[*entry as usize];
+                fy += element_forces[*entry as usize + 1];
+            }
+            force[2 * n] = fx;
+            force[2 * n + 1] = fy;
+        }
+    }
+}
+
 /// An explicit element loop over a model's Quad4 bodies.
 pub trait ExplicitKernel: Send {
     fn elements(&self) -> usize;
@@ -305,6 +321,36 @@ pub trait ExplicitKernel: Send {
     /// added, and the nodal masses the run has still to take.
     fn mass_scaling(&self) -> Option<&ElementScaling>;
     fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling>;
+    /// The element loop a subcycled run steps a few elements at a time with (None: the
+    /// kernel steps all its elements together only).
+    fn partial(&mut self) -> Option<&mut dyn PartialKernel> {
+        None
+    }
+}
+
+/// An element loop that steps a subset of its elements (subcycling, docs/theory.md 8.7c):
+/// each element from its own start positions by its own increment, the nodes that need it
+/// gathering the element forces of their elements' last steps.
+pub trait PartialKernel {
+    /// The global nodes of every kernel element.
+    fn element_nodes(&self) -> &[[u32; 4]];
+    /// Every element's frequency bound squared on the positions `x` from the stored state
+    /// (the bound `stable_step` takes the largest of).
+    fn frequencies(&self, x: &[[f64; 2]], omega_squared: &mut [f64]) -> Result<(), ElementFailure>;
+    /// One step of length `dt` of the elements `elements` (ascending) from the positions `x`
+    /// by the increments `du` (both read at those elements' nodes only): their state and
+    /// their element forces updated, their frequency bounds squared on the end
+    /// configuration written into `omega_squared` (over all elements); the step's sums.
+    fn step_elements(
+        &mut self,
+        elements: &[u32],
+        motion: (&[[f64; 2]], &[f64]),
+        dt: f64,
+        omega_squared: &mut [f64],
+    ) -> Result<StepWork, ElementFailure>;
+    /// The internal force of the nodes `nodes` from their elements' last element forces,
+    /// written into `force` at those nodes only.
+    fn gather_nodes(&self, nodes: &[u32], force: &mut [f64]);
 }
 
 /// A point probe's statistic over the points of a kernel's elements: `point(e, q)` the state of

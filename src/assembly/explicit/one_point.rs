@@ -20,8 +20,8 @@
 //! count.
 
 use super::{
-    BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling,
-    point_statistic, point_step, stable_step_of,
+    BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
+    element_scaling, point_statistic, point_step, stable_step_of,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -353,6 +353,17 @@ impl Reduced {
         }
     }
 
+    /// Writes the state of element `e`.
+    fn store(&mut self, e: usize, state: &ElementState) {
+        self.stress[4 * e..4 * e + 4].copy_from_slice(&state.stress);
+        self.back_stress[4 * e..4 * e + 4].copy_from_slice(&state.back_stress);
+        self.eq_plastic_strain[e] = state.eq_plastic_strain;
+        self.temperature[e] = state.temperature;
+        self.thickness[e] = state.thickness;
+        self.hourglass[2 * e..2 * e + 2].copy_from_slice(&state.hourglass);
+        self.viscous_pressure[e] = state.viscous_pressure;
+    }
+
     fn state_of(&self, e: usize) -> ElementState {
         ElementState {
             stress: std::array::from_fn(|k| self.stress[4 * e + k]),
@@ -575,6 +586,58 @@ impl ExplicitKernel for Reduced {
 
     fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling> {
         self.scaling.as_mut()
+    }
+
+    fn partial(&mut self) -> Option<&mut dyn PartialKernel> {
+        Some(self)
+    }
+}
+
+impl PartialKernel for Reduced {
+    fn element_nodes(&self) -> &[[u32; 4]] {
+        &self.layout.nodes
+    }
+
+    fn frequencies(&self, x: &[[f64; 2]], omega_squared: &mut [f64]) -> Result<(), ElementFailure> {
+        for (e, omega_squared) in omega_squared.iter_mut().enumerate() {
+            *omega_squared = self.frequency(x, e)?;
+        }
+        Ok(())
+    }
+
+    fn step_elements(
+        &mut self,
+        elements: &[u32],
+        (x, du): (&[[f64; 2]], &[f64]),
+        dt: f64,
+        omega_squared: &mut [f64],
+    ) -> Result<StepWork, ElementFailure> {
+        let mut sums = StepWork::default();
+        for &e in elements {
+            let e = e as usize;
+            let element = self.layout.nodes[e];
+            let xe: Nodes = element.map(|n| x[n as usize]);
+            let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+            let p = &self.layout.bodies[self.layout.body[e] as usize];
+            let motion = (&xe, &ue);
+            let step = (dt, self.viscosity.as_ref());
+            let r = element_step(p, motion, &self.state_of(e), self.mass_of(e), step)
+                .map_err(|err| self.layout.failure(e, err))?;
+            omega_squared[e] = r.omega_squared;
+            sums.observe(r.omega_squared, e);
+            self.store(e, &r.state);
+            self.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
+            sums.internal += r.work + r.hourglass_work;
+            sums.plastic += r.plastic_work;
+            sums.hourglass += r.hourglass_work;
+            sums.viscous += r.viscous_work;
+        }
+        self.hourglass_energy += sums.hourglass;
+        Ok(sums)
+    }
+
+    fn gather_nodes(&self, nodes: &[u32], force: &mut [f64]) {
+        self.gather.gather_nodes(nodes, &self.element_forces, force);
     }
 }
 

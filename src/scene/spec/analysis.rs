@@ -161,7 +161,24 @@ pub struct AnalysisSpec {
     /// scaling, the elements whose stable step falls below `target` made heavier until it is
     /// the target (docs/theory.md 8.7b). Default: none (off).
     pub mass_scaling: Option<MassScalingSpec>,
+    /// Central difference with the one-point kernel and dt = "auto": multi-time-step
+    /// integration, each element stepped with its own stable step rounded down to a power of
+    /// two of the shortest (docs/theory.md 8.7c). Default: none (one step for every element).
+    pub subcycling: Option<SubcyclingSpec>,
 }
+
+/// `analysis.subcycling = { levels = 5 }`: the elements' steps are 2^k times the shortest,
+/// k = 0 ..= levels (default [`DEFAULT_SUBCYCLING_LEVELS`]); `subcycling = {}` turns it on
+/// with the default.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SubcyclingSpec {
+    pub levels: Option<u32>,
+}
+
+/// The default number of subcycling levels above the finest: steps up to 32 times the
+/// shortest.
+pub const DEFAULT_SUBCYCLING_LEVELS: u32 = 5;
 
 /// `analysis.mass_scaling = { target = 2e-9 }`: the stable step (a time, > 0) below which an
 /// element's density is raised, re-evaluated every step.

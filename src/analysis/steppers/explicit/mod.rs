@@ -12,6 +12,10 @@
 //! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
+mod subcycling;
+
+pub use subcycling::{Levels, own_levels};
+
 use super::carry::{Carry, ExplicitCarry};
 use super::clock::Clock;
 use super::energies::{Energies, Motion};
@@ -68,6 +72,8 @@ pub struct Explicit<'a> {
     masses: ElementMasses,
     contact: ContactState,
     forces_applied: bool,
+    /// Subcycling's levels and counts (None: every element steps together).
+    subcycler: Option<subcycling::Subcycler>,
     // the step's vectors, allocated once
     v_half: Vec<f64>,
     du: Vec<f64>,
@@ -97,7 +103,16 @@ impl<'a> Explicit<'a> {
         let inverse_mass = (0..model.dofs())
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
-        let clock = explicit_clock(model, spec, dt_crit, &state, kernel.as_ref())?;
+        let mut clock = explicit_clock(model, spec, dt_crit, &state, kernel.as_ref())?;
+        let subcycler = match spec.subcycling {
+            Some(rule) => {
+                let sub =
+                    subcycling::Subcycler::new(model, rule, kernel.as_mut(), &state.coordinates)?;
+                clock.limit = sub.bound(kernel.as_ref());
+                Some(sub)
+            }
+            None => None,
+        };
         let dofs = model.dofs();
         Ok(Explicit {
             model,
@@ -124,6 +139,7 @@ impl<'a> Explicit<'a> {
             masses,
             contact: ContactState::new(&model.contacts),
             forces_applied: loads::has_external_force(model),
+            subcycler,
             v_half: vec![0.0; dofs],
             du: vec![0.0; dofs],
             external: vec![0.0; dofs],
@@ -131,8 +147,9 @@ impl<'a> Explicit<'a> {
         })
     }
 
-    /// The contact correction of the predicted increment (forward-increment multipliers).
-    fn contact_correction(&mut self, h: f64, time: f64) {
+    /// The contact correction of the predicted increment (forward-increment multipliers) of a
+    /// step of length `h` after one of length `last`.
+    fn contact_correction(&mut self, (h, last): (f64, f64), time: f64) {
         let positions = self.state.positions(self.spec.geometry);
         let predicted = Predicted {
             interfaces: &self.interfaces,
@@ -140,9 +157,7 @@ impl<'a> Explicit<'a> {
             du: &self.du,
             inverse_mass: &self.inverse_mass,
         };
-        let step = self
-            .contact
-            .explicit_step(&predicted, h, self.clock.last, time);
+        let step = self.contact.explicit_step(&predicted, h, last, time);
         // the contact work that closes the discrete balance of the step (theory 7): with f =
         // M delta / h^2, du the predicted increment and F_n = M a_n the other forces at its
         // start, f . (du + delta / 2) - delta . F_n / 2. A node the correction stops loses
@@ -191,6 +206,18 @@ impl<'a> Explicit<'a> {
             }
         }
         self.energies.contact_work -= work;
+    }
+
+    /// What F reads at DOF `d`.
+    fn dof(&self, d: usize) -> Dof {
+        Dof {
+            free: self.free[d],
+            external: self.external[d],
+            internal: self.internal[d],
+            m: self.mass[d],
+            a: self.a[d],
+            v: self.v[d],
+        }
     }
 
     /// The mass the mass scaling added in the step just taken joins the nodes at rest
@@ -271,6 +298,9 @@ impl Stepper for Explicit<'_> {
         let (model, spec) = (self.model, self.spec);
         let step = self.step + 1;
         let clock_step = self.clock.next(model, spec, self.state.time, step)?;
+        if let Some(sub) = self.subcycler.take() {
+            return self.advance_subcycled(sub, clock_step);
+        }
         let (time, h) = (clock_step.end, clock_step.length);
         predict(&self.v, &self.a, h, &mut self.v_half, &mut self.du);
         for (dof, value) in loads::prescribed(model, &self.initial, time) {
@@ -278,7 +308,7 @@ impl Stepper for Explicit<'_> {
         }
         if !model.contacts.is_empty() {
             let start = Instant::now();
-            self.contact_correction(h, time);
+            self.contact_correction((h, self.clock.last), time);
             crate::profile::add(crate::profile::Phase::Contact, start);
         }
         let bound = match self.internal_force(h) {
@@ -414,6 +444,10 @@ impl Report for Explicit<'_> {
         let kernel = &self.kernel;
         let scaling = kernel.mass_scaling()?;
         Some(scaling.report(self.model.bodies.len(), |e| kernel.locate(e)))
+    }
+    fn subcycling(&self) -> Option<crate::analysis::summary::SubcyclingSummary> {
+        let sub = self.subcycler.as_ref()?;
+        Some(sub.summary(self.kernel.elements()))
     }
     fn time_step_report(&self) -> Option<TimeStepReport> {
         let c = &self.clock;

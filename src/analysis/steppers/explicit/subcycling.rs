@@ -1,0 +1,550 @@
+//! Multi-time-step central difference (subcycling; docs/theory.md 8.7c): each element steps
+//! with its own stable step rounded down to a power of two of the shortest, each node with
+//! the finest of its elements (Belytschko, Yen & Mullen 1979, nodal partition with linear
+//! interpolation).
+//!
+//! Legend
+//! ```text
+//! dt_e     element e's own stable step 2 / omega_e (its bound where the levels were formed)
+//! k_e      floor(log2(dt_e / dt_min)), at most `levels`
+//! k_n      min of k_e over node n's elements; 0 on the contact surfaces and for the nodes
+//!          of moving prescribed displacements
+//! l_e      min of k_n over element e's nodes: the level e steps at (l_e <= k_e)
+//! H, h     the major step (the clock's rule on 2^K dt_min, K the largest k_n), h = H / 2^K
+//! node n   velocity Verlet over its own step D_n = 2^k_n h from t_s: v_1/2 = v + D_n/2 a,
+//!          x(t) = x_s + (t - t_s) v_1/2 in between (what a finer element reads),
+//!          at t_s + D_n: a = (f_ext - f_int - a_R m v_1/2) / m, v = v_1/2 + D_n/2 a
+//! element  at substep j with 2^l_e | j: from x(t_{j - 2^l_e}) by x(t_j) - x(t_{j - 2^l_e});
+//!          every element of a node steps at the node's ends (l_e <= k_n), so f_int there is
+//!          whole
+//! ```
+//! The levels are formed again at every major step from the frequency bounds of the
+//! elements' last steps (all of them end there). With every element at level 0 this is the
+//! single-step central difference, operation for operation.
+
+use super::{Explicit, total_at};
+use crate::analysis::steppers::clock::Step;
+use crate::analysis::steppers::{StepError, loads};
+use crate::analysis::summary::{RunError, Status, SubcyclingSummary};
+use crate::assembly::StableStep;
+use crate::assembly::explicit::{ExplicitKernel, PartialKernel, StepWork};
+use crate::contact::Interfaces;
+use crate::contact::geometry::Master;
+use crate::element::Strain;
+use crate::output::readable;
+use crate::scene::model::Subcycling;
+use crate::scene::{InputError, Load, Model};
+use std::time::Instant;
+
+/// The levels of a major step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Levels {
+    /// k_n of every node.
+    pub node: Vec<u8>,
+    /// Per level k: the elements stepped at k, the nodes stepping at k, and the nodes the
+    /// elements of k read (each ascending).
+    pub elements: Vec<Vec<u32>>,
+    pub nodes: Vec<Vec<u32>>,
+    pub touched: Vec<Vec<u32>>,
+    /// The largest node level K.
+    pub top: u32,
+    /// The elements' own levels k_e the levels were formed from.
+    pub own: Vec<u8>,
+}
+
+impl Levels {
+    /// The levels of elements with the frequency bounds squared `omega_squared` and nodes
+    /// `element_nodes` (over `node_count` nodes), the nodes `pinned` at level 0, at most
+    /// `levels` above it.
+    pub fn form(
+        omega_squared: &[f64],
+        element_nodes: &[[u32; 4]],
+        pinned: &[bool],
+        levels: u32,
+    ) -> Levels {
+        Levels::of_element_levels(own_levels(omega_squared, levels), element_nodes, pinned)
+    }
+
+    /// The levels of elements whose own levels are `own` (k_e): the nodes take the finest
+    /// of their elements (pinned and element-less nodes 0), the elements the finest of
+    /// their nodes.
+    pub fn of_element_levels(own: Vec<u8>, element_nodes: &[[u32; 4]], pinned: &[bool]) -> Levels {
+        let mut node = vec![u8::MAX; pinned.len()];
+        for (nodes, k) in element_nodes.iter().zip(&own) {
+            for n in nodes {
+                let n = *n as usize;
+                node[n] = node[n].min(*k);
+            }
+        }
+        for (k, pinned) in node.iter_mut().zip(pinned) {
+            if *pinned || *k == u8::MAX {
+                *k = 0;
+            }
+        }
+        let top = node.iter().copied().max().unwrap_or(0) as u32;
+        let count = top as usize + 1;
+        let (mut elements, mut nodes, mut touched) = (
+            vec![Vec::new(); count],
+            vec![Vec::new(); count],
+            vec![Vec::new(); count],
+        );
+        // the levels whose elements read each node, as bits
+        let mut reads = vec![0u32; node.len()];
+        for (e, element) in element_nodes.iter().enumerate() {
+            let level = element.iter().map(|n| node[*n as usize]).min().unwrap_or(0);
+            elements[level as usize].push(e as u32);
+            for n in element {
+                reads[*n as usize] |= 1 << level;
+            }
+        }
+        for (n, (k, reads)) in node.iter().zip(&reads).enumerate() {
+            nodes[*k as usize].push(n as u32);
+            for (level, list) in touched.iter_mut().enumerate() {
+                if reads & (1 << level) != 0 {
+                    list.push(n as u32);
+                }
+            }
+        }
+        Levels {
+            node,
+            elements,
+            nodes,
+            touched,
+            top,
+            own,
+        }
+    }
+
+    /// The level each element steps at (l_e).
+    pub fn element_levels(&self, elements: usize) -> Vec<u8> {
+        let mut level = vec![0u8; elements];
+        for (k, list) in self.elements.iter().enumerate() {
+            for e in list {
+                level[*e as usize] = k as u8;
+            }
+        }
+        level
+    }
+}
+
+/// k_e = floor(log2(dt_e / dt_min)) of every element, at most `levels` (an element that does
+/// not vibrate: `levels`).
+pub fn own_levels(omega_squared: &[f64], levels: u32) -> Vec<u8> {
+    let largest = omega_squared.iter().copied().fold(0.0, f64::max);
+    omega_squared
+        .iter()
+        .map(|w| {
+            if *w <= 0.0 {
+                return levels as u8;
+            }
+            // (dt_e / dt_min)^2 = largest / w = m 2^p with m in [1, 2): floor(log2 of its
+            // square root) = floor(p / 2), p the binary exponent
+            let ratio_squared = largest / w;
+            let exponent = ((ratio_squared.to_bits() >> 52) & 0x7ff) as i64 - 1023;
+            ((exponent.max(0) / 2) as u32).min(levels) as u8
+        })
+        .collect()
+}
+
+/// What a subcycled run carries besides the single-step state.
+pub(super) struct Subcycler {
+    rule: Subcycling,
+    /// The nodes kept at level 0.
+    pinned: Vec<bool>,
+    /// Whether the scene prescribes moving displacements (their nodes are pinned and take
+    /// the curve's value at every substep).
+    moving: bool,
+    pub(super) levels: Levels,
+    /// The frequency bound squared of every element's last step.
+    omega_squared: Vec<f64>,
+    /// The start positions and the increments an element step reads (at its nodes).
+    x: Vec<[f64; 2]>,
+    du: Vec<f64>,
+    /// The last substep's length (the contact's impact conditions read it).
+    last_substep: f64,
+    /// Substeps and element updates so far.
+    pub(super) substeps: u64,
+    pub(super) element_updates: u64,
+}
+
+impl Subcycler {
+    /// The subcycling `rule` of `model`, its levels formed on the initial positions `x`;
+    /// refuses loads it cannot follow (forces between the nodes' steps).
+    pub(super) fn new(
+        model: &Model,
+        rule: Subcycling,
+        kernel: &mut dyn ExplicitKernel,
+        x: &[[f64; 2]],
+    ) -> Result<Subcycler, RunError> {
+        let refuse = |message: String| RunError::from(InputError::new(&model.file, message));
+        if super::loads::has_external_force(model) {
+            return Err(refuse(
+                "analysis.subcycling: steps the nodes at different times, and the scene's forces, tractions or \
+                 pressures would act on nodes between their steps; remove subcycling or the loads"
+                    .into(),
+            ));
+        }
+        let elements = kernel.elements();
+        let Some(partial) = kernel.partial() else {
+            return Err(refuse(
+                "analysis.subcycling: runs in the one-point kernel (quadrature = \"reduced\")"
+                    .into(),
+            ));
+        };
+        let mut omega_squared = vec![0.0; elements];
+        partial
+            .frequencies(x, &mut omega_squared)
+            .map_err(|err| refuse(err.to_string()))?;
+        let (pinned, moving) = pinned_nodes(model, &model.interfaces());
+        let levels = Levels::form(
+            &omega_squared,
+            partial.element_nodes(),
+            &pinned,
+            rule.levels,
+        );
+        Ok(Subcycler {
+            rule,
+            pinned,
+            moving,
+            levels,
+            omega_squared,
+            x: vec![[0.0; 2]; x.len()],
+            du: vec![0.0; 2 * x.len()],
+            last_substep: 0.0,
+            substeps: 0,
+            element_updates: 0,
+        })
+    }
+
+    /// The major step's bound: 2^K times the shortest element step, named by that element.
+    pub(super) fn bound(&self, kernel: &dyn ExplicitKernel) -> StableStep {
+        let mut worst = StepWork::default();
+        for (e, w) in self.omega_squared.iter().enumerate() {
+            worst.observe(*w, e);
+        }
+        let (body, element) = kernel.locate(worst.critical_element);
+        let finest = StableStep::of_frequency(worst.omega_squared, body, element);
+        StableStep {
+            dt: (1u64 << self.levels.top) as f64 * finest.dt,
+            ..finest
+        }
+    }
+
+    /// summary.json `subcycling` of a kernel of `elements` elements.
+    pub(super) fn summary(&self, elements: usize) -> SubcyclingSummary {
+        SubcyclingSummary {
+            substeps: self.substeps,
+            element_updates: self.element_updates,
+            single_step_updates: self.substeps * elements as u64,
+            levels: self.levels.top,
+            elements_per_level: self.levels.elements.iter().map(Vec::len).collect(),
+        }
+    }
+
+    /// The levels of the next major step, from the elements' last bounds (formed again only
+    /// when an element's own level changed).
+    fn reform(&mut self, kernel: &mut dyn PartialKernel) {
+        let own = own_levels(&self.omega_squared, self.rule.levels);
+        if own != self.levels.own {
+            self.levels = Levels::of_element_levels(own, kernel.element_nodes(), &self.pinned);
+        }
+    }
+}
+
+/// The nodes subcycling keeps at level 0: those of the contact surfaces (both sides, so the
+/// correction sees every node it moves at the substep), and of moving prescribed
+/// displacements; and whether there are such displacements.
+fn pinned_nodes(model: &Model, interfaces: &Interfaces) -> (Vec<bool>, bool) {
+    let mut pinned = vec![false; model.node_count];
+    for pair in &interfaces.pairs {
+        for n in &pair.slaves {
+            pinned[*n] = true;
+        }
+        match &pair.master {
+            Master::Segments { edges, .. } => {
+                for n in edges.iter().flatten() {
+                    pinned[*n] = true;
+                }
+            }
+            Master::Nodes { nodes, .. } => {
+                for n in nodes {
+                    pinned[*n] = true;
+                }
+            }
+            Master::Obstacle(_) => {}
+        }
+    }
+    let mut moving = false;
+    for load in &model.loads {
+        if let Load::Displacement { nodes, .. }
+        | Load::Rotation { nodes, .. }
+        | Load::Affine { nodes, .. } = load
+        {
+            moving = true;
+            for n in nodes {
+                pinned[*n] = true;
+            }
+        }
+    }
+    (pinned, moving)
+}
+
+/// The sums of a major step's node updates.
+#[derive(Default)]
+struct NodeSums {
+    /// du . (F_{n+1} + F_n) over every node step (half of it is the external work).
+    work: f64,
+}
+
+impl Explicit<'_> {
+    /// One major step of the subcycled run (see the legend): the clock's step over 2^K
+    /// substeps, the history row at its end.
+    pub(super) fn advance_subcycled(
+        &mut self,
+        mut sub: Subcycler,
+        clock_step: Step,
+    ) -> Result<(), StepError> {
+        let result = self.major_step(&mut sub, clock_step);
+        self.subcycler = Some(sub);
+        result
+    }
+
+    fn major_step(&mut self, sub: &mut Subcycler, clock_step: Step) -> Result<(), StepError> {
+        let (t0, time) = (self.state.time, clock_step.end);
+        let top = sub.levels.top;
+        let count = 1u64 << top;
+        let h = clock_step.length / count as f64;
+        // every node starts a step
+        for (n, k) in sub.levels.node.iter().enumerate() {
+            let span = (1u64 << k) as f64 * h;
+            for d in [2 * n, 2 * n + 1] {
+                self.v_half[d] = self.v[d] + 0.5 * span * self.a[d];
+            }
+        }
+        let mut sums = NodeSums::default();
+        for j in 1..=count {
+            let t = if j == count { time } else { t0 + j as f64 * h };
+            self.substep(sub, (j, h, t), &mut sums)?;
+        }
+        self.state.time = time;
+        self.synced = false;
+        self.end_major_step(sub, &sums, h);
+        let kernel = self
+            .kernel
+            .partial()
+            .expect("a subcycled run has a partial kernel");
+        sub.reform(kernel);
+        let bound = sub.bound(self.kernel.as_ref());
+        self.step += 1;
+        self.clock.took(clock_step, bound);
+        Ok(())
+    }
+
+    /// Substep j (length h, ending at t): the level-0 increments and the contact, the
+    /// elements of every level whose step ends here, then its nodes.
+    fn substep(
+        &mut self,
+        sub: &mut Subcycler,
+        (j, h, t): (u64, f64, f64),
+        sums: &mut NodeSums,
+    ) -> Result<(), StepError> {
+        let finest = (j.trailing_zeros()).min(sub.levels.top);
+        for n in &sub.levels.nodes[0] {
+            let n = *n as usize;
+            for d in [2 * n, 2 * n + 1] {
+                self.du[d] = h * self.v_half[d];
+            }
+        }
+        if sub.moving {
+            for (dof, value) in loads::prescribed(self.model, &self.initial, t) {
+                if sub.levels.node[dof / 2] == 0 {
+                    self.du[dof] = value - self.state.displacement[dof];
+                }
+            }
+        }
+        if !self.model.contacts.is_empty() {
+            let start = Instant::now();
+            self.contact_correction((h, sub.last_substep), t);
+            crate::profile::add(crate::profile::Phase::Contact, start);
+        }
+        for k in 0..=finest {
+            self.step_level(sub, (j, k, h), t)?;
+        }
+        for k in 0..=finest {
+            self.finish_nodes(sub, (j, k, h), sums);
+        }
+        sub.last_substep = h;
+        sub.substeps += 1;
+        Ok(())
+    }
+
+    /// The elements of level k over their step ending at substep j.
+    fn step_level(
+        &mut self,
+        sub: &mut Subcycler,
+        (j, k, h): (u64, u32, f64),
+        t: f64,
+    ) -> Result<(), StepError> {
+        let span = (1u64 << k) as f64 * h;
+        let levels = &sub.levels;
+        for n in &levels.touched[k as usize] {
+            let n = *n as usize;
+            let level = levels.node[n] as u32;
+            // the node's step began at substep s; the element's at j - 2^k
+            let s = ((j - 1) >> level) << level;
+            let offset = j - (1u64 << k) - s;
+            let x = self.state.coordinates[n];
+            for c in 0..2 {
+                let d = 2 * n + c;
+                sub.x[n][c] = if offset == 0 {
+                    x[c]
+                } else {
+                    x[c] + (offset as f64 * h) * self.v_half[d]
+                };
+                sub.du[d] = if level == 0 {
+                    self.du[d]
+                } else {
+                    span * self.v_half[d]
+                };
+            }
+        }
+        let elements = &levels.elements[k as usize];
+        let kernel = self
+            .kernel
+            .partial()
+            .expect("a subcycled run has a partial kernel");
+        let work = crate::profile::time(crate::profile::Phase::Assembly, || {
+            crate::profile::count_elements(elements.len());
+            kernel.step_elements(elements, (&sub.x, &sub.du), span, &mut sub.omega_squared)
+        })
+        .map_err(|err| StepError {
+            status: Status::Diverged,
+            message: format!("at t = {}: {err}", readable(t)),
+            frame: false,
+        })?;
+        sub.element_updates += elements.len() as u64;
+        self.state.internal_work += work.internal;
+        self.state.plastic_work += work.plastic;
+        self.energies.bulk_viscosity_work += work.viscous;
+        Ok(())
+    }
+
+    /// The nodes of level k at the end of their step (substep j): the internal force of
+    /// their elements' steps just taken, the motion, the work; then the next step begins
+    /// unless the major step ends.
+    fn finish_nodes(&mut self, sub: &Subcycler, (j, k, h): (u64, u32, f64), sums: &mut NodeSums) {
+        let span = (1u64 << k) as f64 * h;
+        let nodes = &sub.levels.nodes[k as usize];
+        let kernel = self
+            .kernel
+            .partial()
+            .expect("a subcycled run has a partial kernel");
+        kernel.gather_nodes(nodes, &mut self.internal);
+        let a_r = self.spec.rayleigh[0];
+        let last = j == 1u64 << sub.levels.top;
+        let finite = self.spec.geometry == Strain::Finite;
+        for n in nodes {
+            let n = *n as usize;
+            for c in 0..2 {
+                let d = 2 * n + c;
+                let du = if k == 0 {
+                    self.du[d]
+                } else {
+                    span * self.v_half[d]
+                };
+                if finite {
+                    self.state.coordinates[n][c] += du;
+                }
+                self.state.displacement[d] += du;
+                let m = self.mass[d];
+                if self.free[d] {
+                    self.a[d] =
+                        (self.external[d] - self.internal[d] - a_r * m * self.v_half[d]) / m;
+                    self.v[d] = self.v_half[d] + 0.5 * span * self.a[d];
+                } else {
+                    self.a[d] = (du / span - self.v[d]) * 2.0 / span;
+                    self.v[d] = du / span;
+                }
+                let total = total_at(self.dof(d), a_r);
+                sums.work += du * (total + self.last_total[d]);
+                self.last_total[d] = total;
+                if !last {
+                    self.v_half[d] = self.v[d] + 0.5 * span * self.a[d];
+                }
+            }
+        }
+    }
+
+    /// The energies at the end of a major step (every node has ended a step there).
+    fn end_major_step(&mut self, sub: &Subcycler, sums: &NodeSums, h: f64) {
+        // the shadow h^2 / 8 a.M a with each node's own step, summed per level
+        let mut kinetic = 0.0;
+        let mut shadow = vec![0.0; sub.levels.top as usize + 1];
+        for (d, (v, m)) in self.v.iter().zip(&self.mass).enumerate() {
+            kinetic += m * v * v;
+            if self.free[d] {
+                shadow[sub.levels.node[d / 2] as usize] += m * self.a[d] * self.a[d];
+            }
+        }
+        let shadow: f64 = shadow
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                let span = (1u64 << k) as f64 * h;
+                0.125 * span * span * s
+            })
+            .sum();
+        let energies = &mut self.energies;
+        energies.external_work += 0.5 * sums.work;
+        energies.kinetic = 0.5 * kinetic;
+        energies.kinetic_shadow = shadow;
+        energies.internal = self.state.internal_work - self.state.plastic_work;
+        energies.plastic_work = self.state.plastic_work;
+        if self.step == 0 {
+            self.energy_reference = self.energy_reference.max(energies.internal.abs());
+        }
+        self.energy_reference = self.energy_reference.max(energies.external_work.abs());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A strip of 4 elements in a row (nodes 0-4 bottom, 5-9 top).
+    fn strip() -> Vec<[u32; 4]> {
+        (0..4u32).map(|e| [e, e + 1, e + 6, e + 5]).collect()
+    }
+
+    /// Levels: an element twice as stiff as the rest takes level 0 and drags its nodes'
+    /// other elements to it; a pinned node does the same; nodes take the finest of their
+    /// elements.
+    #[test]
+    fn levels_follow_the_finest_element_of_each_node() {
+        // dt_e: 1, 4, 4, 8 (omega^2 ~ 1 / dt^2)
+        let omega: Vec<f64> = [1.0, 4.0, 4.0, 8.0]
+            .iter()
+            .map(|dt| 1.0 / (dt * dt))
+            .collect();
+        let own = own_levels(&omega, 5);
+        assert_eq!(own, vec![0, 2, 2, 3]);
+        let levels = Levels::form(&omega, &strip(), &[false; 10], 5);
+        // nodes 0, 1 (5, 6) level 0; 2 (7): min(2, 2) = 2; 3 (8): 2; 4 (9): 3
+        assert_eq!(levels.node, vec![0, 0, 2, 2, 3, 0, 0, 2, 2, 3]);
+        // element 1 has nodes 1 and 2: level 0; element 2: 2; element 3: nodes 3, 4: 2
+        assert_eq!(levels.element_levels(4), vec![0, 0, 2, 2]);
+        assert_eq!(levels.top, 3);
+        let mut pinned = [false; 10];
+        pinned[3] = true;
+        let levels = Levels::form(&omega, &strip(), &pinned, 5);
+        assert_eq!(levels.element_levels(4), vec![0, 0, 0, 0]);
+        // capped
+        assert_eq!(own_levels(&omega, 1), vec![0, 1, 1, 1]);
+        // against the logarithm: ratios just below and above the powers of two
+        for ratio in [1.0, 1.999, 2.0, 2.001, 3.99, 4.0, 7.9, 8.1, 1000.0] {
+            let omega = [1.0, 1.0 / (ratio * ratio)];
+            let expected = (ratio as f64).log2().floor() as u8;
+            assert_eq!(own_levels(&omega, 20)[1], expected, "ratio {ratio}");
+        }
+    }
+}
