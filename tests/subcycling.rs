@@ -17,8 +17,9 @@ fn run_scene(name: &str, scene: &str, overrides: &[&str]) -> (Summary, std::path
 }
 
 /// Goal: with every element on one level, subcycling is the single-step central difference
-/// operation for operation. Setup: the Taylor aluminium rod (5 x 30) with `levels = 0`, and
-/// the strip on the wall with the automatic step (its 14 equal elements form one level).
+/// operation for operation, in both kernels. Setup: the Taylor aluminium rod (one-point,
+/// 5 x 30) and the Johnson-Cook rod (2x2, 5 x 50) with `levels = 0`, and the strip on the
+/// wall with the automatic step (its 14 equal elements form one level).
 /// Reference: the single-step runs of the same scenes; history.csv identical to the byte
 /// (the substep is the step, the element and node updates the same operations in the same
 /// order).
@@ -26,6 +27,7 @@ fn run_scene(name: &str, scene: &str, overrides: &[&str]) -> (Summary, std::path
 fn one_level_is_the_single_step_method() {
     for (scene, extra) in [
         ("taylor_aluminum", "analysis.subcycling={levels=0}"),
+        ("taylor_jc", "analysis.subcycling={levels=0}"),
         ("strip_wall", "analysis.subcycling={}"),
     ] {
         let base = ["output.frame_every=0", "analysis.dt=\"auto\""];
@@ -322,15 +324,20 @@ proptest! {
 }
 
 /// Goal: what subcycling cannot follow is refused with the key named (exit 2). Setup: the
-/// Taylor rod with one change each. Reference: the refusals of theory 8.7c.
+/// Taylor rod with one change each; the rod bar on the wall made explicit. Reference: the
+/// refusals of theory 8.7c.
 #[test]
 fn subcycling_refusals_name_the_key() {
     let scene = "models/taylor_aluminum.toml";
     let on = "analysis.subcycling={}";
     for (sets, words) in [
         (
-            vec![on, "analysis.quadrature=\"full\""],
-            vec!["analysis.subcycling", "reduced"],
+            vec![
+                on,
+                "analysis.geometry=\"linear\"",
+                "analysis.quadrature=\"full\"",
+            ],
+            vec!["analysis.subcycling", "nonlinear"],
         ),
         (
             vec![on, "analysis.dt=1e-9"],
@@ -357,6 +364,18 @@ fn subcycling_refusals_name_the_key() {
     ] {
         common::check_refuses_with(scene, &sets, &words);
     }
+    let rods = [
+        "analysis.integrator=\"central_difference\"",
+        "analysis.dt=\"auto\"",
+        "analysis.mass=\"lumped\"",
+        "analysis.geometry=\"nonlinear\"",
+        on,
+    ];
+    common::check_refuses_with(
+        "models/bar_wall.toml",
+        &rods,
+        &["analysis.subcycling", "rod"],
+    );
 }
 
 /// Goal: a scene with forces is refused when the run starts (the nodes step at different

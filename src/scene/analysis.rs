@@ -96,7 +96,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicAnalysis, InputEr
         hourglass,
         bulk_viscosity: bulk_viscosity(cx, spec, integrator)?,
         mass_scaling: mass_scaling(cx, spec, integrator, &step)?,
-        subcycling: subcycling(cx, spec, (integrator, quadrature), &step)?,
+        subcycling: subcycling(cx, spec, integrator, &step)?,
         step,
         end_time,
         integrator,
@@ -491,14 +491,15 @@ fn mass_scaling(
     Ok(Some(MassScaling { target }))
 }
 
-/// `analysis.subcycling`: central difference with the one-point kernel (its element loop
-/// steps a subset of the elements), the automatic step (the levels follow the elements'
+/// `analysis.subcycling`: central difference in the finite-strain explicit Quad4 kernels
+/// (their element loops step a subset of the elements; the scene's checks refuse rods with
+/// them), the automatic step (the levels follow the elements'
 /// own stable steps), no mass scaling (the two answer the same short elements: one at a
 /// time), at most 10 levels (steps up to 1024 times the shortest).
 fn subcycling(
     cx: &Context,
     spec: &AnalysisSpec,
-    (integrator, quadrature): (IntegratorKind, Quadrature),
+    integrator: IntegratorKind,
     step: &TimeStep,
 ) -> Result<Option<Subcycling>, InputError> {
     let Some(given) = spec.subcycling else {
@@ -511,9 +512,9 @@ fn subcycling(
             integrator.name()
         )));
     }
-    if quadrature != Quadrature::Reduced {
+    if spec.geometry == Strain::Small {
         return Err(cx.err(
-            "analysis.subcycling: runs in the one-point kernel; set quadrature = \"reduced\" or remove subcycling",
+            "analysis.subcycling: runs in the finite-strain explicit Quad4 kernels; use geometry = \"nonlinear\" or remove subcycling",
         ));
     }
     if let TimeStep::Fixed(dt) = step {

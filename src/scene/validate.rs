@@ -146,22 +146,32 @@ fn check_bulk_viscosity(
     Ok(())
 }
 
-/// The mass scaling acts in the explicit Quad4 kernels, which run on Quad4 bodies only.
+/// The mass scaling and the subcycling act in the explicit Quad4 kernels, which run on Quad4
+/// bodies only.
 fn check_mass_scaling(
     cx: &Context,
     analysis: &Analysis,
     bodies: &[Body],
 ) -> Result<(), InputError> {
-    if let Analysis::Dynamic(d) = analysis
-        && d.mass_scaling.is_some()
-        && let Some(body) = bodies
-            .iter()
-            .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
-    {
-        return Err(cx.err(format!(
-            "analysis.mass_scaling: acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric); body `{}` is a rod: remove mass_scaling",
-            body.name
-        )));
+    let Analysis::Dynamic(d) = analysis else {
+        return Ok(());
+    };
+    let Some(body) = bodies
+        .iter()
+        .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
+    else {
+        return Ok(());
+    };
+    for (on, key) in [
+        (d.mass_scaling.is_some(), "mass_scaling"),
+        (d.subcycling.is_some(), "subcycling"),
+    ] {
+        if on {
+            return Err(cx.err(format!(
+                "analysis.{key}: acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric); body `{}` is a rod: remove {key}",
+                body.name
+            )));
+        }
     }
     Ok(())
 }

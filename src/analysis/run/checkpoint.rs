@@ -35,7 +35,9 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///    explicit carry.
 /// 8: the mass scaling's loss in the energies and the summary, its factors and the nodal
 ///    masses in the explicit carry; central difference's kinetic shadow in the energies.
-const FORMAT: u32 = 9;
+/// 9: the mortar pairs' master block in the contact state.
+/// 10: the subcycling's element bounds and counts in the explicit carry.
+const FORMAT: u32 = 10;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

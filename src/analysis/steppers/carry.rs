@@ -65,4 +65,17 @@ pub struct ExplicitCarry {
     pub viscous_pressure: Vec<f64>,
     /// The mass scaling's factors, added mass and the nodal masses (None without it).
     pub mass_scaling: Option<ScalingCarry>,
+    /// The subcycling's element bounds and counts (None without it).
+    pub subcycling: Option<SubcyclingCarry>,
+}
+
+/// What a subcycled run carries past a major step: the frequency bound squared of every
+/// element's last step (the next levels are formed from them), the last substep's length,
+/// the substeps and element updates so far.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SubcyclingCarry {
+    pub omega_squared: Vec<f64>,
+    pub last_substep: f64,
+    pub substeps: u64,
+    pub element_updates: u64,
 }

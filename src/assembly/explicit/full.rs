@@ -26,8 +26,8 @@
 //! ```
 
 use super::{
-    CHUNK, ExplicitKernel, Layout, NodeGather, StepWork, element_scaling, point_statistic,
-    point_step, stable_step_of,
+    CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_scaling,
+    point_statistic, point_step, stable_step_of,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -372,6 +372,65 @@ impl Full {
     fn parameters(&self, e: usize) -> &super::BodyParameters {
         &self.layout.bodies[self.layout.body[e] as usize]
     }
+
+    /// Writes the state of element `e`.
+    fn store(&mut self, e: usize, state: &PointsState) {
+        for q in 0..4 {
+            self.stress[16 * e + 4 * q..16 * e + 4 * q + 4].copy_from_slice(&state.stress[q]);
+            self.back_stress[16 * e + 4 * q..16 * e + 4 * q + 4]
+                .copy_from_slice(&state.back_stress[q]);
+        }
+        self.eq_plastic_strain[4 * e..4 * e + 4].copy_from_slice(&state.eq_plastic_strain);
+        self.temperature[4 * e..4 * e + 4].copy_from_slice(&state.temperature);
+        self.thickness[4 * e..4 * e + 4].copy_from_slice(&state.thickness);
+        self.viscous_pressure[4 * e..4 * e + 4].copy_from_slice(&state.viscous_pressure);
+    }
+}
+
+impl PartialKernel for Full {
+    fn element_nodes(&self) -> &[[u32; 4]] {
+        &self.layout.nodes
+    }
+
+    fn frequencies(&self, x: &[[f64; 2]], omega_squared: &mut [f64]) -> Result<(), ElementFailure> {
+        for (e, omega_squared) in omega_squared.iter_mut().enumerate() {
+            *omega_squared = self.frequency(x, e)?;
+        }
+        Ok(())
+    }
+
+    fn step_elements(
+        &mut self,
+        elements: &[u32],
+        (x, du): (&[[f64; 2]], &[f64]),
+        dt: f64,
+        omega_squared: &mut [f64],
+    ) -> Result<StepWork, ElementFailure> {
+        let mut sums = StepWork::default();
+        for &e in elements {
+            let e = e as usize;
+            let element = self.layout.nodes[e];
+            let xe: Nodes = element.map(|n| x[n as usize]);
+            let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+            let motion = (&xe, &ue);
+            let step = (dt, self.viscosity.as_ref());
+            let (p, committed) = (self.parameters(e), self.state_of(e));
+            let r = element_step(p, motion, &committed, &self.lumped_of(e), step)
+                .map_err(|err| self.layout.failure(e, err))?;
+            omega_squared[e] = r.omega_squared;
+            sums.observe(r.omega_squared, e);
+            self.store(e, &r.state);
+            self.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
+            sums.internal += r.work;
+            sums.plastic += r.plastic_work;
+            sums.viscous += r.viscous_work;
+        }
+        Ok(sums)
+    }
+
+    fn gather_nodes(&self, nodes: &[u32], force: &mut [f64]) {
+        self.gather.gather_nodes(nodes, &self.element_forces, force);
+    }
 }
 
 impl ExplicitKernel for Full {
@@ -548,6 +607,10 @@ impl ExplicitKernel for Full {
 
     fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling> {
         self.scaling.as_mut()
+    }
+
+    fn partial(&mut self) -> Option<&mut dyn PartialKernel> {
+        Some(self)
     }
 }
 

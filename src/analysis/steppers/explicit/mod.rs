@@ -493,6 +493,16 @@ impl Resume for Explicit<'_> {
         {
             scaling.restore(carried, &mut self.mass, &mut self.inverse_mass, &self.free);
         }
+        match (self.subcycler.as_mut(), carry.subcycling) {
+            (Some(sub), Some(carried)) => {
+                let Some(kernel) = self.kernel.partial() else {
+                    return false;
+                };
+                sub.restore(carried, kernel);
+            }
+            (None, None) => {}
+            _ => return false,
+        }
         true
     }
 
@@ -521,6 +531,7 @@ impl Resume for Explicit<'_> {
                 None => Vec::new(),
             },
             mass_scaling: self.kernel.mass_scaling().map(|s| s.carry(&self.mass)),
+            subcycling: self.subcycler.as_ref().map(|s| s.carry()),
         }))
     }
 }

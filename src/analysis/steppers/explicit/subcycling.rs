@@ -23,6 +23,7 @@
 //! single-step central difference, operation for operation.
 
 use super::{Explicit, total_at};
+use crate::analysis::steppers::carry::SubcyclingCarry;
 use crate::analysis::steppers::clock::Step;
 use crate::analysis::steppers::{StepError, loads};
 use crate::analysis::summary::{RunError, Status, SubcyclingSummary};
@@ -228,6 +229,30 @@ impl Subcycler {
             dt: (1u64 << self.levels.top) as f64 * finest.dt,
             ..finest
         }
+    }
+
+    /// What a checkpoint keeps.
+    pub(super) fn carry(&self) -> SubcyclingCarry {
+        SubcyclingCarry {
+            omega_squared: self.omega_squared.clone(),
+            last_substep: self.last_substep,
+            substeps: self.substeps,
+            element_updates: self.element_updates,
+        }
+    }
+
+    /// Takes a checkpoint's carry back: the levels are those its bounds form.
+    pub(super) fn restore(&mut self, carry: SubcyclingCarry, kernel: &mut dyn PartialKernel) {
+        self.omega_squared = carry.omega_squared;
+        self.last_substep = carry.last_substep;
+        self.substeps = carry.substeps;
+        self.element_updates = carry.element_updates;
+        self.levels = Levels::form(
+            &self.omega_squared,
+            kernel.element_nodes(),
+            &self.pinned,
+            self.rule.levels,
+        );
     }
 
     /// summary.json `subcycling` of a kernel of `elements` elements.
