@@ -501,7 +501,7 @@ impl ContactState {
     ) {
         let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
         let rows = (&step.active[..], &step.forces[..]);
-        self.set(interfaces, rows, (time, released), coords, None);
+        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
         for (i, (p, k)) in step.active.iter().enumerate() {
             self.tangential[*p][*k] = step.tangential[i];
             self.sliding[*p][*k] = step.sliding[i];
@@ -517,10 +517,9 @@ impl ContactState {
         interfaces: &Interfaces,
         (active, forces): (&[(usize, usize)], &[f64]),
         (time, released): (f64, bool),
-        positions: &[[f64; 2]],
+        x: &impl Fn(usize) -> [f64; 2],
         lowest: Option<Option<f64>>,
     ) {
-        let x = &|n: usize| positions[n];
         for flags in &mut self.active {
             flags.iter_mut().for_each(|a| *a = false);
         }
@@ -560,9 +559,8 @@ impl ContactState {
         }
         for pair in &interfaces.pairs {
             let boundary = &interfaces.bodies[pair.slave_body].boundary;
-            penetration =
-                penetration.max(super::setup::master_penetration(pair, positions, boundary));
-            penetration = penetration.max(super::setup::slave_penetration(pair, positions));
+            penetration = penetration.max(super::setup::master_penetration(pair, x, boundary));
+            penetration = penetration.max(super::setup::slave_penetration(pair, x));
         }
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);

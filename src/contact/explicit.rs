@@ -105,7 +105,8 @@ impl ContactState {
             .iter()
             .zip(&c.in_active)
             .any(|(was, is)| was.iter().zip(is).any(|(was, is)| *was && !*is));
-        let end = step.positions(&c.delta);
+        // the corrected end positions, read at the nodes the contact looks at
+        let end = |node: usize| step.position(&c.delta, node);
         self.master_block = c
             .masters
             .iter()
@@ -190,15 +191,6 @@ impl Predicted<'_> {
             self.start[node][0] + self.du[2 * node] + delta[2 * node],
             self.start[node][1] + self.du[2 * node + 1] + delta[2 * node + 1],
         ]
-    }
-
-    /// `position` of every node.
-    fn positions(&self, delta: &[f64]) -> Vec<[f64; 2]> {
-        self.start
-            .iter()
-            .zip(self.du.chunks_exact(2).zip(delta.chunks_exact(2)))
-            .map(|(s, (du, delta))| [s[0] + du[0] + delta[0], s[1] + du[1] + delta[1]])
-            .collect()
     }
 
     /// The passes of the correction (at most 20): penetrated entries join, the multipliers

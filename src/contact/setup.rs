@@ -117,7 +117,7 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
 /// Zero when none is inside. Only master nodes within the slave boundary's bounding box are tested.
 pub fn master_penetration(
     pair: &ContactPair,
-    x: &[[f64; 2]],
+    x: &impl Fn(usize) -> [f64; 2],
     slave_boundary: &[[usize; 2]],
 ) -> f64 {
     let Master::Segments { edges, .. } = &pair.master else {
@@ -134,14 +134,13 @@ pub fn master_penetration(
 /// projects onto (`mortar::nearest_projection`), which the weighted gaps hold only on
 /// average over the slave segments. Zero for other pairs, whose slave gaps are pointwise
 /// already.
-pub fn slave_penetration(pair: &ContactPair, x: &[[f64; 2]]) -> f64 {
+pub fn slave_penetration(pair: &ContactPair, x: &impl Fn(usize) -> [f64; 2]) -> f64 {
     let (Some(_), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master) else {
         return 0.0;
     };
-    let x = |n: usize| x[n];
     pair.slaves
         .iter()
-        .filter_map(|s| super::mortar::nearest_projection(edges, *s, &x))
+        .filter_map(|s| super::mortar::nearest_projection(edges, *s, x))
         .fold(0.0, |deepest, (distance, _, _)| deepest.max(-distance))
 }
 
@@ -149,12 +148,12 @@ pub fn slave_penetration(pair: &ContactPair, x: &[[f64; 2]]) -> f64 {
 /// positions `x`): for each node inside (an odd number of crossings of a ray), its distance
 /// to the nearest boundary edge; zero when none is inside. Only nodes within the boundary's
 /// bounding box are tested.
-fn deepest_inside(nodes: &[usize], x: &[[f64; 2]], boundary: &[[usize; 2]]) -> f64 {
+fn deepest_inside(nodes: &[usize], x: &impl Fn(usize) -> [f64; 2], boundary: &[[usize; 2]]) -> f64 {
     let slave_boundary = boundary;
     if slave_boundary.is_empty() {
         return 0.0;
     }
-    let segments: Vec<[[f64; 2]; 2]> = slave_boundary.iter().map(|[a, b]| [x[*a], x[*b]]).collect();
+    let segments: Vec<[[f64; 2]; 2]> = slave_boundary.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
     // the bounding box by plain comparisons, the edges' start and end points in separate
     // lanes (independent chains of minima; they differ from `f64::min` only in the sign of
     // a zero bound, which the tests below ignore)
@@ -189,7 +188,7 @@ fn deepest_inside(nodes: &[usize], x: &[[f64; 2]], boundary: &[[usize; 2]]) -> f
         .fold(0.0, f64::max);
     let mut deepest = 0.0f64;
     for &m in nodes {
-        let p = x[m];
+        let p = x(m);
         let boxed = (0..2).all(|c| p[c] > lo[c] && p[c] < hi[c]);
         if !boxed || !inside_by_crossings(p, segments.iter().copied()) {
             continue;

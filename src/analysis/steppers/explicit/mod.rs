@@ -148,8 +148,9 @@ impl<'a> Explicit<'a> {
     }
 
     /// The contact correction of the predicted increment (forward-increment multipliers) of a
-    /// step of length `h` after one of length `last`.
-    fn contact_correction(&mut self, (h, last): (f64, f64), time: f64) {
+    /// step of length `h` after one of length `last`; `moving`: the nodes that step (None:
+    /// all; a subcycled substep moves its finest level's, among them every contact node).
+    fn contact_correction(&mut self, (h, last): (f64, f64), time: f64, moving: Option<&[u32]>) {
         let positions = self.state.positions(self.spec.geometry);
         let predicted = Predicted {
             interfaces: &self.interfaces,
@@ -168,7 +169,14 @@ impl<'a> Explicit<'a> {
         // so is every term, which leaves each sum as it was (a zero term changes a sum at most
         // by the sign of a zero total); a sum in DOF order is a chain of dependent additions
         // that cost the rod pair a fifth of its contact phase over all DOFs.
-        let touched = touched_dofs(&step.step_force, &step.correction);
+        let touched = match moving {
+            None => touched_dofs(&step.step_force, &step.correction),
+            Some(nodes) => nodes
+                .iter()
+                .flat_map(|n| [2 * *n as usize, 2 * *n as usize + 1])
+                .filter(|i| step.step_force[*i] != 0.0 || step.correction[*i] != 0.0)
+                .collect(),
+        };
         let (mass, a) = (&self.mass, &self.a);
         let held = touched
             .iter()
@@ -187,8 +195,16 @@ impl<'a> Explicit<'a> {
                 *v += if *c == 0.0 { *c } else { -0.0 };
             }
         };
-        if self.du.len() <= DOF_CHUNK {
-            // one chunk: not worth the pool's bookkeeping
+        if let Some(nodes) = moving {
+            // the nodes that step only: the others' increments are not read
+            for n in nodes {
+                let d = 2 * *n as usize;
+                let (du, v_half) = (&mut self.du[d..d + 2], &mut self.v_half[d..d + 2]);
+                apply(du, v_half, &step.correction[d..d + 2]);
+            }
+        } else if self.du.len() <= DOF_CHUNK || rayon::current_num_threads() == 1 {
+            // one chunk or one thread: not worth the pool's bookkeeping (the same operation
+            // on every DOF either way)
             apply(&mut self.du, &mut self.v_half, &step.correction);
         } else {
             (
@@ -308,7 +324,7 @@ impl Stepper for Explicit<'_> {
         }
         if !model.contacts.is_empty() {
             let start = Instant::now();
-            self.contact_correction((h, self.clock.last), time);
+            self.contact_correction((h, self.clock.last), time, None);
             crate::profile::add(crate::profile::Phase::Contact, start);
         }
         let bound = match self.internal_force(h) {

@@ -389,7 +389,7 @@ impl Explicit<'_> {
         }
         if !self.model.contacts.is_empty() {
             let start = Instant::now();
-            self.contact_correction((h, sub.last_substep), t);
+            self.contact_correction((h, sub.last_substep), t, Some(&sub.levels.nodes[0]));
             crate::profile::add(crate::profile::Phase::Contact, start);
         }
         for k in 0..=finest {
