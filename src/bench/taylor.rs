@@ -1,7 +1,9 @@
 //! The Taylor benchmarks of `impact bench --case taylor`: two rods of models/ striking a rigid
 //! wall, each on three meshes (twice as fine each time) with the one-point and the 2x2 explicit
-//! kernels, the Johnson-Cook rod also with implicit Newmark; charts of the final shape against
-//! wall time beside the published results.
+//! kernels, each as a single-step, a subcycled (theory 8.7c) and a mass-scaled (8.7b) run, the
+//! Johnson-Cook rod also with implicit Newmark; charts of the final shape against wall time
+//! beside the published results, and of the error of L_f and D_f against the extrapolated
+//! converged value against wall time for the three ways to step.
 
 use super::{Bottom, Case, Method, Row, SceneCase};
 use crate::output::OutputError;
@@ -69,6 +71,49 @@ struct Benchmark {
     implicit: Option<(f64, usize)>,
     charts: &'static [Measure],
     references: Vec<Reference>,
+    /// The mass scaling's target on the coarsest mesh (halved with each refinement, as the
+    /// stable step is): about a quarter of the initial stable step.
+    mass_scaling_target: f64,
+}
+
+/// How an explicit case steps: every element together, subcycled, or mass-scaled.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Stepping {
+    Single,
+    Subcycled,
+    MassScaled,
+}
+
+impl Stepping {
+    const ALL: [Stepping; 3] = [Stepping::Single, Stepping::Subcycled, Stepping::MassScaled];
+
+    /// The part of a case's name that says it (empty for the single step).
+    fn tag(self) -> &'static str {
+        match self {
+            Stepping::Single => "",
+            Stepping::Subcycled => "subcycled_",
+            Stepping::MassScaled => "mass_scaled_",
+        }
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            Stepping::Single => "single step",
+            Stepping::Subcycled => "subcycled",
+            Stepping::MassScaled => "mass-scaled",
+        }
+    }
+
+    /// The stepping of the row named `name`.
+    fn of(name: &str) -> Stepping {
+        if name.contains(Stepping::Subcycled.tag()) {
+            Stepping::Subcycled
+        } else if name.contains(Stepping::MassScaled.tag()) {
+            Stepping::MassScaled
+        } else {
+            Stepping::Single
+        }
+    }
 }
 
 fn benchmarks() -> Vec<Benchmark> {
@@ -81,6 +126,7 @@ fn benchmarks() -> Vec<Benchmark> {
             element: None,
             implicit: None,
             charts: &[Measure::Length, Measure::Radius],
+            mass_scaling_target: 8e-9,
             references: vec![
                 Reference {
                     label: "experiment (Wilkins & Guinan 1973)",
@@ -112,6 +158,7 @@ fn benchmarks() -> Vec<Benchmark> {
                 Measure::PlasticStrain,
                 Measure::Temperature,
             ],
+            mass_scaling_target: 2e-8,
             references: [
                 (Measure::Length, 26.52, 26.56),
                 (Measure::Diameter, 11.15, 11.16),
@@ -158,13 +205,24 @@ pub fn cases() -> Vec<Case> {
             (Method::ExplicitReduced, "reduced"),
             (Method::Explicit, "full"),
         ] {
-            for nx in b.meshes {
-                cases.push(case(
-                    format!("{}_{quadrature}_{}", b.key, mesh(nx)),
-                    method,
-                    nx,
-                    vec![format!("analysis.quadrature={quadrature}")],
-                ));
+            for stepping in Stepping::ALL {
+                for nx in b.meshes {
+                    let mut extra = vec![format!("analysis.quadrature={quadrature}")];
+                    match stepping {
+                        Stepping::Single => {}
+                        Stepping::Subcycled => extra.push("analysis.subcycling={}".into()),
+                        Stepping::MassScaled => extra.push(format!(
+                            "analysis.mass_scaling.target={:e}",
+                            b.mass_scaling_target * b.meshes[0] as f64 / nx as f64
+                        )),
+                    }
+                    cases.push(case(
+                        format!("{}_{quadrature}_{}{}", b.key, stepping.tag(), mesh(nx)),
+                        method,
+                        nx,
+                        extra,
+                    ));
+                }
             }
         }
         if let Some((dt, count)) = b.implicit {
@@ -269,8 +327,12 @@ pub fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
         if runs.is_empty() {
             continue;
         }
+        error_chart(&b, dir, &runs)?;
         let mut points: Vec<(Method, f64, Vec<(Measure, f64)>)> = Vec::new();
-        for r in &runs {
+        for r in runs
+            .iter()
+            .filter(|r| Stepping::of(&r.name) == Stepping::Single)
+        {
             points.push((r.method, r.wall_seconds, finals(&b, dir, r)?));
         }
         let (lo, hi) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
@@ -335,6 +397,113 @@ pub fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
                 &dir.join(format!("{}_{}.svg", b.key, measure.file())),
             )?;
         }
+    }
+    Ok(())
+}
+
+/// KEY_error.svg (and .png): the error of L_f and D_f against the converged value, each
+/// kernel's extrapolated from its three single-step meshes (Celik et al. 2008,
+/// `sweep::qoi::extrapolate`; the finest single-step value where the three are not in the
+/// asymptotic range), against the wall time, one series per kernel and stepping. Nothing is
+/// written unless every kernel with rows has its three single-step meshes.
+fn error_chart(b: &Benchmark, dir: &Path, runs: &[&Row]) -> Result<(), OutputError> {
+    let kernels = [
+        (Method::ExplicitReduced, "one-point"),
+        (Method::Explicit, "2x2"),
+    ];
+    let measures = [(Measure::Length, "L_f"), (Measure::Diameter, "D_f")];
+    let mut panels: Vec<Vec<Series>> = vec![Vec::new(); measures.len()];
+    let mut notes: Vec<Vec<String>> = vec![Vec::new(); measures.len()];
+    for (method, kernel) in kernels {
+        let of_kernel: Vec<&Row> = runs
+            .iter()
+            .copied()
+            .filter(|r| r.method == method)
+            .collect();
+        let single: Vec<&Row> = of_kernel
+            .iter()
+            .copied()
+            .filter(|r| Stepping::of(&r.name) == Stepping::Single)
+            .collect();
+        if of_kernel.is_empty() {
+            continue;
+        }
+        if single.len() != 3 {
+            return Ok(());
+        }
+        let mut values = Vec::new();
+        for r in &of_kernel {
+            values.push((Stepping::of(&r.name), r.wall_seconds, finals(b, dir, r)?));
+        }
+        for (k, (measure, name)) in measures.iter().enumerate() {
+            let value = |v: &[(Measure, f64)]| {
+                v.iter()
+                    .find(|(m, _)| m == measure)
+                    .map_or(f64::NAN, |(_, x)| *x)
+            };
+            // the single-step meshes, finest first (h ~ 1 / nx)
+            let mut by_mesh: Vec<(usize, f64)> = single
+                .iter()
+                .zip(values.iter().filter(|v| v.0 == Stepping::Single))
+                .map(|(r, v)| (r.elements, value(&v.2)))
+                .collect();
+            by_mesh.sort_by(|a, b| b.0.cmp(&a.0));
+            let h: [f64; 3] = std::array::from_fn(|i| 1.0 / (by_mesh[i].0 as f64).sqrt());
+            let f: [f64; 3] = std::array::from_fn(|i| by_mesh[i].1);
+            let extrapolation = crate::sweep::qoi::extrapolate(h, f);
+            let converged = extrapolation.value.unwrap_or(f[0]);
+            notes[k].push(match extrapolation.value {
+                Some(v) => format!("{kernel}: {name} extrapolated {v:.4} mm"),
+                None => format!(
+                    "{kernel}: {name} not extrapolated, finest single step {:.4} mm",
+                    f[0]
+                ),
+            });
+            for stepping in Stepping::ALL {
+                let points: Vec<(f64, f64)> = values
+                    .iter()
+                    .filter(|v| v.0 == stepping)
+                    .map(|v| {
+                        (
+                            v.1,
+                            (100.0 * (value(&v.2) / converged - 1.0)).abs().max(1e-4),
+                        )
+                    })
+                    .collect();
+                if !points.is_empty() {
+                    panels[k].push(Series {
+                        label: format!("{kernel}, {}", stepping.label()),
+                        points,
+                        style: SeriesStyle::LineAndMarkers,
+                    });
+                }
+            }
+        }
+    }
+    let charts: Vec<Chart> = measures
+        .iter()
+        .zip(panels.into_iter().zip(notes))
+        .filter(|(_, (series, _))| !series.is_empty())
+        .map(|((_, name), (series, notes))| Chart {
+            title: format!(
+                "{}: error of {name} against wall time (three meshes each)",
+                b.title
+            ),
+            x_label: "wall time (s)".into(),
+            y_label: format!("|{name} - converged| (% of converged)"),
+            series,
+            log_x: true,
+            log_y: true,
+            x_limits: Default::default(),
+            y_limits: Default::default(),
+            notes,
+        })
+        .collect();
+    if charts.is_empty() {
+        return Ok(());
+    }
+    for ext in ["svg", "png"] {
+        plot::write_panels(&charts, &dir.join(format!("{}_error.{ext}", b.key)))?;
     }
     Ok(())
 }

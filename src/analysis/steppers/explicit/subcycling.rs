@@ -502,23 +502,25 @@ impl Explicit<'_> {
 
     /// The energies at the end of a major step (every node has ended a step there).
     fn end_major_step(&mut self, sub: &Subcycler, sums: &NodeSums, h: f64) {
-        // the shadow h^2 / 8 a.M a with each node's own step, summed per level
         let mut kinetic = 0.0;
-        let mut shadow = vec![0.0; sub.levels.top as usize + 1];
-        for (d, (v, m)) in self.v.iter().zip(&self.mass).enumerate() {
+        for (v, m) in self.v.iter().zip(&self.mass) {
             kinetic += m * v * v;
-            if self.free[d] {
-                shadow[sub.levels.node[d / 2] as usize] += m * self.a[d] * self.a[d];
-            }
         }
-        let shadow: f64 = shadow
-            .iter()
-            .enumerate()
-            .map(|(k, s)| {
-                let span = (1u64 << k) as f64 * h;
-                0.125 * span * span * s
-            })
-            .sum();
+        // the shadow h^2 / 8 a.M a with each node's own step, summed per level
+        let mut shadow = 0.0;
+        for (k, nodes) in sub.levels.nodes.iter().enumerate() {
+            let mut sum = 0.0;
+            for d in nodes
+                .iter()
+                .flat_map(|n| [2 * *n as usize, 2 * *n as usize + 1])
+            {
+                if self.free[d] {
+                    sum += self.mass[d] * self.a[d] * self.a[d];
+                }
+            }
+            let span = (1u64 << k) as f64 * h;
+            shadow += 0.125 * span * span * sum;
+        }
         let energies = &mut self.energies;
         energies.external_work += 0.5 * sums.work;
         energies.kinetic = 0.5 * kinetic;
