@@ -502,13 +502,52 @@ fn results_do_not_depend_on_thread_count_above_the_parallel_threshold() {
             ],
         ),
     ] {
-        results_do_not_depend_on_thread_count(path, &overrides);
+        results_do_not_depend_on_thread_count(path, PARALLEL_ROD, &overrides);
+    }
+    // subcycled, both kernels: a level's elements in parallel chunks of its list
+    for (path, overrides) in [
+        ("subcycled", vec!["analysis.subcycling={}"]),
+        (
+            "subcycled_full",
+            vec!["analysis.quadrature=full", "analysis.subcycling={}"],
+        ),
+    ] {
+        results_do_not_depend_on_thread_count(path, &two_level_rods(), &overrides);
     }
 }
 
-/// The thread-count check of PARALLEL_ROD with `overrides`.
-fn results_do_not_depend_on_thread_count(path: &str, overrides: &[&str]) {
-    let model = common::model("parallel_rod", PARALLEL_ROD, overrides);
+/// PARALLEL_ROD and beside it a ring (x from 6 to 10 mm) meshed twice as coarse, 20 x 50,
+/// on the same wall: subcycled, the rod's elements step on level 0 and most of the ring's
+/// 1000 on level 1, both levels more than one chunk of the kernels' lists.
+fn two_level_rods() -> String {
+    PARALLEL_ROD
+        .replace(
+            "[[support]]\nset = \"left\"",
+            "[[support]]\nbody = \"rod\"\nset = \"left\"",
+        )
+        .replace(
+            "slave = { set = \"bottom\" }",
+            "slave = { body = \"rod\", set = \"bottom\" }",
+        )
+        .replace("[[output.probe]]\n", "[[output.probe]]\nbody = \"rod\"\n")
+        + r#"
+[[body]]
+name = "ring"
+material = "steel"
+formulation = "axisymmetric"
+velocity = [0.0, -200.0]
+mesh = { type = "rectangle", origin = [6.0e-3, 0.0], width = 4.0e-3, height = 20.0e-3, nx = 20, ny = 50 }
+
+[[contact]]
+name = "ring_face"
+slave = { body = "ring", set = "bottom" }
+obstacle = "wall"
+"#
+}
+
+/// The thread-count check of the scene `text` with `overrides`.
+fn results_do_not_depend_on_thread_count(path: &str, text: &str, overrides: &[&str]) {
+    let model = common::model("parallel_rod", text, overrides);
     assert!(
         model.elements() >= impact::analysis::PARALLEL_FROM_ELEMENTS,
         "{path}: the model must be large enough to run in parallel"
@@ -526,6 +565,13 @@ fn results_do_not_depend_on_thread_count(path: &str, overrides: &[&str]) {
                 .install(|| impact::analysis::run_to_state(&model, &dir, Default::default()))
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(summary.contact.peak_force > 0.0, "{name}: the wall acts");
+            if let Some(sub) = &summary.subcycling {
+                let [finest, coarser] = [0, 1].map(|k| sub.elements_per_level.get(k).copied());
+                assert!(
+                    finest > Some(256) && coarser > Some(256),
+                    "{name}: two levels of more than one chunk: {sub:?}"
+                );
+            }
             (
                 std::fs::read_to_string(dir.join("history.csv")).unwrap(),
                 state,

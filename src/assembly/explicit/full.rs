@@ -27,7 +27,7 @@
 
 use super::{
     CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_scaling,
-    point_statistic, point_step, stable_step_of,
+    point_statistic, point_step, stable_step_of, subset_steps,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -406,26 +406,24 @@ impl PartialKernel for Full {
         dt: f64,
         omega_squared: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
-        let mut sums = StepWork::default();
-        for &e in elements {
-            let e = e as usize;
-            let element = self.layout.nodes[e];
+        let step = |this: &Full, e: usize| {
+            let element = this.layout.nodes[e];
             let xe: Nodes = element.map(|n| x[n as usize]);
             let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
-            let motion = (&xe, &ue);
-            let step = (dt, self.viscosity.as_ref());
-            let (p, committed) = (self.parameters(e), self.state_of(e));
-            let r = element_step(p, motion, &committed, &self.lumped_of(e), step)
-                .map_err(|err| self.layout.failure(e, err))?;
+            let step = (dt, this.viscosity.as_ref());
+            let (p, committed) = (this.parameters(e), this.state_of(e));
+            element_step(p, (&xe, &ue), &committed, &this.lumped_of(e), step)
+        };
+        let commit = |this: &mut Full, e: usize, r: ElementStep, sums: &mut StepWork| {
             omega_squared[e] = r.omega_squared;
             sums.observe(r.omega_squared, e);
-            self.store(e, &r.state);
-            self.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
+            this.store(e, &r.state);
+            this.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
             sums.internal += r.work;
             sums.plastic += r.plastic_work;
             sums.viscous += r.viscous_work;
-        }
-        Ok(sums)
+        };
+        subset_steps(self, elements, step, commit).map_err(|(e, err)| self.layout.failure(e, err))
     }
 
     fn gather_nodes(&self, nodes: &[u32], force: &mut [f64]) {

@@ -20,8 +20,8 @@ use super::mass_scaling::ElementScaling;
 use super::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::Formulation;
 use crate::element::Strain;
-use crate::element::Voigt;
 use crate::element::mass_scaling::MassScaling;
+use crate::element::{KernelError, Voigt};
 use crate::material::{Material, PointState, PointStep, StressCondition, UpdateContext};
 use crate::scene::DynamicAnalysis;
 use crate::scene::model::{PointFold, Probe};
@@ -274,6 +274,49 @@ impl NodeGather {
             force[2 * n + 1] = fy;
         }
     }
+}
+
+/// The steps of a subcycling level's elements `elements` (ascending) in chunks of `CHUNK`
+/// entries, the chunk sums added in chunk order, so the bits do not depend on the thread
+/// count (and a list of all elements is chunked as the single-step loop chunks them). With
+/// several chunks and threads, `step(e)` runs in parallel without writing, then `commit`
+/// writes the results back in list order; else each element is stepped and committed in
+/// turn. `commit(e, result, sums)` writes element e's step and takes it into its chunk's sums.
+pub(super) fn subset_steps<K: Sync, R: Send>(
+    kernel: &mut K,
+    elements: &[u32],
+    step: impl Fn(&K, usize) -> Result<R, KernelError> + Sync,
+    mut commit: impl FnMut(&mut K, usize, R, &mut StepWork),
+) -> Result<StepWork, (usize, KernelError)> {
+    let mut total = StepWork::default();
+    if elements.len() > CHUNK && rayon::current_num_threads() > 1 {
+        let this = &*kernel;
+        let chunks: Vec<Result<Vec<R>, (usize, KernelError)>> = elements
+            .par_chunks(CHUNK)
+            .map(|list| {
+                list.iter()
+                    .map(|&e| step(this, e as usize).map_err(|err| (e as usize, err)))
+                    .collect()
+            })
+            .collect();
+        for (list, results) in elements.chunks(CHUNK).zip(chunks) {
+            let mut sums = StepWork::default();
+            for (&e, r) in list.iter().zip(results?) {
+                commit(kernel, e as usize, r, &mut sums);
+            }
+            total.add(&sums);
+        }
+    } else {
+        for list in elements.chunks(CHUNK) {
+            let mut sums = StepWork::default();
+            for &e in list {
+                let r = step(kernel, e as usize).map_err(|err| (e as usize, err))?;
+                commit(kernel, e as usize, r, &mut sums);
+            }
+            total.add(&sums);
+        }
+    }
+    Ok(total)
 }
 
 /// An explicit element loop over a model's Quad4 bodies.

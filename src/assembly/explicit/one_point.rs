@@ -21,7 +21,7 @@
 
 use super::{
     BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
-    element_scaling, point_statistic, point_step, stable_step_of,
+    element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -612,28 +612,28 @@ impl PartialKernel for Reduced {
         dt: f64,
         omega_squared: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
-        let mut sums = StepWork::default();
-        for &e in elements {
-            let e = e as usize;
-            let element = self.layout.nodes[e];
+        let step = |this: &Reduced, e: usize| {
+            let element = this.layout.nodes[e];
             let xe: Nodes = element.map(|n| x[n as usize]);
             let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
-            let p = &self.layout.bodies[self.layout.body[e] as usize];
-            let motion = (&xe, &ue);
-            let step = (dt, self.viscosity.as_ref());
-            let r = element_step(p, motion, &self.state_of(e), self.mass_of(e), step)
-                .map_err(|err| self.layout.failure(e, err))?;
+            let p = &this.layout.bodies[this.layout.body[e] as usize];
+            let step = (dt, this.viscosity.as_ref());
+            element_step(p, (&xe, &ue), &this.state_of(e), this.mass_of(e), step)
+        };
+        let commit = |this: &mut Reduced, e: usize, r: ElementStep, sums: &mut StepWork| {
             omega_squared[e] = r.omega_squared;
             sums.observe(r.omega_squared, e);
-            self.store(e, &r.state);
-            self.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
+            this.store(e, &r.state);
+            this.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
             sums.internal += r.work + r.hourglass_work;
             sums.plastic += r.plastic_work;
             sums.hourglass += r.hourglass_work;
             sums.viscous += r.viscous_work;
-        }
-        self.hourglass_energy += sums.hourglass;
-        Ok(sums)
+        };
+        let total = subset_steps(self, elements, step, commit)
+            .map_err(|(e, err)| self.layout.failure(e, err))?;
+        self.hourglass_energy += total.hourglass;
+        Ok(total)
     }
 
     fn gather_nodes(&self, nodes: &[u32], force: &mut [f64]) {
