@@ -395,3 +395,37 @@ fn subcycling_refuses_forces() {
     assert_eq!(err.exit_code(), 2, "{err}");
     assert!(err.to_string().contains("analysis.subcycling"), "{err}");
 }
+
+/// Goal: `impact check` reports the levels a subcycled run starts with. Setup:
+/// `graded_strip` on eight columns 0.125 wide and nine 1 wide (height 1). Reference, by
+/// hand: the one-point bound goes as (1 / w^2 + 1 / h^2), so the wide columns' own step is
+/// sqrt(65 / 2) = 5.7 times the narrow ones': level floor(log2 5.7) = 2. On level 0: the
+/// eight narrow columns, the wide one sharing their nodes, and the wide one at the wall
+/// (its face nodes are the contact's, kept on level 0): 10; the other 7 on level 2; none on
+/// level 1; the major step 4 substeps. A scene with a force is refused there too (exit 2).
+#[test]
+fn check_reports_the_starting_levels() {
+    let dir = common::out_dir("subcycled_check");
+    let mesh = dir.join("strip.vtk");
+    let widths: Vec<f64> = [0.125; 8].into_iter().chain([1.0; 9]).collect();
+    std::fs::write(&mesh, strip_vtk(&widths)).unwrap();
+    let scene = dir.join("strip.toml");
+    std::fs::write(&scene, graded_strip(&mesh)).unwrap();
+    let output = common::impact(&["check", scene.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(0), "{stdout}");
+    assert!(
+        stdout.contains("levels 0 to 2 on the initial mesh, 10, 0, 7 element(s) per level")
+            && stdout.contains("the major step is 4 times"),
+        "{stdout}"
+    );
+    let forced = format!(
+        "{}\n[[load]]\ntype = \"nodal_force\"\nset = \"tail\"\nforce = [1.0, 0.0]\n",
+        graded_strip(&mesh)
+    );
+    std::fs::write(&scene, forced).unwrap();
+    let output = common::impact(&["check", scene.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("analysis.subcycling"), "{stderr}");
+}

@@ -16,8 +16,8 @@
 //! ```
 
 use super::steppers::stable::{
-    StableStep, checked_step, critical_time_step, explicit_first_step, explicit_start_scaling,
-    implicit_first_step, wave_speed,
+    StableStep, checked_step, critical_time_step, explicit_first_step, explicit_start_levels,
+    explicit_start_scaling, implicit_first_step, wave_speed,
 };
 use crate::output::readable;
 use crate::scene::DynamicAnalysis;
@@ -210,6 +210,32 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
                 readable(model_mass)
             ));
         }
+        if let Some(levels) = explicit_start_levels(model, spec)? {
+            lines.push(subcycling_line(&levels));
+        }
     }
     Ok(lines)
+}
+
+/// `impact check`'s line on the levels a subcycled run starts with.
+fn subcycling_line(levels: &crate::analysis::steppers::explicit::Levels) -> String {
+    let counts: Vec<String> = levels
+        .elements
+        .iter()
+        .map(|l| l.len().to_string())
+        .collect();
+    if levels.top == 0 {
+        return "subcycling: every element on level 0 on the initial mesh (their own stable steps \
+                within a factor 2, or the contact surfaces' neighbours): the run steps as one \
+                until the elements' steps part as the mesh deforms (summary.json `subcycling`)"
+            .to_string();
+    }
+    format!(
+        "subcycling: levels 0 to {} on the initial mesh, {} element(s) per level (finest first); \
+         the major step is {} times the step above (the finest level's); the levels follow the mesh as it deforms \
+         (summary.json `subcycling`)",
+        levels.top,
+        counts.join(", "),
+        1u64 << levels.top
+    )
 }

@@ -83,6 +83,24 @@ pub fn explicit_start_scaling(
         .map(|s| s.report(model.bodies.len(), |e| kernel.locate(e))))
 }
 
+/// The levels a subcycled central-difference run of `model` starts with (None: no
+/// subcycling), formed as the run forms them: what `impact check` reports.
+pub fn explicit_start_levels(
+    model: &Model,
+    spec: &DynamicAnalysis,
+) -> Result<Option<super::explicit::Levels>, InputError> {
+    let Some(rule) = spec.subcycling else {
+        return Ok(None);
+    };
+    let masses =
+        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
+    let state = State::initial(model);
+    let (mut kernel, _) = kernel_for(model, spec, &state, &masses);
+    let (levels, _) =
+        super::explicit::subcycling_start(model, rule, kernel.as_mut(), &state.coordinates)?;
+    Ok(Some(levels))
+}
+
 /// The stability limit of `model` under `spec` (the bulk viscosity's damping at rest taken
 /// into account), or the refusal of a fixed dt above it (unless the scene sets
 /// `allow_unstable` to watch it blow up): the one check `impact check` and a run share.

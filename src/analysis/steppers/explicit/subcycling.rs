@@ -26,7 +26,7 @@ use super::{Explicit, total_at};
 use crate::analysis::steppers::carry::SubcyclingCarry;
 use crate::analysis::steppers::clock::Step;
 use crate::analysis::steppers::{StepError, loads};
-use crate::analysis::summary::{RunError, Status, SubcyclingSummary};
+use crate::analysis::summary::{Status, SubcyclingSummary};
 use crate::assembly::StableStep;
 use crate::assembly::explicit::{ExplicitKernel, PartialKernel, StepWork};
 use crate::contact::Interfaces;
@@ -176,33 +176,9 @@ impl Subcycler {
         rule: Subcycling,
         kernel: &mut dyn ExplicitKernel,
         x: &[[f64; 2]],
-    ) -> Result<Subcycler, RunError> {
-        let refuse = |message: String| RunError::from(InputError::new(&model.file, message));
-        if super::loads::has_external_force(model) {
-            return Err(refuse(
-                "analysis.subcycling: steps the nodes at different times, and the scene's forces, tractions or \
-                 pressures would act on nodes between their steps; remove subcycling or the loads"
-                    .into(),
-            ));
-        }
-        let elements = kernel.elements();
-        let Some(partial) = kernel.partial() else {
-            return Err(refuse(
-                "analysis.subcycling: runs in the one-point kernel (quadrature = \"reduced\")"
-                    .into(),
-            ));
-        };
-        let mut omega_squared = vec![0.0; elements];
-        partial
-            .frequencies(x, &mut omega_squared)
-            .map_err(|err| refuse(err.to_string()))?;
+    ) -> Result<Subcycler, InputError> {
+        let (levels, omega_squared) = start(model, rule, kernel, x)?;
         let (pinned, moving) = pinned_nodes(model, &model.interfaces());
-        let levels = Levels::form(
-            &omega_squared,
-            partial.element_nodes(),
-            &pinned,
-            rule.levels,
-        );
         Ok(Subcycler {
             rule,
             pinned,
@@ -274,6 +250,43 @@ impl Subcycler {
             self.levels = Levels::of_element_levels(own, kernel.element_nodes(), &self.pinned);
         }
     }
+}
+
+/// The levels a subcycled run of `model` starts with (`rule`, the kernel `kernel` on the
+/// positions `x`) and the elements' frequency bounds they come from; refuses loads it cannot
+/// follow (forces between the nodes' steps). What `impact check` reports.
+pub fn start(
+    model: &Model,
+    rule: Subcycling,
+    kernel: &mut dyn ExplicitKernel,
+    x: &[[f64; 2]],
+) -> Result<(Levels, Vec<f64>), InputError> {
+    let refuse = |message: String| InputError::new(&model.file, message);
+    if super::loads::has_external_force(model) {
+        return Err(refuse(
+            "analysis.subcycling: steps the nodes at different times, and the scene's forces, tractions or \
+             pressures would act on nodes between their steps; remove subcycling or the loads"
+                .into(),
+        ));
+    }
+    let elements = kernel.elements();
+    let Some(partial) = kernel.partial() else {
+        return Err(refuse(
+            "analysis.subcycling: runs in the finite-strain explicit Quad4 kernels".into(),
+        ));
+    };
+    let mut omega_squared = vec![0.0; elements];
+    partial
+        .frequencies(x, &mut omega_squared)
+        .map_err(|err| refuse(err.to_string()))?;
+    let (pinned, _) = pinned_nodes(model, &model.interfaces());
+    let levels = Levels::form(
+        &omega_squared,
+        partial.element_nodes(),
+        &pinned,
+        rule.levels,
+    );
+    Ok((levels, omega_squared))
 }
 
 /// The nodes subcycling keeps at level 0: those of the contact surfaces (both sides, so the
