@@ -22,7 +22,8 @@ fn run_scene(name: &str, scene: &str, overrides: &[&str]) -> (Summary, std::path
 /// wall with the automatic step (its 14 equal elements form one level).
 /// Reference: the single-step runs of the same scenes; history.csv identical to the byte
 /// (the substep is the step, the element and node updates the same operations in the same
-/// order).
+/// order); the run warns that subcycling saved nothing (0 % of the element steps, below the
+/// warning's tenth).
 #[test]
 fn one_level_is_the_single_step_method() {
     for (scene, extra) in [
@@ -39,8 +40,20 @@ fn one_level_is_the_single_step_method() {
         let (_, single) = run_scene(&format!("one_level_{scene}"), scene, base);
         let with: Vec<&str> = base.iter().copied().chain([extra]).collect();
         let (summary, sub) = run_scene(&format!("one_level_{scene}_sub"), scene, &with);
-        let levels = summary.subcycling.expect("the subcycling is reported");
+        let levels = summary
+            .subcycling
+            .clone()
+            .expect("the subcycling is reported");
         assert_eq!(levels.levels, 0, "{scene}: one level");
+        // it saved nothing, and says so (a warning at less than a tenth saved)
+        assert!(
+            summary
+                .warnings
+                .iter()
+                .any(|w| w.contains("analysis.subcycling saved 0.0 %")),
+            "{scene}: {:?}",
+            summary.warnings
+        );
         let read = |dir: &Path| std::fs::read(dir.join("history.csv")).unwrap();
         assert!(read(&single) == read(&sub), "{scene}: history.csv differs");
     }
@@ -327,6 +340,11 @@ fn taylor_rod_subcycled_keeps_the_answer_and_the_balance() {
     assert!(
         3 * counts.element_updates < counts.single_step_updates,
         "{counts:?}"
+    );
+    assert!(
+        !summary.warnings.iter().any(|w| w.contains("subcycling")),
+        "{:?}",
+        summary.warnings
     );
 }
 

@@ -510,6 +510,11 @@ fn unit_hint(model: &Model) -> String {
     CONSISTENT.to_string()
 }
 
+/// A subcycled run that took at least this share of the single step's element steps is
+/// warned about: its bookkeeping (a fifth of the aluminium Taylor rod's subcycled run,
+/// docs/performance.md) eats a saving below a tenth.
+const SUBCYCLING_GAIN: f64 = 0.9;
+
 /// The warnings of a run that ended with `summary` and the last `energies`.
 pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<String> {
     let mut out = setup_warnings(model);
@@ -541,6 +546,19 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
     }
     if let Some(problem) = time_step_warning(model, summary) {
         out.push(problem);
+    }
+    if let Some(sub) = &summary.subcycling
+        && (sub.element_updates as f64) >= SUBCYCLING_GAIN * sub.single_step_updates as f64
+    {
+        out.push(format!(
+            "analysis.subcycling saved {:.1} % of the element steps ({} of {}): the elements' own \
+             stable steps stayed within a factor 2 of the shortest (or their neighbours on the \
+             finest level, the contact surfaces' among them, held them there), so the run paid \
+             the single step's element work and the levels' bookkeeping; remove subcycling",
+            100.0 * (1.0 - sub.element_updates as f64 / sub.single_step_updates.max(1) as f64),
+            sub.element_updates,
+            sub.single_step_updates
+        ));
     }
     let moved = summary.energy.initial > 0.0 || energies.external_work.abs() > 0.0;
     if moved {
