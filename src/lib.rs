@@ -14,7 +14,8 @@
 //! 6  assembly                           element dispatch, scatter, parallel loops
 //! 7  buckling                           inertia of K_T, linearized buckling
 //! 8  analysis                           the run scaffold and its steppers
-//! 9  sweep, bench                       studies and speed
+//! 9  sweep                              studies: variations, measures, extrapolation
+//! 10 bench                              speed (its Taylor charts extrapolate as the sweeps do)
 //! ```
 //! The binary (src/main.rs) sits on top and calls analysis, sweep, bench and output.
 
