@@ -63,6 +63,42 @@ fn one_level_is_the_single_step_method() {
 /// wall at x = 10 at V = 0.1, on the mesh `mesh` (`strip_vtk`); M = 100, rho = 0.01,
 /// c = 100.
 fn graded_strip(mesh: &Path) -> String {
+    strip_scene(
+        mesh,
+        "velocity = [0.1, 0.0]",
+        r#"
+[[node_set]]
+name = "tail"
+nearest = [0.0, 0.0]
+
+[[node_set]]
+name = "face"
+box = [9.999, -1.0, 10.001, 2.0]
+
+[[obstacle]]
+name = "wall"
+points = [[10.0, 3.0], [10.0, -1.0]]
+
+[[contact]]
+name = "wall"
+slave = { set = "face" }
+obstacle = "wall"
+
+[[output.probe]]
+quantity = "p_x"
+set = "all"
+
+[[output.probe]]
+quantity = "v_x"
+set = "tail"
+"#,
+    )
+}
+
+/// A subcycled plane-strain strip in uniaxial strain (every node on a y-roller) on the mesh
+/// `mesh` (M = 100, rho = 0.01, c = 100), its body given `motion` (a velocity or nothing),
+/// with the tables `rest` (sets, loads, contact, probes).
+fn strip_scene(mesh: &Path, motion: &str, rest: &str) -> String {
     format!(
         r#"
 [[material]]
@@ -75,29 +111,12 @@ density = 0.01
 name = "strip"
 material = "m"
 formulation = "plane_strain"
-velocity = [0.1, 0.0]
+{motion}
 mesh = {{ type = "vtk", file = "{}" }}
-
-[[node_set]]
-name = "tail"
-nearest = [0.0, 0.0]
-
-[[node_set]]
-name = "face"
-box = [9.999, -1.0, 10.001, 2.0]
 
 [[support]]
 set = "all"
 fix = ["y"]
-
-[[obstacle]]
-name = "wall"
-points = [[10.0, 3.0], [10.0, -1.0]]
-
-[[contact]]
-name = "wall"
-slave = {{ set = "face" }}
-obstacle = "wall"
 
 [analysis]
 type = "dynamic"
@@ -108,15 +127,7 @@ subcycling = {{}}
 
 [output]
 frame_every = 0
-
-[[output.probe]]
-quantity = "p_x"
-set = "all"
-
-[[output.probe]]
-quantity = "v_x"
-set = "tail"
-"#,
+{rest}"#,
         mesh.display()
     )
 }
@@ -138,13 +149,8 @@ set = "tail"
 /// single-step run 7.1 %, subcycled 6.8 %).
 #[test]
 fn dalembert_bar_subcycled() {
-    let dir = common::out_dir("subcycled_strip");
-    let mesh = dir.join("strip.vtk");
     let widths: Vec<f64> = [0.125; 8].into_iter().chain([1.0; 9]).collect();
-    std::fs::write(&mesh, strip_vtk(&widths)).unwrap();
-    let model = common::model("subcycled_strip", &graded_strip(&mesh), &[]);
-    let out = dir.join("out");
-    let summary = impact::analysis::run(&model, &out, Default::default()).unwrap();
+    let (summary, out) = run_strip("subcycled_strip", &widths, graded_strip);
     let sub = summary
         .subcycling
         .clone()
@@ -192,20 +198,10 @@ fn dalembert_bar_subcycled() {
 /// stay on the finest level and take the curve's value at every substep); M = 100,
 /// rho = 0.01, c = 100.
 fn driven_strip(mesh: &Path) -> String {
-    format!(
+    strip_scene(
+        mesh,
+        "",
         r#"
-[[material]]
-name = "m"
-young = 74.28571428571429
-poisson = 0.3
-density = 0.01
-
-[[body]]
-name = "strip"
-material = "m"
-formulation = "plane_strain"
-mesh = {{ type = "vtk", file = "{}" }}
-
 [[node_set]]
 name = "held"
 box = [-1.0e-9, -1.0, 1.0e-9, 2.0]
@@ -213,10 +209,6 @@ box = [-1.0e-9, -1.0, 1.0e-9, 2.0]
 [[node_set]]
 name = "driven"
 box = [9.999, -1.0, 10.001, 2.0]
-
-[[support]]
-set = "all"
-fix = ["y"]
 
 [[support]]
 set = "held"
@@ -232,21 +224,10 @@ set = "driven"
 x = -0.1
 curve = "ramp"
 
-[analysis]
-type = "dynamic"
-integrator = "central_difference"
-quadrature = "reduced"
-end_time = 0.3
-subcycling = {{}}
-
-[output]
-frame_every = 0
-
 [[output.probe]]
 quantity = "s_xx"
 set = "held"
 "#,
-        mesh.display()
     )
 }
 
@@ -264,13 +245,8 @@ set = "held"
 /// +20 / -15 %).
 #[test]
 fn rod_wave_subcycled_doubles_at_the_held_end() {
-    let dir = common::out_dir("subcycled_wave");
-    let mesh = dir.join("strip.vtk");
     let widths: Vec<f64> = [1.0; 9].into_iter().chain([0.125; 8]).collect();
-    std::fs::write(&mesh, strip_vtk(&widths)).unwrap();
-    let model = common::model("subcycled_wave", &driven_strip(&mesh), &[]);
-    let out = dir.join("out");
-    let summary = impact::analysis::run(&model, &out, Default::default()).unwrap();
+    let (summary, out) = run_strip("subcycled_wave", &widths, driven_strip);
     let sub = summary.subcycling.expect("the subcycling is reported");
     assert!(sub.levels >= 1, "the levels part: {sub:?}");
     let (t, stress) = (column(&out, "time"), column(&out, "s_xx[held]"));
@@ -348,6 +324,23 @@ fn taylor_rod_subcycled_keeps_the_answer_and_the_balance() {
     );
 }
 
+/// Runs the scene `scene(mesh)` on a strip of columns of the widths `widths` (`strip_vtk`)
+/// in a fresh folder `name`: its summary and output folder.
+fn run_strip(
+    name: &str,
+    widths: &[f64],
+    scene: fn(&Path) -> String,
+) -> (Summary, std::path::PathBuf) {
+    let dir = common::out_dir(name);
+    let mesh = dir.join("strip.vtk");
+    std::fs::write(&mesh, strip_vtk(widths)).unwrap();
+    let model = common::model(name, &scene(&mesh), &[]);
+    let out = dir.join("out");
+    let summary = impact::analysis::run(&model, &out, Default::default())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    (summary, out)
+}
+
 /// A legacy VTK strip of quads, one row, columns of the widths `widths` (height 1).
 fn strip_vtk(widths: &[f64]) -> String {
     let mut x = vec![0.0];
@@ -375,47 +368,21 @@ fn strip_vtk(widths: &[f64]) -> String {
 }
 
 /// An elastic plane-strain strip in uniaxial strain (every node on a y-roller) on the mesh
-/// `mesh`, its left end held, moving at 1 toward it: a wave runs back and forth.
-fn elastic_strip(mesh: &Path, length: f64) -> String {
-    format!(
+/// `mesh`, its left end held, moving at 1e-4 toward it: a wave runs back and forth (the run's
+/// end and levels set by the caller).
+fn elastic_strip(mesh: &Path) -> String {
+    strip_scene(
+        mesh,
+        "velocity = [-1.0e-4, 0.0]",
         r#"
-[[material]]
-name = "m"
-young = 74.28571428571429
-poisson = 0.3
-density = 0.01
-
-[[body]]
-name = "strip"
-material = "m"
-formulation = "plane_strain"
-velocity = [-1.0e-4, 0.0]
-mesh = {{ type = "vtk", file = "{}" }}
-
 [[node_set]]
 name = "end"
 box = [-1.0e-9, -1.0, 1.0e-9, 2.0]
 
 [[support]]
-set = "all"
-fix = ["y"]
-
-[[support]]
 set = "end"
 fix = ["x"]
-
-[analysis]
-type = "dynamic"
-integrator = "central_difference"
-quadrature = "reduced"
-end_time = {}
-subcycling = {{ levels = 4 }}
-
-[output]
-frame_every = 0
 "#,
-        mesh.display(),
-        10.0 * length / 100.0
     )
 }
 
@@ -441,7 +408,10 @@ proptest! {
         let mesh = dir.join("strip.vtk");
         std::fs::write(&mesh, strip_vtk(&widths)).unwrap();
         let length: f64 = widths.iter().sum();
-        let model = common::model("random_layout", &elastic_strip(&mesh, length), &[]);
+        // ten transits (c = 100), levels up to 4
+        let end = format!("analysis.end_time={}", 10.0 * length / 100.0);
+        let overrides = [end.as_str(), "analysis.subcycling={levels=4}"];
+        let model = common::model("random_layout", &elastic_strip(&mesh), &overrides);
         let summary = impact::analysis::run(&model, &dir.join("out"), Default::default()).unwrap();
         let kinetic = column(&dir.join("out"), "kinetic_energy");
         let internal = column(&dir.join("out"), "internal_energy");

@@ -26,8 +26,8 @@
 //! ```
 
 use super::{
-    CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_scaling,
-    point_statistic, point_step, stable_step_of, subset_steps,
+    CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_motion,
+    element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -392,11 +392,8 @@ impl PartialKernel for Full {
         &self.layout.nodes
     }
 
-    fn frequencies(&self, x: &[[f64; 2]], omega_squared: &mut [f64]) -> Result<(), ElementFailure> {
-        for (e, omega_squared) in omega_squared.iter_mut().enumerate() {
-            *omega_squared = self.frequency(x, e)?;
-        }
-        Ok(())
+    fn frequency_of(&self, x: &[[f64; 2]], e: usize) -> Result<f64, ElementFailure> {
+        self.frequency(x, e)
     }
 
     fn step_elements(
@@ -407,9 +404,7 @@ impl PartialKernel for Full {
         omega_squared: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
         let step = |this: &Full, e: usize| {
-            let element = this.layout.nodes[e];
-            let xe: Nodes = element.map(|n| x[n as usize]);
-            let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+            let (xe, ue) = element_motion(this.layout.nodes[e], x, du);
             let step = (dt, this.viscosity.as_ref());
             let (p, committed) = (this.parameters(e), this.state_of(e));
             element_step(p, (&xe, &ue), &committed, &this.lumped_of(e), step)

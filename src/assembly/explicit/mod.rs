@@ -21,6 +21,7 @@ use super::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::Formulation;
 use crate::element::Strain;
 use crate::element::mass_scaling::MassScaling;
+use crate::element::quad4_one_point::Nodes;
 use crate::element::{KernelError, Voigt};
 use crate::material::{Material, PointState, PointStep, StressCondition, UpdateContext};
 use crate::scene::DynamicAnalysis;
@@ -276,6 +277,15 @@ impl NodeGather {
     }
 }
 
+/// The start positions and the increments of the nodes `nodes` of an element.
+#[inline(always)]
+pub(super) fn element_motion(nodes: [u32; 4], x: &[[f64; 2]], du: &[f64]) -> (Nodes, Nodes) {
+    (
+        nodes.map(|n| x[n as usize]),
+        nodes.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]),
+    )
+}
+
 /// The steps of a subcycling level's elements `elements` (ascending) in chunks of `CHUNK`
 /// entries, the chunk sums added in chunk order, so the bits do not depend on the thread
 /// count (and a list of all elements is chunked as the single-step loop chunks them). With
@@ -377,9 +387,16 @@ pub trait ExplicitKernel: Send {
 pub trait PartialKernel {
     /// The global nodes of every kernel element.
     fn element_nodes(&self) -> &[[u32; 4]];
-    /// Every element's frequency bound squared on the positions `x` from the stored state
-    /// (the bound `stable_step` takes the largest of).
-    fn frequencies(&self, x: &[[f64; 2]], omega_squared: &mut [f64]) -> Result<(), ElementFailure>;
+    /// Element `e`'s frequency bound squared on the positions `x` from the stored state (the
+    /// bound `stable_step` takes the largest of).
+    fn frequency_of(&self, x: &[[f64; 2]], e: usize) -> Result<f64, ElementFailure>;
+    /// Every element's, into `omega_squared`.
+    fn frequencies(&self, x: &[[f64; 2]], omega_squared: &mut [f64]) -> Result<(), ElementFailure> {
+        for (e, omega_squared) in omega_squared.iter_mut().enumerate() {
+            *omega_squared = self.frequency_of(x, e)?;
+        }
+        Ok(())
+    }
     /// One step of length `dt` of the elements `elements` (ascending) from the positions `x`
     /// by the increments `du` (both read at those elements' nodes only): their state and
     /// their element forces updated, their frequency bounds squared on the end

@@ -21,7 +21,7 @@
 
 use super::{
     BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
-    element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
+    element_motion, element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -598,11 +598,8 @@ impl PartialKernel for Reduced {
         &self.layout.nodes
     }
 
-    fn frequencies(&self, x: &[[f64; 2]], omega_squared: &mut [f64]) -> Result<(), ElementFailure> {
-        for (e, omega_squared) in omega_squared.iter_mut().enumerate() {
-            *omega_squared = self.frequency(x, e)?;
-        }
-        Ok(())
+    fn frequency_of(&self, x: &[[f64; 2]], e: usize) -> Result<f64, ElementFailure> {
+        self.frequency(x, e)
     }
 
     fn step_elements(
@@ -613,9 +610,7 @@ impl PartialKernel for Reduced {
         omega_squared: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
         let step = |this: &Reduced, e: usize| {
-            let element = this.layout.nodes[e];
-            let xe: Nodes = element.map(|n| x[n as usize]);
-            let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+            let (xe, ue) = element_motion(this.layout.nodes[e], x, du);
             let p = &this.layout.bodies[this.layout.body[e] as usize];
             let step = (dt, this.viscosity.as_ref());
             element_step(p, (&xe, &ue), &this.state_of(e), this.mass_of(e), step)
