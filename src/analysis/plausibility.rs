@@ -548,6 +548,17 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
         out.push(problem);
     }
     if let Some(sub) = &summary.subcycling
+        && sub.largest_step_ratio > 1.0
+    {
+        out.push(format!(
+            "analysis.subcycling: an element stepped at up to {} times its own stable step: it \
+             stiffened within a major step, after its level was formed; lower \
+             analysis.time_step_scale or analysis.subcycling.levels (fewer substeps between the \
+             levels' re-forming)",
+            readable(sub.largest_step_ratio)
+        ));
+    }
+    if let Some(sub) = &summary.subcycling
         && (sub.element_updates as f64) >= SUBCYCLING_GAIN * sub.single_step_updates as f64
     {
         out.push(format!(

@@ -120,6 +120,10 @@ pub struct SubcyclingSummary {
     pub levels: u32,
     /// Elements per level in the last major step, finest first.
     pub elements_per_level: Vec<usize>,
+    /// The largest ratio of an element's step to its own stable step on the configuration
+    /// the step ended in, over the run: the automatic step's scale (0.9) while the levels
+    /// keep up with the mesh, above 1 where an element outgrew its level within a major step.
+    pub largest_step_ratio: f64,
 }
 
 /// One body in summary.json `mass_scaling.bodies`.

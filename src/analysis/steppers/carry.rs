@@ -78,4 +78,5 @@ pub struct SubcyclingCarry {
     pub last_substep: f64,
     pub substeps: u64,
     pub element_updates: u64,
+    pub largest_step_ratio: f64,
 }

@@ -44,6 +44,16 @@ pub struct Clock {
     /// The shortest and the longest step taken, clipped ones included.
     shortest_taken: f64,
     longest_taken: f64,
+    /// Auto: the steps the rule's step is taken together as one (subcycling's major step,
+    /// 2^K substeps of the rule's step, docs/theory.md 8.7c; 1 otherwise). `dt_min` is
+    /// checked against the rule's step, the clipping to frames and the end applies to the
+    /// whole.
+    #[serde(default = "one")]
+    multiple: u64,
+}
+
+fn one() -> u64 {
+    1
 }
 
 /// A step of the clock: where it ends, its length, and whether it was clipped (ended early
@@ -96,6 +106,7 @@ impl Clock {
             longest: 0.0,
             shortest_taken: f64::INFINITY,
             longest_taken: 0.0,
+            multiple: 1,
         }
     }
 
@@ -139,16 +150,17 @@ impl Clock {
                 })
             }
             Rule::Auto { scale, min } => {
-                let h = scale * limit;
+                let substep = scale * limit;
+                let h = substep * self.multiple as f64;
                 if let Some(min) = min
-                    && h < min
+                    && substep < min
                 {
                     return Err(StepError {
                         status: Status::Diverged,
                         message: format!(
                             "at t = {}: the stable step fell to {}, below analysis.dt_min = {}, set by {}",
                             readable(time),
-                            readable(h),
+                            readable(substep),
                             readable(min),
                             element()
                         ),
@@ -169,6 +181,11 @@ impl Clock {
                 })
             }
         }
+    }
+
+    /// Auto: the next steps are taken `multiple` rule steps at a time (subcycling).
+    pub fn take_together(&mut self, multiple: u64) {
+        self.multiple = multiple;
     }
 
     /// `step` was taken; `limit` is the stable step of the new configuration.

@@ -108,7 +108,7 @@ impl<'a> Explicit<'a> {
             Some(rule) => {
                 let sub =
                     subcycling::Subcycler::new(model, rule, kernel.as_mut(), &state.coordinates)?;
-                clock.limit = sub.bound(kernel.as_ref());
+                clock.take_together(sub.substeps_per_step());
                 Some(sub)
             }
             None => None,

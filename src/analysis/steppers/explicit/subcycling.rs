@@ -166,6 +166,9 @@ pub(super) struct Subcycler {
     /// Substeps and element updates so far.
     pub(super) substeps: u64,
     pub(super) element_updates: u64,
+    /// The largest ratio of an element's step to its own stable step on the configuration
+    /// the step ended in (the level was formed before; above 1 the element outgrew it).
+    largest_step_ratio: f64,
 }
 
 impl Subcycler {
@@ -190,21 +193,24 @@ impl Subcycler {
             last_substep: 0.0,
             substeps: 0,
             element_updates: 0,
+            largest_step_ratio: 0.0,
         })
     }
 
-    /// The major step's bound: 2^K times the shortest element step, named by that element.
+    /// The stable step of the finest level (the clock's limit: the major step is 2^K of its
+    /// steps, `Clock::take_together`), named by its element.
     pub(super) fn bound(&self, kernel: &dyn ExplicitKernel) -> StableStep {
         let mut worst = StepWork::default();
         for (e, w) in self.omega_squared.iter().enumerate() {
             worst.observe(*w, e);
         }
         let (body, element) = kernel.locate(worst.critical_element);
-        let finest = StableStep::of_frequency(worst.omega_squared, body, element);
-        StableStep {
-            dt: (1u64 << self.levels.top) as f64 * finest.dt,
-            ..finest
-        }
+        StableStep::of_frequency(worst.omega_squared, body, element)
+    }
+
+    /// The substeps of a major step, 2^K.
+    pub(super) fn substeps_per_step(&self) -> u64 {
+        1u64 << self.levels.top
     }
 
     /// What a checkpoint keeps.
@@ -214,6 +220,7 @@ impl Subcycler {
             last_substep: self.last_substep,
             substeps: self.substeps,
             element_updates: self.element_updates,
+            largest_step_ratio: self.largest_step_ratio,
         }
     }
 
@@ -223,6 +230,7 @@ impl Subcycler {
         self.last_substep = carry.last_substep;
         self.substeps = carry.substeps;
         self.element_updates = carry.element_updates;
+        self.largest_step_ratio = carry.largest_step_ratio;
         self.levels = Levels::form(
             &self.omega_squared,
             kernel.element_nodes(),
@@ -239,6 +247,7 @@ impl Subcycler {
             single_step_updates: self.substeps * elements as u64,
             levels: self.levels.top,
             elements_per_level: self.levels.elements.iter().map(Vec::len).collect(),
+            largest_step_ratio: self.largest_step_ratio,
         }
     }
 
@@ -290,8 +299,10 @@ pub fn start(
 }
 
 /// The nodes subcycling keeps at level 0: those of the contact surfaces (both sides, so the
-/// correction sees every node it moves at the substep), and of moving prescribed
-/// displacements; and whether there are such displacements.
+/// correction sees every node it moves at the substep; with a deformable master the whole
+/// outlines of both bodies, which its inside tests and penetration checks read at the
+/// substep), and of prescribed displacements (Displacement, Rotation and Affine loads); and
+/// whether there are such displacements.
 fn pinned_nodes(model: &Model, interfaces: &Interfaces) -> (Vec<bool>, bool) {
     let mut pinned = vec![false; model.node_count];
     for pair in &interfaces.pairs {
@@ -299,8 +310,13 @@ fn pinned_nodes(model: &Model, interfaces: &Interfaces) -> (Vec<bool>, bool) {
             pinned[*n] = true;
         }
         match &pair.master {
-            Master::Segments { edges, .. } => {
-                for n in edges.iter().flatten() {
+            Master::Segments {
+                edges, boundary, ..
+            } => {
+                // a deformable master: its body's outline (the corner tests) and the slave
+                // body's (the penetration checks) are read where the correction is made
+                let slave_outline = &interfaces.bodies[pair.slave_body].boundary;
+                for n in edges.iter().chain(boundary).chain(slave_outline).flatten() {
                     pinned[*n] = true;
                 }
             }
@@ -349,8 +365,7 @@ impl Explicit<'_> {
 
     fn major_step(&mut self, sub: &mut Subcycler, clock_step: Step) -> Result<(), StepError> {
         let (t0, time) = (self.state.time, clock_step.end);
-        let top = sub.levels.top;
-        let count = 1u64 << top;
+        let count = sub.substeps_per_step();
         let h = clock_step.length / count as f64;
         // every node starts a step
         for (n, k) in sub.levels.node.iter().enumerate() {
@@ -375,6 +390,7 @@ impl Explicit<'_> {
         let bound = sub.bound(self.kernel.as_ref());
         self.step += 1;
         self.clock.took(clock_step, bound);
+        self.clock.take_together(sub.substeps_per_step());
         Ok(())
     }
 
@@ -461,6 +477,10 @@ impl Explicit<'_> {
             frame: false,
         })?;
         sub.element_updates += elements.len() as u64;
+        // the step against the stable step the elements ended with (2 / omega)
+        sub.largest_step_ratio = sub
+            .largest_step_ratio
+            .max(0.5 * span * work.omega_squared.sqrt());
         self.state.internal_work += work.internal;
         self.state.plastic_work += work.plastic;
         self.energies.bulk_viscosity_work += work.viscous;
