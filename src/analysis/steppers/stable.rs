@@ -96,9 +96,9 @@ pub fn explicit_start_levels(
         ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
     let state = State::initial(model);
     let (mut kernel, _) = kernel_for(model, spec, &state, &masses);
-    let (levels, _) =
+    let start =
         super::explicit::subcycling_start(model, rule, kernel.as_mut(), &state.coordinates)?;
-    Ok(Some(levels))
+    Ok(Some(start.levels))
 }
 
 /// The stability limit of `model` under `spec` (the bulk viscosity's damping at rest taken

@@ -248,32 +248,28 @@ impl NodeGather {
             .enumerate()
             .for_each(|(k, chunk)| {
                 for (i, f) in chunk.chunks_exact_mut(2).enumerate() {
-                    let n = k * CHUNK + i;
-                    let (mut fx, mut fy) = (0.0, 0.0);
-                    for entry in &self.entries[self.start[n]..self.start[n + 1]] {
-                        fx += ef[*entry as usize];
-                        fy += ef[*entry as usize + 1];
-                    }
-                    f[0] = fx;
-                    f[1] = fy;
+                    f.copy_from_slice(&self.node_force(k * CHUNK + i, ef));
                 }
             });
     }
-}
 
-impl NodeGather {
     /// Sums the element forces into the nodes `nodes` only (`force` elsewhere untouched).
     pub(super) fn gather_nodes(&self, nodes: &[u32], element_forces: &[f64], force: &mut [f64]) {
         for &n in nodes {
             let n = n as usize;
-            let (mut fx, mut fy) = (0.0, 0.0);
-            for entry in &self.entries[self.start[n]..self.start[n + 1]] {
-                fx += element_forces[*entry as usize];
-                fy += element_forces[*entry as usize + 1];
-            }
-            force[2 * n] = fx;
-            force[2 * n + 1] = fy;
+            force[2 * n..2 * n + 2].copy_from_slice(&self.node_force(n, element_forces));
         }
+    }
+
+    /// Node n's force: its elements' entries of `element_forces`, in element order.
+    #[inline(always)]
+    fn node_force(&self, n: usize, element_forces: &[f64]) -> [f64; 2] {
+        let (mut fx, mut fy) = (0.0, 0.0);
+        for entry in &self.entries[self.start[n]..self.start[n + 1]] {
+            fx += element_forces[*entry as usize];
+            fy += element_forces[*entry as usize + 1];
+        }
+        [fx, fy]
     }
 }
 

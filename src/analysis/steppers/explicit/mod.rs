@@ -23,7 +23,7 @@ use super::newton::Counters;
 use super::stable::{checked_step, explicit_clock};
 use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
 use crate::analysis::summary::{RunError, Status};
-use crate::assembly::explicit::{ExplicitKernel, StepWork, kernel_for};
+use crate::assembly::explicit::{ExplicitKernel, PartialKernel, StepWork, kernel_for};
 use crate::assembly::mass_scaling::{AddedAtRest, MassScalingReport, NodalMotion};
 use crate::assembly::{ElementMasses, Mass, StableStep, State, System, check_mass};
 use crate::contact::explicit::Predicted;
@@ -224,6 +224,22 @@ impl<'a> Explicit<'a> {
         self.energies.contact_work -= work;
     }
 
+    /// The energies at the end of step `self.step + 1`: the step's external work added, the
+    /// kinetic energy and its shadow, the internal and plastic work of the state; the
+    /// reference the blow-up check compares with.
+    fn close_step_energies(&mut self, external_work: f64, (kinetic, shadow): (f64, f64)) {
+        let energies = &mut self.energies;
+        energies.external_work += external_work;
+        energies.kinetic = kinetic;
+        energies.kinetic_shadow = shadow;
+        energies.internal = self.state.internal_work - self.state.plastic_work;
+        energies.plastic_work = self.state.plastic_work;
+        if self.step == 0 {
+            self.energy_reference = self.energy_reference.max(energies.internal.abs());
+        }
+        self.energy_reference = self.energy_reference.max(energies.external_work.abs());
+    }
+
     /// What F reads at DOF `d`.
     fn dof(&self, d: usize) -> Dof {
         Dof {
@@ -361,18 +377,10 @@ impl Stepper for Explicit<'_> {
         }
         .apply(&mut self.a, &mut self.v, &mut self.total);
         let added = self.add_scaled_mass();
-        let energies = &mut self.energies;
-        energies.external_work += work + added.support_work;
-        energies.mass_scaling_loss += added.loss;
+        self.energies.mass_scaling_loss += added.loss;
         std::mem::swap(&mut self.last_total, &mut self.total);
-        energies.kinetic = kinetic_energy + added.kinetic_energy_change;
-        energies.kinetic_shadow = shadow;
-        energies.internal = self.state.internal_work - self.state.plastic_work;
-        energies.plastic_work = self.state.plastic_work;
-        if step == 1 {
-            self.energy_reference = self.energy_reference.max(energies.internal.abs());
-        }
-        self.energy_reference = self.energy_reference.max(energies.external_work.abs());
+        let kinetic = kinetic_energy + added.kinetic_energy_change;
+        self.close_step_energies(work + added.support_work, (kinetic, shadow));
         self.step = step;
         self.clock.took(clock_step, bound);
         Ok(())
@@ -514,7 +522,9 @@ impl Resume for Explicit<'_> {
                 let Some(kernel) = self.kernel.partial() else {
                     return false;
                 };
-                sub.restore(carried, kernel);
+                if !sub.restore(carried, kernel) {
+                    return false;
+                }
             }
             (None, None) => {}
             _ => return false,
@@ -550,6 +560,15 @@ impl Resume for Explicit<'_> {
             subcycling: self.subcycler.as_ref().map(|s| s.carry()),
         }))
     }
+}
+
+/// The element loop of a subcycled run: the kernels that have one are the only ones a scene
+/// lets subcycle (finite-strain Quad4; `subcycling::start` checks it). A function of the
+/// field, so that the driver's other fields stay free.
+fn partial_of<'k>(kernel: &'k mut Box<dyn ExplicitKernel + '_>) -> &'k mut dyn PartialKernel {
+    kernel
+        .partial()
+        .expect("a subcycled run has a partial kernel")
 }
 
 /// Commits a step of an explicit kernel (whose element state is already updated): the
@@ -639,6 +658,25 @@ fn chunked_sum(dofs: &[usize], x: &[f64], y: &[f64], term: impl Fn(f64, f64) -> 
         .sum()
 }
 
+/// a_{n+1} and v_{n+1} of one DOF at the end of a step of length h: a free DOF from its mass
+/// and its forces (external, internal), `(m, (f_ext, f_int))`, and its mid-step velocity; a
+/// prescribed one from its increment du and its velocity v_n. `motion` is
+/// (v_{n+1/2}, v_n, du).
+#[inline(always)]
+fn end_motion(
+    free: bool,
+    (m, (external, internal)): (f64, (f64, f64)),
+    (v_half, v, du): (f64, f64, f64),
+    (h, a_r): (f64, f64),
+) -> (f64, f64) {
+    if free {
+        let a = (external - internal - a_r * m * v_half) / m;
+        (a, v_half + 0.5 * h * a)
+    } else {
+        ((du / h - v) * 2.0 / h, du / h)
+    }
+}
+
 /// The end of a step, once the internal force at u_{n+1} is known.
 struct StepEnd<'a> {
     free: &'a [bool],
@@ -672,13 +710,11 @@ impl StepEnd<'_> {
                 for (j, ((a, v), total)) in a.iter_mut().zip(v).zip(total).enumerate() {
                     let i = k * DOF_CHUNK + j;
                     let m = self.m[i];
+                    let forces = (self.external[i], self.internal[i]);
+                    let motion = (self.v_half[i], *v, self.du[i]);
+                    (*a, *v) = end_motion(self.free[i], (m, forces), motion, (h, a_r));
                     if self.free[i] {
-                        *a = (self.external[i] - self.internal[i] - a_r * m * self.v_half[i]) / m;
-                        *v = self.v_half[i] + 0.5 * h * *a;
                         shadow += m * *a * *a;
-                    } else {
-                        *a = (self.du[i] / h - *v) * 2.0 / h;
-                        *v = self.du[i] / h;
                     }
                     let dof = Dof {
                         free: self.free[i],

@@ -22,7 +22,7 @@
 //! elements' last steps (all of them end there). With every element at level 0 this is the
 //! single-step central difference, operation for operation.
 
-use super::{Explicit, total_at};
+use super::{DOF_CHUNK, Explicit, end_motion, partial_of, total_at};
 use crate::analysis::steppers::carry::SubcyclingCarry;
 use crate::analysis::steppers::clock::Step;
 use crate::analysis::steppers::{StepError, loads};
@@ -180,8 +180,12 @@ impl Subcycler {
         kernel: &mut dyn ExplicitKernel,
         x: &[[f64; 2]],
     ) -> Result<Subcycler, InputError> {
-        let (levels, omega_squared) = start(model, rule, kernel, x)?;
-        let (pinned, moving) = pinned_nodes(model, &model.interfaces());
+        let Start {
+            levels,
+            omega_squared,
+            pinned,
+            moving,
+        } = start(model, rule, kernel, x)?;
         Ok(Subcycler {
             rule,
             pinned,
@@ -224,8 +228,16 @@ impl Subcycler {
         }
     }
 
-    /// Takes a checkpoint's carry back: the levels are those its bounds form.
-    pub(super) fn restore(&mut self, carry: SubcyclingCarry, kernel: &mut dyn PartialKernel) {
+    /// Takes a checkpoint's carry back: the levels are those its bounds form. False when the
+    /// carry is not of this kernel's elements (a mesh changed since the checkpoint).
+    pub(super) fn restore(
+        &mut self,
+        carry: SubcyclingCarry,
+        kernel: &mut dyn PartialKernel,
+    ) -> bool {
+        if carry.omega_squared.len() != self.omega_squared.len() {
+            return false;
+        }
         self.omega_squared = carry.omega_squared;
         self.last_substep = carry.last_substep;
         self.substeps = carry.substeps;
@@ -237,6 +249,7 @@ impl Subcycler {
             &self.pinned,
             self.rule.levels,
         );
+        true
     }
 
     /// summary.json `subcycling` of a kernel of `elements` elements.
@@ -261,15 +274,24 @@ impl Subcycler {
     }
 }
 
-/// The levels a subcycled run of `model` starts with (`rule`, the kernel `kernel` on the
-/// positions `x`) and the elements' frequency bounds they come from; refuses loads it cannot
-/// follow (forces between the nodes' steps). What `impact check` reports.
+/// What a subcycled run starts with: its levels, the elements' frequency bounds they come
+/// from, the nodes kept on level 0 and whether prescribed displacements move (`pinned_nodes`).
+pub struct Start {
+    pub levels: Levels,
+    pub omega_squared: Vec<f64>,
+    pinned: Vec<bool>,
+    moving: bool,
+}
+
+/// The start of a subcycled run of `model` (`rule`, the kernel `kernel` on the positions
+/// `x`); refuses loads it cannot follow (forces between the nodes' steps). What `impact
+/// check` reports.
 pub fn start(
     model: &Model,
     rule: Subcycling,
     kernel: &mut dyn ExplicitKernel,
     x: &[[f64; 2]],
-) -> Result<(Levels, Vec<f64>), InputError> {
+) -> Result<Start, InputError> {
     let refuse = |message: String| InputError::new(&model.file, message);
     if super::loads::has_external_force(model) {
         return Err(refuse(
@@ -288,14 +310,19 @@ pub fn start(
     partial
         .frequencies(x, &mut omega_squared)
         .map_err(|err| refuse(err.to_string()))?;
-    let (pinned, _) = pinned_nodes(model, &model.interfaces());
+    let (pinned, moving) = pinned_nodes(model, &model.interfaces());
     let levels = Levels::form(
         &omega_squared,
         partial.element_nodes(),
         &pinned,
         rule.levels,
     );
-    Ok((levels, omega_squared))
+    Ok(Start {
+        levels,
+        omega_squared,
+        pinned,
+        moving,
+    })
 }
 
 /// The nodes subcycling keeps at level 0: those of the contact surfaces (both sides, so the
@@ -343,11 +370,33 @@ fn pinned_nodes(model: &Model, interfaces: &Interfaces) -> (Vec<bool>, bool) {
     (pinned, moving)
 }
 
-/// The sums of a major step's node updates.
-#[derive(Default)]
+/// The sums of a major step's node updates, per `DOF_CHUNK` DOFs (added in chunk order at
+/// the end, as the single step adds its chunks: one level gives its bits).
 struct NodeSums {
     /// du . (F_{n+1} + F_n) over every node step (half of it is the external work).
-    work: f64,
+    work: Vec<f64>,
+}
+
+impl NodeSums {
+    fn new(dofs: usize) -> NodeSums {
+        NodeSums {
+            work: vec![0.0; dofs.div_ceil(DOF_CHUNK).max(1)],
+        }
+    }
+}
+
+/// sum_d term(d) over the DOFs `dofs` (ascending), per `DOF_CHUNK` chunk, the chunks' sums
+/// added in chunk order.
+fn chunked(dofs: impl Iterator<Item = usize>, term: impl Fn(usize) -> f64) -> f64 {
+    let mut chunks: Vec<f64> = Vec::new();
+    for d in dofs {
+        let k = d / DOF_CHUNK;
+        if chunks.len() <= k {
+            chunks.resize(k + 1, 0.0);
+        }
+        chunks[k] += term(d);
+    }
+    chunks.into_iter().fold(0.0, |total, chunk| total + chunk)
 }
 
 impl Explicit<'_> {
@@ -374,7 +423,7 @@ impl Explicit<'_> {
                 self.v_half[d] = self.v[d] + 0.5 * span * self.a[d];
             }
         }
-        let mut sums = NodeSums::default();
+        let mut sums = NodeSums::new(self.v.len());
         for j in 1..=count {
             let t = if j == count { time } else { t0 + j as f64 * h };
             self.substep(sub, (j, h, t), &mut sums)?;
@@ -382,10 +431,7 @@ impl Explicit<'_> {
         self.state.time = time;
         self.synced = false;
         self.end_major_step(sub, &sums, h);
-        let kernel = self
-            .kernel
-            .partial()
-            .expect("a subcycled run has a partial kernel");
+        let kernel = partial_of(&mut self.kernel);
         sub.reform(kernel);
         let bound = sub.bound(self.kernel.as_ref());
         self.step += 1;
@@ -463,10 +509,7 @@ impl Explicit<'_> {
             }
         }
         let elements = &levels.elements[k as usize];
-        let kernel = self
-            .kernel
-            .partial()
-            .expect("a subcycled run has a partial kernel");
+        let kernel = partial_of(&mut self.kernel);
         let work = crate::profile::time(crate::profile::Phase::Assembly, || {
             crate::profile::count_elements(elements.len());
             kernel.step_elements(elements, (&sub.x, &sub.du), span, &mut sub.omega_squared)
@@ -493,10 +536,7 @@ impl Explicit<'_> {
     fn finish_nodes(&mut self, sub: &Subcycler, (j, k, h): (u64, u32, f64), sums: &mut NodeSums) {
         let span = (1u64 << k) as f64 * h;
         let nodes = &sub.levels.nodes[k as usize];
-        let kernel = self
-            .kernel
-            .partial()
-            .expect("a subcycled run has a partial kernel");
+        let kernel = partial_of(&mut self.kernel);
         kernel.gather_nodes(nodes, &mut self.internal);
         let a_r = self.spec.rayleigh[0];
         let last = j == 1u64 << sub.levels.top;
@@ -514,17 +554,11 @@ impl Explicit<'_> {
                     self.state.coordinates[n][c] += du;
                 }
                 self.state.displacement[d] += du;
-                let m = self.mass[d];
-                if self.free[d] {
-                    self.a[d] =
-                        (self.external[d] - self.internal[d] - a_r * m * self.v_half[d]) / m;
-                    self.v[d] = self.v_half[d] + 0.5 * span * self.a[d];
-                } else {
-                    self.a[d] = (du / span - self.v[d]) * 2.0 / span;
-                    self.v[d] = du / span;
-                }
+                let forces = (self.mass[d], (self.external[d], self.internal[d]));
+                let motion = (self.v_half[d], self.v[d], du);
+                (self.a[d], self.v[d]) = end_motion(self.free[d], forces, motion, (span, a_r));
                 let total = total_at(self.dof(d), a_r);
-                sums.work += du * (total + self.last_total[d]);
+                sums.work[d / DOF_CHUNK] += du * (total + self.last_total[d]);
                 self.last_total[d] = total;
                 if !last {
                     self.v_half[d] = self.v[d] + 0.5 * span * self.a[d];
@@ -535,35 +569,21 @@ impl Explicit<'_> {
 
     /// The energies at the end of a major step (every node has ended a step there).
     fn end_major_step(&mut self, sub: &Subcycler, sums: &NodeSums, h: f64) {
-        let mut kinetic = 0.0;
-        for (v, m) in self.v.iter().zip(&self.mass) {
-            kinetic += m * v * v;
-        }
+        let (v, m, a, free) = (&self.v, &self.mass, &self.a, &self.free);
+        let kinetic = chunked(0..v.len(), |d| m[d] * v[d] * v[d]);
         // the shadow h^2 / 8 a.M a with each node's own step, summed per level
         let mut shadow = 0.0;
         for (k, nodes) in sub.levels.nodes.iter().enumerate() {
-            let mut sum = 0.0;
-            for d in nodes
+            let dofs = nodes
                 .iter()
                 .flat_map(|n| [2 * *n as usize, 2 * *n as usize + 1])
-            {
-                if self.free[d] {
-                    sum += self.mass[d] * self.a[d] * self.a[d];
-                }
-            }
+                .filter(|d| free[*d]);
+            let sum = chunked(dofs, |d| m[d] * a[d] * a[d]);
             let span = (1u64 << k) as f64 * h;
             shadow += 0.125 * span * span * sum;
         }
-        let energies = &mut self.energies;
-        energies.external_work += 0.5 * sums.work;
-        energies.kinetic = 0.5 * kinetic;
-        energies.kinetic_shadow = shadow;
-        energies.internal = self.state.internal_work - self.state.plastic_work;
-        energies.plastic_work = self.state.plastic_work;
-        if self.step == 0 {
-            self.energy_reference = self.energy_reference.max(energies.internal.abs());
-        }
-        self.energy_reference = self.energy_reference.max(energies.external_work.abs());
+        let work = sums.work.iter().fold(0.0, |total, chunk| total + chunk);
+        self.close_step_energies(0.5 * work, (0.5 * kinetic, shadow));
     }
 }
 
