@@ -314,7 +314,7 @@ pub struct DynamicAnalysis {
     pub bulk_viscosity: Option<BulkViscosity>,
     /// Central difference: the mass scaling of the explicit Quad4 kernels (None: off).
     pub mass_scaling: Option<MassScaling>,
-    /// Central difference: the subcycling of the one-point kernel (None: off).
+    /// Central difference: the subcycling of the explicit Quad4 kernels (None: off).
     pub subcycling: Option<Subcycling>,
 }
 

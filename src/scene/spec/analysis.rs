@@ -161,7 +161,7 @@ pub struct AnalysisSpec {
     /// scaling, the elements whose stable step falls below `target` made heavier until it is
     /// the target (docs/theory.md 8.7b). Default: none (off).
     pub mass_scaling: Option<MassScalingSpec>,
-    /// Central difference with the one-point kernel and dt = "auto": multi-time-step
+    /// Central difference on Quad4 bodies at finite strain with dt = "auto": multi-time-step
     /// integration, each element stepped with its own stable step rounded down to a power of
     /// two of the shortest (docs/theory.md 8.7c). Default: none (one step for every element).
     pub subcycling: Option<SubcyclingSpec>,
