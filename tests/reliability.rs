@@ -711,7 +711,8 @@ fn sigint_stops_cleanly_with_130_and_resume_completes() {
 /// Goal: a subcycled run resumes from its checkpoint bit-identically: the element bounds
 /// that form the next major step's levels, the last substep and the counts travel in it.
 /// Setup: the Johnson-Cook Taylor rod (2x2 kernel, 5 x 50) subcycled, a checkpoint every
-/// 100 major steps, halted at 430 (the levels, all 0 on the initial mesh, 0 to 2 by then)
+/// 100 major steps, halted at 430 (the levels, all 0 on the initial mesh, 0 to 2 by then:
+/// the test fails when the restore keeps the initial bounds instead of the carried ones)
 /// and resumed. Reference: the
 /// uninterrupted run: summary.json (subcycling counts included), history.csv, every frame
 /// byte-identical.

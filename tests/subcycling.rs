@@ -423,7 +423,10 @@ proptest! {
         fine in 0usize..12,
     ) {
         widths.insert(fine, 0.05);
-        let dir = common::out_dir(&format!("random_layout_{}", widths.iter().map(|w| (w * 1e6) as u64).sum::<u64>()));
+        // a folder per case (the cases of one run share the process)
+        static CASE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let case = CASE.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = common::out_dir(&format!("random_layout_{case}"));
         let mesh = dir.join("strip.vtk");
         std::fs::write(&mesh, strip_vtk(&widths)).unwrap();
         let length: f64 = widths.iter().sum();

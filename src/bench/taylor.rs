@@ -405,110 +405,119 @@ pub fn charts(dir: &Path, rows: &[Row]) -> Result<(), OutputError> {
     Ok(())
 }
 
+/// One kernel's explicit runs of a benchmark: per run its stepping, elements, wall time
+/// and final values.
+struct KernelRuns {
+    kernel: &'static str,
+    runs: Vec<(Stepping, usize, f64, Vec<(Measure, f64)>)>,
+}
+
+impl KernelRuns {
+    /// The value of `measure` in final values `v`.
+    fn value(v: &[(Measure, f64)], measure: Measure) -> f64 {
+        v.iter()
+            .find(|(m, _)| *m == measure)
+            .map_or(f64::NAN, |(_, x)| *x)
+    }
+
+    /// The extrapolation of `measure` from the three single-step meshes (None: not three).
+    fn extrapolate(&self, measure: Measure) -> Option<crate::sweep::qoi::Extrapolation> {
+        // the single-step meshes, finest first (h ~ 1 / sqrt(elements))
+        let mut single: Vec<(usize, f64)> = self
+            .runs
+            .iter()
+            .filter(|v| v.0 == Stepping::Single)
+            .map(|v| (v.1, Self::value(&v.3, measure)))
+            .collect();
+        if single.len() != 3 {
+            return None;
+        }
+        single.sort_by(|a, b| b.0.cmp(&a.0));
+        let h: [f64; 3] = std::array::from_fn(|i| 1.0 / (single[i].0 as f64).sqrt());
+        let f: [f64; 3] = std::array::from_fn(|i| single[i].1);
+        Some(crate::sweep::qoi::extrapolate(h, f))
+    }
+
+    /// The error of `measure` against `converged` (%, floored at 1e-4 for the log axis)
+    /// against the wall time, one series per stepping.
+    fn error_series(&self, measure: Measure, converged: f64) -> Vec<Series> {
+        Stepping::ALL
+            .iter()
+            .map(|stepping| Series {
+                label: format!("{}, {}", self.kernel, stepping.label()),
+                points: self
+                    .runs
+                    .iter()
+                    .filter(|v| v.0 == *stepping)
+                    .map(|v| {
+                        let error = 100.0 * (Self::value(&v.3, measure) / converged - 1.0);
+                        (v.2, error.abs().max(1e-4))
+                    })
+                    .collect(),
+                style: SeriesStyle::LineAndMarkers,
+            })
+            .filter(|s| !s.points.is_empty())
+            .collect()
+    }
+}
+
 /// KEY_error.svg (and .png): the error of L_f and D_f against the converged value against
 /// the wall time, one series per kernel and stepping. The converged value of a measure is
 /// the 2x2 kernel's, extrapolated from its three single-step meshes (Celik et al. 2008,
 /// `sweep::qoi::extrapolate`; the B-bar element, whose series converges monotonically on
-/// both rods), else the one-point kernel's, else the finest 2x2 single-step value; the notes
-/// give each kernel's extrapolation. Nothing is written unless a kernel has its three
-/// single-step meshes.
+/// both rods), else the one-point kernel's; the notes give each kernel's extrapolation.
+/// Nothing is written unless every kernel with rows has its three single-step meshes and
+/// one of them extrapolates.
 fn error_chart(b: &Benchmark, dir: &Path, runs: &[&Row]) -> Result<(), OutputError> {
-    let kernels = [
+    let mut kernels = Vec::new();
+    for (method, kernel) in [
         (Method::Explicit, "2x2"),
         (Method::ExplicitReduced, "one-point"),
-    ];
-    let measures = [(Measure::Length, "L_f"), (Measure::Diameter, "D_f")];
-    // per kernel: its runs' stepping, wall time and final values
-    let mut runs_of = Vec::new();
-    for (method, kernel) in kernels {
+    ] {
         let mut values = Vec::new();
         for r in runs.iter().filter(|r| r.method == method) {
-            values.push((
-                Stepping::of(&r.name),
-                r.elements,
-                r.wall_seconds,
-                finals(b, dir, r)?,
-            ));
+            let stepping = Stepping::of(&r.name);
+            values.push((stepping, r.elements, r.wall_seconds, finals(b, dir, r)?));
         }
         if !values.is_empty() {
-            runs_of.push((kernel, values));
+            kernels.push(KernelRuns {
+                kernel,
+                runs: values,
+            });
         }
     }
-    let value = |v: &[(Measure, f64)], measure: Measure| {
-        v.iter()
-            .find(|(m, _)| *m == measure)
-            .map_or(f64::NAN, |(_, x)| *x)
-    };
     let mut charts = Vec::new();
-    for (measure, name) in measures {
+    for (measure, name) in [(Measure::Length, "L_f"), (Measure::Diameter, "D_f")] {
         let mut notes = Vec::new();
         let mut converged = None;
-        for (kernel, values) in &runs_of {
-            // the single-step meshes, finest first (h ~ 1 / sqrt(elements))
-            let mut single: Vec<(usize, f64)> = values
-                .iter()
-                .filter(|v| v.0 == Stepping::Single)
-                .map(|v| (v.1, value(&v.3, measure)))
-                .collect();
-            if single.len() != 3 {
+        for k in &kernels {
+            let Some(extrapolation) = k.extrapolate(measure) else {
                 return Ok(());
-            }
-            single.sort_by(|a, b| b.0.cmp(&a.0));
-            let h: [f64; 3] = std::array::from_fn(|i| 1.0 / (single[i].0 as f64).sqrt());
-            let f: [f64; 3] = std::array::from_fn(|i| single[i].1);
-            let extrapolation = crate::sweep::qoi::extrapolate(h, f);
+            };
             notes.push(match extrapolation.value {
-                Some(v) => format!("{kernel}: {name} extrapolated to {v:.4} mm"),
-                None => format!("{kernel}: {name} not extrapolated (finest {:.4} mm)", f[0]),
+                Some(v) => format!("{}: {name} extrapolated to {v:.4} mm", k.kernel),
+                None => format!("{}: {name} not extrapolated", k.kernel),
             });
             converged = converged.or(extrapolation.value);
         }
-        let Some(converged) = converged.or_else(|| {
-            runs_of.first().and_then(|(_, values)| {
-                values
-                    .iter()
-                    .filter(|v| v.0 == Stepping::Single)
-                    .max_by_key(|v| v.1)
-                    .map(|v| value(&v.3, measure))
-            })
-        }) else {
+        let Some(converged) = converged else {
             return Ok(());
         };
         notes.push(format!("converged {name} taken as {converged:.4} mm"));
-        let mut series = Vec::new();
-        for (kernel, values) in &runs_of {
-            for stepping in Stepping::ALL {
-                let points: Vec<(f64, f64)> = values
-                    .iter()
-                    .filter(|v| v.0 == stepping)
-                    .map(|v| {
-                        let error = 100.0 * (value(&v.3, measure) / converged - 1.0);
-                        (v.2, error.abs().max(1e-4))
-                    })
-                    .collect();
-                if !points.is_empty() {
-                    series.push(Series {
-                        label: format!("{kernel}, {}", stepping.label()),
-                        points,
-                        style: SeriesStyle::LineAndMarkers,
-                    });
-                }
-            }
-        }
         charts.push(Chart {
             title: format!("{}: error of {name}", b.short),
             x_label: "wall time (s)".into(),
             y_label: format!("|{name} - converged| (%)"),
-            series,
+            series: kernels
+                .iter()
+                .flat_map(|k| k.error_series(measure, converged))
+                .collect(),
             log_x: true,
             log_y: true,
             x_limits: Default::default(),
             y_limits: Default::default(),
             notes,
         });
-    }
-    if charts.is_empty() {
-        return Ok(());
     }
     for ext in ["svg", "png"] {
         plot::write_panels(&charts, &dir.join(format!("{}_error.{ext}", b.key)))?;
