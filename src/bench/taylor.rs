@@ -466,8 +466,8 @@ impl KernelRuns {
 /// the 2x2 kernel's, extrapolated from its three single-step meshes (Celik et al. 2008,
 /// `sweep::qoi::extrapolate`; the B-bar element, whose series converges monotonically on
 /// both rods), else the one-point kernel's; the notes give each kernel's extrapolation.
-/// Nothing is written unless every kernel with rows has its three single-step meshes and
-/// one of them extrapolates.
+/// Nothing is written unless every kernel with rows has its three single-step meshes; a
+/// measure no kernel extrapolates has no panel.
 fn error_chart(b: &Benchmark, dir: &Path, runs: &[&Row]) -> Result<(), OutputError> {
     let mut kernels = Vec::new();
     for (method, kernel) in [
@@ -501,7 +501,7 @@ fn error_chart(b: &Benchmark, dir: &Path, runs: &[&Row]) -> Result<(), OutputErr
             converged = converged.or(extrapolation.value);
         }
         let Some(converged) = converged else {
-            return Ok(());
+            continue;
         };
         notes.push(format!("converged {name} taken as {converged:.4} mm"));
         charts.push(Chart {
@@ -518,6 +518,9 @@ fn error_chart(b: &Benchmark, dir: &Path, runs: &[&Row]) -> Result<(), OutputErr
             y_limits: Default::default(),
             notes,
         });
+    }
+    if charts.is_empty() {
+        return Ok(());
     }
     for ext in ["svg", "png"] {
         plot::write_panels(&charts, &dir.join(format!("{}_error.{ext}", b.key)))?;
