@@ -409,7 +409,7 @@ impl PartialKernel for Full {
             let (p, committed) = (this.parameters(e), this.state_of(e));
             element_step(p, (&xe, &ue), &committed, &this.lumped_of(e), step)
         };
-        let commit = |this: &mut Full, e: usize, r: ElementStep, sums: &mut StepWork| {
+        let commit = |this: &mut Full, e: usize, r: &ElementStep, sums: &mut StepWork| {
             omega_squared[e] = r.omega_squared;
             sums.observe(r.omega_squared, e);
             this.store(e, &r.state);

@@ -288,11 +288,12 @@ pub(super) fn element_motion(nodes: [u32; 4], x: &[[f64; 2]], du: &[f64]) -> (No
 /// several chunks and threads, `step(e)` runs in parallel without writing, then `commit`
 /// writes the results back in list order; else each element is stepped and committed in
 /// turn. `commit(e, result, sums)` writes element e's step and takes it into its chunk's sums.
+#[inline(always)]
 pub(super) fn subset_steps<K: Sync, R: Send>(
     kernel: &mut K,
     elements: &[u32],
     step: impl Fn(&K, usize) -> Result<R, KernelError> + Sync,
-    mut commit: impl FnMut(&mut K, usize, R, &mut StepWork),
+    mut commit: impl FnMut(&mut K, usize, &R, &mut StepWork),
 ) -> Result<StepWork, (usize, KernelError)> {
     let mut total = StepWork::default();
     if elements.len() > CHUNK && rayon::current_num_threads() > 1 {
@@ -308,7 +309,7 @@ pub(super) fn subset_steps<K: Sync, R: Send>(
         for (list, results) in elements.chunks(CHUNK).zip(chunks) {
             let mut sums = StepWork::default();
             for (&e, r) in list.iter().zip(results?) {
-                commit(kernel, e as usize, r, &mut sums);
+                commit(kernel, e as usize, &r, &mut sums);
             }
             total.add(&sums);
         }
@@ -317,7 +318,7 @@ pub(super) fn subset_steps<K: Sync, R: Send>(
             let mut sums = StepWork::default();
             for &e in list {
                 let r = step(kernel, e as usize).map_err(|err| (e as usize, err))?;
-                commit(kernel, e as usize, r, &mut sums);
+                commit(kernel, e as usize, &r, &mut sums);
             }
             total.add(&sums);
         }

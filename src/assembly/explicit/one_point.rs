@@ -615,7 +615,7 @@ impl PartialKernel for Reduced {
             let step = (dt, this.viscosity.as_ref());
             element_step(p, (&xe, &ue), &this.state_of(e), this.mass_of(e), step)
         };
-        let commit = |this: &mut Reduced, e: usize, r: ElementStep, sums: &mut StepWork| {
+        let commit = |this: &mut Reduced, e: usize, r: &ElementStep, sums: &mut StepWork| {
             omega_squared[e] = r.omega_squared;
             sums.observe(r.omega_squared, e);
             this.store(e, &r.state);
