@@ -46,6 +46,18 @@ pub struct ContactState {
     /// forces (`contact::explicit`). Empty on every other path.
     #[serde(default)]
     pub master_block: Vec<MasterEntry>,
+    /// The explicit correction's vectors over all DOFs, kept zero between steps, so that a
+    /// step neither allocates nor clears them whole (`contact::explicit`; not in a
+    /// checkpoint: zero vectors of the right length either way).
+    #[serde(skip)]
+    pub(super) scratch: Scratch,
+}
+
+/// Vectors over all DOFs, zero between uses (`ContactState::scratch`).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Scratch {
+    pub delta: Vec<f64>,
+    pub force: Vec<f64>,
 }
 
 /// A master node of a mortar pair held out of the slave body by its own row (the explicit
@@ -213,6 +225,7 @@ impl ContactState {
             penetration: 0.0,
             ever_closed: vec![false; pairs.len()],
             master_block: Vec::new(),
+            scratch: Scratch::default(),
         }
     }
 
@@ -645,7 +658,18 @@ impl ContactState {
         normal: &[Vec<f64>],
         tangential: &[Vec<f64>],
     ) -> Vec<f64> {
-        let mut f = vec![0.0; 2 * coords.len()];
+        let zeros = vec![0.0; 2 * coords.len()];
+        self.nodal_forces_into(pairs, coords, (normal, tangential), zeros)
+    }
+
+    /// The same, added into `f` (zero over all DOFs).
+    pub(super) fn nodal_forces_into(
+        &self,
+        pairs: &[ContactPair],
+        coords: &[[f64; 2]],
+        (normal, tangential): (&[Vec<f64>], &[Vec<f64>]),
+        mut f: Vec<f64>,
+    ) -> Vec<f64> {
         let x = |n: usize| coords[n];
         for s in slave_gaps(pairs, &x, &|p, k| !self.active[p][k]) {
             let (p, k) = (s.pair, s.index);

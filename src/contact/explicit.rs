@@ -38,6 +38,7 @@
 //! ```
 
 use super::Interfaces;
+use super::active::Scratch;
 use super::active::{ContactState, MasterEntry};
 use super::geometry::{COVERED, Friction, Gap, Master};
 use super::mortar::{MASTER_ALLOWANCE, master_node_gap};
@@ -75,7 +76,7 @@ impl ContactState {
         let Predicted {
             interfaces, start, ..
         } = *step;
-        let c = step.correct();
+        let c = step.correct(zeros(&mut self.scratch.delta, step.du.len()));
         let coulomb = |p: usize| coulomb(interfaces, p);
         // entries closed at the start of the step (their multiplier is the step's force)
         let persistent: Vec<bool> = c
@@ -135,8 +136,9 @@ impl ContactState {
                 self.sliding[*p][*k] = coulomb(*p).unwrap_or(0.0) * c.friction_total[i].signum();
             }
         }
-        let mut step_force =
-            self.nodal_forces_of(&interfaces.pairs, start, &step_forces, &step_friction);
+        let zeroed = zeros(&mut self.scratch.force, step.du.len());
+        let rows = (&step_forces[..], &step_friction[..]);
+        let mut step_force = self.nodal_forces_into(&interfaces.pairs, start, rows, zeroed);
         for (dof, impulse) in &c.master_impulse {
             step_force[*dof] += impulse / (h * h);
         }
@@ -145,6 +147,42 @@ impl ContactState {
             step_force,
         }
     }
+}
+
+impl ContactState {
+    /// Takes back the vectors of a step's correction once they are read: the entries at the
+    /// contact surfaces' nodes (the only ones a step writes: its rows and master block) and
+    /// at `nonzero` (the DOFs where either is not zero) are zeroed, and the vectors kept for
+    /// the next step.
+    pub fn recycle(&mut self, step: ExplicitContact, interfaces: &Interfaces, nonzero: &[usize]) {
+        let (mut delta, mut force) = (step.correction, step.step_force);
+        for &d in nonzero {
+            delta[d] = 0.0;
+            force[d] = 0.0;
+        }
+        for pair in &interfaces.pairs {
+            let masters: &[usize] = match &pair.master {
+                Master::Segments { edges, .. } => edges.as_flattened(),
+                Master::Nodes { nodes, .. } => nodes,
+                Master::Obstacle(_) => &[],
+            };
+            for n in pair.slaves.iter().chain(masters) {
+                delta[2 * n..2 * n + 2].fill(0.0);
+                force[2 * n..2 * n + 2].fill(0.0);
+            }
+        }
+        self.scratch = Scratch { delta, force };
+    }
+}
+
+/// `buffer` (zero, or empty) as a zero vector of length `len`.
+fn zeros(buffer: &mut Vec<f64>, len: usize) -> Vec<f64> {
+    let mut v = std::mem::take(buffer);
+    if v.len() != len {
+        v.clear();
+        v.resize(len, 0.0);
+    }
+    v
 }
 
 /// Pair `p`'s Coulomb coefficient, when it has friction.
@@ -196,10 +234,10 @@ impl Predicted<'_> {
     /// The passes of the correction (at most 20): penetrated entries join, the multipliers
     /// close the gaps, friction returns into its cone, entries in tension leave; until no
     /// entry joins and the gaps and sticking slips are within TOL.
-    fn correct(&self) -> Correction {
+    fn correct(&self, delta: Vec<f64>) -> Correction {
         let interfaces = self.interfaces;
         let mut c = Correction {
-            delta: vec![0.0; self.du.len()],
+            delta,
             active: Vec::new(),
             in_active: interfaces
                 .pairs

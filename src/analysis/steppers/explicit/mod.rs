@@ -215,13 +215,14 @@ impl<'a> Explicit<'a> {
                 .zip(step.correction.par_chunks(DOF_CHUNK))
                 .for_each(|((du, v_half), correction)| apply(du, v_half, correction));
         }
-        for i in touched {
+        for &i in &touched {
             let c = step.correction[i];
             if c != 0.0 {
                 self.v_half[i] += c / h;
             }
         }
         self.energies.contact_work -= work;
+        self.contact.recycle(step, &self.interfaces, &touched);
     }
 
     /// The energies at the end of step `self.step + 1`: the step's external work added, the

@@ -385,20 +385,6 @@ impl NodeSums {
     }
 }
 
-/// sum_d term(d) over the DOFs `dofs` (ascending), per `DOF_CHUNK` chunk, the chunks' sums
-/// added in chunk order.
-fn chunked(dofs: impl Iterator<Item = usize>, term: impl Fn(usize) -> f64) -> f64 {
-    let mut chunks: Vec<f64> = Vec::new();
-    for d in dofs {
-        let k = d / DOF_CHUNK;
-        if chunks.len() <= k {
-            chunks.resize(k + 1, 0.0);
-        }
-        chunks[k] += term(d);
-    }
-    chunks.into_iter().fold(0.0, |total, chunk| total + chunk)
-}
-
 impl Explicit<'_> {
     /// One major step of the subcycled run (see the legend): the clock's step over 2^K
     /// substeps, the history row at its end.
@@ -570,18 +556,39 @@ impl Explicit<'_> {
     /// The energies at the end of a major step (every node has ended a step there).
     fn end_major_step(&mut self, sub: &Subcycler, sums: &NodeSums, h: f64) {
         let (v, m, a, free) = (&self.v, &self.mass, &self.a, &self.free);
-        let kinetic = chunked(0..v.len(), |d| m[d] * v[d] * v[d]);
-        // the shadow h^2 / 8 a.M a with each node's own step, summed per level
-        let mut shadow = 0.0;
-        for (k, nodes) in sub.levels.nodes.iter().enumerate() {
-            let dofs = nodes
-                .iter()
-                .flat_map(|n| [2 * *n as usize, 2 * *n as usize + 1])
-                .filter(|d| free[*d]);
-            let sum = chunked(dofs, |d| m[d] * a[d] * a[d]);
-            let span = (1u64 << k) as f64 * h;
-            shadow += 0.125 * span * span * sum;
-        }
+        // sums over all DOFs per `DOF_CHUNK` chunk, the chunks added in order (as the single
+        // step adds them)
+        let chunked = |term: &dyn Fn(usize) -> f64| {
+            (0..v.len())
+                .step_by(DOF_CHUNK)
+                .map(|start| {
+                    let mut sum = 0.0;
+                    for d in start..(start + DOF_CHUNK).min(v.len()) {
+                        sum += term(d);
+                    }
+                    sum
+                })
+                .fold(0.0, |total, chunk| total + chunk)
+        };
+        let kinetic = chunked(&|d| m[d] * v[d] * v[d]);
+        let free_term = |d: usize| if free[d] { m[d] * a[d] * a[d] } else { 0.0 };
+        // the shadow h^2 / 8 a.M a with each node's own step: on one level as the single
+        // step sums it, on several per level
+        let shadow = if sub.levels.top == 0 {
+            0.125 * h * h * chunked(&free_term)
+        } else {
+            let mut shadow = 0.0;
+            for (k, nodes) in sub.levels.nodes.iter().enumerate() {
+                let mut sum = 0.0;
+                for n in nodes {
+                    let d = 2 * *n as usize;
+                    sum += free_term(d) + free_term(d + 1);
+                }
+                let span = (1u64 << k) as f64 * h;
+                shadow += 0.125 * span * span * sum;
+            }
+            shadow
+        };
         let work = sums.work.iter().fold(0.0, |total, chunk| total + chunk);
         self.close_step_energies(0.5 * work, (0.5 * kinetic, shadow));
     }
