@@ -14,7 +14,7 @@
 
 mod subcycling;
 
-pub use subcycling::{Levels, own_levels, start as subcycling_start};
+pub use subcycling::{Levels, start as subcycling_start};
 
 use super::carry::{Carry, ExplicitCarry};
 use super::clock::Clock;

@@ -115,17 +115,6 @@ impl Levels {
             own,
         }
     }
-
-    /// The level each element steps at (l_e).
-    pub fn element_levels(&self, elements: usize) -> Vec<u8> {
-        let mut level = vec![0u8; elements];
-        for (k, list) in self.elements.iter().enumerate() {
-            for e in list {
-                level[*e as usize] = k as u8;
-            }
-        }
-        level
-    }
 }
 
 /// k_e = floor(log2(dt_e / dt_min)) of every element, at most `levels` (an element that does
@@ -598,6 +587,17 @@ impl Explicit<'_> {
 mod tests {
     use super::*;
 
+    /// The level each element steps at (l_e) in `levels`.
+    fn element_levels(levels: &Levels, elements: usize) -> Vec<u8> {
+        let mut level = vec![0u8; elements];
+        for (k, list) in levels.elements.iter().enumerate() {
+            for e in list {
+                level[*e as usize] = k as u8;
+            }
+        }
+        level
+    }
+
     /// A strip of 4 elements in a row (nodes 0-4 bottom, 5-9 top).
     fn strip() -> Vec<[u32; 4]> {
         (0..4u32).map(|e| [e, e + 1, e + 6, e + 5]).collect()
@@ -619,12 +619,12 @@ mod tests {
         // nodes 0, 1 (5, 6) level 0; 2 (7): min(2, 2) = 2; 3 (8): 2; 4 (9): 3
         assert_eq!(levels.node, vec![0, 0, 2, 2, 3, 0, 0, 2, 2, 3]);
         // element 1 has nodes 1 and 2: level 0; element 2: 2; element 3: nodes 3, 4: 2
-        assert_eq!(levels.element_levels(4), vec![0, 0, 2, 2]);
+        assert_eq!(element_levels(&levels, 4), vec![0, 0, 2, 2]);
         assert_eq!(levels.top, 3);
         let mut pinned = [false; 10];
         pinned[3] = true;
         let levels = Levels::form(&omega, &strip(), &pinned, 5);
-        assert_eq!(levels.element_levels(4), vec![0, 0, 0, 0]);
+        assert_eq!(element_levels(&levels, 4), vec![0, 0, 0, 0]);
         // capped
         assert_eq!(own_levels(&omega, 1), vec![0, 1, 1, 1]);
         // against the logarithm: ratios just below and above the powers of two
