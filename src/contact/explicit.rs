@@ -38,11 +38,10 @@
 //! ```
 
 use super::Interfaces;
-use super::active::Scratch;
-use super::active::{ContactState, MasterEntry};
 use super::geometry::{COVERED, Friction, Gap, Master};
 use super::mortar::{MASTER_ALLOWANCE, master_node_gap};
 use super::search::{SlaveGap, penetrates, slave_gaps};
+use super::status::{ContactState, MasterEntry, Scratch};
 
 /// What an explicit contact step gives the driver.
 pub struct ExplicitContact {

@@ -1,6 +1,7 @@
 //! Contact, in one place: detection on the current configuration (`geometry`, `search`),
-//! the active set and the event logic of a step (`active`), Hughes' impact and release
-//! conditions (`conditions`), the explicit forward-increment multipliers (`explicit`) and the
+//! the status carried between steps (`status`), the event logic of an implicit step
+//! (`step`), Hughes' impact and release conditions (`conditions`) met at a step's events
+//! (`impacts`), the explicit forward-increment multipliers (`explicit`) and the
 //! set-up checks of a pair (`setup`).
 //! It works on plain arrays (positions, masses, DOF indices) and never sees the model or
 //! the assembled system: the implicit solver receives the rows of the active entries and
@@ -24,26 +25,27 @@
 //! entry          (pair, slave index): one slave of one pair
 //! ```
 
-pub mod active;
 pub mod conditions;
 pub mod explicit;
 pub mod gap;
 pub mod geometry;
+pub mod impacts;
 pub mod linearization;
 pub mod mortar;
 mod multipliers;
 pub mod search;
 pub mod setup;
+pub mod status;
+pub mod step;
 
-pub use active::{
-    ConstrainedSolution, ContactResult, ContactState, Events, ImpactMotion, LumpedMass,
-    MasterEntry, NodalStatus, Pass, Tangential, Unsettled, apply_conditions,
-};
 pub use geometry::{
     ContactPair, Covered, Friction, Gap, Holds, Master, Obstacle, PairOptions, winding_number,
 };
+pub use impacts::{ImpactMotion, LumpedMass, apply_conditions};
 pub use mortar::MortarSurface;
 pub use search::{SlaveGap, penetration_limits, runaway_penetration, slave_gaps};
+pub use status::{ContactState, MasterEntry, NodalStatus};
+pub use step::{ConstrainedSolution, ContactResult, Events, Pass, Tangential, Unsettled};
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;

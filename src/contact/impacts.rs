@@ -1,0 +1,292 @@
+//! The impact and release conditions of a step's events (Hughes II-8, II-11, II-12; theory
+//! 8.3, 8.3a): the closure of touching slaves at the start of a step, and the conditions of
+//! the entries that closed or were released in it (`conditions` holds the formulas).
+
+use super::Interfaces;
+use super::conditions;
+use super::geometry::Friction;
+use super::search::{SlaveGap, slave_gaps};
+use super::status::ContactState;
+use super::step::ContactResult;
+
+impl ContactState {
+    /// Closes, at the start of a step, the open slaves that touch their master (|g| <= TOL)
+    /// and approach it: the moment of impact. With impact conditions the pair's normal
+    /// velocities and accelerations are made compatible there (Hughes II-8, with the
+    /// velocities of the end of the previous step, which these are). Returns the entries
+    /// closed.
+    pub fn close_touching(
+        &mut self,
+        interfaces: &Interfaces,
+        coords: &[[f64; 2]],
+        mass: LumpedMass,
+        (velocity, acceleration): (&mut [f64], &mut [f64]),
+    ) -> Vec<(usize, usize)> {
+        let LumpedMass {
+            mass: lumped,
+            inverse: inverse_mass,
+        } = mass;
+        let x = |n: usize| coords[n];
+        let touching: Vec<SlaveGap> = slave_gaps(&interfaces.pairs, &x, &|p, k| self.active[p][k])
+            .filter(|s| {
+                let pair = &interfaces.pairs[s.pair];
+                s.gap.gap.abs() <= pair.options.tolerance
+                    && !pair.covers(&interfaces.pairs, &s.gap, &x, &|p, k| self.active[p][k])
+            })
+            .collect();
+        let mut closed = Vec::new();
+        for SlaveGap {
+            pair: p,
+            index: k,
+            node: s,
+            gap,
+        } in touching
+        {
+            let pair = &interfaces.pairs[p];
+            let entry = conditions::Entry {
+                interfaces,
+                pair,
+                slave: s,
+                gap: &gap,
+                coords,
+                lumped,
+            };
+            if !conditions::approaching(&entry, velocity) {
+                continue; // touching but not approaching
+            }
+            self.active[p][k] = true;
+            self.force[p][k] = 0.0;
+            closed.push((p, k));
+            if pair.options.impact_conditions && !pair.joint_conditions() {
+                // the velocities before the impact are the previous step's
+                let previous = velocity.to_vec();
+                let mut force = 0.0;
+                conditions::impact(&entry, &previous, velocity, acceleration, &mut force);
+                self.force[p][k] = force.max(0.0);
+            }
+        }
+        // the rows of the mortar pairs and their hold pairs share nodes: their conditions are
+        // met together
+        let joint = |p: usize| met_together(interfaces, p);
+        if closed.iter().any(|(q, _)| joint(*q)) {
+            let active = &self.active;
+            let entries: Vec<(usize, usize)> = (0..interfaces.pairs.len())
+                .filter(|p| joint(*p))
+                .flat_map(|p| {
+                    (0..interfaces.pairs[p].slaves.len())
+                        .filter(move |k| active[p][*k])
+                        .map(move |k| (p, k))
+                })
+                .collect();
+            let rows = joint_rows(interfaces, &entries, &x);
+            let mut forces: Vec<f64> = entries.iter().map(|(p, k)| self.force[*p][*k]).collect();
+            conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+            for ((p, k), f) in entries.iter().zip(forces) {
+                self.force[*p][*k] = f;
+            }
+        }
+        closed
+    }
+}
+
+/// The nodal motion the impact and release conditions correct: the velocity at the start of
+/// the step, and the step's velocity and acceleration (all DOFs), corrected in place.
+pub struct ImpactMotion<'a> {
+    pub previous_velocity: &'a [f64],
+    pub velocity: &'a mut [f64],
+    pub acceleration: &'a mut [f64],
+}
+
+/// The lumped mass of every DOF and its inverse (0 on prescribed DOFs).
+#[derive(Clone, Copy)]
+pub struct LumpedMass<'a> {
+    pub mass: &'a [f64],
+    pub inverse: &'a [f64],
+}
+
+/// Hughes II-8 for the entries that closed and II-11, II-12 for those released by the
+/// fraction rule: corrects `velocity` and `acceleration` (all DOFs) in place, and the forces
+/// of closed entries. `previous_velocity` is the velocity at the start of the step.
+pub fn apply_conditions<S>(
+    interfaces: &Interfaces,
+    step: &mut ContactResult<S>,
+    coords: &[[f64; 2]],
+    mass: LumpedMass,
+    mut motion: ImpactMotion,
+) {
+    impact_mortar_pairs(interfaces, step, coords, mass.inverse, &mut motion);
+    impact_slaves(interfaces, step, coords, mass.mass, &mut motion);
+    release_slaves(interfaces, step, coords, mass, &mut motion);
+}
+
+/// II-8 on the mortar pairs and their hold pairs where an entry closed: all their active
+/// rows at once (they share nodes), their forces corrected.
+fn impact_mortar_pairs<S>(
+    interfaces: &Interfaces,
+    step: &mut ContactResult<S>,
+    coords: &[[f64; 2]],
+    inverse_mass: &[f64],
+    motion: &mut ImpactMotion,
+) {
+    let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
+    let x = |n: usize| coords[n];
+    let joint = |p: usize| met_together(interfaces, p);
+    if !step.events.closed.iter().any(|(q, _)| joint(*q)) {
+        return;
+    }
+    let entries: Vec<usize> = (0..step.active.len())
+        .filter(|i| joint(step.active[*i].0))
+        .collect();
+    let pairs: Vec<(usize, usize)> = entries.iter().map(|i| step.active[*i]).collect();
+    let rows = joint_rows(interfaces, &pairs, &x);
+    let mut forces: Vec<f64> = entries.iter().map(|i| step.forces[*i]).collect();
+    conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+    for (i, f) in entries.iter().zip(forces) {
+        step.forces[*i] = f;
+    }
+}
+
+/// Whether pair `p` takes impact conditions, met together with the other such pairs' rows
+/// (`ContactPair::joint_conditions`).
+fn met_together(interfaces: &Interfaces, p: usize) -> bool {
+    let pair = &interfaces.pairs[p];
+    pair.options.impact_conditions && pair.joint_conditions()
+}
+
+/// The constraint rows of `entries` (pair, slave index) at positions `x` (an entry whose gap
+/// is gone: an empty row).
+fn joint_rows(
+    interfaces: &Interfaces,
+    entries: &[(usize, usize)],
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> Vec<Vec<(usize, f64)>> {
+    entries
+        .iter()
+        .map(|(p, k)| {
+            let pair = &interfaces.pairs[*p];
+            let s = pair.slaves[*k];
+            pair.gap(s, x).map_or_else(Vec::new, |g| g.row(s))
+        })
+        .collect()
+}
+
+/// II-8 on each closed entry of the other pairs, its force kept compressive and its
+/// friction force following it.
+fn impact_slaves<S>(
+    interfaces: &Interfaces,
+    step: &mut ContactResult<S>,
+    coords: &[[f64; 2]],
+    lumped: &[f64],
+    motion: &mut ImpactMotion,
+) {
+    let previous_velocity = motion.previous_velocity;
+    let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
+    let x = |n: usize| coords[n];
+    for &(p, k) in &step.events.closed {
+        let pair = &interfaces.pairs[p];
+        if !pair.options.impact_conditions || pair.joint_conditions() {
+            continue;
+        }
+        let s = pair.slaves[k];
+        let Some(gap) = pair.gap(s, &x) else { continue };
+        let i = step
+            .active
+            .iter()
+            .position(|e| *e == (p, k))
+            .expect("closed entries are active");
+        let entry = conditions::Entry {
+            interfaces,
+            pair,
+            slave: s,
+            gap: &gap,
+            coords,
+            lumped,
+        };
+        conditions::impact(
+            &entry,
+            previous_velocity,
+            velocity,
+            acceleration,
+            &mut step.forces[i],
+        );
+        // a compressive multiplier: II-8's correction may not turn it into a pull; the
+        // friction force follows the corrected normal force (a sliding entry's stays mu tau,
+        // a sticking one's is held within it), and the slave's tangential acceleration with it
+        step.forces[i] = step.forces[i].max(0.0);
+        if let Friction::Coulomb { mu } = pair.options.friction {
+            let old = step.tangential[i];
+            let limit = mu * step.forces[i];
+            step.tangential[i] = if step.sliding[i] != 0.0 {
+                step.sliding[i] * step.forces[i]
+            } else {
+                old.clamp(-limit, limit)
+            };
+            let t = gap.tangent();
+            let change = step.tangential[i] - old;
+            conditions::add_normal(acceleration, s, t, change / lumped[2 * s]);
+            if let Some(side) = entry.master()
+                && side.mass > 0.0
+            {
+                conditions::spread(acceleration, &side, t, -change / side.mass);
+            }
+        }
+    }
+}
+
+/// II-11, II-12 on the entries released by the fraction rule (along the released row on a
+/// mortar pair).
+fn release_slaves<S>(
+    interfaces: &Interfaces,
+    step: &ContactResult<S>,
+    coords: &[[f64; 2]],
+    mass: LumpedMass,
+    motion: &mut ImpactMotion,
+) {
+    let LumpedMass {
+        mass: lumped,
+        inverse: inverse_mass,
+    } = mass;
+    let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
+    let x = |n: usize| coords[n];
+    for &(p, k, tau, friction) in &step.events.released {
+        let pair = &interfaces.pairs[p];
+        if !pair.options.release_conditions {
+            continue;
+        }
+        let s = pair.slaves[k];
+        let Some(gap) = pair.gap(s, &x) else { continue };
+        let n = gap.normal;
+        let entry = conditions::Entry {
+            interfaces,
+            pair,
+            slave: s,
+            gap: &gap,
+            coords,
+            lumped,
+        };
+        let (ms, zs) = entry.slave_mass_and_impedance();
+        // the impedance is positive for any node with a contact area (an axis node included)
+        debug_assert!(zs > 0.0, "slave {s}: impedance {zs}");
+        if pair.joint_conditions() {
+            let zm = entry.master().map_or(0.0, |side| side.impedance);
+            let compliance = 1.0 / zs + if zm > 0.0 { 1.0 / zm } else { 0.0 };
+            let rows = conditions::Released {
+                normal: gap.row(s),
+                tangential: gap.tangent_row(s),
+            };
+            let forces = (tau, friction, compliance);
+            conditions::release_along(&rows, inverse_mass, (velocity, acceleration), forces);
+            continue;
+        }
+        conditions::add_normal(velocity, s, n, tau / zs);
+        conditions::add_normal(acceleration, s, n, -tau / ms);
+        // the friction force goes with the normal one (its acceleration, as in II-12)
+        let t = gap.tangent();
+        conditions::add_normal(acceleration, s, t, -friction / ms);
+        if let Some(side) = entry.master() {
+            conditions::spread(velocity, &side, n, -tau / side.impedance);
+            conditions::spread(acceleration, &side, n, tau / side.mass);
+            conditions::spread(acceleration, &side, t, friction / side.mass);
+        }
+    }
+}

@@ -1,0 +1,317 @@
+//! The contact status carried from step to step: the active entries and their forces, the
+//! run's contact figures (first contact, last release, peak force, penetration), and what
+//! the frames and the history read of it (nodal forces, gaps, pair totals).
+
+use super::geometry::{ContactPair, Master};
+use super::search::slave_gaps;
+use super::step::ContactResult;
+use super::{ContactSummary, Interfaces, Section};
+
+/// The contact status carried from step to step.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct ContactState {
+    /// Per pair, per slave (in the pair's order): active?
+    pub active: Vec<Vec<bool>>,
+    /// Per pair, per slave: the last converged force.
+    pub force: Vec<Vec<f64>>,
+    /// Per pair, per slave: the last converged tangential (friction) force along t.
+    pub tangential: Vec<Vec<f64>>,
+    /// Per pair, per slave: the signed Coulomb coefficient of a sliding entry, 0 sticking.
+    pub sliding: Vec<Vec<f64>>,
+    pub first_contact_time: Option<f64>,
+    pub last_release_time: Option<f64>,
+    pub peak_force: f64,
+    pub peak_extent: f64,
+    /// The most negative gap of any slave after any step (penetration), or None.
+    pub min_gap: Option<f64>,
+    /// The deepest penetration of either surface into the other body after any step: a
+    /// slave's negative gap, or a deformable master's node inside the slave body (>= 0).
+    pub max_penetration: f64,
+    /// The same after the last step alone.
+    pub penetration: f64,
+    /// Per pair: closed at some step (empty in a checkpoint written before it was kept).
+    #[serde(default)]
+    pub ever_closed: Vec<bool>,
+    /// The explicit correction's master block after the last step: the master nodes of
+    /// mortar pairs held out of the slave body by a row of their own, and their normal
+    /// forces (`contact::explicit`). Empty on every other path.
+    #[serde(default)]
+    pub master_block: Vec<MasterEntry>,
+    /// The explicit correction's vectors over all DOFs, kept zero between steps, so that a
+    /// step neither allocates nor clears them whole (`contact::explicit`; not in a
+    /// checkpoint: zero vectors of the right length either way).
+    #[serde(skip)]
+    pub(super) scratch: Scratch,
+}
+
+/// Vectors over all DOFs, zero between uses (`ContactState::scratch`).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Scratch {
+    pub delta: Vec<f64>,
+    pub force: Vec<f64>,
+}
+
+/// A master node of a mortar pair held out of the slave body by its own row (the explicit
+/// correction's master block), with its reported normal force.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MasterEntry {
+    pub pair: usize,
+    pub node: usize,
+    pub force: f64,
+}
+
+impl ContactState {
+    /// Every pair starts open: slaves touching at the start (|g| <= TOL) close in the first
+    /// step they press on their master, so the impact conditions see that closure.
+    pub fn new(pairs: &[ContactPair]) -> ContactState {
+        let active = pairs.iter().map(|p| vec![false; p.slaves.len()]).collect();
+        let force: Vec<Vec<f64>> = pairs.iter().map(|p| vec![0.0; p.slaves.len()]).collect();
+        let zeros: Vec<Vec<f64>> = force.clone();
+        ContactState {
+            active,
+            tangential: zeros.clone(),
+            sliding: zeros,
+            force,
+            first_contact_time: None,
+            last_release_time: None,
+            peak_force: 0.0,
+            peak_extent: 0.0,
+            min_gap: None,
+            max_penetration: 0.0,
+            penetration: 0.0,
+            ever_closed: vec![false; pairs.len()],
+            master_block: Vec::new(),
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// Takes a step's outcome as the new status; `time` is the end of the step.
+    pub fn commit<S>(
+        &mut self,
+        interfaces: &Interfaces,
+        step: &ContactResult<S>,
+        time: f64,
+        coords: &[[f64; 2]],
+    ) {
+        let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
+        let rows = (&step.active[..], &step.forces[..]);
+        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
+        for (i, (p, k)) in step.active.iter().enumerate() {
+            self.tangential[*p][*k] = step.tangential[i];
+            self.sliding[*p][*k] = step.sliding[i];
+        }
+    }
+
+    /// Sets the status: the active entries and their forces (`(active, forces)`) after a step
+    /// ending at `time` (`released`: some entry let go in it) with the nodes at `positions`.
+    /// `lowest`: the lowest slave gap there when the caller has just computed every slave's
+    /// gap there (Some(None): no slave has a master in reach); None computes them.
+    pub(super) fn set(
+        &mut self,
+        interfaces: &Interfaces,
+        (active, forces): (&[(usize, usize)], &[f64]),
+        (time, released): (f64, bool),
+        x: &impl Fn(usize) -> [f64; 2],
+        lowest: Option<Option<f64>>,
+    ) {
+        for flags in &mut self.active {
+            flags.iter_mut().for_each(|a| *a = false);
+        }
+        for forces in self
+            .force
+            .iter_mut()
+            .chain(&mut self.tangential)
+            .chain(&mut self.sliding)
+        {
+            forces.iter_mut().for_each(|f| *f = 0.0);
+        }
+        for (i, (p, k)) in active.iter().enumerate() {
+            self.active[*p][*k] = true;
+            self.force[*p][*k] = forces[i];
+            if let Some(closed) = self.ever_closed.get_mut(*p) {
+                *closed = true;
+            }
+        }
+        if !active.is_empty() && self.first_contact_time.is_none() {
+            self.first_contact_time = Some(time);
+        }
+        if released {
+            self.last_release_time = Some(time);
+        }
+        let total: f64 =
+            forces.iter().sum::<f64>() + self.master_block.iter().map(|e| e.force).sum::<f64>();
+        self.peak_force = self.peak_force.max(total);
+        let lowest = lowest.unwrap_or_else(|| {
+            slave_gaps(&interfaces.pairs, x, &|_, _| false)
+                .map(|s| s.gap.gap)
+                .reduce(f64::min)
+        });
+        let mut penetration = 0.0f64;
+        if let Some(g) = lowest {
+            self.min_gap = Some(self.min_gap.map_or(g, |m| m.min(g)));
+            penetration = penetration.max(-g);
+        }
+        for pair in &interfaces.pairs {
+            let boundary = &interfaces.bodies[pair.slave_body].boundary;
+            penetration = penetration.max(super::setup::master_penetration(pair, x, boundary));
+            penetration = penetration.max(super::setup::slave_penetration(pair, x));
+        }
+        self.penetration = penetration;
+        self.max_penetration = self.max_penetration.max(penetration);
+        self.peak_extent = self.peak_extent.max(extent(interfaces, active, x));
+    }
+}
+
+impl ContactState {
+    /// The contact block of summary.json.
+    /// The contact block of summary.json for the run's `pairs`.
+    pub fn summary(&self, pairs: &[ContactPair]) -> ContactSummary {
+        // a second pass closes nothing where its first pass holds the contact: the two
+        // passes are one contact
+        let closed = |p: usize| {
+            let first = pairs[p].covered.as_ref().map(|c| c.pair);
+            [Some(p), first]
+                .into_iter()
+                .flatten()
+                .any(|q| self.ever_closed.get(q).copied().unwrap_or(true))
+        };
+        ContactSummary {
+            never_closed: (0..pairs.len().min(self.ever_closed.len()))
+                .filter(|p| !closed(*p))
+                .map(|p| pairs[p].name.clone())
+                .collect(),
+            first_contact_time: self.first_contact_time,
+            last_release_time: self.last_release_time,
+            peak_force: self.peak_force,
+            peak_contact_radius: self.peak_extent,
+            min_gap: self.min_gap,
+            max_penetration: self.min_gap.map(|_| self.max_penetration),
+        }
+    }
+
+    /// Total normal force per pair (the slave entries' and the master block's).
+    pub fn pair_forces(&self) -> Vec<f64> {
+        let mut totals: Vec<f64> = self.force.iter().map(|f| f.iter().sum()).collect();
+        for entry in &self.master_block {
+            totals[entry.pair] += entry.force;
+        }
+        totals
+    }
+
+    /// Total tangential (friction) force along t per pair.
+    pub fn pair_tangential_forces(&self) -> Vec<f64> {
+        self.tangential.iter().map(|f| f.iter().sum()).collect()
+    }
+
+    /// Nodal contact forces (all DOFs) at positions `coords`: +tau n on slaves, -w tau n on
+    /// master nodes.
+    pub fn nodal_forces(&self, pairs: &[ContactPair], coords: &[[f64; 2]]) -> Vec<f64> {
+        let mut f = self.nodal_forces_of(pairs, coords, &self.force, &self.tangential);
+        let x = |n: usize| coords[n];
+        for entry in &self.master_block {
+            let pair = &pairs[entry.pair];
+            let (Some(surface), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master)
+            else {
+                continue;
+            };
+            let gap = super::mortar::master_node_gap(
+                &surface.edges,
+                edges,
+                entry.node,
+                super::mortar::MASTER_ALLOWANCE,
+                &x,
+            );
+            if let Some(gap) = gap {
+                for (dof, c) in gap.row(entry.node) {
+                    f[dof] += entry.force * c;
+                }
+            }
+        }
+        f
+    }
+
+    /// As `nodal_forces`, with the normal forces `normal` and the tangential ones
+    /// `tangential` (per pair, per slave) on the active entries.
+    pub(super) fn nodal_forces_of(
+        &self,
+        pairs: &[ContactPair],
+        coords: &[[f64; 2]],
+        normal: &[Vec<f64>],
+        tangential: &[Vec<f64>],
+    ) -> Vec<f64> {
+        let zeros = vec![0.0; 2 * coords.len()];
+        self.nodal_forces_into(pairs, coords, (normal, tangential), zeros)
+    }
+
+    /// The same, added into `f` (zero over all DOFs).
+    pub(super) fn nodal_forces_into(
+        &self,
+        pairs: &[ContactPair],
+        coords: &[[f64; 2]],
+        (normal, tangential): (&[Vec<f64>], &[Vec<f64>]),
+        mut f: Vec<f64>,
+    ) -> Vec<f64> {
+        let x = |n: usize| coords[n];
+        for s in slave_gaps(pairs, &x, &|p, k| !self.active[p][k]) {
+            let (p, k) = (s.pair, s.index);
+            for (dof, c) in s.gap.row(s.node) {
+                f[dof] += normal[p][k] * c;
+            }
+            for (dof, c) in s.gap.tangent_row(s.node) {
+                f[dof] += tangential[p][k] * c;
+            }
+        }
+        f
+    }
+
+    /// Per node: the gap and the status of slave nodes (status 1 active, 0 open), zeros
+    /// elsewhere.
+    pub fn nodal_status(&self, pairs: &[ContactPair], coords: &[[f64; 2]]) -> NodalStatus {
+        let mut gap = vec![0.0; coords.len()];
+        let mut status = vec![0.0; coords.len()];
+        let x = |n: usize| coords[n];
+        for s in slave_gaps(pairs, &x, &|_, _| false) {
+            gap[s.node] = s.gap.gap;
+        }
+        for (p, pair) in pairs.iter().enumerate() {
+            for (k, s) in pair.slaves.iter().enumerate() {
+                status[*s] = if self.active[p][k] { 1.0 } else { 0.0 };
+            }
+        }
+        NodalStatus { gap, status }
+    }
+}
+
+/// Per node: the gap and the contact status of slave nodes (1 active, 0 open), zeros elsewhere.
+pub struct NodalStatus {
+    pub gap: Vec<f64>,
+    pub status: Vec<f64>,
+}
+
+/// Largest extent of the closed entries: the largest radius for axisymmetric slaves, else
+/// the largest distance between two closed slaves of a pair.
+fn extent(
+    interfaces: &Interfaces,
+    active: &[(usize, usize)],
+    x: &dyn Fn(usize) -> [f64; 2],
+) -> f64 {
+    let mut best: f64 = 0.0;
+    for (p, pair) in interfaces.pairs.iter().enumerate() {
+        let nodes: Vec<[f64; 2]> = active
+            .iter()
+            .filter(|(q, _)| *q == p)
+            .map(|(_, k)| x(pair.slaves[*k]))
+            .collect();
+        let axisymmetric = interfaces.bodies[pair.slave_body].section == Section::Axisymmetric;
+        for (i, a) in nodes.iter().enumerate() {
+            if axisymmetric {
+                best = best.max(a[0]);
+                continue;
+            }
+            for b in &nodes[i + 1..] {
+                best = best.max(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt());
+            }
+        }
+    }
+    best
+}
