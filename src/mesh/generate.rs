@@ -177,7 +177,8 @@ mod tests {
                     center: [0.0, 0.0],
                     radius: 1.0,
                     n: 3,
-                    grading: 1.0
+                    grading: 1.0,
+                    grade_toward: Default::default(),
                 }
                 .build()
             ),

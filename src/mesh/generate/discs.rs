@@ -105,14 +105,17 @@ impl QuarterDisc {
 }
 
 /// `type = "half_disc"`: the half x >= cx of a disc of radius R (a full sphere's axisymmetric
-/// section), graded toward the lower pole (cx, cy - R).
+/// section), graded toward the lower pole (cx, cy - R) or, with `grade_toward = "upper"`,
+/// toward the upper pole (cx, cy + R): a sphere striking upwards.
 ///
 /// Meshing: an O-grid whose core is split at the centre into two quadrilaterals (so the centre
 /// is a node), with three outer blocks (lower pole, rim, upper pole). The arc's n steps grow
-/// geometrically from the lower pole. Each pole block takes a arc steps, a chosen so the three
-/// blocks span angles as even as possible. Quads: n n_layer + a (n - 2 a).
+/// geometrically from the graded pole. Each pole block takes a arc steps, a chosen so the three
+/// blocks span angles as even as possible. Quads: n n_layer + a (n - 2 a). The upper-graded
+/// mesh is the lower-graded one mirrored about y = cy.
 ///
-/// Edge sets `axis` (x = cx), `arc`; one-node sets `pole` (lower pole), `top_pole`, `center`.
+/// Edge sets `axis` (x = cx), `arc`; one-node sets `pole` (lower pole), `top_pole`, `center`
+/// (the names are geometric: `pole` is the lower pole whichever pole is graded).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HalfDisc {
@@ -123,13 +126,35 @@ pub struct HalfDisc {
     pub radius: f64,
     /// Elements along the half circle, >= 4.
     pub n: usize,
-    /// Largest / smallest arc step (smallest at the lower pole), in [1e-6, 1e6]. Default 1.
+    /// Largest / smallest arc step (smallest at the pole `grade_toward` names), in
+    /// [1e-6, 1e6]. Default 1.
     #[serde(default = "one")]
     pub grading: f64,
+    /// The pole of the smallest arc step: `lower` (default) or `upper`.
+    #[serde(default)]
+    pub grade_toward: Pole,
+}
+
+/// A pole of a half disc: the lower (cx, cy - R) or the upper (cx, cy + R).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pole {
+    #[default]
+    Lower,
+    Upper,
 }
 
 impl HalfDisc {
     pub fn build(&self) -> Result<Mesh, MeshError> {
+        let mesh = self.build_lower()?;
+        Ok(match self.grade_toward {
+            Pole::Lower => mesh,
+            Pole::Upper => mirrored(mesh, self.center[1]),
+        })
+    }
+
+    /// The mesh graded toward the lower pole.
+    fn build_lower(&self) -> Result<Mesh, MeshError> {
         let center = finite_point("center", self.center)?;
         let radius = positive("radius", self.radius)?;
         let n = at_least("n", self.n, 4)?;
@@ -175,6 +200,34 @@ impl HalfDisc {
         mesh.add_node_set("center", vec![centre]);
         Ok(mesh)
     }
+}
+
+/// `mesh` mirrored about the line y = `y`: cells and edges reversed so that cells stay
+/// counter-clockwise and edges keep the body on their left; the node sets `pole` and
+/// `top_pole` swap nodes (each keeps naming the lower and the upper pole).
+fn mirrored(mut mesh: Mesh, y: f64) -> Mesh {
+    for node in &mut mesh.nodes {
+        node[1] = 2.0 * y - node[1];
+    }
+    if let crate::mesh::Cells::Quad4(cells) = &mut mesh.cells {
+        for cell in cells.iter_mut() {
+            cell.reverse();
+        }
+    }
+    for edges in mesh.edge_sets.values_mut() {
+        for edge in edges.iter_mut() {
+            edge.reverse();
+        }
+        edges.reverse();
+    }
+    if let (Some(lower), Some(upper)) = (
+        mesh.node_sets.remove("pole"),
+        mesh.node_sets.remove("top_pole"),
+    ) {
+        mesh.node_sets.insert("pole".into(), upper);
+        mesh.node_sets.insert("top_pole".into(), lower);
+    }
+    mesh
 }
 
 /// `type = "ring"`: an annulus, n_radial x n_circ quads: the full ring (closed without a seam)
@@ -425,6 +478,7 @@ mod tests {
                     radius: 5.0,
                     n,
                     grading,
+                    grade_toward: Pole::Lower,
                 };
                 let mesh = spec.build().unwrap();
                 assert_valid(&mesh);
@@ -447,6 +501,7 @@ mod tests {
             radius: 1.0,
             n: 12,
             grading: 6.0,
+            grade_toward: Pole::Lower,
         }
         .build()
         .unwrap();
@@ -456,6 +511,45 @@ mod tests {
             .position(|e| e[0] == mesh.node_sets["pole"][0])
             .unwrap();
         assert!(steps.iter().all(|&s| s >= steps[first] - 1e-12));
+    }
+
+    /// Goal: `grade_toward = "upper"` grades the half disc toward its upper pole: the mesh
+    /// graded toward the lower pole mirrored about y = cy. Setup: n = 12, grading 6 about
+    /// cy = 2. Reference (geometry): every node of the upper-graded mesh is the mirror image
+    /// of one of the lower-graded mesh's (same count), the quads stay counter-clockwise
+    /// (positive area) with the same total area, the arc runs counter-clockwise from the lower
+    /// pole to the upper one, `pole` and `top_pole` keep their places, and the smallest arc
+    /// step touches the upper pole, 1/6 of the largest.
+    #[test]
+    fn half_disc_graded_toward_the_upper_pole_is_the_mirror_image() {
+        let spec = |grade_toward| HalfDisc {
+            center: [1.0, 2.0],
+            radius: 3.0,
+            n: 12,
+            grading: 6.0,
+            grade_toward,
+        };
+        let lower = spec(Pole::Lower).build().unwrap();
+        let upper = spec(Pole::Upper).build().unwrap();
+        assert_valid(&upper);
+        assert_eq!(upper.nodes.len(), lower.nodes.len());
+        for p in &upper.nodes {
+            let image = [p[0], 4.0 - p[1]];
+            assert!(lower.nodes.iter().any(|q| close(*q, image)), "{p:?}");
+        }
+        assert!((total_area(&upper) - total_area(&lower)).abs() < 1e-12);
+        assert!(close(node(&upper, "pole"), [1.0, -1.0]));
+        assert!(close(node(&upper, "top_pole"), [1.0, 5.0]));
+        let arc = &upper.edge_sets["arc"];
+        assert_eq!(arc[0][0], upper.node_sets["pole"][0]);
+        assert_eq!(arc[arc.len() - 1][1], upper.node_sets["top_pole"][0]);
+        assert!(arc.windows(2).all(|w| w[0][1] == w[1][0]));
+        let steps = arc_angles(&upper, "arc", [1.0, 2.0]);
+        let top = upper.node_sets["top_pole"][0];
+        let at_top = arc.iter().position(|e| e.contains(&top)).unwrap();
+        let largest = steps.iter().copied().fold(0.0, f64::max);
+        assert!(steps.iter().all(|&s| s >= steps[at_top] - 1e-12));
+        assert!((largest / steps[at_top] - 6.0).abs() < 1e-9);
     }
 
     /// Ring: counts, polygon area n_circ/2 sin(2 pi/n_circ) (R^2 - r^2), outer ccw, inner cw.
