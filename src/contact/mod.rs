@@ -45,7 +45,9 @@ pub use impacts::{ImpactMotion, LumpedMass, apply_conditions};
 pub use mortar::MortarSurface;
 pub use search::{SlaveGap, penetration_limits, runaway_penetration, slave_gaps};
 pub use status::{ContactState, MasterEntry, NodalStatus};
-pub use step::{ConstrainedSolution, ContactResult, Events, Pass, Tangential, Unsettled};
+pub use step::{
+    ConstrainedSolution, ContactResult, Events, Inside, Pass, Settled, Tangential, Unsettled,
+};
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;

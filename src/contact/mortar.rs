@@ -34,6 +34,7 @@
 
 use super::gap::Gap;
 use crate::mesh::plane::{dot, outward, sub};
+use num_dual::DualNum;
 use std::f64::consts::PI;
 
 /// The slave surface of a mortar pair.
@@ -61,63 +62,111 @@ pub fn weighted_gap(
     slave: usize,
     x: &dyn Fn(usize) -> [f64; 2],
 ) -> Option<Gap> {
+    weighted(surface, master, slave, x).map(|w| Gap {
+        gap: w.gap,
+        normal: w.normal,
+        masters: w.masters,
+        weight: w.share,
+    })
+}
+
+/// A weighted gap in the scalar type `T`: f64, or the dual numbers of its derivatives
+/// (`linearization`). The formulas are the same for both, so the derivatives are those of
+/// the gap the run uses.
+pub(super) struct Weighted<T> {
+    pub gap: T,
+    pub normal: [T; 2],
+    /// The master nodes and their weights M_jm / D_j.
+    pub masters: Vec<(usize, T)>,
+    /// s_j, the slave node's weight.
+    pub share: T,
+}
+
+/// The scalars the mortar integrals are written in: f64, and dual numbers over a fixed
+/// number of DOFs.
+pub(super) trait Scalar: DualNum<Primitive = f64> + Copy {}
+impl<T: DualNum<Primitive = f64> + Copy> Scalar for T {}
+
+fn sub_t<T: Scalar>(a: [T; 2], b: [T; 2]) -> [T; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+fn dot_t<T: Scalar>(a: [T; 2], b: [T; 2]) -> T {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+/// `plane::outward` in `T`.
+fn outward_t<T: Scalar>(a: [T; 2], b: [T; 2]) -> [T; 2] {
+    let d = sub_t(b, a);
+    let l = dot_t(d, d).sqrt();
+    [d[1] / l, -d[0] / l]
+}
+
+/// [`weighted_gap`] in the scalar `T` (see [`Weighted`]).
+pub(super) fn weighted<T: Scalar>(
+    surface: &MortarSurface,
+    master: &[[usize; 2]],
+    slave: usize,
+    x: &dyn Fn(usize) -> [T; 2],
+) -> Option<Weighted<T>> {
+    let zero = T::from(0.0);
     let (own, count, slave_normal) = slave_side(surface, slave, x)?;
     let own = &own[..count];
-    let mut master_normal = [0.0; 2];
-    let mut masters: Vec<(usize, f64)> = Vec::with_capacity(4);
+    let mut master_normal = [zero; 2];
+    let mut masters: Vec<(usize, T)> = Vec::with_capacity(4);
     // D_jj over the whole support, and int Phi_j dA over the overlaps
-    let mut full = 0.0;
-    let mut covered = 0.0;
+    let mut full = zero;
+    let mut covered = zero;
     for [a, b] in own {
         let (xa, xb) = (x(*a), x(*b));
-        let ab = sub(xb, xa);
-        let length2 = dot(ab, ab);
-        if !(length2 > 0.0) {
+        let ab = sub_t(xb, xa);
+        let length2 = dot_t(ab, ab);
+        if !(length2.re() > 0.0) {
             continue;
         }
         let length = length2.sqrt();
-        let area = |eta: f64| {
+        let area = |eta: T| {
             if surface.axisymmetric {
-                2.0 * PI * (xa[0] + eta * ab[0])
+                (xa[0] + eta * ab[0]) * (2.0 * PI)
             } else {
-                1.0
+                T::from(1.0)
             }
         };
         let Some((phi, d)) = dual_shape(length, &area, usize::from(*b == slave)) else {
             continue;
         };
         full += d;
-        let facing = outward(xa, xb);
+        let facing = outward_t(xa, xb);
         for [p, q] in master {
             let (xp, xq) = (x(*p), x(*q));
             // the master's end points both before the slave segment's start (eta < 0) or
             // both past its end (eta > 1): no overlap, told before a normal and the
             // divisions (the overlap test below finds none either)
-            let (along_p, along_q) = (dot(sub(xp, xa), ab), dot(sub(xq, xa), ab));
-            if (along_p < 0.0 && along_q < 0.0) || (along_p > length2 && along_q > length2) {
+            let (along_p, along_q) = (dot_t(sub_t(xp, xa), ab), dot_t(sub_t(xq, xa), ab));
+            let (ap, aq, l2) = (along_p.re(), along_q.re(), length2.re());
+            if (ap < 0.0 && aq < 0.0) || (ap > l2 && aq > l2) {
                 continue;
             }
-            let across = outward(xp, xq);
-            if dot(across, facing) >= 0.0 {
+            let across = outward_t(xp, xq);
+            if dot_t(across, facing).re() >= 0.0 {
                 continue;
             }
             let (eta_p, eta_q) = (along_p / length2, along_q / length2);
-            let low = eta_p.min(eta_q).max(0.0);
-            let high = eta_p.max(eta_q).min(1.0);
-            if !(high > low)
+            let (low, high) = overlap(eta_p, eta_q);
+            if !(high.re() > low.re())
                 || !within_reach((xa, ab, facing), [xp, xq], [eta_p, eta_q], [low, high])
             {
                 continue;
             }
-            let mut overlap = 0.0;
+            let mut overlap = zero;
             for (g, w) in GAUSS {
-                let eta = low + g * (high - low);
+                let eta = low + (high - low) * g;
                 let xi = (eta - eta_p) / (eta_q - eta_p);
-                let da = w * (high - low) * length * area(eta);
-                let dphi = da * (phi[0] * (1.0 - eta) + phi[1] * eta);
+                let da = (high - low) * w * length * area(eta);
+                let dphi = da * (phi[0] * (-eta + 1.0) + phi[1] * eta);
                 covered += dphi;
                 overlap += da;
-                add(&mut masters, *p, dphi * (1.0 - xi));
+                add(&mut masters, *p, dphi * (-xi + 1.0));
                 add(&mut masters, *q, dphi * xi);
             }
             master_normal = [
@@ -127,36 +176,52 @@ pub fn weighted_gap(
         }
     }
     let share = covered / full;
-    if !(share > 0.0) {
+    if !(share.re() > 0.0) {
         return None;
     }
     masters.iter_mut().for_each(|(_, w)| *w /= full);
     // the mean of the two surfaces' normals: on a plane of symmetry between two mirror
     // bodies it is the plane's normal, where either surface's own would push the other
     // body sideways as the surfaces curl
-    let lm = dot(master_normal, master_normal).sqrt();
+    let lm = dot_t(master_normal, master_normal).sqrt();
     let both = [
         slave_normal[0] + master_normal[0] / lm,
         slave_normal[1] + master_normal[1] / lm,
     ];
-    let lb = dot(both, both).sqrt();
-    let normal = if lb > 0.0 {
+    let lb = dot_t(both, both).sqrt();
+    let normal = if lb.re() > 0.0 {
         [both[0] / lb, both[1] / lb]
     } else {
         slave_normal
     };
     let xs = x(slave);
-    let xm = masters.iter().fold([0.0; 2], |acc, (n, w)| {
+    let xm = masters.iter().fold([zero; 2], |acc, (n, w)| {
         let p = x(*n);
-        [acc[0] + w * p[0], acc[1] + w * p[1]]
+        [acc[0] + *w * p[0], acc[1] + *w * p[1]]
     });
-    let gap = dot([share * xs[0] - xm[0], share * xs[1] - xm[1]], normal);
-    Some(Gap {
+    let gap = dot_t([share * xs[0] - xm[0], share * xs[1] - xm[1]], normal);
+    Some(Weighted {
         gap,
         normal,
         masters,
-        weight: share,
+        share,
     })
+}
+
+/// The overlap [low, high] of the master's projections `eta_p`, `eta_q` with [0, 1].
+fn overlap<T: Scalar>(eta_p: T, eta_q: T) -> (T, T) {
+    let (first, last) = if eta_p.re() <= eta_q.re() {
+        (eta_p, eta_q)
+    } else {
+        (eta_q, eta_p)
+    };
+    let low = if first.re() >= 0.0 {
+        first
+    } else {
+        T::from(0.0)
+    };
+    let high = if last.re() <= 1.0 { last } else { T::from(1.0) };
+    (low, high)
 }
 
 /// How deep a master node may sit inside the slave body before its own row holds it, as a
@@ -259,11 +324,11 @@ pub fn nearest_projection(
 /// The slave node's segments (at most two: a surface node has no more) and their count, and
 /// the node's normal: minus the mean of its segments' outward normals. None for a node of
 /// more than two segments or of degenerate ones.
-fn slave_side(
+fn slave_side<T: Scalar>(
     surface: &MortarSurface,
     slave: usize,
-    x: &dyn Fn(usize) -> [f64; 2],
-) -> Option<([[usize; 2]; 2], usize, [f64; 2])> {
+    x: &dyn Fn(usize) -> [T; 2],
+) -> Option<([[usize; 2]; 2], usize, [T; 2])> {
     let mut own = [[0usize; 2]; 2];
     let mut count = 0;
     for e in surface.edges.iter().filter(|e| e.contains(&slave)) {
@@ -273,13 +338,14 @@ fn slave_side(
         own[count] = *e;
         count += 1;
     }
-    let mut sum = [0.0; 2];
+    let zero = T::from(0.0);
+    let mut sum = [zero; 2];
     for [a, b] in &own[..count] {
-        let n = outward(x(*a), x(*b));
+        let n = outward_t(x(*a), x(*b));
         sum = [sum[0] + n[0], sum[1] + n[1]];
     }
-    let l = dot(sum, sum).sqrt();
-    if !(l > 0.0) {
+    let l = dot_t(sum, sum).sqrt();
+    if !(l.re() > 0.0) {
         return None;
     }
     Some((own, count, [-sum[0] / l, -sum[1] / l]))
@@ -290,27 +356,27 @@ fn slave_side(
 /// across the slave segment rather than behind it: at the overlap `[low, high]` it is not
 /// deeper inside the slave body than one slave segment length. A closed master (a ring)
 /// faces a slave segment from its far side too, where the "gap" is the body's thickness.
-fn within_reach(
-    (xa, ab, facing): ([f64; 2], [f64; 2], [f64; 2]),
-    master: [[f64; 2]; 2],
-    etas: [f64; 2],
-    overlap: [f64; 2],
+fn within_reach<T: Scalar>(
+    (xa, ab, facing): ([T; 2], [T; 2], [T; 2]),
+    master: [[T; 2]; 2],
+    etas: [T; 2],
+    overlap: [T; 2],
 ) -> bool {
-    let length = dot(ab, ab).sqrt();
+    let length = dot_t(ab, ab).sqrt();
     overlap.iter().any(|eta| {
-        let xi = (eta - etas[0]) / (etas[1] - etas[0]);
+        let xi = (*eta - etas[0]) / (etas[1] - etas[0]);
         let on_master = [
             master[0][0] + xi * (master[1][0] - master[0][0]),
             master[0][1] + xi * (master[1][1] - master[0][1]),
         ];
-        let on_slave = [xa[0] + eta * ab[0], xa[1] + eta * ab[1]];
+        let on_slave = [xa[0] + *eta * ab[0], xa[1] + *eta * ab[1]];
         // along the slave's outward normal: positive apart, negative inside
-        dot(sub(on_master, on_slave), facing) > -length
+        dot_t(sub_t(on_master, on_slave), facing).re() > -length.re()
     })
 }
 
 /// Adds weight `w` to `node` in `list`.
-fn add(list: &mut Vec<(usize, f64)>, node: usize, w: f64) {
+fn add<T: Scalar>(list: &mut Vec<(usize, T)>, node: usize, w: T) {
     match list.iter_mut().find(|(n, _)| *n == node) {
         Some(entry) => entry.1 += w,
         None => list.push((node, w)),
@@ -322,20 +388,21 @@ fn add(list: &mut Vec<(usize, f64)>, node: usize, w: f64) {
 /// Phi = c_0 N_0 + c_1 N_1 such that int Phi N_k dA = delta_local,k int N_local dA
 /// (biorthogonal: Wohlmuth 2000; Popp, Gee & Wall 2009), and D = int N_local dA. Plane
 /// segments give Phi_0 = 2 N_0 - N_1.
-fn dual_shape(length: f64, area: &dyn Fn(f64) -> f64, local: usize) -> Option<([f64; 2], f64)> {
-    let mut m = [[0.0; 2]; 2];
+fn dual_shape<T: Scalar>(length: T, area: &dyn Fn(T) -> T, local: usize) -> Option<([T; 2], T)> {
+    let zero = T::from(0.0);
+    let mut m = [[zero; 2]; 2];
     for (g, w) in GAUSS {
         let n = [1.0 - g, g];
-        let da = w * length * area(g);
+        let da = length * w * area(T::from(g));
         for i in 0..2 {
             for k in 0..2 {
-                m[i][k] += n[i] * n[k] * da;
+                m[i][k] += da * (n[i] * n[k]);
             }
         }
     }
     let d = m[local][0] + m[local][1];
     let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-    if !(det > 0.0) {
+    if !(det.re() > 0.0) {
         return None;
     }
     // row `local` of diag(d) M^-1

@@ -1,12 +1,17 @@
 //! The event logic inside an implicit step.
 //!
-//! In a step: solve with the current active set; release entries in tension (tau < 0) and
-//! solve again; if inactive slaves penetrate beyond TOL, either shorten the step to the first
-//! contact event (Erklig 2.1.4: the fraction alpha = g_0 / (g_0 - g_1), once per step) or
-//! activate them and solve again (Hughes II-7). After the step, entries whose force fell
-//! below `release_fraction` of the last step's are released; dynamics then applies the
+//! In a step, with the seeds' passes (`Inside::Fixed`): solve with the current active set;
+//! release entries in tension (tau < 0) and solve again; if inactive slaves penetrate beyond
+//! TOL, either shorten the step to the first contact event (Erklig 2.1.4: the fraction
+//! alpha = g_0 / (g_0 - g_1), once per step) or activate them and solve again (Hughes II-7);
+//! Coulomb's stick and slide switch between passes too. With the active set inside Newton
+//! (`step_inside`, a primal-dual active set) the solve itself settles which entries stay
+//! closed and how each sticks or slides; the passes only split the step at the first contact
+//! event and then let the slaves that penetrate close. After the step, entries whose force
+//! fell below `release_fraction` of the last step's are released; dynamics then applies the
 //! impact and release conditions (`impacts`).
 
+use super::Interfaces;
 use super::geometry::{ContactPair, Friction};
 use super::search;
 use super::status::ContactState;
@@ -55,11 +60,39 @@ pub enum Tangential {
 
 /// What the event logic reads of a solve with a given active set: the increment (all DOFs),
 /// the normal multipliers tau of the active entries (in their order) and the forces of the
-/// tangential conditions (in theirs).
+/// tangential conditions (in theirs); for a solve that decided its active set itself
+/// (`Inside::Releases`, `Inside::Closures`), the set it settled on.
 pub trait ConstrainedSolution {
     fn increment(&self) -> &[f64];
     fn normal_forces(&self) -> &[f64];
     fn tangential_forces(&self) -> &[f64];
+    fn settled(&self) -> Option<&Settled>;
+}
+
+/// How a solve may change the active set of its pass (`Pass::inside`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Inside {
+    /// The pass's entries and friction statuses are fixed; the event loop changes them
+    /// between passes (the seeds' method).
+    Fixed,
+    /// Newton's iteration decides which of the pass's entries stay closed (a closed entry
+    /// in tension opens, an open one that penetrates closes again) and whether each sticks
+    /// or slides: a primal-dual active set (Hueber & Wohlmuth 2005; Gitterle, Popp, Gee &
+    /// Wall 2010 for friction). No other slave closes.
+    Releases,
+    /// As `Releases`, and any slave of the pairs that penetrates its master closes.
+    Closures,
+}
+
+/// The active set a solve settled on: the closed entries (pair, slave index), their normal
+/// and tangential forces and sliding coefficients (the signed Coulomb coefficient, 0
+/// sticking or frictionless).
+#[derive(Debug, Clone, Default)]
+pub struct Settled {
+    pub entries: Vec<(usize, usize)>,
+    pub forces: Vec<f64>,
+    pub tangential: Vec<f64>,
+    pub sliding: Vec<f64>,
 }
 
 /// The active set did not settle within the passes a step allows.
@@ -139,15 +172,18 @@ fn first_event(
 }
 /// One pass of a contact step, what the solver is asked to solve: the step's `length`, the
 /// `active` entries as (pair, slave node), their `forces` (the multipliers' start), the
-/// `tangential` conditions, and `warm`: after a change of the active set at the same length
+/// `tangential` conditions, `warm`: after a change of the active set at the same length
 /// the last pass's increment (Newton then starts at the solution it had, not at the predictor
-/// again), after a split or a change of a slip status none.
+/// again), after a split or a change of a slip status none; and how the solve may change the
+/// active set (`inside`; with `Releases` and `Closures` the entries and conditions are where
+/// the iteration starts).
 pub struct Pass<'a> {
     pub length: f64,
     pub active: &'a [(usize, usize)],
     pub forces: Vec<f64>,
     pub tangential: &'a [Tangential],
     pub warm: Option<&'a [f64]>,
+    pub inside: Inside,
 }
 
 impl ContactState {
@@ -205,6 +241,7 @@ impl ContactState {
                 forces: forces.clone(),
                 tangential: &tangential,
                 warm: warm.as_deref(),
+                inside: Inside::Fixed,
             })?;
             let (normal, d) = (solution.normal_forces(), solution.increment());
             warm = Some(d.to_vec());
@@ -291,6 +328,85 @@ impl ContactState {
             }
         }
         Err(Unsettled.into())
+    }
+
+    /// Runs one step with contact from the positions `start` with the active set decided
+    /// inside Newton's iteration: the first pass keeps the slaves open at the start open
+    /// (`Inside::Releases`); if some penetrate at its end, the step is split at the first
+    /// contact event (Erklig 2.1.4, once) or, where it cannot be, solved again with those
+    /// slaves free to close (`Inside::Closures`).
+    pub fn step_inside<S: ConstrainedSolution, E: From<Unsettled>>(
+        &self,
+        pairs: &[ContactPair],
+        start: &[[f64; 2]],
+        length: f64,
+        mut solve: impl FnMut(Pass<'_>) -> Result<S, E>,
+    ) -> Result<ContactResult<S>, E> {
+        let (entries, forces) = self.entries();
+        let slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(pairs, *e)).collect();
+        let nodes: Vec<(usize, usize)> = entries
+            .iter()
+            .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
+            .collect();
+        let tangential = tangential_conditions(&slips);
+        let mut length = length;
+        let mut split = false;
+        let mut inside = Inside::Releases;
+        let mut warm: Option<Vec<f64>> = None;
+        loop {
+            let solution = solve(Pass {
+                length,
+                active: &nodes,
+                forces: forces.clone(),
+                tangential: &tangential,
+                warm: warm.as_deref(),
+                inside,
+            })?;
+            let Some(settled) = solution.settled().cloned() else {
+                return Err(Unsettled.into());
+            };
+            let d = solution.increment();
+            let end = |n: usize| [start[n][0] + d[2 * n], start[n][1] + d[2 * n + 1]];
+            let (penetrating, alpha) = match inside {
+                Inside::Closures => (Vec::new(), 1.0),
+                _ => first_event(pairs, start, &end, &settled.entries),
+            };
+            if penetrating.is_empty() {
+                let rows = ConvergedRows {
+                    entries: settled.entries,
+                    forces: settled.forces,
+                    tangential: settled.tangential,
+                    sliding: settled.sliding,
+                };
+                return Ok(self.finish(pairs, solution, length, rows));
+            }
+            if !split && alpha > MIN_SPLIT && alpha < 1.0 {
+                // Erklig 2.1.4: end the step where the first slave touches
+                length *= alpha;
+                split = true;
+                warm = None;
+                continue;
+            }
+            inside = Inside::Closures;
+            warm = Some(d.to_vec());
+        }
+    }
+
+    /// Takes a step's outcome as the new status; `time` is the end of the step.
+    pub fn commit<S>(
+        &mut self,
+        interfaces: &Interfaces,
+        step: &ContactResult<S>,
+        time: f64,
+        coords: &[[f64; 2]],
+    ) {
+        let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
+        let rows = (&step.active[..], &step.forces[..]);
+        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
+        for (i, (p, k)) in step.active.iter().enumerate() {
+            self.tangential[*p][*k] = step.tangential[i];
+            self.sliding[*p][*k] = step.sliding[i];
+        }
     }
 
     /// The fraction release rule and the event lists of a converged step.

@@ -513,6 +513,36 @@ impl Model {
         2 * self.node_count
     }
 
+    /// Global node `node` in the user's words: its number within its body, the body, and
+    /// the node sets of the body that hold it ("node 12 of body `lower` (sets `top`,
+    /// `right`)"); messages name nodes this way, since global numbers appear nowhere in a
+    /// scene or a frame.
+    pub fn describe_node(&self, node: usize) -> String {
+        let Some(body) = self
+            .bodies
+            .iter()
+            .rev()
+            .find(|b| b.node_offset <= node)
+            .filter(|b| node - b.node_offset < b.mesh.nodes.len())
+        else {
+            return format!("node {node}");
+        };
+        let local = node - body.node_offset;
+        let sets: Vec<String> = body
+            .mesh
+            .node_sets
+            .iter()
+            .filter(|(name, nodes)| name.as_str() != "all" && nodes.binary_search(&local).is_ok())
+            .map(|(name, _)| format!("`{name}`"))
+            .collect();
+        let within = match sets.len() {
+            0 => String::new(),
+            1 => format!(" (set {})", sets[0]),
+            _ => format!(" (sets {})", sets.join(", ")),
+        };
+        format!("node {local} of body `{}`{within}", body.name)
+    }
+
     pub fn elements(&self) -> usize {
         self.bodies.iter().map(Body::elements).sum()
     }

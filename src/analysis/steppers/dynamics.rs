@@ -398,11 +398,13 @@ impl<'a> Dynamics<'a> {
         };
         let (system, solver, factored_for) =
             (&mut self.system, &mut self.solver, &mut self.factored_for);
-        let mut step = self
-            .contact
-            .step(&self.interfaces.pairs, positions, nominal, |pass| {
-                attempt.solve(pass, system, solver, factored_for, counters)
-            })?;
+        let solve = |pass: Pass<'_>| attempt.solve(pass, system, solver, factored_for, counters);
+        let pairs = &self.interfaces.pairs;
+        let mut step = if super::newton::active_set_inside(self.model, &self.spec.newton) {
+            self.contact.step_inside(pairs, positions, nominal, solve)?
+        } else {
+            self.contact.step(pairs, positions, nominal, solve)?
+        };
         let h = step.length;
         let form = self.method.form(h, &self.kin);
         let advance = self.method.advance(h, &self.kin, &step.solution.d);
@@ -623,30 +625,22 @@ struct Attempt<'s> {
 const NEWTON_SHARE: f64 = 0.1;
 
 impl Attempt<'_> {
-    /// The end-of-step gap each active entry must have: 0 (the gap constraint), or for a
-    /// persistent entry the start gap plus the increment that makes the relative normal
-    /// velocity at the solve point zero: with v* = c_v D + v_hat,
+    /// The end-of-step gap of each persistent entry (pair, slave node), where the others'
+    /// is 0 (the gap constraint): the start gap plus the increment that makes the relative
+    /// normal velocity at the solve point zero: with v* = c_v D + v_hat,
     /// n . (c_v D_rel + v_hat_rel) = 0, so g_end = g_start - n . v_hat_rel / c_v.
-    fn targets(&self, active: &[(usize, usize)], form: &StepForm) -> Vec<f64> {
-        if self.persistent.is_empty() {
-            return Vec::new();
-        }
+    fn targets(&self, form: &StepForm) -> Vec<((usize, usize), f64)> {
         let x = |n: usize| self.positions[n];
-        active
+        self.persistent
             .iter()
-            .map(|entry| {
-                let (pair, slave) = *entry;
-                if !self.persistent.contains(entry) {
-                    return 0.0;
-                }
-                self.pairs[pair].gap(slave, &x).map_or(0.0, |gap| {
-                    let relative: f64 = gap
-                        .row(slave)
-                        .iter()
-                        .map(|(dof, c)| c * form.velocity_offset[*dof])
-                        .sum();
-                    gap.gap - relative / form.damping_coefficient
-                })
+            .filter_map(|&(pair, slave)| {
+                let gap = self.pairs[pair].gap(slave, &x)?;
+                let relative: f64 = gap
+                    .row(slave)
+                    .iter()
+                    .map(|(dof, c)| c * form.velocity_offset[*dof])
+                    .sum();
+                Some(((pair, slave), gap.gap - relative / form.damping_coefficient))
             })
             .collect()
     }
@@ -667,6 +661,7 @@ impl Attempt<'_> {
             forces,
             tangential,
             warm,
+            inside,
         } = pass;
         let (model, spec, state) = (self.model, self.spec, self.state);
         let form = self.method.form(h, self.kin);
@@ -728,7 +723,9 @@ impl Attempt<'_> {
                 start: self.positions,
                 forces,
                 tangential,
-                targets: self.targets(active, &form),
+                targets: self.targets(&form),
+                inside,
+                describe: &|node| model.describe_node(node),
             }),
         };
         let result = step.solve(state, d, system, solver, counters);

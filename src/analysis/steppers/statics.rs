@@ -117,6 +117,7 @@ impl Increment<'_> {
             forces,
             tangential,
             warm,
+            inside,
         } = pass;
         let (model, state, target) = (self.model, self.state, self.target);
         let end = if state.time + h >= target {
@@ -148,6 +149,8 @@ impl Increment<'_> {
                 forces,
                 tangential,
                 targets: Vec::new(),
+                inside,
+                describe: &|node| model.describe_node(node),
             }),
         };
         step.solve(state, d, system, solver, counters)
@@ -195,12 +198,13 @@ impl Stepper for Statics<'_> {
                 factor_first,
             };
             let (system, solver) = (&mut self.system, &mut self.solver);
-            let outcome = self.contact.step(
-                &self.model.contacts,
-                &positions,
-                target - self.state.time,
-                |pass| increment.attempt(pass, system, solver, counters),
-            );
+            let solve = |pass: Pass<'_>| increment.attempt(pass, system, solver, counters);
+            let (pairs, length) = (&self.model.contacts, target - self.state.time);
+            let outcome = if super::newton::active_set_inside(self.model, &spec.newton) {
+                self.contact.step_inside(pairs, &positions, length, solve)
+            } else {
+                self.contact.step(pairs, &positions, length, solve)
+            };
             match outcome {
                 Ok(mut step) => {
                     let end = if self.state.time + step.length >= target {

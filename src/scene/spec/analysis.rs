@@ -398,6 +398,22 @@ pub struct NewtonSpec {
     /// K*'s coefficients change.
     #[serde(default)]
     pub refactor_every: Option<usize>,
+    /// Where the contact active set and the stick/slide statuses are decided: `newton`,
+    /// inside the iteration (a primal-dual active set, theory 8.3b), or `passes`, between
+    /// Newton solves (the seeds' method). Default: `newton` where the model has a mortar
+    /// pair (contact between two bodies), `passes` otherwise.
+    #[serde(default)]
+    pub active_set: Option<ActiveSetSolve>,
+}
+
+/// See [`NewtonSpec::active_set`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ActiveSetSolve {
+    /// Inside Newton's iteration.
+    Newton,
+    /// Between Newton solves, each with a fixed active set.
+    Passes,
 }
 
 impl Default for NewtonSpec {
@@ -412,6 +428,7 @@ impl Default for NewtonSpec {
             max_cuts: default_cuts(),
             updates: Updates::default(),
             refactor_every: None,
+            active_set: None,
         }
     }
 }

@@ -39,28 +39,72 @@ pub(super) struct Exact {
 }
 
 impl Exact {
-    fn free(l: &Linearization, system: &System) -> Exact {
+    /// The derivatives of a normal row whose force row is C + slide T (`slide` the signed
+    /// Coulomb coefficient of a sliding entry, 0 otherwise): dg/dx, and dC/dx + slide dT/dx.
+    pub(super) fn combined(l: &Linearization, slide: f64, system: &System) -> Exact {
+        let jacobian = |p: usize, q: usize| {
+            let mut v = l.row_jacobian[(p, q)];
+            if slide != 0.0 {
+                v += slide * l.tangent_jacobian[(p, q)];
+            }
+            v
+        };
+        Exact::of(l, &|i| l.gradient[i], &jacobian, system)
+    }
+
+    /// The derivatives of a sticking entry's tangential row T (on the free DOFs, `row`): its
+    /// constraint's gradient is T, its force's derivative dT/dx.
+    pub(super) fn tangential(l: &Linearization, row: &[(usize, f64)], system: &System) -> Exact {
+        let mut exact = Exact::of(l, &|_| 0.0, &|p, q| l.tangent_jacobian[(p, q)], system);
+        exact.gradient = row.to_vec();
+        exact.equations.extend(row.iter().map(|(eq, _)| *eq));
+        exact.equations.sort_unstable();
+        exact.equations.dedup();
+        exact
+    }
+
+    /// A row whose constraint gradient is `row` itself and whose force does not turn (a
+    /// row against a rigid obstacle): no derivative terms.
+    pub(super) fn plain(row: &[(usize, f64)]) -> Exact {
+        let mut equations: Vec<usize> = row.iter().map(|(eq, _)| *eq).collect();
+        equations.sort_unstable();
+        equations.dedup();
+        Exact {
+            gradient: row.to_vec(),
+            row_jacobian: Vec::new(),
+            equations,
+        }
+    }
+
+    /// The gradient `gradient(local DOF)` and row Jacobian `jacobian(p, q)` of `l` on the
+    /// free DOFs.
+    fn of(
+        l: &Linearization,
+        gradient: &dyn Fn(usize) -> f64,
+        jacobian: &dyn Fn(usize, usize) -> f64,
+        system: &System,
+    ) -> Exact {
         let dofs: Vec<(Option<usize>, usize)> = l
             .dofs()
             .map(|(dof, local)| (system.equation[dof], local))
             .collect();
-        let gradient = dofs
+        let gradient_free = dofs
             .iter()
-            .filter_map(|(eq, i)| eq.map(|eq| (eq, l.gradient[*i])))
+            .filter_map(|(eq, i)| eq.map(|eq| (eq, gradient(*i))))
             .filter(|(_, v)| *v != 0.0)
             .collect();
         let mut row_jacobian = Vec::new();
         let mut equations = Vec::new();
         for (p, i) in &dofs {
             let Some(p) = p else { continue };
-            let mut named = l.gradient[*i] != 0.0;
+            let mut named = gradient(*i) != 0.0;
             for (q, j) in &dofs {
                 if let Some(q) = q {
-                    let v = l.row_jacobian[(*i, *j)];
+                    let v = jacobian(*i, *j);
                     if v != 0.0 {
                         row_jacobian.push((*p, *q, v));
                     }
-                    named |= v != 0.0 || l.row_jacobian[(*j, *i)] != 0.0;
+                    named |= v != 0.0 || jacobian(*j, *i) != 0.0;
                 }
             }
             if named {
@@ -68,7 +112,7 @@ impl Exact {
             }
         }
         Exact {
-            gradient,
+            gradient: gradient_free,
             row_jacobian,
             equations,
         }
@@ -121,6 +165,24 @@ impl Rows {
 }
 
 impl Constraints<'_> {
+    /// The gap entry (pair, slave node) must have at the end of the step: its target, or 0.
+    pub(super) fn target(&self, entry: (usize, usize)) -> f64 {
+        self.targets
+            .iter()
+            .find(|(e, _)| *e == entry)
+            .map_or(0.0, |(_, target)| *target)
+    }
+
+    /// Why an active entry has no row: its slave faces no master segment any more.
+    pub(super) fn lost(&self, pair: usize, slave: usize) -> String {
+        format!(
+            "contact `{}`: {} faces no master segment any more (it lost its master while \
+             closed)",
+            self.pairs[pair].name,
+            (self.describe)(slave)
+        )
+    }
+
     pub(super) fn rows(&self, d: &[f64], system: &System) -> Result<Rows, StepFailure> {
         let x = |n: usize| [self.start[n][0] + d[2 * n], self.start[n][1] + d[2 * n + 1]];
         let free = |row: Vec<(usize, f64)>| -> Vec<(usize, f64)> {
@@ -130,20 +192,18 @@ impl Constraints<'_> {
         };
         let mut rows = Rows::empty();
         let mut gaps = Vec::with_capacity(self.active.len());
-        for (i, &(pair, slave)) in self.active.iter().enumerate() {
-            let gap = self.pairs[pair].gap(slave, &x).ok_or_else(|| {
-                StepFailure(format!(
-                    "contact `{}`: node {slave} lost its master",
-                    self.pairs[pair].name
-                ))
-            })?;
+        for &(pair, slave) in self.active {
+            let gap = self.pairs[pair]
+                .gap(slave, &x)
+                .ok_or_else(|| StepFailure(self.lost(pair, slave)))?;
             rows.rows.push(free(gap.row(slave)));
-            let violation = gap.gap - self.targets.get(i).copied().unwrap_or(0.0);
+            let violation = gap.gap - self.target((pair, slave));
             rows.gaps.push(violation);
             let tolerance = self.pairs[pair].options.tolerance;
             rows.worst_gap = rows.worst_gap.max(violation.abs() / tolerance);
             let exact = row_linearization(self.pairs, pair, slave, &gap, &x);
-            rows.exact.push(exact.map(|l| Exact::free(&l, system)));
+            rows.exact
+                .push(exact.map(|l| Exact::combined(&l, 0.0, system)));
             gaps.push(gap);
         }
         rows.normal = rows.rows.len();

@@ -17,19 +17,31 @@
 //! more than half of the iterations left to reach the force tolerance. Between
 //! factorizations, `updates = "bfgs"` corrects the factored matrix by BFGS updates (`secant`).
 
+mod active_set;
 mod constrained;
 mod secant;
 
 use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System};
-use crate::contact::{ConstrainedSolution, ContactPair, Tangential, Unsettled};
+use crate::contact::{ConstrainedSolution, ContactPair, Inside, Settled, Tangential, Unsettled};
 use crate::element::Strain;
 use crate::integrator::StepForm;
 use crate::profile::{self, Phase};
 use crate::scene::Model;
-use crate::scene::spec::{NewtonSpec, Strategy, Tangent, Updates};
+use crate::scene::spec::{ActiveSetSolve, NewtonSpec, Strategy, Tangent, Updates};
 use crate::solver::Solver;
+use active_set::ActiveSet;
 use constrained::{Rows, add_constraint_forces, constrained_solve};
 use secant::Secant;
+
+/// Whether a run decides its contact active set inside Newton's iteration (`active_set`,
+/// theory 8.3b): as the scene says, else where the model has a mortar pair.
+pub fn active_set_inside(model: &Model, newton: &NewtonSpec) -> bool {
+    match newton.active_set {
+        Some(ActiveSetSolve::Newton) => true,
+        Some(ActiveSetSolve::Passes) => false,
+        None => model.contacts.iter().any(|pair| pair.mortar.is_some()),
+    }
+}
 
 /// Counters of the nonlinear solution.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
@@ -88,10 +100,14 @@ pub struct Constraints<'a> {
     pub forces: Vec<f64>,
     /// Friction on some of the active entries.
     pub tangential: &'a [Tangential],
-    /// Per active entry, the gap it must have at the end of the step: 0 for the gap
-    /// constraint, the start gap plus the persistency increment for velocity-level
-    /// persistency. Empty: all 0.
-    pub targets: Vec<f64>,
+    /// The gap an entry (pair, slave node) must have at the end of the step where it is not
+    /// 0: the start gap plus the persistency increment for velocity-level persistency.
+    pub targets: Vec<((usize, usize), f64)>,
+    /// How the step may change the active set: `Inside::Fixed` solves with `active` and
+    /// `tangential` as given; otherwise they are where Newton's active set starts.
+    pub inside: Inside,
+    /// A global node in the user's words (`Model::describe_node`), for messages.
+    pub describe: &'a dyn Fn(usize) -> String,
 }
 
 /// A converged step: the increment, its evaluation, the contact multipliers (tau, the
@@ -102,6 +118,9 @@ pub struct Solution {
     pub evaluation: Evaluation,
     pub forces: Vec<f64>,
     pub tangential: Vec<f64>,
+    /// The active set Newton settled on, when it decided it (`Inside::Releases`,
+    /// `Inside::Closures`).
+    pub settled: Option<Settled>,
 }
 
 impl ConstrainedSolution for Solution {
@@ -113,6 +132,9 @@ impl ConstrainedSolution for Solution {
     }
     fn tangential_forces(&self) -> &[f64] {
         &self.tangential
+    }
+    fn settled(&self) -> Option<&Settled> {
+        self.settled.as_ref()
     }
 }
 
@@ -152,6 +174,12 @@ impl Relaxation {
             share: 1.0,
             since: 0,
         }
+    }
+
+    /// Forgets the norms so far: the contact rows changed, and a two-iterate cycle across
+    /// the change is the active set's, not the plastic flow's.
+    fn restart(&mut self) {
+        self.since = self.norms.len();
     }
 
     /// Takes an iterate's residual norm; halves the share when the norms since the last
@@ -322,6 +350,10 @@ impl Step<'_> {
     ) -> Result<Solution, StepFailure> {
         let newton = self.newton;
         let mut forces = self.initial_multipliers();
+        let mut active_set = self.contact.as_ref().and_then(|c| match c.inside {
+            Inside::Fixed => None,
+            inside => Some(ActiveSet::new(c, inside == Inside::Closures)),
+        });
         let damping = match &self.inertia {
             Some(i) if i.rayleigh[1] > 0.0 => {
                 self.evaluate(state, &vec![0.0; d.len()], Some(&mut *system))?;
@@ -347,9 +379,15 @@ impl Step<'_> {
             let evaluation = self.evaluate(state, &d, refactor.then_some(&mut *system))?;
             let (mut residual, forces_scale) =
                 self.residual(&d, &evaluation, system, &damping, external_norm);
-            let rows = match &self.contact {
-                Some(c) => profile::time(Phase::Contact, || c.rows(&d, system))?,
-                None => Rows::empty(),
+            let (rows, settled) = match (&self.contact, &mut active_set) {
+                (Some(c), Some(set)) => profile::time(Phase::Contact, || {
+                    let changed = set.update(c, &d);
+                    let (rows, start) = set.rows(c, &d, system)?;
+                    forces = start;
+                    Ok::<_, StepFailure>((rows, !changed))
+                })?,
+                (Some(c), None) => (profile::time(Phase::Contact, || c.rows(&d, system))?, true),
+                _ => (Rows::empty(), true),
             };
             // R alone, without the contact and friction forces: K* is its derivative
             let own = secant.enabled().then(|| residual.clone());
@@ -375,10 +413,11 @@ impl Step<'_> {
             if iteration > 0
                 && (test.passed(newton, eps_displacement) || within_error)
                 && rows.worst_gap <= 1.0
+                && settled
             {
-                let tangential = match &self.contact {
-                    Some(c) => rows.tangential_forces(c.tangential, &forces),
-                    None => Vec::new(),
+                let tangential = match (&self.contact, &active_set) {
+                    (Some(c), None) => rows.tangential_forces(c.tangential, &forces),
+                    _ => Vec::new(),
                 };
                 forces.truncate(rows.normal);
                 return Ok(Solution {
@@ -386,6 +425,7 @@ impl Step<'_> {
                     evaluation,
                     forces,
                     tangential,
+                    settled: active_set.map(|set| set.settled()),
                 });
             }
             // not the answer: its trial states need not sit beside the factor about to be made
@@ -410,9 +450,16 @@ impl Step<'_> {
             } else if let (Some((s, start)), Some(now)) = (last.take(), &own) {
                 secant.learn(solver, s, &start, now);
             }
-            relaxation.observe(residual_norm);
+            if settled {
+                relaxation.observe(residual_norm);
+            } else {
+                relaxation.restart();
+            }
             let (mut delta, tau) = constrained_solve(solver, &rows, residual, &forces, &secant)?;
             forces = relaxation.relax(&mut delta, &forces, tau);
+            if let Some(set) = &mut active_set {
+                set.take(&forces);
+            }
             counters.iterations += 1;
             system.scatter_add(&delta, &mut d);
             let d_norm = norm(&d);

@@ -1,0 +1,425 @@
+//! The contact active set decided inside Newton's iteration: a primal-dual active set
+//! strategy, the semi-smooth Newton method of the contact conditions (Hueber & Wohlmuth
+//! 2005; Popp, Gee & Wall 2009), with Coulomb's stick and slide in the same iteration
+//! (Gitterle, Popp, Gee & Wall 2010; theory 8.3b).
+//!
+//! Legend (an entry: a slave of a pair; tau its normal multiplier, compressive > 0; g its gap
+//! at the iterate, > 0 open; s its slip since the step's start, t . (d_s - sum w_m d_m); f its
+//! tangential force, acting as f t on the slave; mu the pair's Coulomb coefficient)
+//! ```text
+//! closed -> open     tau < 0 after a solve                   (tau - c g > 0 fails, g = 0)
+//! open   -> closed   g < -TOL at the iterate                 (tau = 0: tau - c g > 0)
+//! stick  -> slide    |f| > mu tau after a solve              slide with f = mu sign(f) tau
+//! slide  -> stick    the sliding force pushes along the slip, sign(f) s > 0
+//! ```
+//! These are the complementarity functions' active-set updates with the solved rows at their
+//! constraint (g = 0 on closed entries, s = 0 on sticking ones), where the weight c between
+//! force and gap drops out. Each iteration solves with the rows of the statuses it starts
+//! with; the step has converged when the residual passes and no status changed.
+//!
+//! The rows of a closed entry: its gap row C (the force tau C^T) and the exact derivative
+//! dg/dx for the constraint; a sliding entry's force row is C + mu sign(f) T (its friction
+//! force mu tau T^T rides on tau, so Newton's step is the consistent one, not a known force
+//! of the last iterate), a sticking entry adds the row T for s = 0 with its own multiplier f.
+//! The force rows' own derivatives, tau dC/dx + f dT/dx, enter the tangent (`exact_solve`).
+
+use super::constrained::{Exact, Rows};
+use super::{Constraints, StepFailure};
+use crate::assembly::System;
+use crate::contact::search::{SlaveGap, penetrates, slave_gaps};
+use crate::contact::{Friction, Gap, Settled, Tangential};
+
+/// After this many iterations that changed a status, the statuses stay as they are.
+const FREEZE: usize = 12;
+
+/// The contact status of an entry inside the iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Status {
+    Open,
+    /// Closed without friction.
+    Frictionless,
+    Stick,
+    /// Closed and sliding: the signed Coulomb coefficient of its force.
+    Slide(f64),
+}
+
+impl Status {
+    fn closed(self) -> bool {
+        self != Status::Open
+    }
+}
+
+/// An entry the iteration looks at: every entry it started with, and those that closed.
+#[derive(Debug, Clone)]
+struct Candidate {
+    pair: usize,
+    /// The slave's index in its pair, and its global node.
+    index: usize,
+    node: usize,
+    status: Status,
+    normal: f64,
+    tangential: f64,
+}
+
+/// The active set of a Newton step: its candidates, their statuses and multipliers.
+pub(super) struct ActiveSet {
+    candidates: Vec<Candidate>,
+    /// Slaves not among the candidates may close (`Inside::Closures`).
+    closures: bool,
+    /// Iterations that changed a status.
+    changes: usize,
+    /// The statuses before the last update, per candidate: an update that returns to them
+    /// is a two-iterate cycle (an entry that opens in tension and closes again penetrating,
+    /// a grazing contact), which is settled by keeping the closed state of each entry that
+    /// flips and changing nothing more.
+    before: Vec<Status>,
+    frozen: bool,
+    /// The rows of the last `rows` call: per row, its candidate and whether it is the
+    /// tangential (sticking) row.
+    layout: Vec<(usize, bool)>,
+}
+
+impl ActiveSet {
+    /// The active set a step starts with: the pass's entries closed with their forces and
+    /// friction statuses.
+    pub(super) fn new(c: &Constraints, closures: bool) -> ActiveSet {
+        let candidates = c
+            .active
+            .iter()
+            .enumerate()
+            .map(|(i, &(pair, node))| {
+                let slide = c.tangential.iter().find_map(|t| match *t {
+                    Tangential::Sliding { entry, coefficient } if entry == i => Some(coefficient),
+                    _ => None,
+                });
+                let stick = c
+                    .tangential
+                    .iter()
+                    .any(|t| matches!(t, Tangential::Fixed { entry, .. } if *entry == i));
+                let status = match (slide, stick) {
+                    (Some(coefficient), _) => Status::Slide(coefficient),
+                    (None, true) => Status::Stick,
+                    (None, false) => Status::Frictionless,
+                };
+                let normal = c.forces.get(i).copied().unwrap_or(0.0);
+                Candidate {
+                    pair,
+                    index: index_of(c, pair, node),
+                    node,
+                    status,
+                    normal,
+                    tangential: slide.map_or(0.0, |coefficient| coefficient * normal),
+                }
+            })
+            .collect();
+        ActiveSet {
+            candidates,
+            closures,
+            changes: 0,
+            before: Vec::new(),
+            frozen: false,
+            layout: Vec::new(),
+        }
+    }
+
+    /// The statuses at the iterate `d` from the multipliers of the last solve (module
+    /// legend); whether any changed.
+    pub(super) fn update(&mut self, c: &Constraints, d: &[f64]) -> bool {
+        let x = |n: usize| [c.start[n][0] + d[2 * n], c.start[n][1] + d[2 * n + 1]];
+        let frozen = self.frozen || self.changes >= FREEZE;
+        let now: Vec<Status> = self.candidates.iter().map(|e| e.status).collect();
+        let mut reachable = vec![true; self.candidates.len()];
+        let mut changed = false;
+        for k in 0..self.candidates.len() {
+            let candidate = &self.candidates[k];
+            let pair = &c.pairs[candidate.pair];
+            let gap = pair.gap(candidate.node, &x);
+            reachable[k] = gap.is_some();
+            let next = match gap {
+                // no master in reach: the entry has left the surface
+                None => Status::Open,
+                Some(_) if frozen => candidate.status,
+                Some(gap) => match candidate.status {
+                    Status::Open => {
+                        let s = SlaveGap {
+                            pair: candidate.pair,
+                            index: candidate.index,
+                            node: candidate.node,
+                            gap,
+                        };
+                        if penetrates(c.pairs, &s, &x, &|p, i| self.is_closed(p, i)) {
+                            closed_status(c, candidate.pair)
+                        } else {
+                            Status::Open
+                        }
+                    }
+                    _ if candidate.normal < 0.0 => Status::Open,
+                    status => friction_status(c, candidate, status, &gap, d),
+                },
+            };
+            if next != candidate.status {
+                changed = true;
+                let candidate = &mut self.candidates[k];
+                if !next.closed() {
+                    candidate.normal = 0.0;
+                    candidate.tangential = 0.0;
+                } else if !candidate.status.closed() {
+                    candidate.normal = 0.0;
+                }
+                candidate.status = next;
+            }
+        }
+        if self.closures && !frozen {
+            let closing: Vec<SlaveGap> = slave_gaps(c.pairs, &x, &|p, i| self.is_candidate(p, i))
+                .filter(|s| penetrates(c.pairs, s, &x, &|p, i| self.is_closed(p, i)))
+                .collect();
+            for s in closing {
+                changed = true;
+                self.candidates.push(Candidate {
+                    pair: s.pair,
+                    index: s.index,
+                    node: s.node,
+                    status: closed_status(c, s.pair),
+                    normal: 0.0,
+                    tangential: 0.0,
+                });
+            }
+        }
+        if changed {
+            self.changes += 1;
+            self.settle_cycle(&now, &reachable);
+        }
+        self.before = now;
+        changed
+    }
+
+    /// After an update that changed a status: if the statuses are back where they were
+    /// before the last update (`before`; `now` the ones this update started from), each
+    /// entry that flips takes the closed one of its two states where it still faces its
+    /// master (`reachable`), and the statuses stay from here on.
+    fn settle_cycle(&mut self, now: &[Status], reachable: &[bool]) {
+        let back = self.before.len() == self.candidates.len()
+            && self
+                .candidates
+                .iter()
+                .zip(&self.before)
+                .all(|(e, b)| e.status == *b);
+        if !back {
+            return;
+        }
+        for ((candidate, last), reachable) in self.candidates.iter_mut().zip(now).zip(reachable) {
+            if candidate.status != *last && !candidate.status.closed() && *reachable {
+                candidate.status = *last;
+            }
+        }
+        self.frozen = true;
+    }
+
+    fn is_candidate(&self, pair: usize, index: usize) -> bool {
+        self.candidates
+            .iter()
+            .any(|e| e.pair == pair && e.index == index)
+    }
+
+    fn is_closed(&self, pair: usize, index: usize) -> bool {
+        self.candidates
+            .iter()
+            .any(|e| e.pair == pair && e.index == index && e.status.closed())
+    }
+
+    /// The rows of the closed entries at the iterate `d` (module legend), and the
+    /// multipliers they start from: the normal rows, then the sticking entries' tangential
+    /// rows.
+    pub(super) fn rows(
+        &mut self,
+        c: &Constraints,
+        d: &[f64],
+        system: &System,
+    ) -> Result<(Rows, Vec<f64>), StepFailure> {
+        let x = |n: usize| [c.start[n][0] + d[2 * n], c.start[n][1] + d[2 * n + 1]];
+        let mut rows = Rows::empty();
+        let mut forces = Vec::new();
+        let mut sticking = Vec::new();
+        self.layout.clear();
+        for (k, candidate) in self.candidates.iter().enumerate() {
+            if !candidate.status.closed() {
+                continue;
+            }
+            let pair = &c.pairs[candidate.pair];
+            let gap = pair
+                .gap(candidate.node, &x)
+                .ok_or_else(|| StepFailure(c.lost(candidate.pair, candidate.node)))?;
+            let linearization = pair.linearization(candidate.node, &gap, &x);
+            let slide = match candidate.status {
+                Status::Slide(coefficient) => coefficient,
+                _ => 0.0,
+            };
+            let mut force_row = gap.row(candidate.node);
+            if slide != 0.0 {
+                let tangent = gap.tangent_row(candidate.node);
+                force_row
+                    .iter_mut()
+                    .zip(&tangent)
+                    .for_each(|((_, f), (_, t))| *f += slide * t);
+            }
+            let violation = gap.gap - c.target((candidate.pair, candidate.node));
+            rows.worst_gap = rows.worst_gap.max(violation.abs() / pair.options.tolerance);
+            let exact = match &linearization {
+                Some(l) => Some(Exact::combined(l, slide, system)),
+                // a sliding force row is not the constraint's: its gradient is the gap row
+                None if slide != 0.0 => Some(Exact::plain(&free(gap.row(candidate.node), system))),
+                None => None,
+            };
+            rows.rows.push(free(force_row, system));
+            rows.gaps.push(violation);
+            rows.exact.push(exact);
+            forces.push(candidate.normal);
+            self.layout.push((k, false));
+            if candidate.status == Status::Stick {
+                sticking.push((k, gap, linearization));
+            }
+        }
+        rows.normal = rows.rows.len();
+        for (k, gap, linearization) in sticking {
+            let candidate = &self.candidates[k];
+            let row = gap.tangent_row(candidate.node);
+            let slip: f64 = row
+                .iter()
+                .map(|(dof, coefficient)| coefficient * d[*dof])
+                .sum();
+            // the support holds the slip where the row's free part is (nearly) the normal
+            // row's: an axis node held in x, whose tangent is x but for the tilt of the mean
+            // normal, would get a second row on its y DOFs, the normal row again
+            let on_free = free(row, system);
+            if held_by_support(&on_free, &free(gap.row(candidate.node), system)) {
+                continue;
+            }
+            rows.exact.push(Some(match &linearization {
+                Some(l) => Exact::tangential(l, &on_free, system),
+                None => Exact::plain(&on_free),
+            }));
+            rows.rows.push(on_free);
+            rows.gaps.push(slip);
+            forces.push(candidate.tangential);
+            self.layout.push((k, true));
+        }
+        if rows.exact.iter().all(Option::is_none) {
+            rows.exact.clear();
+        }
+        Ok((rows, forces))
+    }
+
+    /// Takes the multipliers of a solve with the last `rows`: normal forces, the sticking
+    /// entries' tangential forces, and the sliding ones' mu tau.
+    pub(super) fn take(&mut self, multipliers: &[f64]) {
+        for (&(k, tangential), value) in self.layout.iter().zip(multipliers) {
+            let candidate = &mut self.candidates[k];
+            if tangential {
+                candidate.tangential = *value;
+            } else {
+                candidate.normal = *value;
+                if let Status::Slide(coefficient) = candidate.status {
+                    candidate.tangential = coefficient * value;
+                }
+            }
+        }
+    }
+
+    /// The set the iteration settled on.
+    pub(super) fn settled(&self) -> Settled {
+        let mut settled = Settled::default();
+        for candidate in self.candidates.iter().filter(|e| e.status.closed()) {
+            settled.entries.push((candidate.pair, candidate.index));
+            settled.forces.push(candidate.normal);
+            settled.tangential.push(candidate.tangential);
+            settled.sliding.push(match candidate.status {
+                Status::Slide(coefficient) => coefficient,
+                _ => 0.0,
+            });
+        }
+        settled
+    }
+}
+
+/// The status an entry closes with: sticking under Coulomb friction, else frictionless.
+fn closed_status(c: &Constraints, pair: usize) -> Status {
+    match c.pairs[pair].options.friction {
+        Friction::Coulomb { mu } if mu > 0.0 => Status::Stick,
+        _ => Status::Frictionless,
+    }
+}
+
+/// A closed entry's next friction status (module legend): stick -> slide when its force
+/// leaves the cone, slide -> stick when the sliding force would push along the slip.
+fn friction_status(
+    c: &Constraints,
+    candidate: &Candidate,
+    status: Status,
+    gap: &Gap,
+    d: &[f64],
+) -> Status {
+    let pair = &c.pairs[candidate.pair];
+    let Friction::Coulomb { mu } = pair.options.friction else {
+        return status;
+    };
+    match status {
+        Status::Stick if candidate.tangential.abs() > mu * candidate.normal * (1.0 + 1e-9) => {
+            Status::Slide(mu * candidate.tangential.signum())
+        }
+        Status::Slide(coefficient) => {
+            let slip: f64 = gap
+                .tangent_row(candidate.node)
+                .iter()
+                .map(|(dof, v)| v * d[*dof])
+                .sum();
+            if coefficient * slip > 1e-3 * pair.options.tolerance.max(f64::MIN_POSITIVE) {
+                Status::Stick
+            } else {
+                status
+            }
+        }
+        _ => status,
+    }
+}
+
+/// The index of slave `node` in pair `pair`.
+fn index_of(c: &Constraints, pair: usize, node: usize) -> usize {
+    c.pairs[pair]
+        .slaves
+        .iter()
+        .position(|s| *s == node)
+        .expect("an active entry is a slave of its pair")
+}
+
+/// Whether a sticking entry's tangential row `tangential` (on the free DOFs) is left to the
+/// supports: what is left of it after its component along the entry's normal row `normal`
+/// is removed is less than a tenth of it (none at all: prescribed DOFs only). Its
+/// multiplier would then have to enforce the slip through the normal's own DOFs, nearly
+/// the normal row again, and the two multipliers would grow without bound.
+fn held_by_support(tangential: &[(usize, f64)], normal: &[(usize, f64)]) -> bool {
+    let dot = |a: &[(usize, f64)], b: &[(usize, f64)]| -> f64 {
+        a.iter()
+            .map(|(eq, v)| {
+                v * b
+                    .iter()
+                    .filter(|(e, _)| e == eq)
+                    .map(|(_, w)| w)
+                    .sum::<f64>()
+            })
+            .sum()
+    };
+    let (tt, nn, tn) = (
+        dot(tangential, tangential),
+        dot(normal, normal),
+        dot(tangential, normal),
+    );
+    let left = if nn > 0.0 { tt - tn * tn / nn } else { tt };
+    !(left > 0.01 * tt)
+}
+
+/// A row on all DOFs restricted to the free ones (equation numbers).
+fn free(row: Vec<(usize, f64)>, system: &System) -> Vec<(usize, f64)> {
+    row.into_iter()
+        .filter_map(|(dof, v)| system.equation[dof].map(|eq| (eq, v)))
+        .collect()
+}
