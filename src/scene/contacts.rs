@@ -25,7 +25,7 @@ pub(super) fn contacts(
         .contact
         .iter()
         .enumerate()
-        .map(|entry| contact(cx, bodies, obstacles, entry, explicit(scene)))
+        .map(|entry| contact(cx, bodies, obstacles, entry, dynamic(scene)))
         .collect::<Result<Vec<_>, _>>()?;
     let mut contacts = contacts;
     for (k, spec) in scene.contact.iter().enumerate() {
@@ -91,7 +91,7 @@ fn contact(
     bodies: &[Body],
     obstacles: &[Obstacle],
     (k, spec): (usize, &ContactSpec),
-    explicit: bool,
+    dynamic: bool,
 ) -> Result<ContactPair, InputError> {
     let key = format!("contact[{k}] (`{}`)", spec.name);
     let (slave_body, slaves) = node_set(
@@ -139,7 +139,7 @@ fn contact(
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
         None => f64::INFINITY,
     };
-    let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), explicit)?;
+    let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), dynamic)?;
     Ok(ContactPair {
         name: spec.name.clone(),
         slave_body,
@@ -168,14 +168,17 @@ fn mortar_surface(
     bodies: &[Body],
     (key, spec): (&str, &ContactSpec),
     (slave_body, master): (usize, &Master),
-    explicit: bool,
+    dynamic: bool,
 ) -> Result<Option<MortarSurface>, InputError> {
     let slave_edges = bodies[slave_body]
         .mesh
         .edge_sets
         .contains_key(&spec.slave.set);
     let between_bodies = matches!(master, Master::Segments { .. }) && slave_edges;
-    let default = if explicit && between_bodies && !spec.two_pass {
+    // Greco's return is the seeds' node-to-segment friction: its target needs a frictionless
+    // solve of the same step, which the active set inside Newton does not make
+    let greco = spec.return_coefficient.is_some();
+    let default = if dynamic && between_bodies && !spec.two_pass && !greco {
         ContactDiscretization::Mortar
     } else {
         ContactDiscretization::NodeToSegment
@@ -225,8 +228,13 @@ fn mortar_surface(
     }))
 }
 
-/// Whether the scene steps with central difference (the default discretization of a pair
-/// between two bodies depends on it).
+/// Whether the scene is a dynamic one (a pair between two bodies' edge sets is a mortar
+/// pair there by default, on every integrator; static runs keep node-to-segment).
+fn dynamic(scene: &Scene) -> bool {
+    scene.analysis.kind == AnalysisKind::Dynamic
+}
+
+/// Whether the scene steps with central difference.
 fn explicit(scene: &Scene) -> bool {
     scene.analysis.integrator == Some(IntegratorKind::CentralDifference)
 }
