@@ -158,7 +158,8 @@ fn cycling(norms: &[f64]) -> bool {
 }
 
 /// The share of each Newton correction taken: 1, halved at each two-iterate cycle of the
-/// residual norms (`cycling`, theory 8.1-1).
+/// residual norms (`cycling`, theory 8.1-1), and back to 1 once the relaxed iteration shows
+/// that the full correction was right (`linear_at_share`).
 struct Relaxation {
     /// The residual norms of the iterates.
     norms: Vec<f64>,
@@ -189,7 +190,25 @@ impl Relaxation {
         if cycling(&self.norms[self.since..]) {
             self.share *= 0.5;
             self.since = self.norms.len();
+        } else if self.linear_at_share() {
+            self.share = 1.0;
+            self.since = self.norms.len();
         }
+    }
+
+    /// Whether the last two iterations since the last change of the share each took the
+    /// residual down by 1 - share (within a tenth of it): the signature of a correction that
+    /// is right but cut by the share, once the cycle it broke is behind (the residual halves
+    /// at every iteration at share 1/2, where the whole correction would have converged).
+    fn linear_at_share(&self) -> bool {
+        let norms = &self.norms[self.since..];
+        let k = norms.len();
+        if self.share >= 1.0 || k < 3 {
+            return false;
+        }
+        let expected = 1.0 - self.share;
+        let near = |ratio: f64| (ratio - expected).abs() < 0.1 * expected;
+        near(norms[k - 1] / norms[k - 2]) && near(norms[k - 2] / norms[k - 3])
     }
 
     /// A solve's correction `delta` (scaled in place) and multipliers `tau`, relaxed: the
