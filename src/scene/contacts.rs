@@ -201,11 +201,6 @@ fn mortar_surface(
             "{key}.two_pass: mortar contact weighs both surfaces already; give one of `two_pass` and `discretization = \"mortar\"`"
         )));
     }
-    // the master nodes are held by default on frictionless pairs only: with Coulomb friction
-    // (mu 0.2) the explicit one-point rod pair on non-matching meshes gained 41 % energy in
-    // one step at 20 us with them held
-    let frictionless =
-        spec.friction.is_none_or(|mu| mu == 0.0) && spec.return_coefficient.is_none();
     let body = &bodies[slave_body];
     let (_, edges) = edge_set(
         cx,
@@ -224,7 +219,11 @@ fn mortar_surface(
     Ok(Some(MortarSurface {
         edges,
         axisymmetric,
-        hold_master_nodes: spec.hold_master_nodes.unwrap_or(frictionless),
+        // the master nodes are left to the weighted gaps unless the scene asks to hold them:
+        // held, a copper rod at 200 m/s on a steel plate with either body meshed finer
+        // created energy and inverted an element (theory 8.3a), and with Coulomb friction
+        // the one-point rod pair on non-matching meshes gained 41 % energy in one step
+        hold_master_nodes: spec.hold_master_nodes.unwrap_or(false),
     }))
 }
 

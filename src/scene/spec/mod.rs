@@ -332,8 +332,8 @@ pub struct ContactSpec {
     /// is held out by a row of its own (where the surfaces fold at the rim of a contact zone):
     /// under central difference in the explicit correction, beyond 0.25 % of the slave
     /// segment it faces; with the implicit integrators by a hold pair `NAME:held` (its own
-    /// history column). Statics holds the weighted gaps alone. Default true on frictionless
-    /// pairs, false with friction.
+    /// history column), where the master's edges are not much finer than the slave's
+    /// (`mortar::FINER`). Statics holds the weighted gaps alone. Default false.
     pub hold_master_nodes: Option<bool>,
 }
 
