@@ -37,7 +37,7 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///    masses in the explicit carry; central difference's kinetic shadow in the energies.
 /// 9: the mortar pairs' master block in the contact state.
 /// 10: the subcycling's element bounds and counts in the explicit carry.
-const FORMAT: u32 = 10;
+const FORMAT: u32 = 11;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

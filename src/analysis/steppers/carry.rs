@@ -45,6 +45,10 @@ pub struct DynamicCarry {
     pub mean_velocity: Option<Vec<f64>>,
     /// The local error estimates so far (the top speed, the last and largest estimate).
     pub watch: ErrorWatch,
+    /// The acceleration at the start of the last step and that step's length: the error
+    /// estimate reads the change of a over two steps.
+    pub previous_acceleration: Option<Vec<f64>>,
+    pub last_step: f64,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
