@@ -15,7 +15,8 @@
 
 use super::Summary;
 use super::steppers::energies::Energies;
-use super::steppers::stable::{explicit_first_step, implicit_first_step, wave_speed};
+use super::steppers::explicit::Start;
+use super::steppers::stable::{implicit_first_step, wave_speed};
 use crate::assembly::mass_scaling::MassScalingReport;
 use crate::assembly::{self, State};
 use crate::contact::{ContactPair, Master, penetration_limits};
@@ -81,7 +82,7 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
     };
     let step = match d.step {
         TimeStep::Fixed(dt) => Some((dt, "analysis.dt".to_string())),
-        TimeStep::Auto { scale, .. } => explicit_first_step(model, d).ok().map(|dt| {
+        TimeStep::Auto { scale, .. } => explicit_first_step(model, d).map(|dt| {
             (
                 dt,
                 format!(
@@ -136,6 +137,11 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
         ));
     }
     out
+}
+
+/// The first step of a central-difference run of `model` (None: the run would refuse it).
+fn explicit_first_step(model: &Model, spec: &crate::scene::DynamicAnalysis) -> Option<f64> {
+    Start::new(model, spec).ok().map(|start| start.first_step())
 }
 
 /// A node of an axisymmetric body counts as on the axis, or across it, beyond this share of

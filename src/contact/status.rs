@@ -4,7 +4,6 @@
 
 use super::geometry::{ContactPair, Master};
 use super::search::slave_gaps;
-use super::step::ContactResult;
 use super::{ContactSummary, Interfaces, Section};
 
 /// The contact status carried from step to step.
@@ -82,23 +81,6 @@ impl ContactState {
             ever_closed: vec![false; pairs.len()],
             master_block: Vec::new(),
             scratch: Scratch::default(),
-        }
-    }
-
-    /// Takes a step's outcome as the new status; `time` is the end of the step.
-    pub fn commit<S>(
-        &mut self,
-        interfaces: &Interfaces,
-        step: &ContactResult<S>,
-        time: f64,
-        coords: &[[f64; 2]],
-    ) {
-        let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
-        let rows = (&step.active[..], &step.forces[..]);
-        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
-        for (i, (p, k)) in step.active.iter().enumerate() {
-            self.tangential[*p][*k] = step.tangential[i];
-            self.sliding[*p][*k] = step.sliding[i];
         }
     }
 

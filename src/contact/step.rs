@@ -7,6 +7,7 @@
 //! below `release_fraction` of the last step's are released; dynamics then applies the
 //! impact and release conditions (`impacts`).
 
+use super::Interfaces;
 use super::geometry::{ContactPair, Friction};
 use super::search;
 use super::status::ContactState;
@@ -38,6 +39,25 @@ pub struct ContactResult<S> {
     pub tangential: Vec<f64>,
     pub sliding: Vec<f64>,
     pub events: Events,
+}
+
+impl ContactState {
+    /// Takes a step's outcome as the new status; `time` is the end of the step.
+    pub fn commit<S>(
+        &mut self,
+        interfaces: &Interfaces,
+        step: &ContactResult<S>,
+        time: f64,
+        coords: &[[f64; 2]],
+    ) {
+        let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
+        let rows = (&step.active[..], &step.forces[..]);
+        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
+        for (i, (p, k)) in step.active.iter().enumerate() {
+            self.tangential[*p][*k] = step.tangential[i];
+            self.sliding[*p][*k] = step.sliding[i];
+        }
+    }
 }
 
 /// A tangential condition on active entry `entry` (an index into the active entries). The
