@@ -33,6 +33,7 @@ pub mod impacts;
 pub mod linearization;
 pub mod mortar;
 mod multipliers;
+pub mod penetration;
 pub mod search;
 pub mod setup;
 pub mod status;

@@ -244,6 +244,9 @@ impl Probe {
             }
             Statistic::Max => values.fold(f64::NEG_INFINITY, f64::max),
             Statistic::Min => values.fold(f64::INFINITY, f64::min),
+            // the nodes' masses are the caller's (`analysis::run::record`): a scene gives
+            // `mass_mean` only to nodal quantities, which never come here
+            Statistic::MassMean => f64::NAN,
         }
     }
 

@@ -15,7 +15,7 @@ use crate::output::vtk::{Fields, Grid, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
 use crate::scene::model::{PointFold, Probe};
-use crate::scene::spec::{FramePoints, Quantity};
+use crate::scene::spec::{FramePoints, Quantity, Statistic};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -679,7 +679,10 @@ fn probe_value(
     probe: &crate::scene::model::Probe,
 ) -> f64 {
     let (state, motion) = (snapshot.state, snapshot.motion);
-    let nodal = |v: &[f64], c: usize| probe.combine(probe.members.iter().map(|m| v[2 * m + c]));
+    let nodal = |v: &[f64], c: usize| match probe.statistic {
+        Statistic::MassMean => mass_mean(&probe.members, motion.mass, |m| v[2 * m + c], c),
+        _ => probe.combine(probe.members.iter().map(|m| v[2 * m + c])),
+    };
     let ppe = model.bodies[probe.body].points_per_element();
     let body_points = &state.bodies[probe.body].points;
     match probe.quantity {
@@ -709,12 +712,11 @@ fn probe_value(
         }
         Quantity::CoordinateX | Quantity::CoordinateY => {
             let c = (probe.quantity == Quantity::CoordinateY) as usize;
-            probe.combine(
-                probe
-                    .members
-                    .iter()
-                    .map(|&m| initial[m][c] + state.displacement[2 * m + c]),
-            )
+            let x = |m: usize| initial[m][c] + state.displacement[2 * m + c];
+            match probe.statistic {
+                Statistic::MassMean => mass_mean(&probe.members, motion.mass, x, c),
+                _ => probe.combine(probe.members.iter().map(|&m| x(m))),
+            }
         }
         Quantity::ExtentX | Quantity::ExtentY => {
             let c = (probe.quantity == Quantity::ExtentY) as usize;
@@ -738,6 +740,16 @@ fn probe_value(
             probe.fold_points(points).unwrap_or(f64::NAN)
         }
     }
+}
+
+/// sum m q / sum m over the nodes `members`, q = `value(node)` of component `c` and m the
+/// node's lumped mass (NaN without masses: a static analysis, which the scene refuses).
+fn mass_mean(members: &[usize], mass: &[f64], value: impl Fn(usize) -> f64, c: usize) -> f64 {
+    let (weighted, total) = members.iter().fold((0.0, 0.0), |(w, t), &m| {
+        let mass = mass.get(2 * m + c).copied().unwrap_or(f64::NAN);
+        (w + mass * value(m), t + mass)
+    });
+    weighted / total
 }
 
 /// The history.csv columns a run of `model` writes, in order.
