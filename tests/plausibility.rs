@@ -1225,6 +1225,10 @@ fn hourglass_warning_edge_is_ten_percent_of_stored_plus_plastic() {
             energies: &energies,
             hourglass_energy: Some(hourglass),
             mass_scaling: None,
+            velocity: &[],
+            mass: &[],
+            closed_at_end: &[],
+            finished: true,
         };
         plausibility::final_warnings(&model, &end)
     };

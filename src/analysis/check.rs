@@ -126,9 +126,17 @@ fn explicit_stability(start: &Start) -> StepStability {
 /// The lines `impact check` prints after the model's size.
 pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
     let mut lines = Vec::new();
-    for body in &model.bodies {
+    let masses = super::summary::body_masses(model);
+    for (b, body) in model.bodies.iter().enumerate() {
         let m = &body.material;
         let mut parts = Vec::new();
+        if let Some(mass) = masses.get(b).filter(|_| m.density > 0.0) {
+            parts.push(format!(
+                "mass {} ({})",
+                readable(mass.mass),
+                body.kind.mass_in_words()
+            ));
+        }
         if let Some(c) = wave_speed(body) {
             parts.push(format!(
                 "wave speed c = sqrt(M / rho) = {} with M = {} = {}",

@@ -37,6 +37,22 @@ pub struct Deepest {
     pub into: Intruded,
 }
 
+/// summary.json `contact.deepest`: where the deepest penetration of a body's node into an
+/// obstacle or another body was, in words.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DeepestNode {
+    pub depth: f64,
+    /// The end of the step after which it was that deep.
+    pub time: f64,
+    pub body: String,
+    /// The node's number in its body, from 0.
+    pub node: usize,
+    /// What it went into: "obstacle `NAME`" or "body `NAME`".
+    pub into: String,
+    /// Whether a contact pair names the node as a slave.
+    pub slave: bool,
+}
+
 /// The deepest penetration of any body's node into an obstacle of `interfaces`' pairs or
 /// into another body at the positions `x`, 0 when none is inside.
 pub fn deepest_depth(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> f64 {

@@ -169,6 +169,7 @@ impl ContactState {
             peak_contact_radius: self.peak_extent,
             min_gap: self.min_gap,
             max_penetration: self.min_gap.map(|_| self.max_penetration),
+            ..ContactSummary::default()
         }
     }
 

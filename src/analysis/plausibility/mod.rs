@@ -15,12 +15,14 @@
 
 mod contact;
 mod setup;
+mod slaves;
 mod units;
 
 pub use contact::PENETRATION_SHARE;
 pub use setup::{
     AXIS_TOLERANCE, FRAME_BYTES_PER_NODE, MANY_FRAMES, MIN_STEPS, expected_frames, setup_warnings,
 };
+pub use units::{MAX_STEPS, SPEED_SHARE, YIELD_STRAIN_RANGE, units_at_failure};
 
 use super::Summary;
 use super::steppers::energies::Energies;
@@ -80,6 +82,13 @@ pub struct EndOfRun<'a> {
     pub hourglass_energy: Option<f64>,
     /// The mass scaling per body (None without it).
     pub mass_scaling: Option<&'a MassScalingReport>,
+    /// The nodal velocities and lumped masses at the end (per DOF; empty in statics).
+    pub velocity: &'a [f64],
+    pub mass: &'a [f64],
+    /// The contact pairs closed at the end (summary.json `contact.closed_at_end`), and
+    /// whether the run reached its end time (a failed or stopped run ended early).
+    pub closed_at_end: &'a [String],
+    pub finished: bool,
 }
 
 /// What the end of a run shows: nodes of an axisymmetric body that ended across the axis
@@ -88,6 +97,13 @@ pub struct EndOfRun<'a> {
 /// [`ADDED_MASS_SHARE`] of a body's mass or scaled an element on a contact surface.
 pub fn final_warnings(model: &Model, end: &EndOfRun) -> Vec<String> {
     let mut out = setup::axis_crossings(model, end.positions);
+    if end.finished {
+        out.extend(contact::still_closed_warnings(
+            model,
+            end.closed_at_end,
+            (end.positions, end.velocity, end.mass),
+        ));
+    }
     if let Some(report) = end.mass_scaling {
         out.extend(mass_scaling_warnings(model, report));
     }
@@ -239,7 +255,34 @@ pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<St
     }
     out.extend(contact::never_closed_warnings(model, summary, energies));
     out.extend(contact::penetration_warning(model, summary));
+    out.extend(contact::coarse_contact_warnings(model, summary));
+    out.extend(energy_created_warning(model, summary, energies));
     out
+}
+
+/// The kinetic energy at the end above this share more than the energy the run was given
+/// (initial kinetic energy and positive external work) warns: nothing in a run without
+/// loads gives energy back beyond what came in (an elastic rebound returns at most all of
+/// it); the shipped scenes end at most 1 + 5e-13 of it (two_bars_smooth's rebound), a
+/// coarse implicit step on a sphere striking a wall 1.16 of it.
+pub const KINETIC_GAIN: f64 = 0.01;
+
+/// The bodies left with more kinetic energy than they were given (see [`KINETIC_GAIN`]),
+/// with the likely cause.
+fn energy_created_warning(model: &Model, summary: &Summary, energies: &Energies) -> Option<String> {
+    let given = summary.energy.initial + energies.external_work.max(0.0);
+    if given <= 0.0 || energies.kinetic <= (1.0 + KINETIC_GAIN) * given {
+        return None;
+    }
+    Some(format!(
+        "the bodies end with {} of kinetic energy, {:.1} % more than they were given ({}: the \
+         initial kinetic energy and the work of the loads): the run created energy, which no \
+         rebound can; a step too long for the contact (analysis.dt), or mixed units: {}",
+        readable(energies.kinetic),
+        100.0 * (energies.kinetic / given - 1.0),
+        readable(given),
+        units::unit_hint(model)
+    ))
 }
 
 /// The first few of `nodes` (global node ids, or element numbers) in words: `12, 14, 17 and

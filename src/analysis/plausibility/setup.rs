@@ -2,7 +2,8 @@
 //! a run repeats them): too few steps or too short a run for a wave (with the likely unit
 //! mistake), an obstacle no pair uses, axisymmetric axis nodes left free, too many frames.
 
-use super::units::{body_size, unit_hint};
+use super::slaves::slave_surface_warnings;
+use super::units::{MAX_STEPS, body_size, unit_hint, unit_warnings};
 use super::{model_size, some_nodes};
 use crate::analysis::steppers::explicit::Start;
 use crate::analysis::steppers::stable::{implicit_first_step, wave_speed};
@@ -38,6 +39,8 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
             ));
         }
     }
+    out.extend(unit_warnings(model));
+    out.extend(slave_surface_warnings(model));
     out.extend(axis_warnings(model));
     out.extend(frames_warning(model));
     let Analysis::Dynamic(d) = &model.analysis else {
@@ -57,6 +60,21 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
         // the error control lengthens the steps as far as the answer allows: no count
         TimeStep::Adaptive(_) => None,
     };
+    if let Some((dt, what)) = &step {
+        let steps = d.end_time / dt;
+        if steps > MAX_STEPS {
+            out.push(format!(
+                "analysis.end_time = {} spans {} steps of {what} = {}: more than {} steps is days \
+                 of computing and mostly an end time in other units than the step (microseconds \
+                 meant, seconds given?); shorten analysis.end_time, or check the units: {}",
+                readable(d.end_time),
+                readable(steps.round()),
+                readable(*dt),
+                readable(MAX_STEPS),
+                unit_hint(model)
+            ));
+        }
+    }
     if let Some((dt, what)) = step {
         let steps = d.end_time / dt;
         if steps < MIN_STEPS {
