@@ -305,7 +305,10 @@ fn steel_block_wall_clipped_steps_report_the_force_of_their_neighbours() {
     let force = column(&r.dir, "contact_force[wall]");
     let time = column(&r.dir, "time");
     let dt = column(&r.dir, "dt");
-    assert!(peak < bound, "peak_force_raw {peak} above rho c V h = {bound}");
+    assert!(
+        peak < bound,
+        "peak_force_raw {peak} above rho c V h = {bound}"
+    );
     assert_eq!(peak, force.iter().copied().fold(0.0, f64::max));
     assert!(r.summary.contact.peak_force <= peak);
     let rows = clipped_rows(&time, &force, &scene, scene.frame_interval);

@@ -79,7 +79,7 @@ fn peaks(n: usize) -> (f64, f64) {
 /// grid convergence procedure of Celik et al. (2008) (`impact::sweep::qoi::extrapolate`, as
 /// `impact sweep` applies it): the averaged peak is in the asymptotic range (observed order
 /// in [0.5, 3], differences of one sign) with GCI_fine below 2 % (measured: order 2.14, GCI
-/// 0.63 %, docs/validation.md 10.8); the raw peak is not in the asymptotic range
+/// 0.63 %, docs/validation.md 4.11); the raw peak is not in the asymptotic range
 /// (measured: its differences change sign).
 #[test]
 fn rod_on_plate_averaged_peak_converges_where_the_raw_peak_does_not() {

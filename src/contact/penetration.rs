@@ -70,9 +70,6 @@ pub fn deepest(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Optio
             obstacles.push(o);
         }
     }
-    let nodes: Vec<Vec<usize>> = (0..interfaces.bodies.len())
-        .map(|b| surface_nodes(interfaces, b))
-        .collect();
     let mut best: Option<Deepest> = None;
     let mut consider = |candidate: Option<(f64, usize)>, body: usize, into: Intruded| {
         if let Some((depth, node)) = candidate
@@ -86,14 +83,15 @@ pub fn deepest(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Optio
             });
         }
     };
-    for (body, nodes) in nodes.iter().enumerate() {
+    for body in 0..interfaces.bodies.len() {
+        let nodes = || surface_nodes(interfaces, body);
         for obstacle in &obstacles {
-            let found = deepest_in_obstacle(nodes, x, obstacle);
+            let found = deepest_in_obstacle(nodes(), x, obstacle);
             consider(found, body, Intruded::Obstacle(obstacle.name.clone()));
         }
         for (other, surface) in interfaces.bodies.iter().enumerate() {
             if other != body && !surface.boundary.is_empty() {
-                let found = deepest_in_outline(nodes, x, &surface.boundary);
+                let found = deepest_in_outline(nodes(), x, &surface.boundary);
                 consider(found, body, Intruded::Body(other));
             }
         }
@@ -101,23 +99,21 @@ pub fn deepest(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Optio
     best
 }
 
-/// The nodes of body `b` that can meet another: those of its boundary edges (every node of
-/// a rod, which has none).
-fn surface_nodes(interfaces: &Interfaces, b: usize) -> Vec<usize> {
+/// The nodes of body `b` that can meet another (global ids): those with boundary edges
+/// (every node of a rod, which has none).
+fn surface_nodes(interfaces: &Interfaces, b: usize) -> impl Iterator<Item = usize> + '_ {
     let body = &interfaces.bodies[b];
-    let mut nodes: Vec<usize> = if body.boundary.is_empty() {
-        (body.node_offset..body.node_offset + body.boundary_at_node.len()).collect()
-    } else {
-        body.boundary.iter().flatten().copied().collect()
-    };
-    nodes.sort_unstable();
-    nodes.dedup();
-    nodes
+    let rod = body.boundary.is_empty();
+    body.boundary_at_node
+        .iter()
+        .enumerate()
+        .filter(move |(_, edges)| rod || !edges.is_empty())
+        .map(move |(n, _)| body.node_offset + n)
 }
 
 /// The deepest of `nodes` inside the solid of `obstacle` (depth, node).
 fn deepest_in_obstacle(
-    nodes: &[usize],
+    nodes: impl Iterator<Item = usize>,
     x: &impl Fn(usize) -> [f64; 2],
     obstacle: &Obstacle,
 ) -> Option<(f64, usize)> {
@@ -125,7 +121,7 @@ fn deepest_in_obstacle(
     let cavity = obstacle.is_cavity();
     let last = segments.len() - 1;
     let mut best: Option<(f64, usize)> = None;
-    for &node in nodes {
+    for node in nodes {
         let p = x(node);
         let (k, xi, distance) = segments
             .iter()
@@ -152,7 +148,7 @@ fn deepest_in_obstacle(
 /// The deepest of `nodes` inside the closed outline `boundary` (global ids) of another body
 /// (depth, node); only nodes within the outline's bounding box are tested.
 fn deepest_in_outline(
-    nodes: &[usize],
+    nodes: impl Iterator<Item = usize>,
     x: &impl Fn(usize) -> [f64; 2],
     boundary: &[[usize; 2]],
 ) -> Option<(f64, usize)> {
@@ -165,7 +161,7 @@ fn deepest_in_outline(
         }
     }
     let mut best: Option<(f64, usize)> = None;
-    for &node in nodes {
+    for node in nodes {
         let p = x(node);
         let boxed = (0..2).all(|c| p[c] > low[c] && p[c] < high[c]);
         if !boxed || !inside_by_crossings(p, segments.iter().copied()) {
@@ -187,15 +183,18 @@ mod tests {
     use super::*;
     use crate::contact::{BodySurface, Section};
 
-    /// A unit square body (nodes 0..4, counter-clockwise) at `origin`, as global node ids
-    /// from `offset`.
+    /// A unit square body's outline (nodes 0..4, counter-clockwise), as global node ids from
+    /// `offset`.
     fn square(offset: usize) -> BodySurface {
         let n = |k: usize| offset + k;
+        let boundary = vec![[n(0), n(1)], [n(1), n(2)], [n(2), n(3)], [n(3), n(0)]];
         BodySurface {
             section: Section::Plane { thickness: 1.0 },
             impedance_per_area: 1.0,
-            boundary_at_node: vec![Vec::new(); 4],
-            boundary: vec![[n(0), n(1)], [n(1), n(2)], [n(2), n(3)], [n(3), n(0)]],
+            boundary_at_node: (0..4)
+                .map(|k| vec![boundary[(k + 3) % 4], boundary[k]])
+                .collect(),
+            boundary,
             node_offset: offset,
         }
     }
