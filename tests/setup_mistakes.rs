@@ -315,10 +315,6 @@ fn bad_window_and_mass_mean_probes_are_refused() {
 // 0.1 % either side of the edge the user guide documents (far above the round-off of the
 // comparisons; an edge misplaced by more than 0.1 % fails one side).
 
-use impact::analysis::Summary;
-use impact::analysis::plausibility;
-use impact::analysis::steppers::energies::Energies;
-
 /// The sphere's model and a summary of an `ok` run with nothing to warn of.
 fn sphere_summary() -> (impact::scene::Model, Summary) {
     let model = impact::scene::load(Path::new(SPHERE), &[]).unwrap();

@@ -299,10 +299,13 @@ pub struct Summary {
     #[serde(skip)]
     pub subcycling: Option<SubcyclingSummary>,
     /// What the scene and the finished run say about the answer (analysis::plausibility):
-    /// the scene's own warnings (too few steps, a run shorter than a wave transit, an unused
-    /// obstacle, an axis not held, too many frames), then step cuts, the energy balance,
-    /// plastic work above the energy supplied, a step too long for the impact, a pair that
-    /// never closed, a contact penetration beyond TOL, nodes across the axis, hourglass
+    /// the scene's own warnings (too few or too many steps, a run shorter than a wave
+    /// transit, mixed units, a slave set that misses the surface facing its master, an
+    /// unused obstacle, an axis not held, too many frames), then step cuts, the energy
+    /// balance, plastic work above the energy supplied, a step too long for the impact, a
+    /// pair that never closed, a contact penetration beyond TOL (with its node and cause), a
+    /// plastic contact resolved by too few segments, kinetic energy above what was given,
+    /// nodes across the axis, a pair still closed and approaching at the end, hourglass
     /// energy, mass scaling above 1 % of a body's mass or on a contact surface. Empty when
     /// none.
     #[serde(default)]

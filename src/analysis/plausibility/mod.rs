@@ -2,7 +2,10 @@
 //! printed by `impact check` and repeated by the run), and what a finished run can say about
 //! its own answer ([`warnings`]). Each warning is a sentence in summary.json `warnings` and
 //! on the closing lines; a warning never changes the exit code (`--strict` makes any warning
-//! exit 3).
+//! exit 3). Each names the likely cause. The scene's own in `setup` (with the slave sets of
+//! `slaves` and the unit hints of `units`), the pairs' after a run in `contact`, the rest
+//! (step cuts, energies, the step, axis crossings, hourglass, mass scaling) here; a failed
+//! run's message gets [`units_at_failure`].
 //!
 //! Legend
 //! ```text
@@ -18,10 +21,11 @@ mod setup;
 mod slaves;
 mod units;
 
-pub use contact::PENETRATION_SHARE;
+pub use contact::{COARSE_CONTACT_NODES, PENETRATION_SHARE, STILL_APPROACHING};
 pub use setup::{
     AXIS_TOLERANCE, FRAME_BYTES_PER_NODE, MANY_FRAMES, MIN_STEPS, expected_frames, setup_warnings,
 };
+pub use slaves::SLAVE_SHARE;
 pub use units::{MAX_STEPS, SPEED_SHARE, YIELD_STRAIN_RANGE, units_at_failure};
 
 use super::Summary;

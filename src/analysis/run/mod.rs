@@ -441,12 +441,12 @@ impl<'a, S: Stepper> Run<'a, S> {
             summary.dt_limit = Some(DtLimit::of(report.limit, self.model));
         }
         summary.max_temperature = record::max_temperature(self.model, s.state());
-        summary.warnings = plausibility::warnings(self.model, summary, &energies);
+        summary.warnings = plausibility::warnings(self.model, summary, energies);
         let positions = s.state().positions(self.model.analysis.geometry());
         let motion = s.motion();
         let end = plausibility::EndOfRun {
             positions: &positions,
-            energies: &energies,
+            energies,
             hourglass_energy: s.hourglass_energy(),
             mass_scaling: mass_scaling.as_ref(),
             velocity: motion.velocity,
