@@ -13,7 +13,9 @@ use crate::element::{
     Formulation, GeometricStiffness, KernelError, Mat4, Strain, Vec4, Vec8, Voigt, quad4, rod2,
 };
 use crate::kinematics;
-use crate::material::{PointState, Response, StressCondition, UpdateContext, dissipation};
+use crate::material::{
+    PointState, Response, StressCondition, UpdateContext, trapezoid_dissipation,
+};
 use crate::scene::spec::Tangent;
 use crate::scene::{Body, BodyKind};
 use nalgebra::Matrix2;
@@ -170,7 +172,7 @@ impl Kernel {
                 }
                 let stress = responses.map(|r| r.stress);
                 let start = &committed.points[4 * e..4 * e + 4];
-                let (work, plastic_work) = quad_work(&geom, start, &strains, &responses)?;
+                let (work, plastic_work) = quad_work(&geom, start, &strains, &responses);
                 let force = points.internal_force(&geom, &stress);
                 out.force.copy_from_slice(force.as_slice());
                 if let (Some(m), Points::Operators(operators)) = (out.matrix, &points) {
@@ -205,13 +207,12 @@ impl Kernel {
                 // 1/2 (S_n + S_{n+1}) dep, as the work (see trapezoid_dissipation)
                 let plastic_work = area
                     * length
-                    * dissipation(
+                    * trapezoid_dissipation(
                         &committed.points[e].stress,
                         &response.state.stress,
                         &response.state.back_stress,
                         response.plastic_work,
-                    )
-                    .map_err(|work| KernelError::NegativePlasticWork { point: 0, work })?;
+                    );
                 let f4 = rod2::internal_force(&x, &de, stress, area, geometry)?;
                 if let Some(m) = out.matrix {
                     let modulus = if elastic_moduli {
@@ -478,21 +479,20 @@ fn quad_work(
     start: &[PointState],
     strains: &[Voigt; 4],
     responses: &[Response; 4],
-) -> Result<(f64, f64), KernelError> {
+) -> (f64, f64) {
     let (mut work, mut plastic_work) = (0.0, 0.0);
     for q in 0..4 {
         let (weight, end) = (geom.points[q].weight, &responses[q]);
         plastic_work += weight
-            * dissipation(
+            * trapezoid_dissipation(
                 &start[q].stress,
                 &end.state.stress,
                 &end.state.back_stress,
                 end.plastic_work,
-            )
-            .map_err(|work| KernelError::NegativePlasticWork { point: q, work })?;
+            );
         let mut strain = strains[q];
         strain[2] = end.strain_zz;
         work += weight * 0.5 * (start[q].stress + end.stress).dot(&strain);
     }
-    Ok((work, plastic_work))
+    (work, plastic_work)
 }

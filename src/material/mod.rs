@@ -496,7 +496,9 @@ pub fn trapezoid_dissipation(
 /// s_{n+1} : n < 0 needs the start stress reversed beyond the whole elastic range of the
 /// end): a run would book negative plastic work, which no material dissipates. With
 /// kinematic hardening a reversed flow gives back stored back-stress energy, and an
-/// increment may be negative; its total is the run's to check.
+/// increment may be negative; its total is the run's to check. For the explicit kernels,
+/// whose every step is final; Newton's iterates may pass through such states, and the
+/// implicit run checks its committed total instead.
 pub fn dissipation(
     start: &Voigt,
     end: &Voigt,

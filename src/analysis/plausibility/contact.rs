@@ -182,8 +182,11 @@ pub(super) fn coarse_contact_warnings(model: &Model, summary: &Summary) -> Vec<S
             Master::Segments { body, .. } | Master::Nodes { body, .. } => plastic(*body),
             Master::Obstacle(_) => false,
         };
+        // a hold pair or a second pass takes its slaves from its first pass, which is judged
+        let derived = pair.holds.is_some() || pair.covered.is_some();
         let surface = pair.slaves.len() > COARSE_CONTACT_NODES
-            && !model.bodies[pair.slave_body].kind.is_rod();
+            && !model.bodies[pair.slave_body].kind.is_rod()
+            && !derived;
         if !surface
             || *closed == 0
             || *closed > COARSE_CONTACT_NODES
