@@ -169,7 +169,8 @@ fn set_named_by<'a>(body: &'a Body, slaves: &[usize]) -> Option<&'a str> {
 pub const COARSE_CONTACT_NODES: usize = 3;
 
 /// The pairs whose contact was resolved by too few slave nodes at its widest (see
-/// [`COARSE_CONTACT_NODES`]).
+/// [`COARSE_CONTACT_NODES`]): the pair's own slaves and those of its second pass or hold
+/// pair (nodes of the other surface held on it), counted together.
 pub(super) fn coarse_contact_warnings(model: &Model, summary: &Summary) -> Vec<String> {
     if summary.status != Status::Ok {
         // a run that stopped early had no contact to resolve yet
@@ -177,7 +178,16 @@ pub(super) fn coarse_contact_warnings(model: &Model, summary: &Summary) -> Vec<S
     }
     let plastic = |b: usize| model.bodies[b].material.plasticity.is_some();
     let mut out = Vec::new();
-    for (pair, closed) in model.contacts.iter().zip(&summary.contact.closed_at_widest) {
+    let widest = &summary.contact.closed_at_widest;
+    for (p, pair) in model.contacts.iter().enumerate() {
+        // the slaves of the pair's second pass and hold pair close on the same contact
+        let passes = model
+            .contacts
+            .iter()
+            .enumerate()
+            .filter(|(_, q)| q.covered.as_ref().is_some_and(|c| c.pair == p))
+            .map(|(q, _)| widest.get(q).copied().unwrap_or(0));
+        let closed = &(widest.get(p).copied().unwrap_or(0) + passes.sum::<usize>());
         let master_plastic = match &pair.master {
             Master::Segments { body, .. } | Master::Nodes { body, .. } => plastic(*body),
             Master::Obstacle(_) => false,
