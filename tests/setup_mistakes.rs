@@ -200,7 +200,8 @@ fn a_density_in_grams_per_cubic_centimetre_is_caught() {
 /// that diverges says the state points to mixed units, and books no negative plastic work.
 /// Setup: yield_stress = 300, Newmark average at dt = 1e-7 s, n = 12. Reference: a yield
 /// strain of 1.4e-9, below the 1e-5 of any solid; the divergence is a numerical failure
-/// (exit 3) whose message names the units; summary.json `plastic_dissipation` >= 0.
+/// (exit 3: the step that would make the plastic work negative is refused, not recorded)
+/// whose message names the units; summary.json `plastic_dissipation` >= 0.
 #[test]
 fn a_yield_stress_in_mpa_is_caught_and_its_divergence_names_the_units() {
     let (code, stderr) = impact_on_sphere("check", None, &["material.steel.yield_stress=300.0"]);

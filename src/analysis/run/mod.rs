@@ -26,7 +26,7 @@ pub mod record;
 
 use super::plausibility;
 use super::steppers::Stepper;
-use super::steppers::energies::balance_error;
+use super::steppers::energies::{Energies, balance_error};
 use super::steppers::newton::Counters;
 use super::summary::{DtLimit, MassScalingSummary, RunError, Status, StepError, Summary};
 use crate::assembly::State;
@@ -102,6 +102,10 @@ struct Run<'a, S: Stepper> {
     start: Instant,
     progress: Progress,
     penetration_limits: Vec<f64>,
+    /// The energies of the last row recorded: what the summary reports of a run whose last
+    /// step was committed and then refused (negative plastic work is no row of history).
+    recorded: Energies,
+    refused_step: bool,
 }
 
 /// Runs `stepper` (set up from `start` on) from the beginning or from `resume`, writing
@@ -182,6 +186,8 @@ impl<'a, S: Stepper> Run<'a, S> {
                 model.analysis.end_time(),
             ),
             penetration_limits,
+            recorded: Energies::default(),
+            refused_step: false,
         };
         run.summary.energy.initial = run.stepper.initial_kinetic();
         match resume {
@@ -262,6 +268,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             negative_plastic_work(self.stepper.energies(), self.stepper.initial_kinetic())
         {
             let time = self.stepper.state().time;
+            self.refused_step = true;
             return Err(self.fail(
                 Status::Diverged,
                 format!("at t = {}: {message}", readable(time)),
@@ -365,6 +372,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             contact,
         };
         self.recorder.step(self.model, snapshot, last)?;
+        self.recorded = *s.energies();
         Ok(())
     }
 
@@ -402,7 +410,11 @@ impl<'a, S: Stepper> Run<'a, S> {
             self.stepper.sync_points();
         }
         let s = &self.stepper;
-        let energies = s.energies();
+        let energies = if self.refused_step {
+            &self.recorded
+        } else {
+            s.energies()
+        };
         let solver = s.solver();
         let summary = &mut self.summary;
         summary.newton_iterations = self.counters.iterations;
@@ -564,10 +576,7 @@ fn monitor_error(model: &Model, e: buckling::MonitorError) -> RunError {
 /// failure's message: no material dissipates negative work; a return that books it (a
 /// kinematically hardening point reversed beyond what it stored) is a numerical failure,
 /// not a row of history.
-fn negative_plastic_work(
-    e: &crate::analysis::steppers::energies::Energies,
-    initial_kinetic: f64,
-) -> Option<String> {
+fn negative_plastic_work(e: &Energies, initial_kinetic: f64) -> Option<String> {
     let scale = initial_kinetic
         .max(e.external_work.abs())
         .max(e.internal.abs())
