@@ -334,7 +334,19 @@ fn run(
     }
     let model = scene::load(path, set)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&model.name));
-    let summary = analysis::run(&model, &dir, run_options(progress))?;
+    let summary = match analysis::run(&model, &dir, run_options(progress)) {
+        Ok(summary) => summary,
+        Err(e) => {
+            // a failed run's warnings say what it set out with (mixed units, a slave set
+            // that misses the surface, ...): printed before its error
+            if let RunError::Numerical { summary, .. } = &e {
+                for warning in &summary.warnings {
+                    errln!("warning: {warning}");
+                }
+            }
+            return Err(e);
+        }
+    };
     if !quiet {
         outln!(
             "{}: {}, {}, {}, t = {}, {:.2} s -> {}",

@@ -904,6 +904,17 @@ fn check_and_run_scene(
     scene: &str,
     sets: &[String],
 ) -> (String, Option<i32>, Vec<String>) {
+    check_and_run_ending(name, scene, sets, 0)
+}
+
+/// As `check_and_run_scene`, the run exiting with `run_code` (3: a numerical failure, whose
+/// summary.json still holds the warnings).
+fn check_and_run_ending(
+    name: &str,
+    scene: &str,
+    sets: &[String],
+    run_code: i32,
+) -> (String, Option<i32>, Vec<String>) {
     let dir = out_dir(name);
     let d = dir.to_str().unwrap().to_string();
     let mut args: Vec<&str> = vec!["check", scene, "--strict"];
@@ -916,7 +927,7 @@ fn check_and_run_scene(
     args[2] = "--quiet";
     args.extend(["--out", &d]);
     let r = impact(&args);
-    assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+    assert_eq!(r.status.code(), Some(run_code), "{}", text(&r));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
     let warnings = summary["warnings"]
@@ -948,18 +959,27 @@ fn block_in_mm(density: &str) -> Vec<String> {
 
 /// Goal: a scene in mm and MPa with its density left in kg/m^3 is named as such by check and
 /// run. Before: the whole impact ran in one stable step (c = 6.0 for steel, dt_crit 0.14
-/// against end_time 1.2e-5), warnings []. Setup: the steel block in mm, t, s, MPa with
-/// density 7.85e-9 t/mm^3 (correct) and 7850 (the mistake, the only difference).
+/// against end_time 3e-5), warnings []. Setup: the steel block in mm, t, s, MPa with
+/// density 7.85e-9 t/mm^3 (correct) and 7850 (the mistake, the only difference; its run
+/// now fails, a face element inverted by steps of a microsecond, and its summary.json keeps
+/// the warnings).
 /// Reference: c = sqrt(M / rho) is 6000 m/s = 6e6 mm/s for steel; 7850 makes it 3e4 times
 /// slower, the step 3e4 times longer than the 0.085 us of the SI scene, and a wave takes
-/// 10 mm / 6.0 = 1.7 s to cross the block against a 12 us run.
+/// 10 mm / 6.0 = 1.7 s to cross the block against a 30 us run.
 #[test]
 fn a_density_in_kg_per_m3_beside_mpa_and_mm_warns() {
     let (said, code, warnings) = check_and_run("units_mm_ok", &block_in_mm("7.85e-9"));
     assert_eq!(code, Some(0), "{said}");
     assert!(!said.contains("warning"), "{said}");
     assert!(warnings.is_empty(), "{warnings:?}");
-    let (said, code, warnings) = check_and_run("units_mm_density", &block_in_mm("7850"));
+    // the run's steps are the frames' (1 us each, the stable step being 0.09 s): the block
+    // crosses the 0.05 mm gap and its face inverts at the wall within the 30 us (exit 3)
+    let (said, code, warnings) = check_and_run_ending(
+        "units_mm_density",
+        "models/steel_block_wall.toml",
+        &block_in_mm("7850"),
+        3,
+    );
     assert_eq!(code, Some(3), "check --strict with warnings: {said}");
     assert_eq!(warnings.len(), 2, "{warnings:?}");
     assert!(warnings[0].contains("fewer than 10 steps"), "{warnings:?}");
@@ -981,7 +1001,7 @@ fn a_density_in_kg_per_m3_beside_mpa_and_mm_warns() {
 /// Goal: a geometry in mm with every other value in SI is named by check and run. Before:
 /// the 20 x 10 "m" block ran silently. Setup: models/steel_block_wall.toml as shipped
 /// (correct) and with its mesh and wall in mm (the mistake). Reference: a wave crosses the
-/// 10 "m" block in 10 / 6001 = 1.7 ms against a 12 us run, and the stable step of its
+/// 10 "m" block in 10 / 6001 = 1.7 ms against a 30 us run, and the stable step of its
 /// 0.5 "m" elements (0.13 ms) is longer than the run; check prints both.
 #[test]
 fn a_geometry_in_mm_beside_si_material_data_warns() {
@@ -999,7 +1019,7 @@ fn a_geometry_in_mm_beside_si_material_data_warns() {
     .collect();
     let (said, code, warnings) = check_and_run("units_si_mm_geometry", &mm);
     assert_eq!(code, Some(3), "{said}");
-    // and the block never reaches the wall 0.05 "m" ahead in 12 us at 50 m/s
+    // and the block never reaches the wall 0.05 "m" ahead in 30 us at 50 m/s
     assert_eq!(warnings.len(), 3, "{warnings:?}");
     assert!(
         warnings[1].contains("size 10 / wave speed 6000.98"),
@@ -1225,6 +1245,10 @@ fn hourglass_warning_edge_is_ten_percent_of_stored_plus_plastic() {
             energies: &energies,
             hourglass_energy: Some(hourglass),
             mass_scaling: None,
+            velocity: &[],
+            mass: &[],
+            closed_at_end: &[],
+            finished: true,
         };
         plausibility::final_warnings(&model, &end)
     };
@@ -1240,8 +1264,8 @@ fn hourglass_warning_edge_is_ten_percent_of_stored_plus_plastic() {
 /// and lays them out in time linear in their count. Before: frame_interval = 1.2e-11 (1e6
 /// frames, the most allowed) spent 7 min 53 s in `check` (the layout compared every new
 /// frame time with all before it) and a run printed nothing for as long; now 0.01 s.
-/// Setup: models/steel_block_wall.toml as shipped (13 frames, silent) and with
-/// frame_interval = 1.2e-9 (10 000 frames over the 12 us; the mistake) and 1.2e-11.
+/// Setup: models/steel_block_wall.toml as shipped (31 frames, silent) and with
+/// frame_interval = 3e-9 (10 000 frames over the 30 us; the mistake) and 3e-11.
 /// Reference: the frames of the shipped run on disk: the size the warning gives per frame is
 /// within 15 % of theirs; the 1e6 frame times are laid out in under 2 s (a quadratic
 /// layout takes minutes), and a run prints its first progress line within 10 s.
@@ -1261,7 +1285,7 @@ fn many_frames_warn_with_their_size_and_lay_out_quickly() {
         "check",
         "models/steel_block_wall.toml",
         "--set",
-        "output.frame_interval=1.2e-9",
+        "output.frame_interval=3e-9",
     ]);
     let said = text(&o);
     assert_eq!(o.status.code(), Some(0), "{said}");
@@ -1288,7 +1312,7 @@ fn many_frames_warn_with_their_size_and_lay_out_quickly() {
 
     let path = Path::new("models/steel_block_wall.toml");
     let start = std::time::Instant::now();
-    let model = impact::scene::load(path, &["output.frame_interval=1.2e-11".to_string()]).unwrap();
+    let model = impact::scene::load(path, &["output.frame_interval=3e-11".to_string()]).unwrap();
     let layout = start.elapsed().as_secs_f64();
     assert_eq!(model.output.frame_times.len(), 1_000_000);
     assert!(layout < 2.0, "laying out 1e6 frames took {layout} s");
@@ -1301,7 +1325,7 @@ fn many_frames_warn_with_their_size_and_lay_out_quickly() {
             "run",
             "models/steel_block_wall.toml",
             "--set",
-            "output.frame_interval=1.2e-11",
+            "output.frame_interval=3e-11",
             "--progress-every",
             "0",
             "--out",

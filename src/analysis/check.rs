@@ -15,10 +15,8 @@
 //!              Wilson-theta: unconditionally stable for theta >= 1.37 only
 //! ```
 
-use super::steppers::stable::{
-    StableStep, checked_step, critical_time_step, explicit_first_step, explicit_start_levels,
-    explicit_start_scaling, implicit_first_step, wave_speed,
-};
+use super::steppers::explicit::Start;
+use super::steppers::stable::{critical_time_step, implicit_first_step, wave_speed};
 use crate::output::readable;
 use crate::scene::DynamicAnalysis;
 use crate::scene::spec::{IntegratorKind, MassKind};
@@ -81,11 +79,7 @@ fn step_count(model: &Model, spec: &DynamicAnalysis, dt: f64) -> String {
 pub fn step_stability(model: &Model, spec: &DynamicAnalysis) -> Result<StepStability, InputError> {
     let has_mass = model.bodies.iter().all(|b| b.material.density > 0.0);
     if spec.integrator == IntegratorKind::CentralDifference {
-        // the element-eigenvalue limit, and the step the run will take (the automatic step
-        // scales the explicit kernel's conservative bound, below the limit)
-        let StableStep { dt: dt_crit, .. } = checked_step(model, spec)?;
-        let dt = Some(explicit_first_step(model, spec)?);
-        return Ok(StepStability::Conditional { dt, dt_crit });
+        return Start::new(model, spec).map(|start| explicit_stability(&start));
     }
     let dt = implicit_first_step(model, spec)?;
     let newmark = matches!(
@@ -120,12 +114,29 @@ pub fn step_stability(model: &Model, spec: &DynamicAnalysis) -> Result<StepStabi
     })
 }
 
+/// The element-eigenvalue limit of a central-difference run and the step it will take (the
+/// automatic step scales the explicit kernel's conservative bound, below the limit).
+fn explicit_stability(start: &Start) -> StepStability {
+    StepStability::Conditional {
+        dt: Some(start.first_step()),
+        dt_crit: start.dt_crit,
+    }
+}
+
 /// The lines `impact check` prints after the model's size.
 pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
     let mut lines = Vec::new();
-    for body in &model.bodies {
+    let masses = super::summary::body_masses(model);
+    for (b, body) in model.bodies.iter().enumerate() {
         let m = &body.material;
         let mut parts = Vec::new();
+        if let Some(mass) = masses.get(b).filter(|_| m.density > 0.0) {
+            parts.push(format!(
+                "mass {} ({})",
+                readable(mass.mass),
+                body.kind.mass_in_words()
+            ));
+        }
         if let Some(c) = wave_speed(body) {
             parts.push(format!(
                 "wave speed c = sqrt(M / rho) = {} with M = {} = {}",
@@ -150,53 +161,17 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
         ));
     }
     if let crate::scene::model::Analysis::Dynamic(spec) = &model.analysis {
-        let name = spec.integrator.name();
-        lines.push(match step_stability(model, spec)? {
-            StepStability::Conditional { dt: Some(dt), dt_crit } => format!(
-                "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}; {}{}",
-                readable(dt),
-                readable(dt_crit),
-                readable(dt / dt_crit),
-                step_count(model, spec, dt),
-                if spec.mass == MassKind::Consistent {
-                    " (from the lumped-mass frequency bound: the consistent mass's highest \
-                     frequency is higher, sqrt 3 times for rods, so its limit is lower)"
-                } else {
-                    ""
-                }
-            ),
-            StepStability::Conditional { dt: None, dt_crit } => format!(
-                "integrator {name}: stability limit dt_crit = {}",
-                readable(dt_crit)
-            ),
-            StepStability::Unconditional {
-                dt,
-                dt_crit_explicit,
-            } if dt_crit_explicit.is_finite() => format!(
-                "integrator {name}: unconditionally stable; dt = {} is {} times the central-difference limit {} (about the number of elements a wave crosses in one step)",
-                readable(dt),
-                readable(dt / dt_crit_explicit),
-                readable(dt_crit_explicit)
-            ),
-            StepStability::Unconditional { dt, .. } => {
-                format!("integrator {name}: unconditionally stable; dt = {}", readable(dt))
-            }
-            StepStability::WilsonBelowLimit {
-                dt,
-                dt_crit_explicit,
-            } => format!(
-                "integrator {name}: theta = {} < 1.37 is only conditionally stable; dt = {} is {} times the central-difference limit {}",
-                readable(spec.theta),
-                readable(dt),
-                readable(dt / dt_crit_explicit),
-                readable(dt_crit_explicit)
-            ),
-            StepStability::Unstable => format!(
-                "integrator {name}: gamma = {} < 1/2 is unstable at any dt",
-                readable(spec.gamma)
-            ),
-        });
-        if let Some(report) = explicit_start_scaling(model, spec)? {
+        // a central-difference run's start, formed once as the run forms it
+        let start = match spec.integrator {
+            IntegratorKind::CentralDifference => Some(Start::new(model, spec)?),
+            _ => None,
+        };
+        let stability = match &start {
+            Some(start) => explicit_stability(start),
+            None => step_stability(model, spec)?,
+        };
+        lines.push(stability_line(model, spec, stability));
+        if let Some(report) = start.as_ref().and_then(|s| s.mass_scaling(model)) {
             let model_mass = report.model_mass();
             lines.push(format!(
                 "mass scaling: target stable step {}; {} element(s) below it on the initial mesh \
@@ -210,11 +185,67 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
                 readable(model_mass)
             ));
         }
-        if let Some(levels) = explicit_start_levels(model, spec)? {
-            lines.push(subcycling_line(&levels));
+        if let Some(levels) = start.as_ref().and_then(Start::levels) {
+            lines.push(subcycling_line(levels));
         }
     }
     Ok(lines)
+}
+
+/// `impact check`'s line on the step of `spec` against its integrator's limit.
+fn stability_line(model: &Model, spec: &DynamicAnalysis, stability: StepStability) -> String {
+    let name = spec.integrator.name();
+    match stability {
+        StepStability::Conditional {
+            dt: Some(dt),
+            dt_crit,
+        } => format!(
+            "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}; {}{}",
+            readable(dt),
+            readable(dt_crit),
+            readable(dt / dt_crit),
+            step_count(model, spec, dt),
+            if spec.mass == MassKind::Consistent {
+                " (from the lumped-mass frequency bound: the consistent mass's highest \
+                 frequency is higher, sqrt 3 times for rods, so its limit is lower)"
+            } else {
+                ""
+            }
+        ),
+        StepStability::Conditional { dt: None, dt_crit } => format!(
+            "integrator {name}: stability limit dt_crit = {}",
+            readable(dt_crit)
+        ),
+        StepStability::Unconditional {
+            dt,
+            dt_crit_explicit,
+        } if dt_crit_explicit.is_finite() => format!(
+            "integrator {name}: unconditionally stable; dt = {} is {} times the central-difference limit {} (about the number of elements a wave crosses in one step)",
+            readable(dt),
+            readable(dt / dt_crit_explicit),
+            readable(dt_crit_explicit)
+        ),
+        StepStability::Unconditional { dt, .. } => {
+            format!(
+                "integrator {name}: unconditionally stable; dt = {}",
+                readable(dt)
+            )
+        }
+        StepStability::WilsonBelowLimit {
+            dt,
+            dt_crit_explicit,
+        } => format!(
+            "integrator {name}: theta = {} < 1.37 is only conditionally stable; dt = {} is {} times the central-difference limit {}",
+            readable(spec.theta),
+            readable(dt),
+            readable(dt / dt_crit_explicit),
+            readable(dt_crit_explicit)
+        ),
+        StepStability::Unstable => format!(
+            "integrator {name}: gamma = {} < 1/2 is unstable at any dt",
+            readable(spec.gamma)
+        ),
+    }
 }
 
 /// `impact check`'s line on the levels a subcycled run starts with.

@@ -41,6 +41,18 @@ pub enum Status {
     Interrupted,
 }
 
+impl Status {
+    /// The status as summary.json writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Diverged => "diverged",
+            Status::Unstable => "unstable",
+            Status::Interrupted => "interrupted",
+        }
+    }
+}
+
 #[derive(Debug, Clone, Default, Deserialize)]
 pub struct EnergySummary {
     pub initial: f64,
@@ -178,6 +190,30 @@ impl MassScalingSummary {
     }
 }
 
+/// One body in summary.json `bodies`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodyMass {
+    pub name: String,
+    pub mass: f64,
+}
+
+/// The bodies of `model` with their masses (empty where the mass cannot be formed: an
+/// inverted element, which the run then reports).
+pub fn body_masses(model: &Model) -> Vec<BodyMass> {
+    let Ok(mass) = crate::assembly::Mass::new(model, crate::scene::spec::MassKind::Lumped) else {
+        return Vec::new();
+    };
+    model
+        .bodies
+        .iter()
+        .zip(mass.of_bodies(model))
+        .map(|(body, mass)| BodyMass {
+            name: body.name.clone(),
+            mass,
+        })
+        .collect()
+}
+
 /// summary.json's form of a [`StableStep`] (the stable step of the last
 /// configuration, from the element bound, before the scale): the body by name.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -239,6 +275,10 @@ pub struct Summary {
     /// Central difference: the stable step of the final configuration and the element that
     /// sets it.
     pub dt_limit: Option<DtLimit>,
+    /// Each body's mass (the sum of its lumped nodal masses, unscaled; per unit depth in
+    /// plane strain, the full ring's in axisymmetry), in scene order.
+    #[serde(default)]
+    pub bodies: Vec<BodyMass>,
     /// Seconds per phase and element updates (see `profile`); process-wide counters, so
     /// only meaningful for one run per process (as `impact run` and `impact bench` do).
     #[serde(default)]
@@ -259,10 +299,13 @@ pub struct Summary {
     #[serde(skip)]
     pub subcycling: Option<SubcyclingSummary>,
     /// What the scene and the finished run say about the answer (analysis::plausibility):
-    /// the scene's own warnings (too few steps, a run shorter than a wave transit, an unused
-    /// obstacle, an axis not held, too many frames), then step cuts, the energy balance,
-    /// plastic work above the energy supplied, a step too long for the impact, a pair that
-    /// never closed, a contact penetration beyond TOL, nodes across the axis, hourglass
+    /// the scene's own warnings (too few or too many steps, a run shorter than a wave
+    /// transit, mixed units, a slave set that misses the surface facing its master, an
+    /// unused obstacle, an axis not held, too many frames), then step cuts, the energy
+    /// balance, plastic work above the energy supplied, a step too long for the impact, a
+    /// pair that never closed, a contact penetration beyond TOL (with its node and cause), a
+    /// plastic contact resolved by too few segments, kinetic energy above what was given,
+    /// nodes across the axis, a pair still closed and approaching at the end, hourglass
     /// energy, mass scaling above 1 % of a body's mass or on a contact surface. Empty when
     /// none.
     #[serde(default)]
@@ -304,6 +347,7 @@ impl Summary {
             dt_min: None,
             dt_max: None,
             dt_limit: None,
+            bodies: body_masses(model),
             timing: Default::default(),
             max_temperature: None,
             mass_scaling: None,

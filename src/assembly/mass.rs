@@ -52,6 +52,20 @@ impl Mass {
         })
     }
 
+    /// Each body's mass: the sum of its nodes' lumped masses in x (per unit depth in plane
+    /// strain, through the thickness in plane stress, the full ring's in axisymmetry).
+    pub fn of_bodies(&self, model: &Model) -> Vec<f64> {
+        model
+            .bodies
+            .iter()
+            .map(|body| {
+                (0..body.mesh.nodes.len())
+                    .map(|n| self.lumped[2 * body.global(n)])
+                    .sum()
+            })
+            .collect()
+    }
+
     /// The same mass with the nodes flagged in `massless` (per node) carrying none: in each
     /// element their rows and columns are removed and the mass they held goes onto the
     /// element's other nodes in proportion to those nodes' row sums, so every element keeps

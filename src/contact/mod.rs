@@ -33,6 +33,7 @@ pub mod impacts;
 pub mod linearization;
 pub mod mortar;
 mod multipliers;
+pub mod penetration;
 pub mod search;
 pub mod setup;
 pub mod status;
@@ -136,6 +137,21 @@ pub struct ContactSummary {
     /// The pairs (by name) that never closed in the run; empty when every pair closed.
     #[serde(default)]
     pub never_closed: Vec<String>,
+    /// The largest total of the raw normal forces (the multipliers of each step); with a
+    /// `force_window`, `peak_force` is the largest of the forces averaged over it.
+    #[serde(default)]
+    pub peak_force_raw: f64,
+    #[serde(default)]
+    pub force_window: Option<f64>,
+    /// Per pair, in scene order: the most slave nodes closed at once.
+    #[serde(default)]
+    pub closed_at_widest: Vec<usize>,
+    /// The pairs (by name) closed at the end of the run.
+    #[serde(default)]
+    pub closed_at_end: Vec<String>,
+    /// Where the deepest penetration of a body into an obstacle or another body was.
+    #[serde(default)]
+    pub deepest: Option<penetration::DeepestNode>,
 }
 
 #[cfg(test)]

@@ -138,6 +138,7 @@ impl ContactState {
             penetration = penetration.max(super::setup::master_penetration(pair, x, boundary));
             penetration = penetration.max(super::setup::slave_penetration(pair, x));
         }
+        penetration = penetration.max(super::penetration::deepest_depth(interfaces, x));
         self.penetration = penetration;
         self.max_penetration = self.max_penetration.max(penetration);
         self.peak_extent = self.peak_extent.max(extent(interfaces, active, x));
@@ -168,6 +169,7 @@ impl ContactState {
             peak_contact_radius: self.peak_extent,
             min_gap: self.min_gap,
             max_penetration: self.min_gap.map(|_| self.max_penetration),
+            ..ContactSummary::default()
         }
     }
 

@@ -69,4 +69,12 @@ pub enum KernelError {
     /// A rod of zero length.
     #[error("rod of zero length")]
     ZeroLength,
+    /// A return whose plastic work (the trapezoidal rule, per unit volume) is negative: the
+    /// step reversed the stress across the whole elastic range.
+    #[error(
+        "the return at Gauss point {point} would dissipate a negative plastic work ({work:.3e} per \
+         unit volume): the step reversed the stress across the whole elastic range (a step far \
+         too long for the plastic flow, or inconsistent units)"
+    )]
+    NegativePlasticWork { point: usize, work: f64 },
 }

@@ -490,6 +490,30 @@ pub fn trapezoid_dissipation(
     0.5 * (1.0 + dot(start) / along_end) * plastic_work
 }
 
+/// [`trapezoid_dissipation`], refused (`Err` with its value) where it is negative beyond
+/// round-off at a point without back stress. There it cannot be negative for a return that
+/// starts inside the yield surface (|s_n : n| <= sigma_y,n, and the factor 1 + s_n : n /
+/// s_{n+1} : n < 0 needs the start stress reversed beyond the whole elastic range of the
+/// end): a run would book negative plastic work, which no material dissipates. With
+/// kinematic hardening a reversed flow gives back stored back-stress energy, and an
+/// increment may be negative; its total is the run's to check. For the explicit kernels,
+/// whose every step is final; Newton's iterates may pass through such states, and the
+/// implicit run checks its committed total instead.
+pub fn dissipation(
+    start: &Voigt,
+    end: &Voigt,
+    end_back: &Voigt,
+    plastic_work: f64,
+) -> Result<f64, f64> {
+    let d = trapezoid_dissipation(start, end, end_back, plastic_work);
+    let kinematic = end_back.iter().any(|b| *b != 0.0);
+    if d < 0.0 && d < -1e-9 * plastic_work.abs() && !kinematic {
+        Err(d)
+    } else {
+        Ok(d)
+    }
+}
+
 /// Von Mises equivalent stress of [xx yy zz xy].
 pub fn von_mises(s: &Voigt) -> f64 {
     let p = (s[0] + s[1] + s[2]) / 3.0;

@@ -89,6 +89,17 @@ impl BodyKind {
         }
     }
 
+    /// What a body's mass is of, in words: per unit depth (plane strain), through the
+    /// thickness (plane stress), the full ring (axisymmetric), the rod's.
+    pub fn mass_in_words(self) -> &'static str {
+        match self.formulation() {
+            None => "the rod's",
+            Some(Formulation::PlaneStrain) => "per unit depth",
+            Some(Formulation::PlaneStress) => "through the thickness",
+            Some(Formulation::Axisymmetric) => "of the full ring",
+        }
+    }
+
     /// The modulus of the dilatational wave ([`Body::p_wave_modulus`]) in words.
     pub fn modulus_name(self) -> &'static str {
         match self.formulation() {
@@ -244,6 +255,9 @@ impl Probe {
             }
             Statistic::Max => values.fold(f64::NEG_INFINITY, f64::max),
             Statistic::Min => values.fold(f64::INFINITY, f64::min),
+            // the nodes' masses are the caller's (`analysis::run::record`): a scene gives
+            // `mass_mean` only to nodal quantities, which never come here
+            Statistic::MassMean => f64::NAN,
         }
     }
 

@@ -19,6 +19,16 @@ pub(super) fn check_frame_times(cx: &Context, times: &[f64]) -> Result<(), Input
 /// The frame times of `output`: `frame_times` with the multiples of `frame_interval` up to
 /// `end_time` merged in (sorted; a multiple within 1e-9 relative of a listed time is that
 /// time).
+/// `output.contact_force_window`: a time >= 0 (0: no averaging).
+pub(super) fn check_force_window(cx: &Context, window: Option<f64>) -> Result<(), InputError> {
+    match window {
+        Some(w) if !(w.is_finite() && w >= 0.0) => Err(cx.err(format!(
+            "output.contact_force_window: must be a time >= 0 (0: the raw force), got {w}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
 pub(super) fn frame_times(
     cx: &Context,
     output: &super::spec::OutputSpec,
@@ -68,6 +78,7 @@ pub(super) fn probes(
     cx: &Context,
     bodies: &[Body],
     specs: &[ProbeSpec],
+    dynamic: bool,
 ) -> Result<Vec<Probe>, InputError> {
     let mut out = Vec::new();
     for (k, p) in specs.iter().enumerate() {
@@ -88,6 +99,14 @@ pub(super) fn probes(
             return Err(cx.err(format!(
                 "{key}.statistic: {} is {what}; leave statistic out",
                 p.quantity.name()
+            )));
+        }
+        if p.statistic == Statistic::MassMean && !(p.quantity.has_mass_mean() && dynamic) {
+            return Err(cx.err(format!(
+                "{key}.statistic: `mass_mean` weighs the nodes of a set by their mass: it takes \
+                 u_x, u_y, v_x, v_y, a_x, a_y, x or y in a dynamic analysis, not `{}`{}",
+                p.quantity.name(),
+                if dynamic { "" } else { " in a static one" }
             )));
         }
         let members = if p.quantity.is_nodal() {
@@ -123,6 +142,7 @@ pub(super) fn probes(
             Statistic::Mean => format!("{}[{set}]", p.quantity.name()),
             Statistic::Max => format!("max_{}[{set}]", p.quantity.name()),
             Statistic::Min => format!("min_{}[{set}]", p.quantity.name()),
+            Statistic::MassMean => format!("mass_mean_{}[{set}]", p.quantity.name()),
         };
         out.push(Probe {
             statistic: p.statistic,

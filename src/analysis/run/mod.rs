@@ -20,12 +20,13 @@
 
 pub mod buckling;
 pub mod checkpoint;
+pub mod contact_record;
 pub mod progress;
 pub mod record;
 
 use super::plausibility;
 use super::steppers::Stepper;
-use super::steppers::energies::balance_error;
+use super::steppers::energies::{Energies, balance_error};
 use super::steppers::newton::Counters;
 use super::summary::{DtLimit, MassScalingSummary, RunError, Status, StepError, Summary};
 use crate::assembly::State;
@@ -101,6 +102,10 @@ struct Run<'a, S: Stepper> {
     start: Instant,
     progress: Progress,
     penetration_limits: Vec<f64>,
+    /// The energies of the last row recorded: what the summary reports of a run whose last
+    /// step was committed and then refused (negative plastic work is no row of history).
+    recorded: Energies,
+    refused_step: bool,
 }
 
 /// Runs `stepper` (set up from `start` on) from the beginning or from `resume`, writing
@@ -134,7 +139,10 @@ impl<'a, S: Stepper> Run<'a, S> {
     ) -> Result<Run<'a, S>, RunError> {
         let recorder = match &resume {
             Some(c) => Recorder::resume(model, dir, c.recorder.clone())?,
-            None => Recorder::create(model, dir, !options.no_frames)?,
+            None => {
+                let window = contact_record::window(model, stepper.dt());
+                Recorder::create(model, dir, !options.no_frames, window)?
+            }
         };
         let summary = Summary::new(
             model,
@@ -147,6 +155,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         let penetration_limits = crate::contact::penetration_limits(&model.contacts, &coordinates);
         let resuming = resume.is_some();
         if !resuming && let Err(message) = stepper.start() {
+            let message = with_units_hint(model, message, stepper.motion().velocity);
             let mut run_summary = summary;
             run_summary.status = Status::Diverged;
             run_summary.message = Some(message.clone());
@@ -177,6 +186,8 @@ impl<'a, S: Stepper> Run<'a, S> {
                 model.analysis.end_time(),
             ),
             penetration_limits,
+            recorded: Energies::default(),
+            refused_step: false,
         };
         run.summary.energy.initial = run.stepper.initial_kinetic();
         match resume {
@@ -252,6 +263,16 @@ impl<'a, S: Stepper> Run<'a, S> {
                 e.kinetic, e.internal, e.contact_work
             );
             return Err(self.fail(Status::Diverged, message));
+        }
+        if let Some(message) =
+            negative_plastic_work(self.stepper.energies(), self.stepper.initial_kinetic())
+        {
+            let time = self.stepper.state().time;
+            self.refused_step = true;
+            return Err(self.fail(
+                Status::Diverged,
+                format!("at t = {}: {message}", readable(time)),
+            ));
         }
         let stop = self.observe_buckling()?;
         let last = stop || self.stepper.done();
@@ -351,6 +372,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             contact,
         };
         self.recorder.step(self.model, snapshot, last)?;
+        self.recorded = *s.energies();
         Ok(())
     }
 
@@ -388,7 +410,11 @@ impl<'a, S: Stepper> Run<'a, S> {
             self.stepper.sync_points();
         }
         let s = &self.stepper;
-        let energies = s.energies();
+        let energies = if self.refused_step {
+            &self.recorded
+        } else {
+            s.energies()
+        };
         let solver = s.solver();
         let summary = &mut self.summary;
         summary.newton_iterations = self.counters.iterations;
@@ -417,6 +443,9 @@ impl<'a, S: Stepper> Run<'a, S> {
             .map(|r| MassScalingSummary::of(r, self.model));
         summary.subcycling = s.subcycling();
         summary.contact = s.contact().summary(&self.model.contacts);
+        if let Some(record) = &self.recorder.contact {
+            record.fill(self.model, &mut summary.contact, s.contact());
+        }
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
         if let Some(report) = s.time_step_report() {
             summary.dt_min = Some(report.shortest);
@@ -424,17 +453,21 @@ impl<'a, S: Stepper> Run<'a, S> {
             summary.dt_limit = Some(DtLimit::of(report.limit, self.model));
         }
         summary.max_temperature = record::max_temperature(self.model, s.state());
-        summary.warnings = plausibility::warnings(self.model, summary, &energies);
+        summary.warnings = plausibility::warnings(self.model, summary, energies);
         let positions = s.state().positions(self.model.analysis.geometry());
+        let motion = s.motion();
         let end = plausibility::EndOfRun {
             positions: &positions,
-            energies: &energies,
+            energies,
             hourglass_energy: s.hourglass_energy(),
             mass_scaling: mass_scaling.as_ref(),
+            velocity: motion.velocity,
+            mass: motion.mass,
+            closed_at_end: &summary.contact.closed_at_end,
+            finished: summary.status == Status::Ok && s.done(),
         };
-        summary
-            .warnings
-            .extend(plausibility::final_warnings(self.model, &end));
+        let more = plausibility::final_warnings(self.model, &end);
+        summary.warnings.extend(more);
     }
 
     /// A failed step: its frame when asked, then `fail`.
@@ -454,10 +487,13 @@ impl<'a, S: Stepper> Run<'a, S> {
     fn fail(&mut self, status: Status, message: String) -> RunError {
         self.progress
             .finish(self.stepper.state().time, self.summary.steps);
+        let message = with_units_hint(self.model, message, self.stepper.motion().velocity);
+        // the warnings read how the run ended (a pair that never closed in a run that
+        // stopped early is no reason to lengthen the end time)
+        self.summary.status = status;
+        self.summary.message = Some(message.clone());
         self.fill_summary();
-        let mut summary = self.summary.clone();
-        summary.status = status;
-        summary.message = Some(message.clone());
+        let summary = self.summary.clone();
         match self.recorder.write_summary(self.model, &summary) {
             Ok(()) => RunError::Numerical {
                 message,
@@ -533,6 +569,33 @@ fn monitor_error(model: &Model, e: buckling::MonitorError) -> RunError {
             format!("analysis.buckling: {e}"),
         )),
         buckling::MonitorError::Output(e) => RunError::Output(e),
+    }
+}
+
+/// The total plastic work below zero beyond round-off (of the energies in play), as a
+/// failure's message: no material dissipates negative work; a return that books it (a
+/// kinematically hardening point reversed beyond what it stored) is a numerical failure,
+/// not a row of history.
+fn negative_plastic_work(e: &Energies, initial_kinetic: f64) -> Option<String> {
+    let scale = initial_kinetic
+        .max(e.external_work.abs())
+        .max(e.internal.abs())
+        .max(f64::MIN_POSITIVE);
+    (e.plastic_work < -1e-12 * scale).then(|| {
+        format!(
+            "the plastic work fell to {} (below zero): the returns of the step gave back more than \
+             the run had dissipated (a step far too long for the plastic flow, or inconsistent units)",
+            readable(e.plastic_work)
+        )
+    })
+}
+
+/// The message of a numerical failure, with what the state says of mixed units when it
+/// says something (`plausibility::units_at_failure`).
+fn with_units_hint(model: &Model, message: String, velocity: &[f64]) -> String {
+    match plausibility::units_at_failure(model, velocity) {
+        Some(hint) => format!("{message}; {hint}"),
+        None => message,
     }
 }
 

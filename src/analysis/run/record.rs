@@ -1,6 +1,7 @@
 //! What a run writes: VTK frames (every `frame_every` steps, and the last), one history.csv
 //! row per converged step, summary.json at the end (also after a failure).
 
+use super::contact_record::{ContactCarry, ContactRecord};
 use crate::analysis::steppers::energies::{Energies, Motion};
 use crate::analysis::steppers::loads;
 use crate::analysis::summary::Summary;
@@ -15,7 +16,7 @@ use crate::output::vtk::{Fields, Grid, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
 use crate::scene::model::{PointFold, Probe};
-use crate::scene::spec::{FramePoints, Quantity};
+use crate::scene::spec::{FramePoints, Quantity, Statistic};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -55,11 +56,19 @@ pub struct Recorder {
     /// explicit kernel's arrays, so the state's points need no copy), by probe; None (or
     /// missing): read from the state.
     pub point_probes: Vec<Option<f64>>,
+    /// The averaged contact forces, the widest contact, the deepest node (with contact).
+    pub contact: Option<ContactRecord>,
 }
 
 impl Recorder {
-    /// Creates the output folder, the .pvd series and history.csv with its header.
-    pub fn create(model: &Model, dir: &Path, frames: bool) -> Result<Recorder, OutputError> {
+    /// Creates the output folder, the .pvd series and history.csv with its header; the
+    /// contact forces are averaged over `window` (`contact_record::window`).
+    pub fn create(
+        model: &Model,
+        dir: &Path,
+        frames: bool,
+        window: Option<f64>,
+    ) -> Result<Recorder, OutputError> {
         std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
             path: dir.to_path_buf(),
             action: "create folder",
@@ -96,6 +105,13 @@ impl Recorder {
             step_length: 0.0,
             last_probes: Vec::new(),
             point_probes: Vec::new(),
+            contact: contact_record(
+                model,
+                ContactCarry {
+                    window,
+                    ..ContactCarry::default()
+                },
+            ),
         })
     }
 
@@ -112,6 +128,7 @@ impl Recorder {
             last_frame_time: self.last_frame_time,
             negative_pivots: self.negative_pivots,
             probes: self.last_probes.clone(),
+            contact: self.contact.as_ref().map(|c| c.carry.clone()),
         })
     }
 
@@ -152,6 +169,7 @@ impl Recorder {
             step_length: 0.0,
             last_probes: position.probes,
             point_probes: Vec::new(),
+            contact: contact_record(model, position.contact.unwrap_or_default()),
         })
     }
 
@@ -189,9 +207,22 @@ impl Recorder {
             .iter()
             .map(|c| c.options.friction != Friction::None)
             .collect();
+        let forces = match contact {
+            Some(c) => c.pair_forces(),
+            None => vec![0.0; model.contacts.len()],
+        };
+        let averages = match &mut self.contact {
+            Some(record) => record.row(
+                model,
+                (state.time, self.step_length),
+                (&forces, contact),
+                || state.positions(model.analysis.geometry()).into_owned(),
+            ),
+            None => Vec::new(),
+        };
         match contact {
             Some(c) => {
-                row.extend(c.pair_forces());
+                row.extend(forces);
                 row.extend(
                     c.pair_tangential_forces()
                         .into_iter()
@@ -231,6 +262,7 @@ impl Recorder {
         if !model.contacts.is_empty() {
             row.push(contact.map_or(0.0, |c| c.penetration));
         }
+        row.extend(averages);
         if bulk_viscosity_column(model) {
             row.push(energies.bulk_viscosity_work);
         }
@@ -679,7 +711,10 @@ fn probe_value(
     probe: &crate::scene::model::Probe,
 ) -> f64 {
     let (state, motion) = (snapshot.state, snapshot.motion);
-    let nodal = |v: &[f64], c: usize| probe.combine(probe.members.iter().map(|m| v[2 * m + c]));
+    let nodal = |v: &[f64], c: usize| match probe.statistic {
+        Statistic::MassMean => mass_mean(&probe.members, motion.mass, |m| v[2 * m + c], c),
+        _ => probe.combine(probe.members.iter().map(|m| v[2 * m + c])),
+    };
     let ppe = model.bodies[probe.body].points_per_element();
     let body_points = &state.bodies[probe.body].points;
     match probe.quantity {
@@ -709,12 +744,11 @@ fn probe_value(
         }
         Quantity::CoordinateX | Quantity::CoordinateY => {
             let c = (probe.quantity == Quantity::CoordinateY) as usize;
-            probe.combine(
-                probe
-                    .members
-                    .iter()
-                    .map(|&m| initial[m][c] + state.displacement[2 * m + c]),
-            )
+            let x = |m: usize| initial[m][c] + state.displacement[2 * m + c];
+            match probe.statistic {
+                Statistic::MassMean => mass_mean(&probe.members, motion.mass, x, c),
+                _ => probe.combine(probe.members.iter().map(|&m| x(m))),
+            }
         }
         Quantity::ExtentX | Quantity::ExtentY => {
             let c = (probe.quantity == Quantity::ExtentY) as usize;
@@ -738,6 +772,21 @@ fn probe_value(
             probe.fold_points(points).unwrap_or(f64::NAN)
         }
     }
+}
+
+/// sum m q / sum m over the nodes `members`, q = `value(node)` of component `c` and m the
+/// node's lumped mass (NaN without masses: a static analysis, which the scene refuses).
+fn mass_mean(members: &[usize], mass: &[f64], value: impl Fn(usize) -> f64, c: usize) -> f64 {
+    let (weighted, total) = members.iter().fold((0.0, 0.0), |(w, t), &m| {
+        let mass = mass.get(2 * m + c).copied().unwrap_or(f64::NAN);
+        (w + mass * value(m), t + mass)
+    });
+    weighted / total
+}
+
+/// The contact record of a model with contact pairs, starting from `carry`.
+fn contact_record(model: &Model, carry: ContactCarry) -> Option<ContactRecord> {
+    (!model.contacts.is_empty()).then(|| ContactRecord::new(model, carry))
 }
 
 /// The history.csv columns a run of `model` writes, in order.
@@ -788,6 +837,15 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
         // the deepest penetration of either surface into the other body after the step
         columns.push("penetration".to_string());
     }
+    if super::contact_record::averages(model) {
+        // the pairs' forces averaged over output.contact_force_window
+        columns.extend(
+            model
+                .contacts
+                .iter()
+                .map(|c| format!("contact_force_avg[{}]", c.name)),
+        );
+    }
     if bulk_viscosity_column(model) {
         // the cumulative work of the bulk viscosity's pressure
         columns.push("bulk_viscosity_work".to_string());
@@ -828,4 +886,7 @@ pub struct RecorderPosition {
     /// The probes' values in the last row (summary.json `probes`).
     #[serde(default)]
     pub probes: Vec<f64>,
+    /// The contact record (with contact).
+    #[serde(default)]
+    pub contact: Option<ContactCarry>,
 }

@@ -1,6 +1,6 @@
 //! The stable step of central difference and the wave speeds it comes from: one place that
-//! the run, its clock, `impact check`, the set-up warnings and the sweep read
-//! (docs/theory.md 8.7). Its one type is [`StableStep`] (dt, body, element).
+//! the run, its clock and start (`explicit::Start`), `impact check`, the set-up warnings and
+//! the sweep read (docs/theory.md 8.7). Its one type is [`StableStep`] (dt, body, element).
 //!
 //! Legend
 //! ```text
@@ -17,9 +17,8 @@
 //! ```
 
 use super::clock::Clock;
-use crate::assembly::explicit::{ExplicitKernel, kernel_for};
-use crate::assembly::mass_scaling::MassScalingReport;
-use crate::assembly::{self, ElementMasses, State};
+use crate::assembly::explicit::ExplicitKernel;
+use crate::assembly::{self, State};
 use crate::element::bulk_viscosity::damped_step_factor;
 use crate::output::readable;
 use crate::scene::DynamicAnalysis;
@@ -50,55 +49,6 @@ pub fn explicit_clock(
         .stable_step(&state.coordinates)
         .map_err(|err| InputError::new(&model.file, err.to_string()))?;
     Ok(Clock::new(spec, exact, limit))
-}
-
-/// The first step a central-difference run of `model` takes (the fixed dt, or the automatic
-/// step of the kernel that will run), computed as the run computes it ([`explicit_clock`]):
-/// what `impact check` prints and the set-up warnings count steps with.
-pub fn explicit_first_step(model: &Model, spec: &DynamicAnalysis) -> Result<f64, InputError> {
-    let exact = checked_step(model, spec)?.dt;
-    let masses =
-        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    let state = State::initial(model);
-    let (kernel, _) = kernel_for(model, spec, &state, &masses);
-    Ok(explicit_clock(model, spec, exact, &state, kernel.as_ref())?.dt0)
-}
-
-/// The mass scaling a central-difference run of `model` starts with (None: off): the
-/// elements below the target on the initial mesh, scaled as the run scales them
-/// ([`kernel_for`]); what `impact check` reports beside the first step.
-pub fn explicit_start_scaling(
-    model: &Model,
-    spec: &DynamicAnalysis,
-) -> Result<Option<MassScalingReport>, InputError> {
-    if spec.mass_scaling.is_none() {
-        return Ok(None);
-    }
-    let masses =
-        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    let state = State::initial(model);
-    let (kernel, _) = kernel_for(model, spec, &state, &masses);
-    Ok(kernel
-        .mass_scaling()
-        .map(|s| s.report(model.bodies.len(), |e| kernel.locate(e))))
-}
-
-/// The levels a subcycled central-difference run of `model` starts with (None: no
-/// subcycling), formed as the run forms them: what `impact check` reports.
-pub fn explicit_start_levels(
-    model: &Model,
-    spec: &DynamicAnalysis,
-) -> Result<Option<super::explicit::Levels>, InputError> {
-    let Some(rule) = spec.subcycling else {
-        return Ok(None);
-    };
-    let masses =
-        ElementMasses::new(model).map_err(|err| InputError::new(&model.file, err.to_string()))?;
-    let state = State::initial(model);
-    let (mut kernel, _) = kernel_for(model, spec, &state, &masses);
-    let start =
-        super::explicit::subcycling_start(model, rule, kernel.as_mut(), &state.coordinates)?;
-    Ok(Some(start.levels))
 }
 
 /// The stability limit of `model` under `spec` (the bulk viscosity's damping at rest taken

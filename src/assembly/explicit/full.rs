@@ -38,7 +38,7 @@ use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
-use crate::material::{PointState, trapezoid_dissipation};
+use crate::material::{PointState, dissipation};
 use crate::scene::Model;
 use crate::scene::model::Probe;
 use rayon::prelude::*;
@@ -210,12 +210,13 @@ fn element_step(
                 .sum::<f64>();
         // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
         plastic_work += weight
-            * trapezoid_dissipation(
+            * dissipation(
                 &start.stress,
                 &end.stress,
                 &end.back_stress,
                 step.plastic_work,
-            );
+            )
+            .map_err(|work| KernelError::NegativePlasticWork { point: q, work })?;
         state.stress[q] = end.stress.into();
         state.back_stress[q] = end.back_stress.into();
         state.eq_plastic_strain[q] = end.eq_plastic_strain;

@@ -31,7 +31,7 @@ use crate::element::bulk_viscosity::{
 use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4_one_point::{self as one_point, BoundShape, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
-use crate::material::{PointState, trapezoid_dissipation};
+use crate::material::{PointState, dissipation};
 use crate::scene::Model;
 use crate::scene::model::Probe;
 use rayon::prelude::*;
@@ -180,18 +180,20 @@ fn element_step(
         ),
         None => (omega_squared, 0.0),
     };
+    // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
+    let plastic_work = volume
+        * dissipation(
+            &start.stress,
+            &after.stress,
+            &after.back_stress,
+            point.plastic_work,
+        )
+        .map_err(|work| KernelError::NegativePlasticWork { point: 0, work })?;
     Ok(ElementStep {
         state,
         force: end.force,
         work,
-        // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
-        plastic_work: volume
-            * trapezoid_dissipation(
-                &start.stress,
-                &after.stress,
-                &after.back_stress,
-                point.plastic_work,
-            ),
+        plastic_work,
         hourglass_work: hourglass.work,
         viscous_work,
         omega_squared,

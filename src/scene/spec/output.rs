@@ -25,6 +25,12 @@ pub struct OutputSpec {
     pub points: FramePoints,
     #[serde(default)]
     pub probe: Vec<ProbeSpec>,
+    /// The window (a time > 0) over which history.csv's `contact_force_avg[PAIR]` averages
+    /// each pair's force, and from which summary.json's `contact.peak_force` is taken; 0:
+    /// none (`peak_force` is the raw multipliers' peak). Default: 10 first steps for central
+    /// difference, none for the other integrators.
+    #[serde(default)]
+    pub contact_force_window: Option<f64>,
 }
 
 /// The configuration a frame's points show; the `displacement` and `reference_coordinates`
@@ -48,6 +54,7 @@ impl Default for OutputSpec {
             compression: Compression::default(),
             points: FramePoints::default(),
             probe: Vec::new(),
+            contact_force_window: None,
         }
     }
 }
@@ -230,7 +237,9 @@ pub struct ProbeSpec {
     pub body: Option<String>,
     pub set: String,
     /// How the set's values combine: `mean` (default; momentum and reaction: the sum), `max` or `min`
-    /// (over nodes, or over the elements' integration points).
+    /// (over nodes, or over the elements' integration points), `mass_mean` (nodal quantities
+    /// of a dynamic analysis: weighted by the nodes' lumped mass; of `v_x`, `v_y` the velocity
+    /// of the set's centre of mass).
     #[serde(default)]
     pub statistic: Statistic,
 }
@@ -243,4 +252,24 @@ pub enum Statistic {
     Mean,
     Max,
     Min,
+    /// sum m q / sum m over the set's nodes, m their lumped mass.
+    MassMean,
+}
+
+impl Quantity {
+    /// Whether the mass-weighted mean of the quantity over a node set means something: the
+    /// nodal kinematic quantities (of `x`, `y` the centre of mass).
+    pub fn has_mass_mean(self) -> bool {
+        matches!(
+            self,
+            Quantity::DisplacementX
+                | Quantity::DisplacementY
+                | Quantity::VelocityX
+                | Quantity::VelocityY
+                | Quantity::AccelerationX
+                | Quantity::AccelerationY
+                | Quantity::CoordinateX
+                | Quantity::CoordinateY
+        )
+    }
 }

@@ -12,15 +12,16 @@
 //! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
+mod start;
 mod subcycling;
 
-pub use subcycling::{Levels, start as subcycling_start};
+pub use start::Start;
+pub use subcycling::Levels;
 
 use super::carry::{Carry, ExplicitCarry};
 use super::clock::Clock;
 use super::energies::{Energies, Motion};
 use super::newton::Counters;
-use super::stable::{checked_step, explicit_clock};
 use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
 use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, PartialKernel, StepWork, kernel_for};
@@ -85,16 +86,20 @@ impl<'a> Explicit<'a> {
     /// Refuses a fixed dt above the stability limit of the initial configuration (the
     /// element eigenvalues), unless the scene asks to watch it blow up.
     pub fn new(model: &'a Model, spec: &'a DynamicAnalysis) -> Result<Explicit<'a>, RunError> {
-        let dt_crit = checked_step(model, spec)?.dt;
-        let masses = ElementMasses::new(model)
-            .map_err(|err| InputError::new(&model.file, err.to_string()))?;
+        let Start {
+            dt_crit,
+            masses,
+            state,
+            mut kernel,
+            kernel_has_own_state,
+            clock,
+            subcycler,
+        } = Start::new(model, spec)?;
         let system = System::new(model, &model.constrained_dofs());
         let mass = Mass::new(model, MassKind::Lumped)
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
         check_mass(model, &mass, &system)?;
         let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
-        let state = State::initial(model);
-        let (mut kernel, kernel_has_own_state) = kernel_for(model, spec, &state, &masses);
         let mut m = mass.lumped;
         if let Some(scaling) = kernel.mass_scaling_mut() {
             // the elements below the target at the start: the initial velocities move them
@@ -103,16 +108,6 @@ impl<'a> Explicit<'a> {
         let inverse_mass = (0..model.dofs())
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
-        let mut clock = explicit_clock(model, spec, dt_crit, &state, kernel.as_ref())?;
-        let subcycler = match spec.subcycling {
-            Some(rule) => {
-                let sub =
-                    subcycling::Subcycler::new(model, rule, kernel.as_mut(), &state.coordinates)?;
-                clock.take_together(sub.substeps_per_step());
-                Some(sub)
-            }
-            None => None,
-        };
         let dofs = model.dofs();
         Ok(Explicit {
             model,

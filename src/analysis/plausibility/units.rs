@@ -1,0 +1,262 @@
+//! The unit mistakes a model's numbers point to, in words: the hint the set-up warnings give.
+
+use crate::analysis::steppers::stable::{critical_time_step, wave_speed};
+use crate::output::readable;
+use crate::scene::{Body, Model};
+
+/// The two consistent unit systems of metal impacts, in words.
+const CONSISTENT: &str = "consistent units are m, kg, s, Pa (steel: 7850, 210e9) or mm, t, s, \
+                          MPa (steel: 7.85e-9, 210e3)";
+
+/// The size a wave crosses: the shorter side of the body's bounding box (a rod: its length,
+/// the longer side).
+pub(super) fn body_size(body: &Body) -> f64 {
+    let mut low = [f64::INFINITY; 2];
+    let mut high = [f64::NEG_INFINITY; 2];
+    for p in &body.mesh.nodes {
+        for k in 0..2 {
+            low[k] = low[k].min(p[k]);
+            high[k] = high[k].max(p[k]);
+        }
+    }
+    let sides = [high[0] - low[0], high[1] - low[1]];
+    if body.kind.is_rod() {
+        sides[0].max(sides[1])
+    } else {
+        sides[0].min(sides[1])
+    }
+}
+
+/// The unit mistake the model's numbers point to, in words. Two are common: a density in
+/// kg/m^3 beside moduli in MPa (lengths in mm: the density must be in t/mm^3), which makes
+/// waves some 3e4 times slower than in any solid; and a geometry in mm beside SI material
+/// data, which makes the bodies 1000 times too large for their m/s wave speed.
+pub(super) fn unit_hint(model: &Model) -> String {
+    for body in &model.bodies {
+        let m = &body.material;
+        if m.density > 100.0 && m.elastic.young < 1e7 {
+            return format!(
+                "material `{}` has density = {} (kg/m^3?) with young = {} (MPa?): with moduli in \
+                MPa and lengths in mm the density is in t/mm^3 (7850 kg/m^3 = 7.85e-9 t/mm^3); {CONSISTENT}",
+                m.name,
+                readable(m.density),
+                readable(m.elastic.young)
+            );
+        }
+    }
+    for body in &model.bodies {
+        let m = &body.material;
+        if (0.5..=30.0).contains(&m.density) && (1e3..1e7).contains(&m.elastic.young) {
+            return format!(
+                "material `{}` has density = {} (g/cm^3?) with young = {} (MPa?): with moduli in \
+                MPa and lengths in mm the density is in t/mm^3 (7.85 g/cm^3 = 7.85e-9 t/mm^3); {CONSISTENT}",
+                m.name,
+                readable(m.density),
+                readable(m.elastic.young)
+            );
+        }
+    }
+    for body in &model.bodies {
+        let m = &body.material;
+        if let Some(c) = wave_speed(body)
+            && m.elastic.young >= 1e7
+            && c.speed > FASTEST_SOLID
+        {
+            return format!(
+                "material `{}` has density = {} with young = {} (Pa?): its waves run at {}, \
+                 faster than in any solid; in SI units the density is in kg/m^3 (7.85 g/cm^3 = \
+                 7850 kg/m^3); {CONSISTENT}",
+                m.name,
+                readable(m.density),
+                readable(m.elastic.young),
+                readable(c.speed)
+            );
+        }
+    }
+    for body in &model.bodies {
+        if let Some(c) = wave_speed(body)
+            && (1e3..=2e4).contains(&c.speed)
+            && body_size(body) >= 1.0
+        {
+            return format!(
+                "body `{}` has a wave speed of {} (a solid's in m/s) and a size of {} (m, then): \
+                a geometry meant in mm must be given in m with SI material data; {CONSISTENT}",
+                body.name,
+                readable(c.speed),
+                readable(body_size(body))
+            );
+        }
+    }
+    CONSISTENT.to_string()
+}
+
+/// Yield strains sigma_y / E outside this range point to a yield stress and a modulus in
+/// different units: metals yield at 1e-4 to 1e-2 (soft copper 3e-4, maraging steel 1e-2),
+/// polymers up to a few per cent; a yield stress in MPa beside E in Pa gives 1e-9, one in
+/// Pa beside E in MPa 1e3.
+pub const YIELD_STRAIN_RANGE: (f64, f64) = (1e-5, 0.1);
+
+/// A body whose material data are in SI or mm-t-s units ([`in_known_units`]) that starts
+/// faster than this share of its dilatational wave speed warns: solid
+/// impacts run at a few per cent of it (a Taylor test at 200 m/s is 0.04 c of aluminium),
+/// a quarter is the hypervelocity range where the material model here does not hold, and
+/// a velocity in mm/s beside lengths in m (5 m/s written 5000) lands there.
+pub const SPEED_SHARE: f64 = 0.25;
+
+/// A dynamic run of more steps than this warns: the longest shipped explicit runs take
+/// some 1e5 steps; 1e7 is days of wall time and mostly an end time in other units than the
+/// step (60 meant in microseconds, given in seconds).
+pub const MAX_STEPS: f64 = 1e7;
+
+/// The fastest dilatational wave in any solid in m/s (diamond: 18 km/s): a faster one in a
+/// scene with SI moduli has its density in other units (g/cm^3: 7.85 for steel).
+const FASTEST_SOLID: f64 = 2.5e4;
+
+/// The warnings on material data and speeds that point to mixed units: a yield strain
+/// outside [`YIELD_STRAIN_RANGE`], a wave faster than any solid's with SI moduli (a density
+/// in g/cm^3), a body starting faster than [`SPEED_SHARE`] of its wave speed.
+pub(super) fn unit_warnings(model: &Model) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut seen: Vec<&str> = Vec::new();
+    for body in &model.bodies {
+        let m = &body.material;
+        if seen.contains(&m.name.as_str()) {
+            continue;
+        }
+        seen.push(&m.name);
+        if let Some(problem) = yield_strain_problem(body) {
+            out.push(problem);
+        }
+        if let Some(c) = wave_speed(body)
+            && m.elastic.young >= 1e7
+            && c.speed > FASTEST_SOLID
+        {
+            out.push(format!(
+                "material `{}` carries waves at {} (sqrt(M / rho), M = {}, density = {}): faster \
+                 than in any solid ({} m/s at most) if the moduli are in Pa; the density is in \
+                 kg/m^3 in SI units (steel 7850, not the 7.85 of g/cm^3); {CONSISTENT}",
+                m.name,
+                readable(c.speed),
+                readable(c.modulus),
+                readable(m.density),
+                readable(FASTEST_SOLID)
+            ));
+        }
+    }
+    for body in model.bodies.iter().filter(|b| in_known_units(b)) {
+        if let Some((speed, c)) = start_speed(model, body)
+            && speed > SPEED_SHARE * c
+        {
+            out.push(format!(
+                "body `{}` starts at {} ({} of its wave speed {}): faster than solid impacts go \
+                 (a few per cent of the wave speed; here beyond {} of it, where the material \
+                 model does not hold); a velocity in mm/s beside lengths in m? {CONSISTENT}",
+                body.name,
+                readable(speed),
+                readable(speed / c),
+                readable(c),
+                readable(SPEED_SHARE)
+            ));
+        }
+    }
+    out
+}
+
+/// Whether a body's material data are those of a metal or polymer in one of the two unit
+/// systems of impacts: SI (density 100 to 3e4 kg/m^3, E 1e7 to 1e13 Pa) or mm, t, s, MPa
+/// (density 1e-10 to 1e-7 t/mm^3, E 1e2 to 1e7 MPa). Only there does a speed against the
+/// wave speed point to a unit mistake: a scene without units (a rod as a spring, E = 1,
+/// rho = 2) may move its nodes as fast as it likes.
+fn in_known_units(body: &Body) -> bool {
+    let m = &body.material;
+    let (rho, young) = (m.density, m.elastic.young);
+    let si = (100.0..=3e4).contains(&rho) && (1e7..=1e13).contains(&young);
+    let mm = (1e-10..=1e-7).contains(&rho) && (1e2..=1e7).contains(&young);
+    si || mm
+}
+
+/// A yield strain outside [`YIELD_STRAIN_RANGE`], in words.
+fn yield_strain_problem(body: &Body) -> Option<String> {
+    let m = &body.material;
+    let j2 = m.plasticity.as_ref()?;
+    let strain = j2.yield_stress / m.elastic.young;
+    let (low, high) = YIELD_STRAIN_RANGE;
+    if (low..=high).contains(&strain) {
+        return None;
+    }
+    let likely = if strain < low {
+        "a yield stress in MPa beside young in Pa? (300 MPa = 3e8 Pa)"
+    } else {
+        "a yield stress in Pa beside young in MPa, or young too low?"
+    };
+    Some(format!(
+        "material `{}` yields at sigma_y / E = {} (yield stress {}, young {}), outside the {} to \
+         {} of solids: {likely} {CONSISTENT}",
+        m.name,
+        readable(strain),
+        readable(j2.yield_stress),
+        readable(m.elastic.young),
+        readable(low),
+        readable(high)
+    ))
+}
+
+/// The largest initial speed of a body's nodes and its wave speed (None without density
+/// or motion).
+fn start_speed(model: &Model, body: &Body) -> Option<(f64, f64)> {
+    let c = wave_speed(body)?.speed;
+    let v = &model.initial_velocity;
+    let speed = (0..body.mesh.nodes.len())
+        .map(|n| body.global(n))
+        .map(|n| v[2 * n].hypot(v[2 * n + 1]))
+        .fold(0.0, f64::max);
+    (speed > 0.0).then_some((speed, c))
+}
+
+/// What a failed run's state says of its units: a yield strain outside
+/// [`YIELD_STRAIN_RANGE`], a node faster than [`SPEED_SHARE`] of its body's wave speed
+/// (`velocity`, all DOFs),
+/// more than [`MAX_STEPS`] central-difference stable steps to the end time (None: nothing
+/// points to units).
+pub fn units_at_failure(model: &Model, velocity: &[f64]) -> Option<String> {
+    let mut signs = Vec::new();
+    for body in &model.bodies {
+        if let Some(problem) = yield_strain_problem(body) {
+            signs.push(problem);
+        }
+        let Some(c) = wave_speed(body).filter(|_| in_known_units(body)) else {
+            continue;
+        };
+        let fastest = (0..body.mesh.nodes.len())
+            .map(|n| body.global(n))
+            .filter(|n| 2 * n + 1 < velocity.len())
+            .map(|n| (n, velocity[2 * n].hypot(velocity[2 * n + 1])))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((node, speed)) = fastest
+            && speed > SPEED_SHARE * c.speed
+        {
+            signs.push(format!(
+                "node {} of body `{}` moves at {}, {} of its wave speed {} (beyond {} of it: a \
+                 velocity in mm/s beside lengths in m, or moduli or density in other units)",
+                node - body.node_offset,
+                body.name,
+                readable(speed),
+                readable(speed / c.speed),
+                readable(c.speed),
+                readable(SPEED_SHARE)
+            ));
+        }
+    }
+    let first_step = critical_time_step(model).map_or(0.0, |s| s.dt);
+    let steps = model.analysis.end_time() / first_step;
+    if first_step > 0.0 && steps > MAX_STEPS {
+        signs.push(format!(
+            "the run would take {} stable steps of {} to end_time = {}: the end time and the \
+             stable step are in different units",
+            readable(steps.round()),
+            readable(first_step),
+            readable(model.analysis.end_time())
+        ));
+    }
+    (!signs.is_empty()).then(|| format!("the state points to mixed units: {}", signs.join("; ")))
+}

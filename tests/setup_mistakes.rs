@@ -1,0 +1,402 @@
+//! Set-up mistakes a new user makes, each as a scene: tests/data/sphere_wall_si.toml (an
+//! elastic-plastic steel sphere, R = 5 mm, striking a rigid wall at 5 m/s, SI units) with one
+//! key spoiled. Each is refused or warned with its likely cause in the message, and
+//! `--strict` exits 3 (docs/user-guide.md 3.2a). The scene as it stands warns of nothing, and
+//! neither do the shipped scenes under `impact check` (tests/scenes.rs asserts their runs).
+
+mod common;
+
+use impact::analysis::Summary;
+use impact::analysis::plausibility;
+use impact::analysis::steppers::energies::Energies;
+use std::path::Path;
+
+const SPHERE: &str = "tests/data/sphere_wall_si.toml";
+
+/// `impact ARGS` on the sphere scene with `--set` edits; returns the exit code and stderr.
+fn impact_on_sphere(command: &str, out: Option<&Path>, edits: &[&str]) -> (i32, String) {
+    let mut args: Vec<String> = vec![command.into(), SPHERE.into(), "--strict".into()];
+    if let Some(out) = out {
+        args.extend(["--out".into(), out.display().to_string(), "--quiet".into()]);
+    }
+    for edit in edits {
+        args.extend(["--set".into(), edit.to_string()]);
+    }
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let output = common::impact(&refs);
+    (
+        output.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+/// Asserts that `stderr` holds a warning line with every one of `words`.
+fn warned(stderr: &str, words: &[&str]) {
+    let found = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning: "))
+        .any(|l| words.iter().all(|w| l.contains(w)));
+    assert!(found, "no warning with {words:?} in:\n{stderr}");
+}
+
+/// summary.json of a run folder.
+fn summary_json(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Goal: no shipped scene and not the sphere as it stands gives a set-up warning: the new
+/// checks (slave sets, units) are no false alarms on scenes meant to be right. Setup: every
+/// models/*.toml and tests/data/sphere_wall_si.toml. Reference: none expected (tests/scenes.rs
+/// holds their runs' warnings to three_rings' energy balance alone).
+#[test]
+fn shipped_scenes_and_the_sphere_give_no_setup_warning() {
+    let mut paths: Vec<_> = std::fs::read_dir("models")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    paths.push(SPHERE.into());
+    for path in paths {
+        let model = impact::scene::load(&path, &[]).unwrap();
+        let warnings = impact::analysis::plausibility::setup_warnings(&model);
+        assert!(warnings.is_empty(), "{}: {warnings:?}", path.display());
+    }
+}
+
+/// Goal: the sphere as it stands runs silent, and the mass-weighted probe is the centre of
+/// mass's velocity. Setup: the scene, central difference to 40 us (the contact ends at about
+/// 24 us). Reference: momentum conservation's definition of the centre of mass, v_cm =
+/// p_y / m with p_y = sum m v (the `p_y` probe) and m the body's mass of summary.json
+/// `bodies`; to 1e-12 (two sums of the same products in one order or another: round-off).
+/// The plain nodal mean `v_y[all]` is a different number on this graded mesh (its small
+/// elements at the pole count as much as the large ones): at least 1 % off.
+#[test]
+fn the_sphere_runs_silent_and_its_mass_mean_velocity_is_p_over_m() {
+    let dir = common::out_dir("sphere_right");
+    let (code, stderr) = impact_on_sphere("run", Some(&dir), &[]);
+    assert_eq!(code, 0, "{stderr}");
+    let json = summary_json(&dir);
+    assert_eq!(json["warnings"].as_array().unwrap().len(), 0);
+    let mass = json["bodies"][0]["mass"].as_f64().unwrap();
+    let last = |column: &str| *common::column(&dir, column).last().unwrap();
+    let (v_cm, p_y) = (last("mass_mean_v_y[all]"), last("p_y[all]"));
+    assert!(v_cm > 0.0, "the sphere rebounds: {v_cm}");
+    assert!(
+        (v_cm - p_y / mass).abs() <= 1e-12 * v_cm.abs(),
+        "v_cm {v_cm} against p_y / m {}",
+        p_y / mass
+    );
+    let plain = last("v_y[all]");
+    assert!((plain / v_cm - 1.0).abs() > 0.01, "{plain} vs {v_cm}");
+    println!(
+        "v_cm = {v_cm:.10}, p_y / m = {:.10}, plain mean {plain:.6}",
+        p_y / mass
+    );
+}
+
+/// Goal: a run that ends during the impact says so. Setup: end_time = 10 us, while the sphere
+/// is still pressed into the wall (the contact lasts about 24 us). Reference: the user
+/// guide's rule: a pair closed at the end while its slave body still approaches the master
+/// at more than 10 % of its approach speed at the start; `--strict` exits 3.
+#[test]
+fn an_end_time_inside_the_impact_is_warned() {
+    let dir = common::out_dir("sphere_short");
+    let (code, stderr) = impact_on_sphere("run", Some(&dir), &["analysis.end_time=10e-6"]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(
+        &stderr,
+        &[
+            "contact `wall` is still closed",
+            "lengthen analysis.end_time",
+        ],
+    );
+}
+
+/// Goal: a slave set that misses the surface meeting the wall is caught before the run,
+/// and the run reports the true penetration, its node and its cause. Setup: slave =
+/// `axis` (the sphere's axis nodes: of its surface facing the wall only the pole) instead
+/// of `arc`; the run writes its last frame. Reference: `check --strict` exits 3 naming
+/// `arc`; the run's last `penetration` within 5 % of the largest depth of the last frame's
+/// nodes behind the wall y = 0 (reference_coordinates + displacement: the frame's own
+/// arrays, not the contact code); the warning names a node no pair holds.
+#[test]
+fn a_slave_set_that_misses_the_surface_is_caught_and_measured() {
+    let edit = "contact.wall.slave.set=axis";
+    let (code, stderr) = impact_on_sphere("check", None, &[edit]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(
+        &stderr,
+        &["the slave set `axis` holds 1 of", "`arc` holds them all"],
+    );
+    let dir = common::out_dir("sphere_axis");
+    let (code, stderr) = impact_on_sphere("run", Some(&dir), &[edit, "output.frame_every=100000"]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(&stderr, &["no contact pair names it as a slave", "`arc`"]);
+    let frames = impact::output::vtk::read_pvd(&dir.join("sphere_wall_si.pvd")).unwrap();
+    let (_, last) = frames.last().unwrap();
+    let frame = impact::output::vtu::read_frame(last).unwrap();
+    use impact::output::vtu::Section::PointData;
+    let (_, reference) = frame.floats(PointData, "reference_coordinates").unwrap();
+    let (_, displacement) = frame.floats(PointData, "displacement").unwrap();
+    let deepest = (0..frame.points)
+        .map(|n| -(reference[3 * n + 1] + displacement[3 * n + 1]))
+        .fold(0.0, f64::max);
+    let reported = *common::column(&dir, "penetration").last().unwrap();
+    assert!(
+        deepest > 1e-5,
+        "the sphere went through the wall: {deepest}"
+    );
+    assert!(
+        (reported / deepest - 1.0).abs() < 0.05,
+        "reported {reported}, the frame's deepest node {deepest}"
+    );
+    println!("penetration: reported {reported:.6e} m, last frame {deepest:.6e} m");
+}
+
+/// Goal: a mesh too coarse for the contact is warned, with the count. Setup: half_disc with
+/// n = 6 and no grading (six elements on the half circle). Reference: the rule of the user
+/// guide: a plastic contact that closed at most three slave nodes at once (fewer than three
+/// segments); `--strict` exits 3.
+#[test]
+fn a_mesh_too_coarse_for_the_contact_is_warned() {
+    let dir = common::out_dir("sphere_coarse");
+    let edits = ["body.sphere.mesh.n=6", "body.sphere.mesh.grading=1"];
+    let (code, stderr) = impact_on_sphere("run", Some(&dir), &edits);
+    assert_eq!(code, 3, "{stderr}");
+    warned(
+        &stderr,
+        &[
+            "closed at most 1 slave node(s) at once",
+            "resolved by 0 segment(s)",
+        ],
+    );
+}
+
+/// Goal: a density in g/cm^3 beside SI moduli is caught before the run, and a run that
+/// then gains kinetic energy says so. Setup: density = 7.85; the run with Newmark average
+/// at dt = 2e-7 s on a coarser arc (n = 12), the step a user takes from the wave speed he
+/// expects. Reference: waves faster than in any solid (25 km/s) with moduli in Pa;
+/// kinetic energy at the end above the initial one by more than 1 %, which no rebound
+/// gives; `--strict` exits 3 both times.
+#[test]
+fn a_density_in_grams_per_cubic_centimetre_is_caught() {
+    let (code, stderr) = impact_on_sphere("check", None, &["material.steel.density=7.85"]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(&stderr, &["faster than in any solid", "kg/m^3"]);
+    let dir = common::out_dir("sphere_density");
+    let edits = [
+        "material.steel.density=7.85",
+        "analysis.integrator=average",
+        "analysis.dt=2e-7",
+        "analysis.mass=lumped",
+        "body.sphere.mesh.n=12",
+    ];
+    let (code, stderr) = impact_on_sphere("run", Some(&dir), &edits);
+    assert_eq!(code, 3, "{stderr}");
+    warned(&stderr, &["more than they were given", "kg/m^3"]);
+}
+
+/// Goal: a yield stress in MPa beside a modulus in Pa is caught before the run; the run
+/// that diverges says the state points to mixed units, and books no negative plastic work.
+/// Setup: yield_stress = 300, Newmark average at dt = 1e-7 s, n = 12. Reference: a yield
+/// strain of 1.4e-9, below the 1e-5 of any solid; the divergence is a numerical failure
+/// (exit 3: the step that would make the plastic work negative is refused, not recorded)
+/// whose message names the units; summary.json `plastic_dissipation` >= 0.
+#[test]
+fn a_yield_stress_in_mpa_is_caught_and_its_divergence_names_the_units() {
+    let (code, stderr) = impact_on_sphere("check", None, &["material.steel.yield_stress=300.0"]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(&stderr, &["a yield stress in MPa beside young in Pa"]);
+    let dir = common::out_dir("sphere_mpa");
+    let edits = [
+        "material.steel.yield_stress=300.0",
+        "analysis.integrator=average",
+        "analysis.dt=1e-7",
+        "body.sphere.mesh.n=12",
+    ];
+    let (code, stderr) = impact_on_sphere("run", Some(&dir), &edits);
+    assert_eq!(code, 3, "{stderr}");
+    let error = stderr.lines().find(|l| l.starts_with("error: ")).unwrap();
+    assert!(error.contains("mixed units"), "{error}");
+    let json = summary_json(&dir);
+    assert_eq!(json["status"], "diverged");
+    assert!(json["energy"]["plastic_dissipation"].as_f64().unwrap() >= 0.0);
+}
+
+/// Goal: a velocity in mm/s beside lengths in m is caught before the run, and the run that
+/// fails says its state points to mixed units. Setup: velocity = [0, -5000]. Reference: a
+/// start at 0.83 of the wave speed, beyond the quarter of it solid impacts stay under;
+/// the failure (an element inverted at the contact) names a node beyond a quarter of the
+/// wave speed.
+#[test]
+fn a_velocity_in_mm_per_second_is_caught() {
+    let edit = "body.sphere.velocity=[0,-5000.0]";
+    let (code, stderr) = impact_on_sphere("check", None, &[edit]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(&stderr, &["a velocity in mm/s beside lengths in m"]);
+    let dir = common::out_dir("sphere_mm_per_s");
+    let (code, stderr) = impact_on_sphere("run", Some(&dir), &[edit]);
+    assert_eq!(code, 3, "{stderr}");
+    let error = stderr.lines().find(|l| l.starts_with("error: ")).unwrap();
+    assert!(
+        error.contains("mixed units") && error.contains("of its wave speed"),
+        "{error}"
+    );
+}
+
+/// Goal: the advice of a pair that never closed follows what happened: after a run that
+/// failed in its first step it does not ask for a longer end time. Setup: the sphere 1 mm
+/// above the wall, its pole node alone thrown at 2000 m/s into the sphere (an initial
+/// velocity on the set `pole`): an element at the pole inverts within the first 0.4 us,
+/// long before the sphere (5 m/s) could cross the 1 mm to the wall (200 us). Reference:
+/// status diverged; the never-closed warning says the run stopped before its end time and
+/// does not say to lengthen it.
+#[test]
+fn the_never_closed_advice_follows_a_failed_run() {
+    let text = std::fs::read_to_string(SPHERE).unwrap().replace(
+        "[[support]]",
+        "[[initial_velocity]]\nset = \"pole\"\nvelocity = [0.0, 2000.0]\n\n[[support]]",
+    );
+    let scene = common::out_dir("sphere_crash_scene").join("crash.toml");
+    std::fs::write(&scene, text).unwrap();
+    let dir = common::out_dir("sphere_crash");
+    let out = common::impact(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "body.sphere.mesh.center=[0.0,6.0e-3]",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    let json = summary_json(&dir);
+    assert_eq!(json["status"], "diverged");
+    let warnings: Vec<&str> = json["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    let never = warnings
+        .iter()
+        .find(|w| w.contains("never closed"))
+        .unwrap_or_else(|| panic!("{warnings:?}"));
+    assert!(never.contains("stopped before its end time"), "{never}");
+    assert!(!never.contains("lengthen analysis.end_time"), "{never}");
+}
+
+/// Goal: the new scene keys refuse bad values naming the key (exit 2). Setup: a negative
+/// `output.contact_force_window`; `statistic = "mass_mean"` on a stress probe. Reference:
+/// the user guide (2.13): a window is a time >= 0; `mass_mean` takes nodal kinematic
+/// quantities only.
+#[test]
+fn bad_window_and_mass_mean_probes_are_refused() {
+    let (code, stderr) = impact_on_sphere("check", None, &["output.contact_force_window=-1e-6"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("output.contact_force_window"), "{stderr}");
+    let (code, stderr) = impact_on_sphere(
+        "check",
+        None,
+        &[
+            "output.probe.0.quantity=s_yy",
+            "output.probe.1.quantity=s_yy",
+        ],
+    );
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("output.probe[1].statistic") && stderr.contains("mass_mean"),
+        "{stderr}"
+    );
+}
+
+// The new thresholds at their edges: `plausibility::warnings` and `final_warnings` on the
+// sphere with a summary, energies and an end state set by hand so that one quantity sits
+// 0.1 % either side of the edge the user guide documents (far above the round-off of the
+// comparisons; an edge misplaced by more than 0.1 % fails one side).
+
+/// The sphere's model and a summary of an `ok` run with nothing to warn of.
+fn sphere_summary() -> (impact::scene::Model, Summary) {
+    let model = impact::scene::load(Path::new(SPHERE), &[]).unwrap();
+    let summary = Summary::new(&model, "central_difference", 1e-8, 40e-6, 100);
+    (model, summary)
+}
+
+/// Goal: the kinetic-energy warning fires above 1.01 times the energy given. Setup: initial
+/// kinetic energy 1, no external work, final kinetic energy 1.01 (1 -+ 1e-3). Reference:
+/// the user guide's edge, 1.01.
+#[test]
+fn kinetic_energy_gain_warns_above_one_per_cent() {
+    let (model, mut summary) = sphere_summary();
+    summary.energy.initial = 1.0;
+    let at = |kinetic: f64| {
+        let energies = Energies {
+            kinetic,
+            ..Energies::default()
+        };
+        plausibility::warnings(&model, &summary, &energies)
+    };
+    assert!(at(1.01 * (1.0 - 1e-3)).is_empty());
+    let above = at(1.01 * (1.0 + 1e-3));
+    assert_eq!(above.len(), 1, "{above:?}");
+    assert!(
+        above[0].contains("more than they were given"),
+        "{}",
+        above[0]
+    );
+}
+
+/// Goal: the coarse-contact warning fires at three closed slaves at most, on a plastic body.
+/// Setup: the sphere's pair closed at most 4, then 3 slave nodes at once. Reference: the
+/// user guide: fewer than three segments, i.e. three nodes or fewer.
+#[test]
+fn coarse_contact_warns_at_three_closed_nodes() {
+    let (model, mut summary) = sphere_summary();
+    let energies = Energies::default();
+    summary.contact.closed_at_widest = vec![4];
+    assert!(plausibility::warnings(&model, &summary, &energies).is_empty());
+    summary.contact.closed_at_widest = vec![3];
+    let warned = plausibility::warnings(&model, &summary, &energies);
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    assert!(
+        warned[0].contains("resolved by 2 segment(s)"),
+        "{}",
+        warned[0]
+    );
+}
+
+/// Goal: the still-closed warning fires when the slave body approaches the wall at more
+/// than a tenth of its approach speed at the start. Setup: the sphere (5 m/s towards the
+/// wall at the start), the pair closed at the end, every node moving towards the wall at
+/// 0.5 m/s (1 -+ 1e-3). Reference: the user guide's edge, 10 % of the start's approach.
+#[test]
+fn still_closed_warns_above_a_tenth_of_the_approach() {
+    let (model, _) = sphere_summary();
+    let mass = impact::assembly::Mass::new(&model, impact::scene::spec::MassKind::Lumped)
+        .unwrap()
+        .lumped;
+    let positions = model.coordinates();
+    let closed = vec!["wall".to_string()];
+    let energies = Energies::default();
+    let at = |speed: f64| {
+        let velocity: Vec<f64> = (0..model.dofs())
+            .map(|i| if i % 2 == 1 { -speed } else { 0.0 })
+            .collect();
+        let end = plausibility::EndOfRun {
+            positions: &positions,
+            energies: &energies,
+            hourglass_energy: None,
+            mass_scaling: None,
+            velocity: &velocity,
+            mass: &mass,
+            closed_at_end: &closed,
+            finished: true,
+        };
+        plausibility::final_warnings(&model, &end)
+    };
+    assert!(at(0.5 * (1.0 - 1e-3)).is_empty());
+    let above = at(0.5 * (1.0 + 1e-3));
+    assert_eq!(above.len(), 1, "{above:?}");
+    assert!(above[0].contains("is still closed"), "{}", above[0]);
+}
