@@ -45,25 +45,6 @@ pub struct ContactResult<S> {
     pub events: Events,
 }
 
-impl ContactState {
-    /// Takes a step's outcome as the new status; `time` is the end of the step.
-    pub fn commit<S>(
-        &mut self,
-        interfaces: &Interfaces,
-        step: &ContactResult<S>,
-        time: f64,
-        coords: &[[f64; 2]],
-    ) {
-        let released = !step.events.released.is_empty() || !step.events.separated.is_empty();
-        let rows = (&step.active[..], &step.forces[..]);
-        self.set(interfaces, rows, (time, released), &|n| coords[n], None);
-        for (i, (p, k)) in step.active.iter().enumerate() {
-            self.tangential[*p][*k] = step.tangential[i];
-            self.sliding[*p][*k] = step.sliding[i];
-        }
-    }
-}
-
 /// A tangential condition on active entry `entry` (an index into the active entries). The
 /// slip s of a step is t . (d_s - sum w_m d_m), t = (-n_y, n_x); a tangential force f acts as
 /// f t on the slave and -w_m f t on the master nodes.

@@ -314,6 +314,19 @@ fn non_finite(system: &System, residual: &[f64], d: &[f64]) -> String {
     }
 }
 
+/// The largest entry of a correction `delta` and Erklig's eps_1, ||delta|| / ||d|| (0 for
+/// d = 0), `d` the increment it was added to.
+fn correction_sizes(delta: &[f64], d: &[f64]) -> (f64, f64) {
+    let d_norm = norm(d);
+    let largest = delta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let ratio = if d_norm > 0.0 {
+        norm(delta) / d_norm
+    } else {
+        0.0
+    };
+    (largest, ratio)
+}
+
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
@@ -373,15 +386,7 @@ impl Step<'_> {
             Inside::Fixed => None,
             inside => Some(ActiveSet::new(c, inside == Inside::Closures)),
         });
-        let damping = match &self.inertia {
-            Some(i) if i.rayleigh[1] > 0.0 => {
-                self.evaluate(state, &vec![0.0; d.len()], Some(&mut *system))?;
-                Some(Damping {
-                    values: system.values.clone(),
-                })
-            }
-            _ => None,
-        };
+        let damping = self.damping(state, d.len(), system)?;
         let external_norm = norm(&system.gather(self.external));
         let mut secant =
             Secant::new(newton.updates == Updates::Bfgs && newton.strategy != Strategy::Full);
@@ -398,16 +403,7 @@ impl Step<'_> {
             let evaluation = self.evaluate(state, &d, refactor.then_some(&mut *system))?;
             let (mut residual, forces_scale) =
                 self.residual(&d, &evaluation, system, &damping, external_norm);
-            let (rows, settled) = match (&self.contact, &mut active_set) {
-                (Some(c), Some(set)) => profile::time(Phase::Contact, || {
-                    let changed = set.update(c, &d);
-                    let (rows, start) = set.rows(c, &d, system)?;
-                    forces = start;
-                    Ok::<_, StepFailure>((rows, !changed))
-                })?,
-                (Some(c), None) => (profile::time(Phase::Contact, || c.rows(&d, system))?, true),
-                _ => (Rows::empty(), true),
-            };
+            let (rows, settled) = self.contact_rows(&d, system, &mut active_set, &mut forces)?;
             // R alone, without the contact and friction forces: K* is its derivative
             let own = secant.enabled().then(|| residual.clone());
             // sliding friction: known forces from the last solve's normal multipliers
@@ -439,12 +435,13 @@ impl Step<'_> {
                     _ => Vec::new(),
                 };
                 forces.truncate(rows.normal);
+                let settled = active_set.map(|set| set.settled());
                 return Ok(Solution {
                     d,
                     evaluation,
                     forces,
                     tangential,
-                    settled: active_set.map(|set| set.settled()),
+                    settled,
                 });
             }
             // not the answer: its trial states need not sit beside the factor about to be made
@@ -481,13 +478,7 @@ impl Step<'_> {
             }
             counters.iterations += 1;
             system.scatter_add(&delta, &mut d);
-            let d_norm = norm(&d);
-            correction = delta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            eps_displacement = if d_norm > 0.0 {
-                norm(&delta) / d_norm
-            } else {
-                0.0
-            };
+            (correction, eps_displacement) = correction_sizes(&delta, &d);
             previous_residual = residual_norm;
             last = own.map(|r| (delta, r));
         }
@@ -495,6 +486,50 @@ impl Step<'_> {
             "no convergence in {} iterations",
             newton.max_iterations
         )))
+    }
+
+    /// The stiffness-proportional damping matrix of the step (the tangent at the start),
+    /// when the Rayleigh coefficient b_R asks for one.
+    fn damping(
+        &self,
+        state: &State,
+        dofs: usize,
+        system: &mut System,
+    ) -> Result<Option<Damping>, StepFailure> {
+        match &self.inertia {
+            Some(i) if i.rayleigh[1] > 0.0 => {
+                self.evaluate(state, &vec![0.0; dofs], Some(&mut *system))?;
+                Ok(Some(Damping {
+                    values: system.values.clone(),
+                }))
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// The contact rows of the iterate `d` and whether the active set is the one the last
+    /// solve had: the given set's rows (`Inside::Fixed`), or the statuses `active_set`
+    /// decides from the last solve's multipliers, whose rows start from `forces` (theory
+    /// 8.3b).
+    fn contact_rows(
+        &self,
+        d: &[f64],
+        system: &System,
+        active_set: &mut Option<ActiveSet>,
+        forces: &mut Vec<f64>,
+    ) -> Result<(Rows, bool), StepFailure> {
+        let Some(c) = &self.contact else {
+            return Ok((Rows::empty(), true));
+        };
+        profile::time(Phase::Contact, || match active_set {
+            Some(set) => {
+                let changed = set.update(c, d);
+                let (rows, start) = set.rows(c, d, system)?;
+                *forces = start;
+                Ok((rows, !changed))
+            }
+            None => Ok((c.rows(d, system)?, true)),
+        })
     }
 
     /// The multipliers the iteration starts from: the normal ones given, then the fixed
