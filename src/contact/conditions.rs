@@ -235,7 +235,7 @@ pub(super) fn impact_together(
     velocity: &mut [f64],
     acceleration: &mut [f64],
     forces: &mut [f64],
-) {
+) -> Vec<f64> {
     let along =
         |row: &[(usize, f64)], v: &[f64]| -> f64 { row.iter().map(|(d, c)| c * v[*d]).sum() };
     let push = |v: &mut [f64], row: &[(usize, f64)], mu: f64| {
@@ -244,8 +244,8 @@ pub(super) fn impact_together(
         }
     };
     let rates: Vec<f64> = rows.iter().map(|r| along(r, velocity)).collect();
-    let mu = super::multipliers::lumped_multipliers(rows, &rates, inverse_mass);
-    for (row, m) in rows.iter().zip(&mu) {
+    let impulses = super::multipliers::lumped_multipliers(rows, &rates, inverse_mass);
+    for (row, m) in rows.iter().zip(&impulses) {
         push(velocity, row, *m);
     }
     let mut kept: Vec<usize> = (0..rows.len()).collect();
@@ -267,6 +267,33 @@ pub(super) fn impact_together(
             forces[*i] += mu[a];
         }
         break;
+    }
+    impulses
+}
+
+/// The tangential part of (8.3a-1) under Coulomb friction: the relative tangential
+/// velocities of the rows `tangential` stopped together by impulses on the lumped mass,
+/// (T M^-1 T^T) mu_t = -T v, each within the cone of its row's normal impulse,
+/// |mu_t| <= `limits` (mu times the normal impulse of the closure), then v <- v + M^-1 T^T mu_t.
+/// A sticking entry starts its contact with the relative tangential velocity it is held at
+/// (the stick rows hold it at zero), and a sliding one loses what the cone allows. Rows
+/// that move no free DOF are left to their supports.
+pub(super) fn stick_together(
+    tangential: &[Vec<(usize, f64)>],
+    limits: &[f64],
+    inverse_mass: &[f64],
+    velocity: &mut [f64],
+) {
+    let rates: Vec<f64> = tangential
+        .iter()
+        .map(|r| r.iter().map(|(d, c)| c * velocity[*d]).sum())
+        .collect();
+    let impulses = super::multipliers::lumped_multipliers(tangential, &rates, inverse_mass);
+    for ((row, mu), limit) in tangential.iter().zip(&impulses).zip(limits) {
+        let mu = mu.clamp(-limit.max(0.0), limit.max(0.0));
+        for (d, c) in row {
+            velocity[*d] += inverse_mass[*d] * c * mu;
+        }
     }
 }
 

@@ -80,7 +80,20 @@ impl ContactState {
                 .collect();
             let rows = joint_rows(interfaces, &entries, &x);
             let mut forces: Vec<f64> = entries.iter().map(|(p, k)| self.force[*p][*k]).collect();
-            conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+            let impulses = conditions::impact_together(
+                &rows,
+                inverse_mass,
+                velocity,
+                acceleration,
+                &mut forces,
+            );
+            stick_joint(
+                interfaces,
+                (&entries, &impulses),
+                &x,
+                inverse_mass,
+                velocity,
+            );
             for ((p, k), f) in entries.iter().zip(forces) {
                 self.force[*p][*k] = f;
             }
@@ -140,9 +153,38 @@ fn impact_mortar_pairs<S>(
     let pairs: Vec<(usize, usize)> = entries.iter().map(|i| step.active[*i]).collect();
     let rows = joint_rows(interfaces, &pairs, &x);
     let mut forces: Vec<f64> = entries.iter().map(|i| step.forces[*i]).collect();
-    conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+    let impulses =
+        conditions::impact_together(&rows, inverse_mass, velocity, acceleration, &mut forces);
+    stick_joint(interfaces, (&pairs, &impulses), &x, inverse_mass, velocity);
     for (i, f) in entries.iter().zip(forces) {
         step.forces[*i] = f;
+    }
+}
+
+/// The tangential part of the joint impact conditions (`conditions::stick_together`) on the
+/// entries `pairs` of pairs with Coulomb friction, whose normal impulses were `impulses`.
+fn stick_joint(
+    interfaces: &Interfaces,
+    (entries, impulses): (&[(usize, usize)], &[f64]),
+    x: &dyn Fn(usize) -> [f64; 2],
+    inverse_mass: &[f64],
+    velocity: &mut [f64],
+) {
+    let mut rows = Vec::new();
+    let mut limits = Vec::new();
+    for ((p, k), impulse) in entries.iter().zip(impulses) {
+        let pair = &interfaces.pairs[*p];
+        let Friction::Coulomb { mu } = pair.options.friction else {
+            continue;
+        };
+        let s = pair.slaves[*k];
+        if let Some(gap) = pair.gap(s, x) {
+            rows.push(gap.tangent_row(s));
+            limits.push(mu * impulse);
+        }
+    }
+    if !rows.is_empty() {
+        conditions::stick_together(&rows, &limits, inverse_mass, velocity);
     }
 }
 

@@ -521,10 +521,15 @@ impl Step<'_> {
         let Some(c) = &self.contact else {
             return Ok((Rows::empty(), true));
         };
+        // dynamics: v* = c_v D + v_hat at the solve point, for velocity-level stick
+        let motion = self.inertia.as_ref().map(|_| {
+            let form = self.form;
+            (&form.velocity_offset[..], form.damping_coefficient)
+        });
         profile::time(Phase::Contact, || match active_set {
             Some(set) => {
-                let changed = set.update(c, d);
-                let (rows, start) = set.rows(c, d, system)?;
+                let changed = set.update(c, d, motion);
+                let (rows, start) = set.rows(c, d, system, motion)?;
                 *forces = start;
                 Ok((rows, !changed))
             }
