@@ -60,7 +60,7 @@ fn peaks(n: usize) -> (f64, f64) {
     let edits: Vec<&str> = edits.iter().map(String::as_str).collect();
     let model = common::model(
         "rod_on_plate",
-        &std::fs::read_to_string("tests/data/rod_on_plate.toml").unwrap(),
+        &std::fs::read_to_string("models/rod_on_plate.toml").unwrap(),
         &edits,
     );
     let dir = common::out_dir(&format!("rod_on_plate_{n}"));
@@ -73,7 +73,7 @@ fn peaks(n: usize) -> (f64, f64) {
 
 /// Goal: the averaged contact force of central difference has a peak that converges under
 /// mesh and step refinement, where the raw multipliers' peak (a first step's spike) does
-/// not. Setup: tests/data/rod_on_plate.toml (a copper rod at 100 m/s on a clamped steel
+/// not. Setup: models/rod_on_plate.toml (a copper rod at 100 m/s on a clamped steel
 /// plate, axisymmetric, J2, mortar contact) at three levels, elements of 1, 0.5 and 0.25 mm
 /// (rod 4 x 25, 8 x 50, 16 x 100; the step follows), a window of 1 us. Reference: the
 /// grid convergence procedure of Celik et al. (2008) (`impact::sweep::qoi::extrapolate`, as
