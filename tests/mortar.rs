@@ -1056,7 +1056,11 @@ fn rod_pair_with_friction_on_newmark_matches_the_explicit_pair() {
     let explicit = shape("pair_friction_explicit", &[friction]);
     let newmark = shape(
         "pair_friction_newmark",
-        &["analysis.integrator=average", "analysis.dt=1.0e-7", friction],
+        &[
+            "analysis.integrator=average",
+            "analysis.dt=1.0e-7",
+            friction,
+        ],
     );
     for k in 0..4 {
         assert!(

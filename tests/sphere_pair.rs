@@ -99,14 +99,26 @@ fn sphere_pair_rebounds_as_one_sphere_on_the_wall_on_every_path() {
         &["analysis.integrator=central_difference", "analysis.dt=auto"],
     );
     for e in [upper, lower] {
-        assert!((e / wall_fixed - 1.0).abs() < 0.005, "{e} against {wall_fixed}");
-        assert!((e / explicit_wall - 1.0).abs() < 0.005, "{e} against {explicit_wall}");
+        assert!(
+            (e / wall_fixed - 1.0).abs() < 0.005,
+            "{e} against {wall_fixed}"
+        );
+        assert!(
+            (e / explicit_wall - 1.0).abs() < 0.005,
+            "{e} against {explicit_wall}"
+        );
     }
     let (upper, lower, auto_iterations) = pair("pair_auto", &["analysis.dt=auto"]);
     let (wall_auto, _) = wall("wall_auto", &["analysis.dt=auto"]);
     for e in [upper, lower] {
-        assert!((e / wall_auto - 1.0).abs() < 0.005, "{e} against {wall_auto}");
-        assert!((e / explicit_wall - 1.0).abs() < 0.005, "{e} against {explicit_wall}");
+        assert!(
+            (e / wall_auto - 1.0).abs() < 0.005,
+            "{e} against {wall_auto}"
+        );
+        assert!(
+            (e / explicit_wall - 1.0).abs() < 0.005,
+            "{e} against {explicit_wall}"
+        );
     }
     assert!(
         auto_iterations <= 2 * fixed_iterations,
@@ -124,7 +136,10 @@ fn sphere_pair_rebounds_as_one_sphere_on_the_wall_on_every_path() {
         &[coarse[0], coarse[1], "body.sphere.mesh.n=24"],
     );
     for e in [upper, lower] {
-        assert!((e / wall_coarse - 1.0).abs() < 0.005, "{e} against {wall_coarse}");
+        assert!(
+            (e / wall_coarse - 1.0).abs() < 0.005,
+            "{e} against {wall_coarse}"
+        );
     }
 }
 
@@ -152,7 +167,11 @@ fn adaptive_step_gives_one_restitution_at_nearby_speeds() {
         .iter()
         .map(|v| {
             let velocity = format!("body.sphere.velocity=[0.0, -{v}]");
-            wall(&format!("wall_v10_{v}"), &["analysis.dt=auto", &velocity, end]).0
+            wall(
+                &format!("wall_v10_{v}"),
+                &["analysis.dt=auto", &velocity, end],
+            )
+            .0
         })
         .collect();
     let (low, high) = restitutions
