@@ -4,7 +4,9 @@
 //! (Gitterle, Popp, Gee & Wall 2010; theory 8.3b).
 //!
 //! Legend (an entry: a slave of a pair; tau its normal multiplier, compressive > 0; g its gap
-//! at the iterate, > 0 open; s its slip since the step's start, t . (d_s - sum w_m d_m); f its
+//! at the iterate, > 0 open; T its tangential row t . (d_s - sum w_m d_m); s its slip beyond
+//! sticking: T d in statics, T v* / c_v in dynamics (v* = c_v D + v_hat, the relative
+//! tangential velocity at the solve point in units of a slip, `slip_beyond_stick`); f its
 //! tangential force, acting as f t on the slave; mu the pair's Coulomb coefficient)
 //! ```text
 //! closed -> open     tau < 0 after a solve                   (tau - c g > 0 fails, g = 0)
