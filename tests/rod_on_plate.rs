@@ -204,3 +204,44 @@ fn either_body_refined_alone_keeps_the_plastic_work_and_creates_no_energy() {
         }
     }
 }
+
+/// Goal: a run whose contact creates more than a few per cent of the energy in play ends with
+/// a numerical failure (exit 3) naming the pair, not `ok`. Setup: models/rod_on_plate.toml at
+/// 200 m/s, one-point kernel, the rod twice as fine as the plate and the master nodes held
+/// (`hold_master_nodes = true`: the plate's rows push nodes that were already inside out in
+/// one step; validation 4.12: before the check this run ended `ok` having created 347 J).
+/// Reference: the energy balance (theory 7): the contact work, energy the interfaces took up,
+/// is >= 0 for a contact that creates none; the run fails when it ends below -3 % of the
+/// energy in play (the initial kinetic energy, 225.2 J), its history kept.
+#[test]
+fn a_contact_that_creates_energy_ends_the_run_with_exit_3() {
+    let dir = common::out_dir("rop_energy_guard");
+    let out = common::impact(&[
+        "run",
+        "models/rod_on_plate.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "body.rod.velocity=[0, -200]",
+        "--set",
+        "analysis.quadrature=reduced",
+        "--set",
+        "contact.impact.hold_master_nodes=true",
+        "--set",
+        "body.rod.mesh.nx=16",
+        "--set",
+        "body.rod.mesh.ny=100",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("contact `impact` created energy"),
+        "{stderr}"
+    );
+    let kinetic = common::column(&dir, "kinetic_energy")[0];
+    let work = *common::column(&dir, "contact_work").last().unwrap();
+    assert!(work < -0.03 * kinetic, "{work} of {kinetic}");
+    let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    assert!(summary.contains("\"diverged\""), "{summary}");
+}
