@@ -73,18 +73,21 @@ fn creates_no_energy(name: &str, o: &Outcome) {
 /// and the stick/slide statuses inside Newton's iteration, mortar rows linearized exactly)
 /// lands on the explicit answer, frictionless and with Coulomb friction, at a fixed step and
 /// with the step chosen by its error.
-/// Setup: models/rod_on_plate.toml as shipped (explicit 2x2) and on Newmark at dt = 1e-7
-/// (about 30 explicit steps) and dt = "auto", mu = 0 and 0.1.
+/// Setup: models/rod_on_plate.toml as shipped (explicit 2x2; lumped mass, which Newmark takes
+/// too) and on Newmark at dt = 1e-7 (about 30 explicit steps) with mu = 0, 0.1 and 0.3, and
+/// at dt = "auto" with mu = 0.
 /// Reference: the explicit run of the same mesh. Bands: L_f 0.5 %, D_f 1 %, plastic work 1 %
-/// (measured: L_f -0.04 to -0.05 %, D_f -0.11 to +0.16 %, plastic work -0.71 to -0.73 %: the
-/// consistent mass of Newmark against the lumped one); no step cut; contact work >= 0. The
-/// plate's largest plastic strain, a corner value under the rod's rim, is held to 20 %:
-/// measured -9.7 % (mu = 0) and +2.5 % (mu = 0.1) at dt = 1e-7, -15 % and -11 % at "auto",
-/// and it does not approach the explicit value as dt falls (-15 % at 2.5e-8, mu = 0): the
-/// 5 % the issue asks for is not met (docs/validation.md 4.12).
+/// (measured: L_f -0.05 to -0.07 %, D_f +0.07 to +0.25 %, plastic work -0.53 to -0.77 %);
+/// no step cut; contact work >= 0. The plate's largest plastic strain, at the plate's top on
+/// the axis, is held to 10 %: measured -0.8 % (mu = 0), +2.6 % (0.1), +3.4 % (0.3) at
+/// dt = 1e-7 and -5.2 % at "auto", but what the axis element gathers after the first 12 us
+/// (a third of it, under the rod pressed on the vibrating plate) is not converged in dt:
+/// -7 % to +18 % at 2.5e-8, 5e-8 and "auto" with a tighter tolerance (docs/validation.md
+/// 4.12). Before the sticking rows of the axis slave were left to the supports, mu = 0.3 gave
+/// that element 5 times the explicit strain.
 #[test]
 fn newmark_lands_on_the_explicit_rod_on_plate_with_and_without_friction() {
-    for (mu, auto) in [("0", true), ("0.1", false)] {
+    for (mu, auto) in [("0", true), ("0.1", false), ("0.3", false)] {
         let friction = format!("contact.impact.friction={mu}");
         let explicit = rod_on_plate(&format!("rop_explicit_{mu}"), &[&friction]);
         let mut steps = vec!["1.0e-7"];
@@ -102,7 +105,7 @@ fn newmark_lands_on_the_explicit_rod_on_plate_with_and_without_friction() {
                 "{name}: W_p"
             );
             assert!(
-                off(o.plate_strain, explicit.plate_strain) < 0.2,
+                off(o.plate_strain, explicit.plate_strain) < 0.1,
                 "{name}: eps_p"
             );
             assert_eq!(o.cuts, 0, "{name}");
@@ -118,7 +121,7 @@ fn newmark_lands_on_the_explicit_rod_on_plate_with_and_without_friction() {
 /// Newmark run ended `ok` with 9.3 J of energy created at 200 m/s).
 /// Setup: models/rod_on_plate.toml on Newmark dt = 1e-7, the pair's sets swapped.
 /// Reference: the explicit run with the right roles; bands as in the test above (measured:
-/// L_f -0.05 %, D_f +0.19 %, plastic work -0.69 %, contact work >= 0, no cut).
+/// L_f -0.05 %, D_f +0.23 %, plastic work -0.50 %, contact work >= 0, no cut).
 #[test]
 fn roles_swapped_on_newmark_give_the_same_rod_and_create_no_energy() {
     let explicit = rod_on_plate("rop_roles_explicit", &[]);
@@ -150,9 +153,9 @@ fn roles_swapped_on_newmark_give_the_same_rod_and_create_no_energy() {
 /// Setup: models/rod_on_plate.toml on a coarse base (rod 4 x 25, plate 20 x 10: 1 mm and
 /// 0.5 mm elements), the plate or the rod refined 2 and 4 times alone; explicit 2x2 and
 /// one-point, Newmark dt = 1e-7 (twice as fine; four times as fine measured in
-/// docs/validation.md 4.12: +0.85 % plate, +1.55 % rod, the run 20-36 s).
+/// docs/validation.md 4.12: +0.64 % plate, +0.61 % rod, the run 16-27 s).
 /// Reference: the matching base mesh of the same path. Band: the issue's 2 % (measured
-/// +0.38 to +0.75 % on 2x2, +0.43 to +1.44 % one-point, +0.46 / +0.50 % Newmark). Before, with
+/// +0.38 to +0.75 % on 2x2, +0.43 to +1.44 % one-point, +0.34 / +0.39 % Newmark). Before, with
 /// the master nodes held by default, the rod at 200 m/s on a plate twice as fine created
 /// 751 J in 11 steps and inverted an element.
 #[test]
