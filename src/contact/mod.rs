@@ -1,8 +1,8 @@
 //! Contact, in one place: detection on the current configuration (`geometry`, `search`),
 //! the status carried between steps (`status`), the event logic of an implicit step
 //! (`step`), Hughes' impact and release conditions (`conditions`) met at a step's events
-//! (`impacts`), the explicit forward-increment multipliers (`explicit`) and the
-//! set-up checks of a pair (`setup`).
+//! (`impacts`), the explicit forward-increment multipliers (`explicit`), the
+//! set-up checks of a pair (`setup`) and the tractions the frames show (`traction`).
 //! It works on plain arrays (positions, masses, DOF indices) and never sees the model or
 //! the assembled system: the implicit solver receives the rows of the active entries and
 //! returns their multipliers (Hughes, Taylor & Sackman 1975, section II; Greco & Coda 2003).
@@ -38,6 +38,7 @@ pub mod search;
 pub mod setup;
 pub mod status;
 pub mod step;
+pub mod traction;
 
 pub use geometry::{
     ContactPair, Covered, Friction, Gap, Holds, Master, Obstacle, PairOptions, winding_number,
@@ -49,6 +50,7 @@ pub use status::{ContactState, MasterEntry, NodalStatus};
 pub use step::{
     ConstrainedSolution, ContactResult, Events, Inside, Pass, Settled, Tangential, Unsettled,
 };
+pub use traction::Tractions;
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -80,6 +82,18 @@ pub struct BodySurface {
     pub node_offset: usize,
 }
 
+/// How a node's boundary edges share their area (`Interfaces::tributary_area`); the two
+/// differ in axisymmetry only, where an edge sweeps 2 pi r.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Share {
+    /// The surface of revolution of the half edge next to the node, 2 pi (L/2) (3 r + r')/4.
+    HalfEdges,
+    /// The integral of the node's shape function over the edge, 2 pi L (2 r + r') / 6: the
+    /// share of a uniform pressure's consistent nodal force, so a node's force over it is
+    /// the pressure, on the axis too (where the half edge gives 3/4 of it).
+    Consistent,
+}
+
 /// The contact problem of a model: its pairs and, per body, its surface data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Interfaces {
@@ -94,29 +108,47 @@ impl Interfaces {
     /// halves, 2 pi (L/2) (3 r_node + r_other) / 4 per edge, so that a node on the axis
     /// carries the disc pi (r_other / 2)^2 and not zero).
     pub fn impedance(&self, body: usize, node: usize, coords: &[[f64; 2]]) -> f64 {
+        let all = |_: [usize; 2]| true;
+        self.bodies[body].impedance_per_area
+            * self.tributary_area(body, node, coords, (&all, Share::HalfEdges))
+    }
+
+    /// The tributary area of global node `node` of body `body` at the positions `coords`
+    /// over its boundary edges that `counts`, shared as `share` says (a rod: its
+    /// cross-section).
+    pub fn tributary_area(
+        &self,
+        body: usize,
+        node: usize,
+        coords: &[[f64; 2]],
+        (counts, share): (&dyn Fn([usize; 2]) -> bool, Share),
+    ) -> f64 {
         let b = &self.bodies[body];
-        let edges = &b.boundary_at_node[node - b.node_offset];
+        let edges = b.boundary_at_node[node - b.node_offset]
+            .iter()
+            .filter(|e| counts(**e));
         let length =
             |a: [f64; 2], c: [f64; 2]| ((a[0] - c[0]).powi(2) + (a[1] - c[1]).powi(2)).sqrt();
-        let area = match b.section {
+        match b.section {
             Section::Rod { area } => area,
             Section::Plane { thickness } => {
                 let half_edges: f64 = edges
-                    .iter()
                     .map(|[p, q]| 0.5 * length(coords[*p], coords[*q]))
                     .sum();
                 half_edges * thickness
             }
             Section::Axisymmetric => edges
-                .iter()
                 .map(|[p, q]| {
                     let other = if *p == node { *q } else { *p };
                     let (r, r_other) = (coords[node][0].max(0.0), coords[other][0].max(0.0));
-                    2.0 * PI * 0.5 * length(coords[*p], coords[*q]) * (3.0 * r + r_other) / 4.0
+                    let length = length(coords[*p], coords[*q]);
+                    match share {
+                        Share::HalfEdges => 2.0 * PI * 0.5 * length * (3.0 * r + r_other) / 4.0,
+                        Share::Consistent => 2.0 * PI * length * (2.0 * r + r_other) / 6.0,
+                    }
                 })
                 .sum(),
-        };
-        b.impedance_per_area * area
+        }
     }
 }
 

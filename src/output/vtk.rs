@@ -9,13 +9,20 @@
 //! point data  displacement, velocity, acceleration, contact_force,  3 components, z = 0
 //!             reference_coordinates
 //!             gap, contact_status                                   1 component
-//!             nodal_stress (6), nodal_von_mises (1): the cell values averaged to the
-//!             points (only when given)
+//!             nodal_stress (6), nodal_von_mises, nodal_eq_plastic_strain,
+//!             nodal_pressure, nodal_temperature (1): the cell values averaged to the
+//!             points; body (Int64, the point's body) (only when given)
+//!             contact_pressure, contact_shear (1): the contact's normal (compressive > 0)
+//!             and tangential traction on the contact surfaces (only when given)
 //! cell data   stress (XX YY ZZ XY YZ XZ), von_mises, eq_plastic_strain, pressure,
 //!             strain (XX YY ZZ XY YZ XZ, Green-Lagrange; only when given),
 //!             body (Int64: the index of the cell's body in the scene, from 0; only when
 //!             given), temperature (only when given)
 //! ```
+//! The rigid obstacles, which do not move, go beside the series once: DIR/NAME_obstacles.pvd
+//! listing DIR/vtk/NAME_obstacles.vtu, their segments as lines with the cell array
+//! `obstacle` (`write_obstacles`).
+//!
 //! `displacement` is the active vectors array, so ParaView's Warp By Vector picks it by
 //! default (to exaggerate the motion of a frame drawn in the reference configuration);
 //! `reference_coordinates` holds the initial coordinates whichever configuration the points are in.
@@ -60,12 +67,28 @@ pub struct Fields<'a> {
     /// Per cell, the index of its body in the scene (from 0): ParaView's Threshold on
     /// `body` picks one body. Written only when given.
     pub body: Option<&'a [i64]>,
-    /// Per point, `stress` and `von_mises` averaged over the cells around it. Written only
-    /// when given.
-    pub nodal_stress: Option<(&'a [[f64; 6]], &'a [f64])>,
+    /// Per point, the cell values averaged over the cells around it, and its body. Written
+    /// only when given.
+    pub nodal: Option<PointValues<'a>>,
+    /// Per point, the contact pressure and tangential traction (`contact::Tractions`).
+    /// Written only when given.
+    pub traction: Option<(&'a [f64], &'a [f64])>,
     /// Per cell, the Green-Lagrange strain XX YY ZZ XY YZ XZ (tensor shear). Written only
     /// when given.
     pub strain: Option<&'a [[f64; 6]]>,
+}
+
+/// Per point: the cell values averaged over the cells around it (`Grid::cell_to_point_mean`:
+/// smooth contours of what the integration points carry), and the index of its body.
+#[derive(Clone, Copy, Debug)]
+pub struct PointValues<'a> {
+    pub stress: &'a [[f64; 6]],
+    pub von_mises: &'a [f64],
+    pub eq_plastic_strain: &'a [f64],
+    pub pressure: &'a [f64],
+    /// Written only when given.
+    pub temperature: Option<&'a [f64]>,
+    pub body: &'a [i64],
 }
 
 /// A time series: DIR/NAME.pvd listing DIR/vtk/NAME_NNNNN.vtu.
@@ -345,15 +368,75 @@ impl Series {
     }
 
     fn pvd_text(&self) -> String {
-        let mut text = String::from(concat!(
-            "<?xml version=\"1.0\"?>\n",
-            "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n",
-            "  <Collection>\n",
-        ));
-        self.entries.iter().for_each(|entry| text.push_str(entry));
-        text.push_str("  </Collection>\n</VTKFile>\n");
-        text
+        collection(&self.entries)
     }
+}
+
+/// A .pvd's text listing the `<DataSet>` lines `entries`.
+fn collection(entries: &[String]) -> String {
+    let mut text = String::from(concat!(
+        "<?xml version=\"1.0\"?>\n",
+        "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n",
+        "  <Collection>\n",
+    ));
+    entries.iter().for_each(|entry| text.push_str(entry));
+    text.push_str("  </Collection>\n</VTKFile>\n");
+    text
+}
+
+/// A rigid obstacle for the frames: its polyline and whether it closes on itself.
+#[derive(Clone, Copy, Debug)]
+pub struct Polyline<'a> {
+    pub points: &'a [[f64; 2]],
+    pub closed: bool,
+}
+
+/// Writes the rigid obstacles beside the bodies' series: DIR/vtk/NAME_obstacles.vtu, their
+/// segments as lines (VTK_LINE) with the cell array `obstacle` (Int64: the obstacle's index
+/// in the scene, from 0), and DIR/NAME_obstacles.pvd listing it at time 0, so ParaView shows
+/// them at every time of the bodies' series (obstacles do not move). Returns the .pvd's path.
+pub fn write_obstacles(
+    dir: &Path,
+    name: &str,
+    obstacles: &[Polyline],
+    compression: Compression,
+) -> Result<PathBuf, OutputError> {
+    let file_name = format!("{name}_obstacles.vtu");
+    let path = dir.join("vtk").join(&file_name);
+    fs::create_dir_all(dir.join("vtk"))
+        .map_err(|e| OutputError::io(&dir.join("vtk"), "create folder", e))?;
+    let mut grid = Grid {
+        points: Vec::new(),
+        quads: Vec::new(),
+        lines: Vec::new(),
+    };
+    let mut ids = Vec::new();
+    for (index, obstacle) in obstacles.iter().enumerate() {
+        let first = grid.points.len();
+        let n = obstacle.points.len();
+        grid.points.extend_from_slice(obstacle.points);
+        let segments = if obstacle.closed {
+            n
+        } else {
+            n.saturating_sub(1)
+        };
+        for i in 0..segments {
+            grid.lines.push([first + i, first + (i + 1) % n]);
+            ids.push(index as i64);
+        }
+    }
+    let ids_field = Field {
+        section: Section::CellData,
+        name: "obstacle",
+        source: Source::Integers(&ids),
+        width: 1,
+    };
+    let payload = Payload::new(&path, &grid, &[ids_field], None)?;
+    write_atomic_parts(&path, &payload.into_parts(compression))?;
+    let pvd = dir.join(format!("{name}_obstacles.pvd"));
+    let entry = pvd_entry(0.0, &format!("vtk/{file_name}"));
+    write_atomic(&pvd, collection(&[entry]).as_bytes())?;
+    Ok(pvd)
 }
 
 /// One `<DataSet>` line of the .pvd; `file` is relative to the .pvd, with forward slashes.
@@ -482,10 +565,28 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
         .temperature
         .map(|t| field(CellData, "temperature", Singles(t), 1));
     let body = fields.body.map(|b| field(CellData, "body", Integers(b), 1));
-    let nodal = fields.nodal_stress.into_iter().flat_map(|(stress, mises)| {
+    let nodal = fields.nodal.into_iter().flat_map(|v| {
         [
-            field(PointData, "nodal_stress", Sixes(stress), 6),
-            field(PointData, "nodal_von_mises", Singles(mises), 1),
+            Some(field(PointData, "nodal_stress", Sixes(v.stress), 6)),
+            Some(field(PointData, "nodal_von_mises", Singles(v.von_mises), 1)),
+            Some(field(
+                PointData,
+                "nodal_eq_plastic_strain",
+                Singles(v.eq_plastic_strain),
+                1,
+            )),
+            Some(field(PointData, "nodal_pressure", Singles(v.pressure), 1)),
+            v.temperature
+                .map(|t| field(PointData, "nodal_temperature", Singles(t), 1)),
+            Some(field(PointData, "body", Integers(v.body), 1)),
+        ]
+        .into_iter()
+        .flatten()
+    });
+    let traction = fields.traction.into_iter().flat_map(|(pressure, shear)| {
+        [
+            field(PointData, "contact_pressure", Singles(pressure), 1),
+            field(PointData, "contact_shear", Singles(shear), 1),
         ]
     });
     let strain = fields
@@ -494,6 +595,7 @@ fn payload(path: &Path, grid: &Grid, fields: &Fields) -> Result<Payload, OutputE
     let list: Vec<Field> = list
         .into_iter()
         .chain(nodal)
+        .chain(traction)
         .chain(strain)
         .chain(body)
         .chain(temperature)
@@ -575,7 +677,8 @@ mod tests {
                 pressure: &self.cell_scalars[2],
                 temperature: None,
                 body: None,
-                nodal_stress: None,
+                nodal: None,
+                traction: None,
                 strain: None,
             }
         }

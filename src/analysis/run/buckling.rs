@@ -211,7 +211,8 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
             pressure: &cell_zeros,
             temperature: None,
             body: Some(&body_ids),
-            nodal_stress: None,
+            nodal: None,
+            traction: None,
             strain: None,
         };
         series.write_frame((i + 1) as f64, &grid, &fields)?;

@@ -21,6 +21,7 @@
 pub mod buckling;
 pub mod checkpoint;
 pub mod contact_record;
+mod frame;
 pub mod progress;
 pub mod record;
 

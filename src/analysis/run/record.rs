@@ -2,22 +2,22 @@
 //! row per converged step, summary.json at the end (also after a failure).
 
 use super::contact_record::{ContactCarry, ContactRecord};
+use super::frame::{PointArrays, cell_fields, point_body_ids};
 use crate::analysis::steppers::energies::{Energies, Motion};
 use crate::analysis::steppers::loads;
 use crate::analysis::summary::Summary;
 use crate::assembly::State;
 use crate::contact::ContactState;
 use crate::contact::Friction;
+use crate::contact::Interfaces;
 use crate::material::PointState;
-use crate::material::{pressure, von_mises};
 use crate::mesh::Cells;
 use crate::output::history::History;
-use crate::output::vtk::{Fields, Grid, Series};
+use crate::output::vtk::{Fields, Grid, Polyline, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
 use crate::scene::model::{PointFold, Probe};
 use crate::scene::spec::{FramePoints, Quantity, Statistic};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 pub struct Recorder {
@@ -26,8 +26,11 @@ pub struct Recorder {
     grid: Grid,
     /// The initial coordinates (the `reference_coordinates` array).
     reference: Vec<[f64; 2]>,
-    /// Per cell of `grid`, its body's index (the `body` cell array).
+    /// Per cell of `grid`, its body's index (the `body` cell array), and per point.
     body_ids: Vec<i64>,
+    point_body_ids: Vec<i64>,
+    /// The contact surfaces, for the frames' tractions (None without contact pairs).
+    interfaces: Option<Interfaces>,
     series: Option<Series>,
     history: History,
     frame_every: usize,
@@ -77,6 +80,7 @@ impl Recorder {
         let wanted = model.output.frame_every > 0 || !model.output.frame_times.is_empty();
         let series = if frames && wanted {
             let mut series = Series::create(dir, &model.name, model.output.compression)?;
+            write_obstacles(model, dir)?;
             // frames are encoded and written off the stepping thread
             series.set_background(true);
             Some(series)
@@ -89,6 +93,8 @@ impl Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
             body_ids: body_ids(model),
+            point_body_ids: point_body_ids(model),
+            interfaces: (!model.contacts.is_empty()).then(|| model.interfaces()),
             reference: model.coordinates(),
             series,
             history,
@@ -142,6 +148,7 @@ impl Recorder {
         let series = match position.series {
             Some(p) => {
                 let mut series = Series::resume(dir, &model.name, model.output.compression, p)?;
+                write_obstacles(model, dir)?;
                 series.set_background(true);
                 Some(series)
             }
@@ -153,6 +160,8 @@ impl Recorder {
             dir: dir.to_path_buf(),
             grid: grid(model),
             body_ids: body_ids(model),
+            point_body_ids: point_body_ids(model),
+            interfaces: (!model.contacts.is_empty()).then(|| model.interfaces()),
             reference: model.coordinates(),
             series,
             history,
@@ -337,15 +346,11 @@ impl Recorder {
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };
+        let tractions = contact
+            .zip(self.interfaces.as_ref())
+            .map(|(c, interfaces)| c.tractions(interfaces, &positions));
         let strain = cell_strains(model, &self.reference, state);
-        let nodal_stress = self.grid.cell_to_point_mean(&cells.stress);
-        let mises: Vec<[f64; 1]> = cells.von_mises.iter().map(|v| [*v]).collect();
-        let nodal_von_mises: Vec<f64> = self
-            .grid
-            .cell_to_point_mean(&mises)
-            .into_iter()
-            .map(|[v]| v)
-            .collect();
+        let points = PointArrays::of(&self.grid, &cells);
         let fields = Fields {
             displacement: &vectors(&state.displacement),
             velocity: &vectors(motion.velocity),
@@ -360,7 +365,8 @@ impl Recorder {
             pressure: &cells.pressure,
             temperature: cells.temperature.as_deref(),
             body: Some(&self.body_ids),
-            nodal_stress: Some((&nodal_stress, &nodal_von_mises)),
+            nodal: Some(points.values(&self.point_body_ids)),
+            traction: tractions.as_ref().map(|t| (&t.pressure[..], &t.shear[..])),
             strain: Some(&strain),
         };
         let points = match model.output.points {
@@ -525,6 +531,23 @@ pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -
     out
 }
 
+/// The scene's rigid obstacles beside the frames (`vtk::write_obstacles`), when it has any.
+fn write_obstacles(model: &Model, dir: &Path) -> Result<(), OutputError> {
+    if model.obstacles.is_empty() {
+        return Ok(());
+    }
+    let polylines: Vec<Polyline> = model
+        .obstacles
+        .iter()
+        .map(|o| Polyline {
+            points: &o.points,
+            closed: o.closed,
+        })
+        .collect();
+    crate::output::vtk::write_obstacles(dir, &model.name, &polylines, model.output.compression)?;
+    Ok(())
+}
+
 /// Per cell of [`grid`], the index of its body in the scene (quads first, then rods).
 pub(crate) fn body_ids(model: &Model) -> Vec<i64> {
     let of = |quads: bool| {
@@ -553,74 +576,6 @@ pub(crate) fn grid(model: &Model) -> Grid {
         quads,
         lines,
     }
-}
-
-struct CellFields {
-    stress: Vec<[f64; 6]>,
-    von_mises: Vec<f64>,
-    eq_plastic_strain: Vec<f64>,
-    pressure: Vec<f64>,
-    /// When some material carries a temperature (0 in the cells of the bodies whose
-    /// material carries none: their points keep 0).
-    temperature: Option<Vec<f64>>,
-}
-
-/// Per cell, the mean over its points; quads first, then rods (as in `grid`). Parallel over
-/// the cells, each written in its own slot.
-fn cell_fields(model: &Model, state: &State) -> CellFields {
-    let quads_first = model
-        .bodies
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| b.points_per_element() == 4)
-        .chain(
-            model
-                .bodies
-                .iter()
-                .enumerate()
-                .filter(|(_, b)| b.points_per_element() == 1),
-        );
-    let cells: usize = model.bodies.iter().map(|b| b.elements()).sum();
-    let mut out = CellFields {
-        stress: vec![[0.0; 6]; cells],
-        von_mises: vec![0.0; cells],
-        eq_plastic_strain: vec![0.0; cells],
-        pressure: vec![0.0; cells],
-        temperature: model.carries_temperature().then(|| vec![0.0; cells]),
-    };
-    let mut first = 0;
-    for (b, body) in quads_first {
-        let ppe = body.points_per_element();
-        let last = first + body.elements();
-        if let Some(temperature) = out.temperature.as_mut() {
-            temperature[first..last]
-                .par_iter_mut()
-                .zip(state.bodies[b].points.par_chunks_exact(ppe))
-                .for_each(|(t, points)| {
-                    *t = points.iter().map(|p| p.temperature).sum::<f64>() / ppe as f64;
-                });
-        }
-        (
-            &mut out.stress[first..last],
-            &mut out.von_mises[first..last],
-            &mut out.eq_plastic_strain[first..last],
-            &mut out.pressure[first..last],
-        )
-            .into_par_iter()
-            .zip(state.bodies[b].points.par_chunks_exact(ppe))
-            .for_each(|((stress, mises, eps_p, p), points)| {
-                let mean = |f: &dyn Fn(&crate::material::PointState) -> f64| {
-                    points.iter().map(f).sum::<f64>() / ppe as f64
-                };
-                let s: [f64; 4] = std::array::from_fn(|k| mean(&|p| p.stress[k]));
-                *stress = [s[0], s[1], s[2], s[3], 0.0, 0.0];
-                *mises = mean(&|p| von_mises(&p.stress));
-                *eps_p = mean(&|p| p.eq_plastic_strain);
-                *p = mean(&|p| pressure(&p.stress));
-            });
-        first = last;
-    }
-    out
 }
 
 fn is_reaction(quantity: Quantity) -> bool {
