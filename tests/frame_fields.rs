@@ -216,3 +216,22 @@ fn two_rods_show_their_contact_pressure_plastic_strain_and_bodies() {
         assert!(cells_around.iter().all(|c| cell_bodies[*c] == bodies[n]));
     }
 }
+
+/// Goal: the first frame shows the initial gaps (it showed 0 everywhere). Setup:
+/// models/rod_on_plate.toml to 1 us, frames every 0.5 us. Reference: the scene places the
+/// rod's bottom 1 um above the plate's top: the 9 slave nodes' gap is 1e-6 (to round-off of
+/// coordinates near 1e-2), every other point's 0.
+#[test]
+fn the_first_frame_shows_the_initial_gaps() {
+    let run = common::run_scene(
+        "frame_initial_gap",
+        "rod_on_plate",
+        &["analysis.end_time=1.0e-6", "output.frame_interval=0.5e-6"],
+    );
+    let (t, frame) = frame_at(&run.dir, "rod_on_plate", 0.0);
+    assert_eq!(t, 0.0);
+    let gap = point_array(&frame, "gap");
+    let open: Vec<f64> = gap.iter().copied().filter(|g| *g != 0.0).collect();
+    assert_eq!(open.len(), 9, "{open:?}");
+    assert!(open.iter().all(|g| (g - 1e-6).abs() < 1e-15), "{open:?}");
+}

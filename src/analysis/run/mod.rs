@@ -371,6 +371,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             motion: &motion,
             energies: s.energies(),
             contact,
+            frame_contact: Some(s.contact()),
         };
         self.recorder.step(self.model, snapshot, last)?;
         self.recorded = *s.energies();

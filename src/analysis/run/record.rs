@@ -200,6 +200,7 @@ impl Recorder {
             motion,
             energies,
             contact,
+            frame_contact,
         } = snapshot;
         let start = std::time::Instant::now();
         let mut row = vec![
@@ -283,7 +284,7 @@ impl Recorder {
         crate::profile::add(crate::profile::Phase::Output, start);
         self.steps_since_frame += 1;
         if self.frame_due(model, state.time, force_frame, 0) {
-            self.frame(model, state, motion, contact)?;
+            self.frame(model, state, motion, frame_contact)?;
         }
         Ok(())
     }
@@ -642,6 +643,8 @@ pub struct Snapshot<'a> {
     pub energies: &'a Energies,
     /// The contact status (None before the first step).
     pub contact: Option<&'a ContactState>,
+    /// The contact status for the frames: before the first step too (the initial gaps).
+    pub frame_contact: Option<&'a ContactState>,
 }
 
 /// A probe's statistic over the state's points.
