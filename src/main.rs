@@ -120,7 +120,9 @@ enum Command {
         #[arg(long)]
         scenes: bool,
     },
-    /// Plot columns of a history.csv against time (or another column) as SVG or PNG.
+    /// Plot columns of a history.csv against time (or another column) as SVG or PNG; or a
+    /// frame's point arrays (a .vtu: columns x, y and the point arrays, one row per point)
+    /// against a column, e.g. the contact pressure along the interface.
     Plot {
         history: PathBuf,
         /// A column to plot (repeat for more; one series each).
@@ -135,6 +137,10 @@ enum Command {
         /// Chart title. Default: the history's path.
         #[arg(long)]
         title: Option<String>,
+        /// Frames only: the points where this column is not 0 (e.g. `contact_status`: the
+        /// touching nodes), sorted by the x column.
+        #[arg(long = "where", value_name = "COLUMN")]
+        keep: Option<String>,
         /// Another run's history.csv whose same columns are overlaid, labelled with its name
         /// (its folder's when the file names agree). Repeat for more runs.
         #[arg(long)]
@@ -202,6 +208,7 @@ fn main() -> ExitCode {
             x,
             out,
             title,
+            keep,
             reference,
             panels,
             xmin,
@@ -210,7 +217,7 @@ fn main() -> ExitCode {
             ymax,
         } => plot_history(
             &history,
-            (&x, &y),
+            (&x, &y, keep.as_deref()),
             out,
             PlotLook {
                 title,
@@ -622,7 +629,7 @@ struct PlotLook {
 
 fn plot_history(
     history: &Path,
-    (x, y): (&str, &[String]),
+    (x, y, keep): (&str, &[String], Option<&str>),
     out: Option<PathBuf>,
     look: PlotLook,
     references: &[PathBuf],
@@ -630,7 +637,21 @@ fn plot_history(
     let names: Vec<&str> = std::iter::once(x)
         .chain(y.iter().map(String::as_str))
         .collect();
-    let columns = plot::history_columns(history, &names).map_err(bad_input)?;
+    // a frame's point arrays, or a history's columns
+    let load = |path: &Path| -> Result<Vec<Vec<f64>>, RunError> {
+        let frame = path.extension().is_some_and(|e| e == "vtu");
+        match (frame, keep) {
+            (true, _) => plot::frame_columns(path, &names, keep),
+            (false, None) => plot::history_columns(path, &names),
+            (false, Some(_)) => Err(OutputError::Invalid {
+                path: path.to_path_buf(),
+                reason: "--where selects the points of a frame (.vtu), not rows of a history"
+                    .into(),
+            }),
+        }
+        .map_err(bad_input)
+    };
+    let columns = load(history)?;
     let file_name = |p: &Path| p.file_name().map(|n| n.to_string_lossy().into_owned());
     // runs' files are usually all history.csv: then their folders tell them apart
     let run_name = |p: &Path| -> String {
@@ -645,7 +666,7 @@ fn plot_history(
     let own = (!references.is_empty()).then(|| run_name(history));
     let mut series = history_series(&columns, y, own.as_deref());
     for reference in references {
-        let columns = plot::history_columns(reference, &names).map_err(bad_input)?;
+        let columns = load(reference)?;
         series.extend(history_series(&columns, y, Some(&run_name(reference))));
     }
     let out = out.unwrap_or_else(|| {

@@ -235,3 +235,61 @@ fn the_first_frame_shows_the_initial_gaps() {
     assert_eq!(open.len(), 9, "{open:?}");
     assert!(open.iter().all(|g| (g - 1e-6).abs() < 1e-15), "{open:?}");
 }
+
+/// Goal: `impact plot FRAME.vtu` charts a point array along the touching nodes (the contact
+/// pressure against the radius), and a column the frame lacks is an input error naming it.
+/// Setup: frame 16 of sphere_wall (t = 0.127, its peak force). Reference: the frame's
+/// own arrays read back: the rows are the points with contact_status 1, by increasing x.
+#[test]
+fn a_frame_plots_the_pressure_along_the_interface() {
+    let run = common::run_scene("frame_plot", "sphere_wall", &["output.frame_every=1"]);
+    let entries = impact::output::vtk::read_pvd(&run.dir.join("sphere_wall.pvd")).unwrap();
+    let path = &entries[16].1;
+    let frame = read_frame(path).unwrap();
+    let status = point_array(&frame, "contact_status");
+    let pressure = point_array(&frame, "contact_pressure");
+    let x = points(&frame);
+    let mut expected: Vec<(f64, f64)> = (0..x.len())
+        .filter(|i| status[*i] != 0.0)
+        .map(|i| (x[i][0], pressure[i]))
+        .collect();
+    expected.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let columns = impact::output::plot::frame_columns(
+        path,
+        &["x", "contact_pressure"],
+        Some("contact_status"),
+    )
+    .unwrap();
+    let rows: Vec<(f64, f64)> = columns[0].iter().copied().zip(columns[1].clone()).collect();
+    assert!(expected.len() >= 10);
+    assert_eq!(rows, expected);
+
+    let chart = run.dir.join("pressure.svg");
+    let frame_arg = path.to_str().unwrap();
+    let args = ["plot", frame_arg, "--x", "x", "--y", "contact_pressure"];
+    let ok = common::impact(
+        &[
+            &args[..],
+            &[
+                "--where",
+                "contact_status",
+                "--out",
+                chart.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(
+        std::fs::read_to_string(&chart)
+            .unwrap()
+            .contains("contact_pressure")
+    );
+    let bad = common::impact(&["plot", frame_arg, "--x", "x", "--y", "pressure_of_contact"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("no point column `pressure_of_contact`"));
+}

@@ -23,6 +23,15 @@ impact run models/sphere_wall.toml --quiet --out $out/sphere_wall
 impact plot $out/sphere_wall/history.csv --y 'contact_force[wall]' \
   --title 'Sphere on a wall, V = 0.8: contact force (Hertz peak 60.2, duration 0.256)' --out $fig/sphere_wall_force.svg
 
+# the contact pressure along the interface at the peak force, against Hertz (validation 4.13)
+impact run models/sphere_wall.toml --quiet --out $out/sphere_wall_frames --set output.frame_every=1
+peak=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "contact_force[wall]") c = i; next }
+  $c > best { best = $c; t = $1 } END { print t }' $out/sphere_wall_frames/history.csv)
+frame=$(grep -F "timestep=\"$peak\"" $out/sphere_wall_frames/sphere_wall.pvd | sed 's/.*file="\([^"]*\)".*/\1/')
+impact plot $out/sphere_wall_frames/$frame --x x --y contact_pressure --where contact_status --ymin 0 \
+  --title "Sphere on a wall at its peak force 62.34 (t = $peak): contact pressure; Hertz p0 83.5, a 0.597" \
+  --out $fig/sphere_wall_pressure.svg
+
 impact run models/cantilever_large.toml --quiet --out $out/cantilever_large
 impact plot $out/cantilever_large/history.csv --y 'u_x[right]' --y 'u_y[right]' \
   --title 'Elastica cantilever: tip displacement against load factor (k = 2 t)' --out $fig/cantilever_tip.svg

@@ -21,8 +21,10 @@ use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Once;
 
+mod frame;
 mod map;
 
+pub use frame::frame_columns;
 pub use map::{Cell, CellKind, Map, write_map};
 
 /// Width and height of every chart, in pixels (PNG) or user units (SVG).
