@@ -241,8 +241,8 @@ fn body_extent(body: &Body) -> f64 {
 /// most 131 (taylor_aluminum).
 pub const MANY_FRAMES: f64 = 1000.0;
 
-/// The size of an uncompressed frame per node of the model (measured: 335 to 536 bytes on
-/// the last frames of the shipped scenes, most near 370; the point fields, the cell fields
+/// The size of an uncompressed frame per node of the model (measured: 376 to 616 bytes on
+/// the last frames of the shipped scenes, most 400 to 421; the point fields, the cell fields
 /// and the connectivity of a Quad4 mesh). `lz4` and `zlib` compression write less.
 pub const FRAME_BYTES_PER_NODE: f64 = 400.0;
 
