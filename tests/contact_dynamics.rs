@@ -279,20 +279,16 @@ fn median(rows: Vec<(usize, f64)>) -> f64 {
     deviations[deviations.len() / 2]
 }
 
-/// Goal: a step clipped to land on a frame time reports the contact force of its
-/// neighbours, not a spike; `peak_force_raw` stays below the elastic impact force; summary.json's
-/// `dt_min`, `dt_max` leave the clipped steps out.
-/// Setup: models/steel_block_wall.toml as shipped (frames every 1 us, so a step ends on each
-/// microsecond, some of them 1.7e-9 s long against stable steps of about 9e-8 s).
-/// Reference: the elastic impact force rho c V h, the plane-strain impact stress rho c V on
-/// the face of height h = 10 mm: 7850 x 6001 x 50 x 0.01 = 2.36e7 N/m (c = sqrt(M / rho),
-/// M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) = 2.83e11 Pa); the block yields, so the force stays
-/// below it. Each frame-aligned step inside the contact, and the step after it, within 10 %
-/// of the mean of its two neighbours, or between them where the force turns (the step at
-/// 3 us, barely clipped, lies 23 % below the mean of a steeply falling force, between its
-/// neighbours). Before this reporting: peak 3.32e7 at 7 us (the step of 1.0e-8 s between
-/// 6.8e6 and 3.7e6), the 4 us step 37 times its neighbours' mean. dt_min and dt_max: the
-/// extremes of history.csv's dt over the rows that do not end on a frame time or the end.
+/// Goal: the frames cost the steel block's contact force nothing: `peak_force_raw` stays
+/// below the elastic impact force, and no step is clipped short. Setup:
+/// models/steel_block_wall.toml as shipped (frames every 1 us, about 11 stable steps apart,
+/// each microsecond reached in equal steps). Reference: the elastic bound rho c V h of a
+/// block striking a rigid wall (the plastic block's force stays below it); summary.json's
+/// `dt_min`, `dt_max` (the full steps of the stable limit the equal steps divide): no step of
+/// history.csv above 1.01 of dt_max (the equal steps' stretch where the limit fell) nor
+/// below 0.8 of dt_min (one equal step more per microsecond than the limit asks: 10/11).
+/// Before the equal steps: steps of 1.7e-9 s beside 9.2e-8 s, whose force was 37 times its
+/// neighbours' mean before the reporting kept the impulse (and a peak of 3.32e7 at 7 us).
 #[test]
 fn steel_block_wall_clipped_steps_report_the_force_of_their_neighbours() {
     let scene = steel_block_scene();
@@ -303,7 +299,6 @@ fn steel_block_wall_clipped_steps_report_the_force_of_their_neighbours() {
     // the raw multipliers' peak (`peak_force` is the averaged force's, never above it)
     let peak = r.summary.contact.peak_force_raw;
     let force = column(&r.dir, "contact_force[wall]");
-    let time = column(&r.dir, "time");
     let dt = column(&r.dir, "dt");
     assert!(
         peak < bound,
@@ -311,38 +306,13 @@ fn steel_block_wall_clipped_steps_report_the_force_of_their_neighbours() {
     );
     assert_eq!(peak, force.iter().copied().fold(0.0, f64::max));
     assert!(r.summary.contact.peak_force <= peak);
-    let rows = clipped_rows(&time, &force, &scene, scene.frame_interval);
-    assert!(rows.len() >= 16, "{rows:?}");
-    for &(k, deviation) in &rows {
-        eprintln!(
-            "t = {:.3e} s, dt {:.3e} s: force {:.4e} N/m, {deviation:+.3} from its neighbours' mean",
-            time[k], dt[k], force[k]
-        );
-        assert!(
-            consistent(&force, k),
-            "t = {}: force {} beside {} and {}",
-            time[k],
-            force[k],
-            force[k - 1],
-            force[k + 1]
-        );
-    }
-    let aligned = frame_aligned(&time, scene.frame_interval, scene.end_time);
-    let set: Vec<f64> = (1..dt.len())
-        .filter(|k| !aligned[*k])
-        .map(|k| dt[k])
-        .collect();
-    let shortest = set.iter().copied().fold(f64::INFINITY, f64::min);
-    let longest = set.iter().copied().fold(0.0, f64::max);
-    assert_eq!(r.summary.dt_min, Some(shortest));
-    assert_eq!(r.summary.dt_max, Some(longest));
-    let clipped = dt[1..].iter().copied().fold(f64::INFINITY, f64::min);
-    assert!(
-        clipped < 0.1 * shortest,
-        "the scene clips a step short: {clipped}"
-    );
+    let shortest = dt[1..].iter().copied().fold(f64::INFINITY, f64::min);
+    let longest = dt[1..].iter().copied().fold(0.0, f64::max);
+    let (rule_min, rule_max) = (r.summary.dt_min.unwrap(), r.summary.dt_max.unwrap());
+    assert!(longest <= 1.01 * rule_max, "{longest} beyond {rule_max}");
+    assert!(shortest > 0.8 * rule_min, "{shortest} against {rule_min}");
     eprintln!(
-        "peak_force {peak:.4e} N/m (rho c V h {bound:.4e}); dt_min {shortest:.4e} s, dt_max {longest:.4e} s (shortest clipped step {clipped:.3e} s)"
+        "peak_force {peak:.4e} N/m (rho c V h {bound:.4e}); dt_min {shortest:.4e} s, dt_max {longest:.4e} s"
     );
 }
 

@@ -268,8 +268,9 @@ pub struct Summary {
     pub contact: ContactSummary,
     pub energy: EnergySummary,
     pub buckling: Option<BucklingSummary>,
-    /// Central difference: the shortest and the longest step the step rule set (steps
-    /// clipped to a frame time or the end time not counted).
+    /// Central difference: the shortest and the longest step the step rule set (a fixed
+    /// step's last one, clipped to the end time, not counted; the automatic step's equal
+    /// steps to a frame or the end are the rule's).
     pub dt_min: Option<f64>,
     pub dt_max: Option<f64>,
     /// Central difference: the stable step of the final configuration and the element that

@@ -7,15 +7,19 @@
 //!              configuration (Kernel::frequency_bound, quad4_one_point::frequency_bound)
 //! dt_bound     2 / sqrt(max_e omega^2_e): a stable step (Irons: the assembled model's
 //!              highest frequency is at most the elements')
-//! auto         h = scale dt_bound, ended early at a listed frame time or the end time
-//!              (a clipped step: shorter than the rule's by more than 1e-9 h)
+//! auto         h = scale dt_bound; the stop (the next listed frame time or the end time)
+//!              reached in equal steps once it is at most EQUAL_STEPS steps of h away:
+//!              length = remaining / ceil((1 - STRETCH) remaining / h), the last ending on
+//!              the stop exactly (none clipped; `dt_min`, `dt_max` read the full steps h)
 //! fixed        h = dt; stopped (status `unstable`) when dt > c dt_bound, c the ratio of the
 //!              initial element-eigenvalue limit to the initial dt_bound (so the first check
 //!              is the exact one, and the later ones follow the elements as they deform);
 //!              the last step ends at the end time (clipped when shorter than dt)
 //! ```
 //! The shortest and the longest step (summary.json `dt_min`, `dt_max`) are over the steps
-//! the rule set: a clipped step says where a frame or the end fell, not what the mesh needed.
+//! the rule set, what the mesh needed: the automatic step's h, not the equal parts it is
+//! divided into before a frame; not a fixed step's clipped last one, which says where the
+//! end fell.
 
 use super::control::{snap, step_length};
 use crate::analysis::summary::{Status, StepError};
@@ -25,6 +29,17 @@ use crate::scene::DynamicAnalysis;
 use crate::scene::Model;
 use crate::scene::spec::TimeStep;
 use serde::{Deserialize, Serialize};
+
+/// Auto: the steps before a listed frame time or the end time that are made equal (the
+/// stop is reached in ceil(remaining / h) equal steps once that is at most this many): the
+/// steps change by at most 1/EQUAL_STEPS where the split starts, and none is clipped short.
+const EQUAL_STEPS: f64 = 16.0;
+
+/// Auto: how much longer than h the equal steps to a stop may be (a share): the stable step
+/// falls a little as elements deform inside the equal steps, and without it the last of them
+/// would split in two halves (steel_block_wall: two steps of 0.5 h before a frame). At the
+/// default scale 0.9 such a step is 0.909 of the bound.
+const STRETCH: f64 = 0.01;
 
 /// The step rule of a central-difference run and what it has seen.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -38,7 +53,9 @@ pub struct Clock {
     pub limit: StableStep,
     /// The last step taken (0 before the first).
     pub last: f64,
-    /// The shortest and the longest step the rule set (clipped steps not counted).
+    /// The shortest and the longest step the rule set (auto: the full step of the limit,
+    /// also where equal steps to a frame divide it; a fixed step's clipped last one not
+    /// counted).
     shortest: f64,
     longest: f64,
     /// The shortest and the longest step taken, clipped ones included.
@@ -56,12 +73,14 @@ fn one() -> u64 {
     1
 }
 
-/// A step of the clock: where it ends, its length, and whether it was clipped (ended early
-/// at a frame time or the end time, shorter than the rule's step).
+/// A step of the clock: where it ends, its length, the rule's step (auto: the full step of
+/// the stable limit, which the equal steps to a frame divide), and whether it was clipped
+/// (a fixed step's last one, ended early at the end time).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Step {
     pub end: f64,
     pub length: f64,
+    pub rule: f64,
     pub clipped: bool,
 }
 
@@ -146,6 +165,7 @@ impl Clock {
                 Ok(Step {
                     end,
                     length,
+                    rule: dt,
                     clipped: length < dt,
                 })
             }
@@ -171,13 +191,31 @@ impl Clock {
                     .output
                     .next_frame_after(time * (1.0 + 1e-12))
                     .unwrap_or(f64::INFINITY);
+                // a frame time that is the end time but for round-off ends the run there
+                let next_frame = if (next_frame - spec.end_time).abs() <= 1e-9 * h {
+                    spec.end_time
+                } else {
+                    next_frame
+                };
                 let stop = spec.end_time.min(next_frame);
-                let full = time + h;
-                let end = if stop - full <= 1e-9 * h { stop } else { full };
+                let remaining = stop - time;
+                // the steps left to the stop, each at most h (but for STRETCH): the last
+                // EQUAL_STEPS before it are equal, so no short step lands on a frame (no
+                // spike in a column, no alternation of long and short steps with frequent
+                // frames)
+                let left = (remaining / h * (1.0 - STRETCH)).ceil().max(1.0);
+                let (end, length) = if left <= 1.0 {
+                    (stop, remaining)
+                } else if left <= EQUAL_STEPS {
+                    (time + remaining / left, remaining / left)
+                } else {
+                    (time + h, h)
+                };
                 Ok(Step {
                     end,
-                    length: end - time,
-                    clipped: full - stop > 1e-9 * h,
+                    length,
+                    rule: h,
+                    clipped: false,
                 })
             }
         }
@@ -193,8 +231,8 @@ impl Clock {
         let h = step.length;
         self.last = h;
         if !step.clipped {
-            self.shortest = self.shortest.min(h);
-            self.longest = self.longest.max(h);
+            self.shortest = self.shortest.min(step.rule);
+            self.longest = self.longest.max(step.rule);
         }
         self.shortest_taken = self.shortest_taken.min(h);
         self.longest_taken = self.longest_taken.max(h);
