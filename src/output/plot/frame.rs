@@ -20,7 +20,15 @@ pub fn frame_columns(
     keep: Option<&str>,
 ) -> Result<Vec<Vec<f64>>, OutputError> {
     let frame = read_frame(path)?;
-    let mut available: Vec<(String, Vec<f64>)> = Vec::new();
+    // the points' coordinates, x and y of three components
+    let mut available: Vec<(String, Vec<f64>)> = match frame.floats(Section::Points, "Points") {
+        Some((_, v)) => ["x", "y"]
+            .into_iter()
+            .enumerate()
+            .map(|(k, name)| (name.into(), v.iter().skip(k).step_by(3).copied().collect()))
+            .collect(),
+        None => Vec::new(),
+    };
     let mut add = |name: &str, components: usize, values: &[f64]| {
         let suffixes: &[&str] = match components {
             1 => &[""],
@@ -35,21 +43,12 @@ pub fn frame_columns(
     };
     for array in &frame.arrays {
         match (&array.values, array.section) {
-            (Values::Float64(v), Section::Points) => {
-                add("", 3, v);
-            }
             (Values::Float64(v), Section::PointData) => add(&array.name, array.components, v),
             (Values::Int64(v), Section::PointData) => {
                 let v: Vec<f64> = v.iter().map(|i| *i as f64).collect();
                 add(&array.name, 1, &v);
             }
             _ => {}
-        }
-    }
-    // the points' coordinates are `x` and `y`, not `_x` and `_y`
-    for (name, _) in available.iter_mut() {
-        if name == "_x" || name == "_y" {
-            name.remove(0);
         }
     }
     let column = |name: &str| -> Result<&Vec<f64>, OutputError> {
