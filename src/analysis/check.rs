@@ -170,7 +170,14 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
             Some(start) => explicit_stability(start),
             None => step_stability(model, spec)?,
         };
+        let dt = match stability {
+            StepStability::Conditional { dt, .. } => dt,
+            StepStability::Unconditional { dt, .. }
+            | StepStability::WilsonBelowLimit { dt, .. } => Some(dt),
+            StepStability::Unstable => None,
+        };
         lines.push(stability_line(model, spec, stability));
+        lines.push(history_line(model, spec.end_time, dt));
         if let Some(report) = start.as_ref().and_then(|s| s.mass_scaling(model)) {
             let model_mass = report.model_mass();
             lines.push(format!(
@@ -190,6 +197,41 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
         }
     }
     Ok(lines)
+}
+
+/// `impact check`'s line on the history rows: the cadence and about how many rows it gives
+/// for `dt` (the nominal step).
+fn history_line(model: &Model, end_time: f64, dt: Option<f64>) -> String {
+    let cadence = model.history_cadence();
+    let steps = dt.filter(|dt| *dt > 0.0).map(|dt| (end_time / dt).ceil());
+    if cadence.every == Some(1) {
+        return "history.csv: a row every step".into();
+    }
+    let mut rows = steps;
+    let mut parts = Vec::new();
+    if let Some(n) = cadence.every {
+        parts.push(format!("every {n} steps"));
+        rows = steps.map(|s| (s / n as f64).ceil());
+    }
+    if let Some(h) = cadence.interval {
+        parts.push(format!("at every multiple of {}", readable(h)));
+        let grid = (end_time / h).ceil();
+        rows = Some(
+            rows.map_or(grid, |r| r.max(grid))
+                .min(steps.unwrap_or(f64::INFINITY)),
+        );
+    }
+    let source = if model.output.history_every.is_some() || model.output.history_interval.is_some()
+    {
+        "output.history_*"
+    } else {
+        "central difference's default, end_time / 1e4"
+    };
+    format!(
+        "history.csv: a row {} ({source}){}, and the steps between rows where a column peaks",
+        parts.join(" or "),
+        rows.map_or(String::new(), |r| format!(", about {r:.0} rows"))
+    )
 }
 
 /// `impact check`'s line on the step of `spec` against its integrator's limit.

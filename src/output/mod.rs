@@ -9,6 +9,7 @@
 pub mod console;
 pub mod history;
 pub mod plot;
+pub mod thinning;
 pub mod vtk;
 pub mod vtu;
 

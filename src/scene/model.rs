@@ -491,6 +491,15 @@ impl Reference {
 }
 
 impl Model {
+    /// Which steps get a history row (`output.history_every`, `output.history_interval`, or
+    /// the default: every step; central difference's grid of its end time).
+    pub fn history_cadence(&self) -> crate::output::thinning::Cadence {
+        let explicit = matches!(&self.analysis, Analysis::Dynamic(d)
+            if d.integrator == IntegratorKind::CentralDifference);
+        self.output
+            .history_cadence(explicit.then(|| self.analysis.end_time()))
+    }
+
     /// Constrained DOFs: supports and prescribed-displacement loads (sorted, unique).
     pub fn constrained_dofs(&self) -> Vec<usize> {
         Model::constrained_dofs_of(&self.fixed_dofs, &self.loads)

@@ -16,9 +16,6 @@ pub(super) fn check_frame_times(cx: &Context, times: &[f64]) -> Result<(), Input
     Ok(())
 }
 
-/// The frame times of `output`: `frame_times` with the multiples of `frame_interval` up to
-/// `end_time` merged in (sorted; a multiple within 1e-9 relative of a listed time is that
-/// time).
 /// `output.contact_force_window`: a time >= 0 (0: no averaging).
 pub(super) fn check_force_window(cx: &Context, window: Option<f64>) -> Result<(), InputError> {
     match window {
@@ -29,6 +26,27 @@ pub(super) fn check_force_window(cx: &Context, window: Option<f64>) -> Result<()
     }
 }
 
+/// `output.history_every` (>= 1) and `output.history_interval` (a time > 0).
+pub(super) fn check_history_cadence(
+    cx: &Context,
+    output: &super::spec::OutputSpec,
+) -> Result<(), InputError> {
+    if output.history_every == Some(0) {
+        return Err(
+            cx.err("output.history_every: must be >= 1 (1: a row every step), got 0".to_string())
+        );
+    }
+    match output.history_interval {
+        Some(h) if !(h.is_finite() && h > 0.0) => Err(cx.err(format!(
+            "output.history_interval: must be a time > 0, got {h}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// The frame times of `output`: `frame_times` with the multiples of `frame_interval` up to
+/// `end_time` merged in (sorted; a multiple within 1e-9 relative of a listed time is that
+/// time).
 pub(super) fn frame_times(
     cx: &Context,
     output: &super::spec::OutputSpec,

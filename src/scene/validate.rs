@@ -11,7 +11,7 @@ use super::context::Context;
 use super::loads::{curves, default_curve, fixed_dofs, loads};
 use super::materials::materials;
 use super::model::{Analysis, Body, BodyKind, Load, Model, Probe, SceneSource};
-use super::probes::{check_force_window, frame_times, probes};
+use super::probes::{check_force_window, check_history_cadence, frame_times, probes};
 use super::reference::reference;
 use super::spec::{IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene};
 use crate::contact::{ContactPair, Friction};
@@ -34,6 +34,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let probes = probes(&cx, &bodies, &scene.output.probe, dynamic)?;
     let frame_times = frame_times(&cx, &scene.output, analysis.end_time())?;
     check_force_window(&cx, scene.output.contact_force_window)?;
+    check_history_cadence(&cx, &scene.output)?;
     let obstacles = obstacles(&cx, &scene)?;
     let contacts = contacts(&cx, &scene, &bodies, &obstacles)?;
     check_contact_setup(&cx, &scene, &bodies, &contacts)?;

@@ -156,9 +156,13 @@ impl Plan {
     }
 
     /// The `--set` list of a case: no VTK frames (a scene or `--set output.frame_every=N`
-    /// may ask for them), the plan's fixed overrides, then the case's values.
+    /// may ask for them), a history row every step (the force measures integrate and time
+    /// the rows; `--set output.history_every=N` thins them), the plan's fixed overrides, then
+    /// the case's values.
     pub fn overrides(&self, case: &Case) -> Vec<String> {
-        std::iter::once("output.frame_every=0".to_string())
+        ["output.frame_every=0", "output.history_every=1"]
+            .into_iter()
+            .map(String::from)
             .chain(self.sets.iter().cloned())
             .chain(case.values.iter().map(|(k, v)| format!("{k}={v}")))
             .collect()

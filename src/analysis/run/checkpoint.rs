@@ -37,7 +37,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///    masses in the explicit carry; central difference's kinetic shadow in the energies.
 /// 9: the mortar pairs' master block in the contact state.
 /// 10: the subcycling's element bounds and counts in the explicit carry.
-const FORMAT: u32 = 11;
+/// 12: the history's window since its last row (rows at a cadence, `output::thinning`).
+const FORMAT: u32 = 12;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -138,7 +138,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         resume: Option<Checkpoint>,
         (mut stepper, start): (S, Instant),
     ) -> Result<Run<'a, S>, RunError> {
-        let recorder = match &resume {
+        let mut recorder = match &resume {
             Some(c) => Recorder::resume(model, dir, c.recorder.clone())?,
             None => {
                 let window = contact_record::window(model, stepper.dt());

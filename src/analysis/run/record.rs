@@ -1,5 +1,6 @@
-//! What a run writes: VTK frames (every `frame_every` steps, and the last), one history.csv
-//! row per converged step, summary.json at the end (also after a failure).
+//! What a run writes: VTK frames (every `frame_every` steps, and the last), history.csv rows
+//! at the scene's cadence (`output::thinning`: with the extremes between them, and at every
+//! frame), summary.json at the end (also after a failure).
 
 use super::contact_record::{ContactCarry, ContactRecord};
 use super::frame::{PointArrays, cell_fields, point_body_ids};
@@ -13,6 +14,7 @@ use crate::contact::Interfaces;
 use crate::material::PointState;
 use crate::mesh::Cells;
 use crate::output::history::History;
+use crate::output::thinning::{Thinning, Window};
 use crate::output::vtk::{Fields, Grid, Polyline, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
@@ -33,6 +35,8 @@ pub struct Recorder {
     interfaces: Option<Interfaces>,
     series: Option<Series>,
     history: History,
+    /// Which steps' rows history.csv gets.
+    thinning: Thinning,
     frame_every: usize,
     steps_since_frame: usize,
     last_frame_time: Option<f64>,
@@ -98,6 +102,7 @@ impl Recorder {
             reference: model.coordinates(),
             series,
             history,
+            thinning: Thinning::new(model.history_cadence()),
             frame_every: model.output.frame_every,
             steps_since_frame: 0,
             last_frame_time: None,
@@ -130,6 +135,7 @@ impl Recorder {
         Ok(RecorderPosition {
             series: self.series.as_ref().map(Series::position),
             history_bytes: self.history.byte_len()?,
+            history_window: self.thinning.window().clone(),
             steps_since_frame: self.steps_since_frame,
             last_frame_time: self.last_frame_time,
             negative_pivots: self.negative_pivots,
@@ -165,6 +171,7 @@ impl Recorder {
             reference: model.coordinates(),
             series,
             history,
+            thinning: Thinning::resume(model.history_cadence(), position.history_window),
             frame_every: model.output.frame_every,
             steps_since_frame: position.steps_since_frame,
             last_frame_time: position.last_frame_time,
@@ -280,10 +287,13 @@ impl Recorder {
             row.push(energies.mass_scaling_loss);
             row.push(self.added_mass);
         }
-        self.history.append(&row)?;
+        let frame = self.frame_due(model, state.time, force_frame, 1);
+        let history = &mut self.history;
+        self.thinning
+            .offer(&row, force_frame || frame, |r| history.append(r))?;
         crate::profile::add(crate::profile::Phase::Output, start);
         self.steps_since_frame += 1;
-        if self.frame_due(model, state.time, force_frame, 0) {
+        if frame {
             self.frame(model, state, motion, frame_contact)?;
         }
         Ok(())
@@ -384,12 +394,14 @@ impl Recorder {
 
     /// Writes summary.json: the summary, then `max_temperature` and the probes' final values
     /// (`probes`, by column) when there are any.
-    pub fn write_summary(&self, model: &Model, summary: &Summary) -> Result<(), OutputError> {
+    pub fn write_summary(&mut self, model: &Model, summary: &Summary) -> Result<(), OutputError> {
         // every frame and row on disk (and the frames listed) before the summary says how
-        // the run ended
+        // the run ended: the last step's row too when the run ended between two rows
         if let Some(series) = &self.series {
             series.flush()?;
         }
+        let history = &mut self.history;
+        self.thinning.finish(|r| history.append(r))?;
         self.history.flush()?;
         let path = self.dir.join("summary.json");
         let file = SummaryFile {
@@ -838,6 +850,8 @@ fn hourglass_column(model: &Model) -> bool {
 pub struct RecorderPosition {
     pub series: Option<crate::output::vtk::SeriesPosition>,
     pub history_bytes: u64,
+    /// The steps since the last row written, and that row.
+    pub history_window: Window,
     pub steps_since_frame: usize,
     pub last_frame_time: Option<f64>,
     pub negative_pivots: Option<usize>,

@@ -31,7 +31,20 @@ pub struct OutputSpec {
     /// difference, none for the other integrators.
     #[serde(default)]
     pub contact_force_window: Option<f64>,
+    /// A history.csv row at least every N steps (1: every step).
+    #[serde(default)]
+    pub history_every: Option<usize>,
+    /// A history.csv row at every multiple of this time. Without either key: every step, and
+    /// for central difference a row at every `end_time / DEFAULT_HISTORY_ROWS`.
+    #[serde(default)]
+    pub history_interval: Option<f64>,
 }
+
+/// The history rows of a central-difference run that names no cadence: at most this many on
+/// the time grid (and the extremes between them, `output::thinning`), so an explicit run of
+/// 1e5 steps or more writes a few megabytes, not one row a step. (The implicit and static
+/// paths, whose steps each cost a solve, write every step.)
+pub const DEFAULT_HISTORY_ROWS: f64 = 1e4;
 
 /// The configuration a frame's points show; the `displacement` and `reference_coordinates`
 /// arrays are written either way.
@@ -55,11 +68,39 @@ impl Default for OutputSpec {
             points: FramePoints::default(),
             probe: Vec::new(),
             contact_force_window: None,
+            history_every: None,
+            history_interval: None,
         }
     }
 }
 
 impl OutputSpec {
+    /// Which steps get a history row: the keys; without them a row every step, or for
+    /// central difference (`explicit_end_time`: its end time) at every `end_time /
+    /// DEFAULT_HISTORY_ROWS`.
+    pub fn history_cadence(
+        &self,
+        explicit_end_time: Option<f64>,
+    ) -> crate::output::thinning::Cadence {
+        use crate::output::thinning::Cadence;
+        if self.history_every.is_some() || self.history_interval.is_some() {
+            return Cadence {
+                every: self.history_every,
+                interval: self.history_interval,
+            };
+        }
+        match explicit_end_time.filter(|t| *t > 0.0) {
+            Some(end_time) => Cadence {
+                every: None,
+                interval: Some(end_time / DEFAULT_HISTORY_ROWS),
+            },
+            None => Cadence {
+                every: Some(1),
+                interval: None,
+            },
+        }
+    }
+
     /// The first frame time after `time` (strictly), or None. The validated `frame_times`
     /// are sorted, so a binary search finds it: a run of many frames does not scan the list
     /// at every step.
