@@ -116,6 +116,19 @@ fn default_cadence_is_every_step_or_the_grid() {
         &["analysis.dt=1.5e-9", "output.frame_interval=3e-5"],
     );
     assert_eq!(long.summary.steps, 20_000);
+    // impact check says so beforehand: the grid's end_time / (end_time / 1e4) rows
+    let check = common::impact(&[
+        "check",
+        "models/steel_block_wall.toml",
+        "--set",
+        "analysis.dt=1.5e-9",
+    ]);
+    let stdout = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        stdout.contains("history.csv: a row at every multiple of 3e-9")
+            && stdout.contains("about 10000 rows"),
+        "{stdout}"
+    );
     let rows = lines(&long.dir).len() - 1;
     // the grid's 1e4 rows and the first; peaks of the contact force and the probes between
     // them (a block settling on a wall: its energies are monotone or smooth between rows)

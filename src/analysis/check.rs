@@ -207,20 +207,18 @@ fn history_line(model: &Model, end_time: f64, dt: Option<f64>) -> String {
     if cadence.every == Some(1) {
         return "history.csv: a row every step".into();
     }
-    let mut rows = steps;
+    // a row when either is due: at most the sum of theirs, at most one a step
     let mut parts = Vec::new();
+    let mut rows = 0.0;
     if let Some(n) = cadence.every {
         parts.push(format!("every {n} steps"));
-        rows = steps.map(|s| (s / n as f64).ceil());
+        rows += steps.map_or(0.0, |s| (s / n as f64).ceil());
     }
     if let Some(h) = cadence.interval {
         parts.push(format!("at every multiple of {}", readable(h)));
-        let grid = (end_time / h).ceil();
-        rows = Some(
-            rows.map_or(grid, |r| r.max(grid))
-                .min(steps.unwrap_or(f64::INFINITY)),
-        );
+        rows += (end_time / h).ceil();
     }
+    let rows = steps.map(|s| rows.min(s));
     let source = if model.output.history_every.is_some() || model.output.history_interval.is_some()
     {
         "output.history_*"
