@@ -473,5 +473,123 @@ proptest! {
         let bound = (2.0 / step).powi(2);
         prop_assert!(bound >= exact * (1.0 - 1e-6), "{formulation} {quadrature}: bound {bound} below {exact}");
         prop_assert!(bound <= 16.0 * exact, "{formulation} {quadrature}: bound {bound} far above {exact}");
+        // `analysis.stable_step = "tight"`: the kernel's step is that highest frequency's
+        // (1e-5: both from differences of the forces, each 1e-7 of the shortest edge)
+        let tight = tight_kernel(&model, quadrature, kappa).stable_step(&positions).unwrap().dt;
+        let tight = (2.0 / tight).powi(2);
+        prop_assert!((tight / exact - 1.0).abs() < 1e-5, "{formulation} {quadrature}: tight {tight} against {exact}");
+    }
+}
+
+/// As `explicit_kernel`, its stable step the elements' exact frequencies (`stable_step =
+/// "tight"`).
+fn tight_kernel(
+    model: &impact::scene::Model,
+    quadrature: &str,
+    kappa: f64,
+) -> Box<dyn impact::assembly::explicit::ExplicitKernel> {
+    use impact::assembly::explicit::{Full, Reduced};
+    let state = impact::assembly::State::initial(model);
+    let masses = impact::assembly::ElementMasses::new(model).unwrap();
+    if quadrature == "reduced" {
+        Box::new(Reduced::new(model, &state, kappa, &masses).with_tight_step(true))
+    } else {
+        Box::new(Full::new(model, &state, &masses).with_tight_step(true))
+    }
+}
+
+/// One free element of `model` stepped by central difference at `factor` times its tight
+/// stable step from random nodal velocities (seed `seed`), `steps` steps: the largest kinetic
+/// energy over the first, and the status the run ended with (the driver stops a run that
+/// blows up: `unstable`).
+fn kinetic_growth(
+    model: &mut impact::scene::Model,
+    quadrature: &str,
+    kappa: f64,
+    (factor, steps, seed): (f64, usize, u64),
+) -> (f64, impact::analysis::Status) {
+    let tight = tight_kernel(model, quadrature, kappa)
+        .stable_step(&model.coordinates())
+        .unwrap()
+        .dt;
+    let mut state = seed;
+    let mut random = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    // small: the element stays linear until the growth is plain
+    model.initial_velocity = (0..model.dofs()).map(|_| 1e-6 * random()).collect();
+    let dt = factor * tight;
+    if let impact::scene::model::Analysis::Dynamic(spec) = &mut model.analysis {
+        spec.step = impact::scene::spec::TimeStep::Fixed(dt);
+        spec.end_time = steps as f64 * dt;
+        spec.allow_unstable = true;
+    }
+    let dir = std::env::temp_dir().join(format!(
+        "impact-tests-{}/tight_{quadrature}_{factor}_{seed}",
+        std::process::id()
+    ));
+    let status = match impact::analysis::run(model, &dir, Default::default()) {
+        Ok(summary) => summary.status,
+        Err(impact::analysis::RunError::Numerical { summary, .. }) => summary.status,
+        Err(e) => panic!("{e}"),
+    };
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let mut lines = text.lines();
+    let k = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|c| c == "kinetic_energy")
+        .unwrap();
+    let kinetic: Vec<f64> = lines
+        .map(|l| {
+            l.split(',')
+                .nth(k)
+                .unwrap()
+                .parse::<f64>()
+                .unwrap_or(f64::INFINITY)
+        })
+        .collect();
+    (
+        kinetic.iter().copied().fold(0.0, f64::max) / kinetic[0],
+        status,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 12, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Goal: the tight stable step is the element's limit, not a lucky margin: a free element
+    /// stepped at 0.95 of it keeps its energy over thousands of steps, at 1.05 of it blows up.
+    /// Setup: one elastic element (random convex shape squashed down to 1e-3, plane strain,
+    /// plane stress or axisymmetric, the 2x2 kernel or the one-point kernel with kappa 0.05 to
+    /// 1), random nodal velocities (which hold some of the highest mode), a fixed step of 0.95
+    /// and 1.05 times the tight step, 2000 and 400 steps. Reference: central difference on a
+    /// linear system is stable for omega dt <= 2 and its highest mode grows by a factor
+    /// |1 - (omega dt)^2 / 2| + (((omega dt)^2 / 2 - 1)^2 - 1)^(1/2) per step beyond (1.88 at
+    /// 1.05); the run at 0.95 ends `ok` with its kinetic energy below its start plus the strain
+    /// energy it can trade (1.5 times), the run at 1.05 is stopped as blown up (status
+    /// `unstable`) or its energy grows past 1e6 times.
+    #[test]
+    fn tight_step_is_stable_below_and_unstable_above(
+        (x, _) in crushed_quad(),
+        nu in 0.0f64..0.45,
+        kappa in 0.05f64..1.0,
+        form in 0usize..3,
+        reduced: bool,
+        seed in 0u64..1000,
+    ) {
+        let formulation = ["plane_strain", "plane_stress", "axisymmetric"][form];
+        let quadrature = if reduced { "reduced" } else { "full" };
+        let mut model = one_element_model(&x, formulation, quadrature, nu, kappa);
+        use impact::analysis::Status;
+        let (below, status) = kinetic_growth(&mut model, quadrature, kappa, (0.95, 2000, seed));
+        prop_assert!(status == Status::Ok && below < 1.5, "{formulation} {quadrature}: grew {below} at 0.95 ({status:?})");
+        let mut model = one_element_model(&x, formulation, quadrature, nu, kappa);
+        let (above, status) = kinetic_growth(&mut model, quadrature, kappa, (1.05, 400, seed));
+        prop_assert!(status == Status::Unstable || above > 1e6, "{formulation} {quadrature}: grew {above} at 1.05 ({status:?})");
     }
 }

@@ -245,6 +245,42 @@ fn explicit_automatic_step_resume_is_bit_identical() {
     assert!(a["dt_min"].as_f64().unwrap() > 0.0);
 }
 
+/// Goal: the tight stable step resumes bit-identically: its ratios, taken on earlier
+/// configurations, are in the checkpoint. Setup: PLASTIC_BLOCK, frictionless, central
+/// difference with dt = "auto" and `stable_step = "tight"`, checkpoints every 15 steps, killed
+/// at 40. Reference: the uninterrupted run, byte for byte (history.csv with its dt column).
+#[test]
+fn explicit_tight_step_resume_is_bit_identical() {
+    let name = "plastic_block_tight";
+    let set = [
+        "analysis.integrator=central_difference",
+        "analysis.dt=auto",
+        "analysis.stable_step=tight",
+        "analysis.end_time=0.3",
+        "analysis.checkpoint_every=15",
+    ];
+    let text = frictionless();
+    let full = run_full(name, &text, &set);
+    let resumed = run_killed_and_resumed(name, &text, &set, 40);
+    assert_same_output(&full, &resumed, name);
+    // a key that does not apply is refused, naming it (exit 2)
+    for (sets, words) in [
+        (
+            &["analysis.stable_step=tight"][..],
+            "applies to dt = \"auto\" only",
+        ),
+        (
+            &[
+                "analysis.integrator=central_difference",
+                "analysis.stable_step=loose",
+            ][..],
+            "stable_step",
+        ),
+    ] {
+        common::check_refuses_with("models/bar_wall.toml", sets, &[words]);
+    }
+}
+
 /// Goal: history rows at a cadence resume bit-identically: the steps since the last row (whose
 /// extremes may still be written) and that row are in the checkpoint. Setup: PLASTIC_BLOCK,
 /// frictionless, central difference with dt = "auto", a row every 7 steps (and the extremes
@@ -537,7 +573,7 @@ fn resume_without_checkpoint_is_bad_input() {
     assert!(stderr.contains("checkpoint.bin"), "{stderr}");
     assert!(stderr.contains("checkpoint_every"), "{stderr}");
     // an older format is refused as such; the current format with a damaged body as damaged
-    for (version, needle) in [(11u32, "checkpoint format 11"), (12, "damaged checkpoint")] {
+    for (version, needle) in [(12u32, "checkpoint format 12"), (13, "damaged checkpoint")] {
         let mut bytes = b"IMPACTCP".to_vec();
         bytes.extend(version.to_le_bytes());
         bytes.extend(b"garbage");

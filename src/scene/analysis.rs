@@ -31,6 +31,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
         AnalysisKind::Static => {
             given(spec.dt.is_some(), "dt", "static")?;
             given(spec.time_step_scale.is_some(), "time_step_scale", "static")?;
+            given(spec.stable_step.is_some(), "stable_step", "static")?;
             given(spec.dt_min.is_some(), "dt_min", "static")?;
             given(spec.dt_max.is_some(), "dt_max", "static")?;
             given(spec.error_tolerance.is_some(), "error_tolerance", "static")?;
@@ -130,6 +131,7 @@ fn time_step(
         Some(StepSpec::Fixed(dt)) => {
             for (present, key) in [
                 (spec.time_step_scale.is_some(), "time_step_scale"),
+                (spec.stable_step.is_some(), "stable_step"),
                 (spec.dt_min.is_some(), "dt_min"),
                 (spec.dt_max.is_some(), "dt_max"),
                 (spec.error_tolerance.is_some(), "error_tolerance"),
@@ -169,7 +171,8 @@ fn time_step(
                 .dt_min
                 .map(|m| positive(cx, "analysis.dt_min", m))
                 .transpose()?;
-            Ok(TimeStep::Auto { scale, min })
+            let tight = spec.stable_step == Some(crate::scene::spec::StableStepKind::Tight);
+            Ok(TimeStep::Auto { scale, min, tight })
         }
     }
 }
@@ -205,6 +208,11 @@ fn adaptive(
     if spec.time_step_scale.is_some() {
         return Err(cx.err(
             "analysis.time_step_scale: applies to central difference's dt = \"auto\" (the implicit step follows error_tolerance)",
+        ));
+    }
+    if spec.stable_step.is_some() {
+        return Err(cx.err(
+            "analysis.stable_step: applies to central difference's dt = \"auto\" (the implicit step follows error_tolerance)",
         ));
     }
     let tolerance = spec

@@ -352,6 +352,17 @@ pub struct StaticAnalysis {
 impl DynamicAnalysis {
     /// The fixed step (every implicit analysis has one; scene validation refuses `auto`
     /// for them).
+    /// Whether central difference's automatic step scales the elements' exact frequencies
+    /// (`analysis.stable_step = "tight"`) rather than their bounds (the default): not with the
+    /// bulk viscosity (whose damping folds into the bound), the mass scaling (which scales
+    /// elements by their bounds) or the subcycling (whose levels come from the bounds).
+    pub fn tight_step(&self) -> bool {
+        matches!(self.step, TimeStep::Auto { tight: true, .. })
+            && self.bulk_viscosity.is_none()
+            && self.mass_scaling.is_none()
+            && self.subcycling.is_none()
+    }
+
     pub fn fixed_dt(&self) -> Option<f64> {
         match self.step {
             TimeStep::Fixed(dt) => Some(dt),

@@ -38,7 +38,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 9: the mortar pairs' master block in the contact state.
 /// 10: the subcycling's element bounds and counts in the explicit carry.
 /// 12: the history's window since its last row (rows at a cadence, `output::thinning`).
-const FORMAT: u32 = 12;
+/// 13: the tight stable step's ratios in the explicit carry.
+const FORMAT: u32 = 13;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

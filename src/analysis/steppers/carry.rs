@@ -71,6 +71,9 @@ pub struct ExplicitCarry {
     pub mass_scaling: Option<ScalingCarry>,
     /// The subcycling's element bounds and counts (None without it).
     pub subcycling: Option<SubcyclingCarry>,
+    /// The tight stable step's ratios and the bounds they were taken at (None: the kernel's
+    /// bounds stand).
+    pub tightness: Option<crate::assembly::explicit::tight::Tightness>,
 }
 
 /// What a subcycled run carries past a major step: the frequency bound squared of every

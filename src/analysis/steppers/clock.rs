@@ -110,7 +110,7 @@ impl Clock {
                 dt,
                 exact / limit.dt,
             ),
-            TimeStep::Auto { scale, min } => (Rule::Auto { scale, min }, scale * limit.dt, 1.0),
+            TimeStep::Auto { scale, min, .. } => (Rule::Auto { scale, min }, scale * limit.dt, 1.0),
             TimeStep::Adaptive(_) => {
                 unreachable!("the scene gives central difference a fixed or automatic step")
             }

@@ -25,6 +25,7 @@
 //!                       gets a larger s (mass_scaling.rs)
 //! ```
 
+use super::tight::{Tightness, max_frequency_squared, shortest_edge, stiffness_by_differences};
 use super::{
     CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_motion,
     element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
@@ -85,6 +86,10 @@ pub struct Full {
     gather: NodeGather,
     /// The mass scaling (None: off).
     scaling: Option<ElementScaling>,
+    /// Each element's frequency bound of the last step, and the ratios that make them tight
+    /// (`tight`; None: the bounds stand, as with the bulk viscosity and subcycling).
+    bounds: Vec<f64>,
+    tightness: Option<Tightness>,
 }
 
 /// The increment gradient, strain and spin at one point.
@@ -279,6 +284,8 @@ impl Full {
             gather: NodeGather::new(&layout.nodes, state.coordinates.len()),
             layout,
             scaling: None,
+            bounds: vec![0.0; count],
+            tightness: None,
         };
         for &(b, e) in &kernel.layout.origin {
             let committed = &state.bodies[b];
@@ -298,8 +305,42 @@ impl Full {
     }
 
     /// The kernel with the bulk viscosity `viscosity` (None: off).
+    /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
+    /// the exact frequency, `tight`) or its elements' bounds (the default).
+    pub fn with_tight_step(self, on: bool) -> Full {
+        let tightness = on.then(|| Tightness::new(self.bounds.len()));
+        Full { tightness, ..self }
+    }
+
+    /// Its damping folds into the bound, which then stands (no tight ratio).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Full {
-        Full { viscosity, ..self }
+        let tightness = self.tightness.filter(|_| viscosity.is_none());
+        Full {
+            viscosity,
+            tightness,
+            ..self
+        }
+    }
+
+    /// The exact highest frequency squared of element `e` at the nodes `xe` with its masses:
+    /// the kernel's stiffness from a stress-free state (`tight`).
+    fn exact_frequency(&self, xe: &Nodes, e: usize) -> Option<f64> {
+        let p = self.parameters(e);
+        let fresh = PointsState {
+            stress: [[0.0; 4]; 4],
+            back_stress: [[0.0; 4]; 4],
+            eq_plastic_strain: [0.0; 4],
+            viscous_pressure: [0.0; 4],
+            ..self.state_of(e)
+        };
+        let lumped = self.lumped_of(e);
+        let h = 1e-7 * shortest_edge(xe);
+        let k = stiffness_by_differences(h, |u| {
+            element_step(p, (xe, u), &fresh, &lumped, (1.0, None))
+                .ok()
+                .map(|r| r.force)
+        })?;
+        Some(max_frequency_squared(&k, &lumped))
     }
 
     /// The kernel with the mass scaling `rule` (None: off), the elements below its target
@@ -338,6 +379,106 @@ impl Full {
             Some(v) => damped_frequency_squared(w, v.damping_fraction_at_rest()),
             None => w,
         })
+    }
+
+    /// The element loop of a step: the elements' new states, forces and frequency bounds
+    /// (`bounds`), the sums with the largest bound.
+    fn step_bounds(
+        &mut self,
+        x: &[[f64; 2]],
+        du: &[f64],
+        dt: f64,
+    ) -> Result<StepWork, ElementFailure> {
+        let layout = &self.layout;
+        let lumped = &self.lumped;
+        let viscosity = self.viscosity.as_ref();
+        let scaling = self.scaling.as_ref();
+        let results: Vec<ChunkResult> = (
+            self.stress.par_chunks_mut(16 * CHUNK),
+            self.back_stress.par_chunks_mut(16 * CHUNK),
+            self.eq_plastic_strain.par_chunks_mut(4 * CHUNK),
+            self.temperature.par_chunks_mut(4 * CHUNK),
+            self.thickness.par_chunks_mut(4 * CHUNK),
+            self.viscous_pressure.par_chunks_mut(4 * CHUNK),
+            self.element_forces.par_chunks_mut(8 * CHUNK),
+            self.bounds.par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(
+                |(k, (stress, back, eps_p, temperature, thickness, viscous, forces, bounds))| {
+                    let mut sums = StepWork::default();
+                    let mut grown = Vec::new();
+                    for i in 0..forces.len() / 8 {
+                        let e = k * CHUNK + i;
+                        let element = layout.nodes[e];
+                        let xe: Nodes = element.map(|n| x[n as usize]);
+                        let ue: Nodes =
+                            element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+                        let committed = PointsState {
+                            stress: std::array::from_fn(|q| {
+                                std::array::from_fn(|c| stress[16 * i + 4 * q + c])
+                            }),
+                            back_stress: std::array::from_fn(|q| {
+                                std::array::from_fn(|c| back[16 * i + 4 * q + c])
+                            }),
+                            eq_plastic_strain: std::array::from_fn(|q| eps_p[4 * i + q]),
+                            temperature: std::array::from_fn(|q| temperature[4 * i + q]),
+                            thickness: std::array::from_fn(|q| thickness[4 * i + q]),
+                            viscous_pressure: std::array::from_fn(|q| viscous[4 * i + q]),
+                        };
+                        let p = &layout.bodies[layout.body[e] as usize];
+                        let factor = scaling.map(|s| s.factor(e));
+                        let element_lumped = scaled(&lumped[e], factor);
+                        let motion = (&xe, &ue);
+                        let step = (dt, viscosity);
+                        let r = match element_step(p, motion, &committed, &element_lumped, step) {
+                            Ok(r) => r,
+                            Err(err) => return (sums, Some((e, err)), grown),
+                        };
+                        let omega_squared = match scaling
+                            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
+                        {
+                            Some(rescaled) => {
+                                grown.push((e, rescaled.factor));
+                                rescaled.omega_squared
+                            }
+                            None => r.omega_squared,
+                        };
+                        sums.observe(omega_squared, e);
+                        bounds[i] = omega_squared;
+                        for q in 0..4 {
+                            stress[16 * i + 4 * q..16 * i + 4 * q + 4]
+                                .copy_from_slice(&r.state.stress[q]);
+                            back[16 * i + 4 * q..16 * i + 4 * q + 4]
+                                .copy_from_slice(&r.state.back_stress[q]);
+                        }
+                        eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
+                        temperature[4 * i..4 * i + 4].copy_from_slice(&r.state.temperature);
+                        thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
+                        viscous[4 * i..4 * i + 4].copy_from_slice(&r.state.viscous_pressure);
+                        forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
+                        sums.internal += r.work;
+                        sums.plastic += r.plastic_work;
+                        sums.viscous += r.viscous_work;
+                    }
+                    (sums, None, grown)
+                },
+            )
+            .collect();
+        let mut total = StepWork::default();
+        for (sums, error, grown) in results {
+            if let Some((e, err)) = error {
+                return Err(self.layout.failure(e, err));
+            }
+            total.add(&sums);
+            if let Some(scaling) = self.scaling.as_mut() {
+                for (e, factor) in grown {
+                    scaling.grow(e, factor);
+                }
+            }
+        }
+        Ok(total)
     }
 
     fn state_of(&self, e: usize) -> PointsState {
@@ -452,8 +593,16 @@ impl ExplicitKernel for Full {
 
     fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure> {
         let mut worst = StepWork::default();
+        let mut bounds = Vec::with_capacity(self.elements());
         for e in 0..self.elements() {
-            worst.observe(self.frequency(x, e)?, e);
+            let bound = self.frequency(x, e)?;
+            worst.observe(bound, e);
+            bounds.push(bound);
+        }
+        if let Some(tight) = &self.tightness {
+            let nodes = |e: usize| self.layout.nodes[e].map(|n| x[n as usize]);
+            (worst.omega_squared, worst.critical_element) =
+                tight.peek(&bounds, |e| self.exact_frequency(&nodes(e), e));
         }
         Ok(stable_step_of(&self.layout, &worst))
     }
@@ -465,92 +614,17 @@ impl ExplicitKernel for Full {
         dt: f64,
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
-        let layout = &self.layout;
-        let lumped = &self.lumped;
-        let viscosity = self.viscosity.as_ref();
-        let scaling = self.scaling.as_ref();
-        let results: Vec<ChunkResult> = (
-            self.stress.par_chunks_mut(16 * CHUNK),
-            self.back_stress.par_chunks_mut(16 * CHUNK),
-            self.eq_plastic_strain.par_chunks_mut(4 * CHUNK),
-            self.temperature.par_chunks_mut(4 * CHUNK),
-            self.thickness.par_chunks_mut(4 * CHUNK),
-            self.viscous_pressure.par_chunks_mut(4 * CHUNK),
-            self.element_forces.par_chunks_mut(8 * CHUNK),
-        )
-            .into_par_iter()
-            .enumerate()
-            .map(
-                |(k, (stress, back, eps_p, temperature, thickness, viscous, forces))| {
-                    let mut sums = StepWork::default();
-                    let mut grown = Vec::new();
-                    for i in 0..forces.len() / 8 {
-                        let e = k * CHUNK + i;
-                        let element = layout.nodes[e];
-                        let xe: Nodes = element.map(|n| x[n as usize]);
-                        let ue: Nodes =
-                            element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
-                        let committed = PointsState {
-                            stress: std::array::from_fn(|q| {
-                                std::array::from_fn(|c| stress[16 * i + 4 * q + c])
-                            }),
-                            back_stress: std::array::from_fn(|q| {
-                                std::array::from_fn(|c| back[16 * i + 4 * q + c])
-                            }),
-                            eq_plastic_strain: std::array::from_fn(|q| eps_p[4 * i + q]),
-                            temperature: std::array::from_fn(|q| temperature[4 * i + q]),
-                            thickness: std::array::from_fn(|q| thickness[4 * i + q]),
-                            viscous_pressure: std::array::from_fn(|q| viscous[4 * i + q]),
-                        };
-                        let p = &layout.bodies[layout.body[e] as usize];
-                        let factor = scaling.map(|s| s.factor(e));
-                        let element_lumped = scaled(&lumped[e], factor);
-                        let motion = (&xe, &ue);
-                        let step = (dt, viscosity);
-                        let r = match element_step(p, motion, &committed, &element_lumped, step) {
-                            Ok(r) => r,
-                            Err(err) => return (sums, Some((e, err)), grown),
-                        };
-                        let omega_squared = match scaling
-                            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
-                        {
-                            Some(rescaled) => {
-                                grown.push((e, rescaled.factor));
-                                rescaled.omega_squared
-                            }
-                            None => r.omega_squared,
-                        };
-                        sums.observe(omega_squared, e);
-                        for q in 0..4 {
-                            stress[16 * i + 4 * q..16 * i + 4 * q + 4]
-                                .copy_from_slice(&r.state.stress[q]);
-                            back[16 * i + 4 * q..16 * i + 4 * q + 4]
-                                .copy_from_slice(&r.state.back_stress[q]);
-                        }
-                        eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
-                        temperature[4 * i..4 * i + 4].copy_from_slice(&r.state.temperature);
-                        thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
-                        viscous[4 * i..4 * i + 4].copy_from_slice(&r.state.viscous_pressure);
-                        forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
-                        sums.internal += r.work;
-                        sums.plastic += r.plastic_work;
-                        sums.viscous += r.viscous_work;
-                    }
-                    (sums, None, grown)
-                },
-            )
-            .collect();
-        let mut total = StepWork::default();
-        for (sums, error, grown) in results {
-            if let Some((e, err)) = error {
-                return Err(self.layout.failure(e, err));
-            }
-            total.add(&sums);
-            if let Some(scaling) = self.scaling.as_mut() {
-                for (e, factor) in grown {
-                    scaling.grow(e, factor);
-                }
-            }
+        let mut total = self.step_bounds(x, du, dt)?;
+        if let Some(mut tight) = self.tightness.take() {
+            let end = |e: usize| {
+                self.layout.nodes[e].map(|n| {
+                    let n = n as usize;
+                    [x[n][0] + du[2 * n], x[n][1] + du[2 * n + 1]]
+                })
+            };
+            (total.omega_squared, total.critical_element) =
+                tight.apply(&self.bounds, |e| self.exact_frequency(&end(e), e));
+            self.tightness = Some(tight);
         }
         self.gather.gather(&self.element_forces, force);
         Ok(total)
@@ -597,6 +671,16 @@ impl ExplicitKernel for Full {
 
     fn mass_scaling(&self) -> Option<&ElementScaling> {
         self.scaling.as_ref()
+    }
+
+    fn tightness(&self) -> Option<&Tightness> {
+        self.tightness.as_ref()
+    }
+
+    fn restore_tightness(&mut self, tightness: Tightness) {
+        if self.tightness.is_some() {
+            self.tightness = Some(tightness);
+        }
     }
 
     fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling> {

@@ -11,6 +11,7 @@
 pub mod full;
 pub mod general;
 pub mod one_point;
+pub mod tight;
 
 pub use full::Full;
 pub use general::General;
@@ -371,6 +372,13 @@ pub trait ExplicitKernel: Send {
     /// added, and the nodal masses the run has still to take.
     fn mass_scaling(&self) -> Option<&ElementScaling>;
     fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling>;
+    /// The tight stable step's ratios (None: the element bounds stand): what a checkpoint
+    /// carries, since the ratios were taken on earlier configurations.
+    fn tightness(&self) -> Option<&tight::Tightness> {
+        None
+    }
+    /// Takes the ratios of a checkpoint (as `tightness` gave them).
+    fn restore_tightness(&mut self, _tightness: tight::Tightness) {}
     /// The element loop a subcycled run steps a few elements at a time with (None: the
     /// kernel steps all its elements together only).
     fn partial(&mut self) -> Option<&mut dyn PartialKernel> {
@@ -506,6 +514,7 @@ pub fn kernel_for<'a>(
         Quadrature::Reduced => (
             Box::new(
                 Reduced::new(model, state, spec.hourglass, masses)
+                    .with_tight_step(spec.tight_step())
                     .with_bulk_viscosity(spec.bulk_viscosity)
                     .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
             ),
@@ -514,6 +523,7 @@ pub fn kernel_for<'a>(
         Quadrature::Full if quads_only && spec.geometry == Strain::Finite => (
             Box::new(
                 Full::new(model, state, masses)
+                    .with_tight_step(spec.tight_step())
                     .with_bulk_viscosity(spec.bulk_viscosity)
                     .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
             ),

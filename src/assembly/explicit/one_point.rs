@@ -19,6 +19,7 @@
 //! the chunk sums of the work are added in chunk order. The bits do not depend on the thread
 //! count.
 
+use super::tight::{Tightness, max_frequency_squared, shortest_edge, stiffness_by_differences};
 use super::{
     BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
     element_motion, element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
@@ -227,6 +228,12 @@ pub struct Reduced {
     pub hourglass_energy: f64,
     /// The mass scaling (None: off).
     scaling: Option<ElementScaling>,
+    /// The lumped mass at the four nodes of each element (unscaled), for the exact frequency.
+    nodal: Vec<[f64; 4]>,
+    /// Each element's frequency bound of the last step, and the ratios that make them tight
+    /// (`tight`; None: the bounds stand, as with the bulk viscosity and subcycling).
+    bounds: Vec<f64>,
+    tightness: Option<Tightness>,
 }
 
 impl Reduced {
@@ -243,6 +250,7 @@ impl Reduced {
             Vec::with_capacity(count),
             Vec::with_capacity(count),
         );
+        let mut nodal_masses = Vec::with_capacity(count);
         for &(b, e) in &layout.origin {
             let committed = &state.bodies[b];
             let p = &committed.points[4 * e];
@@ -256,6 +264,7 @@ impl Reduced {
                 smallest: nodal.iter().copied().fold(f64::INFINITY, f64::min),
                 total: nodal.iter().sum(),
             });
+            nodal_masses.push([nodal[0], nodal[1], nodal[2], nodal[3]]);
         }
         let gather = NodeGather::new(&layout.nodes, state.coordinates.len());
         Reduced {
@@ -273,12 +282,53 @@ impl Reduced {
             gather,
             hourglass_energy: 0.0,
             scaling: None,
+            nodal: nodal_masses,
+            bounds: vec![0.0; count],
+            tightness: None,
         }
     }
 
     /// The kernel with the bulk viscosity `viscosity` (None: off).
+    /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
+    /// the exact frequency, `tight`) or its elements' bounds (the default).
+    pub fn with_tight_step(self, on: bool) -> Reduced {
+        let tightness = on.then(|| Tightness::new(self.bounds.len()));
+        Reduced { tightness, ..self }
+    }
+
+    /// Its damping folds into the bound, which then stands (no tight ratio).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Reduced {
-        Reduced { viscosity, ..self }
+        let tightness = self.tightness.filter(|_| viscosity.is_none());
+        Reduced {
+            viscosity,
+            tightness,
+            ..self
+        }
+    }
+
+    /// The exact highest frequency squared of element `e` at the nodes `xe` with its masses:
+    /// the kernel's stiffness (hourglass and hoop included) from a stress-free state
+    /// (`tight`).
+    fn exact_frequency(&self, xe: &Nodes, e: usize) -> Option<f64> {
+        let p = &self.layout.bodies[self.layout.body[e] as usize];
+        let fresh = ElementState {
+            stress: [0.0; 4],
+            back_stress: [0.0; 4],
+            eq_plastic_strain: 0.0,
+            hourglass: [0.0; 2],
+            viscous_pressure: 0.0,
+            ..self.state_of(e)
+        };
+        let mass = self.mass_of(e);
+        let factor = self.scaling.as_ref().map_or(1.0, |s| s.factor(e));
+        let lumped = self.nodal[e].map(|m| m * factor);
+        let h = 1e-7 * shortest_edge(xe);
+        let k = stiffness_by_differences(h, |u| {
+            element_step(p, (xe, u), &fresh, mass, (1.0, None))
+                .ok()
+                .map(|r| r.force)
+        })?;
+        Some(max_frequency_squared(&k, &lumped))
     }
 
     /// The kernel with the mass scaling `rule` (None: off), the elements below its target
@@ -366,6 +416,116 @@ impl Reduced {
         self.viscous_pressure[e] = state.viscous_pressure;
     }
 
+    /// The element loop of a step: the elements' new states, forces and frequency bounds
+    /// (`bounds`), the sums with the largest bound.
+    fn step_bounds(
+        &mut self,
+        x: &[[f64; 2]],
+        du: &[f64],
+        dt: f64,
+    ) -> Result<StepWork, ElementFailure> {
+        let layout = &self.layout;
+        let mass = &self.mass;
+        let viscosity = self.viscosity.as_ref();
+        let scaling = self.scaling.as_ref();
+        let results: Vec<ChunkResult> = (
+            self.stress.par_chunks_mut(4 * CHUNK),
+            self.back_stress.par_chunks_mut(4 * CHUNK),
+            self.eq_plastic_strain.par_chunks_mut(CHUNK),
+            self.temperature.par_chunks_mut(CHUNK),
+            self.thickness.par_chunks_mut(CHUNK),
+            self.hourglass.par_chunks_mut(2 * CHUNK),
+            self.viscous_pressure.par_chunks_mut(CHUNK),
+            self.element_forces.par_chunks_mut(8 * CHUNK),
+            self.bounds.par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, chunks)| {
+                let (
+                    stress,
+                    back,
+                    eps_p,
+                    temperature,
+                    thickness,
+                    hourglass,
+                    viscous,
+                    forces,
+                    bounds,
+                ) = chunks;
+                let mut sums = StepWork::default();
+                let mut grown = Vec::new();
+                for i in 0..eps_p.len() {
+                    let e = k * CHUNK + i;
+                    let element = layout.nodes[e];
+                    let xe: Nodes = element.map(|n| x[n as usize]);
+                    let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
+                    let committed = ElementState {
+                        stress: std::array::from_fn(|c| stress[4 * i + c]),
+                        back_stress: std::array::from_fn(|c| back[4 * i + c]),
+                        eq_plastic_strain: eps_p[i],
+                        temperature: temperature[i],
+                        thickness: thickness[i],
+                        hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
+                        viscous_pressure: viscous[i],
+                    };
+                    let p = &layout.bodies[layout.body[e] as usize];
+                    let element_mass = match scaling {
+                        Some(scaling) => mass[e].scaled(scaling.factor(e)),
+                        None => mass[e],
+                    };
+                    let r = match element_step(
+                        p,
+                        (&xe, &ue),
+                        &committed,
+                        element_mass,
+                        (dt, viscosity),
+                    ) {
+                        Ok(r) => r,
+                        Err(err) => return (sums, Some((e, err)), grown),
+                    };
+                    let omega_squared = match scaling
+                        .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
+                    {
+                        Some(rescaled) => {
+                            grown.push((e, rescaled.factor));
+                            rescaled.omega_squared
+                        }
+                        None => r.omega_squared,
+                    };
+                    sums.observe(omega_squared, e);
+                    bounds[i] = omega_squared;
+                    stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
+                    back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
+                    eps_p[i] = r.state.eq_plastic_strain;
+                    temperature[i] = r.state.temperature;
+                    thickness[i] = r.state.thickness;
+                    hourglass[2 * i..2 * i + 2].copy_from_slice(&r.state.hourglass);
+                    viscous[i] = r.state.viscous_pressure;
+                    forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
+                    sums.internal += r.work + r.hourglass_work;
+                    sums.plastic += r.plastic_work;
+                    sums.hourglass += r.hourglass_work;
+                    sums.viscous += r.viscous_work;
+                }
+                (sums, None, grown)
+            })
+            .collect();
+        let mut total = StepWork::default();
+        for (sums, error, grown) in results {
+            if let Some((e, err)) = error {
+                return Err(self.layout.failure(e, err));
+            }
+            total.add(&sums);
+            if let Some(scaling) = self.scaling.as_mut() {
+                for (e, factor) in grown {
+                    scaling.grow(e, factor);
+                }
+            }
+        }
+        Ok(total)
+    }
+
     fn state_of(&self, e: usize) -> ElementState {
         ElementState {
             stress: std::array::from_fn(|k| self.stress[4 * e + k]),
@@ -422,8 +582,16 @@ impl ExplicitKernel for Reduced {
 
     fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure> {
         let mut worst = StepWork::default();
+        let mut bounds = Vec::with_capacity(self.elements());
         for e in 0..self.elements() {
-            worst.observe(self.frequency(x, e)?, e);
+            let bound = self.frequency(x, e)?;
+            worst.observe(bound, e);
+            bounds.push(bound);
+        }
+        if let Some(tight) = &self.tightness {
+            let nodes = |e: usize| self.layout.nodes[e].map(|n| x[n as usize]);
+            (worst.omega_squared, worst.critical_element) =
+                tight.peek(&bounds, |e| self.exact_frequency(&nodes(e), e));
         }
         Ok(stable_step_of(&self.layout, &worst))
     }
@@ -435,93 +603,17 @@ impl ExplicitKernel for Reduced {
         dt: f64,
         force: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
-        let layout = &self.layout;
-        let mass = &self.mass;
-        let viscosity = self.viscosity.as_ref();
-        let scaling = self.scaling.as_ref();
-        let results: Vec<ChunkResult> = (
-            self.stress.par_chunks_mut(4 * CHUNK),
-            self.back_stress.par_chunks_mut(4 * CHUNK),
-            self.eq_plastic_strain.par_chunks_mut(CHUNK),
-            self.temperature.par_chunks_mut(CHUNK),
-            self.thickness.par_chunks_mut(CHUNK),
-            self.hourglass.par_chunks_mut(2 * CHUNK),
-            self.viscous_pressure.par_chunks_mut(CHUNK),
-            self.element_forces.par_chunks_mut(8 * CHUNK),
-        )
-            .into_par_iter()
-            .enumerate()
-            .map(|(k, chunks)| {
-                let (stress, back, eps_p, temperature, thickness, hourglass, viscous, forces) =
-                    chunks;
-                let mut sums = StepWork::default();
-                let mut grown = Vec::new();
-                for i in 0..eps_p.len() {
-                    let e = k * CHUNK + i;
-                    let element = layout.nodes[e];
-                    let xe: Nodes = element.map(|n| x[n as usize]);
-                    let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
-                    let committed = ElementState {
-                        stress: std::array::from_fn(|c| stress[4 * i + c]),
-                        back_stress: std::array::from_fn(|c| back[4 * i + c]),
-                        eq_plastic_strain: eps_p[i],
-                        temperature: temperature[i],
-                        thickness: thickness[i],
-                        hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
-                        viscous_pressure: viscous[i],
-                    };
-                    let p = &layout.bodies[layout.body[e] as usize];
-                    let element_mass = match scaling {
-                        Some(scaling) => mass[e].scaled(scaling.factor(e)),
-                        None => mass[e],
-                    };
-                    let r = match element_step(
-                        p,
-                        (&xe, &ue),
-                        &committed,
-                        element_mass,
-                        (dt, viscosity),
-                    ) {
-                        Ok(r) => r,
-                        Err(err) => return (sums, Some((e, err)), grown),
-                    };
-                    let omega_squared = match scaling
-                        .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
-                    {
-                        Some(rescaled) => {
-                            grown.push((e, rescaled.factor));
-                            rescaled.omega_squared
-                        }
-                        None => r.omega_squared,
-                    };
-                    sums.observe(omega_squared, e);
-                    stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
-                    back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
-                    eps_p[i] = r.state.eq_plastic_strain;
-                    temperature[i] = r.state.temperature;
-                    thickness[i] = r.state.thickness;
-                    hourglass[2 * i..2 * i + 2].copy_from_slice(&r.state.hourglass);
-                    viscous[i] = r.state.viscous_pressure;
-                    forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
-                    sums.internal += r.work + r.hourglass_work;
-                    sums.plastic += r.plastic_work;
-                    sums.hourglass += r.hourglass_work;
-                    sums.viscous += r.viscous_work;
-                }
-                (sums, None, grown)
-            })
-            .collect();
-        let mut total = StepWork::default();
-        for (sums, error, grown) in results {
-            if let Some((e, err)) = error {
-                return Err(self.layout.failure(e, err));
-            }
-            total.add(&sums);
-            if let Some(scaling) = self.scaling.as_mut() {
-                for (e, factor) in grown {
-                    scaling.grow(e, factor);
-                }
-            }
+        let mut total = self.step_bounds(x, du, dt)?;
+        if let Some(mut tight) = self.tightness.take() {
+            let end = |e: usize| {
+                self.layout.nodes[e].map(|n| {
+                    let n = n as usize;
+                    [x[n][0] + du[2 * n], x[n][1] + du[2 * n + 1]]
+                })
+            };
+            (total.omega_squared, total.critical_element) =
+                tight.apply(&self.bounds, |e| self.exact_frequency(&end(e), e));
+            self.tightness = Some(tight);
         }
         self.gather.gather(&self.element_forces, force);
         self.hourglass_energy += total.hourglass;
@@ -584,6 +676,16 @@ impl ExplicitKernel for Reduced {
 
     fn mass_scaling(&self) -> Option<&ElementScaling> {
         self.scaling.as_ref()
+    }
+
+    fn tightness(&self) -> Option<&Tightness> {
+        self.tightness.as_ref()
+    }
+
+    fn restore_tightness(&mut self, tightness: Tightness) {
+        if self.tightness.is_some() {
+            self.tightness = Some(tightness);
+        }
     }
 
     fn mass_scaling_mut(&mut self) -> Option<&mut ElementScaling> {

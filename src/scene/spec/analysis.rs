@@ -99,6 +99,10 @@ pub struct AnalysisSpec {
     pub dt: Option<StepSpec>,
     /// `dt = "auto"`: the fraction of the critical step taken, in (0, 1]. Default 0.9.
     pub time_step_scale: Option<f64>,
+    /// `dt = "auto"`, central difference: the critical step the scale applies to: `bound`
+    /// (default: the kernels' closed-form frequency bounds) or `tight` (each element's exact
+    /// highest frequency, `assembly::explicit::tight`: up to twice the step).
+    pub stable_step: Option<StableStepKind>,
     /// `dt = "auto"`, central difference: the run stops (status `diverged`) when the step
     /// would fall below this (a time); default no limit. Implicit: the shortest step the
     /// error control takes (a step there is accepted whatever its estimate); default none,
@@ -246,11 +250,24 @@ pub enum TimeStep {
     /// The same step throughout (the last one shorter to end at `end_time`).
     Fixed(f64),
     /// `scale` times the critical step of the current configuration, every step; the run
-    /// stops when it would fall below `min`.
-    Auto { scale: f64, min: Option<f64> },
+    /// stops when it would fall below `min`; `tight`: the elements' exact frequencies, else
+    /// their bounds.
+    Auto {
+        scale: f64,
+        min: Option<f64>,
+        tight: bool,
+    },
     /// Implicit: each step as long as the local error estimate allows; the first from the
     /// wave speed and the smallest element.
     Adaptive(AdaptiveStep),
+}
+
+/// `analysis.stable_step`: the critical step central difference's `dt = "auto"` scales.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StableStepKind {
+    Tight,
+    Bound,
 }
 
 /// The implicit error-controlled step (`dt = "auto"`): the tolerance of the local error

@@ -507,6 +507,10 @@ impl Resume for Explicit<'_> {
             self.kernel
                 .restore_viscous_pressure(&carry.viscous_pressure);
         }
+        // the tight step's ratios as the run had taken them
+        if let Some(tightness) = carry.tightness {
+            self.kernel.restore_tightness(tightness);
+        }
         // the factors and the nodal masses as the run had grown them
         if let Some(scaling) = self.kernel.mass_scaling_mut()
             && let Some(carried) = &carry.mass_scaling
@@ -554,6 +558,7 @@ impl Resume for Explicit<'_> {
             },
             mass_scaling: self.kernel.mass_scaling().map(|s| s.carry(&self.mass)),
             subcycling: self.subcycler.as_ref().map(|s| s.carry()),
+            tightness: self.kernel.tightness().cloned(),
         }))
     }
 }

@@ -1,0 +1,201 @@
+//! The tight stable step: each element's closed-form frequency bound (what the kernels give
+//! every step, cheap and never below the truth) times the ratio of the element's exact highest
+//! frequency squared to that bound, the ratio taken again whenever the element's bound has
+//! moved by more than `DRIFT` since (docs/theory.md 8.7).
+//!
+//! ```text
+//! omega_e^2 (step n)  =  rho_e  bound_e(n),      rho_e = lambda_max(M_e^-1 K_e) / bound_e
+//!                                                 at the last step where |bound_e / at_e - 1|
+//!                                                 exceeded DRIFT (at_e: the bound then)
+//! K_e                 the kernel's own stiffness on the element's current configuration,
+//!                     from a stress-free state (elastic; hourglass, hoop and B-bar as the
+//!                     kernel has them), by central differences of its nodal forces
+//! M_e                 the element's lumped masses as the bound takes them (mass scaling's
+//!                     factor included)
+//! ```
+//!
+//! The elastic tangent is the stiffest the material can be (plastic flow only softens it), and
+//! Irons' element eigenvalue inequality puts the mesh's highest frequency below the largest
+//! element's: 2 / sqrt(max_e omega_e^2) is a stable step of the whole mesh, to the drift of
+//! the ratio between two evaluations (the bound tracks the element's size every step; the ratio
+//! only its shape, within DRIFT of it).
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// How far an element's bound may move (relative) before its ratio is taken again.
+pub const DRIFT: f64 = 0.02;
+
+/// Per element, the ratio of its exact frequency squared to its bound and the bound it was
+/// taken at (0: not yet taken).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Tightness {
+    ratio: Vec<f64>,
+    at: Vec<f64>,
+}
+
+impl Tightness {
+    /// `elements` elements, no ratio taken yet.
+    pub fn new(elements: usize) -> Tightness {
+        Tightness {
+            ratio: vec![1.0; elements],
+            at: vec![0.0; elements],
+        }
+    }
+
+    /// Whether element `e`'s ratio is due again at its bound `bound`.
+    fn stale(&self, e: usize, bound: f64) -> bool {
+        let at = self.at[e];
+        !(at > 0.0 && (bound / at - 1.0).abs() <= DRIFT)
+    }
+
+    /// The ratio of element `e` for its bound `bound` and exact value `exact` (None: the
+    /// exact value could not be formed; the bound then stands). Never above 1 (round-off of
+    /// the differences aside, the bound is an upper bound).
+    fn ratio_of(bound: f64, exact: Option<f64>) -> f64 {
+        match exact {
+            Some(exact) if bound > 0.0 && exact.is_finite() && exact > 0.0 => {
+                (exact / bound).min(1.0)
+            }
+            _ => 1.0,
+        }
+    }
+
+    /// The tight frequency squared of every element from this step's `bounds`, the largest
+    /// and its element (the lowest index among equals), the stale ratios taken again with
+    /// `exact(e)` (in parallel; the result does not depend on the thread count).
+    pub fn apply(
+        &mut self,
+        bounds: &[f64],
+        exact: impl Fn(usize) -> Option<f64> + Sync,
+    ) -> (f64, usize) {
+        let stale: Vec<usize> = (0..bounds.len())
+            .filter(|&e| self.stale(e, bounds[e]))
+            .collect();
+        let fresh: Vec<f64> = stale
+            .par_iter()
+            .map(|&e| Tightness::ratio_of(bounds[e], exact(e)))
+            .collect();
+        for (&e, ratio) in stale.iter().zip(fresh) {
+            self.ratio[e] = ratio;
+            self.at[e] = bounds[e];
+        }
+        self.largest(bounds, |e| self.ratio[e])
+    }
+
+    /// As `apply`, without keeping the ratios taken (the stable step of a configuration
+    /// before a step, `impact check`).
+    pub fn peek(
+        &self,
+        bounds: &[f64],
+        exact: impl Fn(usize) -> Option<f64> + Sync,
+    ) -> (f64, usize) {
+        let ratios: Vec<f64> = (0..bounds.len())
+            .into_par_iter()
+            .map(|e| match self.stale(e, bounds[e]) {
+                true => Tightness::ratio_of(bounds[e], exact(e)),
+                false => self.ratio[e],
+            })
+            .collect();
+        self.largest(bounds, |e| ratios[e])
+    }
+
+    fn largest(&self, bounds: &[f64], ratio: impl Fn(usize) -> f64) -> (f64, usize) {
+        let mut best = (0.0, usize::MAX);
+        for (e, bound) in bounds.iter().enumerate() {
+            let omega_squared = ratio(e) * bound;
+            if omega_squared > best.0 {
+                best = (omega_squared, e);
+            }
+        }
+        best
+    }
+}
+
+/// The largest eigenvalue of M^-1 K for an 8 x 8 element stiffness `k` (symmetrized) and the
+/// lumped nodal masses `lumped` (each for both directions of its node).
+pub fn max_frequency_squared(k: &[[f64; 8]; 8], lumped: &[f64; 4]) -> f64 {
+    let scale: [f64; 8] = std::array::from_fn(|i| 1.0 / lumped[i / 2].sqrt());
+    let a = nalgebra::SMatrix::<f64, 8, 8>::from_fn(|i, j| {
+        0.5 * (k[i][j] + k[j][i]) * scale[i] * scale[j]
+    });
+    a.symmetric_eigenvalues().max()
+}
+
+/// The stiffness of an element's nodal forces `force(u)` (u: a nodal increment from the
+/// stress-free state; forces linear in it) by central differences with step `h` (a small
+/// fraction of the element's shortest edge: the forces are linear to O(h^2 / L^2)). None when
+/// a force could not be formed.
+pub fn stiffness_by_differences(
+    h: f64,
+    force: impl Fn(&[[f64; 2]; 4]) -> Option<[f64; 8]>,
+) -> Option<[[f64; 8]; 8]> {
+    let mut k = [[0.0; 8]; 8];
+    for j in 0..8 {
+        let mut u = [[0.0; 2]; 4];
+        u[j / 2][j % 2] = h;
+        let plus = force(&u)?;
+        u[j / 2][j % 2] = -h;
+        let minus = force(&u)?;
+        for i in 0..8 {
+            k[i][j] = (plus[i] - minus[i]) / (2.0 * h);
+        }
+    }
+    Some(k)
+}
+
+/// The shortest edge of a quad.
+pub fn shortest_edge(x: &[[f64; 2]; 4]) -> f64 {
+    (0..4)
+        .map(|a| {
+            let (p, q) = (x[a], x[(a + 1) % 4]);
+            (q[0] - p[0]).hypot(q[1] - p[1])
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Goal: a ratio is taken once, kept while the bound stays within DRIFT, taken again past
+    /// it; the largest tight value and its element. Reference: by hand.
+    #[test]
+    fn ratios_are_kept_within_the_drift_and_taken_again_past_it() {
+        let mut t = Tightness::new(2);
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let exact = |e: usize| {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            Some([2.0, 3.0][e])
+        };
+        // ratios 0.5 and 0.75: tight values 2 and 3
+        assert_eq!(t.apply(&[4.0, 4.0], exact), (3.0, 1));
+        assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 2);
+        // element 0's bound moves 1 %: kept (0.5 * 4.04); element 1 by 5 %: taken again
+        // (exact 3 over 4.2)
+        assert_eq!(t.apply(&[4.04, 4.2], exact), (3.0, 1));
+        assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 3);
+        assert_eq!(t.ratio[0], 0.5);
+        // a bound below the exact value (round-off) is not trusted beyond 1
+        let mut t = Tightness::new(1);
+        assert_eq!(t.apply(&[1.0], |_| Some(1.0 + 1e-12)), (1.0, 0));
+        assert_eq!(t.apply(&[1.0], |_| None).0, 1.0);
+    }
+
+    /// Goal: the eigenvalue of M^-1 K of a known system. Reference: two unit masses joined
+    /// by a spring k along x (nodes 0 and 1): omega^2 = 2 k / m; the other DOFs free.
+    #[test]
+    fn spring_between_two_masses() {
+        let mut k = [[0.0; 8]; 8];
+        let s = 3.0;
+        k[0][0] = s;
+        k[2][2] = s;
+        k[0][2] = -s;
+        k[2][0] = -s;
+        let w = max_frequency_squared(&k, &[1.0, 1.0, 5.0, 5.0]);
+        assert!((w - 6.0).abs() < 1e-12, "{w}");
+        let w = max_frequency_squared(&k, &[2.0, 1.0, 5.0, 5.0]);
+        // 1/m_0 + 1/m_1 = 1.5 times s
+        assert!((w - 4.5).abs() < 1e-12, "{w}");
+    }
+}
