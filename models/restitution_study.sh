@@ -4,16 +4,18 @@
 # on three paths (central difference 2x2 B-bar, central difference one-point, Newmark average
 # at a fixed step), each run to 1.6 Hertz contact times of its speed, and Thornton's (1997)
 # closed form beside them. Writes OUT/restitution.csv: one row per speed with e per path and
-# each run's wall seconds.
-# Usage (from the repository root): bash models/restitution_study.sh [OUT] [N]
-#   N: the sphere's arc steps (default the scene's 40; the mesh keeps its grading 20).
+# each run's wall seconds, and its chart FIGURES/sphere_restitution.svg (e against V / V_y).
+# Usage (from the repository root): bash models/restitution_study.sh [OUT] [N] [FIGURES]
+#   N: the sphere's arc steps (default the scene's 40; the mesh keeps its grading 20);
+#   FIGURES: default OUT.
 set -uo pipefail
 if ! command -v impact >/dev/null; then
   impact() { cargo run --release --quiet -- "$@"; }
 fi
 out=${1:-output/restitution_study}
 n=${2:-40}
-mkdir -p "$out"
+fig=${3:-$out}
+mkdir -p "$out" "$fig"
 # the scene's data (keep in step with models/sphere_restitution.toml)
 young=210e9 nu=0.3 rho=7850 yield=1e9 radius=5e-3
 read -r vy hertz_1 < <(awk -v E="$young" -v nu="$nu" -v rho="$rho" -v Y="$yield" -v R="$radius" 'BEGIN {
@@ -55,3 +57,7 @@ for ratio in 1 2 5 10 20 50 100; do
   echo "$row$times" >> "$out/restitution.csv"
 done
 column -s, -t "$out/restitution.csv" 2>/dev/null || cat "$out/restitution.csv"
+impact plot "$out/restitution.csv" --x v_over_vy --log-x --ymin 0 --ymax 1.05 \
+  --y e_thornton --y e_explicit --y e_one_point --y e_newmark \
+  --title "Steel sphere on a rigid wall (n = $n): restitution against V / V_y; Thornton 1997 below" \
+  --out "$fig/sphere_restitution.svg"

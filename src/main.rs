@@ -158,6 +158,12 @@ enum Command {
         ymin: Option<f64>,
         #[arg(long, allow_hyphen_values = true)]
         ymax: Option<f64>,
+        /// A logarithmic horizontal axis (values > 0).
+        #[arg(long)]
+        log_x: bool,
+        /// A logarithmic vertical axis (values > 0).
+        #[arg(long)]
+        log_y: bool,
     },
 }
 
@@ -215,6 +221,8 @@ fn main() -> ExitCode {
             xmax,
             ymin,
             ymax,
+            log_x,
+            log_y,
         } => plot_history(
             &history,
             (&x, &y, keep.as_deref()),
@@ -222,6 +230,7 @@ fn main() -> ExitCode {
             PlotLook {
                 title,
                 panels,
+                log: (log_x, log_y),
                 x_limits: Limits {
                     low: xmin,
                     high: xmax,
@@ -623,6 +632,8 @@ fn sweep(args: SweepArgs) -> Result<(), RunError> {
 struct PlotLook {
     title: Option<String>,
     panels: bool,
+    /// Logarithmic axes (x, y).
+    log: (bool, bool),
     x_limits: Limits,
     y_limits: Limits,
 }
@@ -689,8 +700,8 @@ fn plot_history(
         x_label: x.to_string(),
         y_label,
         series,
-        log_x: false,
-        log_y: false,
+        log_x: look.log.0,
+        log_y: look.log.1,
         x_limits: look.x_limits,
         y_limits: look.y_limits,
         notes: Vec::new(),

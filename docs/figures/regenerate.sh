@@ -130,3 +130,6 @@ IMPACT_STUDY_OUT=$out/mass_scaling_study cargo test --release --quiet --test mas
   --ignored mass_scaling_taylor_study --nocapture
 copy $out/mass_scaling_study/mass_scaling_taylor mass_scaling_taylor
 cp $out/mass_scaling_study/mass_scaling_taylor.json $fig/
+
+# the restitution of an elastic-perfectly-plastic sphere against V / V_y (validation 4.14)
+bash models/restitution_study.sh $out/restitution_study 40 $fig

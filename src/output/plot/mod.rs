@@ -159,23 +159,15 @@ fn draw_all<DB: DrawingBackend>(
     root.present().map_err(e)
 }
 
-/// Reads the columns `names` of a history.csv (header line of names, first `time`; one row of
-/// numbers per line), each as a vector over the rows, in the order asked.
+/// Reads the columns `names` of a history.csv, or of any table of numbers in its form
+/// (header line of names, one row of numbers per line; a study's table such as
+/// models/restitution_study.sh writes), each as a vector over the rows, in the order asked.
 ///
 /// A missing column is an [`OutputError::Invalid`] that names it and lists the columns there are.
 pub fn history_columns(path: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, OutputError> {
     let text = std::fs::read_to_string(path).map_err(|e| OutputError::io(path, "read", e))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    if header.first() != Some(&"time") {
-        return Err(OutputError::invalid(
-            path,
-            format!(
-                "not a history file: the first column is `{}`, expected `time`",
-                header.first().unwrap_or(&"")
-            ),
-        ));
-    }
     let mut indices = Vec::with_capacity(names.len());
     for name in names {
         let index = header.iter().position(|h| h == name).ok_or_else(|| {
