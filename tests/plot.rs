@@ -412,3 +412,59 @@ fn cli_plot_panels_and_axis_ranges() {
         String::from_utf8_lossy(&bad.stderr)
     );
 }
+
+/// Goal: `impact plot` draws any table in history.csv's form against a column named by --x, on
+/// a logarithmic axis with --log-x, and refuses a logarithmic axis over a value <= 0 (exit 2,
+/// the value named). Setup: a study's table (v_over_vy 1, 10, 100 and a column e).
+#[test]
+fn cli_plot_draws_a_study_table_on_a_log_axis() {
+    let dir = common::out_dir("plot_table");
+    let table = dir.join("restitution.csv");
+    std::fs::write(&table, "v_over_vy,e\n1,1\n10,0.85\n100,0.57\n").unwrap();
+    let table = table.to_str().unwrap();
+    let out = dir.join("e.svg");
+    let args = [
+        "plot",
+        table,
+        "--x",
+        "v_over_vy",
+        "--y",
+        "e",
+        "--log-x",
+        "--out",
+    ];
+    let run = impact(&[&args[..], &[out.to_str().unwrap()]].concat());
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let svg = std::fs::read_to_string(&out).unwrap();
+    // the decades of the logarithmic axis are labelled
+    for label in ["10", "100"] {
+        assert!(
+            svg_texts(&svg).contains(&label),
+            "{label} not in {:?}",
+            svg_texts(&svg)
+        );
+    }
+    let zero = dir.join("zero.csv");
+    std::fs::write(&zero, "v_over_vy,e\n0,1\n10,0.85\n").unwrap();
+    let args = [
+        "plot",
+        zero.to_str().unwrap(),
+        "--x",
+        "v_over_vy",
+        "--y",
+        "e",
+        "--log-x",
+    ];
+    let run = impact(&args);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("x = 0") && stderr.contains("logarithmic axis"),
+        "{stderr}"
+    );
+}
