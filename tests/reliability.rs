@@ -792,3 +792,22 @@ fn subcycled_resume_is_bit_identical() {
     let resumed = run_killed_and_resumed(name, &scene, &set, 430);
     assert_same_output(&full, &resumed, name);
 }
+
+/// Goal: a subcycled run with the tight stable step resumes bit-identically (its levels' tight
+/// frequencies and the ratios are in the checkpoint). Setup: as above with `stable_step =
+/// "tight"`. Reference: the uninterrupted run, byte for byte.
+#[test]
+fn subcycled_tight_resume_is_bit_identical() {
+    let scene = std::fs::read_to_string("models/taylor_jc.toml").unwrap();
+    let name = "taylor_subcycled_tight";
+    let set = [
+        "analysis.end_time=30e-6",
+        "analysis.checkpoint_every=100",
+        "analysis.subcycling={}",
+        "analysis.stable_step=tight",
+        "output.frame_every=100",
+    ];
+    let full = run_full(name, &scene, &set);
+    let resumed = run_killed_and_resumed(name, &scene, &set, 430);
+    assert_same_output(&full, &resumed, name);
+}

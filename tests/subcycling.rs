@@ -20,7 +20,8 @@ fn run_scene(name: &str, scene: &str, overrides: &[&str]) -> (Summary, std::path
 /// operation for operation, in both kernels. Setup: the Taylor aluminium rod (one-point,
 /// 5 x 30, and 20 x 120 to 3 us: 5082 DOFs, more than one chunk of the driver's sums) and the
 /// Johnson-Cook rod (2x2, 5 x 50) with `levels = 0`, and the strip on the wall with the
-/// automatic step (its 14 equal elements form one level). Reference: the single-step runs of
+/// automatic step (its 14 equal elements form one level); the two rods again with the tight
+/// stable step (the ratios taken at the same steps on both paths). Reference: the single-step runs of
 /// the same scenes; history.csv identical to the byte (the substep is the step, the element
 /// and node updates the same operations in the same order, the energies summed per chunk as
 /// the single step sums them); the run warns that subcycling saved nothing (0 % of the
@@ -28,8 +29,10 @@ fn run_scene(name: &str, scene: &str, overrides: &[&str]) -> (Summary, std::path
 #[test]
 fn one_level_is_the_single_step_method() {
     let one = "analysis.subcycling={levels=0}";
-    let cases: [(&str, &str, &[&str]); 4] = [
+    let cases: [(&str, &str, &[&str]); 6] = [
         ("taylor_aluminum", one, &[]),
+        ("taylor_aluminum", one, &["analysis.stable_step=tight"]),
+        ("taylor_jc", one, &["analysis.stable_step=tight"]),
         (
             "taylor_aluminum",
             one,

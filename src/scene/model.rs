@@ -354,13 +354,11 @@ impl DynamicAnalysis {
     /// for them).
     /// Whether central difference's automatic step scales the elements' exact frequencies
     /// (`analysis.stable_step = "tight"`) rather than their bounds (the default): not with the
-    /// bulk viscosity (whose damping folds into the bound), the mass scaling (which scales
-    /// elements by their bounds) or the subcycling (whose levels come from the bounds).
+    /// bulk viscosity (whose damping folds into the bound). With the mass scaling the elements
+    /// are scaled by their bounds as without it (more mass than the tight step needs); with the
+    /// subcycling the levels come from the tight frequencies.
     pub fn tight_step(&self) -> bool {
-        matches!(self.step, TimeStep::Auto { tight: true, .. })
-            && self.bulk_viscosity.is_none()
-            && self.mass_scaling.is_none()
-            && self.subcycling.is_none()
+        matches!(self.step, TimeStep::Auto { tight: true, .. }) && self.bulk_viscosity.is_none()
     }
 
     pub fn fixed_dt(&self) -> Option<f64> {

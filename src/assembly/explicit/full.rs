@@ -25,7 +25,9 @@
 //!                       gets a larger s (mass_scaling.rs)
 //! ```
 
-use super::tight::{Tightness, max_frequency_squared, shortest_edge, stiffness_by_differences};
+use super::tight::{
+    Tightness, end_nodes, max_frequency_squared, shortest_edge, stiffness_by_differences,
+};
 use super::{
     CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_motion,
     element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
@@ -535,7 +537,14 @@ impl PartialKernel for Full {
     }
 
     fn frequency_of(&self, x: &[[f64; 2]], e: usize) -> Result<f64, ElementFailure> {
-        self.frequency(x, e)
+        let bound = self.frequency(x, e)?;
+        Ok(match &self.tightness {
+            Some(tight) => {
+                let nodes = self.layout.nodes[e].map(|n| x[n as usize]);
+                bound * tight.ratio_for(e, bound, || self.exact_frequency(&nodes, e))
+            }
+            None => bound,
+        })
     }
 
     fn step_elements(
@@ -560,7 +569,17 @@ impl PartialKernel for Full {
             sums.plastic += r.plastic_work;
             sums.viscous += r.viscous_work;
         };
-        subset_steps(self, elements, step, commit).map_err(|(e, err)| self.layout.failure(e, err))
+        let mut total = subset_steps(self, elements, step, commit)
+            .map_err(|(e, err)| self.layout.failure(e, err))?;
+        if let Some(mut tight) = self.tightness.take() {
+            let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
+            (total.omega_squared, total.critical_element) =
+                tight.apply_subset(elements, omega_squared, |e| {
+                    self.exact_frequency(&end(e), e)
+                });
+            self.tightness = Some(tight);
+        }
+        Ok(total)
     }
 
     fn gather_nodes(&self, nodes: &[u32], force: &mut [f64]) {
@@ -616,12 +635,7 @@ impl ExplicitKernel for Full {
     ) -> Result<StepWork, ElementFailure> {
         let mut total = self.step_bounds(x, du, dt)?;
         if let Some(mut tight) = self.tightness.take() {
-            let end = |e: usize| {
-                self.layout.nodes[e].map(|n| {
-                    let n = n as usize;
-                    [x[n][0] + du[2 * n], x[n][1] + du[2 * n + 1]]
-                })
-            };
+            let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
                 tight.apply(&self.bounds, |e| self.exact_frequency(&end(e), e));
             self.tightness = Some(tight);

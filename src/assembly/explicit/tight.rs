@@ -100,6 +100,48 @@ impl Tightness {
         self.largest(bounds, |e| ratios[e])
     }
 
+    /// The ratio of element `e` at its bound `bound`: the one kept, or when stale a fresh one
+    /// from `exact()` (not kept).
+    pub fn ratio_for(&self, e: usize, bound: f64, exact: impl FnOnce() -> Option<f64>) -> f64 {
+        match self.stale(e, bound) {
+            true => Tightness::ratio_of(bound, exact()),
+            false => self.ratio[e],
+        }
+    }
+
+    /// As `apply` over the elements `elements` only (a subcycled substep), whose entries of
+    /// `omega_squared` hold this step's bounds and are made tight; the largest of them and its
+    /// element.
+    pub fn apply_subset(
+        &mut self,
+        elements: &[u32],
+        omega_squared: &mut [f64],
+        exact: impl Fn(usize) -> Option<f64> + Sync,
+    ) -> (f64, usize) {
+        let stale: Vec<usize> = elements
+            .iter()
+            .map(|&e| e as usize)
+            .filter(|&e| self.stale(e, omega_squared[e]))
+            .collect();
+        let fresh: Vec<f64> = stale
+            .par_iter()
+            .map(|&e| Tightness::ratio_of(omega_squared[e], exact(e)))
+            .collect();
+        for (&e, ratio) in stale.iter().zip(fresh) {
+            self.ratio[e] = ratio;
+            self.at[e] = omega_squared[e];
+        }
+        let mut best = (0.0, usize::MAX);
+        for &e in elements {
+            let e = e as usize;
+            omega_squared[e] *= self.ratio[e];
+            if omega_squared[e] > best.0 || (omega_squared[e] == best.0 && e < best.1) {
+                best = (omega_squared[e], e);
+            }
+        }
+        best
+    }
+
     fn largest(&self, bounds: &[f64], ratio: impl Fn(usize) -> f64) -> (f64, usize) {
         let mut best = (0.0, usize::MAX);
         for (e, bound) in bounds.iter().enumerate() {
@@ -142,6 +184,14 @@ pub fn stiffness_by_differences(
         }
     }
     Some(k)
+}
+
+/// The nodes of an element at the end of a step: `x` at its start moved by `du`.
+pub fn end_nodes(nodes: [u32; 4], x: &[[f64; 2]], du: &[f64]) -> [[f64; 2]; 4] {
+    nodes.map(|n| {
+        let n = n as usize;
+        [x[n][0] + du[2 * n], x[n][1] + du[2 * n + 1]]
+    })
 }
 
 /// The shortest edge of a quad.
