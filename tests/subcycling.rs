@@ -448,6 +448,51 @@ proptest! {
     }
 }
 
+/// A known defect, kept as its reproducer: a layout of levels on which the subcycled strip's
+/// energy grows (found by `random_layouts_conserve_energy`). Setup: the strip of that test with
+/// the widths below (the 0.05 column second), 40 transits. Measured: the energy off its start
+/// by at most 3.4 %, 30 %, 209 % and 1183 % in the four quarters of the run: an instability of
+/// the nodal partition, not the O((omega dt)^2) oscillation. Lowering the levels' step by 0.9
+/// (and 0.8) removed it here and showed it on another random layout (1 of 60 each): the known
+/// weak instability of nodal-partition subcycling at some level interfaces, to be found and
+/// fixed in the method. Reference: energy conservation within 3 % (as the random test).
+#[test]
+#[ignore = "a known instability of nodal-partition subcycling on this layout (see the comment)"]
+fn subcycling_layout_found_unstable() {
+    let mut widths = vec![
+        0.24713419547826784,
+        0.4877544385361692,
+        0.4759172926387534,
+        0.4447882644894193,
+        0.1926192695942342,
+        0.26772002201808315,
+        0.792653078999676,
+        0.39247247475313213,
+        0.6447179797576453,
+        0.17445797929592197,
+        0.353510651594276,
+    ];
+    widths.insert(1, 0.05);
+    let dir = common::out_dir("unstable_layout");
+    let mesh = dir.join("strip.vtk");
+    std::fs::write(&mesh, strip_vtk(&widths)).unwrap();
+    let length: f64 = widths.iter().sum();
+    let end = format!("analysis.end_time={}", 40.0 * length / 100.0);
+    let overrides = [end.as_str(), "analysis.subcycling={levels=4}"];
+    let model = common::model("unstable_layout", &elastic_strip(&mesh), &overrides);
+    let _ = impact::analysis::run(&model, &dir.join("out"), Default::default());
+    let kinetic = column(&dir.join("out"), "kinetic_energy");
+    let internal = column(&dir.join("out"), "internal_energy");
+    let e0 = kinetic[0] + internal[0];
+    for (k, i) in kinetic.iter().zip(&internal) {
+        assert!(
+            ((k + i) - e0).abs() < 0.03 * e0,
+            "energy {} against {e0}",
+            k + i
+        );
+    }
+}
+
 /// Goal: what subcycling cannot follow is refused with the key named (exit 2). Setup: the
 /// Taylor rod with one change each; the rod bar on the wall made explicit. Reference: the
 /// refusals of theory 8.7c.
