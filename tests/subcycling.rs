@@ -453,9 +453,8 @@ proptest! {
 /// the widths below (the 0.05 column second), 40 transits. Measured: the energy off its start
 /// by at most 3.4 %, 30 %, 209 % and 1183 % in the four quarters of the run: an instability of
 /// the nodal partition, not the O((omega dt)^2) oscillation. Lowering the levels' step by 0.9
-/// (and 0.8) removed it here and showed it on another random layout (1 of 60 each): the known
-/// weak instability of nodal-partition subcycling at some level interfaces, to be found and
-/// fixed in the method. Reference: energy conservation within 3 % (as the random test).
+/// removed it here, and 0.8 showed it on another random layout (1 of 60): an instability of
+/// the nodal partition at some level interfaces, to be found and fixed in the method. Reference: energy conservation within 3 % (as the random test).
 #[test]
 #[ignore = "a known instability of nodal-partition subcycling on this layout (see the comment)"]
 fn subcycling_layout_found_unstable() {
