@@ -89,7 +89,7 @@ pub struct Full {
     /// The mass scaling (None: off).
     scaling: Option<ElementScaling>,
     /// Each element's frequency bound of the last step, and the ratios that make them tight
-    /// (`tight`; None: the bounds stand, as with the bulk viscosity and subcycling).
+    /// (`tight`; None: the bounds stand, the default and with the bulk viscosity).
     bounds: Vec<f64>,
     tightness: Option<Tightness>,
 }
@@ -306,7 +306,6 @@ impl Full {
         kernel
     }
 
-    /// The kernel with the bulk viscosity `viscosity` (None: off).
     /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
     /// the exact frequency, `tight`) or its elements' bounds (the default).
     pub fn with_tight_step(self, on: bool) -> Full {
@@ -314,7 +313,8 @@ impl Full {
         Full { tightness, ..self }
     }
 
-    /// Its damping folds into the bound, which then stands (no tight ratio).
+    /// The kernel with the bulk viscosity `viscosity` (None: off). Its damping folds into the
+    /// bound, which then stands (no tight ratio).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Full {
         let tightness = self.tightness.filter(|_| viscosity.is_none());
         Full {

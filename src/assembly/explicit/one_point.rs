@@ -233,7 +233,7 @@ pub struct Reduced {
     /// The lumped mass at the four nodes of each element (unscaled), for the exact frequency.
     nodal: Vec<[f64; 4]>,
     /// Each element's frequency bound of the last step, and the ratios that make them tight
-    /// (`tight`; None: the bounds stand, as with the bulk viscosity and subcycling).
+    /// (`tight`; None: the bounds stand, the default and with the bulk viscosity).
     bounds: Vec<f64>,
     tightness: Option<Tightness>,
 }
@@ -290,7 +290,6 @@ impl Reduced {
         }
     }
 
-    /// The kernel with the bulk viscosity `viscosity` (None: off).
     /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
     /// the exact frequency, `tight`) or its elements' bounds (the default).
     pub fn with_tight_step(self, on: bool) -> Reduced {
@@ -298,7 +297,8 @@ impl Reduced {
         Reduced { tightness, ..self }
     }
 
-    /// Its damping folds into the bound, which then stands (no tight ratio).
+    /// The kernel with the bulk viscosity `viscosity` (None: off). Its damping folds into the
+    /// bound, which then stands (no tight ratio).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Reduced {
         let tightness = self.tightness.filter(|_| viscosity.is_none());
         Reduced {
