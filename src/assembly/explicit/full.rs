@@ -30,7 +30,7 @@ use super::tight::{
 };
 use super::{
     CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_motion,
-    element_scaling, point_statistic, point_step, stable_step_of, subset_steps,
+    element_scaling, kernel_stable_step, point_statistic, point_step, subset_steps,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -611,19 +611,13 @@ impl ExplicitKernel for Full {
     }
 
     fn stable_step(&self, x: &[[f64; 2]]) -> Result<StableStep, ElementFailure> {
-        let mut worst = StepWork::default();
-        let mut bounds = Vec::with_capacity(self.elements());
-        for e in 0..self.elements() {
-            let bound = self.frequency(x, e)?;
-            worst.observe(bound, e);
-            bounds.push(bound);
-        }
-        if let Some(tight) = &self.tightness {
-            let nodes = |e: usize| self.layout.nodes[e].map(|n| x[n as usize]);
-            (worst.omega_squared, worst.critical_element) =
-                tight.peek(&bounds, |e| self.exact_frequency(&nodes(e), e));
-        }
-        Ok(stable_step_of(&self.layout, &worst))
+        kernel_stable_step(
+            &self.layout,
+            x,
+            self.tightness.as_ref(),
+            |e| self.frequency(x, e),
+            |xe, e| self.exact_frequency(xe, e),
+        )
     }
 
     fn step(

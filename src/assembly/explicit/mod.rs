@@ -490,6 +490,31 @@ pub(super) fn element_scaling(
     ElementScaling::new(rule, nodal, layout.nodes.clone())
 }
 
+/// The stable step of a kernel's elements on the positions `x`: the largest of their bounds
+/// `bound(e)`, made tight by `tightness` (when on) with their exact frequencies
+/// `exact(nodes, e)` (`tight`).
+pub(super) fn kernel_stable_step(
+    layout: &Layout,
+    x: &[[f64; 2]],
+    tightness: Option<&tight::Tightness>,
+    bound: impl Fn(usize) -> Result<f64, ElementFailure>,
+    exact: impl Fn(&Nodes, usize) -> Option<f64> + Sync,
+) -> Result<StableStep, ElementFailure> {
+    let mut worst = StepWork::default();
+    let mut bounds = Vec::with_capacity(layout.nodes.len());
+    for e in 0..layout.nodes.len() {
+        let omega_squared = bound(e)?;
+        worst.observe(omega_squared, e);
+        bounds.push(omega_squared);
+    }
+    if let Some(tight) = tightness {
+        let nodes = |e: usize| layout.nodes[e].map(|n| x[n as usize]);
+        (worst.omega_squared, worst.critical_element) =
+            tight.peek(&bounds, |e| exact(&nodes(e), e));
+    }
+    Ok(stable_step_of(layout, &worst))
+}
+
 /// The stable step of a step's sums, its element as the model names it.
 pub(super) fn stable_step_of(layout: &Layout, work: &StepWork) -> StableStep {
     let (body, element) = layout
