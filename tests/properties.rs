@@ -394,13 +394,23 @@ fn explicit_kernel(
     quadrature: &str,
     kappa: f64,
 ) -> Box<dyn impact::assembly::explicit::ExplicitKernel> {
+    kernel_of(model, quadrature, kappa, false)
+}
+
+/// The kernel of `explicit_kernel`, its stable step tight or from the bounds.
+fn kernel_of(
+    model: &impact::scene::Model,
+    quadrature: &str,
+    kappa: f64,
+    tight: bool,
+) -> Box<dyn impact::assembly::explicit::ExplicitKernel> {
     use impact::assembly::explicit::{Full, Reduced};
     let state = impact::assembly::State::initial(model);
     let masses = impact::assembly::ElementMasses::new(model).unwrap();
     if quadrature == "reduced" {
-        Box::new(Reduced::new(model, &state, kappa, &masses))
+        Box::new(Reduced::new(model, &state, kappa, &masses).with_tight_step(tight))
     } else {
-        Box::new(Full::new(model, &state, &masses))
+        Box::new(Full::new(model, &state, &masses).with_tight_step(tight))
     }
 }
 
@@ -488,14 +498,7 @@ fn tight_kernel(
     quadrature: &str,
     kappa: f64,
 ) -> Box<dyn impact::assembly::explicit::ExplicitKernel> {
-    use impact::assembly::explicit::{Full, Reduced};
-    let state = impact::assembly::State::initial(model);
-    let masses = impact::assembly::ElementMasses::new(model).unwrap();
-    if quadrature == "reduced" {
-        Box::new(Reduced::new(model, &state, kappa, &masses).with_tight_step(true))
-    } else {
-        Box::new(Full::new(model, &state, &masses).with_tight_step(true))
-    }
+    kernel_of(model, quadrature, kappa, true)
 }
 
 /// One free element of `model` stepped by central difference at `factor` times its tight

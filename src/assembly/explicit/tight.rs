@@ -69,9 +69,19 @@ impl Tightness {
         bounds: &[f64],
         exact: impl Fn(usize) -> Option<f64> + Sync,
     ) -> (f64, usize) {
-        let stale: Vec<usize> = (0..bounds.len())
-            .filter(|&e| self.stale(e, bounds[e]))
-            .collect();
+        self.refresh(0..bounds.len(), bounds, exact);
+        self.largest(bounds, |e| self.ratio[e])
+    }
+
+    /// Takes again the stale ratios among `elements`, whose bounds are in `bounds` (by element
+    /// index), with `exact(e)` in parallel.
+    fn refresh(
+        &mut self,
+        elements: impl Iterator<Item = usize>,
+        bounds: &[f64],
+        exact: impl Fn(usize) -> Option<f64> + Sync,
+    ) {
+        let stale: Vec<usize> = elements.filter(|&e| self.stale(e, bounds[e])).collect();
         let fresh: Vec<f64> = stale
             .par_iter()
             .map(|&e| Tightness::ratio_of(bounds[e], exact(e)))
@@ -80,7 +90,6 @@ impl Tightness {
             self.ratio[e] = ratio;
             self.at[e] = bounds[e];
         }
-        self.largest(bounds, |e| self.ratio[e])
     }
 
     /// As `apply`, without keeping the ratios taken (the stable step of a configuration
@@ -118,19 +127,7 @@ impl Tightness {
         omega_squared: &mut [f64],
         exact: impl Fn(usize) -> Option<f64> + Sync,
     ) -> (f64, usize) {
-        let stale: Vec<usize> = elements
-            .iter()
-            .map(|&e| e as usize)
-            .filter(|&e| self.stale(e, omega_squared[e]))
-            .collect();
-        let fresh: Vec<f64> = stale
-            .par_iter()
-            .map(|&e| Tightness::ratio_of(omega_squared[e], exact(e)))
-            .collect();
-        for (&e, ratio) in stale.iter().zip(fresh) {
-            self.ratio[e] = ratio;
-            self.at[e] = omega_squared[e];
-        }
+        self.refresh(elements.iter().map(|&e| e as usize), omega_squared, exact);
         let mut best = (0.0, usize::MAX);
         for &e in elements {
             let e = e as usize;
