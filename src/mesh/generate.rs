@@ -179,6 +179,7 @@ mod tests {
                     n: 3,
                     grading: 1.0,
                     grade_toward: Default::default(),
+                    refine: 0,
                 }
                 .build()
             ),

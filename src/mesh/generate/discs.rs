@@ -7,7 +7,7 @@ use serde::Deserialize;
 
 use super::blocks::{glue, ruled};
 use super::ogrid::{HalfOGrid, QuarterOGrid};
-use super::params::{at_least, finite_point, grading, one, param, positive};
+use super::params::{MAX_DIVISIONS, at_least, finite_point, grading, one, param, positive};
 use super::sets::{feature_tol, name_boundary, node_at, on_line};
 use super::spacing::{graded, layer_fractions, nearest};
 use crate::mesh::plane::{Point, norm, sub};
@@ -43,6 +43,9 @@ pub struct QuarterDisc {
     /// Default "lower".
     #[serde(default = "lower")]
     pub quadrant: String,
+    /// Levels of the mesh family's refinement, 0 to `MAX_REFINE` (see `refined`). Default 0.
+    #[serde(default)]
+    pub refine: u32,
 }
 
 /// The default quadrant of a quarter disc.
@@ -55,7 +58,7 @@ impl QuarterDisc {
         let center = finite_point("center", self.center)?;
         let radius = positive("radius", self.radius)?;
         let n = at_least("n", self.n, 2)?;
-        let grading = grading("grading", self.grading)?;
+        let (n, grading) = refined(n, grading("grading", self.grading)?, self.refine)?;
         let pole_sign = match self.quadrant.as_str() {
             "lower" => -1.0,
             "upper" => 1.0,
@@ -104,6 +107,39 @@ impl QuarterDisc {
     }
 }
 
+/// The most levels `refine` takes (n 2^6 arc steps).
+const MAX_REFINE: u32 = 6;
+
+/// The arc steps n and grading of a disc mesh `refine` levels down its family: each level
+/// splits every arc step in two, with the ratio of consecutive steps the square root of the
+/// level above's, so n becomes n 2^k, the ratio q = g^(1 / (n - 1)) becomes q^(1 / 2^k) and the
+/// grading (n 2^k - 1) / (2^k (n - 1)) powers of g. The base mesh's arc nodes stay nodes
+/// (two steps q^(j/2), q^((j+1)/2) sum to the base step q^(j/2) (1 + q^(1/2)), the same factor
+/// for every pair) and the pole step halves at each level: the fixed rule a grid convergence
+/// study needs (docs/validation.md 4.14), where changing n alone also moves the pole step and
+/// the grading. The O-grid's inner layers and blocks follow the arc by the generator's rules.
+fn refined(n: usize, grading: f64, refine: u32) -> Result<(usize, f64), MeshError> {
+    if refine > MAX_REFINE {
+        return Err(param(
+            "refine",
+            format!("must be at most {MAX_REFINE}, got {refine}"),
+        ));
+    }
+    let split = 1usize << refine;
+    let fine = n * split;
+    if fine > MAX_DIVISIONS {
+        return Err(param(
+            "refine",
+            format!("n 2^refine = {fine} arc steps is above the limit {MAX_DIVISIONS}"),
+        ));
+    }
+    if refine == 0 || n < 2 {
+        return Ok((fine, grading));
+    }
+    let power = (fine - 1) as f64 / (split * (n - 1)) as f64;
+    Ok((fine, grading.powf(power)))
+}
+
 /// `type = "half_disc"`: the half x >= cx of a disc of radius R (a full sphere's axisymmetric
 /// section), graded toward the lower pole (cx, cy - R) or, with `grade_toward = "upper"`,
 /// toward the upper pole (cx, cy + R): a sphere striking upwards.
@@ -133,6 +169,9 @@ pub struct HalfDisc {
     /// The pole of the smallest arc step: `lower` (default) or `upper`.
     #[serde(default)]
     pub grade_toward: Pole,
+    /// Levels of the mesh family's refinement, 0 to `MAX_REFINE` (see `refined`). Default 0.
+    #[serde(default)]
+    pub refine: u32,
 }
 
 /// A pole of a half disc: the lower (cx, cy - R) or the upper (cx, cy + R).
@@ -158,7 +197,7 @@ impl HalfDisc {
         let center = finite_point("center", self.center)?;
         let radius = positive("radius", self.radius)?;
         let n = at_least("n", self.n, 4)?;
-        let grading = grading("grading", self.grading)?;
+        let (n, grading) = refined(n, grading("grading", self.grading)?, self.refine)?;
 
         let arc = graded(n, grading);
         let thickness = (1.0 - DISC_CORE) * radius;
@@ -479,6 +518,7 @@ mod tests {
                     n,
                     grading,
                     grade_toward: Pole::Lower,
+                    refine: 0,
                 };
                 let mesh = spec.build().unwrap();
                 assert_valid(&mesh);
@@ -502,6 +542,7 @@ mod tests {
             n: 12,
             grading: 6.0,
             grade_toward: Pole::Lower,
+            refine: 0,
         }
         .build()
         .unwrap();
@@ -528,6 +569,7 @@ mod tests {
             n: 12,
             grading: 6.0,
             grade_toward,
+            refine: 0,
         };
         let lower = spec(Pole::Lower).build().unwrap();
         let upper = spec(Pole::Upper).build().unwrap();
@@ -550,6 +592,64 @@ mod tests {
         let largest = steps.iter().copied().fold(0.0, f64::max);
         assert!(steps.iter().all(|&s| s >= steps[at_top] - 1e-12));
         assert!((largest / steps[at_top] - 6.0).abs() < 1e-9);
+    }
+
+    /// Goal: `refine` is a mesh family by a fixed rule. Setup: half discs n = 10, grading 20
+    /// (and a quarter disc n = 8, grading 5) at refine 0 to 3. Reference (geometry of the
+    /// rule): at level k the arc has n 2^k steps; every arc node of level k - 1 is an arc node
+    /// of level k; the pole step is half the level above's (the base's over 2^k); the ratio of
+    /// consecutive arc steps is the 2^k-th root of the base's; the quads stay valid with the
+    /// area of the same polygon refined. Too many levels are refused naming `refine`.
+    #[test]
+    fn refine_splits_every_arc_step_in_two_per_level() {
+        let half = |refine| HalfDisc {
+            center: [0.0, 5.0],
+            radius: 5.0,
+            n: 10,
+            grading: 20.0,
+            grade_toward: Pole::Lower,
+            refine,
+        };
+        let arc_nodes = |mesh: &Mesh| -> Vec<Point> {
+            let arc = &mesh.edge_sets["arc"];
+            let mut points: Vec<Point> = arc.iter().map(|e| mesh.nodes[e[0]]).collect();
+            points.push(mesh.nodes[arc[arc.len() - 1][1]]);
+            points
+        };
+        let base_ratio = 20f64.powf(1.0 / 9.0);
+        let mut above: Option<Mesh> = None;
+        for k in 0..4u32 {
+            let mesh = half(k).build().unwrap();
+            assert_valid(&mesh);
+            let steps = arc_angles(&mesh, "arc", [0.0, 5.0]);
+            assert_eq!(steps.len(), 10 << k);
+            let ratio = base_ratio.powf(1.0 / f64::from(1u32 << k));
+            for w in steps[..steps.len() / 2].windows(2) {
+                assert!((w[1] / w[0] - ratio).abs() < 1e-9, "level {k}");
+            }
+            if let Some(coarse) = &above {
+                let fine = arc_nodes(&mesh);
+                for p in arc_nodes(coarse) {
+                    assert!(fine.iter().any(|q| close(*q, p)), "level {k}: {p:?}");
+                }
+                let coarse_steps = arc_angles(coarse, "arc", [0.0, 5.0]);
+                let pole_ratio = steps[0] / coarse_steps[0];
+                // two fine steps make the coarse one: s + s q^(1/2) = S, so s / S = 1 / (1 + q^(1/2))
+                assert!((pole_ratio - 1.0 / (1.0 + ratio)).abs() < 1e-9, "level {k}");
+                assert!((pole_ratio - 0.5).abs() < 0.08, "level {k}: {pole_ratio}");
+            }
+            above = Some(mesh);
+        }
+        let mut quarter_spec = quarter(8, 5.0, "lower");
+        quarter_spec.refine = 2;
+        let mesh = quarter_spec.build().unwrap();
+        assert_valid(&mesh);
+        assert_eq!(mesh.edge_sets["arc"].len(), 32);
+        let steps = arc_angles(&mesh, "arc", [0.5, 2.0]);
+        let ratio = 5f64.powf(1.0 / 7.0 / 4.0);
+        assert!((steps[1] / steps[0] - ratio).abs() < 1e-9);
+        let err = half(7).build().unwrap_err().to_string();
+        assert!(err.contains("refine"), "{err}");
     }
 
     /// Ring: counts, polygon area n_circ/2 sin(2 pi/n_circ) (R^2 - r^2), outer ccw, inner cw.

@@ -133,6 +133,7 @@ pub(super) fn quarter(n: usize, grading: f64, quadrant: &str) -> QuarterDisc {
         n,
         grading,
         quadrant: quadrant.into(),
+        refine: 0,
     }
 }
 
