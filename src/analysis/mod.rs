@@ -99,7 +99,7 @@ fn run_from(
 
 /// Below this many elements a run uses one thread (measured with `impact bench`: a
 /// 150-element explicit scene took 2.2 times as long on two threads as on one).
-pub const PARALLEL_FROM_ELEMENTS: usize = 4000;
+pub const PARALLEL_FROM_ELEMENTS: usize = 1000;
 
 /// Runs the scene's analysis with the stepper it names.
 fn dispatch(

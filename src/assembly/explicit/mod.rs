@@ -34,7 +34,11 @@ use crate::scene::{Continuum, Model};
 use rayon::prelude::*;
 
 /// Elements per parallel task (fixed, so the work sums do not depend on the thread count).
-pub(super) const CHUNK: usize = 256;
+pub(super) const CHUNK: usize = 64;
+
+/// The fewest chunks of `CHUNK` nodes a task of the gather takes: a node's sum reads four
+/// entries, so a task of fewer than 4096 nodes costs less than handing it over.
+const GATHER_CHUNKS_PER_TASK: usize = 64;
 
 /// The sums of one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -249,6 +253,7 @@ impl NodeGather {
         force
             .par_chunks_mut(2 * CHUNK)
             .enumerate()
+            .with_min_len(GATHER_CHUNKS_PER_TASK)
             .for_each(|(k, chunk)| {
                 for (i, f) in chunk.chunks_exact_mut(2).enumerate() {
                     f.copy_from_slice(&self.node_force(k * CHUNK + i, ef));
