@@ -216,6 +216,12 @@ pub struct Extrapolation {
     /// finest value).
     pub value: Option<f64>,
     pub gci: Option<f64>,
+    /// Oscillatory convergence (the differences change sign): the uncertainty of the finest
+    /// value, half the range of the three levels' values relative to the finest (Stern,
+    /// Wilson, Coleman & Paterson 2001, J. Fluids Eng. 123: U = (S_U - S_L) / 2), where no
+    /// order and no GCI can be formed. None otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<f64>,
     /// Why there is no extrapolated value (or a caution beside one).
     pub note: Option<String>,
     /// The same in a few words, for the charts.
@@ -231,6 +237,7 @@ pub fn extrapolate(h: [f64; 3], f: [f64; 3]) -> Extrapolation {
         order: None,
         value: None,
         gci: None,
+        uncertainty: None,
         note: None,
         verdict: None,
     };
@@ -268,8 +275,14 @@ pub fn extrapolate(h: [f64; 3], f: [f64; 3]) -> Extrapolation {
     out.order = p.is_finite().then_some(p);
     let (low, high) = ORDER_BAND;
     if s < 0.0 {
+        let range = f.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v))
+            - f.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+        out.uncertainty = (f[0] != 0.0).then(|| 0.5 * range / f[0].abs());
+        let u = out
+            .uncertainty
+            .map_or(String::new(), |u| format!("; U = {:.3} % (half the range of the three, Stern et al. 2001)", 100.0 * u));
         out.note = Some(format!(
-            "the differences change sign (f2 - f1 = {e21:.3e}, f3 - f2 = {e32:.3e}): oscillating, not in the asymptotic range"
+            "the differences change sign (f2 - f1 = {e21:.3e}, f3 - f2 = {e32:.3e}): oscillating, not in the asymptotic range{u}"
         ));
         out.verdict = Some("oscillating: not in the asymptotic range, no extrapolation");
     } else if !(p.is_finite() && (low..=high).contains(&p)) {
@@ -699,9 +712,11 @@ mod tests {
         let h = [0.25, 0.5, 1.0];
         let oscillating = extrapolate(h, [1.0, 1.1, 0.9]);
         assert!(oscillating.value.is_none());
+        // half the range 0.9..1.1 over the finest value 1.0
+        approx::assert_abs_diff_eq!(oscillating.uncertainty.unwrap(), 0.1, epsilon = 1e-12);
         assert!(oscillating.note.unwrap().contains("oscillating"));
         let steep = extrapolate(h, [1.0, 1.0 + 1e-4, 1.0 + 1e-4 + 1.0]);
-        assert!(steep.value.is_none());
+        assert!(steep.value.is_none() && steep.uncertainty.is_none());
         assert!(steep.note.unwrap().contains("outside"));
         let flat = extrapolate(h, [2.0, 2.0, 2.0]);
         assert!(flat.value.is_none() && flat.order.is_none());
