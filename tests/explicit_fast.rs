@@ -478,7 +478,7 @@ set = "top"
 "#;
 
 /// Goal: results do not depend on the thread count where the run really is parallel.
-/// Setup: PARALLEL_ROD (4000 elements: `PARALLEL_FROM_ELEMENTS`, below which a run takes
+/// Setup: PARALLEL_ROD (4000 elements: at least `parallel_from`, below which a run takes
 /// one thread whatever the pool) in rayon pools of 1, 2 and 4 threads, on the three paths
 /// that split work over threads: explicit one-point (the kernel's chunks, the element
 /// minimum of the automatic step, the nodal updates), explicit 2x2 in rate form, and
@@ -549,7 +549,7 @@ obstacle = "wall"
 fn results_do_not_depend_on_thread_count(path: &str, text: &str, overrides: &[&str]) {
     let model = common::model("parallel_rod", text, overrides);
     assert!(
-        model.elements() >= impact::analysis::PARALLEL_FROM_ELEMENTS,
+        model.elements() >= impact::analysis::parallel_from(&model),
         "{path}: the model must be large enough to run in parallel"
     );
     let runs: Vec<(String, impact::assembly::State)> = [1, 2, 4]

@@ -84,7 +84,7 @@ fn run_from(
     let model = imperfect.as_ref().unwrap_or(model);
     // a small model pays more for handing work to threads than the threads give back: it
     // runs on the calling thread (the results are the same bits either way)
-    if model.elements() < PARALLEL_FROM_ELEMENTS && rayon::current_num_threads() > 1 {
+    if model.elements() < parallel_from(model) && rayon::current_num_threads() > 1 {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()
@@ -97,9 +97,24 @@ fn run_from(
     rayon::scope(|_| dispatch(model, out_dir, options, resume))
 }
 
-/// Below this many elements a run uses one thread (measured with `impact bench`: a
-/// 150-element explicit scene took 2.2 times as long on two threads as on one).
-pub const PARALLEL_FROM_ELEMENTS: usize = 1000;
+/// Below this many elements an implicit or static run uses one thread (measured with `impact
+/// bench`: a 150-element explicit scene took 2.2 times as long on two threads as on one; the
+/// implicit timings of docs/performance.md were taken under this rule).
+pub const PARALLEL_FROM_ELEMENTS: usize = 4000;
+
+/// The same for central difference, whose step hands its element loop over once and keeps
+/// short vector loops on its own thread (docs/performance.md, "Fewer hand-overs per step": a
+/// 1000-element rod 1.3-1.5 times faster on two threads than on one).
+pub const PARALLEL_FROM_ELEMENTS_EXPLICIT: usize = 1000;
+
+/// The element count from which `model` runs on the pool.
+pub fn parallel_from(model: &Model) -> usize {
+    if model.is_explicit() {
+        PARALLEL_FROM_ELEMENTS_EXPLICIT
+    } else {
+        PARALLEL_FROM_ELEMENTS
+    }
+}
 
 /// Runs the scene's analysis with the stepper it names.
 fn dispatch(

@@ -500,13 +500,17 @@ impl Reference {
 }
 
 impl Model {
+    /// Whether the analysis is explicit dynamics (central difference).
+    pub fn is_explicit(&self) -> bool {
+        matches!(&self.analysis, Analysis::Dynamic(d)
+            if d.integrator == IntegratorKind::CentralDifference)
+    }
+
     /// Which steps get a history row (`output.history_every`, `output.history_interval`, or
     /// the default: every step; central difference's grid of its end time).
     pub fn history_cadence(&self) -> crate::output::thinning::Cadence {
-        let explicit = matches!(&self.analysis, Analysis::Dynamic(d)
-            if d.integrator == IntegratorKind::CentralDifference);
         self.output
-            .history_cadence(explicit.then(|| self.analysis.end_time()))
+            .history_cadence(self.is_explicit().then(|| self.analysis.end_time()))
     }
 
     /// Constrained DOFs: supports and prescribed-displacement loads (sorted, unique).

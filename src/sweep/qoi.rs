@@ -278,9 +278,12 @@ pub fn extrapolate(h: [f64; 3], f: [f64; 3]) -> Extrapolation {
         let range = f.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v))
             - f.iter().fold(f64::INFINITY, |m, v| m.min(*v));
         out.uncertainty = (f[0] != 0.0).then(|| 0.5 * range / f[0].abs());
-        let u = out
-            .uncertainty
-            .map_or(String::new(), |u| format!("; U = {:.3} % (half the range of the three, Stern et al. 2001)", 100.0 * u));
+        let u = out.uncertainty.map_or(String::new(), |u| {
+            format!(
+                "; U = {:.3} % (half the range of the three, Stern et al. 2001)",
+                100.0 * u
+            )
+        });
         out.note = Some(format!(
             "the differences change sign (f2 - f1 = {e21:.3e}, f3 - f2 = {e32:.3e}): oscillating, not in the asymptotic range{u}"
         ));

@@ -17,8 +17,6 @@
 use crate::contact::penetration::{self, DeepestNode, Intruded};
 use crate::contact::{ContactState, ContactSummary, Interfaces};
 use crate::scene::Model;
-use crate::scene::model::Analysis;
-use crate::scene::spec::IntegratorKind;
 use std::collections::VecDeque;
 
 /// The default window of central difference, in first steps: it spans the step-to-step
@@ -33,7 +31,7 @@ pub fn averages(model: &Model) -> bool {
     !model.contacts.is_empty()
         && match model.output.contact_force_window {
             Some(window) => window > 0.0,
-            None => is_explicit(model),
+            None => model.is_explicit(),
         }
 }
 
@@ -48,10 +46,6 @@ pub fn window(model: &Model, first_step: f64) -> Option<f64> {
             .contact_force_window
             .unwrap_or(DEFAULT_WINDOW_STEPS * first_step),
     )
-}
-
-fn is_explicit(model: &Model) -> bool {
-    matches!(&model.analysis, Analysis::Dynamic(d) if d.integrator == IntegratorKind::CentralDifference)
 }
 
 /// The record, as a checkpoint carries it.
