@@ -133,3 +133,11 @@ cp $out/mass_scaling_study/mass_scaling_taylor.json $fig/
 
 # the restitution of an elastic-perfectly-plastic sphere against V / V_y (validation 4.14)
 bash models/restitution_study.sh $out/restitution_study 40 $fig
+
+# the restitution on the sphere's mesh family (validation 4.14): the table holds the runs of
+# models/restitution_gci.sh (n = 40, 80, 160) and of `refine = 3` (n = 320), hours on two cores;
+# the chart is drawn from it
+impact plot $fig/sphere_restitution_family.csv --x n --log-x \
+  --y explicit_20 --y one_point_20 --y newmark_20 --y explicit_100 --y one_point_100 --y newmark_100 \
+  --title 'Restitution e on the mesh family: 20 V_y (upper), 100 V_y (lower)' \
+  --out $fig/sphere_restitution_family.svg
