@@ -29,8 +29,9 @@ use super::tight::{
     Tightness, end_nodes, max_frequency_squared, shortest_edge, stiffness_by_differences,
 };
 use super::{
-    CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, element_motion,
-    element_scaling, kernel_stable_step, point_statistic, point_step, subset_steps,
+    CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
+    element_motion, element_scaling, fold_chunks, kernel_stable_step, point_statistic, point_step,
+    subset_steps,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -468,19 +469,7 @@ impl Full {
                 },
             )
             .collect();
-        let mut total = StepWork::default();
-        for (sums, error, grown) in results {
-            if let Some((e, err)) = error {
-                return Err(self.layout.failure(e, err));
-            }
-            total.add(&sums);
-            if let Some(scaling) = self.scaling.as_mut() {
-                for (e, factor) in grown {
-                    scaling.grow(e, factor);
-                }
-            }
-        }
-        Ok(total)
+        fold_chunks(results, &self.layout, self.scaling.as_mut())
     }
 
     fn state_of(&self, e: usize) -> PointsState {
@@ -699,10 +688,6 @@ impl ExplicitKernel for Full {
         Some(self)
     }
 }
-
-/// A chunk's sums, its failed element, and the elements whose mass factor grew (with the
-/// new factor), in element order.
-type ChunkResult = (StepWork, Option<(usize, KernelError)>, Vec<(usize, f64)>);
 
 /// An element's lumped masses `lumped` times its mass factor (as they are without one).
 #[inline(always)]

@@ -281,6 +281,32 @@ impl NodeGather {
     }
 }
 
+/// A chunk's sums, its failed element, and the elements whose mass factor grew (with the
+/// new factor), in element order.
+pub(super) type ChunkResult = (StepWork, Option<(usize, KernelError)>, Vec<(usize, f64)>);
+
+/// The chunks' results of an element loop, in chunk order: the first element that failed,
+/// else the sums, with the grown mass factors taken into `scaling`.
+pub(super) fn fold_chunks(
+    results: Vec<ChunkResult>,
+    layout: &Layout,
+    mut scaling: Option<&mut ElementScaling>,
+) -> Result<StepWork, ElementFailure> {
+    let mut total = StepWork::default();
+    for (sums, error, grown) in results {
+        if let Some((e, err)) = error {
+            return Err(layout.failure(e, err));
+        }
+        total.add(&sums);
+        if let Some(scaling) = scaling.as_deref_mut() {
+            for (e, factor) in grown {
+                scaling.grow(e, factor);
+            }
+        }
+    }
+    Ok(total)
+}
+
 /// The start positions and the increments of the nodes `nodes` of an element.
 #[inline(always)]
 pub(super) fn element_motion(nodes: [u32; 4], x: &[[f64; 2]], du: &[f64]) -> (Nodes, Nodes) {

@@ -23,8 +23,9 @@ use super::tight::{
     Tightness, end_nodes, max_frequency_squared, shortest_edge, stiffness_by_differences,
 };
 use super::{
-    BodyParameters, CHUNK, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
-    element_motion, element_scaling, kernel_stable_step, point_statistic, point_step, subset_steps,
+    BodyParameters, CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel,
+    StepWork, element_motion, element_scaling, fold_chunks, kernel_stable_step, point_statistic,
+    point_step, subset_steps,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -513,19 +514,7 @@ impl Reduced {
                 (sums, None, grown)
             })
             .collect();
-        let mut total = StepWork::default();
-        for (sums, error, grown) in results {
-            if let Some((e, err)) = error {
-                return Err(self.layout.failure(e, err));
-            }
-            total.add(&sums);
-            if let Some(scaling) = self.scaling.as_mut() {
-                for (e, factor) in grown {
-                    scaling.grow(e, factor);
-                }
-            }
-        }
-        Ok(total)
+        fold_chunks(results, &self.layout, self.scaling.as_mut())
     }
 
     fn state_of(&self, e: usize) -> ElementState {
@@ -745,10 +734,6 @@ impl PartialKernel for Reduced {
         self.gather.gather_nodes(nodes, &self.element_forces, force);
     }
 }
-
-/// A chunk's sums, its failed element, and the elements whose mass factor grew (with the
-/// new factor), in element order.
-type ChunkResult = (StepWork, Option<(usize, KernelError)>, Vec<(usize, f64)>);
 
 #[cfg(test)]
 mod tests {
