@@ -147,3 +147,24 @@ mod tests {
         assert!(error.contains("below dt / 2^6 / 10"), "{error}");
     }
 }
+
+/// The growth of an adaptive step: at most doubled, at least a fifth; the estimate grows as
+/// dt^2 (eta ~ c dt |da/dt| / V and the jump of a over the step ~ dt), so the step that meets
+/// the tolerance is dt (tol / eta)^(1/2), taken with a safety factor 0.9.
+pub(super) fn step_factor(tolerance: f64, estimate: f64) -> f64 {
+    if estimate <= 0.0 {
+        return 2.0;
+    }
+    (0.9 * (tolerance / estimate).sqrt()).clamp(0.2, 2.0)
+}
+
+/// The ratio of the ladder an adaptive step moves on: a proposed step is rounded down to
+/// first x LADDER^k, so steady stretches repeat one length and K*(dt) stays factored
+/// (a factorization per new length would cost more than the steps it saves).
+const LADDER: f64 = std::f64::consts::SQRT_2;
+
+/// `proposal` rounded down to the ladder through `first`.
+pub(super) fn on_ladder(first: f64, proposal: f64) -> f64 {
+    let k = ((proposal / first).ln() / LADDER.ln() + 1e-9).floor();
+    first * LADDER.powf(k)
+}

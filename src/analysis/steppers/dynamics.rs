@@ -15,7 +15,7 @@
 //! impact conditions, and the step is split at the first contact event inside it.
 
 use super::carry::{Carry, DynamicCarry};
-use super::control::{ErrorWatch, StepControl, snap, step_length};
+use super::control::{ErrorWatch, StepControl, on_ladder, snap, step_factor, step_length};
 use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
 use super::{Report, Resume, StepError, Stepper, loads};
@@ -52,21 +52,6 @@ pub fn integrator(spec: &DynamicAnalysis) -> Box<dyn Integrator> {
             unreachable!("the explicit stepper runs central difference")
         }
     }
-}
-
-/// The nodes of every contact surface (slaves, and the nodes of deformable masters).
-fn contact_nodes(model: &Model) -> Vec<bool> {
-    use crate::contact::Master;
-    let mut flags = vec![false; model.dofs() / 2];
-    for pair in &model.contacts {
-        pair.slaves.iter().for_each(|s| flags[*s] = true);
-        match &pair.master {
-            Master::Segments { edges, .. } => edges.iter().flatten().for_each(|n| flags[*n] = true),
-            Master::Nodes { nodes, .. } => nodes.iter().for_each(|n| flags[*n] = true),
-            Master::Obstacle(_) => {}
-        }
-    }
-    flags
 }
 
 /// Implicit time stepping: the state, the motion, the solver and what the loop carries.
@@ -184,27 +169,6 @@ impl WatchedPoint {
     }
 }
 
-/// The growth of an adaptive step: at most doubled, at least a fifth; the estimate grows as
-/// dt^2 (eta ~ c dt |da/dt| / V and the jump of a over the step ~ dt), so the step that meets
-/// the tolerance is dt (tol / eta)^(1/2), taken with a safety factor 0.9.
-fn step_factor(tolerance: f64, estimate: f64) -> f64 {
-    if estimate <= 0.0 {
-        return 2.0;
-    }
-    (0.9 * (tolerance / estimate).sqrt()).clamp(0.2, 2.0)
-}
-
-/// The ratio of the ladder an adaptive step moves on: a proposed step is rounded down to
-/// first x LADDER^k, so steady stretches repeat one length and K*(dt) stays factored
-/// (a factorization per new length would cost more than the steps it saves).
-const LADDER: f64 = std::f64::consts::SQRT_2;
-
-/// `proposal` rounded down to the ladder through `first`.
-fn on_ladder(first: f64, proposal: f64) -> f64 {
-    let k = ((proposal / first).ln() / LADDER.ln() + 1e-9).floor();
-    first * LADDER.powf(k)
-}
-
 impl<'a> Dynamics<'a> {
     pub fn new(
         model: &'a Model,
@@ -226,7 +190,7 @@ impl<'a> Dynamics<'a> {
             }
         }
         if spec.contact_dynamics == ContactDynamics::MassRedistribution {
-            mass = mass.redistributed(model, &contact_nodes(model));
+            mass = mass.redistributed(model, &crate::contact::surface_nodes(model));
         }
         let inverse_mass = mass
             .lumped
@@ -244,7 +208,7 @@ impl<'a> Dynamics<'a> {
         let n = model.dofs();
         let nominal = super::stable::implicit_first_step(model, spec)?;
         let method = integrator(spec);
-        let on_surface = contact_nodes(model);
+        let on_surface = crate::contact::surface_nodes(model);
         let estimated: Vec<bool> = system
             .equation
             .iter()
@@ -467,6 +431,10 @@ impl<'a> Dynamics<'a> {
         for (u, du) in kin.displacement.iter_mut().zip(&d) {
             *u += du;
         }
+        // the contact force of the step's end as the integrator applied it (before the
+        // conditions below change the motion)
+        let applied = self.motion_contact_force(&internal);
+        let kin = &mut self.kin;
         // the impact and release conditions change velocities only at a step's events
         let events = &step.events;
         let conditions = !events.closed.is_empty() || !events.released.is_empty();
@@ -484,23 +452,25 @@ impl<'a> Dynamics<'a> {
         crate::contact::apply_conditions(&self.interfaces, &mut step, &positions, mass, motion);
         self.contact
             .commit(&self.interfaces, &step, self.state.time, &positions);
-        let contact_force = self
-            .contact
-            .nodal_forces(&self.interfaces.pairs, &positions);
+        // the next step starts from the motion the conditions left
+        let next_start = match conditions {
+            true => self.motion_contact_force(&internal),
+            false => applied.clone(),
+        };
         let total = self.total_force(&internal);
         let energies = &mut self.energies;
         energies.external_work += super::trapezoid_work(&d, &total, &self.last_total);
         energies.kinetic = self.mass.kinetic_energy(model, &self.kin.velocity);
         // energy taken up by the interface: minus the work of the contact forces on the
         // bodies, plus what the impact/release conditions removed
-        energies.contact_work += -super::trapezoid_work(&d, &contact_force, &self.last_contact)
+        energies.contact_work += -super::trapezoid_work(&d, &applied, &self.last_contact)
             + kinetic_before.unwrap_or(energies.kinetic)
             - energies.kinetic;
         energies.internal = self.state.internal_work - self.state.plastic_work;
         energies.plastic_work = self.state.plastic_work;
         self.last_total = total;
         self.last_internal = internal;
-        self.last_contact = contact_force;
+        self.last_contact = next_start;
         self.increments += 1;
         self.control.accept(true);
     }
@@ -606,16 +576,48 @@ impl<'a> Dynamics<'a> {
     }
 
     /// F: f_ext on the free DOFs, the reaction M a + a_R M v + f_int on the prescribed ones.
-    fn total_force(&self, internal: &[f64]) -> Vec<f64> {
+    /// M a + a_r M v + f_int over all DOFs, and f_ext, at the present time.
+    fn motion_terms(&self, internal: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let model = self.model;
         let external = loads::external_force(model, &self.state, &self.initial, self.state.time);
-        let ma = self.mass.product(model, &self.kin.acceleration);
+        let mut f = self.mass.product(model, &self.kin.acceleration);
         let a_r = self.spec.rayleigh[0];
-        let mv = (a_r != 0.0).then(|| self.mass.product(model, &self.kin.velocity));
-        (0..model.dofs())
-            .map(|i| match self.system.equation[i] {
-                Some(_) => external[i],
-                None => ma[i] + mv.as_ref().map_or(0.0, |mv| a_r * mv[i]) + internal[i],
+        if a_r != 0.0 {
+            let mv = self.mass.product(model, &self.kin.velocity);
+            f.iter_mut().zip(mv).for_each(|(f, mv)| *f += a_r * mv);
+        }
+        f.iter_mut().zip(internal).for_each(|(f, fi)| *f += fi);
+        (f, external)
+    }
+
+    fn total_force(&self, internal: &[f64]) -> Vec<f64> {
+        let (motion, external) = self.motion_terms(internal);
+        let prescribed = |i: usize| self.system.equation[i].is_none();
+        (0..self.model.dofs())
+            .map(|i| {
+                if prescribed(i) {
+                    motion[i]
+                } else {
+                    external[i]
+                }
+            })
+            .collect()
+    }
+
+    /// The contact force the motion implies on the contact nodes' free DOFs, M a + a_r M v +
+    /// f_int - f_ext (zero elsewhere): the force the integrator's step applied, whatever the
+    /// impact conditions then do to the entries' multipliers (theory 7).
+    fn motion_contact_force(&self, internal: &[f64]) -> Vec<f64> {
+        let (motion, external) = self.motion_terms(internal);
+        let on = crate::contact::surface_nodes(self.model);
+        let free = |i: usize| self.system.equation[i].is_some() && on[i / 2];
+        (0..self.model.dofs())
+            .map(|i| {
+                if free(i) {
+                    motion[i] - external[i]
+                } else {
+                    0.0
+                }
             })
             .collect()
     }
@@ -792,8 +794,13 @@ impl Stepper for Dynamics<'_> {
                 inverse: &self.inverse_mass,
             };
             let motion = (&mut self.kin.velocity[..], &mut self.kin.acceleration[..]);
-            self.contact
+            let closed = self
+                .contact
                 .close_touching(&self.interfaces, &positions, mass, motion);
+            if !closed.is_empty() {
+                // their impact conditions changed the motion the step starts from
+                self.last_contact = self.motion_contact_force(&self.last_internal);
+            }
             self.energies.contact_work +=
                 kinetic_before_impact - self.mass.kinetic_energy(self.model, &self.kin.velocity);
             match self.attempt(nominal, &positions, counters) {
@@ -992,7 +999,7 @@ end_time = 0.1
         let model = crate::scene::from_str(STACK, Path::new("stack.toml"), &[]).unwrap();
         let mass = Mass::new(&model, MassKind::Consistent)
             .unwrap()
-            .redistributed(&model, &contact_nodes(&model));
+            .redistributed(&model, &crate::contact::surface_nodes(&model));
         let coords = model.coordinates();
         for (body, surface_y, nodes_on_surface, total) in [(0, 0.001, 5, 4.0), (1, 0.0, 7, 6.0)] {
             let b = &model.bodies[body];
