@@ -6,7 +6,8 @@
 //! Dependencies flow one way, from the ground up: a module uses only modules of lower
 //! layers (tests/architecture.rs checks it on the source).
 //! ```text
-//! 1  profile, reference, mesh, output   timing, closed forms, meshes, writers on plain arrays
+//! 1  profile, reference, mesh, output,  timing, closed forms, meshes, writers, the ALE
+//!    ale                                smoother and remap on plain arrays
 //! 2  element                            pure kernels and the small fixed-size types
 //! 3  material, kinematics               constitutive update, objective push-forward
 //! 4  contact, solver, integrator        contact on plain arrays, faer, step coefficients
@@ -19,6 +20,7 @@
 //! ```
 //! The binary (src/main.rs) sits on top and calls analysis, sweep, bench and output.
 
+pub mod ale;
 pub mod analysis;
 pub mod assembly;
 pub mod bench;

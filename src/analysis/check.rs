@@ -195,8 +195,38 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
         if let Some(levels) = start.as_ref().and_then(Start::levels) {
             lines.push(subcycling_line(levels));
         }
+        if let Some(ale) = &spec.ale {
+            lines.push(ale_line(model, ale));
+        }
     }
     Ok(lines)
+}
+
+/// `impact check`'s line on the ALE steps: how often, by which smoother, and per body the nodes
+/// held, sliding along the boundary and free inside.
+fn ale_line(model: &Model, ale: &crate::scene::model::Ale) -> String {
+    let motion = crate::analysis::steppers::explicit::MeshMotion::new(model, *ale);
+    let bodies: Vec<String> = model
+        .bodies
+        .iter()
+        .zip(motion.node_classes())
+        .map(|(b, [held, boundary, inside])| {
+            format!(
+                "`{}` {held} held, {boundary} on the boundary (sliding where it turns by less than {} degrees), {inside} inside",
+                b.name,
+                readable(ale.rules.slide_angle.to_degrees())
+            )
+        })
+        .collect();
+    format!(
+        "ALE: every {} steps the nodes are smoothed ({}, each move sweeping at most {} of an \
+         element's area) and the state remapped conservatively; {} (summary.json `ale`, \
+         history.csv `remap_loss`)",
+        ale.every,
+        ale.rules.smoother.name(),
+        readable(ale.rules.max_move),
+        bodies.join("; ")
+    )
 }
 
 /// `impact check`'s line on the history rows: the cadence and about how many rows it gives

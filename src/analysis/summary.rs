@@ -72,10 +72,14 @@ pub struct EnergySummary {
     /// has the field only then.
     #[serde(default)]
     pub mass_scaling_loss: Option<f64>,
+    /// The kinetic energy the ALE remaps took out of the motion (history.csv
+    /// `remap_loss`); only with `analysis.ale`, and summary.json has the field only then.
+    #[serde(default)]
+    pub remap_loss: Option<f64>,
 }
 
-/// summary.json (a human-readable format) leaves `bulk_viscosity_work` and
-/// `mass_scaling_loss` out when there are none, so the scenes without them keep their file
+/// summary.json (a human-readable format) leaves `bulk_viscosity_work`, `mass_scaling_loss`
+/// and `remap_loss` out when there are none, so the scenes without them keep their file
 /// as it was; a checkpoint (a binary format whose fields are positional) always stores them.
 impl Serialize for EnergySummary {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
@@ -83,7 +87,8 @@ impl Serialize for EnergySummary {
         let binary = !serializer.is_human_readable();
         let viscosity = self.bulk_viscosity_work.is_some() || binary;
         let scaling = self.mass_scaling_loss.is_some() || binary;
-        let fields = 4 + usize::from(viscosity) + usize::from(scaling);
+        let remap = self.remap_loss.is_some() || binary;
+        let fields = 4 + usize::from(viscosity) + usize::from(scaling) + usize::from(remap);
         let mut s = serializer.serialize_struct("EnergySummary", fields)?;
         s.serialize_field("initial", &self.initial)?;
         s.serialize_field("final", &self.final_)?;
@@ -98,6 +103,11 @@ impl Serialize for EnergySummary {
             s.serialize_field("mass_scaling_loss", &self.mass_scaling_loss)?;
         } else {
             s.skip_field("mass_scaling_loss")?;
+        }
+        if remap {
+            s.serialize_field("remap_loss", &self.remap_loss)?;
+        } else {
+            s.skip_field("remap_loss")?;
         }
         s.end()
     }
@@ -117,6 +127,18 @@ pub struct MassScalingSummary {
     pub max_body_added_mass_percent: f64,
     pub max_body: String,
     pub bodies: Vec<BodyMassScaling>,
+}
+
+/// summary.json `ale` (only with `analysis.ale`; docs/theory.md 8.8): the remaps, the nodes
+/// they moved, the largest share of an element's volume one remap swept out of it, and the
+/// mass the sliding boundary nodes' chords took from the bodies' volume (the mass stays; its
+/// density rises) as a share of the volume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AleSummary {
+    pub remaps: u64,
+    pub node_moves: u64,
+    pub largest_courant: f64,
+    pub boundary_volume_change: f64,
 }
 
 /// summary.json `subcycling` (only with `analysis.subcycling`; docs/theory.md 8.7c): the
@@ -299,6 +321,10 @@ pub struct Summary {
     /// `mass_scaling` and only then.
     #[serde(skip)]
     pub subcycling: Option<SubcyclingSummary>,
+    /// The ALE steps (with `analysis.ale`): summary.json writes it after `subcycling` and
+    /// only then.
+    #[serde(skip)]
+    pub ale: Option<AleSummary>,
     /// What the scene and the finished run say about the answer (analysis::plausibility):
     /// the scene's own warnings (too few or too many steps, a run shorter than a wave
     /// transit, mixed units, a slave set that misses the surface facing its master, an
@@ -353,6 +379,7 @@ impl Summary {
             max_temperature: None,
             mass_scaling: None,
             subcycling: None,
+            ale: None,
             warnings: Vec::new(),
         }
     }

@@ -457,6 +457,33 @@ impl ElementMasses {
         Ok(ElementMasses { bodies })
     }
 
+    /// Body `b`'s element masses replaced by `masses` (element-major, as `of` reads them): an
+    /// ALE remap moves mass between the elements (docs/theory.md 8.8).
+    pub fn replace(&mut self, b: usize, masses: Vec<f64>) {
+        assert_eq!(
+            masses.len(),
+            self.bodies[b].len(),
+            "one mass per element node"
+        );
+        self.bodies[b] = masses;
+    }
+
+    /// The lumped nodal masses, 2 per node (both components): the sums of the elements'.
+    pub fn lumped(&self, model: &Model) -> Vec<f64> {
+        let mut m = vec![0.0; model.dofs()];
+        for (b, body) in model.bodies.iter().enumerate() {
+            for e in 0..body.elements() {
+                let nodes = body.mesh.cells.nodes_of(e);
+                for (n, value) in nodes.iter().zip(self.of(model, b, e)) {
+                    let g = body.global(*n);
+                    m[2 * g] += value;
+                    m[2 * g + 1] += value;
+                }
+            }
+        }
+        m
+    }
+
     /// The lumped masses of element `e` of body `b`.
     pub fn of(&self, model: &Model, b: usize, e: usize) -> &[f64] {
         let nn = model.bodies[b].mesh.cells.nodes_of(e).len();

@@ -4,9 +4,9 @@
 use super::InputError;
 use super::context::{Context, positive};
 use super::model::Analysis;
-use super::model::{DynamicAnalysis, StaticAnalysis, Subcycling};
+use super::model::{Ale, DynamicAnalysis, StaticAnalysis, Subcycling};
 use super::spec::{
-    AdaptiveStep, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics,
+    AdaptiveStep, AleSmoother, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics,
     DEFAULT_SUBCYCLING_LEVELS, IntegratorKind, MassKind, NewtonSpec, Quadrature, StepSpec,
     TimeStep,
 };
@@ -51,6 +51,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 (spec.bulk_viscosity.is_some(), "bulk_viscosity"),
                 (spec.mass_scaling.is_some(), "mass_scaling"),
                 (spec.subcycling.is_some(), "subcycling"),
+                (spec.ale.is_some(), "ale"),
             ] {
                 given(present, key, "static")?;
             }
@@ -98,6 +99,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicAnalysis, InputEr
         bulk_viscosity: bulk_viscosity(cx, spec, integrator)?,
         mass_scaling: mass_scaling(cx, spec, integrator, &step)?,
         subcycling: subcycling(cx, spec, integrator, &step)?,
+        ale: ale(cx, spec, integrator)?,
         step,
         end_time,
         integrator,
@@ -545,6 +547,73 @@ fn subcycling(
         )));
     }
     Ok(Some(Subcycling { levels }))
+}
+
+/// `analysis.ale`: central difference in the finite-strain explicit Quad4 kernels (the
+/// scene's checks refuse rods with it), without the subcycling and the mass scaling (their
+/// element levels and factors belong to the Lagrangian elements) and without checkpoints (the
+/// carry holds no remapped masses); `every` >= 1, `max_move` in (0, 0.5], `slide_angle` in
+/// [0, 45] degrees.
+fn ale(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    integrator: IntegratorKind,
+) -> Result<Option<Ale>, InputError> {
+    let Some(given) = spec.ale else {
+        return Ok(None);
+    };
+    if integrator != IntegratorKind::CentralDifference {
+        return Err(cx.err(format!(
+            "analysis.ale: smooths and remaps the mesh of central_difference's explicit kernels; integrator {} \
+             is implicit: remove ale or use integrator = \"central_difference\"",
+            integrator.name()
+        )));
+    }
+    if spec.geometry == Strain::Small {
+        return Err(cx.err(
+            "analysis.ale: runs in the finite-strain explicit Quad4 kernels; use geometry = \"nonlinear\" or remove ale",
+        ));
+    }
+    for (on, key) in [
+        (spec.subcycling.is_some(), "subcycling"),
+        (spec.mass_scaling.is_some(), "mass_scaling"),
+        (spec.checkpoint_every > 0, "checkpoint_every"),
+    ] {
+        if on {
+            return Err(cx.err(format!(
+                "analysis.ale: is not combined with analysis.{key} (its state belongs to the Lagrangian elements); use one of them"
+            )));
+        }
+    }
+    let every = given.every.unwrap_or(10);
+    if every == 0 {
+        return Err(cx.err("analysis.ale.every: smooth every N steps, N >= 1; got 0"));
+    }
+    let max_move = given.max_move.unwrap_or(0.25);
+    if !(max_move > 0.0 && max_move <= 0.5) {
+        return Err(cx.err(format!(
+            "analysis.ale.max_move: a fraction of a node's shortest edge in (0, 0.5], got {max_move}"
+        )));
+    }
+    let slide = given.slide_angle.unwrap_or(30.0);
+    if !(0.0..=45.0).contains(&slide) {
+        return Err(cx.err(format!(
+            "analysis.ale.slide_angle: degrees in [0, 45], got {slide}"
+        )));
+    }
+    let smoother = match given.smoother.unwrap_or(AleSmoother::Equipotential) {
+        AleSmoother::Volume => crate::ale::Smoother::Volume,
+        AleSmoother::Laplace => crate::ale::Smoother::Laplace,
+        AleSmoother::Equipotential => crate::ale::Smoother::Equipotential,
+    };
+    Ok(Some(Ale {
+        every,
+        rules: crate::ale::Rules {
+            smoother,
+            max_move,
+            slide_angle: slide.to_radians(),
+        },
+    }))
 }
 
 /// The most subcycling levels a scene may ask for.

@@ -330,6 +330,16 @@ pub struct DynamicAnalysis {
     pub mass_scaling: Option<MassScaling>,
     /// Central difference: the subcycling of the explicit Quad4 kernels (None: off).
     pub subcycling: Option<Subcycling>,
+    /// Central difference: the arbitrary Lagrangian-Eulerian steps (None: Lagrangian).
+    pub ale: Option<Ale>,
+}
+
+/// `analysis.ale` validated: smooth and remap every `every` steps by `rules`
+/// (docs/theory.md 8.8).
+#[derive(Debug, Clone, Copy)]
+pub struct Ale {
+    pub every: usize,
+    pub rules: crate::ale::Rules,
 }
 
 /// Multi-time-step central difference (docs/theory.md 8.7c): each element steps with its
@@ -421,6 +431,14 @@ impl Analysis {
         match self {
             Analysis::Static(_) => None,
             Analysis::Dynamic(s) => s.bulk_viscosity.as_ref(),
+        }
+    }
+
+    /// The ALE steps of a central-difference analysis (None: Lagrangian, or not dynamic).
+    pub fn ale(&self) -> Option<&Ale> {
+        match self {
+            Analysis::Static(_) => None,
+            Analysis::Dynamic(s) => s.ale.as_ref(),
         }
     }
 

@@ -168,6 +168,7 @@ fn check_mass_scaling(
     for (on, key) in [
         (d.mass_scaling.is_some(), "mass_scaling"),
         (d.subcycling.is_some(), "subcycling"),
+        (d.ale.is_some(), "ale"),
     ] {
         if on {
             return Err(cx.err(format!(

@@ -394,7 +394,8 @@ impl Units {
             | "contact_work"
             | "hourglass_energy"
             | "bulk_viscosity_work"
-            | "mass_scaling_loss" => per(self.energy),
+            | "mass_scaling_loss"
+            | "remap_loss" => per(self.energy),
             "added_mass" => per(self.mass),
             "contact_force" | "tangential_force" => per(self.force),
             "penetration" => self.length.to_string(),

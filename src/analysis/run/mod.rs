@@ -439,6 +439,8 @@ impl<'a, S: Stepper> Run<'a, S> {
             .analysis
             .mass_scaling()
             .map(|_| energies.mass_scaling_loss);
+        summary.energy.remap_loss = self.model.analysis.ale().map(|_| energies.remap_loss);
+        summary.ale = s.ale();
         let mass_scaling = s.mass_scaling();
         summary.mass_scaling = mass_scaling
             .as_ref()

@@ -287,6 +287,9 @@ impl Recorder {
             row.push(energies.mass_scaling_loss);
             row.push(self.added_mass);
         }
+        if model.analysis.ale().is_some() {
+            row.push(energies.remap_loss);
+        }
         let frame = self.frame_due(model, state.time, force_frame, 1);
         let history = &mut self.history;
         self.thinning
@@ -409,6 +412,7 @@ impl Recorder {
             max_temperature: summary.max_temperature,
             mass_scaling: summary.mass_scaling.as_ref(),
             subcycling: summary.subcycling.as_ref(),
+            ale: summary.ale.as_ref(),
             probes: FinalProbes {
                 columns: &model.probes,
                 values: &self.last_probes,
@@ -420,8 +424,8 @@ impl Recorder {
 }
 
 /// summary.json: the summary's fields, then `max_temperature` when there is one, then
-/// `mass_scaling` with the mass scaling, `subcycling` with the subcycling, then the probes' last values when the scene has
-/// probes.
+/// `mass_scaling` with the mass scaling, `subcycling` with the subcycling, `ale` with the ALE
+/// steps, then the probes' last values when the scene has probes.
 #[derive(serde::Serialize)]
 struct SummaryFile<'a> {
     #[serde(flatten)]
@@ -432,6 +436,8 @@ struct SummaryFile<'a> {
     mass_scaling: Option<&'a crate::analysis::summary::MassScalingSummary>,
     #[serde(skip_serializing_if = "Option::is_none")]
     subcycling: Option<&'a crate::analysis::summary::SubcyclingSummary>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ale: Option<&'a crate::analysis::summary::AleSummary>,
     #[serde(skip_serializing_if = "FinalProbes::is_empty")]
     probes: FinalProbes<'a>,
 }
@@ -824,6 +830,10 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
         // the kinetic energy lost as added mass joined the nodes, and the mass added so far
         columns.push("mass_scaling_loss".to_string());
         columns.push("added_mass".to_string());
+    }
+    if model.analysis.ale().is_some() {
+        // the kinetic energy the ALE remaps took out of the motion
+        columns.push("remap_loss".to_string());
     }
     (columns, pivots_column)
 }

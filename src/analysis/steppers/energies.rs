@@ -19,6 +19,9 @@ pub struct Energies {
     /// The kinetic energy lost as the mass scaling's added mass joined the moving nodes at
     /// rest (central difference; 0 without it; docs/theory.md 8.7b).
     pub mass_scaling_loss: f64,
+    /// The kinetic energy the ALE remaps took out of the nodal motion (central difference
+    /// with `analysis.ale`; 0 without it; docs/theory.md 8.8).
+    pub remap_loss: f64,
 }
 
 /// Nodal kinematic fields beyond the displacement (zero in statics).
@@ -32,9 +35,9 @@ pub struct Motion<'a> {
     pub internal_force: &'a [f64],
 }
 
-/// Relative energy balance error |KE + W_int + W_contact + W_visc + L_ms - W_ext - KE_0| /
+/// Relative energy balance error |KE + W_int + W_contact + W_visc + L_ms + L_remap - W_ext - KE_0| /
 /// max(KE_0, |W_ext|, |W_elastic|, KE), W_int = W_elastic + W_plastic, W_visc the bulk
-/// viscosity's work, L_ms the mass scaling's loss. KE is in the scale for a body that starts at
+/// viscosity's work, L_ms the mass scaling's loss, L_remap the ALE remaps'. KE is in the scale for a body that starts at
 /// rest under a load: the first step's kinetic energy comes before the external work that
 /// books it (a step's work is its force times an increment taken before that force acted),
 /// and against a scale of nothing but that lag the error read 1e300 %; where energy is created
@@ -51,6 +54,7 @@ pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
         + energies.contact_work
         + energies.bulk_viscosity_work
         + energies.mass_scaling_loss
+        + energies.remap_loss
         - energies.external_work
         - initial_kinetic)
         .abs()

@@ -97,6 +97,10 @@ pub trait Report {
     fn mass_scaling(&self) -> Option<crate::assembly::mass_scaling::MassScalingReport> {
         None
     }
+    /// The ALE steps' counts at the end: summary.json `ale` (None: off).
+    fn ale(&self) -> Option<crate::analysis::summary::AleSummary> {
+        None
+    }
     /// The subcycling's counts at the end: summary.json `subcycling` (None: off).
     fn subcycling(&self) -> Option<crate::analysis::summary::SubcyclingSummary> {
         None

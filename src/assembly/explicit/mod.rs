@@ -393,6 +393,13 @@ pub trait ExplicitKernel: Send {
     fn viscous_pressure(&self) -> &[f64];
     /// Takes the viscous pressures of a checkpoint (as `viscous_pressure` gave them).
     fn restore_viscous_pressure(&mut self, values: &[f64]);
+    /// The kernel's element state that `State` does not hold (the one-point kernel's hourglass
+    /// forces, 2 per element, and their work so far), to carry into a kernel rebuilt after an
+    /// ALE remap (None: there is none).
+    fn hourglass_state(&self) -> Option<(Vec<f64>, f64)> {
+        None
+    }
+    fn restore_hourglass_state(&mut self, _forces: Vec<f64>, _work: f64) {}
     /// The statistic of point probe `probe` over the kernel's own point values, as
     /// `write_points` and the probe over the state's points would give it (None: a body the
     /// kernel does not hold, or a nodal quantity).

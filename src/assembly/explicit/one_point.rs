@@ -629,6 +629,15 @@ impl ExplicitKernel for Reduced {
         }
     }
 
+    fn hourglass_state(&self) -> Option<(Vec<f64>, f64)> {
+        Some((self.hourglass.clone(), self.hourglass_energy))
+    }
+
+    fn restore_hourglass_state(&mut self, forces: Vec<f64>, work: f64) {
+        self.hourglass = forces;
+        self.hourglass_energy = work;
+    }
+
     fn hourglass_energy(&self) -> Option<f64> {
         Some(self.hourglass_energy)
     }

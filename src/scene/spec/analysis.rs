@@ -169,6 +169,37 @@ pub struct AnalysisSpec {
     /// integration, each element stepped with its own stable step rounded down to a power of
     /// two of the shortest (docs/theory.md 8.7c). Default: none (one step for every element).
     pub subcycling: Option<SubcyclingSpec>,
+    /// Central difference on Quad4 bodies at finite strain: arbitrary Lagrangian-Eulerian
+    /// steps, the mesh smoothed and the state remapped every few steps (docs/theory.md 8.8).
+    /// Default: none (Lagrangian).
+    pub ale: Option<AleSpec>,
+}
+
+/// `analysis.ale = { every = 10, smoother = "equipotential", max_move = 0.25, slide_angle = 30 }`:
+/// smooth and remap every `every` steps (default 10, Abaqus/Explicit's); the smoother
+/// (`equipotential`, default, `volume` or `laplace`); a node's move sweeps at most `max_move`
+/// of each of its elements' areas per smoothing (default 0.25); a boundary node slides along
+/// the boundary where it turns by at most `slide_angle` degrees (default 30). `ale = {}`
+/// turns it on with the defaults.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AleSpec {
+    pub every: Option<usize>,
+    pub smoother: Option<AleSmoother>,
+    pub max_move: Option<f64>,
+    pub slide_angle: Option<f64>,
+}
+
+/// `analysis.ale.smoother`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AleSmoother {
+    /// The area-weighted mean of the centroids of a node's elements (Abaqus' volume smoothing).
+    Volume,
+    /// The mean of the nodes joined to a node by an edge.
+    Laplace,
+    /// Winslow's equipotential smoothing (structured nodes; volume elsewhere).
+    Equipotential,
 }
 
 /// `analysis.subcycling = { levels = 5 }`: the elements' steps are 2^k times the shortest,

@@ -12,9 +12,11 @@
 //! status `unstable` once the energy exceeds 100 times its reference (the initial kinetic
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
+mod ale;
 mod start;
 mod subcycling;
 
+pub use ale::MeshMotion;
 pub use start::Start;
 pub use subcycling::Levels;
 
@@ -75,6 +77,8 @@ pub struct Explicit<'a> {
     forces_applied: bool,
     /// Subcycling's levels and counts (None: every element steps together).
     subcycler: Option<subcycling::Subcycler>,
+    /// The ALE steps (None: Lagrangian).
+    mesh_motion: Option<ale::MeshMotion>,
     // the step's vectors, allocated once
     v_half: Vec<f64>,
     du: Vec<f64>,
@@ -135,6 +139,7 @@ impl<'a> Explicit<'a> {
             contact: ContactState::new(&model.contacts),
             forces_applied: loads::has_external_force(model),
             subcycler,
+            mesh_motion: spec.ale.map(|a| ale::MeshMotion::new(model, a)),
             v_half: vec![0.0; dofs],
             du: vec![0.0; dofs],
             external: vec![0.0; dofs],
@@ -380,6 +385,13 @@ impl Stepper for Explicit<'_> {
         self.close_step_energies(work + added.support_work, (kinetic, shadow));
         self.step = step;
         self.clock.took(clock_step, bound);
+        if self.mesh_motion.as_ref().is_some_and(|m| m.due(step)) {
+            self.ale_step().map_err(|err| StepError {
+                status: Status::Diverged,
+                message: format!("at t = {}, ALE step: {err}", readable(time)),
+                frame: false,
+            })?;
+        }
         Ok(())
     }
 
@@ -469,6 +481,9 @@ impl Report for Explicit<'_> {
         let kernel = &self.kernel;
         let scaling = kernel.mass_scaling()?;
         Some(scaling.report(self.model.bodies.len(), |e| kernel.locate(e)))
+    }
+    fn ale(&self) -> Option<crate::analysis::summary::AleSummary> {
+        self.mesh_motion.as_ref().map(ale::MeshMotion::summary)
     }
     fn subcycling(&self) -> Option<crate::analysis::summary::SubcyclingSummary> {
         let sub = self.subcycler.as_ref()?;
