@@ -1,4 +1,4 @@
-//! ALE steps on the explicit path (docs/theory.md 8.8, docs/validation.md 12): the Taylor rods
+//! ALE steps on the explicit path (docs/theory.md 8.11, docs/validation.md 11): the Taylor rods
 //! against the published results and the Lagrangian runs, the copper rod past the Lagrangian
 //! mesh's limit on both kernels, the energy balance with the remap's term, and the scene's
 //! refusals. The remap itself (exact on linear fields, conservative, second order, no new
@@ -59,7 +59,7 @@ fn taylor_jc_with_ale_lands_on_the_published_results() {
 /// within the 1 % (measured 1.1e-4, 9.3e-5); the hourglass energy of the one-point
 /// kernel below the 2 % of the work on 10 x 100 (measured 0.3 %; 2.7 % on 5 x 50,
 /// where five elements span a foot four times the rod's radius); the two kernels' L_f within
-/// 1 % of each other, the 5 x 50 level's spread in the mesh study of docs/validation.md 12
+/// 1 % of each other, the 5 x 50 level's spread in the mesh study of docs/validation.md 11
 /// (measured 10.228 and 10.154 mm).
 #[test]
 fn a_copper_rod_at_400_m_s_completes_on_both_kernels_with_ale() {

@@ -141,3 +141,18 @@ impact plot $fig/sphere_restitution_family.csv --x n --log-x \
   --y explicit_20 --y one_point_20 --y newmark_20 --y explicit_100 --y one_point_100 --y newmark_100 \
   --title 'Restitution e on the mesh family: 20 V_y (upper), 100 V_y (lower)' \
   --out $fig/sphere_restitution_family.svg
+
+# ALE steps on the Taylor rods and the copper rod at 400 m/s (validation 11): the tables hold
+# the runs of `impact run` with and without `analysis.ale = {}` at 5, 10 and 20 elements across
+# (the aluminium rod) and the copper rod's `impact sweep` over the same levels; the charts are
+# drawn from them
+impact plot $fig/ale_taylor_aluminum.csv --x nx --log-x \
+  --y D_f_lagrangian_one_point --y D_f_ale_one_point --y D_f_lagrangian_2x2 --y D_f_ale_2x2 \
+  --title 'Aluminium Taylor rod: impact-face diameter (mm) against elements across' \
+  --out $fig/ale_taylor_aluminum.svg
+impact plot $fig/ale_copper.csv --x nx --log-x --y L_f_2x2 --y L_f_one_point \
+  --title 'Copper rod at 400 m/s with ALE: final length L_f (mm) against elements across' \
+  --out $fig/ale_copper_length.svg
+impact plot $fig/ale_copper.csv --x nx --log-x --y D_f_2x2 --y D_f_one_point \
+  --title 'Copper rod at 400 m/s with ALE: face diameter D_f (mm) against elements across' \
+  --out $fig/ale_copper_diameter.svg

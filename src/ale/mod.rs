@@ -1,7 +1,7 @@
 //! Arbitrary Lagrangian-Eulerian steps on a fixed-topology Quad4 mesh, on plain arrays: move
 //! the nodes by a smoother (`smooth`), then carry the element quantities, the mass and the
 //! nodal momentum from the old elements to the new ones through the regions the interior
-//! edges sweep (`remap`; docs/theory.md 8.8). The explicit driver calls them every few steps
+//! edges sweep (`remap`; docs/theory.md 8.11). The explicit driver calls them every few steps
 //! (`analysis.ale`); nothing here knows the scene or the material.
 //!
 //! Legend of the momentum remap (element e with old corner masses m_a^e, new ones n_a^e, node a

@@ -129,7 +129,7 @@ pub struct MassScalingSummary {
     pub bodies: Vec<BodyMassScaling>,
 }
 
-/// summary.json `ale` (only with `analysis.ale`; docs/theory.md 8.8): the remaps, the nodes
+/// summary.json `ale` (only with `analysis.ale`; docs/theory.md 8.11): the remaps, the nodes
 /// they moved, the largest share of an element's volume one remap swept out of it, and the
 /// mass the sliding boundary nodes' chords took from the bodies' volume (the mass stays; its
 /// density rises) as a share of the volume.

@@ -458,7 +458,7 @@ impl ElementMasses {
     }
 
     /// Body `b`'s element masses replaced by `masses` (element-major, as `of` reads them): an
-    /// ALE remap moves mass between the elements (docs/theory.md 8.8).
+    /// ALE remap moves mass between the elements (docs/theory.md 8.11).
     pub fn replace(&mut self, b: usize, masses: Vec<f64>) {
         assert_eq!(
             masses.len(),

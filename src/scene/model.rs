@@ -335,7 +335,7 @@ pub struct DynamicAnalysis {
 }
 
 /// `analysis.ale` validated: smooth and remap every `every` steps by `rules`
-/// (docs/theory.md 8.8).
+/// (docs/theory.md 8.11).
 #[derive(Debug, Clone, Copy)]
 pub struct Ale {
     pub every: usize,

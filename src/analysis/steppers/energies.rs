@@ -20,7 +20,7 @@ pub struct Energies {
     /// rest (central difference; 0 without it; docs/theory.md 8.7b).
     pub mass_scaling_loss: f64,
     /// The kinetic energy the ALE remaps took out of the nodal motion (central difference
-    /// with `analysis.ale`; 0 without it; docs/theory.md 8.8).
+    /// with `analysis.ale`; 0 without it; docs/theory.md 8.11).
     pub remap_loss: f64,
 }
 

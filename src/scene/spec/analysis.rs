@@ -170,7 +170,7 @@ pub struct AnalysisSpec {
     /// two of the shortest (docs/theory.md 8.7c). Default: none (one step for every element).
     pub subcycling: Option<SubcyclingSpec>,
     /// Central difference on Quad4 bodies at finite strain: arbitrary Lagrangian-Eulerian
-    /// steps, the mesh smoothed and the state remapped every few steps (docs/theory.md 8.8).
+    /// steps, the mesh smoothed and the state remapped every few steps (docs/theory.md 8.11).
     /// Default: none (Lagrangian).
     pub ale: Option<AleSpec>,
 }

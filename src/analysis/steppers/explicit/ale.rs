@@ -1,4 +1,4 @@
-//! Central difference's ALE step (docs/theory.md 8.8): every `analysis.ale.every` steps the
+//! Central difference's ALE step (docs/theory.md 8.11): every `analysis.ale.every` steps the
 //! nodes move by the smoother (`crate::ale::smooth`) and the element state, the element
 //! masses and the nodal velocities follow them by the conservative remap
 //! (`crate::ale::remap`). Which nodes may move is decided once: a node stays where a load,
