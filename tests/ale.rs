@@ -107,7 +107,7 @@ fn a_copper_rod_at_400_m_s_completes_on_both_kernels_with_ale() {
 
 /// Goal: `analysis.ale` is refused where it does not apply, naming the key. Setup: the
 /// copper rod's scene with an implicit integrator, small strain, the subcycling, the mass
-/// scaling, checkpoints, and out-of-range keys; a rod body. Reference: exit code 2 (input) and
+/// scaling, and out-of-range keys; a rod body. Reference: exit code 2 (input) and
 /// the key in the message.
 #[test]
 fn ale_is_refused_where_it_does_not_apply() {
@@ -125,7 +125,6 @@ fn ale_is_refused_where_it_does_not_apply() {
             "analysis.mass_scaling={target=1e-9}",
             "analysis.mass_scaling",
         ),
-        (scene, "analysis.checkpoint_every=10", "checkpoint_every"),
         (scene, "analysis.ale.every=0", "analysis.ale.every"),
         (scene, "analysis.ale.max_move=0.9", "analysis.ale.max_move"),
         (

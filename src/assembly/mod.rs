@@ -426,7 +426,7 @@ pub fn commit(
 
 /// The lumped mass of every element at its nodes (per body, element-major, nodes per
 /// element each): invariant in the updated-Lagrangian description (rho dV is).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ElementMasses {
     bodies: Vec<Vec<f64>>,
 }

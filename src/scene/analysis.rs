@@ -551,8 +551,7 @@ fn subcycling(
 
 /// `analysis.ale`: central difference in the finite-strain explicit Quad4 kernels (the
 /// scene's checks refuse rods with it), without the subcycling and the mass scaling (their
-/// element levels and factors belong to the Lagrangian elements) and without checkpoints (the
-/// carry holds no remapped masses); `every` >= 1, `max_move` in (0, 0.5], `slide_angle` in
+/// element levels and factors belong to the Lagrangian elements); `every` >= 1, `max_move` in (0, 0.5], `slide_angle` in
 /// [0, 45] degrees.
 fn ale(
     cx: &Context,
@@ -577,7 +576,6 @@ fn ale(
     for (on, key) in [
         (spec.subcycling.is_some(), "subcycling"),
         (spec.mass_scaling.is_some(), "mass_scaling"),
-        (spec.checkpoint_every > 0, "checkpoint_every"),
     ] {
         if on {
             return Err(cx.err(format!(

@@ -39,7 +39,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 10: the subcycling's element bounds and counts in the explicit carry.
 /// 12: the history's window since its last row (rows at a cadence, `output::thinning`).
 /// 13: the tight stable step's ratios in the explicit carry.
-/// 14: the ALE remaps' kinetic energy loss in the energies and the summary.
+/// 14: the ALE remaps' kinetic energy loss in the energies and the summary, their element
+///     masses and counts in the explicit carry.
 const FORMAT: u32 = 14;
 
 /// A whole run at the end of a converged step.

@@ -74,6 +74,16 @@ pub struct ExplicitCarry {
     /// The tight stable step's ratios and the bounds they were taken at (None: the kernel's
     /// bounds stand).
     pub tightness: Option<crate::assembly::explicit::tight::Tightness>,
+    /// The ALE steps' element masses (remapped) and counts (None without ALE).
+    pub ale: Option<AleCarry>,
+}
+
+/// What a run with ALE steps carries: the element masses as the remaps left them (the nodal
+/// masses and the kernel are formed from them) and the counts of summary.json `ale`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct AleCarry {
+    pub masses: crate::assembly::ElementMasses,
+    pub summary: crate::analysis::summary::AleSummary,
 }
 
 /// What a subcycled run carries past a major step: the frequency bound squared of every

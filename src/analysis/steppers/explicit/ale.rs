@@ -89,6 +89,11 @@ impl MeshMotion {
         self.summary.clone()
     }
 
+    /// The counts of a resumed run as its checkpoint had them.
+    pub fn restore(&mut self, summary: AleSummary) {
+        self.summary = summary;
+    }
+
     /// Per body, the nodes held, sliding along the boundary and free inside (`impact check`).
     pub fn node_classes(&self) -> Vec<[usize; 3]> {
         self.bodies

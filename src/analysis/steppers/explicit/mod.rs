@@ -519,6 +519,19 @@ impl Resume for Explicit<'_> {
         self.contact = carry.contact;
         self.step = carry.step;
         self.clock = carry.clock;
+        // the remapped element masses, before the kernel and the nodal masses are formed
+        match (self.mesh_motion.as_mut(), carry.ale) {
+            (Some(motion), Some(ale)) => {
+                self.masses = ale.masses;
+                motion.restore(ale.summary);
+                self.mass = self.masses.lumped(self.model);
+                for (i, m) in self.mass.iter().enumerate() {
+                    self.inverse_mass[i] = if self.free[i] { 1.0 / m } else { 0.0 };
+                }
+            }
+            (None, None) => {}
+            _ => return false,
+        }
         // a kernel with its own arrays starts again from the restored points (and the viscous
         // pressures of the last step, which the next step's work needs)
         (self.kernel, self.kernel_has_own_state) =
@@ -579,6 +592,10 @@ impl Resume for Explicit<'_> {
             mass_scaling: self.kernel.mass_scaling().map(|s| s.carry(&self.mass)),
             subcycling: self.subcycler.as_ref().map(|s| s.carry()),
             tightness: self.kernel.tightness().cloned(),
+            ale: self.mesh_motion.as_ref().map(|m| super::carry::AleCarry {
+                masses: self.masses.clone(),
+                summary: m.summary(),
+            }),
         }))
     }
 }
