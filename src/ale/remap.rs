@@ -24,7 +24,7 @@
 //! one element and enters the other); first order where the limiter acts.
 
 use super::geometry::{Moments, moments};
-use super::topology::Topology;
+use super::topology::{Edge, Topology};
 
 /// The geometry of one remap: the old and new element moments and the swept regions.
 #[derive(Debug, Clone)]
@@ -69,12 +69,7 @@ impl Sweep {
     pub fn courant(&self, topology: &Topology) -> f64 {
         let mut out = vec![0.0; self.old.len()];
         for (edge, s) in topology.edges.iter().zip(&self.swept) {
-            let donor = if s.volume > 0.0 {
-                edge.right
-            } else {
-                edge.left
-            };
-            out[donor] += s.volume.abs();
+            out[donor(edge, s)] += s.volume.abs();
         }
         out.iter()
             .zip(&self.old)
@@ -88,11 +83,7 @@ impl Sweep {
         let slopes = limited_gradients(topology, self, values, count);
         let mut fluxes = vec![0.0; topology.edges.len() * count];
         for (k, (edge, s)) in topology.edges.iter().zip(&self.swept).enumerate() {
-            let d = if s.volume > 0.0 {
-                edge.right
-            } else {
-                edge.left
-            };
+            let d = donor(edge, s);
             let c = self.old[d].centroid();
             let arm = [s.first[0] - c[0] * s.volume, s.first[1] - c[1] * s.volume];
             for j in 0..count {
@@ -167,11 +158,7 @@ impl Sweep {
         let slopes = limited_gradients(topology, self, velocity, 2);
         let mut carried = vec![0.0; topology.edges.len() * 2];
         for (k, (edge, s)) in topology.edges.iter().zip(&self.swept).enumerate() {
-            let d = if s.volume > 0.0 {
-                edge.right
-            } else {
-                edge.left
-            };
+            let d = donor(edge, s);
             let c = self.old[d].centroid();
             let arm = [self.midpoint[k][0] - c[0], self.midpoint[k][1] - c[1]];
             for j in 0..2 {
@@ -181,6 +168,16 @@ impl Sweep {
             }
         }
         self.net(topology, &carried, 2)
+    }
+}
+
+/// The element whose material an edge's swept region takes: the right one when the left
+/// grows (positive swept volume), else the left.
+fn donor(edge: &Edge, swept: &Moments) -> usize {
+    if swept.volume > 0.0 {
+        edge.right
+    } else {
+        edge.left
     }
 }
 

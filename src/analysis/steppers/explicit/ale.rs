@@ -144,39 +144,8 @@ impl MeshMotion {
             let t = &motion.topology;
             self.summary.largest_courant = self.summary.largest_courant.max(sweep.courant(t));
             remap_points(t, sweep, state, b);
-            let body = &model.bodies[b];
-            return_to_yield(body, &mut state.bodies[b].points, dt);
-            let kernel = Kernel::of(body);
-            let old: Vec<[f64; 4]> = (0..body.elements())
-                .map(|e| {
-                    let m = masses.of(model, b, e);
-                    [m[0], m[1], m[2], m[3]]
-                })
-                .collect();
-            let mut mass: Vec<f64> = old.iter().map(|m| m.iter().sum()).collect();
-            let flux = sweep.remap_mass(t, &mut mass);
-            // the lumped shares of the new shape; an element that the one-point kernel's
-            // steps left folded at a 2x2 Gauss point (its centroid is what that kernel
-            // integrates) keeps the shares it had
-            let new: Vec<[f64; 4]> = (0..body.elements())
-                .map(|e| {
-                    let shape = kernel
-                        .lumped_mass(body, &coordinates, e)
-                        .unwrap_or_else(|_| old[e].to_vec());
-                    let total: f64 = shape.iter().sum();
-                    [0, 1, 2, 3].map(|a| shape[a] / total * mass[e])
-                })
-                .collect();
-            let offset = body.node_offset;
-            let range = 2 * offset..2 * (offset + t.nodes);
-            let mut v = velocity[range.clone()].to_vec();
-            ale::remap_velocity(t, sweep, (&old, &new), &flux, &mut v);
-            for (i, value) in range.clone().zip(v) {
-                if free[i] {
-                    velocity[i] = value;
-                }
-            }
-            masses.replace(b, new.iter().flatten().copied().collect());
+            return_to_yield(&model.bodies[b], &mut state.bodies[b].points, dt);
+            remap_mass_and_motion(model, b, (t, sweep), &coordinates, masses, (velocity, free));
             let geometric: f64 = sweep.new.iter().map(|m| m.volume).sum();
             let carried: f64 = sweep.volume_in(t).iter().sum();
             self.summary.boundary_volume_change += (geometric - carried) / geometric;
@@ -191,6 +160,49 @@ impl MeshMotion {
         self.summary.node_moves += remapped.nodes_moved as u64;
         remapped
     }
+}
+
+/// Body `b`'s element masses moved by the sweep, their corner shares those of the new shapes
+/// (`coordinates`: all nodes, new), and its nodal velocities (the non-`free` DOFs kept).
+fn remap_mass_and_motion(
+    model: &Model,
+    b: usize,
+    (t, sweep): (&Topology, &Sweep),
+    coordinates: &[[f64; 2]],
+    masses: &mut ElementMasses,
+    (velocity, free): (&mut [f64], &[bool]),
+) {
+    let body = &model.bodies[b];
+    let kernel = Kernel::of(body);
+    let old: Vec<[f64; 4]> = (0..body.elements())
+        .map(|e| {
+            let m = masses.of(model, b, e);
+            [m[0], m[1], m[2], m[3]]
+        })
+        .collect();
+    let mut mass: Vec<f64> = old.iter().map(|m| m.iter().sum()).collect();
+    let flux = sweep.remap_mass(t, &mut mass);
+    // the lumped shares of the new shape; an element that the one-point kernel's steps left
+    // folded at a 2x2 Gauss point (its centroid is what that kernel integrates) keeps the
+    // shares it had
+    let new: Vec<[f64; 4]> = (0..body.elements())
+        .map(|e| {
+            let shape = kernel
+                .lumped_mass(body, coordinates, e)
+                .unwrap_or_else(|_| old[e].to_vec());
+            let total: f64 = shape.iter().sum();
+            [0, 1, 2, 3].map(|a| shape[a] / total * mass[e])
+        })
+        .collect();
+    let range = 2 * body.node_offset..2 * (body.node_offset + t.nodes);
+    let mut v = velocity[range.clone()].to_vec();
+    ale::remap_velocity(t, sweep, (&old, &new), &flux, &mut v);
+    for (i, value) in range.zip(v) {
+        if free[i] {
+            velocity[i] = value;
+        }
+    }
+    masses.replace(b, new.iter().flatten().copied().collect());
 }
 
 /// The points of body `b` remapped: each element's means of the fields moved by the sweep,
