@@ -336,6 +336,9 @@ impl super::Explicit<'_> {
         }
         let hourglass = self.kernel.hourglass_state();
         let viscous = self.kernel.viscous_pressure().to_vec();
+        // the tight step's ratios: each is taken again when its element's bound has moved by
+        // 2 % (8.7), as the smoothed elements' have; the others stand
+        let tightness = self.kernel.tightness().cloned();
         (self.kernel, _) = super::kernel_for(model, self.spec, &self.state, &self.masses);
         if let Some((forces, work)) = hourglass {
             // the hourglass forces resisted the hourglass shape of the old mesh, which the
@@ -347,6 +350,9 @@ impl super::Explicit<'_> {
         }
         if !viscous.is_empty() {
             self.kernel.restore_viscous_pressure(&viscous);
+        }
+        if let Some(tightness) = tightness {
+            self.kernel.restore_tightness(tightness);
         }
         self.synced = true;
         self.kernel
