@@ -49,11 +49,6 @@ pub fn moments<const N: usize>(points: &[[f64; 2]; N], axisymmetric: bool) -> Mo
     m
 }
 
-/// The plane area of a quadrilateral (counter-clockwise: positive).
-pub fn area(points: &[[f64; 2]; 4]) -> f64 {
-    moments(points, false).volume
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -307,6 +307,15 @@ fn held_nodes(model: &Model) -> Vec<bool> {
 }
 
 impl super::Explicit<'_> {
+    /// The nodal masses (and their inverses on the free DOFs) as the sums of the element
+    /// masses the remaps left: after an ALE step, and on resuming a run with them.
+    pub(super) fn nodal_masses_from_elements(&mut self) {
+        self.mass = self.masses.lumped(self.model);
+        for (i, m) in self.mass.iter().enumerate() {
+            self.inverse_mass[i] = if self.free[i] { 1.0 / m } else { 0.0 };
+        }
+    }
+
     /// The ALE step at the end of a step: the kernel's points into the state, the nodes
     /// smoothed and the state remapped, then the nodal masses, the kernel (its hourglass
     /// forces and viscous pressures kept), the internal force, the accelerations and the
@@ -330,10 +339,7 @@ impl super::Explicit<'_> {
             self.synced = true;
             return Ok(());
         }
-        self.mass = self.masses.lumped(model);
-        for (i, m) in self.mass.iter().enumerate() {
-            self.inverse_mass[i] = if self.free[i] { 1.0 / m } else { 0.0 };
-        }
+        self.nodal_masses_from_elements();
         let hourglass = self.kernel.hourglass_state();
         let viscous = self.kernel.viscous_pressure().to_vec();
         // the tight step's ratios: each is taken again when its element's bound has moved by

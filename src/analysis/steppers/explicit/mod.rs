@@ -524,10 +524,7 @@ impl Resume for Explicit<'_> {
             (Some(motion), Some(ale)) => {
                 self.masses = ale.masses;
                 motion.restore(ale.summary);
-                self.mass = self.masses.lumped(self.model);
-                for (i, m) in self.mass.iter().enumerate() {
-                    self.inverse_mass[i] = if self.free[i] { 1.0 / m } else { 0.0 };
-                }
+                self.nodal_masses_from_elements();
             }
             (None, None) => {}
             _ => return false,
