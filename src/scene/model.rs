@@ -360,8 +360,6 @@ pub struct StaticAnalysis {
 }
 
 impl DynamicAnalysis {
-    /// The fixed step (every implicit analysis has one; scene validation refuses `auto`
-    /// for them).
     /// Whether central difference's automatic step scales the elements' exact frequencies
     /// (`analysis.stable_step = "tight"`) rather than their bounds (the default): not with the
     /// bulk viscosity (whose damping folds into the bound). With the mass scaling the elements
@@ -371,6 +369,8 @@ impl DynamicAnalysis {
         matches!(self.step, TimeStep::Auto { tight: true, .. }) && self.bulk_viscosity.is_none()
     }
 
+    /// The fixed step (every implicit analysis has one; scene validation refuses `auto`
+    /// for them).
     pub fn fixed_dt(&self) -> Option<f64> {
         match self.step {
             TimeStep::Fixed(dt) => Some(dt),
