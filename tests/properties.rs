@@ -408,9 +408,9 @@ fn kernel_of(
     let state = impact::assembly::State::initial(model);
     let masses = impact::assembly::ElementMasses::new(model).unwrap();
     if quadrature == "reduced" {
-        Box::new(Reduced::new(model, &state, kappa, &masses).with_tight_step(tight))
+        Box::new(Reduced::new(model, &state, kappa, &masses).with_tight_step(tight, false))
     } else {
-        Box::new(Full::new(model, &state, &masses).with_tight_step(tight))
+        Box::new(Full::new(model, &state, &masses).with_tight_step(tight, false))
     }
 }
 

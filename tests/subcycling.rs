@@ -528,6 +528,10 @@ fn subcycling_refusals_name_the_key() {
         ),
         (vec!["analysis.subcycling={steps=2}"], vec!["steps"]),
         (
+            vec![on, "analysis.stable_step=\"global\""],
+            vec!["analysis.stable_step", "global", "tight"],
+        ),
+        (
             vec![
                 on,
                 "analysis.integrator=\"average\"",

@@ -7,8 +7,8 @@ use super::model::Analysis;
 use super::model::{Ale, DynamicAnalysis, StaticAnalysis, Subcycling};
 use super::spec::{
     AdaptiveStep, AleSmoother, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics,
-    DEFAULT_SUBCYCLING_LEVELS, IntegratorKind, MassKind, NewtonSpec, Quadrature, StepSpec,
-    TimeStep,
+    DEFAULT_SUBCYCLING_LEVELS, IntegratorKind, MassKind, NewtonSpec, Quadrature, StableStepKind,
+    StepSpec, TimeStep,
 };
 use crate::element::Strain;
 use crate::element::bulk_viscosity::{self, BulkViscosity};
@@ -173,8 +173,14 @@ fn time_step(
                 .dt_min
                 .map(|m| positive(cx, "analysis.dt_min", m))
                 .transpose()?;
-            let tight = spec.stable_step == Some(crate::scene::spec::StableStepKind::Tight);
-            Ok(TimeStep::Auto { scale, min, tight })
+            let stable = spec.stable_step.unwrap_or(StableStepKind::Bound);
+            if stable == StableStepKind::Global && spec.subcycling.is_some() {
+                return Err(cx.err(
+                    "analysis.stable_step: \"global\" estimates one step for the whole mesh, and analysis.subcycling \
+                     steps each element at its own: use stable_step = \"tight\" with the subcycling",
+                ));
+            }
+            Ok(TimeStep::Auto { scale, min, stable })
         }
     }
 }

@@ -10,7 +10,7 @@
 
 use super::spec::{
     AdaptiveStep, BucklingSpec, ContactDynamics, IntegratorKind, MassKind, NewtonSpec, OutputSpec,
-    Quadrature, Quantity, ReferenceKind, Statistic, TimeStep,
+    Quadrature, Quantity, ReferenceKind, StableStepKind, Statistic, TimeStep,
 };
 use crate::contact::{BodySurface, ContactPair, Interfaces, Obstacle, Section};
 use crate::element::bulk_viscosity::BulkViscosity;
@@ -366,7 +366,28 @@ impl DynamicAnalysis {
     /// are scaled by their bounds as without it (more mass than the tight step needs); with the
     /// subcycling the levels come from the tight frequencies.
     pub fn tight_step(&self) -> bool {
-        matches!(self.step, TimeStep::Auto { tight: true, .. }) && self.bulk_viscosity.is_none()
+        let tight = matches!(
+            self.step,
+            TimeStep::Auto {
+                stable: StableStepKind::Tight | StableStepKind::Global,
+                ..
+            }
+        );
+        tight && self.bulk_viscosity.is_none()
+    }
+
+    /// Whether the tight elements' step gives way to the estimate of the mesh's highest
+    /// frequency over them (`analysis.stable_step = "global"`; not with the bulk viscosity,
+    /// as `tight_step`).
+    pub fn global_step(&self) -> bool {
+        let global = matches!(
+            self.step,
+            TimeStep::Auto {
+                stable: StableStepKind::Global,
+                ..
+            }
+        );
+        global && self.bulk_viscosity.is_none()
     }
 
     /// The fixed step (every implicit analysis has one; scene validation refuses `auto`

@@ -41,7 +41,9 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 13: the tight stable step's ratios in the explicit carry.
 /// 14: the ALE remaps' kinetic energy loss in the energies and the summary, their element
 ///     masses and counts in the explicit carry.
-const FORMAT: u32 = 14;
+/// 15: the global stable step's element stiffnesses and last estimate in the tight step's
+///     carry.
+const FORMAT: u32 = 15;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

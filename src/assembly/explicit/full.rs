@@ -26,7 +26,7 @@
 //! ```
 
 use super::tight::{
-    Tightness, end_nodes, max_frequency_squared, shortest_edge, stiffness_by_differences,
+    ElementStiffness, Tightness, end_nodes, shortest_edge, stiffness_by_differences,
 };
 use super::{
     CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
@@ -308,9 +308,10 @@ impl Full {
     }
 
     /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
-    /// the exact frequency, `tight`) or its elements' bounds (the default).
-    pub fn with_tight_step(self, on: bool) -> Full {
-        let tightness = on.then(|| Tightness::new(self.bounds.len()));
+    /// the exact frequency, `tight`; with `global` the mesh's estimate over them, `global`)
+    /// or its elements' bounds (the default).
+    pub fn with_tight_step(self, on: bool, global: bool) -> Full {
+        let tightness = on.then(|| Tightness::new(self.bounds.len(), global));
         Full { tightness, ..self }
     }
 
@@ -325,9 +326,10 @@ impl Full {
         }
     }
 
-    /// The exact highest frequency squared of element `e` at the nodes `xe` with its masses:
+    /// The stiffness and lumped masses of element `e` at the nodes `xe` (its exact highest
+    /// frequency squared their largest eigenvalue):
     /// the kernel's stiffness from a stress-free state (`tight`).
-    fn exact_frequency(&self, xe: &Nodes, e: usize) -> Option<f64> {
+    fn exact_stiffness(&self, xe: &Nodes, e: usize) -> Option<ElementStiffness> {
         let p = self.parameters(e);
         let fresh = PointsState {
             stress: [[0.0; 4]; 4],
@@ -343,7 +345,7 @@ impl Full {
                 .ok()
                 .map(|r| r.force)
         })?;
-        Some(max_frequency_squared(&k, &lumped))
+        Some(ElementStiffness { k, lumped })
     }
 
     /// The kernel with the mass scaling `rule` (None: off), the elements below its target
@@ -530,7 +532,7 @@ impl PartialKernel for Full {
         Ok(match &self.tightness {
             Some(tight) => {
                 let nodes = self.layout.nodes[e].map(|n| x[n as usize]);
-                bound * tight.ratio_for(e, bound, || self.exact_frequency(&nodes, e))
+                bound * tight.ratio_for(e, bound, || self.exact_stiffness(&nodes, e))
             }
             None => bound,
         })
@@ -564,7 +566,7 @@ impl PartialKernel for Full {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
                 tight.apply_subset(elements, omega_squared, |e| {
-                    self.exact_frequency(&end(e), e)
+                    self.exact_stiffness(&end(e), e)
                 });
             self.tightness = Some(tight);
         }
@@ -605,7 +607,7 @@ impl ExplicitKernel for Full {
             x,
             self.tightness.as_ref(),
             |e| self.frequency(x, e),
-            |xe, e| self.exact_frequency(xe, e),
+            |xe, e| self.exact_stiffness(xe, e),
         )
     }
 
@@ -620,7 +622,9 @@ impl ExplicitKernel for Full {
         if let Some(mut tight) = self.tightness.take() {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
-                tight.apply(&self.bounds, |e| self.exact_frequency(&end(e), e));
+                tight.apply(&self.bounds, &self.layout.nodes, |e| {
+                    self.exact_stiffness(&end(e), e)
+                });
             self.tightness = Some(tight);
         }
         self.gather.gather(&self.element_forces, force);

@@ -12,6 +12,7 @@
 
 pub mod full;
 pub mod general;
+pub mod global;
 pub mod one_point;
 pub mod tight;
 
@@ -536,7 +537,7 @@ pub(super) fn kernel_stable_step(
     x: &[[f64; 2]],
     tightness: Option<&tight::Tightness>,
     bound: impl Fn(usize) -> Result<f64, ElementFailure>,
-    exact: impl Fn(&Nodes, usize) -> Option<f64> + Sync,
+    exact: impl Fn(&Nodes, usize) -> Option<tight::ElementStiffness> + Sync,
 ) -> Result<StableStep, ElementFailure> {
     let mut worst = StepWork::default();
     let mut bounds = Vec::with_capacity(layout.nodes.len());
@@ -579,7 +580,7 @@ pub fn kernel_for<'a>(
         Quadrature::Reduced => (
             Box::new(
                 Reduced::new(model, state, spec.hourglass, masses)
-                    .with_tight_step(spec.tight_step())
+                    .with_tight_step(spec.tight_step(), spec.global_step())
                     .with_bulk_viscosity(spec.bulk_viscosity)
                     .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
             ),
@@ -588,7 +589,7 @@ pub fn kernel_for<'a>(
         Quadrature::Full if quads_only && spec.geometry == Strain::Finite => (
             Box::new(
                 Full::new(model, state, masses)
-                    .with_tight_step(spec.tight_step())
+                    .with_tight_step(spec.tight_step(), spec.global_step())
                     .with_bulk_viscosity(spec.bulk_viscosity)
                     .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
             ),

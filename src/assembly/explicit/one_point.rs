@@ -20,7 +20,7 @@
 //! count.
 
 use super::tight::{
-    Tightness, end_nodes, max_frequency_squared, shortest_edge, stiffness_by_differences,
+    ElementStiffness, Tightness, end_nodes, shortest_edge, stiffness_by_differences,
 };
 use super::{
     BodyParameters, CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel,
@@ -292,9 +292,10 @@ impl Reduced {
     }
 
     /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
-    /// the exact frequency, `tight`) or its elements' bounds (the default).
-    pub fn with_tight_step(self, on: bool) -> Reduced {
-        let tightness = on.then(|| Tightness::new(self.bounds.len()));
+    /// the exact frequency, `tight`; with `global` the mesh's estimate over them, `global`)
+    /// or its elements' bounds (the default).
+    pub fn with_tight_step(self, on: bool, global: bool) -> Reduced {
+        let tightness = on.then(|| Tightness::new(self.bounds.len(), global));
         Reduced { tightness, ..self }
     }
 
@@ -309,10 +310,11 @@ impl Reduced {
         }
     }
 
-    /// The exact highest frequency squared of element `e` at the nodes `xe` with its masses:
+    /// The stiffness and lumped masses of element `e` at the nodes `xe` (its exact highest
+    /// frequency squared their largest eigenvalue):
     /// the kernel's stiffness (hourglass and hoop included) from a stress-free state
     /// (`tight`).
-    fn exact_frequency(&self, xe: &Nodes, e: usize) -> Option<f64> {
+    fn exact_stiffness(&self, xe: &Nodes, e: usize) -> Option<ElementStiffness> {
         let p = &self.layout.bodies[self.layout.body[e] as usize];
         let fresh = ElementState {
             stress: [0.0; 4],
@@ -331,7 +333,7 @@ impl Reduced {
                 .ok()
                 .map(|r| r.force)
         })?;
-        Some(max_frequency_squared(&k, &lumped))
+        Some(ElementStiffness { k, lumped })
     }
 
     /// The kernel with the mass scaling `rule` (None: off), the elements below its target
@@ -577,7 +579,7 @@ impl ExplicitKernel for Reduced {
             x,
             self.tightness.as_ref(),
             |e| self.frequency(x, e),
-            |xe, e| self.exact_frequency(xe, e),
+            |xe, e| self.exact_stiffness(xe, e),
         )
     }
 
@@ -592,7 +594,9 @@ impl ExplicitKernel for Reduced {
         if let Some(mut tight) = self.tightness.take() {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
-                tight.apply(&self.bounds, |e| self.exact_frequency(&end(e), e));
+                tight.apply(&self.bounds, &self.layout.nodes, |e| {
+                    self.exact_stiffness(&end(e), e)
+                });
             self.tightness = Some(tight);
         }
         self.gather.gather(&self.element_forces, force);
@@ -696,7 +700,7 @@ impl PartialKernel for Reduced {
         Ok(match &self.tightness {
             Some(tight) => {
                 let nodes = self.layout.nodes[e].map(|n| x[n as usize]);
-                bound * tight.ratio_for(e, bound, || self.exact_frequency(&nodes, e))
+                bound * tight.ratio_for(e, bound, || self.exact_stiffness(&nodes, e))
             }
             None => bound,
         })
@@ -731,7 +735,7 @@ impl PartialKernel for Reduced {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
                 tight.apply_subset(elements, omega_squared, |e| {
-                    self.exact_frequency(&end(e), e)
+                    self.exact_stiffness(&end(e), e)
                 });
             self.tightness = Some(tight);
         }

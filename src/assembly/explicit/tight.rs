@@ -20,6 +20,8 @@
 //! the ratio between two evaluations (the bound tracks the element's size every step; the ratio
 //! only its shape, within DRIFT of it).
 
+use super::global::Global;
+pub use super::global::{ElementStiffness, max_frequency_squared};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -27,20 +29,28 @@ use serde::{Deserialize, Serialize};
 pub const DRIFT: f64 = 0.02;
 
 /// Per element, the ratio of its exact frequency squared to its bound and the bound it was
-/// taken at (0: not yet taken).
+/// taken at (0: not yet taken); with the global step, the estimate of the mesh's.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Tightness {
     ratio: Vec<f64>,
     at: Vec<f64>,
+    global: Option<Global>,
 }
 
 impl Tightness {
-    /// `elements` elements, no ratio taken yet.
-    pub fn new(elements: usize) -> Tightness {
+    /// `elements` elements, no ratio taken yet; `global`: the mesh's highest frequency
+    /// estimated over them (`global.rs`).
+    pub fn new(elements: usize, global: bool) -> Tightness {
         Tightness {
             ratio: vec![1.0; elements],
             at: vec![0.0; elements],
+            global: global.then(|| Global::new(elements)),
         }
+    }
+
+    /// The global estimates taken so far (None: the step is the elements').
+    pub fn global_estimates(&self) -> Option<usize> {
+        self.global.as_ref().map(Global::estimates)
     }
 
     /// Whether element `e`'s ratio is due again at its bound `bound`.
@@ -52,8 +62,8 @@ impl Tightness {
     /// The ratio of element `e` for its bound `bound` and exact value `exact` (None: the
     /// exact value could not be formed; the bound then stands). Never above 1 (round-off of
     /// the differences aside, the bound is an upper bound).
-    fn ratio_of(bound: f64, exact: Option<f64>) -> f64 {
-        match exact {
+    fn ratio_of(bound: f64, exact: Option<&ElementStiffness>) -> f64 {
+        match exact.map(ElementStiffness::frequency_squared) {
             Some(exact) if bound > 0.0 && exact.is_finite() && exact > 0.0 => {
                 (exact / bound).min(1.0)
             }
@@ -63,14 +73,23 @@ impl Tightness {
 
     /// The tight frequency squared of every element from this step's `bounds`, the largest
     /// and its element (the lowest index among equals), the stale ratios taken again with
-    /// `exact(e)` (in parallel; the result does not depend on the thread count).
+    /// `exact(e)` (in parallel; the result does not depend on the thread count). With the
+    /// global step, the mesh's estimate from the elements `nodes` in its place.
     pub fn apply(
         &mut self,
         bounds: &[f64],
-        exact: impl Fn(usize) -> Option<f64> + Sync,
+        nodes: &[[u32; 4]],
+        exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
         self.refresh(0..bounds.len(), bounds, exact);
-        self.largest(bounds, |e| self.ratio[e])
+        let largest = self.largest(bounds, |e| self.ratio[e]);
+        match self.global.as_mut() {
+            Some(global) => {
+                let at = &self.at;
+                global.frequency(nodes, |e| bounds[e] / at[e], largest, DRIFT)
+            }
+            None => largest,
+        }
     }
 
     /// Takes again the stale ratios among `elements`, whose bounds are in `bounds` (by element
@@ -79,16 +98,16 @@ impl Tightness {
         &mut self,
         elements: impl Iterator<Item = usize>,
         bounds: &[f64],
-        exact: impl Fn(usize) -> Option<f64> + Sync,
+        exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) {
         let stale: Vec<usize> = elements.filter(|&e| self.stale(e, bounds[e])).collect();
-        let fresh: Vec<f64> = stale
-            .par_iter()
-            .map(|&e| Tightness::ratio_of(bounds[e], exact(e)))
-            .collect();
-        for (&e, ratio) in stale.iter().zip(fresh) {
-            self.ratio[e] = ratio;
+        let fresh: Vec<Option<ElementStiffness>> = stale.par_iter().map(|&e| exact(e)).collect();
+        for (&e, stiffness) in stale.iter().zip(fresh) {
+            self.ratio[e] = Tightness::ratio_of(bounds[e], stiffness.as_ref());
             self.at[e] = bounds[e];
+            if let Some(global) = self.global.as_mut() {
+                global.keep(e, stiffness);
+            }
         }
     }
 
@@ -97,12 +116,12 @@ impl Tightness {
     pub fn peek(
         &self,
         bounds: &[f64],
-        exact: impl Fn(usize) -> Option<f64> + Sync,
+        exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
         let ratios: Vec<f64> = (0..bounds.len())
             .into_par_iter()
             .map(|e| match self.stale(e, bounds[e]) {
-                true => Tightness::ratio_of(bounds[e], exact(e)),
+                true => Tightness::ratio_of(bounds[e], exact(e).as_ref()),
                 false => self.ratio[e],
             })
             .collect();
@@ -111,9 +130,14 @@ impl Tightness {
 
     /// The ratio of element `e` at its bound `bound`: the one kept, or when stale a fresh one
     /// from `exact()` (not kept).
-    pub fn ratio_for(&self, e: usize, bound: f64, exact: impl FnOnce() -> Option<f64>) -> f64 {
+    pub fn ratio_for(
+        &self,
+        e: usize,
+        bound: f64,
+        exact: impl FnOnce() -> Option<ElementStiffness>,
+    ) -> f64 {
         match self.stale(e, bound) {
-            true => Tightness::ratio_of(bound, exact()),
+            true => Tightness::ratio_of(bound, exact().as_ref()),
             false => self.ratio[e],
         }
     }
@@ -125,7 +149,7 @@ impl Tightness {
         &mut self,
         elements: &[u32],
         omega_squared: &mut [f64],
-        exact: impl Fn(usize) -> Option<f64> + Sync,
+        exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
         self.refresh(elements.iter().map(|&e| e as usize), omega_squared, exact);
         let mut best = (0.0, usize::MAX);
@@ -149,16 +173,6 @@ impl Tightness {
         }
         best
     }
-}
-
-/// The largest eigenvalue of M^-1 K for an 8 x 8 element stiffness `k` (symmetrized) and the
-/// lumped nodal masses `lumped` (each for both directions of its node).
-pub fn max_frequency_squared(k: &[[f64; 8]; 8], lumped: &[f64; 4]) -> f64 {
-    let scale: [f64; 8] = std::array::from_fn(|i| 1.0 / lumped[i / 2].sqrt());
-    let a = nalgebra::SMatrix::<f64, 8, 8>::from_fn(|i, j| {
-        0.5 * (k[i][j] + k[j][i]) * scale[i] * scale[j]
-    });
-    a.symmetric_eigenvalues().max()
 }
 
 /// The stiffness of an element's nodal forces `force(u)` (u: a nodal increment from the
@@ -209,24 +223,39 @@ mod tests {
     /// it; the largest tight value and its element. Reference: by hand.
     #[test]
     fn ratios_are_kept_within_the_drift_and_taken_again_past_it() {
-        let mut t = Tightness::new(2);
+        let mut t = Tightness::new(2, false);
         let calls = std::sync::atomic::AtomicUsize::new(0);
         let exact = |e: usize| {
             calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            Some([2.0, 3.0][e])
+            Some(of_frequency([2.0, 3.0][e]))
         };
+        let nodes = [[0, 1, 2, 3], [1, 4, 5, 2]];
         // ratios 0.5 and 0.75: tight values 2 and 3
-        assert_eq!(t.apply(&[4.0, 4.0], exact), (3.0, 1));
+        assert_eq!(t.apply(&[4.0, 4.0], &nodes, exact), (3.0, 1));
         assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 2);
         // element 0's bound moves 1 %: kept (0.5 * 4.04); element 1 by 5 %: taken again
         // (exact 3 over 4.2)
-        assert_eq!(t.apply(&[4.04, 4.2], exact), (3.0, 1));
+        assert_eq!(t.apply(&[4.04, 4.2], &nodes, exact), (3.0, 1));
         assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 3);
         assert_eq!(t.ratio[0], 0.5);
         // a bound below the exact value (round-off) is not trusted beyond 1
-        let mut t = Tightness::new(1);
-        assert_eq!(t.apply(&[1.0], |_| Some(1.0 + 1e-12)), (1.0, 0));
-        assert_eq!(t.apply(&[1.0], |_| None).0, 1.0);
+        let mut t = Tightness::new(1, false);
+        let one = [[0, 1, 2, 3]];
+        assert_eq!(
+            t.apply(&[1.0], &one, |_| Some(of_frequency(1.0 + 1e-12))),
+            (1.0, 0)
+        );
+        assert_eq!(t.apply(&[1.0], &one, |_| None).0, 1.0);
+    }
+
+    /// An element whose highest frequency squared is `omega_squared` (unit masses).
+    fn of_frequency(omega_squared: f64) -> ElementStiffness {
+        let mut k = [[0.0; 8]; 8];
+        k[0][0] = omega_squared;
+        ElementStiffness {
+            k,
+            lumped: [1.0; 4],
+        }
     }
 
     /// Goal: the eigenvalue of M^-1 K of a known system. Reference: two unit masses joined

@@ -100,8 +100,10 @@ pub struct AnalysisSpec {
     /// `dt = "auto"`: the fraction of the critical step taken, in (0, 1]. Default 0.9.
     pub time_step_scale: Option<f64>,
     /// `dt = "auto"`, central difference: the critical step the scale applies to: `bound`
-    /// (default: the kernels' closed-form frequency bounds) or `tight` (each element's exact
-    /// highest frequency, `assembly::explicit::tight`: up to twice the step).
+    /// (default: the kernels' closed-form frequency bounds), `tight` (each element's exact
+    /// highest frequency, `assembly::explicit::tight`: up to twice the step) or `global`
+    /// (the mesh's highest frequency estimated over the tight elements,
+    /// `assembly::explicit::global`).
     pub stable_step: Option<StableStepKind>,
     /// `dt = "auto"`, central difference: the run stops (status `diverged`) when the step
     /// would fall below this (a time); default no limit. Implicit: the shortest step the
@@ -281,12 +283,12 @@ pub enum TimeStep {
     /// The same step throughout (the last one shorter to end at `end_time`).
     Fixed(f64),
     /// `scale` times the critical step of the current configuration, every step; the run
-    /// stops when it would fall below `min`; `tight`: the elements' exact frequencies, else
-    /// their bounds.
+    /// stops when it would fall below `min`; `stable`: the critical step it scales (the
+    /// elements' bounds, their exact frequencies, or the mesh's estimate over them).
     Auto {
         scale: f64,
         min: Option<f64>,
-        tight: bool,
+        stable: StableStepKind,
     },
     /// Implicit: each step as long as the local error estimate allows; the first from the
     /// wave speed and the smallest element.
@@ -299,6 +301,7 @@ pub enum TimeStep {
 pub enum StableStepKind {
     Tight,
     Bound,
+    Global,
 }
 
 /// The implicit error-controlled step (`dt = "auto"`): the tolerance of the local error

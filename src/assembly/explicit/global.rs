@@ -1,0 +1,401 @@
+//! The global stable step (`analysis.stable_step = "global"`): an estimate of the mesh's
+//! highest frequency, above the largest element's, from the element stiffnesses the tight
+//! step takes (docs/theory.md 8.7b).
+//!
+//! ```text
+//! A        = D^-1/2 K D^-1/2,   K = sum_e s_e K_e,   D the nodal lumped masses (both directions)
+//! s_e      = bound_e / at_e     the element's bound now over its bound when K_e was taken
+//!                               (the tight step's own drift rule, 8.7)
+//! theta    the largest Ritz value of ITERATIONS Lanczos steps (full reorthogonalization)
+//!          from the last estimate's Ritz vector plus a fixed pseudo-random vector
+//! r        = beta_m |s_m|       its residual: an eigenvalue of A lies within r of theta
+//! lambda   = min(theta + r, max_e omega_e^2)    omega_e^2 the tight element frequencies
+//! ```
+//!
+//! Irons' element eigenvalue inequality puts the mesh's highest eigenvalue at or below the
+//! largest element's, and a Ritz value is at or below it too: the estimate lies between the
+//! two, the element step its safety net. Between two estimates the step follows the tight
+//! element maximum at the ratio last found (`lambda / max_e omega_e^2`); an estimate is taken
+//! again every `EVERY` steps and whenever that maximum has moved by more than the tight
+//! step's `DRIFT`. Everything here runs on the stepping thread in a fixed order: the estimate
+//! does not depend on the thread count.
+
+use serde::{Deserialize, Serialize};
+
+/// Lanczos steps of an estimate (the first from the pseudo-random vector alone takes twice).
+const ITERATIONS: usize = 30;
+
+/// Steps between two estimates when the element maximum stays within the drift.
+pub const EVERY: usize = 100;
+
+/// An element's stiffness from a stress-free state and its lumped nodal masses (each for
+/// both directions of its node), as the tight step forms them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ElementStiffness {
+    pub k: [[f64; 8]; 8],
+    pub lumped: [f64; 4],
+}
+
+impl ElementStiffness {
+    /// The element's highest frequency squared, the largest eigenvalue of M^-1 K.
+    pub fn frequency_squared(&self) -> f64 {
+        max_frequency_squared(&self.k, &self.lumped)
+    }
+}
+
+/// The largest eigenvalue of M^-1 K for an 8 x 8 element stiffness `k` (symmetrized) and the
+/// lumped nodal masses `lumped` (each for both directions of its node).
+pub fn max_frequency_squared(k: &[[f64; 8]; 8], lumped: &[f64; 4]) -> f64 {
+    let scale: [f64; 8] = std::array::from_fn(|i| 1.0 / lumped[i / 2].sqrt());
+    let a = nalgebra::SMatrix::<f64, 8, 8>::from_fn(|i, j| {
+        0.5 * (k[i][j] + k[j][i]) * scale[i] * scale[j]
+    });
+    a.symmetric_eigenvalues().max()
+}
+
+/// The global estimate's state: the element stiffnesses and what the last estimate found.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Global {
+    /// Each element's stiffness and lumped masses as the tight step last took them.
+    stiffness: Vec<Option<ElementStiffness>>,
+    /// The last estimate over the element maximum then (0: none yet).
+    ratio: f64,
+    /// The element maximum at the last estimate.
+    at: f64,
+    /// Steps since the last estimate.
+    since: usize,
+    /// The last estimate's Ritz vector (the next one starts from it).
+    vector: Vec<f64>,
+    /// Estimates taken.
+    estimates: usize,
+}
+
+impl Global {
+    /// The state of a mesh of `elements` elements, no stiffness taken yet.
+    pub fn new(elements: usize) -> Global {
+        Global {
+            stiffness: vec![None; elements],
+            ..Global::default()
+        }
+    }
+
+    /// Keeps element `e`'s stiffness (None: it could not be formed; no estimate is then
+    /// taken until it is).
+    pub fn keep(&mut self, e: usize, stiffness: Option<ElementStiffness>) {
+        self.stiffness[e] = stiffness;
+    }
+
+    /// The estimates taken so far.
+    pub fn estimates(&self) -> usize {
+        self.estimates
+    }
+
+    /// The mesh's highest frequency squared for this step from the tight element maximum
+    /// `largest` (its value and element), the elements' `nodes` and their stiffness scales
+    /// `scale(e)`; an estimate taken when one is due (`drift`: how far the maximum may move
+    /// before one is, the tight step's own `DRIFT`).
+    pub fn frequency(
+        &mut self,
+        nodes: &[[u32; 4]],
+        scale: impl Fn(usize) -> f64,
+        largest: (f64, usize),
+        drift: f64,
+    ) -> (f64, usize) {
+        let (max, element) = largest;
+        let due = self.ratio == 0.0 || self.since >= EVERY || (max / self.at - 1.0).abs() > drift;
+        if due {
+            self.ratio = match self.estimate(nodes, scale) {
+                Some(lambda) if max > 0.0 => (lambda / max).min(1.0),
+                _ => 1.0,
+            };
+            self.at = max;
+            self.since = 0;
+            self.estimates += 1;
+        }
+        self.since += 1;
+        (self.ratio * max, element)
+    }
+
+    /// theta + r of the Lanczos estimate (module docs); None when an element's stiffness is
+    /// missing or the masses are not positive.
+    fn estimate(&mut self, nodes: &[[u32; 4]], scale: impl Fn(usize) -> f64) -> Option<f64> {
+        let count = nodes.iter().flatten().map(|&n| n as usize + 1).max()?;
+        let mut mass = vec![0.0; count];
+        for (e, element) in nodes.iter().enumerate() {
+            let stiffness = self.stiffness[e].as_ref()?;
+            for (a, &n) in element.iter().enumerate() {
+                mass[n as usize] += stiffness.lumped[a];
+            }
+        }
+        // nodes of no element (an obstacle's, a rod's) take no part
+        let weight: Vec<f64> = mass
+            .iter()
+            .flat_map(|&m| {
+                let w = if m > 0.0 { 1.0 / m.sqrt() } else { 0.0 };
+                [w, w]
+            })
+            .collect();
+        let stiffness = &self.stiffness;
+        let apply = |q: &[f64], out: &mut [f64]| {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            for (e, element) in nodes.iter().enumerate() {
+                let Some(k) = stiffness[e].as_ref() else {
+                    continue;
+                };
+                let s = scale(e);
+                let dofs: [usize; 8] = std::array::from_fn(|i| 2 * element[i / 2] as usize + i % 2);
+                let v: [f64; 8] = std::array::from_fn(|i| q[dofs[i]] * weight[dofs[i]]);
+                for i in 0..8 {
+                    let row: f64 = (0..8).map(|j| k.k[i][j] * v[j]).sum();
+                    out[dofs[i]] += s * row * weight[dofs[i]];
+                }
+            }
+        };
+        let mut start = pseudo_random(2 * count);
+        let iterations = if self.vector.len() == start.len() {
+            let norm = dot(&start, &start).sqrt();
+            for (v, previous) in start.iter_mut().zip(&self.vector) {
+                *v = 0.1 * *v / norm + previous;
+            }
+            ITERATIONS
+        } else {
+            2 * ITERATIONS
+        };
+        let (theta, residual, vector) = lanczos(apply, start, iterations)?;
+        self.vector = vector;
+        Some(theta + residual)
+    }
+}
+
+/// The largest Ritz value of at most `iterations` Lanczos steps on the symmetric operator
+/// `apply` from `start` (full reorthogonalization), its residual norm and its unit Ritz
+/// vector; the steps stop early once the residual is below `TOLERANCE` of the value.
+pub fn lanczos(
+    apply: impl Fn(&[f64], &mut [f64]),
+    start: Vec<f64>,
+    iterations: usize,
+) -> Option<(f64, f64, Vec<f64>)> {
+    let n = start.len();
+    let norm = dot(&start, &start).sqrt();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return None;
+    }
+    let mut basis: Vec<Vec<f64>> = vec![start.iter().map(|v| v / norm).collect()];
+    let (mut alpha, mut beta) = (Vec::new(), Vec::new());
+    let mut w = vec![0.0; n];
+    let last = iterations.min(n).max(1) - 1;
+    let ritz = loop {
+        let j = alpha.len();
+        apply(&basis[j], &mut w);
+        alpha.push(dot(&w, &basis[j]));
+        for _ in 0..2 {
+            for q in &basis {
+                let c = dot(&w, q);
+                w.iter_mut().zip(q).for_each(|(w, q)| *w -= c * q);
+            }
+        }
+        let b = dot(&w, &w).sqrt();
+        beta.push(b);
+        let exhausted = !(b > 1e-12 * alpha[0].abs().max(alpha[j].abs()));
+        if j == last || exhausted || j % CHECK_EVERY == CHECK_EVERY - 1 {
+            let (theta, residual, s) = largest_ritz(&alpha, &beta)?;
+            if j == last || exhausted || residual <= TOLERANCE * theta.abs() {
+                break (theta, residual, s);
+            }
+        }
+        basis.push(w.iter().map(|v| v / b).collect());
+    };
+    let (theta, residual, s) = ritz;
+    let mut vector = vec![0.0; n];
+    for (q, c) in basis.iter().zip(s.iter()) {
+        vector.iter_mut().zip(q).for_each(|(v, q)| *v += c * q);
+    }
+    Some((theta, residual, vector))
+}
+
+/// Lanczos steps between two looks at the Ritz value.
+const CHECK_EVERY: usize = 5;
+
+/// The residual, relative to the Ritz value, at which the Lanczos steps stop.
+const TOLERANCE: f64 = 1e-4;
+
+/// The largest eigenvalue of the tridiagonal matrix of diagonal `alpha` and off-diagonal
+/// `beta` (its last entry the next step's coefficient), the residual `beta_m |s_m|` and the
+/// eigenvector `s`.
+fn largest_ritz(alpha: &[f64], beta: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
+    let m = alpha.len();
+    let t = nalgebra::DMatrix::from_fn(m, m, |i, j| match i.abs_diff(j) {
+        0 => alpha[i],
+        1 => beta[i.min(j)],
+        _ => 0.0,
+    });
+    let eigen = t.symmetric_eigen();
+    let (top, theta) = eigen
+        .eigenvalues
+        .iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let s: Vec<f64> = eigen.eigenvectors.column(top).iter().copied().collect();
+    let residual = beta[m - 1] * s[m - 1].abs();
+    theta.is_finite().then_some((theta, residual, s))
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// `n` values in [-1, 1] from a fixed xorshift sequence (the same on every run).
+fn pseudo_random(n: usize) -> Vec<f64> {
+    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+    (0..n)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+
+    /// A grid of `nx` x `ny` elements with random positive semi-definite stiffnesses
+    /// (B^T B, B 4 x 8: three zero-energy modes and more, as a one-point element has) and
+    /// random lumped masses in [0.5, 1.5]; the nodes, the stiffnesses and the node count.
+    fn random_mesh(
+        nx: usize,
+        ny: usize,
+        seed: u64,
+    ) -> (Vec<[u32; 4]>, Vec<ElementStiffness>, usize) {
+        let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let node = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+        let mut nodes = Vec::new();
+        let mut stiffness = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                nodes.push([
+                    node(i, j),
+                    node(i + 1, j),
+                    node(i + 1, j + 1),
+                    node(i, j + 1),
+                ]);
+                let b: Vec<[f64; 8]> = (0..4)
+                    .map(|_| std::array::from_fn(|_| 2.0 * next() - 1.0))
+                    .collect();
+                let k = std::array::from_fn(|r| {
+                    std::array::from_fn(|c| b.iter().map(|row| row[r] * row[c]).sum())
+                });
+                let lumped = std::array::from_fn(|_| 0.5 + next());
+                stiffness.push(ElementStiffness { k, lumped });
+            }
+        }
+        (nodes, stiffness, (nx + 1) * (ny + 1))
+    }
+
+    /// The assembled stiffness and the diagonal lumped mass of a mesh.
+    fn assemble(
+        nodes: &[[u32; 4]],
+        stiffness: &[ElementStiffness],
+        count: usize,
+    ) -> (DMatrix<f64>, Vec<f64>) {
+        let mut k = DMatrix::zeros(2 * count, 2 * count);
+        let mut m = vec![0.0; 2 * count];
+        for (element, s) in nodes.iter().zip(stiffness) {
+            let dofs: [usize; 8] = std::array::from_fn(|i| 2 * element[i / 2] as usize + i % 2);
+            for i in 0..8 {
+                m[dofs[i]] += s.lumped[i / 2];
+                for j in 0..8 {
+                    k[(dofs[i], dofs[j])] += s.k[i][j];
+                }
+            }
+        }
+        (k, m)
+    }
+
+    fn estimate_of(nodes: &[[u32; 4]], stiffness: &[ElementStiffness]) -> (f64, f64) {
+        let mut global = Global::new(nodes.len());
+        for (e, s) in stiffness.iter().enumerate() {
+            global.keep(e, Some(s.clone()));
+        }
+        let element_max = stiffness
+            .iter()
+            .map(ElementStiffness::frequency_squared)
+            .fold(0.0, f64::max);
+        (
+            global.frequency(nodes, |_| 1.0, (element_max, 0), 0.02).0,
+            element_max,
+        )
+    }
+
+    /// Goal: the estimate is the mesh's highest eigenvalue, below the largest element's.
+    /// Setup: random 6 x 5 meshes (random element stiffnesses and masses). Reference: the
+    /// largest eigenvalue of the assembled D^-1/2 K D^-1/2 by a dense symmetric eigensolver,
+    /// to 1e-3 (the Lanczos steps stop at a residual of 1e-4 of the value; the first estimate
+    /// starts from a pseudo-random vector); Irons' inequality, the largest element
+    /// eigenvalue at or above it.
+    #[test]
+    fn the_estimate_is_the_assembled_mesh_highest_eigenvalue() {
+        for seed in 1..=8 {
+            let (nodes, stiffness, count) = random_mesh(6, 5, seed);
+            let (k, m) = assemble(&nodes, &stiffness, count);
+            let a = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
+                k[(i, j)] / (m[i] * m[j]).sqrt()
+            });
+            let exact = a.symmetric_eigenvalues().max();
+            let (estimate, element_max) = estimate_of(&nodes, &stiffness);
+            assert!(
+                (estimate / exact - 1.0).abs() < 1e-3,
+                "seed {seed}: {estimate} against {exact}"
+            );
+            assert!(exact <= element_max * (1.0 + 1e-12), "seed {seed}: Irons");
+            assert!(
+                estimate < 0.95 * element_max,
+                "seed {seed}: {estimate} against the elements' {element_max}"
+            );
+        }
+    }
+
+    /// Goal: the estimate is the limit of central difference on the mesh, not a lucky margin.
+    /// Setup: random 6 x 5 meshes, u'' = -M^-1 K u from a random displacement at rest, stepped
+    /// by central difference at 0.95 and at 1.05 times 2 / sqrt(estimate), 3000 steps.
+    /// Reference: central difference on a linear system is stable iff omega_max dt <= 2: at
+    /// 0.95 the displacement stays within 100 times its start (it is bounded), at 1.05 it
+    /// grows past 1e6 times.
+    #[test]
+    fn central_difference_is_stable_below_the_estimate_and_unstable_above() {
+        for seed in 1..=4 {
+            let (nodes, stiffness, count) = random_mesh(6, 5, seed);
+            let (k, m) = assemble(&nodes, &stiffness, count);
+            let (estimate, _) = estimate_of(&nodes, &stiffness);
+            let start = nalgebra::DVector::from_vec(pseudo_random(2 * count));
+            let largest = |factor: f64| {
+                let dt = factor * 2.0 / estimate.sqrt();
+                let (mut previous, mut u) = (start.clone(), start.clone());
+                let mut largest: f64 = 0.0;
+                for _ in 0..3000 {
+                    let force = &k * &u;
+                    let next = nalgebra::DVector::from_fn(u.len(), |i, _| {
+                        2.0 * u[i] - previous[i] - dt * dt * force[i] / m[i]
+                    });
+                    (previous, u) = (u, next);
+                    largest = largest.max(u.amax() / start.amax());
+                }
+                largest
+            };
+            let below = largest(0.95);
+            let above = largest(1.05);
+            assert!(below < 100.0, "seed {seed}: {below} at 0.95");
+            assert!(above > 1e6, "seed {seed}: {above} at 1.05");
+        }
+    }
+}
