@@ -488,6 +488,41 @@ proptest! {
         let tight = tight_kernel(&model, quadrature, kappa).stable_step(&positions).unwrap().dt;
         let tight = (2.0 / tight).powi(2);
         prop_assert!((tight / exact - 1.0).abs() < 1e-5, "{formulation} {quadrature}: tight {tight} against {exact}");
+        // with the bulk viscosity (Abaqus' defaults b_1 = 0.06, b_2 = 1.2) the tight step at
+        // rest is that limit shortened by the damping b_1 as Abaqus' Theory Manual gives it,
+        // 2 / omega (sqrt(1 + xi^2) - xi)
+        let viscosity = impact::element::bulk_viscosity::BulkViscosity { linear: 0.06, quadratic: 1.2 };
+        let damped = viscous_tight_kernel(&model, quadrature, kappa, viscosity)
+            .stable_step(&positions)
+            .unwrap()
+            .dt;
+        let expected = 2.0 / exact.sqrt() * ((1.0f64 + 0.06 * 0.06).sqrt() - 0.06);
+        prop_assert!((damped / expected - 1.0).abs() < 1e-5, "{formulation} {quadrature}: damped tight {damped} against {expected}");
+    }
+}
+
+/// As `tight_kernel`, with the bulk viscosity `viscosity`.
+fn viscous_tight_kernel(
+    model: &impact::scene::Model,
+    quadrature: &str,
+    kappa: f64,
+    viscosity: impact::element::bulk_viscosity::BulkViscosity,
+) -> Box<dyn impact::assembly::explicit::ExplicitKernel> {
+    use impact::assembly::explicit::{Full, Reduced};
+    let state = impact::assembly::State::initial(model);
+    let masses = impact::assembly::ElementMasses::new(model).unwrap();
+    if quadrature == "reduced" {
+        Box::new(
+            Reduced::new(model, &state, kappa, &masses)
+                .with_tight_step(true, false)
+                .with_bulk_viscosity(Some(viscosity)),
+        )
+    } else {
+        Box::new(
+            Full::new(model, &state, &masses)
+                .with_tight_step(true, false)
+                .with_bulk_viscosity(Some(viscosity)),
+        )
     }
 }
 

@@ -26,6 +26,7 @@ use crate::assembly::{self, ElementFailure, State, StepIncrement, System};
 use crate::element::Strain;
 use crate::scene::Model;
 use crate::scene::spec::Tangent;
+use crate::solver::lanczos::{start_vector, tridiagonal_eigen};
 use crate::solver::{Ix, Pattern, Solver, SolverError};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -262,19 +263,6 @@ impl Operator<'_> {
     }
 }
 
-/// A deterministic start vector with every component (a linear congruential sequence).
-fn start_vector(n: usize) -> Vec<f64> {
-    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
-    (0..n)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect()
-}
-
 /// Lanczos on A in the K_0 inner product, the basis fully K_0-orthogonalized: the converged
 /// Ritz pairs (mu, shape on the free DOFs) of the `count` largest positive mu, checked every
 /// 5 steps once the basis has 2 count + 10 vectors (at most 400 steps).
@@ -336,18 +324,7 @@ fn ritz_pairs(
 ) -> Option<Vec<(f64, Vec<f64>)>> {
     let m = alpha.len();
     let n = basis[0].len();
-    let t = nalgebra::DMatrix::from_fn(m, m, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i == j + 1 {
-            beta[j]
-        } else if j == i + 1 {
-            beta[i]
-        } else {
-            0.0
-        }
-    });
-    let eigen = t.symmetric_eigen();
+    let eigen = tridiagonal_eigen(alpha, beta);
     // mu below 1e-8 of the spectrum's largest |mu| is round-off of a zero (a mode
     // the stresses leave alone), not a buckling load
     let largest = eigen.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));

@@ -361,10 +361,12 @@ pub struct StaticAnalysis {
 
 impl DynamicAnalysis {
     /// Whether central difference's automatic step scales the elements' exact frequencies
-    /// (`analysis.stable_step = "tight"`) rather than their bounds (the default): not with the
-    /// bulk viscosity (whose damping folds into the bound). With the mass scaling the elements
-    /// are scaled by their bounds as without it (more mass than the tight step needs); with the
-    /// subcycling the levels come from the tight frequencies.
+    /// (`analysis.stable_step = "tight"`) rather than their bounds (the default). With the
+    /// bulk viscosity the ratios are taken against the undamped bounds and scale the damped
+    /// ones; not with the bulk viscosity and the subcycling together (there the bound stands).
+    /// With the mass scaling the elements are scaled by their bounds as without it (more mass
+    /// than the tight step needs); with the subcycling the levels come from the tight
+    /// frequencies.
     pub fn tight_step(&self) -> bool {
         let tight = matches!(
             self.step,
@@ -373,12 +375,11 @@ impl DynamicAnalysis {
                 ..
             }
         );
-        tight && self.bulk_viscosity.is_none()
+        tight && !(self.bulk_viscosity.is_some() && self.subcycling.is_some())
     }
 
     /// Whether the tight elements' step gives way to the estimate of the mesh's highest
-    /// frequency over them (`analysis.stable_step = "global"`; not with the bulk viscosity,
-    /// as `tight_step`).
+    /// frequency over them (`analysis.stable_step = "global"`; where `tight_step` is).
     pub fn global_step(&self) -> bool {
         let global = matches!(
             self.step,
@@ -387,7 +388,7 @@ impl DynamicAnalysis {
                 ..
             }
         );
-        global && self.bulk_viscosity.is_none()
+        global && self.tight_step()
     }
 
     /// The fixed step (every implicit analysis has one; scene validation refuses `auto`

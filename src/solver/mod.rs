@@ -6,6 +6,8 @@
 //! The matrix is stored as its lower triangle in compressed sparse columns (`Pattern`); the
 //! assembly writes into `values` through precomputed positions.
 
+pub mod lanczos;
+
 use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError as LltFactorError;

@@ -36,7 +36,8 @@ use super::{
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::bulk_viscosity::{
-    BulkViscosity, ElementScale, damped_frequency_squared, loaded_stress, volumetric_increment,
+    BulkViscosity, ElementScale, damped_frequency_squared, damped_step_factor, loaded_stress,
+    volumetric_increment,
 };
 use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4::{self, QuadValues};
@@ -68,6 +69,8 @@ struct ElementStep {
     plastic_work: f64,
     viscous_work: f64,
     omega_squared: f64,
+    /// The undamped bound over the damped one (1 without the bulk viscosity).
+    damping: f64,
 }
 
 /// The 2x2 explicit kernel over a model's Quad4 bodies.
@@ -92,6 +95,9 @@ pub struct Full {
     /// Each element's frequency bound of the last step, and the ratios that make them tight
     /// (`tight`; None: the bounds stand, the default and with the bulk viscosity).
     bounds: Vec<f64>,
+    /// Each element's `ElementStep::damping` of the last step (the bulk viscosity's at rest
+    /// before the first): the tight ratios are taken against the undamped bounds.
+    damping: Vec<f64>,
     tightness: Option<Tightness>,
 }
 
@@ -240,6 +246,7 @@ fn element_step(
             work,
             plastic_work,
             viscous_work: 0.0,
+            damping: 1.0,
         });
     };
     let mut loaded = state.stress;
@@ -266,6 +273,7 @@ fn element_step(
         work,
         plastic_work,
         viscous_work,
+        damping: damped_step_factor(damping_fraction).powi(2),
     })
 }
 
@@ -288,6 +296,7 @@ impl Full {
             layout,
             scaling: None,
             bounds: vec![0.0; count],
+            damping: vec![1.0; count],
             tightness: None,
         };
         for &(b, e) in &kernel.layout.origin {
@@ -318,10 +327,13 @@ impl Full {
     /// The kernel with the bulk viscosity `viscosity` (None: off). Its damping folds into the
     /// bound, which then stands (no tight ratio).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Full {
-        let tightness = self.tightness.filter(|_| viscosity.is_none());
+        let at_rest = viscosity.map_or(1.0, |v| {
+            damped_step_factor(v.damping_fraction_at_rest()).powi(2)
+        });
+        let damping = vec![at_rest; self.bounds.len()];
         Full {
             viscosity,
-            tightness,
+            damping,
             ..self
         }
     }
@@ -407,11 +419,15 @@ impl Full {
             self.viscous_pressure.par_chunks_mut(4 * CHUNK),
             self.element_forces.par_chunks_mut(8 * CHUNK),
             self.bounds.par_chunks_mut(CHUNK),
+            self.damping.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
             .map(
-                |(k, (stress, back, eps_p, temperature, thickness, viscous, forces, bounds))| {
+                |(
+                    k,
+                    (stress, back, eps_p, temperature, thickness, viscous, forces, bounds, damping),
+                )| {
                     let mut sums = StepWork::default();
                     let mut grown = Vec::new();
                     for i in 0..forces.len() / 8 {
@@ -452,6 +468,7 @@ impl Full {
                         };
                         sums.observe(omega_squared, e);
                         bounds[i] = omega_squared;
+                        damping[i] = r.damping;
                         for q in 0..4 {
                             stress[16 * i + 4 * q..16 * i + 4 * q + 4]
                                 .copy_from_slice(&r.state.stress[q]);
@@ -553,6 +570,7 @@ impl PartialKernel for Full {
         };
         let commit = |this: &mut Full, e: usize, r: &ElementStep, sums: &mut StepWork| {
             omega_squared[e] = r.omega_squared;
+            this.damping[e] = r.damping;
             sums.observe(r.omega_squared, e);
             this.store(e, &r.state);
             this.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
@@ -605,7 +623,7 @@ impl ExplicitKernel for Full {
         kernel_stable_step(
             &self.layout,
             x,
-            self.tightness.as_ref(),
+            (self.tightness.as_ref(), &self.damping),
             |e| self.frequency(x, e),
             |xe, e| self.exact_stiffness(xe, e),
         )
@@ -622,7 +640,7 @@ impl ExplicitKernel for Full {
         if let Some(mut tight) = self.tightness.take() {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
-                tight.apply(&self.bounds, &self.layout.nodes, |e| {
+                tight.apply(&self.bounds, &self.damping, &self.layout.nodes, |e| {
                     self.exact_stiffness(&end(e), e)
                 });
             self.tightness = Some(tight);

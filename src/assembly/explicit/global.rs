@@ -1,13 +1,16 @@
 //! The global stable step (`analysis.stable_step = "global"`): an estimate of the mesh's
-//! highest frequency, above the largest element's, from the element stiffnesses the tight
-//! step takes (docs/theory.md 8.7b).
+//! highest frequency, below the largest element's (a step longer than the tight element
+//! step), from the element stiffnesses the tight step takes (docs/theory.md 8.7, "The global
+//! step").
 //!
 //! ```text
 //! A        = D^-1/2 K D^-1/2,   K = sum_e s_e K_e,   D the nodal lumped masses (both directions)
 //! s_e      = bound_e / at_e     the element's bound now over its bound when K_e was taken
 //!                               (the tight step's own drift rule, 8.7)
-//! theta    the largest Ritz value of ITERATIONS Lanczos steps (full reorthogonalization)
-//!          from the last estimate's Ritz vector plus a fixed pseudo-random vector
+//! theta    the largest Ritz value of at most ITERATIONS Lanczos steps (twice as many the
+//!          first time; full reorthogonalization; stopped once r <= TOLERANCE theta) from
+//!          the last estimate's Ritz vector plus a tenth of a fixed pseudo-random vector
+//!          (`solver::lanczos::start_vector`)
 //! r        = beta_m |s_m|       its residual: an eigenvalue of A lies within r of theta
 //! lambda   = min(theta + r, max_e omega_e^2)    omega_e^2 the tight element frequencies
 //! ```
@@ -20,6 +23,7 @@
 //! step's `DRIFT`. Everything here runs on the stepping thread in a fixed order: the estimate
 //! does not depend on the thread count.
 
+use crate::solver::lanczos::{start_vector, tridiagonal_eigen};
 use serde::{Deserialize, Serialize};
 
 /// Lanczos steps of an estimate (the first from the pseudo-random vector alone takes twice).
@@ -90,18 +94,17 @@ impl Global {
         self.estimates
     }
 
-    /// The mesh's highest frequency squared for this step from the tight element maximum
-    /// `largest` (its value and element), the elements' `nodes` and their stiffness scales
-    /// `scale(e)`; an estimate taken when one is due (`drift`: how far the maximum may move
-    /// before one is, the tight step's own `DRIFT`).
-    pub fn frequency(
+    /// The mesh's highest frequency squared for this step over the tight element maximum
+    /// `max` (at most 1), from the elements' `nodes` and their stiffness scales `scale(e)`;
+    /// an estimate taken when one is due (`drift`: how far the maximum may move before one
+    /// is, the tight step's own `DRIFT`).
+    pub fn ratio(
         &mut self,
         nodes: &[[u32; 4]],
         scale: impl Fn(usize) -> f64,
-        largest: (f64, usize),
+        max: f64,
         drift: f64,
-    ) -> (f64, usize) {
-        let (max, element) = largest;
+    ) -> f64 {
         let due = self.ratio == 0.0 || self.since >= EVERY || (max / self.at - 1.0).abs() > drift;
         if due {
             self.ratio = match self.estimate(nodes, scale) {
@@ -113,7 +116,7 @@ impl Global {
             self.estimates += 1;
         }
         self.since += 1;
-        (self.ratio * max, element)
+        self.ratio
     }
 
     /// theta + r of the Lanczos estimate (module docs); None when an element's stiffness is
@@ -151,7 +154,7 @@ impl Global {
                 }
             }
         };
-        let mut start = pseudo_random(2 * count);
+        let mut start = start_vector(2 * count);
         let iterations = if self.vector.len() == start.len() {
             let norm = dot(&start, &start).sqrt();
             for (v, previous) in start.iter_mut().zip(&self.vector) {
@@ -224,12 +227,7 @@ const TOLERANCE: f64 = 1e-4;
 /// eigenvector `s`.
 fn largest_ritz(alpha: &[f64], beta: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
     let m = alpha.len();
-    let t = nalgebra::DMatrix::from_fn(m, m, |i, j| match i.abs_diff(j) {
-        0 => alpha[i],
-        1 => beta[i.min(j)],
-        _ => 0.0,
-    });
-    let eigen = t.symmetric_eigen();
+    let eigen = tridiagonal_eigen(alpha, beta);
     let (top, theta) = eigen
         .eigenvalues
         .iter()
@@ -243,19 +241,6 @@ fn largest_ritz(alpha: &[f64], beta: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()
-}
-
-/// `n` values in [-1, 1] from a fixed xorshift sequence (the same on every run).
-fn pseudo_random(n: usize) -> Vec<f64> {
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    (0..n)
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        })
-        .collect()
 }
 
 #[cfg(test)]
@@ -331,10 +316,8 @@ mod tests {
             .iter()
             .map(ElementStiffness::frequency_squared)
             .fold(0.0, f64::max);
-        (
-            global.frequency(nodes, |_| 1.0, (element_max, 0), 0.02).0,
-            element_max,
-        )
+        let share = global.ratio(nodes, |_| 1.0, element_max, 0.02);
+        (share * element_max, element_max)
     }
 
     /// Goal: the estimate is the mesh's highest eigenvalue, below the largest element's.
@@ -377,7 +360,7 @@ mod tests {
             let (nodes, stiffness, count) = random_mesh(6, 5, seed);
             let (k, m) = assemble(&nodes, &stiffness, count);
             let (estimate, _) = estimate_of(&nodes, &stiffness);
-            let start = nalgebra::DVector::from_vec(pseudo_random(2 * count));
+            let start = nalgebra::DVector::from_vec(start_vector(2 * count));
             let largest = |factor: f64| {
                 let dt = factor * 2.0 / estimate.sqrt();
                 let (mut previous, mut u) = (start.clone(), start.clone());

@@ -530,12 +530,12 @@ pub(super) fn element_scaling(
 }
 
 /// The stable step of a kernel's elements on the positions `x`: the largest of their bounds
-/// `bound(e)`, made tight by `tightness` (when on) with their exact frequencies
-/// `exact(nodes, e)` (`tight`).
+/// `bound(e)`, made tight by `tightness` (when on; `damping` each bound's undamped value
+/// over it) with their exact frequencies `exact(nodes, e)` (`tight`).
 pub(super) fn kernel_stable_step(
     layout: &Layout,
     x: &[[f64; 2]],
-    tightness: Option<&tight::Tightness>,
+    (tightness, damping): (Option<&tight::Tightness>, &[f64]),
     bound: impl Fn(usize) -> Result<f64, ElementFailure>,
     exact: impl Fn(&Nodes, usize) -> Option<tight::ElementStiffness> + Sync,
 ) -> Result<StableStep, ElementFailure> {
@@ -549,7 +549,7 @@ pub(super) fn kernel_stable_step(
     if let Some(tight) = tightness {
         let nodes = |e: usize| layout.nodes[e].map(|n| x[n as usize]);
         (worst.omega_squared, worst.critical_element) =
-            tight.peek(&bounds, |e| exact(&nodes(e), e));
+            tight.peek(&bounds, damping, |e| exact(&nodes(e), e));
     }
     Ok(stable_step_of(layout, &worst))
 }

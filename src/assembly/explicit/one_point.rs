@@ -30,7 +30,8 @@ use super::{
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::bulk_viscosity::{
-    BulkViscosity, ElementScale, damped_frequency_squared, loaded_stress, volumetric_increment,
+    BulkViscosity, ElementScale, damped_frequency_squared, damped_step_factor, loaded_stress,
+    volumetric_increment,
 };
 use crate::element::mass_scaling::MassScaling;
 use crate::element::quad4_one_point::{self as one_point, BoundShape, Nodes, Section, rotate};
@@ -72,6 +73,9 @@ pub struct ElementStep {
     /// The bound of the element's highest frequency squared on the end configuration (with
     /// the bulk viscosity: the damped bound, `damped_frequency_squared`).
     pub omega_squared: f64,
+    /// The undamped bound over the damped one (the square of `damped_step_factor`; 1
+    /// without the bulk viscosity).
+    pub damping: f64,
 }
 
 /// What the one-point kernel knows of an element's mass: the smallest of its lumped nodal
@@ -177,12 +181,13 @@ fn element_step(
     };
     let omega_squared =
         one_point::frequency_bound(shape, p.wave_modulus, p.hourglass_modulus, mass.smallest);
-    let (omega_squared, viscous_work) = match viscous {
+    let (omega_squared, viscous_work, damping) = match viscous {
         Some(v) => (
             damped_frequency_squared(omega_squared, v.damping_fraction),
             v.work,
+            damped_step_factor(v.damping_fraction).powi(2),
         ),
-        None => (omega_squared, 0.0),
+        None => (omega_squared, 0.0, 1.0),
     };
     // 1/2 (S_n + S_{n+1}) : d eps_p, the rule of the work above (trapezoid_dissipation)
     let plastic_work = volume
@@ -201,6 +206,7 @@ fn element_step(
         hourglass_work: hourglass.work,
         viscous_work,
         omega_squared,
+        damping,
     })
 }
 
@@ -236,6 +242,9 @@ pub struct Reduced {
     /// Each element's frequency bound of the last step, and the ratios that make them tight
     /// (`tight`; None: the bounds stand, the default and with the bulk viscosity).
     bounds: Vec<f64>,
+    /// Each element's `ElementStep::damping` of the last step (the bulk viscosity's at rest
+    /// before the first): the tight ratios are taken against the undamped bounds.
+    damping: Vec<f64>,
     tightness: Option<Tightness>,
 }
 
@@ -287,6 +296,7 @@ impl Reduced {
             scaling: None,
             nodal: nodal_masses,
             bounds: vec![0.0; count],
+            damping: vec![1.0; count],
             tightness: None,
         }
     }
@@ -302,10 +312,13 @@ impl Reduced {
     /// The kernel with the bulk viscosity `viscosity` (None: off). Its damping folds into the
     /// bound, which then stands (no tight ratio).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Reduced {
-        let tightness = self.tightness.filter(|_| viscosity.is_none());
+        let at_rest = viscosity.map_or(1.0, |v| {
+            damped_step_factor(v.damping_fraction_at_rest()).powi(2)
+        });
+        let damping = vec![at_rest; self.bounds.len()];
         Reduced {
             viscosity,
-            tightness,
+            damping,
             ..self
         }
     }
@@ -443,6 +456,7 @@ impl Reduced {
             self.viscous_pressure.par_chunks_mut(CHUNK),
             self.element_forces.par_chunks_mut(8 * CHUNK),
             self.bounds.par_chunks_mut(CHUNK),
+            self.damping.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
@@ -457,6 +471,7 @@ impl Reduced {
                     viscous,
                     forces,
                     bounds,
+                    damping,
                 ) = chunks;
                 let mut sums = StepWork::default();
                 let mut grown = Vec::new();
@@ -500,6 +515,7 @@ impl Reduced {
                     };
                     sums.observe(omega_squared, e);
                     bounds[i] = omega_squared;
+                    damping[i] = r.damping;
                     stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
                     back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
                     eps_p[i] = r.state.eq_plastic_strain;
@@ -577,7 +593,7 @@ impl ExplicitKernel for Reduced {
         kernel_stable_step(
             &self.layout,
             x,
-            self.tightness.as_ref(),
+            (self.tightness.as_ref(), &self.damping),
             |e| self.frequency(x, e),
             |xe, e| self.exact_stiffness(xe, e),
         )
@@ -594,7 +610,7 @@ impl ExplicitKernel for Reduced {
         if let Some(mut tight) = self.tightness.take() {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
-                tight.apply(&self.bounds, &self.layout.nodes, |e| {
+                tight.apply(&self.bounds, &self.damping, &self.layout.nodes, |e| {
                     self.exact_stiffness(&end(e), e)
                 });
             self.tightness = Some(tight);
@@ -721,6 +737,7 @@ impl PartialKernel for Reduced {
         };
         let commit = |this: &mut Reduced, e: usize, r: &ElementStep, sums: &mut StepWork| {
             omega_squared[e] = r.omega_squared;
+            this.damping[e] = r.damping;
             sums.observe(r.omega_squared, e);
             this.store(e, &r.state);
             this.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);

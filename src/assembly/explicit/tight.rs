@@ -73,23 +73,31 @@ impl Tightness {
 
     /// The tight frequency squared of every element from this step's `bounds`, the largest
     /// and its element (the lowest index among equals), the stale ratios taken again with
-    /// `exact(e)` (in parallel; the result does not depend on the thread count). With the
-    /// global step, the mesh's estimate from the elements `nodes` in its place.
+    /// `exact(e)` (in parallel; the result does not depend on the thread count). `damping`:
+    /// each bound's undamped value over it (the bulk viscosity's, 1 without): the ratios
+    /// are taken against the undamped bounds and scale the damped ones. With the global
+    /// step, the mesh's estimate from the elements `nodes` in its place.
     pub fn apply(
         &mut self,
         bounds: &[f64],
+        damping: &[f64],
         nodes: &[[u32; 4]],
         exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
-        self.refresh(0..bounds.len(), bounds, exact);
+        let undamped = undamped(bounds, damping);
+        self.refresh(0..bounds.len(), &undamped, exact);
         let largest = self.largest(bounds, |e| self.ratio[e]);
-        match self.global.as_mut() {
-            Some(global) => {
-                let at = &self.at;
-                global.frequency(nodes, |e| bounds[e] / at[e], largest, DRIFT)
-            }
-            None => largest,
-        }
+        let Some(global) = self.global.as_mut() else {
+            return largest;
+        };
+        let (ratio, at) = (&self.ratio, &self.at);
+        let peak = undamped
+            .iter()
+            .enumerate()
+            .map(|(e, bound)| ratio[e] * bound)
+            .fold(0.0, f64::max);
+        let share = global.ratio(nodes, |e| undamped[e] / at[e], peak, DRIFT);
+        (share * largest.0, largest.1)
     }
 
     /// Takes again the stale ratios among `elements`, whose bounds are in `bounds` (by element
@@ -116,12 +124,14 @@ impl Tightness {
     pub fn peek(
         &self,
         bounds: &[f64],
+        damping: &[f64],
         exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
+        let undamped = undamped(bounds, damping);
         let ratios: Vec<f64> = (0..bounds.len())
             .into_par_iter()
-            .map(|e| match self.stale(e, bounds[e]) {
-                true => Tightness::ratio_of(bounds[e], exact(e).as_ref()),
+            .map(|e| match self.stale(e, undamped[e]) {
+                true => Tightness::ratio_of(undamped[e], exact(e).as_ref()),
                 false => self.ratio[e],
             })
             .collect();
@@ -172,6 +182,16 @@ impl Tightness {
             }
         }
         best
+    }
+}
+
+/// The bounds without the bulk viscosity's damping: `bounds` times `damping` (borrowed where
+/// every factor is 1).
+fn undamped<'a>(bounds: &'a [f64], damping: &[f64]) -> std::borrow::Cow<'a, [f64]> {
+    if damping.iter().all(|d| *d == 1.0) {
+        std::borrow::Cow::Borrowed(bounds)
+    } else {
+        std::borrow::Cow::Owned(bounds.iter().zip(damping).map(|(b, d)| b * d).collect())
     }
 }
 
@@ -231,21 +251,21 @@ mod tests {
         };
         let nodes = [[0, 1, 2, 3], [1, 4, 5, 2]];
         // ratios 0.5 and 0.75: tight values 2 and 3
-        assert_eq!(t.apply(&[4.0, 4.0], &nodes, exact), (3.0, 1));
+        assert_eq!(t.apply(&[4.0, 4.0], &[1.0; 2], &nodes, exact), (3.0, 1));
         assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 2);
         // element 0's bound moves 1 %: kept (0.5 * 4.04); element 1 by 5 %: taken again
         // (exact 3 over 4.2)
-        assert_eq!(t.apply(&[4.04, 4.2], &nodes, exact), (3.0, 1));
+        assert_eq!(t.apply(&[4.04, 4.2], &[1.0; 2], &nodes, exact), (3.0, 1));
         assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 3);
         assert_eq!(t.ratio[0], 0.5);
         // a bound below the exact value (round-off) is not trusted beyond 1
         let mut t = Tightness::new(1, false);
         let one = [[0, 1, 2, 3]];
         assert_eq!(
-            t.apply(&[1.0], &one, |_| Some(of_frequency(1.0 + 1e-12))),
+            t.apply(&[1.0], &[1.0], &one, |_| Some(of_frequency(1.0 + 1e-12))),
             (1.0, 0)
         );
-        assert_eq!(t.apply(&[1.0], &one, |_| None).0, 1.0);
+        assert_eq!(t.apply(&[1.0], &[1.0], &one, |_| None).0, 1.0);
     }
 
     /// An element whose highest frequency squared is `omega_squared` (unit masses).
