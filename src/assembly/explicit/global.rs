@@ -70,8 +70,6 @@ pub struct Global {
     since: usize,
     /// The last estimate's Ritz vector (the next one starts from it).
     vector: Vec<f64>,
-    /// Estimates taken.
-    estimates: usize,
 }
 
 impl Global {
@@ -89,15 +87,10 @@ impl Global {
         self.stiffness[e] = stiffness;
     }
 
-    /// The estimates taken so far.
-    pub fn estimates(&self) -> usize {
-        self.estimates
-    }
-
-    /// The mesh's highest frequency squared for this step over the tight element maximum
-    /// `max` (at most 1), from the elements' `nodes` and their stiffness scales `scale(e)`;
-    /// an estimate taken when one is due (`drift`: how far the maximum may move before one
-    /// is, the tight step's own `DRIFT`).
+    /// The ratio of the mesh's highest frequency squared to the tight element maximum `max`
+    /// for this step (at most 1), from the elements' `nodes` and their stiffness scales
+    /// `scale(e)`: the last estimate's, or a new one when one is due (`drift`: how far the
+    /// maximum may move before one is, the tight step's own `DRIFT`).
     pub fn ratio(
         &mut self,
         nodes: &[[u32; 4]],
@@ -113,7 +106,6 @@ impl Global {
             };
             self.at = max;
             self.since = 0;
-            self.estimates += 1;
         }
         self.since += 1;
         self.ratio

@@ -48,11 +48,6 @@ impl Tightness {
         }
     }
 
-    /// The global estimates taken so far (None: the step is the elements').
-    pub fn global_estimates(&self) -> Option<usize> {
-        self.global.as_ref().map(Global::estimates)
-    }
-
     /// Whether element `e`'s ratio is due again at its bound `bound`.
     fn stale(&self, e: usize, bound: f64) -> bool {
         let at = self.at[e];
