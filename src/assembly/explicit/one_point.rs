@@ -240,7 +240,7 @@ pub struct Reduced {
     /// The lumped mass at the four nodes of each element (unscaled), for the exact frequency.
     nodal: Vec<[f64; 4]>,
     /// Each element's frequency bound of the last step, and the ratios that make them tight
-    /// (`tight`; None: the bounds stand, the default and with the bulk viscosity).
+    /// (`tight`; None: the bounds stand, the default).
     bounds: Vec<f64>,
     /// Each element's `ElementStep::damping` of the last step (the bulk viscosity's at rest
     /// before the first): the tight ratios are taken against the undamped bounds.
@@ -310,7 +310,8 @@ impl Reduced {
     }
 
     /// The kernel with the bulk viscosity `viscosity` (None: off). Its damping folds into the
-    /// bound, which then stands (no tight ratio).
+    /// bounds; the tight ratios are taken against the undamped ones (`damping`, at rest
+    /// until the first step).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Reduced {
         let at_rest = viscosity.map_or(1.0, |v| {
             damped_step_factor(v.damping_fraction_at_rest()).powi(2)
