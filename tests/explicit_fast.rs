@@ -484,7 +484,8 @@ set = "top"
 /// minimum of the automatic step, the nodal updates), explicit 2x2 in rate form, and
 /// implicit average acceleration (the assembly's parallel chunks: 16 000 points, above
 /// its 8192; the Schur complement of the wall's 41 contact rows), each with the wall
-/// closed from the first step.
+/// closed from the first step; and the one-point kernel with the global stable step (its
+/// tight ratios taken in parallel, its estimate on the stepping thread).
 /// Reference: bit-for-bit equality of history.csv and of the final displacements and
 /// stresses (the kernels gather nodal forces in element order and reduce in chunk order).
 #[test]
@@ -492,6 +493,8 @@ fn results_do_not_depend_on_thread_count_above_the_parallel_threshold() {
     for (path, overrides) in [
         ("one_point", vec![]),
         ("full", vec!["analysis.quadrature=full"]),
+        // the tight ratios taken in parallel, the global estimate on the stepping thread
+        ("global", vec!["analysis.stable_step=global"]),
         (
             "implicit",
             vec![
