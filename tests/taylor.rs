@@ -270,11 +270,10 @@ fn taylor_jc_tight_step_matches_abaqus() {
 /// frequency estimated over the tight elements) lands the Johnson-Cook rod on the published
 /// results as the bound's and the tight step do, on both kernels, with the energy balanced.
 /// Setup: models/taylor_jc.toml (5 x 50) with the global step, 2x2 B-bar and one-point.
-/// Reference: DynELA and Abaqus/Explicit in the bands of `reference_band` (measured 26.526 mm,
+/// Reference: DynELA and Abaqus/Explicit in the bands of `reference_band` (measured 26.525 mm,
 /// 11.146 mm in 3 442 steps on 2x2 against the bound's 5 449 and the tight step's 4 233);
-/// the energy balance (theory 7) within 1e-3 of the energy in play (measured 1.3e-4 2x2,
-/// 5.4e-4 one-point, against 1.1e-4 and 8e-5 with the tight step: closer to the limit,
-/// central difference's energy error grows).
+/// the energy balance (theory 7) within 1e-3 of the energy in play (measured 5.8e-5 2x2,
+/// 2.5e-4 one-point, against 1.1e-4 and 8e-5 with the tight step).
 #[test]
 fn taylor_jc_global_step_matches_abaqus() {
     let (global, summary) = taylor_jc("taylor_jc_global", &["analysis.stable_step=global"]);

@@ -549,7 +549,7 @@ pub(super) fn kernel_stable_step(
     if let Some(tight) = tightness {
         let nodes = |e: usize| layout.nodes[e].map(|n| x[n as usize]);
         (worst.omega_squared, worst.critical_element) =
-            tight.peek(&bounds, damping, |e| exact(&nodes(e), e));
+            tight.peek(&bounds, damping, &layout.nodes, |e| exact(&nodes(e), e));
     }
     Ok(stable_step_of(layout, &worst))
 }

@@ -114,23 +114,16 @@ impl Tightness {
         }
     }
 
-    /// As `apply`, without keeping the ratios taken (the stable step of a configuration
-    /// before a step, `impact check`).
+    /// As `apply`, without keeping the ratios taken or the estimate made (the stable step of a
+    /// configuration before a step, `impact check`).
     pub fn peek(
         &self,
         bounds: &[f64],
         damping: &[f64],
+        nodes: &[[u32; 4]],
         exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
-        let undamped = undamped(bounds, damping);
-        let ratios: Vec<f64> = (0..bounds.len())
-            .into_par_iter()
-            .map(|e| match self.stale(e, undamped[e]) {
-                true => Tightness::ratio_of(undamped[e], exact(e).as_ref()),
-                false => self.ratio[e],
-            })
-            .collect();
-        self.largest(bounds, |e| ratios[e])
+        self.clone().apply(bounds, damping, nodes, exact)
     }
 
     /// The ratio of element `e` at its bound `bound`: the one kept, or when stale a fresh one
