@@ -364,9 +364,7 @@ fn load_stepping_perfect_column_loses_definiteness_at_euler_load() {
         "P / P_E = {ratio} at the change"
     );
     // history.csv: zero negative pivots up to the change, one from there on
-    let dir = std::env::temp_dir()
-        .join(format!("impact-tests-{}", std::process::id()))
-        .join("stepped_perfect");
+    let dir = common::tests_root().join("stepped_perfect");
     let time = common::column(&dir, "time");
     let pivots = common::column(&dir, "tangent_negative_pivots");
     for (t_row, n) in time.iter().zip(&pivots) {
@@ -396,9 +394,7 @@ fn imperfect_column_follows_amplification_and_elastica() {
     let lambda = buckling::linear_modes(&model, 1).unwrap()[0].lambda;
     approx::assert_relative_eq!(lambda * 1.05, 1.0, max_relative = 0.01);
     let (summary, _) = common::run("stepped_imperfect", &model);
-    let dir = std::env::temp_dir()
-        .join(format!("impact-tests-{}", std::process::id()))
-        .join("stepped_imperfect");
+    let dir = common::tests_root().join("stepped_imperfect");
     let time = common::column(&dir, "time");
     let w = common::column(&dir, "u_y[mid]");
     let pivots = common::column(&dir, "tangent_negative_pivots");

@@ -3,6 +3,8 @@
 //! under rigid motion (a finite rigid rotation plus translation strains nothing; the
 //! stiffness of a moved element is the rotated stiffness).
 
+mod common;
+
 use impact::element::quad4::{self, Coords};
 use impact::element::{Formulation, GeometricStiffness, Mat8, Moduli, Strain, Vec8};
 use impact::material::{Elastic, StressCondition};
@@ -565,10 +567,7 @@ fn kinetic_growth(
         spec.end_time = steps as f64 * dt;
         spec.allow_unstable = true;
     }
-    let dir = std::env::temp_dir().join(format!(
-        "impact-tests-{}/tight_{quadrature}_{factor}_{seed}",
-        std::process::id()
-    ));
+    let dir = common::tests_root().join(format!("tight_{quadrature}_{factor}_{seed}"));
     let status = match impact::analysis::run(model, &dir, Default::default()) {
         Ok(summary) => summary.status,
         Err(impact::analysis::RunError::Numerical { summary, .. }) => summary.status,

@@ -6,11 +6,21 @@ use impact::assembly::State;
 use impact::scene::{self, Model};
 use std::path::{Path, PathBuf};
 
-/// A fresh, empty output folder under the system temp dir, unique per test name.
+/// The folder of this test binary's outputs: `impact-tests/<binary>` under the system temp
+/// dir, one per test binary and build (its file name carries cargo's hash), so that a run
+/// replaces the last run's outputs, left for inspection, instead of piling up beside them
+/// (one folder per process had filled a development disk with 55 GB).
+pub fn tests_root() -> PathBuf {
+    let binary = std::env::current_exe()
+        .ok()
+        .and_then(|exe| exe.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| std::process::id().to_string());
+    std::env::temp_dir().join("impact-tests").join(binary)
+}
+
+/// A fresh, empty output folder under `tests_root`, unique per test name.
 pub fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir()
-        .join(format!("impact-tests-{}", std::process::id()))
-        .join(name);
+    let dir = tests_root().join(name);
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -18,9 +28,7 @@ pub fn out_dir(name: &str) -> PathBuf {
 
 /// The output folder of `run(name, ..)`, as it is (not emptied).
 pub fn out_dir_of(name: &str) -> PathBuf {
-    std::env::temp_dir()
-        .join(format!("impact-tests-{}", std::process::id()))
-        .join(name)
+    tests_root().join(name)
 }
 
 /// Builds the model of a scene text as if it were the file `tests/<name>.toml` (so mesh
