@@ -143,13 +143,20 @@ pub fn damped_step_factor(damping_fraction: f64) -> f64 {
     (1.0 + xi * xi).sqrt() - xi
 }
 
+/// The square of `damped_step_factor`: an element's undamped frequency bound squared over
+/// its damped one (`damped_frequency_squared`).
+#[inline(always)]
+pub fn damping_factor(damping_fraction: f64) -> f64 {
+    let factor = damped_step_factor(damping_fraction);
+    factor * factor
+}
+
 /// The element frequency bound squared whose undamped step 2 / omega is the damped step
 /// of an element with bound `omega_squared` and damping fraction `damping_fraction`: the
 /// stable-step rule then takes the damping into account unchanged.
 #[inline(always)]
 pub fn damped_frequency_squared(omega_squared: f64, damping_fraction: f64) -> f64 {
-    let factor = damped_step_factor(damping_fraction);
-    omega_squared / (factor * factor)
+    omega_squared / damping_factor(damping_fraction)
 }
 
 /// The volumetric part of a strain increment (see the legend): the trace over the components

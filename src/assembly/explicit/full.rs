@@ -36,7 +36,7 @@ use super::{
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::bulk_viscosity::{
-    BulkViscosity, ElementScale, damped_frequency_squared, damped_step_factor, loaded_stress,
+    BulkViscosity, ElementScale, damped_frequency_squared, damping_factor, loaded_stress,
     volumetric_increment,
 };
 use crate::element::mass_scaling::MassScaling;
@@ -273,7 +273,7 @@ fn element_step(
         work,
         plastic_work,
         viscous_work,
-        damping: damped_step_factor(damping_fraction).powi(2),
+        damping: damping_factor(damping_fraction),
     })
 }
 
@@ -328,9 +328,7 @@ impl Full {
     /// bounds; the tight ratios are taken against the undamped ones (`damping`, at rest
     /// until the first step).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Full {
-        let at_rest = viscosity.map_or(1.0, |v| {
-            damped_step_factor(v.damping_fraction_at_rest()).powi(2)
-        });
+        let at_rest = viscosity.map_or(1.0, |v| damping_factor(v.damping_fraction_at_rest()));
         let damping = vec![at_rest; self.bounds.len()];
         Full {
             viscosity,

@@ -30,7 +30,7 @@ use super::{
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
 use crate::element::bulk_viscosity::{
-    BulkViscosity, ElementScale, damped_frequency_squared, damped_step_factor, loaded_stress,
+    BulkViscosity, ElementScale, damped_frequency_squared, damping_factor, loaded_stress,
     volumetric_increment,
 };
 use crate::element::mass_scaling::MassScaling;
@@ -73,8 +73,8 @@ pub struct ElementStep {
     /// The bound of the element's highest frequency squared on the end configuration (with
     /// the bulk viscosity: the damped bound, `damped_frequency_squared`).
     pub omega_squared: f64,
-    /// The undamped bound over the damped one (the square of `damped_step_factor`; 1
-    /// without the bulk viscosity).
+    /// The undamped bound over the damped one (`damping_factor`; 1 without the bulk
+    /// viscosity).
     pub damping: f64,
 }
 
@@ -185,7 +185,7 @@ fn element_step(
         Some(v) => (
             damped_frequency_squared(omega_squared, v.damping_fraction),
             v.work,
-            damped_step_factor(v.damping_fraction).powi(2),
+            damping_factor(v.damping_fraction),
         ),
         None => (omega_squared, 0.0, 1.0),
     };
@@ -313,9 +313,7 @@ impl Reduced {
     /// bounds; the tight ratios are taken against the undamped ones (`damping`, at rest
     /// until the first step).
     pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Reduced {
-        let at_rest = viscosity.map_or(1.0, |v| {
-            damped_step_factor(v.damping_fraction_at_rest()).powi(2)
-        });
+        let at_rest = viscosity.map_or(1.0, |v| damping_factor(v.damping_fraction_at_rest()));
         let damping = vec![at_rest; self.bounds.len()];
         Reduced {
             viscosity,
