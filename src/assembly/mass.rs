@@ -208,10 +208,10 @@ fn redistribute(m: &mut [f64], nn: usize, flagged: &[bool]) {
     }
 }
 
-/// Refuses a dynamic model without mass on some free DOF (zero density).
-pub fn check_mass(model: &Model, mass: &Mass, system: &System) -> Result<(), InputError> {
-    for (dof, eq) in system.equation.iter().enumerate() {
-        if eq.is_some() && !(mass.lumped[dof] > 0.0) {
+/// Refuses a dynamic model without mass on some free DOF (`free`: per DOF; zero density).
+pub fn check_mass(model: &Model, mass: &Mass, free: &[bool]) -> Result<(), InputError> {
+    for (dof, free) in free.iter().enumerate() {
+        if *free && !(mass.lumped[dof] > 0.0) {
             let node = dof / 2;
             let body = model
                 .bodies

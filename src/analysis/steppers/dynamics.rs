@@ -156,7 +156,7 @@ impl WatchedPoint {
         let probe = &model.probes[self.probe];
         let ppe = model.bodies[probe.body].points_per_element();
         let value = |points: &[PointState]| {
-            let f: &dyn Fn(&PointState) -> f64 = match probe.quantity {
+            let f: &(dyn Fn(&PointState) -> f64 + Sync) = match probe.quantity {
                 Quantity::Temperature => &|p| p.temperature,
                 _ => &|p| p.eq_plastic_strain,
             };
@@ -178,7 +178,8 @@ impl<'a> Dynamics<'a> {
         let system = System::new(model, &model.constrained_dofs());
         let mut mass =
             Mass::new(model, spec.mass).map_err(|e| InputError::new(&model.file, e.to_string()))?;
-        check_mass(model, &mass, &system)?;
+        let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
+        check_mass(model, &mass, &free)?;
         let mut interfaces = model.interfaces();
         if spec.contact_dynamics != ContactDynamics::Hughes {
             // no velocity jumps; a pair releases when its multiplier turns to tension

@@ -38,8 +38,9 @@ use rayon::prelude::*;
 pub(super) const CHUNK: usize = 64;
 
 /// The fewest chunks of `CHUNK` nodes a task of the gather takes: a node's sum reads four
-/// entries, so a task of fewer than 4096 nodes costs less than handing it over.
-const GATHER_CHUNKS_PER_TASK: usize = 64;
+/// entries, so a task of 512 nodes takes about what handing it to a thread still awake from
+/// the element loop costs.
+const GATHER_CHUNKS_PER_TASK: usize = 8;
 
 /// The sums of one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -472,9 +473,9 @@ pub(super) struct KernelPoints<'a, P> {
     pub point: P,
 }
 
-impl<P: Fn(usize, usize) -> PointState> PointFold for KernelPoints<'_, P> {
+impl<P: Fn(usize, usize) -> PointState + Sync> PointFold for KernelPoints<'_, P> {
     #[inline]
-    fn fold(self, value: impl Fn(&PointState) -> f64) -> f64 {
+    fn fold(self, value: impl Fn(&PointState) -> f64 + Sync) -> f64 {
         let KernelPoints {
             probe,
             first,
@@ -483,17 +484,19 @@ impl<P: Fn(usize, usize) -> PointState> PointFold for KernelPoints<'_, P> {
             point,
         } = self;
         let (point, value) = (&point, &value);
-        let values = probe.members.iter().flat_map(|&e| {
-            let one = (distinct == 1).then(|| value(&point(first + e, 0)));
-            (0..points_per_element).map(move |q| one.unwrap_or_else(|| value(&point(first + e, q))))
-        });
-        probe.combine(values)
+        probe.combine(|members| {
+            members.iter().flat_map(move |&e| {
+                let one = (distinct == 1).then(|| value(&point(first + e, 0)));
+                (0..points_per_element)
+                    .map(move |q| one.unwrap_or_else(|| value(&point(first + e, q))))
+            })
+        })
     }
 }
 
 /// The statistic of point probe `probe` over `layout`'s elements (see `KernelPoints`); None
 /// for a body the kernel does not hold or a nodal quantity.
-pub(super) fn point_statistic<P: Fn(usize, usize) -> PointState>(
+pub(super) fn point_statistic<P: Fn(usize, usize) -> PointState + Sync>(
     layout: &Layout,
     model: &Model,
     probe: &Probe,

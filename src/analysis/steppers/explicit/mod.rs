@@ -28,7 +28,7 @@ use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
 use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, PartialKernel, StepWork, kernel_for};
 use crate::assembly::mass_scaling::{AddedAtRest, MassScalingReport, NodalMotion};
-use crate::assembly::{ElementMasses, Mass, StableStep, State, System, check_mass};
+use crate::assembly::{ElementMasses, Mass, StableStep, State, check_mass};
 use crate::contact::explicit::Predicted;
 use crate::contact::{ContactState, Interfaces};
 use crate::element::Strain;
@@ -47,6 +47,9 @@ pub struct Explicit<'a> {
     model: &'a Model,
     spec: &'a DynamicAnalysis,
     interfaces: Interfaces,
+    /// The nodes of the contact surfaces, ascending: the only ones a contact correction
+    /// writes.
+    surface_nodes: Vec<u32>,
     initial: Vec<[f64; 2]>,
     free: Vec<bool>,
     /// The lumped mass per DOF, and its inverse (zero on prescribed DOFs: contact
@@ -99,11 +102,14 @@ impl<'a> Explicit<'a> {
             clock,
             subcycler,
         } = Start::new(model, spec)?;
-        let system = System::new(model, &model.constrained_dofs());
+        // the free DOFs (no equations: central difference assembles no matrix)
+        let mut free = vec![true; model.dofs()];
+        for c in model.constrained_dofs() {
+            free[c] = false;
+        }
         let mass = Mass::new(model, MassKind::Lumped)
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
-        check_mass(model, &mass, &system)?;
-        let free: Vec<bool> = system.equation.iter().map(Option::is_some).collect();
+        check_mass(model, &mass, &free)?;
         let mut m = mass.lumped;
         if let Some(scaling) = kernel.mass_scaling_mut() {
             // the elements below the target at the start: the initial velocities move them
@@ -117,6 +123,11 @@ impl<'a> Explicit<'a> {
             model,
             spec,
             interfaces: model.interfaces(),
+            surface_nodes: crate::contact::surface_nodes(model)
+                .iter()
+                .enumerate()
+                .filter_map(|(n, on)| on.then_some(n as u32))
+                .collect(),
             initial: model.coordinates(),
             free,
             mass: m,
@@ -168,15 +179,16 @@ impl<'a> Explicit<'a> {
         // The sums run over the DOFs the contact touched: elsewhere f and delta are zero and
         // so is every term, which leaves each sum as it was (a zero term changes a sum at most
         // by the sign of a zero total); a sum in DOF order is a chain of dependent additions
-        // that cost the rod pair a fifth of its contact phase over all DOFs.
-        let touched = match moving {
-            None => touched_dofs(&step.step_force, &step.correction),
-            Some(nodes) => nodes
-                .iter()
-                .flat_map(|n| [2 * *n as usize, 2 * *n as usize + 1])
-                .filter(|i| step.step_force[*i] != 0.0 || step.correction[*i] != 0.0)
-                .collect(),
-        };
+        // that cost the rod pair a fifth of its contact phase over all DOFs. f and delta are
+        // zero off the contact surfaces, so only their nodes are looked at (subcycled: the
+        // moving ones, among them all of the surfaces'); a scan of every DOF was a serial
+        // pass per step that the threads could not share.
+        let nodes = moving.unwrap_or(&self.surface_nodes);
+        let touched: Vec<usize> = nodes
+            .iter()
+            .flat_map(|n| [2 * *n as usize, 2 * *n as usize + 1])
+            .filter(|i| step.step_force[*i] != 0.0 || step.correction[*i] != 0.0)
+            .collect();
         let (mass, a) = (&self.mass, &self.a);
         let held = touched
             .iter()
@@ -185,39 +197,11 @@ impl<'a> Explicit<'a> {
         let work = chunked_sum(&touched, &step.step_force, &self.du, |f, u| f * u)
             + 0.5 * chunked_sum(&touched, &step.step_force, &step.correction, |f, c| f * c)
             - 0.5 * held;
-        // du += delta and v_half += delta / h. Where delta is a zero, delta / h is the same
-        // zero: the loop over all DOFs adds it as it is (elsewhere -0, which leaves v_half as
-        // it is), and the division, which made this loop the costliest part of the rod pair's
-        // contact phase outside the correction, is left to the touched DOFs.
-        let apply = |du: &mut [f64], v_half: &mut [f64], correction: &[f64]| {
-            for ((du, v), c) in du.iter_mut().zip(v_half).zip(correction) {
-                *du += c;
-                *v += if *c == 0.0 { *c } else { -0.0 };
-            }
-        };
-        if let Some(nodes) = moving {
-            // the nodes that step only: the others' increments are not read
-            for n in nodes {
-                let d = 2 * *n as usize;
-                let (du, v_half) = (&mut self.du[d..d + 2], &mut self.v_half[d..d + 2]);
-                apply(du, v_half, &step.correction[d..d + 2]);
-            }
-        } else if self.du.len() <= DOF_CHUNK || rayon::current_num_threads() == 1 {
-            // one chunk or one thread: not worth the pool's bookkeeping (the same operation
-            // on every DOF either way)
-            apply(&mut self.du, &mut self.v_half, &step.correction);
-        } else {
-            (
-                self.du.par_chunks_mut(DOF_CHUNK),
-                self.v_half.par_chunks_mut(DOF_CHUNK),
-            )
-                .into_par_iter()
-                .zip(step.correction.par_chunks(DOF_CHUNK))
-                .with_min_len(CHUNKS_PER_TASK)
-                .for_each(|((du, v_half), correction)| apply(du, v_half, correction));
-        }
+        // du += delta and v_half += delta / h at the touched DOFs (the division left to
+        // them: elsewhere delta is zero)
         for &i in &touched {
             let c = step.correction[i];
+            self.du[i] += c;
             if c != 0.0 {
                 self.v_half[i] += c / h;
             }
@@ -640,13 +624,14 @@ fn commit_kernel_step(state: &mut State, du: &[f64], work: StepWork, geometry: S
 /// DOFs per chunk of the driver's vector loops: they run in parallel over fixed chunks and
 /// their sums add the chunks' partial sums in chunk order, so the results are the same bits
 /// for any number of threads.
-const DOF_CHUNK: usize = 4096;
+const DOF_CHUNK: usize = 1024;
 
-/// The fewest chunks of `DOF_CHUNK` a task of the driver's vector loops takes: a chunk streams
-/// through in a few microseconds, about what handing a task to another thread costs, so a
-/// model under 4 chunks (16 384 DOFs) runs these loops on the stepping thread (the same chunks
-/// and sums, the same bits) and larger ones split into tasks of 4 chunks or more.
-const CHUNKS_PER_TASK: usize = 4;
+/// The fewest chunks of `DOF_CHUNK` a task of the driver's vector loops takes. One: a model
+/// on the pool (1000 elements or more, `analysis::parallel_from`) shares even its few chunks,
+/// since the other thread, still awake from the element loop, takes a chunk for less than the
+/// chunk's own microsecond. (Four chunks of 4096 kept models under 16 384 DOFs on the stepping
+/// thread: the aluminium rod's 5082 DOFs ran serial beside a parallel element loop.)
+const CHUNKS_PER_TASK: usize = 1;
 
 /// The predictor: v_{n+1/2} = v_n + h/2 a_n, du = h v_{n+1/2}.
 fn predict(v: &[f64], a: &[f64], h: f64, v_half: &mut [f64], du: &mut [f64]) {
@@ -663,28 +648,6 @@ fn predict(v: &[f64], a: &[f64], h: f64, v_half: &mut [f64], du: &mut [f64]) {
                 *d = h * *vh;
             }
         });
-}
-
-/// The DOFs where `a` or `b` is not zero, ascending: a branch-free test per block of 16
-/// DOFs (the blocks without any are most of them) and the DOFs of the other blocks one by one.
-fn touched_dofs(a: &[f64], b: &[f64]) -> Vec<usize> {
-    const BLOCK: usize = 16;
-    let mut touched = Vec::new();
-    for (k, (a, b)) in a.chunks(BLOCK).zip(b.chunks(BLOCK)).enumerate() {
-        let any = a
-            .iter()
-            .zip(b)
-            .fold(false, |any, (a, b)| any | (*a != 0.0) | (*b != 0.0));
-        if any {
-            let nonzero = a
-                .iter()
-                .zip(b)
-                .enumerate()
-                .filter(|(_, (a, b))| **a != 0.0 || **b != 0.0);
-            touched.extend(nonzero.map(|(i, _)| k * BLOCK + i));
-        }
-    }
-    touched
 }
 
 /// sum_i term(x_i, y_i) over the DOFs `dofs` (ascending) outside which every term is zero:
