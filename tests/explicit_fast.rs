@@ -475,6 +475,22 @@ statistic = "max"
 [[output.probe]]
 quantity = "u_y"
 set = "top"
+
+# means and extents over every element and node: each is taken in parts, in parallel on
+# several threads, and the parts' sums must add in a fixed order
+[[output.probe]]
+quantity = "eq_plastic_strain"
+set = "all"
+statistic = "mean"
+
+[[output.probe]]
+quantity = "u_y"
+set = "all"
+statistic = "mean"
+
+[[output.probe]]
+quantity = "extent_x"
+set = "all"
 "#;
 
 /// Goal: results do not depend on the thread count where the run really is parallel.

@@ -20,6 +20,7 @@ use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
 use crate::scene::model::{PointFold, Probe};
 use crate::scene::spec::{FramePoints, Quantity, Statistic};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 pub struct Recorder {
@@ -628,10 +629,27 @@ fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
     reaction
 }
 
-/// The smallest and the largest of `x` over `members`, in four independent lanes (min and
-/// max are exact, so the lanes give the one fold's answer; the lanes let the comparisons of
-/// a long set overlap instead of waiting each on the last).
-fn span(members: &[usize], x: impl Fn(usize) -> f64) -> (f64, f64) {
+/// The smallest and the largest of `x` over `members`: in parts of `SPAN_PART` members, in
+/// parallel on several threads (an extent over a whole body is a serial pass per step
+/// otherwise; min and max are exact, so the parts give the one fold's answer).
+fn span(members: &[usize], x: impl Fn(usize) -> f64 + Sync) -> (f64, f64) {
+    const SPAN_PART: usize = 1024;
+    let part = |part: &[usize]| span_lanes(part, &x);
+    let parts: Vec<(f64, f64)> = if members.len() > SPAN_PART && rayon::current_num_threads() > 1 {
+        members.par_chunks(SPAN_PART).map(part).collect()
+    } else {
+        members.chunks(SPAN_PART).map(part).collect()
+    };
+    parts
+        .into_iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), (l, h)| {
+            (low.min(l), high.max(h))
+        })
+}
+
+/// The smallest and the largest of `x` over `members`, in four independent lanes (the lanes
+/// let the comparisons of a long set overlap instead of waiting each on the last).
+fn span_lanes(members: &[usize], x: impl Fn(usize) -> f64) -> (f64, f64) {
     let mut low = [f64::INFINITY; 4];
     let mut high = [f64::NEG_INFINITY; 4];
     let chunks = members.chunks_exact(4);
@@ -674,7 +692,7 @@ struct StatePoints<'a> {
 
 impl PointFold for StatePoints<'_> {
     #[inline]
-    fn fold(self, value: impl Fn(&PointState) -> f64) -> f64 {
+    fn fold(self, value: impl Fn(&PointState) -> f64 + Sync) -> f64 {
         (self.probe).of_points(self.points, self.points_per_element, value)
     }
 }
@@ -689,7 +707,7 @@ fn probe_value(
     let (state, motion) = (snapshot.state, snapshot.motion);
     let nodal = |v: &[f64], c: usize| match probe.statistic {
         Statistic::MassMean => mass_mean(&probe.members, motion.mass, |m| v[2 * m + c], c),
-        _ => probe.combine(probe.members.iter().map(|m| v[2 * m + c])),
+        _ => probe.combine(|members| members.iter().map(move |m| v[2 * m + c])),
     };
     let ppe = model.bodies[probe.body].points_per_element();
     let body_points = &state.bodies[probe.body].points;
@@ -723,7 +741,7 @@ fn probe_value(
             let x = |m: usize| initial[m][c] + state.displacement[2 * m + c];
             match probe.statistic {
                 Statistic::MassMean => mass_mean(&probe.members, motion.mass, x, c),
-                _ => probe.combine(probe.members.iter().map(|&m| x(m))),
+                _ => probe.combine(|members| members.iter().map(|&m| x(m))),
             }
         }
         Quantity::ExtentX | Quantity::ExtentY => {
