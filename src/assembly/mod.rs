@@ -615,14 +615,11 @@ fn element_eigenvalues(
     let mut eigenvalues = Vec::new();
     for (b, body) in model.bodies.iter().enumerate() {
         let kernel = Kernel::of(body);
-        for e in 0..body.elements() {
-            let failure = |error| ElementFailure {
-                body: body.name.clone(),
-                element: e,
-                error,
-            };
-            let lambda = kernel
-                .max_frequency_squared(
+        // the elements in parallel, then the first failure in element order
+        let lambdas: Vec<Result<f64, KernelError>> = (0..body.elements())
+            .into_par_iter()
+            .map(|e| {
+                kernel.max_frequency_squared(
                     ElementAt {
                         body,
                         committed: &state.bodies[b],
@@ -633,7 +630,14 @@ fn element_eigenvalues(
                     &zero,
                     geometry,
                 )
-                .map_err(failure)?;
+            })
+            .collect();
+        for (e, lambda) in lambdas.into_iter().enumerate() {
+            let lambda = lambda.map_err(|error| ElementFailure {
+                body: body.name.clone(),
+                element: e,
+                error,
+            })?;
             eigenvalues.push((b, e, lambda));
         }
     }

@@ -20,6 +20,7 @@ pub mod plane;
 mod tagged;
 pub mod vtk;
 
+use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 
 pub use generate::MeshSpec;
@@ -125,18 +126,22 @@ impl Mesh {
         let Cells::Quad4(quads) = &self.cells else {
             return Vec::new();
         };
-        let mut count: BTreeMap<(usize, usize), ([usize; 2], usize)> = BTreeMap::new();
-        for q in quads {
-            for k in 0..4 {
-                let edge = [q[k], q[(k + 1) % 4]];
-                let key = (edge[0].min(edge[1]), edge[0].max(edge[1]));
-                count.entry(key).or_insert((edge, 0)).1 += 1;
-            }
-        }
-        count
-            .into_values()
-            .filter(|(_, n)| *n == 1)
-            .map(|(e, _)| e)
+        // every element edge under its sorted node pair; an edge of one element is the
+        // boundary's (in the order of the pairs, as a map over them gave it)
+        let mut edges: Vec<((usize, usize), [usize; 2])> = quads
+            .iter()
+            .flat_map(|q| {
+                (0..4).map(move |k| {
+                    let edge = [q[k], q[(k + 1) % 4]];
+                    ((edge[0].min(edge[1]), edge[0].max(edge[1])), edge)
+                })
+            })
+            .collect();
+        edges.par_sort_unstable_by_key(|(key, _)| *key);
+        edges
+            .chunk_by(|a, b| a.0 == b.0)
+            .filter(|run| run.len() == 1)
+            .map(|run| run[0].1)
             .collect()
     }
 }
