@@ -26,7 +26,7 @@ use super::energies::{Energies, Motion};
 use super::newton::Counters;
 use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
 use crate::analysis::summary::{RunError, Status};
-use crate::assembly::explicit::{ExplicitKernel, PartialKernel, StepWork, kernel_for};
+use crate::assembly::explicit::{ExplicitKernel, PartialKernel, kernel_for};
 use crate::assembly::mass_scaling::{AddedAtRest, MassScalingReport, NodalMotion};
 use crate::assembly::{ElementMasses, Mass, StableStep, State, check_mass};
 use crate::contact::explicit::Predicted;
@@ -256,14 +256,20 @@ impl<'a> Explicit<'a> {
 
     /// The internal force at u_{n+1} (a step of length `h`), the committed element state and
     /// the stable step of the new configuration; the message of an element that failed.
-    fn internal_force(&mut self, h: f64) -> Result<StableStep, String> {
+    /// `move_state`: the displacements and positions move by du here (else the caller moves
+    /// them, in the pass of the step's end).
+    fn internal_force(&mut self, h: f64, move_state: bool) -> Result<StableStep, String> {
         let (du, kernel) = (&self.du, &mut self.kernel);
         let work = crate::profile::time(crate::profile::Phase::Assembly, || {
             crate::profile::count_elements(kernel.elements());
             kernel.step(&self.state.coordinates, du, h, &mut self.internal)
         })
         .map_err(|e| e.to_string())?;
-        commit_kernel_step(&mut self.state, du, work, self.spec.geometry);
+        if move_state {
+            commit_kernel_step(&mut self.state, du, self.spec.geometry);
+        }
+        self.state.internal_work += work.internal;
+        self.state.plastic_work += work.plastic;
         self.energies.bulk_viscosity_work += work.viscous;
         let (body, element) = kernel.locate(work.critical_element);
         Ok(StableStep::of_frequency(work.omega_squared, body, element))
@@ -329,7 +335,10 @@ impl Stepper for Explicit<'_> {
             self.contact_correction((h, self.clock.last), time, None);
             crate::profile::add(crate::profile::Phase::Contact, start);
         }
-        let bound = match self.internal_force(h) {
+        // without external forces (which read the moved state) the state moves by du in the
+        // pass that ends the step: one parallel loop fewer a step
+        let fused = !self.forces_applied;
+        let bound = match self.internal_force(h, !fused) {
             Ok(bound) => bound,
             Err(err) => {
                 let status = if self.clock.fixed_above_limit() {
@@ -361,7 +370,10 @@ impl Stepper for Explicit<'_> {
             h,
             a_r: spec.rayleigh[0],
         }
-        .apply(&mut self.a, &mut self.v, &mut self.total);
+        .apply(
+            (&mut self.a, &mut self.v, &mut self.total),
+            fused.then(|| StateMotion::of(&mut self.state, spec.geometry)),
+        );
         let added = self.add_scaled_mass();
         self.energies.mass_scaling_loss += added.loss;
         std::mem::swap(&mut self.last_total, &mut self.total);
@@ -590,35 +602,57 @@ fn partial_of<'k>(kernel: &'k mut Box<dyn ExplicitKernel + '_>) -> &'k mut dyn P
         .expect("a subcycled run has a partial kernel")
 }
 
-/// Commits a step of an explicit kernel (whose element state is already updated): the
-/// configuration moves by du (finite strain; at small strain it stays the initial one), the
-/// work accumulates.
-fn commit_kernel_step(state: &mut State, du: &[f64], work: StepWork, geometry: Strain) {
-    if geometry == Strain::Finite {
-        state
-            .coordinates
-            .par_chunks_mut(DOF_CHUNK / 2)
-            .zip(du.par_chunks(DOF_CHUNK))
-            .with_min_len(CHUNKS_PER_TASK)
-            .for_each(|(x, du)| {
-                for (x, d) in x.iter_mut().zip(du.chunks_exact(2)) {
-                    x[0] += d[0];
-                    x[1] += d[1];
-                }
-            });
-    }
-    state
-        .displacement
-        .par_chunks_mut(DOF_CHUNK)
+/// Moves the configuration of an explicit step (whose element state is already updated) by
+/// du: the displacements, and at finite strain the positions (at small strain they stay the
+/// initial ones).
+fn commit_kernel_step(state: &mut State, du: &[f64], geometry: Strain) {
+    let (coordinates, displacement) = StateMotion::of(state, geometry).chunks();
+    coordinates
+        .into_par_iter()
+        .zip(displacement)
         .zip(du.par_chunks(DOF_CHUNK))
         .with_min_len(CHUNKS_PER_TASK)
-        .for_each(|(u, du)| {
-            for (u, d) in u.iter_mut().zip(du) {
-                *u += d;
-            }
-        });
-    state.internal_work += work.internal;
-    state.plastic_work += work.plastic;
+        .for_each(|((x, u), du)| move_by(x, u, du));
+}
+
+/// The arrays a step's du moves: the displacements, and the positions at finite strain.
+struct StateMotion<'a> {
+    coordinates: Option<&'a mut [[f64; 2]]>,
+    displacement: &'a mut [f64],
+}
+
+impl<'a> StateMotion<'a> {
+    fn of(state: &'a mut State, geometry: Strain) -> StateMotion<'a> {
+        StateMotion {
+            coordinates: (geometry == Strain::Finite).then_some(&mut state.coordinates[..]),
+            displacement: &mut state.displacement,
+        }
+    }
+
+    /// Per `DOF_CHUNK` DOFs: the positions (empty at small strain) and the displacements.
+    fn chunks(self) -> (Vec<&'a mut [[f64; 2]]>, Vec<&'a mut [f64]>) {
+        let displacement: Vec<&mut [f64]> = self.displacement.chunks_mut(DOF_CHUNK).collect();
+        let coordinates = match self.coordinates {
+            Some(x) => x.chunks_mut(DOF_CHUNK / 2).collect(),
+            None => displacement
+                .iter()
+                .map(|_| <&mut [[f64; 2]]>::default())
+                .collect(),
+        };
+        (coordinates, displacement)
+    }
+}
+
+/// x += du and u += du over one chunk (`x` empty: the positions stay).
+#[inline(always)]
+fn move_by(x: &mut [[f64; 2]], u: &mut [f64], du: &[f64]) {
+    for (x, d) in x.iter_mut().zip(du.chunks_exact(2)) {
+        x[0] += d[0];
+        x[1] += d[1];
+    }
+    for (u, d) in u.iter_mut().zip(du) {
+        *u += d;
+    }
 }
 
 /// DOFs per chunk of the driver's vector loops: they run in parallel over fixed chunks and
@@ -703,17 +737,30 @@ impl StepEnd<'_> {
     /// returns the external work of the step by the trapezoidal rule,
     /// du . (F_{n+1} + F_n) / 2, the kinetic energy 1/2 v.M v and its shadow h^2 / 8 a.M a
     /// (free DOFs).
-    fn apply(&self, a: &mut [f64], v: &mut [f64], total: &mut [f64]) -> (f64, f64, f64) {
+    /// `motion`: the state that du moves, in the same pass (None: moved before).
+    fn apply(
+        &self,
+        (a, v, total): (&mut [f64], &mut [f64], &mut [f64]),
+        motion: Option<StateMotion>,
+    ) -> (f64, f64, f64) {
         let (h, a_r) = (self.h, self.a_r);
+        let chunks = a.len().div_ceil(DOF_CHUNK);
+        let (coordinates, displacement) = match motion {
+            Some(motion) => motion.chunks(),
+            None => (0..chunks).map(|_| Default::default()).unzip(),
+        };
         let sums: Vec<(f64, f64, f64)> = (
             a.par_chunks_mut(DOF_CHUNK),
             v.par_chunks_mut(DOF_CHUNK),
             total.par_chunks_mut(DOF_CHUNK),
+            coordinates.into_par_iter().zip(displacement),
         )
             .into_par_iter()
             .enumerate()
             .with_min_len(CHUNKS_PER_TASK)
-            .map(|(k, (a, v, total))| {
+            .map(|(k, (a, v, total, (x, u)))| {
+                let start = k * DOF_CHUNK;
+                move_by(x, u, &self.du[start..start + a.len()]);
                 let (mut work, mut kinetic, mut shadow) = (0.0, 0.0, 0.0);
                 for (j, ((a, v), total)) in a.iter_mut().zip(v).zip(total).enumerate() {
                     let i = k * DOF_CHUNK + j;
