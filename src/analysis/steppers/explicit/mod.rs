@@ -661,10 +661,11 @@ fn move_by(x: &mut [[f64; 2]], u: &mut [f64], du: &[f64]) {
 const DOF_CHUNK: usize = 1024;
 
 /// The fewest chunks of `DOF_CHUNK` a task of the driver's vector loops takes. One: a model
-/// on the pool (1000 elements or more, `analysis::parallel_from`) shares even its few chunks,
-/// since the other thread, still awake from the element loop, takes a chunk for less than the
-/// chunk's own microsecond. (Four chunks of 4096 kept models under 16 384 DOFs on the stepping
-/// thread: the aluminium rod's 5082 DOFs ran serial beside a parallel element loop.)
+/// on the pool (1000 elements or more, `analysis::parallel_from`) shares even its few chunks.
+/// The loops alone hardly gain (a chunk's arrays may sit in the other core's cache), but the
+/// other thread stays awake for the element loop and the end of the step runs on both cores:
+/// the aluminium rod (5082 DOFs) on two threads ran 6 % faster than with tasks of 4 chunks of
+/// 4096, which kept it on the stepping thread (docs/performance.md).
 const CHUNKS_PER_TASK: usize = 1;
 
 /// The predictor: v_{n+1/2} = v_n + h/2 a_n, du = h v_{n+1/2}.
