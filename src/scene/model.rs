@@ -239,9 +239,22 @@ pub struct Probe {
     pub column: String,
 }
 
-/// Members per part of a probe's statistic (`Probe::combine`): a thousand values take about
+/// Members per part of a probe's statistic (`Probe::combine`, `in_parts`): a thousand values take about
 /// a microsecond, what handing a part to another thread costs.
 const MEMBERS_PER_PART: usize = 1024;
+
+/// `part` of each part of `MEMBERS_PER_PART` members, in order: in parallel on several
+/// threads, on the calling one for a single part (the parts, and so the bits, are the same).
+pub fn in_parts<'m, T: Send>(
+    members: &'m [usize],
+    part: impl Fn(&'m [usize]) -> T + Sync,
+) -> Vec<T> {
+    if members.len() > MEMBERS_PER_PART && rayon::current_num_threads() > 1 {
+        members.par_chunks(MEMBERS_PER_PART).map(&part).collect()
+    } else {
+        members.chunks(MEMBERS_PER_PART).map(part).collect()
+    }
+}
 
 /// The statistic of a part of a probe's members: the sum and count of a mean, or the
 /// extreme of a max or min.
@@ -304,16 +317,9 @@ impl Probe {
         let part = |members: &'m [usize]| {
             values(members).fold(Partial::EMPTY, |p, v| p.take(v, statistic))
         };
-        let parts: Vec<Partial> =
-            if self.members.len() > MEMBERS_PER_PART && rayon::current_num_threads() > 1 {
-                self.members
-                    .par_chunks(MEMBERS_PER_PART)
-                    .map(part)
-                    .collect()
-            } else {
-                self.members.chunks(MEMBERS_PER_PART).map(part).collect()
-            };
-        let total = parts.into_iter().fold(Partial::EMPTY, Partial::join);
+        let total = in_parts(&self.members, part)
+            .into_iter()
+            .fold(Partial::EMPTY, Partial::join);
         match statistic {
             Statistic::Mean => total.sum / total.count.max(1) as f64,
             Statistic::Max => total.max,

@@ -18,9 +18,8 @@ use crate::output::thinning::{Thinning, Window};
 use crate::output::vtk::{Fields, Grid, Polyline, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
-use crate::scene::model::{PointFold, Probe};
+use crate::scene::model::{PointFold, Probe, in_parts};
 use crate::scene::spec::{FramePoints, Quantity, Statistic};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 pub struct Recorder {
@@ -629,18 +628,11 @@ fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
     reaction
 }
 
-/// The smallest and the largest of `x` over `members`: in parts of `SPAN_PART` members, in
-/// parallel on several threads (an extent over a whole body is a serial pass per step
+/// The smallest and the largest of `x` over `members`, in the probes' parts (`in_parts`: in
+/// parallel on several threads; an extent over a whole body is a serial pass per step
 /// otherwise; min and max are exact, so the parts give the one fold's answer).
 fn span(members: &[usize], x: impl Fn(usize) -> f64 + Sync) -> (f64, f64) {
-    const SPAN_PART: usize = 1024;
-    let part = |part: &[usize]| span_lanes(part, &x);
-    let parts: Vec<(f64, f64)> = if members.len() > SPAN_PART && rayon::current_num_threads() > 1 {
-        members.par_chunks(SPAN_PART).map(part).collect()
-    } else {
-        members.chunks(SPAN_PART).map(part).collect()
-    };
-    parts
+    in_parts(members, |part| span_lanes(part, &x))
         .into_iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), (l, h)| {
             (low.min(l), high.max(h))
