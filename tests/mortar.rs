@@ -395,8 +395,13 @@ fn rod_pair_with_non_matching_meshes_matches_the_wall() {
 /// turned them into a velocity that flips sign every step (+-47.7 m/s at the axis).
 /// Measured with the hold pair (theory 8.3a-4): L_f +0.06 / -0.01 %, D_f -0.27 / +0.29 %,
 /// energy balance 6.6e-4, momentum 4.4e-11 of rho A L V, penetration 3.4e-6 m (0.74 % of
-/// the 0.457 mm slave face element), no step cut (asserted: none). Without it 1.2e-5 m
-/// (2.6 %) and 2 step cuts, in the steps after the slave's axis node closes again.
+/// the 0.457 mm slave face element). Without it 1.2e-5 m (2.6 %) and step cuts in the steps
+/// after the slave's axis node closes again. How many cuts is a matter of round-off: the
+/// steps are sub-incremented to each contact event, and a change in the last bits moves the
+/// events and so the steps. Over dt within 1e-5 of 1e-7 (relative; eleven runs) the held
+/// pair cut no step in ten and one step at dt = 1e-7 itself (the Johnson-Cook return in
+/// ln dl, theory 8.1a; the build before it cut none there and five at 1.0000001e-7); without
+/// the hold 0, 1, 2, 2, 7 and 9 over six. Asserted: at most one.
 #[test]
 fn rod_pair_with_non_matching_meshes_on_newmark_matches_the_wall() {
     pair_against_wall(
@@ -411,7 +416,7 @@ fn rod_pair_with_non_matching_meshes_on_newmark_matches_the_wall() {
         Some(&[]),
         0.01,
         0.01,
-        0,
+        1,
     );
 }
 

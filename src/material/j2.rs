@@ -143,14 +143,23 @@ impl J2 {
     /// or the slope is not finite. (Johnson-Cook needs it: from dl = 0 below the reference
     /// rate Newton does not see the rate term and overshoots; from there, on the convex g of
     /// the logarithm, it can fall back to 0.) Returns dl and the hardening slope at the
-    /// solution.
+    /// solution. Johnson-Cook goes first by [`J2::johnson_cook_multiplier`] from the start's
+    /// flow stress `start_stress`, and here only where that fails.
     #[inline]
-    fn plastic_multiplier(&self, a: f64, b: f64, flow: &Flow) -> (f64, f64) {
+    fn plastic_multiplier(&self, a: f64, b: f64, flow: &Flow, start_stress: f64) -> (f64, f64) {
         let start = &flow.start;
-        if let Hardening::Linear { modulus } = self.hardening {
-            let yield_stress = self.yield_stress + modulus * start.eq_plastic_strain;
-            let dl = (a - SQRT_2_3 * yield_stress) / (b + 2.0 / 3.0 * modulus);
-            return (dl.max(0.0), modulus);
+        match self.hardening {
+            Hardening::Linear { modulus } => {
+                let yield_stress = self.yield_stress + modulus * start.eq_plastic_strain;
+                let dl = (a - SQRT_2_3 * yield_stress) / (b + 2.0 / 3.0 * modulus);
+                return (dl.max(0.0), modulus);
+            }
+            Hardening::JohnsonCook(_) => {
+                if let Some(found) = Self::johnson_cook_multiplier(a, b, flow, start_stress) {
+                    return found;
+                }
+            }
+            Hardening::Table { .. } => {}
         }
         let (mut lo, mut hi) = (0.0, a / b);
         let mut dl = 0.0;
@@ -183,6 +192,46 @@ impl J2 {
             };
         }
         (dl, slope)
+    }
+
+    /// g(dl) = 0 for Johnson-Cook by Newton in s = ln dl, from the perfectly plastic return
+    /// dl_0 = (a - sqrt(2/3) sigma_y(0)) / b. The flow stress rises with the increment
+    /// (hardening, rate; the thermal factor is the step's), so g(dl_0) <= 0: dl_0 lies above
+    /// the root. In s, sigma_y is convex: A + B (eps_p + e^s)^n is (its second derivative is
+    /// B n (eps_p + e^s)^(n - 2) e^s (eps_p + n e^s) > 0), the rate factor 1 + C (s - ln(r_0
+    /// dt)) is linear above its kink and 1 below it (a kink that only steepens it), and a
+    /// product of positive, rising, convex factors is convex. So g(s) = a - b e^s -
+    /// sqrt(2/3) sigma_y is concave, and Newton from a point where g <= 0 falls to the root
+    /// without passing it (a tangent of a concave function lies above it). In dl itself the
+    /// rate term's logarithm made Newton overshoot below zero and the safeguard bisect: 8.7
+    /// iterates a return on the Johnson-Cook Taylor rod (each a powf and a logarithm). None
+    /// where an iterate is not finite or 50 do not reach the tolerance (the bracketed
+    /// Newton of `plastic_multiplier` then takes over).
+    fn johnson_cook_multiplier(
+        a: f64,
+        b: f64,
+        flow: &Flow,
+        start_stress: f64,
+    ) -> Option<(f64, f64)> {
+        let mut dl = (a - SQRT_2_3 * start_stress) / b;
+        if !(dl > 0.0 && dl.is_finite()) {
+            return None;
+        }
+        for _ in 0..50 {
+            let (sy, h) = flow.stress(SQRT_2_3 * dl);
+            let g = a - b * dl - SQRT_2_3 * sy;
+            // the tolerance of plastic_multiplier
+            if g.abs() <= 1e-15 * (1.0 + dl) * b {
+                return Some((dl, h));
+            }
+            // dg/ds = dl dg/d dl
+            let ds = g / (dl * (b + 2.0 / 3.0 * h));
+            if !ds.is_finite() {
+                return None;
+            }
+            dl *= ds.exp();
+        }
+        None
     }
 
     /// The consistent tangent of a radial return from the elastic moduli:
@@ -226,7 +275,8 @@ impl J2 {
         }
         let eta_norm = eta_squared.sqrt();
         let h_kin = self.kinematic_modulus;
-        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, &flow);
+        let (dl, h_iso) =
+            self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, &flow, sy);
         let n = eta / eta_norm;
         Some(Radial {
             stress: trial - n * (2.0 * mu * dl),
@@ -258,7 +308,7 @@ impl J2 {
         // dl = sqrt(3/2) de_p: a = sqrt(2/3)|xi|, b = 2/3 (E + H_kin)
         let h_kin = self.kinematic_modulus;
         let (dl, h_iso) =
-            self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), &flow);
+            self.plastic_multiplier(SQRT_2_3 * xi.abs(), 2.0 / 3.0 * (young + h_kin), &flow, sy);
         let dep = SQRT_2_3 * dl;
         let h = h_iso + h_kin;
         Some(UniaxialReturn {
@@ -447,6 +497,67 @@ mod tests {
                     );
                     assert!(dep > 0.0);
                 }
+            }
+        }
+    }
+
+    /// Newton in ln dl (`johnson_cook_multiplier`) reaches the root on its own, without the
+    /// bracketed fallback, on the 42CrMo4 law of models/taylor_jc.toml at that rod's steps
+    /// (1e-9 to 4e-8 s) and on the grid of the test above, from trial stresses just above
+    /// the flow stress to 20 times it. Reference: the law written out here (A + B eps^n)
+    /// (1 + C ln(rate)) (1 - T*^m) and the consistency condition
+    /// ||eta_tr|| - 2 mu dl = sqrt(2/3) sigma_y(eps_p + sqrt(2/3) dl) to twice the
+    /// iteration's own stopping test |g| <= 1e-15 (1 + dl) 2 mu (3e-4 Pa) and 1e-14 of the
+    /// trial for the round-off of the law evaluated here.
+    #[test]
+    fn johnson_cook_log_newton_converges_without_the_fallback() {
+        let law = JohnsonCook {
+            b: 614.0e6,
+            n: 0.168,
+            c: 0.0089,
+            reference_rate: 1.0,
+            m: 1.1,
+            room_temperature: 20.0,
+            melting_temperature: 1540.0,
+            specific_heat: 460.0,
+            taylor_quinney: 0.9,
+            initial_temperature: 20.0,
+        };
+        let j2 = J2 {
+            yield_stress: 806.0e6,
+            hardening: Hardening::JohnsonCook(law),
+            kinematic_modulus: 0.0,
+        };
+        let sigma = |eps: f64, rate: f64, t: f64| -> f64 {
+            let homologous: f64 = ((t - 20.0) / 1520.0).clamp(0.0, 1.0);
+            (806.0e6 + 614.0e6 * eps.powf(0.168))
+                * (1.0 + 0.0089 * rate.max(1.0).ln())
+                * (1.0 - homologous.powf(1.1))
+        };
+        let two_mu = 206.0e9 / 1.3;
+        for (eps_p, temperature, over) in itertools(
+            &[0.0, 1e-6, 0.02, 0.5, 1.8],
+            &[20.0, 300.0, 900.0, 1500.0],
+            &[1.0 + 1e-9, 1.001, 1.1, 2.0, 20.0],
+        ) {
+            for dt in [1e-9, 3.2e-9, 4e-8] {
+                let start = FlowStart {
+                    eq_plastic_strain: eps_p,
+                    temperature,
+                    dt,
+                };
+                let flow = Flow::new(&j2, start);
+                let start_stress = flow.at_start();
+                let a = SQRT_2_3 * over * start_stress;
+                let (dl, _) = J2::johnson_cook_multiplier(a, two_mu, &flow, start_stress)
+                    .unwrap_or_else(|| panic!("eps_p {eps_p} T {temperature} x{over} dt {dt}"));
+                let dep = SQRT_2_3 * dl;
+                let residual =
+                    a - two_mu * dl - SQRT_2_3 * sigma(eps_p + dep, dep / dt, temperature);
+                assert!(
+                    residual.abs() <= 2e-15 * (1.0 + dl) * two_mu + 1e-14 * a,
+                    "eps_p {eps_p} T {temperature} x{over} dt {dt}: residual {residual} of {a}"
+                );
             }
         }
     }

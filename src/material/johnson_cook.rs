@@ -72,7 +72,13 @@ impl JohnsonCook {
     /// The thermal softening factor 1 - T*^m of `temperature`.
     #[inline]
     pub fn thermal_factor(&self, temperature: f64) -> f64 {
-        1.0 - self.homologous_temperature(temperature).powf(self.m)
+        // at or below room temperature (every point the plastic work has not heated) T* = 0
+        // and the factor is 1: no powf (0^m = 0 for m > 0, so the same bits)
+        let homologous = self.homologous_temperature(temperature);
+        if homologous == 0.0 {
+            return 1.0;
+        }
+        1.0 - homologous.powf(self.m)
     }
 
     /// The flow stress of a zero increment, without its slope (the elastic check of every
@@ -80,7 +86,13 @@ impl JohnsonCook {
     #[inline]
     pub fn start_flow_stress(&self, a: f64, eq_plastic_strain: f64, thermal: f64) -> f64 {
         // the rate factor of a zero increment is 1 (as flow_stress takes it)
-        (a + self.b * eq_plastic_strain.powf(self.n)) * 1.0 * thermal
+        // a point that never flowed: eps_p^n = 0 without the powf (n > 0: the same bits)
+        let power = if eq_plastic_strain == 0.0 {
+            0.0
+        } else {
+            eq_plastic_strain.powf(self.n)
+        };
+        (a + self.b * power) * 1.0 * thermal
     }
 
     /// `flow_stress` with the thermal factor of the step's temperature given (it is the same
@@ -100,8 +112,14 @@ impl JohnsonCook {
         let hardening_slope = if self.b == 0.0 {
             0.0
         } else {
-            // infinite at eps_p = 0 for n < 1 (see the module notes)
-            self.b * self.n * eps_p.powf(self.n - 1.0)
+            // infinite at eps_p = 0 for n < 1 (see the module notes); above it eps_p^(n - 1)
+            // is eps_p^n / eps_p, one powf fewer an iterate of the return
+            let lower = if eps_p > 0.0 {
+                power / eps_p
+            } else {
+                eps_p.powf(self.n - 1.0)
+            };
+            self.b * self.n * lower
         };
         let ratio = dep / (dt * self.reference_rate);
         let (rate_factor, rate_slope) = if self.c > 0.0 && ratio > 1.0 {
