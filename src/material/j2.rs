@@ -449,23 +449,7 @@ mod tests {
     /// Reference: the law written here; 1e-12 of the trial stress.
     #[test]
     fn johnson_cook_return_satisfies_the_consistency_condition() {
-        let law = JohnsonCook {
-            b: 0.3,
-            n: 0.3,
-            c: 0.02,
-            reference_rate: 1.0,
-            m: 1.0,
-            room_temperature: 0.0,
-            melting_temperature: 1.0,
-            specific_heat: 1.0,
-            taylor_quinney: 0.9,
-            initial_temperature: 0.0,
-        };
-        let j2 = J2 {
-            yield_stress: 0.5,
-            hardening: Hardening::JohnsonCook(law),
-            kinematic_modulus: 0.0,
-        };
+        let j2 = johnson_cook([0.5, 0.3, 0.3, 0.02, 1.0], [0.0, 1.0]);
         let flow = |eps_p: f64, rate: f64, t: f64| -> f64 {
             (0.5 + 0.3 * eps_p.powf(0.3)) * (1.0 + 0.02 * rate.max(1.0).ln()) * (1.0 - t)
         };
@@ -503,31 +487,15 @@ mod tests {
 
     /// Newton in ln dl (`johnson_cook_multiplier`) reaches the root on its own, without the
     /// bracketed fallback, on the 42CrMo4 law of models/taylor_jc.toml at that rod's steps
-    /// (1e-9 to 4e-8 s) and on the grid of the test above, from trial stresses just above
-    /// the flow stress to 20 times it. Reference: the law written out here (A + B eps^n)
+    /// (1e-9 to 4e-8 s), eps_p 0 to 1.8, T from room to 40 C below melting, from trial
+    /// stresses just above the flow stress to 20 times it. Reference: the law written out here (A + B eps^n)
     /// (1 + C ln(rate)) (1 - T*^m) and the consistency condition
     /// ||eta_tr|| - 2 mu dl = sqrt(2/3) sigma_y(eps_p + sqrt(2/3) dl) to twice the
     /// iteration's own stopping test |g| <= 1e-15 (1 + dl) 2 mu (3e-4 Pa) and 1e-14 of the
     /// trial for the round-off of the law evaluated here.
     #[test]
     fn johnson_cook_log_newton_converges_without_the_fallback() {
-        let law = JohnsonCook {
-            b: 614.0e6,
-            n: 0.168,
-            c: 0.0089,
-            reference_rate: 1.0,
-            m: 1.1,
-            room_temperature: 20.0,
-            melting_temperature: 1540.0,
-            specific_heat: 460.0,
-            taylor_quinney: 0.9,
-            initial_temperature: 20.0,
-        };
-        let j2 = J2 {
-            yield_stress: 806.0e6,
-            hardening: Hardening::JohnsonCook(law),
-            kinematic_modulus: 0.0,
-        };
+        let j2 = johnson_cook([806.0e6, 614.0e6, 0.168, 0.0089, 1.1], [20.0, 1540.0]);
         let sigma = |eps: f64, rate: f64, t: f64| -> f64 {
             let homologous: f64 = ((t - 20.0) / 1520.0).clamp(0.0, 1.0);
             (806.0e6 + 614.0e6 * eps.powf(0.168))
@@ -559,6 +527,28 @@ mod tests {
                     "eps_p {eps_p} T {temperature} x{over} dt {dt}: residual {residual} of {a}"
                 );
             }
+        }
+    }
+
+    /// J2 with the Johnson-Cook law [A, B, n, C, m] (reference rate 1) between the room and
+    /// melting temperatures [T_room, T_melt], starting at room temperature.
+    fn johnson_cook([a, b, n, c, m]: [f64; 5], [room, melting]: [f64; 2]) -> J2 {
+        let law = JohnsonCook {
+            b,
+            n,
+            c,
+            reference_rate: 1.0,
+            m,
+            room_temperature: room,
+            melting_temperature: melting,
+            specific_heat: 1.0,
+            taylor_quinney: 0.9,
+            initial_temperature: room,
+        };
+        J2 {
+            yield_stress: a,
+            hardening: Hardening::JohnsonCook(law),
+            kinematic_modulus: 0.0,
         }
     }
 
