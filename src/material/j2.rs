@@ -140,11 +140,11 @@ impl J2 {
     /// plastic trial state: g(0) > 0): in closed form for linear hardening (g is linear in
     /// dl), else by Newton to round-off, kept inside the bracket (lo, hi] that starts as
     /// (0, a / b] (g(a / b) = -sqrt(2/3) sigma_y <= 0) by bisection when an iterate leaves it
-    /// or the slope is not finite. (Johnson-Cook needs it: from dl = 0 below the reference
-    /// rate Newton does not see the rate term and overshoots; from there, on the convex g of
-    /// the logarithm, it can fall back to 0.) Returns dl and the hardening slope at the
-    /// solution. Johnson-Cook goes first by [`J2::johnson_cook_multiplier`] from the start's
-    /// flow stress `start_stress`, and here only where that fails.
+    /// or the slope is not finite. Returns dl and the hardening slope at the solution.
+    /// Johnson-Cook goes first by [`J2::johnson_cook_multiplier`] from the start's flow
+    /// stress `start_stress`, and comes here only where that fails; then it needs the
+    /// bracket: from dl = 0 below the reference rate Newton does not see the rate term and
+    /// overshoots, and on the convex g of the logarithm it can fall back to 0.
     #[inline]
     fn plastic_multiplier(&self, a: f64, b: f64, flow: &Flow, start_stress: f64) -> (f64, f64) {
         let start = &flow.start;
@@ -488,8 +488,8 @@ mod tests {
     /// Newton in ln dl (`johnson_cook_multiplier`) reaches the root on its own, without the
     /// bracketed fallback, on the 42CrMo4 law of models/taylor_jc.toml at that rod's steps
     /// (1e-9 to 4e-8 s), eps_p 0 to 1.8, T from room to 40 C below melting, from trial
-    /// stresses just above the flow stress to 20 times it. Reference: the law written out here (A + B eps^n)
-    /// (1 + C ln(rate)) (1 - T*^m) and the consistency condition
+    /// stresses just above the flow stress to 20 times it. Reference: the law written out
+    /// here, (A + B eps^n) (1 + C ln(rate)) (1 - T*^m), and the consistency condition
     /// ||eta_tr|| - 2 mu dl = sqrt(2/3) sigma_y(eps_p + sqrt(2/3) dl) to twice the
     /// iteration's own stopping test |g| <= 1e-15 (1 + dl) 2 mu (3e-4 Pa) and 1e-14 of the
     /// trial for the round-off of the law evaluated here.
