@@ -1,7 +1,7 @@
 //! Blocks: structured patches of quads (maps of the unit square) and the gluing of blocks
 //! into one mesh by merging coincident nodes.
 
-use std::collections::HashMap;
+use rayon::prelude::*;
 
 use crate::mesh::plane::{Point, norm, quad_area, sub};
 use crate::mesh::{Cells, Mesh};
@@ -117,27 +117,111 @@ pub(super) fn min_edge(points: &[Point], quads: &[[usize; 4]]) -> f64 {
 }
 
 /// Distinct points (first occurrence kept) and each input point's new id; points closer than
-/// `tol` are one.
+/// `tol` are one: a point takes the node of the earliest point within `tol` of it (in the
+/// generators' meshes coincident points are 1e6 times closer than any two others).
+///
+/// The points are sorted by their cell of side `tol` (in parallel), and each looks for its
+/// earliest neighbour in the three rows of cells around its own by binary search (in
+/// parallel); the ids are then numbered in order of first occurrence. The result does not
+/// depend on the thread count.
 pub(super) fn merge_coincident(points: &[Point], tol: f64) -> (Vec<Point>, Vec<usize>) {
     let cell = tol.max(f64::MIN_POSITIVE);
     let key = |p: Point| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
-    let mut buckets: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    let mut sorted: Vec<((i64, i64), usize)> = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| (key(*p), i))
+        .collect();
+    sorted.par_sort_unstable();
+    // the earliest point within tol of each (itself when none is earlier)
+    let earliest: Vec<usize> = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let (kx, ky) = key(p);
+            let mut first = i;
+            for row in [kx.saturating_sub(1), kx, kx.saturating_add(1)] {
+                let (low, high) = ((row, ky.saturating_sub(1)), (row, ky.saturating_add(1)));
+                let from = sorted.partition_point(|(k, _)| *k < low);
+                for &(k, j) in sorted[from..].iter().take_while(|(k, _)| *k <= high) {
+                    debug_assert!(k >= low);
+                    if j < first && norm(sub(points[j], p)) <= tol {
+                        first = j;
+                    }
+                }
+            }
+            first
+        })
+        .collect();
+    // each point's root (earliest[i] <= i, so the roots before i are known), numbered in
+    // order of first occurrence
+    let mut ids = vec![0; points.len()];
     let mut nodes: Vec<Point> = Vec::new();
-    let mut ids = Vec::with_capacity(points.len());
-    for &p in points {
-        let (kx, ky) = key(p);
-        let neighbours = (-1..=1).flat_map(|dx| (-1..=1).map(move |dy| (kx + dx, ky + dy)));
-        let found = neighbours
-            .filter_map(|k| buckets.get(&k))
-            .flatten()
-            .copied()
-            .find(|&n| norm(sub(nodes[n], p)) <= tol);
-        let id = found.unwrap_or_else(|| {
-            nodes.push(p);
-            buckets.entry((kx, ky)).or_default().push(nodes.len() - 1);
+    for (i, &first) in earliest.iter().enumerate() {
+        ids[i] = if first == i {
+            nodes.push(points[i]);
             nodes.len() - 1
-        });
-        ids.push(id);
+        } else {
+            ids[first]
+        };
     }
     (nodes, ids)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The merge against its definition by brute force: points on a lattice with copies
+    /// moved by less than tol (and one chain of two steps below tol), in scrambled order.
+    #[test]
+    fn merge_coincident_matches_the_pairwise_definition() {
+        let tol = 1e-3;
+        let mut points = Vec::new();
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for k in 0..400 {
+            let base = [(k % 20) as f64 * 0.01 - 0.1, (k / 20) as f64 * 0.01];
+            points.push(base);
+            // a third of them have a copy within tol / 2 in a random direction
+            if k % 3 == 0 {
+                let (r, phi) = (0.5 * tol * next(), 6.283 * next());
+                points.push([base[0] + r * phi.cos(), base[1] + r * phi.sin()]);
+            }
+        }
+        // a chain: a, b at 0.8 tol from a, c at 0.8 tol from b (1.6 tol from a)
+        points.push([5.0, 5.0]);
+        points.push([5.0 + 0.8 * tol, 5.0]);
+        points.push([5.0 + 1.6 * tol, 5.0]);
+        // scrambled
+        for i in (1..points.len()).rev() {
+            let j = (next() * (i + 1) as f64) as usize;
+            points.swap(i, j.min(i));
+        }
+        let (nodes, ids) = merge_coincident(&points, tol);
+        // by definition: i joins the earliest j within tol, transitively
+        let mut reference = vec![usize::MAX; points.len()];
+        let mut count = 0;
+        for i in 0..points.len() {
+            let first = (0..i).find(|&j| norm(sub(points[j], points[i])) <= tol);
+            reference[i] = match first {
+                Some(j) => reference[j],
+                None => {
+                    count += 1;
+                    count - 1
+                }
+            };
+        }
+        assert_eq!(ids, reference);
+        assert_eq!(nodes.len(), count);
+        // 400 lattice points (their copies merged) and the chain as one or two nodes (b
+        // takes a's or c's node, whichever comes first; a and c are apart)
+        assert!(count == 401 || count == 402, "{count}");
+        for (i, id) in ids.iter().enumerate() {
+            assert!(norm(sub(nodes[*id], points[i])) <= 2.0 * tol);
+        }
+    }
 }
