@@ -125,15 +125,17 @@ fn body(
     };
     check_cells(cx, &key, &mesh, &kind)?;
     let initial_stress = Voigt::from(spec.initial_stress.unwrap_or([0.0; 4]));
+    let boundary = mesh.boundary_edges();
     let mut boundary_at_node = vec![Vec::new(); mesh.nodes.len()];
-    for edge in mesh.boundary_edges() {
+    for edge in &boundary {
         for node in edge {
-            boundary_at_node[node].push(edge);
+            boundary_at_node[*node].push(*edge);
         }
     }
     Ok(Body {
         name: spec.name.clone(),
         boundary_at_node,
+        boundary,
         mesh,
         kind,
         material,

@@ -300,8 +300,7 @@ fn reverse_pair(
     slaves.sort_unstable();
     slaves.dedup();
     let boundary = slave_body
-        .mesh
-        .boundary_edges()
+        .boundary
         .iter()
         .map(|e| e.map(|n| slave_body.global(n)))
         .collect();
@@ -353,8 +352,7 @@ fn master_body(
         (Some(_), None) => {
             let (b, edges) = edge_set(cx, bodies, m.body.as_deref(), &m.set, &mkey)?;
             let boundary = bodies[b]
-                .mesh
-                .boundary_edges()
+                .boundary
                 .iter()
                 .map(|e| e.map(|n| bodies[b].global(n)))
                 .collect();

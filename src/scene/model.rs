@@ -124,6 +124,9 @@ pub struct Body {
     /// The boundary edges of the mesh touching each node (local numbers; empty for rods):
     /// the contact impedance's tributary length, found once.
     pub boundary_at_node: Vec<Vec<[usize; 2]>>,
+    /// The mesh's boundary edges as `Mesh::boundary_edges` gives them (local numbers; empty
+    /// for rods), found once: the contact surfaces, the record and the warnings read them.
+    pub boundary: Vec<[usize; 2]>,
 }
 
 impl Body {
@@ -733,7 +736,7 @@ impl Model {
                         .iter()
                         .map(|edges| edges.iter().map(|e| e.map(|n| b.global(n))).collect())
                         .collect(),
-                    boundary: (b.mesh.boundary_edges().iter())
+                    boundary: (b.boundary.iter())
                         .map(|e| e.map(|n| b.global(n)))
                         .collect(),
                     node_offset: b.node_offset,

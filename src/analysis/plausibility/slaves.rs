@@ -56,9 +56,9 @@ pub(super) fn slave_surface_warnings(model: &Model) -> Vec<String> {
 
 /// The boundary nodes of `body` (global ids) that face `pair`'s master nearest it.
 fn near_facing_nodes(body: &Body, pair: &ContactPair, coords: &[[f64; 2]]) -> Vec<usize> {
-    let edges = body.mesh.boundary_edges();
+    let edges = &body.boundary;
     let mut normal = vec![[0.0; 2]; body.mesh.nodes.len()];
-    for [a, b] in &edges {
+    for [a, b] in edges {
         let n = outward(body.mesh.nodes[*a], body.mesh.nodes[*b]);
         for node in [a, b] {
             normal[*node] = [normal[*node][0] + n[0], normal[*node][1] + n[1]];
