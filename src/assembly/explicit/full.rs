@@ -30,8 +30,8 @@ use super::tight::{
 };
 use super::{
     CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
-    element_motion, element_scaling, fold_chunks, kernel_stable_step, point_statistic, point_step,
-    subset_steps,
+    cut, element_motion, element_scaling, fold_chunks, kernel_stable_step, point_statistic,
+    point_step,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -405,10 +405,13 @@ impl Full {
         du: &[f64],
         dt: f64,
     ) -> Result<StepWork, ElementFailure> {
-        let layout = &self.layout;
-        let lumped = &self.lumped;
-        let viscosity = self.viscosity.as_ref();
-        let scaling = self.scaling.as_ref();
+        let reads = Reads {
+            layout: &self.layout,
+            lumped: &self.lumped,
+            scaling: self.scaling.as_ref(),
+            viscosity: self.viscosity.as_ref(),
+        };
+        let count = self.bounds.len();
         let results: Vec<ChunkResult> = (
             self.stress.par_chunks_mut(16 * CHUNK),
             self.back_stress.par_chunks_mut(16 * CHUNK),
@@ -422,72 +425,73 @@ impl Full {
         )
             .into_par_iter()
             .enumerate()
-            .map(
-                |(
-                    k,
-                    (stress, back, eps_p, temperature, thickness, viscous, forces, bounds, damping),
-                )| {
-                    let mut sums = StepWork::default();
-                    let mut grown = Vec::new();
-                    for i in 0..forces.len() / 8 {
-                        let e = k * CHUNK + i;
-                        let element = layout.nodes[e];
-                        let xe: Nodes = element.map(|n| x[n as usize]);
-                        let ue: Nodes =
-                            element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
-                        let committed = PointsState {
-                            stress: std::array::from_fn(|q| {
-                                std::array::from_fn(|c| stress[16 * i + 4 * q + c])
-                            }),
-                            back_stress: std::array::from_fn(|q| {
-                                std::array::from_fn(|c| back[16 * i + 4 * q + c])
-                            }),
-                            eq_plastic_strain: std::array::from_fn(|q| eps_p[4 * i + q]),
-                            temperature: std::array::from_fn(|q| temperature[4 * i + q]),
-                            thickness: std::array::from_fn(|q| thickness[4 * i + q]),
-                            viscous_pressure: std::array::from_fn(|q| viscous[4 * i + q]),
-                        };
-                        let p = &layout.bodies[layout.body[e] as usize];
-                        let factor = scaling.map(|s| s.factor(e));
-                        let element_lumped = scaled(&lumped[e], factor);
-                        let motion = (&xe, &ue);
-                        let step = (dt, viscosity);
-                        let r = match element_step(p, motion, &committed, &element_lumped, step) {
-                            Ok(r) => r,
-                            Err(err) => return (sums, Some((e, err)), grown),
-                        };
-                        let omega_squared = match scaling
-                            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
-                        {
-                            Some(rescaled) => {
-                                grown.push((e, rescaled.factor));
-                                rescaled.omega_squared
-                            }
-                            None => r.omega_squared,
-                        };
-                        sums.observe(omega_squared, e);
-                        bounds[i] = omega_squared;
-                        damping[i] = r.damping;
-                        for q in 0..4 {
-                            stress[16 * i + 4 * q..16 * i + 4 * q + 4]
-                                .copy_from_slice(&r.state.stress[q]);
-                            back[16 * i + 4 * q..16 * i + 4 * q + 4]
-                                .copy_from_slice(&r.state.back_stress[q]);
-                        }
-                        eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
-                        temperature[4 * i..4 * i + 4].copy_from_slice(&r.state.temperature);
-                        thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
-                        viscous[4 * i..4 * i + 4].copy_from_slice(&r.state.viscous_pressure);
-                        forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
-                        sums.internal += r.work;
-                        sums.plastic += r.plastic_work;
-                        sums.viscous += r.viscous_work;
-                    }
-                    (sums, None, grown)
-                },
-            )
+            .map(|(k, parts)| {
+                let first = k * CHUNK;
+                let mut columns = Columns::of(first, parts);
+                let elements = first..(first + CHUNK).min(count);
+                step_chunk(&reads, &mut columns, elements, (x, du), dt, true)
+            })
             .collect();
         fold_chunks(results, &self.layout, self.scaling.as_mut())
+    }
+
+    /// The steps of the elements `elements` (ascending, each once) in chunks of `CHUNK`
+    /// entries, in parallel, each chunk writing its elements' state, forces and frequency
+    /// bounds (into `omega_squared`) where they lie (the arrays `cut` at the chunks' first
+    /// elements). The chunk sums are added in chunk order, so a list of all elements is
+    /// summed as `step_bounds` sums them, and the bits do not depend on the thread count.
+    fn step_subset(
+        &mut self,
+        elements: &[u32],
+        motion: (&[[f64; 2]], &[f64]),
+        dt: f64,
+        omega_squared: &mut [f64],
+    ) -> Result<StepWork, ElementFailure> {
+        let reads = Reads {
+            layout: &self.layout,
+            lumped: &self.lumped,
+            scaling: self.scaling.as_ref(),
+            viscosity: self.viscosity.as_ref(),
+        };
+        let starts: Vec<usize> = elements.chunks(CHUNK).map(|c| c[0] as usize).collect();
+        let mut parts = (
+            cut(&mut self.stress, 16, &starts),
+            cut(&mut self.back_stress, 16, &starts),
+            cut(&mut self.eq_plastic_strain, 4, &starts),
+            cut(&mut self.temperature, 4, &starts),
+            cut(&mut self.thickness, 4, &starts),
+            cut(&mut self.viscous_pressure, 4, &starts),
+            cut(&mut self.element_forces, 8, &starts),
+            cut(omega_squared, 1, &starts),
+            cut(&mut self.damping, 1, &starts),
+        );
+        let columns: Vec<Columns> = starts
+            .iter()
+            .map_while(|first| {
+                let (a, b, c, d, e, f, g, h, i) = &mut parts;
+                let next = (
+                    a.next()?,
+                    b.next()?,
+                    c.next()?,
+                    d.next()?,
+                    e.next()?,
+                    f.next()?,
+                    g.next()?,
+                    h.next()?,
+                    i.next()?,
+                );
+                Some(Columns::of(*first, next))
+            })
+            .collect();
+        let results: Vec<ChunkResult> = columns
+            .into_par_iter()
+            .zip(elements.par_chunks(CHUNK))
+            .map(|(mut columns, list)| {
+                let list = list.iter().map(|e| *e as usize);
+                step_chunk(&reads, &mut columns, list, motion, dt, false)
+            })
+            .collect();
+        fold_chunks(results, &self.layout, None)
     }
 
     fn state_of(&self, e: usize) -> PointsState {
@@ -523,19 +527,6 @@ impl Full {
     fn parameters(&self, e: usize) -> &super::BodyParameters {
         &self.layout.bodies[self.layout.body[e] as usize]
     }
-
-    /// Writes the state of element `e`.
-    fn store(&mut self, e: usize, state: &PointsState) {
-        for q in 0..4 {
-            self.stress[16 * e + 4 * q..16 * e + 4 * q + 4].copy_from_slice(&state.stress[q]);
-            self.back_stress[16 * e + 4 * q..16 * e + 4 * q + 4]
-                .copy_from_slice(&state.back_stress[q]);
-        }
-        self.eq_plastic_strain[4 * e..4 * e + 4].copy_from_slice(&state.eq_plastic_strain);
-        self.temperature[4 * e..4 * e + 4].copy_from_slice(&state.temperature);
-        self.thickness[4 * e..4 * e + 4].copy_from_slice(&state.thickness);
-        self.viscous_pressure[4 * e..4 * e + 4].copy_from_slice(&state.viscous_pressure);
-    }
 }
 
 impl PartialKernel for Full {
@@ -561,24 +552,7 @@ impl PartialKernel for Full {
         dt: f64,
         omega_squared: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
-        let step = |this: &Full, e: usize| {
-            let (xe, ue) = element_motion(this.layout.nodes[e], x, du);
-            let step = (dt, this.viscosity.as_ref());
-            let (p, committed) = (this.parameters(e), this.state_of(e));
-            element_step(p, (&xe, &ue), &committed, &this.lumped_of(e), step)
-        };
-        let commit = |this: &mut Full, e: usize, r: &ElementStep, sums: &mut StepWork| {
-            omega_squared[e] = r.omega_squared;
-            this.damping[e] = r.damping;
-            sums.observe(r.omega_squared, e);
-            this.store(e, &r.state);
-            this.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
-            sums.internal += r.work;
-            sums.plastic += r.plastic_work;
-            sums.viscous += r.viscous_work;
-        };
-        let mut total = subset_steps(self, elements, step, commit)
-            .map_err(|(e, err)| self.layout.failure(e, err))?;
+        let mut total = self.step_subset(elements, (x, du), dt, omega_squared)?;
         if let Some(mut tight) = self.tightness.take() {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
@@ -593,6 +567,141 @@ impl PartialKernel for Full {
     fn gather_nodes(&self, nodes: &[u32], force: &mut [f64]) {
         self.gather.gather_nodes(nodes, &self.element_forces, force);
     }
+}
+
+/// What an element loop of the kernel reads besides the element arrays.
+struct Reads<'a> {
+    layout: &'a Layout,
+    lumped: &'a [[f64; 4]],
+    scaling: Option<&'a ElementScaling>,
+    viscosity: Option<&'a BulkViscosity>,
+}
+
+/// The element arrays of one chunk of an element loop: element `first + i` at entry i.
+struct Columns<'a> {
+    first: usize,
+    stress: &'a mut [f64],
+    back: &'a mut [f64],
+    eps_p: &'a mut [f64],
+    temperature: &'a mut [f64],
+    thickness: &'a mut [f64],
+    viscous: &'a mut [f64],
+    forces: &'a mut [f64],
+    /// The frequency bounds the loop writes.
+    bounds: &'a mut [f64],
+    damping: &'a mut [f64],
+}
+
+/// The parts of a chunk's columns, in the order of `Columns`' fields after `first`.
+type Parts<'a> = (
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+);
+
+impl<'a> Columns<'a> {
+    fn of(first: usize, parts: Parts<'a>) -> Columns<'a> {
+        let (stress, back, eps_p, temperature, thickness, viscous, forces, bounds, damping) = parts;
+        Columns {
+            first,
+            stress,
+            back,
+            eps_p,
+            temperature,
+            thickness,
+            viscous,
+            forces,
+            bounds,
+            damping,
+        }
+    }
+
+    /// Element e's committed state.
+    #[inline(always)]
+    fn state(&self, e: usize) -> PointsState {
+        let i = e - self.first;
+        PointsState {
+            stress: std::array::from_fn(|q| {
+                std::array::from_fn(|c| self.stress[16 * i + 4 * q + c])
+            }),
+            back_stress: std::array::from_fn(|q| {
+                std::array::from_fn(|c| self.back[16 * i + 4 * q + c])
+            }),
+            eq_plastic_strain: std::array::from_fn(|q| self.eps_p[4 * i + q]),
+            temperature: std::array::from_fn(|q| self.temperature[4 * i + q]),
+            thickness: std::array::from_fn(|q| self.thickness[4 * i + q]),
+            viscous_pressure: std::array::from_fn(|q| self.viscous[4 * i + q]),
+        }
+    }
+
+    /// Writes element e's step `r` with its frequency bound `omega_squared`.
+    #[inline(always)]
+    fn store(&mut self, e: usize, r: &ElementStep, omega_squared: f64) {
+        let i = e - self.first;
+        self.bounds[i] = omega_squared;
+        self.damping[i] = r.damping;
+        for q in 0..4 {
+            self.stress[16 * i + 4 * q..16 * i + 4 * q + 4].copy_from_slice(&r.state.stress[q]);
+            self.back[16 * i + 4 * q..16 * i + 4 * q + 4]
+                .copy_from_slice(&r.state.back_stress[q]);
+        }
+        self.eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
+        self.temperature[4 * i..4 * i + 4].copy_from_slice(&r.state.temperature);
+        self.thickness[4 * i..4 * i + 4].copy_from_slice(&r.state.thickness);
+        self.viscous[4 * i..4 * i + 4].copy_from_slice(&r.state.viscous_pressure);
+        self.forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
+    }
+}
+
+/// Steps the elements `elements` of the chunk `columns` from the positions and increments
+/// `(x, du)`: their sums in element order, the first that failed, and (with `grow`, under
+/// the mass scaling) the elements whose mass factor grew.
+#[inline(always)]
+fn step_chunk(
+    reads: &Reads,
+    columns: &mut Columns,
+    elements: impl Iterator<Item = usize>,
+    (x, du): (&[[f64; 2]], &[f64]),
+    dt: f64,
+    grow: bool,
+) -> ChunkResult {
+    let layout = reads.layout;
+    let mut sums = StepWork::default();
+    let mut grown = Vec::new();
+    for e in elements {
+        let (xe, ue) = element_motion(layout.nodes[e], x, du);
+        let p = &layout.bodies[layout.body[e] as usize];
+        let lumped = scaled(&reads.lumped[e], reads.scaling.map(|s| s.factor(e)));
+        let committed = columns.state(e);
+        let step = (dt, reads.viscosity);
+        let r = match element_step(p, (&xe, &ue), &committed, &lumped, step) {
+            Ok(r) => r,
+            Err(err) => return (sums, Some((e, err)), grown),
+        };
+        let rescaled = reads
+            .scaling
+            .filter(|_| grow)
+            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared));
+        let omega_squared = match rescaled {
+            Some(rescaled) => {
+                grown.push((e, rescaled.factor));
+                rescaled.omega_squared
+            }
+            None => r.omega_squared,
+        };
+        sums.observe(omega_squared, e);
+        columns.store(e, &r, omega_squared);
+        sums.internal += r.work;
+        sums.plastic += r.plastic_work;
+        sums.viscous += r.viscous_work;
+    }
+    (sums, None, grown)
 }
 
 impl ExplicitKernel for Full {

@@ -318,52 +318,27 @@ pub(super) fn element_motion(nodes: [u32; 4], x: &[[f64; 2]], du: &[f64]) -> (No
     )
 }
 
-/// The steps of a subcycling level's elements `elements` (ascending) in chunks of `CHUNK`
-/// entries, the chunk sums added in chunk order, so the bits do not depend on the thread
-/// count (and a list of all elements is chunked as the single-step loop chunks them). With
-/// several chunks and threads, `step(e)` runs in parallel without writing, then `commit`
-/// writes the results back in list order; else each element is stepped and committed in
-/// turn. `commit(e, result, sums)` writes element e's step and takes it into its chunk's sums.
-#[inline(always)]
-pub(super) fn subset_steps<K: Sync, R: Send>(
-    kernel: &mut K,
-    elements: &[u32],
-    step: impl Fn(&K, usize) -> Result<R, KernelError> + Sync,
-    mut commit: impl FnMut(&mut K, usize, &R, &mut StepWork),
-) -> Result<StepWork, (usize, KernelError)> {
-    let mut total = StepWork::default();
-    if elements.len() > CHUNK && rayon::current_num_threads() > 1 {
-        let this = &*kernel;
-        let chunks: Vec<Result<Vec<R>, (usize, KernelError)>> = elements
-            .par_chunks(CHUNK)
-            .map(|list| {
-                // sized once: collecting through the Result has no size hint, and the growing
-                // vector's copies of the element results took 8 % of a subcycled run
-                let mut results = Vec::with_capacity(list.len());
-                for &e in list {
-                    results.push(step(this, e as usize).map_err(|err| (e as usize, err))?);
-                }
-                Ok(results)
-            })
-            .collect();
-        for (list, results) in elements.chunks(CHUNK).zip(chunks) {
-            let mut sums = StepWork::default();
-            for (&e, r) in list.iter().zip(results?) {
-                commit(kernel, e as usize, &r, &mut sums);
-            }
-            total.add(&sums);
-        }
-    } else {
-        for list in elements.chunks(CHUNK) {
-            let mut sums = StepWork::default();
-            for &e in list {
-                let r = step(kernel, e as usize).map_err(|err| (e as usize, err))?;
-                commit(kernel, e as usize, &r, &mut sums);
-            }
-            total.add(&sums);
-        }
+/// `data` (`width` values per element) cut at the elements `starts` (ascending): part c
+/// holds elements starts[c] .. starts[c + 1], the last part those from the last start on
+/// (the elements before the first start are in no part). What lets a loop over a list of
+/// elements write each chunk's elements in parallel.
+pub(super) fn cut<'a>(
+    data: &'a mut [f64],
+    width: usize,
+    starts: &[usize],
+) -> std::vec::IntoIter<&'a mut [f64]> {
+    let mut parts = Vec::with_capacity(starts.len());
+    let Some(&first) = starts.first() else {
+        return parts.into_iter();
+    };
+    let (_, mut rest) = data.split_at_mut(width * first);
+    for pair in starts.windows(2) {
+        let (part, tail) = std::mem::take(&mut rest).split_at_mut(width * (pair[1] - pair[0]));
+        parts.push(part);
+        rest = tail;
     }
-    Ok(total)
+    parts.push(rest);
+    parts.into_iter()
 }
 
 /// An explicit element loop over a model's Quad4 bodies.

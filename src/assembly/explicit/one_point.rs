@@ -25,7 +25,7 @@ use super::tight::{
 use super::{
     BodyParameters, CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel,
     StepWork, element_motion, element_scaling, fold_chunks, kernel_stable_step, point_statistic,
-    point_step, subset_steps,
+    cut, point_step,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -422,17 +422,6 @@ impl Reduced {
         }
     }
 
-    /// Writes the state of element `e`.
-    fn store(&mut self, e: usize, state: &ElementState) {
-        self.stress[4 * e..4 * e + 4].copy_from_slice(&state.stress);
-        self.back_stress[4 * e..4 * e + 4].copy_from_slice(&state.back_stress);
-        self.eq_plastic_strain[e] = state.eq_plastic_strain;
-        self.temperature[e] = state.temperature;
-        self.thickness[e] = state.thickness;
-        self.hourglass[2 * e..2 * e + 2].copy_from_slice(&state.hourglass);
-        self.viscous_pressure[e] = state.viscous_pressure;
-    }
-
     /// The element loop of a step: the elements' new states, forces and frequency bounds
     /// (`bounds`), the sums with the largest bound.
     fn step_bounds(
@@ -441,10 +430,13 @@ impl Reduced {
         du: &[f64],
         dt: f64,
     ) -> Result<StepWork, ElementFailure> {
-        let layout = &self.layout;
-        let mass = &self.mass;
-        let viscosity = self.viscosity.as_ref();
-        let scaling = self.scaling.as_ref();
+        let reads = Reads {
+            layout: &self.layout,
+            mass: &self.mass,
+            scaling: self.scaling.as_ref(),
+            viscosity: self.viscosity.as_ref(),
+        };
+        let count = self.eq_plastic_strain.len();
         let results: Vec<ChunkResult> = (
             self.stress.par_chunks_mut(4 * CHUNK),
             self.back_stress.par_chunks_mut(4 * CHUNK),
@@ -459,79 +451,75 @@ impl Reduced {
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, chunks)| {
-                let (
-                    stress,
-                    back,
-                    eps_p,
-                    temperature,
-                    thickness,
-                    hourglass,
-                    viscous,
-                    forces,
-                    bounds,
-                    damping,
-                ) = chunks;
-                let mut sums = StepWork::default();
-                let mut grown = Vec::new();
-                for i in 0..eps_p.len() {
-                    let e = k * CHUNK + i;
-                    let element = layout.nodes[e];
-                    let xe: Nodes = element.map(|n| x[n as usize]);
-                    let ue: Nodes = element.map(|n| [du[2 * n as usize], du[2 * n as usize + 1]]);
-                    let committed = ElementState {
-                        stress: std::array::from_fn(|c| stress[4 * i + c]),
-                        back_stress: std::array::from_fn(|c| back[4 * i + c]),
-                        eq_plastic_strain: eps_p[i],
-                        temperature: temperature[i],
-                        thickness: thickness[i],
-                        hourglass: [hourglass[2 * i], hourglass[2 * i + 1]],
-                        viscous_pressure: viscous[i],
-                    };
-                    let p = &layout.bodies[layout.body[e] as usize];
-                    let element_mass = match scaling {
-                        Some(scaling) => mass[e].scaled(scaling.factor(e)),
-                        None => mass[e],
-                    };
-                    let r = match element_step(
-                        p,
-                        (&xe, &ue),
-                        &committed,
-                        element_mass,
-                        (dt, viscosity),
-                    ) {
-                        Ok(r) => r,
-                        Err(err) => return (sums, Some((e, err)), grown),
-                    };
-                    let omega_squared = match scaling
-                        .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared))
-                    {
-                        Some(rescaled) => {
-                            grown.push((e, rescaled.factor));
-                            rescaled.omega_squared
-                        }
-                        None => r.omega_squared,
-                    };
-                    sums.observe(omega_squared, e);
-                    bounds[i] = omega_squared;
-                    damping[i] = r.damping;
-                    stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
-                    back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
-                    eps_p[i] = r.state.eq_plastic_strain;
-                    temperature[i] = r.state.temperature;
-                    thickness[i] = r.state.thickness;
-                    hourglass[2 * i..2 * i + 2].copy_from_slice(&r.state.hourglass);
-                    viscous[i] = r.state.viscous_pressure;
-                    forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
-                    sums.internal += r.work + r.hourglass_work;
-                    sums.plastic += r.plastic_work;
-                    sums.hourglass += r.hourglass_work;
-                    sums.viscous += r.viscous_work;
-                }
-                (sums, None, grown)
+            .map(|(k, parts)| {
+                let first = k * CHUNK;
+                let mut columns = Columns::of(first, parts);
+                let elements = first..(first + CHUNK).min(count);
+                step_chunk(&reads, &mut columns, elements, (x, du), dt, true)
             })
             .collect();
         fold_chunks(results, &self.layout, self.scaling.as_mut())
+    }
+
+    /// The steps of the elements `elements` (ascending, each once) in chunks of `CHUNK`
+    /// entries, in parallel, each chunk writing its elements' state, forces and frequency
+    /// bounds (into `omega_squared`) where they lie: the arrays are cut at the chunks' first
+    /// elements. The chunk sums are added in chunk order, so a list of all elements is
+    /// summed as `step_bounds` sums them, and the bits do not depend on the thread count.
+    fn step_subset(
+        &mut self,
+        elements: &[u32],
+        motion: (&[[f64; 2]], &[f64]),
+        dt: f64,
+        omega_squared: &mut [f64],
+    ) -> Result<StepWork, ElementFailure> {
+        let reads = Reads {
+            layout: &self.layout,
+            mass: &self.mass,
+            scaling: self.scaling.as_ref(),
+            viscosity: self.viscosity.as_ref(),
+        };
+        let starts: Vec<usize> = elements.chunks(CHUNK).map(|c| c[0] as usize).collect();
+        let mut parts = (
+            cut(&mut self.stress, 4, &starts),
+            cut(&mut self.back_stress, 4, &starts),
+            cut(&mut self.eq_plastic_strain, 1, &starts),
+            cut(&mut self.temperature, 1, &starts),
+            cut(&mut self.thickness, 1, &starts),
+            cut(&mut self.hourglass, 2, &starts),
+            cut(&mut self.viscous_pressure, 1, &starts),
+            cut(&mut self.element_forces, 8, &starts),
+            cut(omega_squared, 1, &starts),
+            cut(&mut self.damping, 1, &starts),
+        );
+        let columns: Vec<Columns> = starts
+            .iter()
+            .map_while(|first| {
+                let (a, b, c, d, e, f, g, h, i, j) = &mut parts;
+                let next = (
+                    a.next()?,
+                    b.next()?,
+                    c.next()?,
+                    d.next()?,
+                    e.next()?,
+                    f.next()?,
+                    g.next()?,
+                    h.next()?,
+                    i.next()?,
+                    j.next()?,
+                );
+                Some(Columns::of(*first, next))
+            })
+            .collect();
+        let results: Vec<ChunkResult> = columns
+            .into_par_iter()
+            .zip(elements.par_chunks(CHUNK))
+            .map(|(mut columns, list)| {
+                let list = list.iter().map(|e| *e as usize);
+                step_chunk(&reads, &mut columns, list, motion, dt, false)
+            })
+            .collect();
+        fold_chunks(results, &self.layout, None)
     }
 
     fn state_of(&self, e: usize) -> ElementState {
@@ -545,6 +533,143 @@ impl Reduced {
             viscous_pressure: self.viscous_pressure[e],
         }
     }
+}
+
+/// What an element loop of the kernel reads besides the element arrays.
+struct Reads<'a> {
+    layout: &'a Layout,
+    mass: &'a [ElementMass],
+    scaling: Option<&'a ElementScaling>,
+    viscosity: Option<&'a BulkViscosity>,
+}
+
+/// The element arrays of one chunk of an element loop: element `first + i` at entry i.
+struct Columns<'a> {
+    first: usize,
+    stress: &'a mut [f64],
+    back: &'a mut [f64],
+    eps_p: &'a mut [f64],
+    temperature: &'a mut [f64],
+    thickness: &'a mut [f64],
+    hourglass: &'a mut [f64],
+    viscous: &'a mut [f64],
+    forces: &'a mut [f64],
+    /// The frequency bounds the loop writes.
+    bounds: &'a mut [f64],
+    damping: &'a mut [f64],
+}
+
+/// The parts of a chunk's columns, in the order of `Columns`' fields after `first`.
+type Parts<'a> = (
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+);
+
+impl<'a> Columns<'a> {
+    fn of(first: usize, parts: Parts<'a>) -> Columns<'a> {
+        let (stress, back, eps_p, temperature, thickness, hourglass, viscous, forces, bounds, damping) =
+            parts;
+        Columns {
+            first,
+            stress,
+            back,
+            eps_p,
+            temperature,
+            thickness,
+            hourglass,
+            viscous,
+            forces,
+            bounds,
+            damping,
+        }
+    }
+
+    /// Element e's committed state.
+    #[inline(always)]
+    fn state(&self, e: usize) -> ElementState {
+        let i = e - self.first;
+        ElementState {
+            stress: std::array::from_fn(|c| self.stress[4 * i + c]),
+            back_stress: std::array::from_fn(|c| self.back[4 * i + c]),
+            eq_plastic_strain: self.eps_p[i],
+            temperature: self.temperature[i],
+            thickness: self.thickness[i],
+            hourglass: [self.hourglass[2 * i], self.hourglass[2 * i + 1]],
+            viscous_pressure: self.viscous[i],
+        }
+    }
+
+    /// Writes element e's step `r` with its frequency bound `omega_squared`.
+    #[inline(always)]
+    fn store(&mut self, e: usize, r: &ElementStep, omega_squared: f64) {
+        let i = e - self.first;
+        self.bounds[i] = omega_squared;
+        self.damping[i] = r.damping;
+        self.stress[4 * i..4 * i + 4].copy_from_slice(&r.state.stress);
+        self.back[4 * i..4 * i + 4].copy_from_slice(&r.state.back_stress);
+        self.eps_p[i] = r.state.eq_plastic_strain;
+        self.temperature[i] = r.state.temperature;
+        self.thickness[i] = r.state.thickness;
+        self.hourglass[2 * i..2 * i + 2].copy_from_slice(&r.state.hourglass);
+        self.viscous[i] = r.state.viscous_pressure;
+        self.forces[8 * i..8 * i + 8].copy_from_slice(&r.force);
+    }
+}
+
+/// Steps the elements `elements` of the chunk `columns` from the positions and increments
+/// `(x, du)`: their sums in element order, the first that failed, and (with `grow`, under
+/// the mass scaling) the elements whose mass factor grew.
+#[inline(always)]
+fn step_chunk(
+    reads: &Reads,
+    columns: &mut Columns,
+    elements: impl Iterator<Item = usize>,
+    (x, du): (&[[f64; 2]], &[f64]),
+    dt: f64,
+    grow: bool,
+) -> ChunkResult {
+    let layout = reads.layout;
+    let mut sums = StepWork::default();
+    let mut grown = Vec::new();
+    for e in elements {
+        let (xe, ue) = element_motion(layout.nodes[e], x, du);
+        let p = &layout.bodies[layout.body[e] as usize];
+        let mass = match reads.scaling {
+            Some(scaling) => reads.mass[e].scaled(scaling.factor(e)),
+            None => reads.mass[e],
+        };
+        let committed = columns.state(e);
+        let r = match element_step(p, (&xe, &ue), &committed, mass, (dt, reads.viscosity)) {
+            Ok(r) => r,
+            Err(err) => return (sums, Some((e, err)), grown),
+        };
+        let rescaled = reads
+            .scaling
+            .filter(|_| grow)
+            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared));
+        let omega_squared = match rescaled {
+            Some(rescaled) => {
+                grown.push((e, rescaled.factor));
+                rescaled.omega_squared
+            }
+            None => r.omega_squared,
+        };
+        sums.observe(omega_squared, e);
+        columns.store(e, &r, omega_squared);
+        sums.internal += r.work + r.hourglass_work;
+        sums.plastic += r.plastic_work;
+        sums.hourglass += r.hourglass_work;
+        sums.viscous += r.viscous_work;
+    }
+    (sums, None, grown)
 }
 
 impl ExplicitKernel for Reduced {
@@ -728,25 +853,7 @@ impl PartialKernel for Reduced {
         dt: f64,
         omega_squared: &mut [f64],
     ) -> Result<StepWork, ElementFailure> {
-        let step = |this: &Reduced, e: usize| {
-            let (xe, ue) = element_motion(this.layout.nodes[e], x, du);
-            let p = &this.layout.bodies[this.layout.body[e] as usize];
-            let step = (dt, this.viscosity.as_ref());
-            element_step(p, (&xe, &ue), &this.state_of(e), this.mass_of(e), step)
-        };
-        let commit = |this: &mut Reduced, e: usize, r: &ElementStep, sums: &mut StepWork| {
-            omega_squared[e] = r.omega_squared;
-            this.damping[e] = r.damping;
-            sums.observe(r.omega_squared, e);
-            this.store(e, &r.state);
-            this.element_forces[8 * e..8 * e + 8].copy_from_slice(&r.force);
-            sums.internal += r.work + r.hourglass_work;
-            sums.plastic += r.plastic_work;
-            sums.hourglass += r.hourglass_work;
-            sums.viscous += r.viscous_work;
-        };
-        let mut total = subset_steps(self, elements, step, commit)
-            .map_err(|(e, err)| self.layout.failure(e, err))?;
+        let mut total = self.step_subset(elements, (x, du), dt, omega_squared)?;
         if let Some(mut tight) = self.tightness.take() {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
