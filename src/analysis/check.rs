@@ -16,7 +16,7 @@
 //! ```
 
 use super::steppers::explicit::Start;
-use super::steppers::stable::{critical_time_step, implicit_first_step, wave_speed};
+use super::steppers::stable::{critical_time_step, implicit_first_step, initial_limit, wave_speed};
 use crate::output::readable;
 use crate::scene::DynamicAnalysis;
 use crate::scene::spec::{IntegratorKind, MassKind};
@@ -83,7 +83,8 @@ fn step_count(model: &Model, spec: &DynamicAnalysis, dt: f64) -> String {
 pub fn step_stability(model: &Model, spec: &DynamicAnalysis) -> Result<StepStability, InputError> {
     let has_mass = model.bodies.iter().all(|b| b.material.density > 0.0);
     if spec.integrator == IntegratorKind::CentralDifference {
-        return Start::new(model, spec).map(|start| explicit_stability(&start));
+        let start = Start::new(model, spec)?;
+        return explicit_stability(model, spec, &start);
     }
     let dt = implicit_first_step(model, spec)?;
     let newmark = matches!(
@@ -120,11 +121,20 @@ pub fn step_stability(model: &Model, spec: &DynamicAnalysis) -> Result<StepStabi
 
 /// The element-eigenvalue limit of a central-difference run and the step it will take (the
 /// automatic step scales the explicit kernel's conservative bound, below the limit).
-fn explicit_stability(start: &Start) -> StepStability {
-    StepStability::Conditional {
+fn explicit_stability(
+    model: &Model,
+    spec: &DynamicAnalysis,
+    start: &Start,
+) -> Result<StepStability, InputError> {
+    // the automatic step's run does not find the limit; the check does
+    let dt_crit = match start.dt_crit {
+        Some(dt_crit) => dt_crit,
+        None => initial_limit(model, spec)?.dt,
+    };
+    Ok(StepStability::Conditional {
         dt: Some(start.first_step()),
-        dt_crit: start.dt_crit,
-    }
+        dt_crit,
+    })
 }
 
 /// The lines `impact check` prints after the model's size.
@@ -171,7 +181,7 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
             _ => None,
         };
         let stability = match &start {
-            Some(start) => explicit_stability(start),
+            Some(start) => explicit_stability(model, spec, start)?,
             None => step_stability(model, spec)?,
         };
         let dt = match stability {

@@ -42,13 +42,20 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
     out.extend(unit_warnings(model));
     out.extend(slave_surface_warnings(model));
     out.extend(axis_warnings(model));
-    out.extend(frames_warning(model));
+    // the automatic step of the initial mesh, found once (a run's whole explicit set-up)
+    let auto_step = match &model.analysis {
+        Analysis::Dynamic(d) if matches!(d.step, TimeStep::Auto { .. }) => {
+            explicit_first_step(model, d)
+        }
+        _ => None,
+    };
+    out.extend(frames_warning(model, auto_step));
     let Analysis::Dynamic(d) = &model.analysis else {
         return out;
     };
     let step = match d.step {
         TimeStep::Fixed(dt) => Some((dt, "analysis.dt".to_string())),
-        TimeStep::Auto { scale, .. } => explicit_first_step(model, d).map(|dt| {
+        TimeStep::Auto { scale, .. } => auto_step.map(|dt| {
             (
                 dt,
                 format!(
@@ -249,16 +256,14 @@ pub const FRAME_BYTES_PER_NODE: f64 = 400.0;
 /// The frames a run of `model` writes, estimated before it starts: the listed frame times
 /// (`frame_times` and the multiples of `frame_interval`), the first, and one every
 /// `frame_every` steps of the nominal step (the fixed step, or the automatic step of the
-/// initial mesh; the steps of a static analysis).
-pub fn expected_frames(model: &Model) -> f64 {
+/// initial mesh, `auto_step`, found by the caller; the steps of a static analysis).
+pub fn expected_frames(model: &Model, auto_step: Option<f64>) -> f64 {
     let output = &model.output;
     let steps = match &model.analysis {
         Analysis::Static(s) => s.steps as f64,
         Analysis::Dynamic(d) => match d.step {
             TimeStep::Fixed(dt) => d.end_time / dt,
-            TimeStep::Auto { .. } => explicit_first_step(model, d)
-                .map(|dt| d.end_time / dt)
-                .unwrap_or(0.0),
+            TimeStep::Auto { .. } => auto_step.map(|dt| d.end_time / dt).unwrap_or(0.0),
             // the first step's count: the error control may lengthen them
             TimeStep::Adaptive(_) => implicit_first_step(model, d)
                 .map(|dt| d.end_time / dt)
@@ -274,8 +279,8 @@ pub fn expected_frames(model: &Model) -> f64 {
 }
 
 /// More than [`MANY_FRAMES`] frames, with the disk they will take.
-fn frames_warning(model: &Model) -> Option<String> {
-    let frames = expected_frames(model);
+fn frames_warning(model: &Model, auto_step: Option<f64>) -> Option<String> {
+    let frames = expected_frames(model, auto_step);
     if frames <= MANY_FRAMES {
         return None;
     }

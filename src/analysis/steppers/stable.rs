@@ -55,7 +55,7 @@ pub fn explicit_clock(
 /// into account), or the refusal of a fixed dt above it (unless the scene sets
 /// `allow_unstable` to watch it blow up): the one check `impact check` and a run share.
 pub fn checked_step(model: &Model, spec: &DynamicAnalysis) -> Result<StableStep, InputError> {
-    let limit = damped_at_rest(critical_time_step(model)?, spec);
+    let limit = initial_limit(model, spec)?;
     if let Some(dt) = spec.fixed_dt()
         && dt > limit.dt
         && !spec.allow_unstable
@@ -79,6 +79,12 @@ pub fn checked_step(model: &Model, spec: &DynamicAnalysis) -> Result<StableStep,
         ));
     }
     Ok(limit)
+}
+
+/// The stability limit of `model`'s initial configuration under `spec` (the element
+/// eigenvalues; the bulk viscosity's damping at rest taken into account).
+pub fn initial_limit(model: &Model, spec: &DynamicAnalysis) -> Result<StableStep, InputError> {
+    Ok(damped_at_rest(critical_time_step(model)?, spec))
 }
 
 /// The stability limit `limit` shortened by the damping of `spec`'s bulk viscosity at rest

@@ -56,7 +56,9 @@ pub struct Explicit<'a> {
     /// corrections never move them).
     mass: Vec<f64>,
     inverse_mass: Vec<f64>,
-    dt_crit: f64,
+    /// The stability limit of the initial configuration (None: not found, the automatic
+    /// step; `initial_limit` finds it when an instability names it).
+    dt_crit: Option<f64>,
     /// The one-point kernel keeps its element state in its own arrays (copied into `state`
     /// only when output reads stresses).
     kernel: Box<dyn ExplicitKernel + 'a>,
@@ -90,6 +92,14 @@ pub struct Explicit<'a> {
 }
 
 impl<'a> Explicit<'a> {
+    /// The stability limit of the initial configuration: the one a fixed step was checked
+    /// against, or (the automatic step) found now (NaN where an element cannot give it).
+    fn initial_limit(&self) -> f64 {
+        self.dt_crit.unwrap_or_else(|| {
+            super::stable::initial_limit(self.model, self.spec).map_or(f64::NAN, |s| s.dt)
+        })
+    }
+
     /// Refuses a fixed dt above the stability limit of the initial configuration (the
     /// element eigenvalues), unless the scene asks to watch it blow up.
     pub fn new(model: &'a Model, spec: &'a DynamicAnalysis) -> Result<Explicit<'a>, RunError> {
@@ -406,7 +416,7 @@ impl Stepper for Explicit<'_> {
                     readable(self.energy_reference),
                     readable(self.state.time),
                     readable(self.clock.last),
-                    readable(self.dt_crit)
+                    readable(self.initial_limit())
                 ),
                 frame: true,
             });
