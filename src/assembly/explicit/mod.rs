@@ -589,3 +589,28 @@ pub fn kernel_for<'a>(
         ),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::cut;
+
+    /// The parts of `cut` hold the elements from each start to the next (the last to the
+    /// end), `width` values each, and none before the first start: checked against the
+    /// element number written into each value.
+    #[test]
+    fn cut_parts_hold_their_elements() {
+        let width = 3;
+        let mut data: Vec<f64> = (0..10 * width).map(|k| (k / width) as f64).collect();
+        let parts: Vec<&mut [f64]> = cut(&mut data, width, &[2, 3, 7]).collect();
+        let elements: Vec<Vec<f64>> = parts
+            .iter()
+            .map(|p| p.iter().step_by(width).copied().collect())
+            .collect();
+        assert_eq!(
+            elements,
+            vec![vec![2.0], vec![3.0, 4.0, 5.0, 6.0], vec![7.0, 8.0, 9.0]]
+        );
+        assert!(parts.iter().all(|p| p.len() % width == 0));
+        assert_eq!(cut(&mut data, width, &[]).count(), 0);
+    }
+}
