@@ -29,8 +29,8 @@ use super::tight::{
     ElementStiffness, Tightness, end_nodes, shortest_edge, stiffness_by_differences,
 };
 use super::{
-    CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork,
-    cut, element_motion, element_scaling, fold_chunks, kernel_stable_step, point_statistic,
+    CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel, StepWork, cut,
+    element_motion, element_scaling, fold_chunks, kept_bound, kernel_stable_step, point_statistic,
     point_step,
 };
 use crate::assembly::mass_scaling::ElementScaling;
@@ -648,8 +648,7 @@ impl<'a> Columns<'a> {
         self.damping[i] = r.damping;
         for q in 0..4 {
             self.stress[16 * i + 4 * q..16 * i + 4 * q + 4].copy_from_slice(&r.state.stress[q]);
-            self.back[16 * i + 4 * q..16 * i + 4 * q + 4]
-                .copy_from_slice(&r.state.back_stress[q]);
+            self.back[16 * i + 4 * q..16 * i + 4 * q + 4].copy_from_slice(&r.state.back_stress[q]);
         }
         self.eps_p[4 * i..4 * i + 4].copy_from_slice(&r.state.eq_plastic_strain);
         self.temperature[4 * i..4 * i + 4].copy_from_slice(&r.state.temperature);
@@ -684,17 +683,8 @@ fn step_chunk(
             Ok(r) => r,
             Err(err) => return (sums, Some((e, err)), grown),
         };
-        let rescaled = reads
-            .scaling
-            .filter(|_| grow)
-            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared));
-        let omega_squared = match rescaled {
-            Some(rescaled) => {
-                grown.push((e, rescaled.factor));
-                rescaled.omega_squared
-            }
-            None => r.omega_squared,
-        };
+        let scaling = reads.scaling.filter(|_| grow);
+        let omega_squared = kept_bound(scaling, e, r.omega_squared, &mut grown);
         sums.observe(omega_squared, e);
         columns.store(e, &r, omega_squared);
         sums.internal += r.work;

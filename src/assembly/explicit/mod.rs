@@ -318,6 +318,25 @@ pub(super) fn element_motion(nodes: [u32; 4], x: &[[f64; 2]], du: &[f64]) -> (No
     )
 }
 
+/// Element e's frequency bound `omega_squared` as an element loop keeps it: under the mass
+/// scaling `scaling` (None: off, or not grown in this loop) the bound of its grown mass
+/// factor where the target asks (the element and its factor noted in `grown`).
+#[inline(always)]
+pub(super) fn kept_bound(
+    scaling: Option<&ElementScaling>,
+    e: usize,
+    omega_squared: f64,
+    grown: &mut Vec<(usize, f64)>,
+) -> f64 {
+    match scaling.and_then(|s| s.rule().rescale(s.factor(e), omega_squared)) {
+        Some(rescaled) => {
+            grown.push((e, rescaled.factor));
+            rescaled.omega_squared
+        }
+        None => omega_squared,
+    }
+}
+
 /// `data` (`width` values per element) cut at the elements `starts` (ascending): part c
 /// holds elements starts[c] .. starts[c + 1], the last part those from the last start on
 /// (the elements before the first start are in no part). What lets a loop over a list of

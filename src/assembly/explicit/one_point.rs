@@ -24,8 +24,8 @@ use super::tight::{
 };
 use super::{
     BodyParameters, CHUNK, ChunkResult, ExplicitKernel, Layout, NodeGather, PartialKernel,
-    StepWork, element_motion, element_scaling, fold_chunks, kernel_stable_step, point_statistic,
-    cut, point_step,
+    StepWork, cut, element_motion, element_scaling, fold_chunks, kept_bound, kernel_stable_step,
+    point_statistic, point_step,
 };
 use crate::assembly::mass_scaling::ElementScaling;
 use crate::assembly::{ElementFailure, ElementMasses, StableStep, State};
@@ -575,8 +575,18 @@ type Parts<'a> = (
 
 impl<'a> Columns<'a> {
     fn of(first: usize, parts: Parts<'a>) -> Columns<'a> {
-        let (stress, back, eps_p, temperature, thickness, hourglass, viscous, forces, bounds, damping) =
-            parts;
+        let (
+            stress,
+            back,
+            eps_p,
+            temperature,
+            thickness,
+            hourglass,
+            viscous,
+            forces,
+            bounds,
+            damping,
+        ) = parts;
         Columns {
             first,
             stress,
@@ -651,17 +661,8 @@ fn step_chunk(
             Ok(r) => r,
             Err(err) => return (sums, Some((e, err)), grown),
         };
-        let rescaled = reads
-            .scaling
-            .filter(|_| grow)
-            .and_then(|s| s.rule().rescale(s.factor(e), r.omega_squared));
-        let omega_squared = match rescaled {
-            Some(rescaled) => {
-                grown.push((e, rescaled.factor));
-                rescaled.omega_squared
-            }
-            None => r.omega_squared,
-        };
+        let scaling = reads.scaling.filter(|_| grow);
+        let omega_squared = kept_bound(scaling, e, r.omega_squared, &mut grown);
         sums.observe(omega_squared, e);
         columns.store(e, &r, omega_squared);
         sums.internal += r.work + r.hourglass_work;
