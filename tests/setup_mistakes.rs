@@ -335,7 +335,7 @@ fn kinetic_energy_gain_warns_above_one_per_cent() {
             kinetic,
             ..Energies::default()
         };
-        plausibility::warnings(&model, &summary, &energies)
+        plausibility::warnings(&model, &summary, &energies, None)
     };
     assert!(at(1.01 * (1.0 - 1e-3)).is_empty());
     let above = at(1.01 * (1.0 + 1e-3));
@@ -355,9 +355,9 @@ fn coarse_contact_warns_at_three_closed_nodes() {
     let (model, mut summary) = sphere_summary();
     let energies = Energies::default();
     summary.contact.closed_at_widest = vec![4];
-    assert!(plausibility::warnings(&model, &summary, &energies).is_empty());
+    assert!(plausibility::warnings(&model, &summary, &energies, None).is_empty());
     summary.contact.closed_at_widest = vec![3];
-    let warned = plausibility::warnings(&model, &summary, &energies);
+    let warned = plausibility::warnings(&model, &summary, &energies, None);
     assert_eq!(warned.len(), 1, "{warned:?}");
     assert!(
         warned[0].contains("resolved by 2 segment(s)"),

@@ -201,9 +201,15 @@ fn mass_scaling_warnings(model: &Model, report: &MassScalingReport) -> Vec<Strin
 /// docs/performance.md) eats a saving below a tenth.
 const SUBCYCLING_GAIN: f64 = 0.9;
 
-/// The warnings of a run that ended with `summary` and the last `energies`.
-pub fn warnings(model: &Model, summary: &Summary, energies: &Energies) -> Vec<String> {
-    let mut out = setup_warnings(model);
+/// The warnings of a run that ended with `summary` and the last `energies`; `first_step` is
+/// the step the run started with where it reports it (the set-up warnings find it otherwise).
+pub fn warnings(
+    model: &Model,
+    summary: &Summary,
+    energies: &Energies,
+    first_step: Option<f64>,
+) -> Vec<String> {
+    let mut out = setup::setup_warnings_given(model, first_step);
     if summary.step_cuts > 0 {
         out.push(format!(
             "{} step cut(s): Newton did not converge in the nominal step there; a smaller \

@@ -24,6 +24,12 @@ pub const MIN_STEPS: f64 = 10.0;
 /// a run repeats them in summary.json. A dynamic run of fewer than [`MIN_STEPS`] steps, and
 /// one shorter than a wave transit of its smallest body, each with the likely unit mistake.
 pub fn setup_warnings(model: &Model) -> Vec<String> {
+    setup_warnings_given(model, None)
+}
+
+/// [`setup_warnings`] with the run's first step `first_step` where the run reports it (the
+/// automatic step of the initial mesh is then not found again: a whole explicit set-up).
+pub(super) fn setup_warnings_given(model: &Model, first_step: Option<f64>) -> Vec<String> {
     let mut out = Vec::new();
     for obstacle in &model.obstacles {
         let used = model
@@ -45,7 +51,7 @@ pub fn setup_warnings(model: &Model) -> Vec<String> {
     // the automatic step of the initial mesh, found once (a run's whole explicit set-up)
     let auto_step = match &model.analysis {
         Analysis::Dynamic(d) if matches!(d.step, TimeStep::Auto { .. }) => {
-            explicit_first_step(model, d)
+            first_step.or_else(|| explicit_first_step(model, d))
         }
         _ => None,
     };

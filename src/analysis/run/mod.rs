@@ -457,7 +457,8 @@ impl<'a, S: Stepper> Run<'a, S> {
             summary.dt_limit = Some(DtLimit::of(report.limit, self.model));
         }
         summary.max_temperature = record::max_temperature(self.model, s.state());
-        summary.warnings = plausibility::warnings(self.model, summary, energies);
+        let first_step = s.time_step_report().map(|report| report.first);
+        summary.warnings = plausibility::warnings(self.model, summary, energies, first_step);
         let positions = s.state().positions(self.model.analysis.geometry());
         let motion = s.motion();
         let end = plausibility::EndOfRun {

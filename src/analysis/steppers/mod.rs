@@ -133,6 +133,9 @@ pub struct TimeStepReport {
     pub longest: f64,
     /// The stable step of the last configuration.
     pub limit: StableStep,
+    /// The step the rule started with (the fixed dt, or the automatic step of the initial
+    /// mesh): what the set-up warnings count the run's steps by.
+    pub first: f64,
 }
 
 /// The scene's initial velocity, with the constrained DOFs (`free` false) moving as their

@@ -502,6 +502,7 @@ impl Report for Explicit<'_> {
             shortest: range.shortest,
             longest: range.longest,
             limit: c.limit,
+            first: c.dt0,
         })
     }
 }
