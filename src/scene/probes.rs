@@ -166,6 +166,7 @@ pub(super) fn probes(
             statistic: p.statistic,
             quantity: p.quantity,
             body: b,
+            consecutive: crate::scene::model::consecutive_run(&members),
             members,
             column,
         });

@@ -18,8 +18,10 @@ use crate::output::thinning::{Thinning, Window};
 use crate::output::vtk::{Fields, Grid, Polyline, Series};
 use crate::output::{OutputError, write_atomic};
 use crate::scene::Model;
-use crate::scene::model::{PointFold, Probe, in_parts};
+use crate::scene::model::{PointFold, Probe, RUN_PART, in_parts};
 use crate::scene::spec::{FramePoints, Quantity, Statistic};
+use rayon::prelude::*;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 pub struct Recorder {
@@ -639,6 +641,39 @@ fn span(members: &[usize], x: impl Fn(usize) -> f64 + Sync) -> (f64, f64) {
         })
 }
 
+/// The smallest and the largest of initial + displacement in component `c` over the nodes
+/// `nodes` (consecutive; `initial` theirs): what `span` gives over their ids (min and max are
+/// exact), read from contiguous arrays, in parallel parts on several threads for a long run.
+fn span_of_run(
+    initial: &[[f64; 2]],
+    displacement: &[f64],
+    nodes: &Range<usize>,
+    c: usize,
+) -> (f64, f64) {
+    let u = &displacement[2 * nodes.start..2 * nodes.end];
+    let part = |(x, u): (&[[f64; 2]], &[f64])| {
+        x.iter()
+            .zip(u.chunks_exact(2))
+            .map(|(x, u)| x[c] + u[c])
+            .fold(EMPTY_SPAN, |(low, high), v| (low.min(v), high.max(v)))
+    };
+    let spans: Vec<(f64, f64)> = if initial.len() > RUN_PART && rayon::current_num_threads() > 1 {
+        initial
+            .par_chunks(RUN_PART)
+            .zip(u.par_chunks(2 * RUN_PART))
+            .map(part)
+            .collect()
+    } else {
+        vec![part((initial, u))]
+    };
+    spans
+        .into_iter()
+        .fold(EMPTY_SPAN, |(low, high), (l, h)| (low.min(l), high.max(h)))
+}
+
+/// The span of no value.
+const EMPTY_SPAN: (f64, f64) = (f64::INFINITY, f64::NEG_INFINITY);
+
 /// The smallest and the largest of `x` over `members`, in four independent lanes (the lanes
 /// let the comparisons of a long set overlap instead of waiting each on the last).
 fn span_lanes(members: &[usize], x: impl Fn(usize) -> f64) -> (f64, f64) {
@@ -738,9 +773,12 @@ fn probe_value(
         }
         Quantity::ExtentX | Quantity::ExtentY => {
             let c = (probe.quantity == Quantity::ExtentY) as usize;
-            let (low, high) = span(&probe.members, |m| {
-                initial[m][c] + state.displacement[2 * m + c]
-            });
+            let (low, high) = match &probe.consecutive {
+                Some(nodes) => span_of_run(&initial[nodes.clone()], &state.displacement, nodes, c),
+                None => span(&probe.members, |m| {
+                    initial[m][c] + state.displacement[2 * m + c]
+                }),
+            };
             if c == 0 && model.bodies[probe.body].is_axisymmetric() {
                 // the body of revolution spans -r_max .. r_max
                 2.0 * high
@@ -881,4 +919,32 @@ pub struct RecorderPosition {
     /// The contact record (with contact).
     #[serde(default)]
     pub contact: Option<ContactCarry>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_span_of_a_long_run_of_nodes_is_its_ends() {
+        // more nodes than two parts, on three threads, against the ends of the sorted
+        // positions, in each component, over the run of nodes 5..n
+        let n = 2 * RUN_PART + 400;
+        let initial: Vec<[f64; 2]> = (0..n)
+            .map(|k| [(k % 97) as f64, -((k % 89) as f64)])
+            .collect();
+        let displacement: Vec<f64> = (0..2 * n).map(|i| ((i * 31) % 53) as f64 * 0.01).collect();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        for c in 0..2 {
+            let mut x: Vec<f64> = (5..n)
+                .map(|m| initial[m][c] + displacement[2 * m + c])
+                .collect();
+            x.sort_by(f64::total_cmp);
+            let span = pool.install(|| span_of_run(&initial[5..], &displacement, &(5..n), c));
+            assert_eq!(span, (x[0], x[x.len() - 1]));
+        }
+    }
 }

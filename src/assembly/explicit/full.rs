@@ -764,13 +764,16 @@ impl ExplicitKernel for Full {
     }
 
     fn point_probe(&self, model: &Model, probe: &Probe) -> Option<f64> {
-        point_statistic(&self.layout, model, probe, 4, |e, q| PointState {
-            stress: Voigt::from(std::array::from_fn(|k| self.stress[16 * e + 4 * q + k])),
-            eq_plastic_strain: self.eq_plastic_strain[4 * e + q],
-            back_stress: Voigt::from(std::array::from_fn(|k| {
-                self.back_stress[16 * e + 4 * q + k]
-            })),
-            temperature: self.temperature[4 * e + q],
+        let scalars = [&self.eq_plastic_strain[..], &self.temperature[..]];
+        point_statistic(&self.layout, model, probe, (4, scalars), |e, q| {
+            PointState {
+                stress: Voigt::from(std::array::from_fn(|k| self.stress[16 * e + 4 * q + k])),
+                eq_plastic_strain: self.eq_plastic_strain[4 * e + q],
+                back_stress: Voigt::from(std::array::from_fn(|k| {
+                    self.back_stress[16 * e + 4 * q + k]
+                })),
+                temperature: self.temperature[4 * e + q],
+            }
         })
     }
 

@@ -29,8 +29,9 @@ use crate::element::quad4_one_point::Nodes;
 use crate::element::{KernelError, Voigt};
 use crate::material::{Material, PointState, PointStep, StressCondition, UpdateContext};
 use crate::scene::DynamicAnalysis;
-use crate::scene::model::{PointFold, Probe};
+use crate::scene::model::{PointFold, PointScalar, Probe, extreme_of_run};
 use crate::scene::spec::Quadrature;
+use crate::scene::spec::Statistic;
 use crate::scene::{Continuum, Model};
 use rayon::prelude::*;
 
@@ -469,6 +470,9 @@ pub(super) struct KernelPoints<'a, P> {
     pub points_per_element: usize,
     pub distinct: usize,
     pub point: P,
+    /// The kernel's arrays of the points' equivalent plastic strain and temperature
+    /// (`distinct` entries per element), which a probe of either reads directly.
+    pub scalars: [&'a [f64]; 2],
 }
 
 impl<P: Fn(usize, usize) -> PointState + Sync> PointFold for KernelPoints<'_, P> {
@@ -480,6 +484,7 @@ impl<P: Fn(usize, usize) -> PointState + Sync> PointFold for KernelPoints<'_, P>
             points_per_element,
             distinct,
             point,
+            ..
         } = self;
         let (point, value) = (&point, &value);
         probe.combine(|members| {
@@ -487,6 +492,30 @@ impl<P: Fn(usize, usize) -> PointState + Sync> PointFold for KernelPoints<'_, P>
                 let one = (distinct == 1).then(|| value(&point(first + e, 0)));
                 (0..points_per_element)
                     .map(move |q| one.unwrap_or_else(|| value(&point(first + e, q))))
+            })
+        })
+    }
+
+    /// The same values as `fold` of `scalar`, read from the kernel's array: a point's whole
+    /// state is not built for one number of it (a probe of the largest plastic strain was 3 %
+    /// of a Taylor rod's run on one thread). The largest or smallest of a one-point element's
+    /// points is its one value; a mean weighs each element by its points, as `fold` does.
+    fn fold_scalar(self, scalar: PointScalar) -> f64 {
+        let (probe, first, distinct) = (self.probe, self.first, self.distinct);
+        let values = self.scalars[scalar as usize];
+        if distinct == 1 && matches!(probe.statistic, Statistic::Max | Statistic::Min) {
+            // (min and max are exact: any order of the values gives the same bits)
+            if let Some(elements) = &probe.consecutive {
+                let run = &values[first + elements.start..first + elements.end];
+                return extreme_of_run(run, probe.statistic == Statistic::Max);
+            }
+            return probe.combine(|members| members.iter().map(move |&e| values[first + e]));
+        }
+        let points_per_element = self.points_per_element;
+        probe.combine(|members| {
+            members.iter().flat_map(move |&e| {
+                let element = &values[(first + e) * distinct..(first + e + 1) * distinct];
+                (0..points_per_element).map(move |q| element[if distinct == 1 { 0 } else { q }])
             })
         })
     }
@@ -498,7 +527,7 @@ pub(super) fn point_statistic<P: Fn(usize, usize) -> PointState + Sync>(
     layout: &Layout,
     model: &Model,
     probe: &Probe,
-    distinct: usize,
+    (distinct, scalars): (usize, [&[f64]; 2]),
     point: P,
 ) -> Option<f64> {
     let first = layout.first_of_body.get(probe.body).copied().flatten()?;
@@ -508,6 +537,7 @@ pub(super) fn point_statistic<P: Fn(usize, usize) -> PointState + Sync>(
         points_per_element: model.bodies[probe.body].points_per_element(),
         distinct,
         point,
+        scalars,
     })
 }
 

@@ -796,11 +796,14 @@ impl ExplicitKernel for Reduced {
     }
 
     fn point_probe(&self, model: &Model, probe: &Probe) -> Option<f64> {
-        point_statistic(&self.layout, model, probe, 1, |e, _| PointState {
-            stress: Voigt::from(std::array::from_fn(|k| self.stress[4 * e + k])),
-            eq_plastic_strain: self.eq_plastic_strain[e],
-            back_stress: Voigt::from(std::array::from_fn(|k| self.back_stress[4 * e + k])),
-            temperature: self.temperature[e],
+        let scalars = [&self.eq_plastic_strain[..], &self.temperature[..]];
+        point_statistic(&self.layout, model, probe, (1, scalars), |e, _| {
+            PointState {
+                stress: Voigt::from(std::array::from_fn(|k| self.stress[4 * e + k])),
+                eq_plastic_strain: self.eq_plastic_strain[e],
+                back_stress: Voigt::from(std::array::from_fn(|k| self.back_stress[4 * e + k])),
+                temperature: self.temperature[e],
+            }
         })
     }
 
