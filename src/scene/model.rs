@@ -240,8 +240,8 @@ pub struct Probe {
     /// Node ids (nodal quantities, global) or element ids of the body.
     pub members: Vec<usize>,
     pub column: String,
-    /// `members` as the range they are, when they are one (`consecutive_run`): an extent
-    /// then reads contiguous arrays.
+    /// `members` as the range they are, when they are one (`consecutive_run`): an extent, and
+    /// the max or min of a kernel's plastic strain or temperature, then read contiguous arrays.
     pub consecutive: Option<std::ops::Range<usize>>,
 }
 

@@ -636,9 +636,7 @@ fn reactions(model: &Model, state: &State, motion: &Motion) -> Vec<f64> {
 fn span(members: &[usize], x: impl Fn(usize) -> f64 + Sync) -> (f64, f64) {
     in_parts(members, |part| span_lanes(part, &x))
         .into_iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), (l, h)| {
-            (low.min(l), high.max(h))
-        })
+        .fold(EMPTY_SPAN, |(low, high), (l, h)| (low.min(l), high.max(h)))
 }
 
 /// The smallest and the largest of initial + displacement in component `c` over the nodes
