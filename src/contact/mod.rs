@@ -80,6 +80,40 @@ pub struct BodySurface {
     /// master node's penetration into this body is sought.
     pub boundary: Vec<[usize; 2]>,
     pub node_offset: usize,
+    /// The nodes that can meet another body (global ids, ascending): those with boundary
+    /// edges, every node of a rod (which has none). Kept from `BodySurface::new`: the
+    /// penetration check of every explicit step reads them, and a scan of every node's edge
+    /// list for them cost the aluminium rod 0.6 % of its run.
+    surface_nodes: Vec<usize>,
+}
+
+impl BodySurface {
+    /// A body's surface from its boundary edges at each node and once each (global ids).
+    pub fn new(
+        (section, impedance_per_area): (Section, f64),
+        boundary_at_node: Vec<Vec<[usize; 2]>>,
+        boundary: Vec<[usize; 2]>,
+        node_offset: usize,
+    ) -> BodySurface {
+        let rod = boundary.is_empty();
+        let surface_nodes = (boundary_at_node.iter().enumerate())
+            .filter(|(_, edges)| rod || !edges.is_empty())
+            .map(|(n, _)| node_offset + n)
+            .collect();
+        BodySurface {
+            section,
+            impedance_per_area,
+            boundary_at_node,
+            boundary,
+            node_offset,
+            surface_nodes,
+        }
+    }
+
+    /// The nodes that can meet another body (global ids, ascending).
+    pub fn surface_nodes(&self) -> &[usize] {
+        &self.surface_nodes
+    }
 }
 
 /// How a node's boundary edges share their area (`Interfaces::tributary_area`); the two
@@ -201,13 +235,12 @@ mod tests {
         let coords = [[0.0, 0.0], [1.0, 0.0], [3.0, 0.0]];
         let interfaces = Interfaces {
             pairs: Vec::new(),
-            bodies: vec![BodySurface {
-                section: Section::Axisymmetric,
-                impedance_per_area: 1.0,
-                boundary_at_node: vec![vec![[0, 1]], vec![[0, 1], [1, 2]], vec![[1, 2]]],
-                boundary: vec![[0, 1], [1, 2]],
-                node_offset: 0,
-            }],
+            bodies: vec![BodySurface::new(
+                (Section::Axisymmetric, 1.0),
+                vec![vec![[0, 1]], vec![[0, 1], [1, 2]], vec![[1, 2]]],
+                vec![[0, 1], [1, 2]],
+                0,
+            )],
         };
         let exact = [PI / 4.0, PI * (4.0 - 0.25), PI * (9.0 - 4.0)];
         for (node, area) in exact.iter().enumerate() {

@@ -84,7 +84,7 @@ pub fn deepest(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Optio
         }
     };
     for body in 0..interfaces.bodies.len() {
-        let nodes = || surface_nodes(interfaces, body);
+        let nodes = || interfaces.bodies[body].surface_nodes().iter().copied();
         for obstacle in &obstacles {
             let found = deepest_in_obstacle(nodes(), x, obstacle);
             consider(found, body, Intruded::Obstacle(obstacle.name.clone()));
@@ -97,18 +97,6 @@ pub fn deepest(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Optio
         }
     }
     best
-}
-
-/// The nodes of body `b` that can meet another (global ids): those with boundary edges
-/// (every node of a rod, which has none).
-fn surface_nodes(interfaces: &Interfaces, b: usize) -> impl Iterator<Item = usize> + '_ {
-    let body = &interfaces.bodies[b];
-    let rod = body.boundary.is_empty();
-    body.boundary_at_node
-        .iter()
-        .enumerate()
-        .filter(move |(_, edges)| rod || !edges.is_empty())
-        .map(move |(n, _)| body.node_offset + n)
 }
 
 /// The deepest of `nodes` inside the solid of `obstacle` (depth, node).
@@ -188,15 +176,10 @@ mod tests {
     fn square(offset: usize) -> BodySurface {
         let n = |k: usize| offset + k;
         let boundary = vec![[n(0), n(1)], [n(1), n(2)], [n(2), n(3)], [n(3), n(0)]];
-        BodySurface {
-            section: Section::Plane { thickness: 1.0 },
-            impedance_per_area: 1.0,
-            boundary_at_node: (0..4)
-                .map(|k| vec![boundary[(k + 3) % 4], boundary[k]])
-                .collect(),
-            boundary,
-            node_offset: offset,
-        }
+        let at_node = (0..4)
+            .map(|k| vec![boundary[(k + 3) % 4], boundary[k]])
+            .collect();
+        BodySurface::new((Section::Plane { thickness: 1.0 }, 1.0), at_node, boundary, offset)
     }
 
     /// Goal: a body through a wall is measured from every boundary node, not only the

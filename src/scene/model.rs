@@ -784,19 +784,17 @@ impl Model {
                         Formulation::Axisymmetric => Section::Axisymmetric,
                     },
                 };
-                BodySurface {
-                    section,
-                    impedance_per_area: (b.p_wave_modulus() * b.material.density).sqrt(),
-                    boundary_at_node: b
-                        .boundary_at_node
-                        .iter()
+                let impedance_per_area = (b.p_wave_modulus() * b.material.density).sqrt();
+                BodySurface::new(
+                    (section, impedance_per_area),
+                    (b.boundary_at_node.iter())
                         .map(|edges| edges.iter().map(|e| e.map(|n| b.global(n))).collect())
                         .collect(),
-                    boundary: (b.boundary.iter())
+                    (b.boundary.iter())
                         .map(|e| e.map(|n| b.global(n)))
                         .collect(),
-                    node_offset: b.node_offset,
-                }
+                    b.node_offset,
+                )
             })
             .collect();
         Interfaces {
