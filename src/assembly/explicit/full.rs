@@ -424,6 +424,7 @@ impl Full {
             self.damping.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
+            .with_max_len(1)
             .enumerate()
             .map(|(k, parts)| {
                 let first = k * CHUNK;
@@ -486,6 +487,7 @@ impl Full {
         let results: Vec<ChunkResult> = columns
             .into_par_iter()
             .zip(elements.par_chunks(CHUNK))
+            .with_max_len(1)
             .map(|(mut columns, list)| {
                 let list = list.iter().map(|e| *e as usize);
                 step_chunk(&reads, &mut columns, list, motion, dt, false)

@@ -450,6 +450,7 @@ impl Reduced {
             self.damping.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
+            .with_max_len(1)
             .enumerate()
             .map(|(k, parts)| {
                 let first = k * CHUNK;
@@ -514,6 +515,7 @@ impl Reduced {
         let results: Vec<ChunkResult> = columns
             .into_par_iter()
             .zip(elements.par_chunks(CHUNK))
+            .with_max_len(1)
             .map(|(mut columns, list)| {
                 let list = list.iter().map(|e| *e as usize);
                 step_chunk(&reads, &mut columns, list, motion, dt, false)
