@@ -179,7 +179,12 @@ mod tests {
         let at_node = (0..4)
             .map(|k| vec![boundary[(k + 3) % 4], boundary[k]])
             .collect();
-        BodySurface::new((Section::Plane { thickness: 1.0 }, 1.0), at_node, boundary, offset)
+        BodySurface::new(
+            (Section::Plane { thickness: 1.0 }, 1.0),
+            at_node,
+            boundary,
+            offset,
+        )
     }
 
     /// Goal: a body through a wall is measured from every boundary node, not only the
