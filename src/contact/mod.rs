@@ -82,9 +82,9 @@ pub struct BodySurface {
     pub node_offset: usize,
     /// The nodes that can meet another body (global ids, ascending): those with boundary
     /// edges, every node of a rod (which has none). Kept from `BodySurface::new`: the
-    /// penetration check of every explicit step reads them, and a scan of every node's edge
-    /// list for them cost the aluminium rod 0.6 % of its run.
-    surface_nodes: Vec<usize>,
+    /// penetration check of every explicit step reads them (it scanned every node's edge list
+    /// for them, 2541 nodes a step on the aluminium rod).
+    boundary_nodes: Vec<usize>,
 }
 
 impl BodySurface {
@@ -96,7 +96,7 @@ impl BodySurface {
         node_offset: usize,
     ) -> BodySurface {
         let rod = boundary.is_empty();
-        let surface_nodes = (boundary_at_node.iter().enumerate())
+        let boundary_nodes = (boundary_at_node.iter().enumerate())
             .filter(|(_, edges)| rod || !edges.is_empty())
             .map(|(n, _)| node_offset + n)
             .collect();
@@ -106,13 +106,13 @@ impl BodySurface {
             boundary_at_node,
             boundary,
             node_offset,
-            surface_nodes,
+            boundary_nodes,
         }
     }
 
     /// The nodes that can meet another body (global ids, ascending).
-    pub fn surface_nodes(&self) -> &[usize] {
-        &self.surface_nodes
+    pub fn boundary_nodes(&self) -> &[usize] {
+        &self.boundary_nodes
     }
 }
 

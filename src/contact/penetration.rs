@@ -84,7 +84,7 @@ pub fn deepest(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Optio
         }
     };
     for body in 0..interfaces.bodies.len() {
-        let nodes = || interfaces.bodies[body].surface_nodes().iter().copied();
+        let nodes = || interfaces.bodies[body].boundary_nodes().iter().copied();
         for obstacle in &obstacles {
             let found = deepest_in_obstacle(nodes(), x, obstacle);
             consider(found, body, Intruded::Obstacle(obstacle.name.clone()));

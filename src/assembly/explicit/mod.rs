@@ -36,6 +36,10 @@ use crate::scene::{Continuum, Model};
 use rayon::prelude::*;
 
 /// Elements per parallel task (fixed, so the work sums do not depend on the thread count).
+/// The element loops give each chunk its own task (`with_max_len(1)`): rayon's adaptive
+/// splitter cuts a loop into about as many pieces as threads and splits further only where a
+/// piece is stolen, which left the stepping thread two pieces of 9-10 chunks holding a Taylor
+/// rod's plastic elements (16 % more element work than the other thread; docs/performance.md).
 pub(super) const CHUNK: usize = 64;
 
 /// The fewest chunks of `CHUNK` nodes a task of the gather takes: a node's sum reads four
