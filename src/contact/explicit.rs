@@ -75,7 +75,7 @@ impl ContactState {
         let Predicted {
             interfaces, start, ..
         } = *step;
-        let c = step.correct(zeros(&mut self.scratch.delta, step.du.len()));
+        let c = step.balanced_correction(zeros(&mut self.scratch.delta, step.du.len()));
         let coulomb = |p: usize| coulomb(interfaces, p);
         // entries closed at the start of the step (their multiplier is the step's force)
         let persistent: Vec<bool> = c
@@ -230,10 +230,30 @@ impl Predicted<'_> {
         ]
     }
 
-    /// The passes of the correction (at most 20): penetrated entries join, the multipliers
-    /// close the gaps, friction returns into its cone, entries in tension leave; until no
-    /// entry joins and the gaps and sticking slips are within TOL.
-    fn correct(&self, delta: Vec<f64>) -> Correction {
+    /// The correction of the step. Without a balanced pair, `correct` over every pair.
+    /// With one (a pair and its reverse pass, `ContactPair::balances`), the mean of two
+    /// corrections of the same prediction: the first over every pair but the reverse
+    /// passes, the second over every pair but their first passes (balanced master-slave
+    /// contact: each surface the slave once). Each is a projection of the predicted motion
+    /// in the mass metric onto its pass's constraints, which takes approach away and adds no
+    /// kinetic energy; their mean cannot add any either (docs/theory.md 8.3d). Neither pass
+    /// solves the other's rows, so the two never meet in one system, where a node held by
+    /// both would make it singular.
+    fn balanced_correction(&self, delta: Vec<f64>) -> Correction {
+        let pairs = &self.interfaces.pairs;
+        if pairs.iter().all(|p| p.balances.is_none()) {
+            return self.correct(delta, &|_| true);
+        }
+        let first_pass = |p: usize| pairs.iter().any(|q| q.balances == Some(p));
+        let first = self.correct(delta.clone(), &|p| pairs[p].balances.is_none());
+        let second = self.correct(delta, &|p| !first_pass(p));
+        first.mean(second)
+    }
+
+    /// The passes of the correction (at most 20) over the pairs that `include`: penetrated
+    /// entries join, the multipliers close the gaps, friction returns into its cone, entries
+    /// in tension leave; until no entry joins and the gaps and sticking slips are within TOL.
+    fn correct(&self, delta: Vec<f64>, include: &dyn Fn(usize) -> bool) -> Correction {
         let interfaces = self.interfaces;
         let mut c = Correction {
             delta,
@@ -251,7 +271,9 @@ impl Predicted<'_> {
             master_impulse: Vec::new(),
         };
         let pairs = &interfaces.pairs;
-        let candidates = master_candidates(interfaces);
+        let mut candidates = master_candidates(interfaces);
+        candidates.retain(|(p, _)| include(*p));
+        let left_out: Vec<bool> = (0..pairs.len()).map(|p| !include(p)).collect();
         for _ in 0..20 {
             // gaps at the corrected positions: the active entries', and the others', of
             // which the penetrated join (with the gap found)
@@ -259,7 +281,8 @@ impl Predicted<'_> {
             let delta = &c.delta;
             let x = |node: usize| self.position(delta, node);
             let in_active = |p: usize, k: usize| c.in_active[p][k];
-            let others: Vec<SlaveGap> = slave_gaps(pairs, &x, &in_active).collect();
+            let skipped = |p: usize, k: usize| left_out[p] || c.in_active[p][k];
+            let others: Vec<SlaveGap> = slave_gaps(pairs, &x, &skipped).collect();
             let lowest = others
                 .iter()
                 .map(|s| s.gap.gap)
@@ -528,6 +551,70 @@ impl Predicted<'_> {
         let kept: Vec<bool> = c.nu_total.iter().map(|nu| *nu >= 0.0).collect();
         keep(&mut c.masters, &kept);
         keep(&mut c.nu_total, &kept);
+    }
+}
+
+impl Correction {
+    /// The mean of two corrections of the same prediction (the two passes of a balanced
+    /// pair): the mean delta; per entry (pair, slave) and per master-block entry the mean of
+    /// the two passes' multipliers (half of one where only one pass has it).
+    fn mean(self, other: Correction) -> Correction {
+        let delta = (self.delta.iter().zip(&other.delta))
+            .map(|(a, b)| 0.5 * (a + b))
+            .collect();
+        let mut in_active = self.in_active.clone();
+        let mut active: Vec<(usize, usize)> = Vec::new();
+        let (mut mu_total, mut friction_total) = (Vec::new(), Vec::new());
+        for c in [&self, &other] {
+            for (i, &(p, k)) in c.active.iter().enumerate() {
+                let at = match active.iter().position(|e| *e == (p, k)) {
+                    Some(at) => at,
+                    None => {
+                        active.push((p, k));
+                        mu_total.push(0.0);
+                        friction_total.push(0.0);
+                        active.len() - 1
+                    }
+                };
+                mu_total[at] += 0.5 * c.mu_total[i];
+                friction_total[at] += 0.5 * c.friction_total[i];
+                in_active[p][k] = true;
+            }
+        }
+        let mut masters: Vec<(usize, usize)> = Vec::new();
+        let mut nu_total = Vec::new();
+        for c in [&self, &other] {
+            for (i, entry) in c.masters.iter().enumerate() {
+                match masters.iter().position(|e| e == entry) {
+                    Some(at) => nu_total[at] += 0.5 * c.nu_total[i],
+                    None => {
+                        masters.push(*entry);
+                        nu_total.push(0.5 * c.nu_total[i]);
+                    }
+                }
+            }
+        }
+        let master_impulse = (self.master_impulse.iter().chain(&other.master_impulse))
+            .map(|(dof, value)| (*dof, 0.5 * value))
+            .collect();
+        let lowest = match (self.lowest, other.lowest) {
+            (Some(a), Some(b)) => Some(match (a, b) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            }),
+            _ => None,
+        };
+        Correction {
+            delta,
+            active,
+            in_active,
+            mu_total,
+            friction_total,
+            lowest,
+            masters,
+            nu_total,
+            master_impulse,
+        }
     }
 }
 

@@ -117,6 +117,11 @@ pub struct ContactPair {
     /// the mortar pair's master nodes and its master the mortar pair's slave surface, and a
     /// slave's gap is `mortar::master_node_gap` (docs/theory.md 8.3a-4). None otherwise.
     pub holds: Option<Holds>,
+    /// The second pass of a balanced pair (`NAME:reverse`, the index of its first pass): the
+    /// first pass's master surface as the slave of its slave surface. The explicit
+    /// correction solves each pass on its own and applies the mean of the two corrections
+    /// (`explicit`); None otherwise.
+    pub balances: Option<usize>,
 }
 
 /// See [`ContactPair::holds`].
@@ -336,8 +341,21 @@ impl ContactPair {
                 let inside =
                     || inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)]));
                 let segment = |k: usize| [x(edges[k][0]), x(edges[k][1])];
-                let (k, xi, _, _) = gap_to_segments(xs, edges.len(), segment, inside)?;
+                let (k, xi, corner_gap, corner_normal) =
+                    gap_to_segments(xs, edges.len(), segment, inside)?;
                 let [a, b] = edges[k];
+                if (xi <= 0.0 || xi >= 1.0) && corner_gap > 0.0 {
+                    // beyond the master's end and outside its body: the distance from the
+                    // end (the nodal normal there would read the surface's extension)
+                    let end = if xi <= 0.0 { a } else { b };
+                    return Some(Gap {
+                        gap: corner_gap,
+                        normal: corner_normal,
+                        masters: vec![(end, 1.0)],
+                        weight: 1.0,
+                    })
+                    .filter(|g| g.gap <= self.options.search_distance);
+                }
                 // the normal interpolated between the master nodes' averaged normals: it
                 // turns continuously across a vertex, where a dented deformable surface would
                 // otherwise flip the slave's row between its two segments
@@ -530,6 +548,7 @@ pub(super) mod tests {
             master,
             options: options(),
             covered: None,
+            balances: None,
             mortar: None,
             holds: None,
         }

@@ -6,7 +6,7 @@ use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
 use super::model::{Body, BodyKind};
 use super::spec::{
-    AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Scene, SurfaceSpec,
+    AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Roles, Scene, SurfaceSpec,
 };
 use crate::contact::{
     ContactPair, Covered, Friction, Holds, Master, MortarSurface, Obstacle, PairOptions, setup,
@@ -25,12 +25,18 @@ pub(super) fn contacts(
         .contact
         .iter()
         .enumerate()
-        .map(|entry| contact(cx, bodies, obstacles, entry, dynamic(scene)))
+        .map(|entry| contact(cx, bodies, obstacles, entry, scene))
         .collect::<Result<Vec<_>, _>>()?;
     let mut contacts = contacts;
     for (k, spec) in scene.contact.iter().enumerate() {
         if spec.two_pass {
             let reverse = reverse_pair(cx, bodies, k, spec, &contacts[k])?;
+            contacts.push(reverse);
+        }
+        if symmetric(cx, bodies, (k, spec), scene)? {
+            let mut reverse = reverse_pair(cx, bodies, k, spec, &contacts[k])?;
+            reverse.covered = None;
+            reverse.balances = Some(k);
             contacts.push(reverse);
         }
         let held = contacts[k]
@@ -91,7 +97,7 @@ fn contact(
     bodies: &[Body],
     obstacles: &[Obstacle],
     (k, spec): (usize, &ContactSpec),
-    dynamic: bool,
+    scene: &Scene,
 ) -> Result<ContactPair, InputError> {
     let key = format!("contact[{k}] (`{}`)", spec.name);
     let (slave_body, slaves) = node_set(
@@ -139,7 +145,10 @@ fn contact(
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
         None => f64::INFINITY,
     };
-    let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), dynamic)?;
+    let balanced = symmetric(cx, bodies, (k, spec), scene)?;
+    let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), {
+        dynamic(scene) && !balanced
+    })?;
     Ok(ContactPair {
         name: spec.name.clone(),
         slave_body,
@@ -156,9 +165,61 @@ fn contact(
             persistency: false,
         },
         covered: None,
+        balances: None,
         mortar,
         holds: None,
     })
+}
+
+/// Whether pair `k` (`spec`) is balanced (`roles = "symmetric"`): each surface the slave of
+/// the other in a pass of its own, the explicit correction the mean of the two passes
+/// (docs/theory.md 8.3d). The default for a pair between two bodies' edge sets under
+/// central difference, unless the pair asks for what one pass does (`two_pass`, `mortar`,
+/// `hold_master_nodes`); refused on the implicit and static paths, against an obstacle or a
+/// node-to-node master, and with those keys.
+fn symmetric(
+    cx: &Context,
+    bodies: &[Body],
+    (k, spec): (usize, &ContactSpec),
+    scene: &Scene,
+) -> Result<bool, InputError> {
+    let key = format!("contact[{k}] (`{}`).roles", spec.name);
+    let edge_set_of = |surface: &SurfaceSpec| {
+        surface.normal.is_none()
+            && body_index(cx, bodies, surface.body.as_deref(), &key)
+                .is_ok_and(|b| bodies[b].mesh.edge_sets.contains_key(&surface.set))
+    };
+    let between_bodies = spec.master.as_ref().is_some_and(edge_set_of) && edge_set_of(&spec.slave);
+    let one_pass = [
+        (spec.two_pass, "`two_pass`"),
+        (
+            spec.discretization == Some(ContactDiscretization::Mortar),
+            "`discretization = \"mortar\"`",
+        ),
+        (spec.hold_master_nodes.is_some(), "`hold_master_nodes`"),
+    ];
+    match spec.roles {
+        None => Ok(explicit(scene) && between_bodies && one_pass.iter().all(|(on, _)| !on)),
+        Some(Roles::AsWritten) => Ok(false),
+        Some(Roles::Symmetric) => {
+            if !explicit(scene) {
+                return Err(cx.err(format!(
+                    "{key}: balanced contact runs under central_difference only; the implicit and static paths take `roles = \"as_written\"` (one pass, the slave set the slave)"
+                )));
+            }
+            if !between_bodies {
+                return Err(cx.err(format!(
+                    "{key}: balanced contact needs a slave and a master edge set on two bodies (an obstacle or a node-to-node master is a master only)"
+                )));
+            }
+            if let Some((_, name)) = one_pass.iter().find(|(on, _)| *on) {
+                return Err(cx.err(format!(
+                    "{key}: {name} is a one-pass choice; give `roles = \"as_written\"` with it, or leave it out"
+                )));
+            }
+            Ok(true)
+        }
+    }
 }
 
 /// The slave surface of a `discretization = "mortar"` pair (`key`, `spec`): the slave set's
@@ -316,6 +377,7 @@ fn reverse_pair(
         options: pair.options.clone(),
         mortar: None,
         holds: None,
+        balances: None,
         covered: Some(Covered {
             pair: k,
             slaves: {

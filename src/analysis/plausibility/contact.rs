@@ -74,7 +74,8 @@ pub(super) fn penetration_warning(model: &Model, summary: &Summary) -> Option<St
         Some(d) => format!(
             "node {} of body `{}` (a slave) went {} into {} at t = {}: a slave node one-pass \
              contact did not hold, or a master node sinking into the slave body, which one-pass \
-             contact does not see (swap the roles or refine the slave surface)",
+             contact does not see (a balanced pair, `roles = \"symmetric\"`, checks both \
+             surfaces: the default under central difference; or refine both surfaces)",
             d.node,
             d.body,
             readable(d.depth),
@@ -82,7 +83,8 @@ pub(super) fn penetration_warning(model: &Model, summary: &Summary) -> Option<St
             readable(d.time)
         ),
         None => "a master node sinking into the slave body is not seen by one-pass contact: \
-                 swap the roles or refine the slave surface"
+                 a balanced pair (`roles = \"symmetric\"`, the default under central \
+                 difference) checks both surfaces; or refine both surfaces"
             .to_string(),
     };
     Some(format!(

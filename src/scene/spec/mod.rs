@@ -324,9 +324,10 @@ pub struct ContactSpec {
     pub return_coefficient: Option<f64>,
     /// `node_to_segment` (each slave node against the master) or `mortar` (segment-to-segment:
     /// the gap weighted over the slave surface; a slave and a master edge set on two
-    /// deformable bodies). Default: `mortar` for such a pair under central difference (where
-    /// node-to-segment crushes the master's corners at large strain), `node_to_segment`
-    /// otherwise (implicit and static runs, obstacles, node-to-node, `two_pass`).
+    /// deformable bodies). Default: `mortar` for such a pair in a dynamic analysis with one
+    /// pass (`roles = "as_written"`: the implicit integrators, or by choice), and
+    /// `node_to_segment` otherwise (a balanced pair's two passes, statics, obstacles,
+    /// node-to-node, `two_pass`).
     pub discretization: Option<ContactDiscretization>,
     /// Mortar pairs in dynamics: a master node that the weighted gaps let into the slave body
     /// is held out by a row of its own (where the surfaces fold at the rim of a contact zone):
@@ -335,6 +336,23 @@ pub struct ContactSpec {
     /// history column), where the master's edges are not much finer than the slave's
     /// (`mortar::FINER`). Statics holds the weighted gaps alone. Default false.
     pub hold_master_nodes: Option<bool>,
+    /// Which surface is the slave of a pair between two bodies' edge sets: `symmetric` (a
+    /// balanced pair: each surface the slave of the other in a pass of its own, node to
+    /// segment, the explicit correction the mean of the two; the default under central
+    /// difference, refused elsewhere) or `as_written` (one pass: the slave set the slave;
+    /// the default on the implicit and static paths).
+    pub roles: Option<Roles>,
+}
+
+/// Whether a pair between two bodies checks both surfaces or the slave's alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Roles {
+    /// Both surfaces are slaves of the other (two node-to-segment passes, each solved on its
+    /// own, their corrections averaged).
+    Symmetric,
+    /// The slave set is the slave, the master set the master (one pass).
+    AsWritten,
 }
 
 /// How a contact pair's constraints are discretized.
