@@ -55,8 +55,8 @@ fn block_on_plate(name: &str, overrides: &[&str]) -> Outcome {
 }
 
 /// Goal: the answer does not depend on which surface the scene names the slave.
-/// Setup: models/block_on_plate.toml (matching meshes, 0.5 mm faces) as shipped and with
-/// the roles swapped. Reference: the problem itself, which names no slave: the two runs must
+/// Setup: models/block_on_plate.toml (matching meshes, 0.5 mm faces, the pair balanced by
+/// default) as shipped and with the roles swapped. Reference: the problem itself, which names no slave: the two runs must
 /// be the same run (the balanced correction takes the mean of both passes, whose order is
 /// the pair's and its reverse's whatever the names), so the numbers agree to the bit. With
 /// one pass (`roles = "as_written"`) the swapped run ends on an inverted block element at
@@ -102,7 +102,8 @@ fn balanced_contact_gives_no_energy_and_holds_the_faces() {
 }
 
 /// Goal: two like rods striking each other stay each other's mirror image.
-/// Setup: models/rod_on_rod.toml as shipped (two copper rods, 8 x 40 each, at +-100 m/s).
+/// Setup: models/rod_on_rod.toml as shipped (two 42CrMo4 rods, 5 x 50 each, at +-287 m/s; the
+/// pair balanced by default).
 /// Reference: the symmetry of the problem about the contact plane: the upper and the lower
 /// rod's final lengths and widths are equal. A balanced pair treats the two faces alike, so
 /// they agree to round-off (1e-12 relative); one pass, with one rod the slave, leaves them

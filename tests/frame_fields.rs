@@ -132,7 +132,9 @@ fn sphere_on_the_wall_shows_the_wall_and_hertz_pressure() {
     assert!(checked >= 10, "{checked} nodes inside 0.8 a = {}", 0.8 * a);
 }
 
-/// Goal: two deformable bodies (models/rod_on_rod.toml, mortar, explicit): the contact
+/// Goal: two deformable bodies (models/rod_on_rod.toml, one pass of mortar, explicit; the
+/// balanced default's master face integrates to 0.56 % of its slave face's, the pressures of
+/// two node-to-segment passes recovered on half edges): the contact
 /// pressure on the slave face integrates to the history's force, the master face carries
 /// the same load, the point plastic strain lies within the cells around each point, and each
 /// point names its body. Setup: the scene to 10 us (the rods pressed together), frames every
@@ -146,7 +148,11 @@ fn two_rods_show_their_contact_pressure_plastic_strain_and_bodies() {
     let run = common::run_scene(
         "frame_rod_on_rod",
         "rod_on_rod",
-        &["analysis.end_time=10.0e-6", "output.frame_every=100"],
+        &[
+            "analysis.end_time=10.0e-6",
+            "output.frame_every=100",
+            "contact.faces.roles=as_written",
+        ],
     );
     let dir = &run.dir;
     assert!(
@@ -218,9 +224,12 @@ fn two_rods_show_their_contact_pressure_plastic_strain_and_bodies() {
 }
 
 /// Goal: the first frame shows the initial gaps (it showed 0 everywhere). Setup:
-/// models/rod_on_plate.toml to 1 us, frames every 0.5 us. Reference: the scene places the
-/// rod's bottom 1 um above the plate's top: the 9 slave nodes' gap is 1e-6 (to round-off of
-/// coordinates near 1e-2), every other point's 0.
+/// models/rod_on_plate.toml to 1 us, frames every 0.5 us (a balanced pair: the rod's face and
+/// the plate's top are each the other's slaves). Reference: the scene places the rod's bottom
+/// (r <= 4 mm) 1 um above the plate's top: the rod's 9 face nodes and the plate's 9 top nodes
+/// under it have the gap 1e-6 (to round-off of coordinates near 1e-2); the plate's 32 top
+/// nodes beyond the rod's rim (r = 4.5 ... 20 mm) their distance from its corner,
+/// sqrt((r - 4 mm)^2 + (1 um)^2); every other point 0.
 #[test]
 fn the_first_frame_shows_the_initial_gaps() {
     let run = common::run_scene(
@@ -232,8 +241,19 @@ fn the_first_frame_shows_the_initial_gaps() {
     assert_eq!(t, 0.0);
     let gap = point_array(&frame, "gap");
     let open: Vec<f64> = gap.iter().copied().filter(|g| *g != 0.0).collect();
-    assert_eq!(open.len(), 9, "{open:?}");
-    assert!(open.iter().all(|g| (g - 1e-6).abs() < 1e-15), "{open:?}");
+    assert_eq!(open.len(), 50, "{open:?}");
+    let facing = open.iter().filter(|g| (*g - 1e-6).abs() < 1e-15).count();
+    assert_eq!(facing, 18, "{open:?}");
+    let mut beyond: Vec<f64> = open
+        .into_iter()
+        .filter(|g| (g - 1e-6).abs() >= 1e-15)
+        .collect();
+    beyond.sort_by(f64::total_cmp);
+    for (k, g) in beyond.iter().enumerate() {
+        let r = 4.5e-3 + 0.5e-3 * k as f64;
+        let exact = ((r - 4.0e-3).powi(2) + 1e-12).sqrt();
+        assert!((g / exact - 1.0).abs() < 1e-9, "{k}: {g} against {exact}");
+    }
 }
 
 /// Goal: `impact plot FRAME.vtu` charts a point array along the touching nodes (the contact

@@ -80,6 +80,12 @@ pub struct PairOptions {
     /// it closed with, so an open slave that starts inside its master counts as penetrating
     /// only when it goes deeper.
     pub persistency: bool,
+    /// A slave beyond the end of its master surface and outside the master body gets its
+    /// distance from that end (`ContactPair::node_gap`), not its distance along the surface's
+    /// extension: the passes of a balanced pair, where every node of both surfaces is a
+    /// slave and those beside the other body must not read its face extended. One-pass pairs
+    /// keep the extension, with which the seeds' scenes were validated.
+    pub distance_beyond_ends: bool,
 }
 
 /// The tangential law of a contact pair.
@@ -344,9 +350,14 @@ impl ContactPair {
                 let (k, xi, corner_gap, corner_normal) =
                     gap_to_segments(xs, edges.len(), segment, inside)?;
                 let [a, b] = edges[k];
-                if (xi <= 0.0 || xi >= 1.0) && corner_gap > 0.0 {
-                    // beyond the master's end and outside its body: the distance from the
-                    // end (the nodal normal there would read the surface's extension)
+                let ab = sub(x(b), x(a));
+                let turned =
+                    (corner_normal[0] * ab[0] + corner_normal[1] * ab[1]).abs() > 1e-9 * length(ab);
+                let beyond = (xi <= 0.0 || xi >= 1.0) && corner_gap > 0.0 && turned;
+                if beyond && self.options.distance_beyond_ends {
+                    // beyond the master's end and outside its body (the direction from the
+                    // end turned off the segment's normal): the distance from the end (the
+                    // nodal normal there would read the surface's extension)
                     let end = if xi <= 0.0 { a } else { b };
                     return Some(Gap {
                         gap: corner_gap,
@@ -564,6 +575,7 @@ pub(super) mod tests {
             split_at_events: true,
             friction: Friction::None,
             persistency: false,
+            distance_beyond_ends: false,
         }
     }
 

@@ -186,6 +186,24 @@ impl Interfaces {
     }
 }
 
+/// Per-pair values (forces) folded onto the pairs the history reports: the reverse pass of a
+/// balanced pair (`ContactPair::balances`) adds its value to its first pass's and has no
+/// column of its own, so `contact_force[NAME]` is the pair's whole force.
+pub fn fold_passes(pairs: &[ContactPair], values: &[f64]) -> Vec<f64> {
+    let mut folded = values.to_vec();
+    for (p, pair) in pairs.iter().enumerate() {
+        if let Some(first) = pair.balances {
+            folded[first] += values[p];
+        }
+    }
+    pairs
+        .iter()
+        .zip(folded)
+        .filter(|(pair, _)| pair.balances.is_none())
+        .map(|(_, value)| value)
+        .collect()
+}
+
 /// The contact block of summary.json.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct ContactSummary {

@@ -163,6 +163,7 @@ fn contact(
             split_at_events: spec.split_at_events,
             friction,
             persistency: false,
+            distance_beyond_ends: balanced,
         },
         covered: None,
         balances: None,

@@ -11,6 +11,7 @@ use crate::assembly::State;
 use crate::contact::ContactState;
 use crate::contact::Friction;
 use crate::contact::Interfaces;
+use crate::contact::fold_passes;
 use crate::material::PointState;
 use crate::mesh::Cells;
 use crate::output::history::History;
@@ -221,14 +222,15 @@ impl Recorder {
             energies.contact_work,
             self.step_length,
         ];
-        let friction: Vec<bool> = model
-            .contacts
+        let pairs = &model.contacts;
+        let friction: Vec<bool> = pairs
             .iter()
+            .filter(|c| c.balances.is_none())
             .map(|c| c.options.friction != Friction::None)
             .collect();
         let forces = match contact {
-            Some(c) => c.pair_forces(),
-            None => vec![0.0; model.contacts.len()],
+            Some(c) => fold_passes(pairs, &c.pair_forces()),
+            None => vec![0.0; friction.len()],
         };
         let averages = match &mut self.contact {
             Some(record) => record.row(
@@ -243,7 +245,7 @@ impl Recorder {
             Some(c) => {
                 row.extend(forces);
                 row.extend(
-                    c.pair_tangential_forces()
+                    fold_passes(pairs, &c.pair_tangential_forces())
                         .into_iter()
                         .zip(&friction)
                         .filter_map(|(f, on)| on.then_some(f)),
@@ -251,7 +253,7 @@ impl Recorder {
             }
             None => row.extend(std::iter::repeat_n(
                 0.0,
-                model.contacts.len() + friction.iter().filter(|f| **f).count(),
+                friction.len() + friction.iter().filter(|f| **f).count(),
             )),
         }
         let reaction = if model.probes.iter().any(|p| is_reaction(p.quantity)) {
@@ -830,16 +832,11 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
     .iter()
     .map(|s| s.to_string())
     .collect();
+    // a balanced pair's reverse pass is folded into its pair's columns (`fold_passes`)
+    let reported = || model.contacts.iter().filter(|c| c.balances.is_none());
+    columns.extend(reported().map(|c| format!("contact_force[{}]", c.name)));
     columns.extend(
-        model
-            .contacts
-            .iter()
-            .map(|c| format!("contact_force[{}]", c.name)),
-    );
-    columns.extend(
-        model
-            .contacts
-            .iter()
+        reported()
             .filter(|c| c.options.friction != Friction::None)
             .map(|c| format!("tangential_force[{}]", c.name)),
     );
@@ -861,12 +858,7 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
     }
     if super::contact_record::averages(model) {
         // the pairs' forces averaged over output.contact_force_window
-        columns.extend(
-            model
-                .contacts
-                .iter()
-                .map(|c| format!("contact_force_avg[{}]", c.name)),
-        );
+        columns.extend(reported().map(|c| format!("contact_force_avg[{}]", c.name)));
     }
     if bulk_viscosity_column(model) {
         // the cumulative work of the bulk viscosity's pressure
