@@ -10,8 +10,8 @@ mod common;
 
 /// What a rod-on-plate run gives: the rod's final length and diameter (the extent of its
 /// final shape), the plate's largest equivalent plastic strain, the plastic work, the least
-/// contact work over the run (energy the contact took up, negative where it gave energy to
-/// the bodies) and the step cuts.
+/// contact work over the run, friction's included (energy the contact took up, negative
+/// where it gave energy to the bodies) and the step cuts.
 struct Outcome {
     length: f64,
     diameter: f64,
@@ -30,8 +30,18 @@ fn rod_on_plate(name: &str, overrides: &[&str]) -> Outcome {
         run.summary.warnings
     );
     let last = |column: &str| *common::column(&run.dir, column).last().unwrap();
-    let least_contact_work = common::column(&run.dir, "contact_work")
-        .into_iter()
+    // the work of the normal rows and of the friction together (central difference books
+    // the friction's apart, `friction_work`; the implicit paths keep it in contact_work):
+    // the normal rows' share alone gives back up to 0.45 % of the energy with mu = 0.3
+    let contact_work = common::column(&run.dir, "contact_work");
+    let header = std::fs::read_to_string(run.dir.join("history.csv")).unwrap();
+    let friction_work = if header.lines().next().unwrap().contains("friction_work") {
+        common::column(&run.dir, "friction_work")
+    } else {
+        vec![0.0; contact_work.len()]
+    };
+    let least_contact_work = (contact_work.iter().zip(&friction_work))
+        .map(|(c, f)| c + f)
         .fold(f64::INFINITY, f64::min);
     let outcome = Outcome {
         length: last("extent_y[rod.all]"),
@@ -217,8 +227,8 @@ fn either_body_refined_alone_keeps_the_plastic_work_and_creates_no_energy() {
 /// (`hold_master_nodes = true`: the plate's rows push nodes that were already inside out in
 /// one step; validation 4.12: before the check this run ended `ok` having created 347 J).
 /// Reference: the energy balance (theory 7): the contact work, energy the interfaces took up,
-/// is >= 0 for a contact that creates none; the run fails when it ends below -3 % of the
-/// energy in play (the initial kinetic energy, 225.2 J), its history kept.
+/// is >= 0 for a contact that creates none; the run fails at the step where it falls below
+/// -2 % of the energy in play (the initial kinetic energy, 225.2 J), its history kept.
 #[test]
 fn a_contact_that_creates_energy_ends_the_run_with_exit_3() {
     let dir = common::out_dir("rop_energy_guard");
@@ -251,7 +261,9 @@ fn a_contact_that_creates_energy_ends_the_run_with_exit_3() {
     );
     let kinetic = common::column(&dir, "kinetic_energy")[0];
     let work = *common::column(&dir, "contact_work").last().unwrap();
-    assert!(work < -0.03 * kinetic, "{work} of {kinetic}");
+    // the last row is the step before the one that failed: already giving energy
+    assert!(work < -0.005 * kinetic, "{work} of {kinetic}");
+    assert!(stderr.contains("more than 1 %"), "{stderr}");
     let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
     assert!(summary.contains("\"diverged\""), "{summary}");
 }

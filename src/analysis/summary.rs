@@ -76,10 +76,14 @@ pub struct EnergySummary {
     /// `remap_loss`); only with `analysis.ale`, and summary.json has the field only then.
     #[serde(default)]
     pub remap_loss: Option<f64>,
+    /// The energy Coulomb friction dissipated (history.csv `friction_work`); only under
+    /// central difference with a friction pair, and summary.json has the field only then.
+    #[serde(default)]
+    pub friction_work: Option<f64>,
 }
 
-/// summary.json (a human-readable format) leaves `bulk_viscosity_work`, `mass_scaling_loss`
-/// and `remap_loss` out when there are none, so the scenes without them keep their file
+/// summary.json (a human-readable format) leaves `bulk_viscosity_work`, `mass_scaling_loss`,
+/// `remap_loss` and `friction_work` out when there are none, so the scenes without them keep their file
 /// as it was; a checkpoint (a binary format whose fields are positional) always stores them.
 impl Serialize for EnergySummary {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
@@ -88,7 +92,12 @@ impl Serialize for EnergySummary {
         let viscosity = self.bulk_viscosity_work.is_some() || binary;
         let scaling = self.mass_scaling_loss.is_some() || binary;
         let remap = self.remap_loss.is_some() || binary;
-        let fields = 4 + usize::from(viscosity) + usize::from(scaling) + usize::from(remap);
+        let friction = self.friction_work.is_some() || binary;
+        let fields = 4
+            + usize::from(viscosity)
+            + usize::from(scaling)
+            + usize::from(remap)
+            + usize::from(friction);
         let mut s = serializer.serialize_struct("EnergySummary", fields)?;
         s.serialize_field("initial", &self.initial)?;
         s.serialize_field("final", &self.final_)?;
@@ -108,6 +117,11 @@ impl Serialize for EnergySummary {
             s.serialize_field("remap_loss", &self.remap_loss)?;
         } else {
             s.skip_field("remap_loss")?;
+        }
+        if friction {
+            s.serialize_field("friction_work", &self.friction_work)?;
+        } else {
+            s.skip_field("friction_work")?;
         }
         s.end()
     }

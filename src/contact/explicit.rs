@@ -52,6 +52,10 @@ pub struct ExplicitContact {
     /// DOFs): what does the step's contact work on its corrected increment (the friction's
     /// share is the work it dissipates).
     pub step_force: Vec<f64>,
+    /// The work of the friction's share of `step_force`, T^T lambda / h^2, on the corrected
+    /// increment, f_t . (du + delta / 2): minus the energy the friction dissipates in the
+    /// step (0 without a pair with Coulomb friction).
+    pub friction_work: f64,
 }
 
 impl ContactState {
@@ -141,9 +145,13 @@ impl ContactState {
         for (dof, impulse) in &c.master_impulse {
             step_force[*dof] += impulse / (h * h);
         }
+        let increment = |dof: usize| step.du[dof] + 0.5 * c.delta[dof];
+        let friction_work =
+            self.tangential_work(&interfaces.pairs, start, &step_friction, &increment);
         ExplicitContact {
             correction: c.delta,
             step_force,
+            friction_work,
         }
     }
 }

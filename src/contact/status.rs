@@ -248,6 +248,27 @@ impl ContactState {
         f
     }
 
+    /// The work `tangential`'s forces do on the increment `increment(dof)`, the rows at
+    /// positions `coords`: T^T lambda . du over the active entries, what the forces of
+    /// `nodal_forces_into`'s tangential rows would do.
+    pub(super) fn tangential_work(
+        &self,
+        pairs: &[ContactPair],
+        coords: &[[f64; 2]],
+        tangential: &[Vec<f64>],
+        increment: &dyn Fn(usize) -> f64,
+    ) -> f64 {
+        let x = |n: usize| coords[n];
+        slave_gaps(pairs, &x, &|p, k| {
+            !self.active[p][k] || tangential[p][k] == 0.0
+        })
+        .map(|s| {
+            let row = s.gap.tangent_row(s.node);
+            tangential[s.pair][s.index] * row.iter().map(|(d, c)| c * increment(*d)).sum::<f64>()
+        })
+        .sum()
+    }
+
     /// Per node: the gap and the status of slave nodes (status 1 active, 0 open), zeros
     /// elsewhere.
     pub fn nodal_status(&self, pairs: &[ContactPair], coords: &[[f64; 2]]) -> NodalStatus {

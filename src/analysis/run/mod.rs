@@ -275,6 +275,14 @@ impl<'a, S: Stepper> Run<'a, S> {
                 format!("at t = {}: {message}", readable(time)),
             ));
         }
+        if let Some(message) = self.energy_created() {
+            let time = self.stepper.state().time;
+            self.stepper.sync_points();
+            return Err(self.fail_with_cause(
+                Status::Diverged,
+                format!("at t = {}: {message}", readable(time)),
+            ));
+        }
         let stop = self.observe_buckling()?;
         let last = stop || self.stepper.done();
         self.record(last)?;
@@ -440,6 +448,8 @@ impl<'a, S: Stepper> Run<'a, S> {
             .mass_scaling()
             .map(|_| energies.mass_scaling_loss);
         summary.energy.remap_loss = self.model.analysis.ale().map(|_| energies.remap_loss);
+        summary.energy.friction_work =
+            record::friction_column(self.model).then_some(energies.friction_work);
         summary.ale = s.ale();
         let mass_scaling = s.mass_scaling();
         summary.mass_scaling = mass_scaling
@@ -545,18 +555,6 @@ impl<'a, S: Stepper> Run<'a, S> {
 
     /// A run stopped before its end time on purpose (the buckling check's `stop`).
     fn finish(mut self) -> Result<Outcome, RunError> {
-        let energies = self.stepper.energies();
-        let initial = self.stepper.initial_kinetic();
-        let explicit = matches!(&self.model.analysis,
-            crate::scene::model::Analysis::Dynamic(spec)
-                if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference);
-        let gave = explicit
-            .then(|| contact_gave_energy(energies, initial, &self.model.contacts))
-            .flatten();
-        if let Some(message) = gave {
-            self.stepper.sync_points();
-            return Err(self.fail_with_cause(Status::Diverged, message));
-        }
         self.progress
             .finish(self.stepper.state().time, self.summary.steps);
         self.end()
@@ -613,45 +611,60 @@ fn negative_plastic_work(e: &Energies, initial_kinetic: f64) -> Option<String> {
     })
 }
 
-/// The share of the energy in play that the contact may give the bodies before a run stops:
-/// a few per cent. Contact takes energy (an arrest, an impact, friction) and gives back at
-/// most the discretization's error of frictionless sliding (docs/validation.md 4.12: up to
-/// 1.2 % of 225 J on a rod sliding over a plate four times as fine); beyond that it is
-/// creating energy, and the answer is not the physics'.
-const CONTACT_ENERGY_SHARE: f64 = 0.03;
+/// The share of the energy in play that the contact of an explicit run may give the bodies,
+/// at any step, before the run stops. Contact takes energy (an arrest, an impact, friction)
+/// and gives back at most the discretization's error of sliding (docs/validation.md 4.12:
+/// up to 1.2 % of 225 J at a run's end, on a rod sliding over a plate four times as fine,
+/// one pass of mortar; no run of the suite reaches this bound at any step); beyond it the
+/// contact is creating energy, and the answer is not the physics'.
+const CREATED_SHARE: f64 = 0.01;
 
-/// Why an explicit run that reached its end is a failure when its contact work (energy taken
-/// up by the interfaces, theory 7) ends below -CONTACT_ENERGY_SHARE of the energy in play,
-/// naming the pairs `pairs`; None otherwise. Explicit runs only: there the contact work is the
-/// work of the correction's impulses on the corrected increment; the implicit paths' is the
-/// trapezoidal work of the multipliers, which gives energy back for a while and takes it again
-/// under the seeds' options (two bars without impact conditions: -5 % at t = 0.01) and is not
-/// what Wilson's interpolated step does (a plastic block on a floor: -67 %), so there it stays
-/// in the energy balance and its warning.
-fn contact_gave_energy(
-    e: &Energies,
-    initial_kinetic: f64,
-    pairs: &[crate::contact::ContactPair],
-) -> Option<String> {
-    let scale = initial_kinetic
-        .max(e.external_work.abs())
-        .max(e.internal.abs())
-        .max(f64::MIN_POSITIVE);
-    if !(-e.contact_work > CONTACT_ENERGY_SHARE * scale) {
-        return None;
+impl<S: Stepper> Run<'_, S> {
+    /// Why an explicit run fails at this step: its contact work, friction's included (energy
+    /// taken up by the interfaces, theory 7), is below -CREATED_SHARE of the energy in play,
+    /// the pairs named;
+    /// None otherwise. Explicit runs only: the implicit paths' contact work is the
+    /// trapezoidal work of the multipliers, which gives energy back for a while and takes it
+    /// again under the seeds' options (two bars without impact conditions: -5 % at
+    /// t = 0.01), and Wilson's interpolated step is not what it books (a plastic block on a
+    /// floor: -67 %); there it stays in the energy balance and its warning. The balance
+    /// itself is not guarded: central difference's own error at a Courant number near 1 is a
+    /// few per cent on the wave problems (strip_wall 2.7 %, theory 7), created by no one.
+    fn energy_created(&self) -> Option<String> {
+        let explicit = matches!(&self.model.analysis,
+            crate::scene::model::Analysis::Dynamic(spec)
+                if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference);
+        if !explicit {
+            return None;
+        }
+        let e = self.stepper.energies();
+        let scale = (self.stepper.initial_kinetic())
+            .max(e.external_work.abs())
+            .max(e.internal.abs())
+            .max(f64::MIN_POSITIVE);
+        // the interface as a whole: the normal rows' and the friction's work together (their
+        // split follows the rows at the step's start, and a block held on a floor by friction
+        // moves energy between the two columns while the sum takes it)
+        let given = -(e.contact_work + e.friction_work);
+        (given > CREATED_SHARE * scale).then(|| {
+            let names: Vec<String> = (self.model.contacts.iter())
+                .filter(|p| p.balances.is_none())
+                .map(|p| format!("`{}`", p.name))
+                .collect();
+            format!(
+                "the contact gave the bodies {} of energy, {:.1} % of the {} in play (more than \
+                 {} %): contact {} created energy, so the answer is not the physics'; likely \
+                 causes: a step too long for the contact (a shorter dt), master nodes held on \
+                 meshes of unlike size (hold_master_nodes = false), or surfaces that do not face \
+                 each other",
+                readable(given),
+                100.0 * given / scale,
+                readable(scale),
+                100.0 * CREATED_SHARE,
+                names.join(", ")
+            )
+        })
     }
-    let names: Vec<String> = pairs.iter().map(|p| format!("`{}`", p.name)).collect();
-    Some(format!(
-        "the contact gave the bodies {} of energy, {:.1} % of the {} in play (more than {} %): \
-         contact {} created energy, so the answer is not the physics'; likely causes: a step \
-         too long for the contact (a shorter dt), master nodes held on meshes of unlike size \
-         (hold_master_nodes = false), or surfaces that do not face each other",
-        readable(-e.contact_work),
-        100.0 * -e.contact_work / scale,
-        readable(scale),
-        100.0 * CONTACT_ENERGY_SHARE,
-        names.join(", ")
-    ))
 }
 
 /// The message of a numerical failure, with what the state says of mixed units when it

@@ -294,6 +294,9 @@ impl Recorder {
         if model.analysis.ale().is_some() {
             row.push(energies.remap_loss);
         }
+        if friction_column(model) {
+            row.push(energies.friction_work);
+        }
         let frame = self.frame_due(model, state.time, force_frame, 1);
         let history = &mut self.history;
         self.thinning
@@ -873,7 +876,20 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
         // the kinetic energy the ALE remaps took out of the motion
         columns.push("remap_loss".to_string());
     }
+    if friction_column(model) {
+        // the energy Coulomb friction dissipated (the normal rows' share is contact_work)
+        columns.push("friction_work".to_string());
+    }
     (columns, pivots_column)
+}
+
+/// Whether the history has `friction_work`: central difference with a Coulomb pair (the
+/// implicit paths book the friction's dissipation in `contact_work`).
+pub(super) fn friction_column(model: &Model) -> bool {
+    let explicit = matches!(&model.analysis, crate::scene::model::Analysis::Dynamic(d)
+        if d.integrator == crate::scene::spec::IntegratorKind::CentralDifference);
+    explicit
+        && (model.contacts.iter()).any(|c| matches!(c.options.friction, Friction::Coulomb { .. }))
 }
 
 fn bulk_viscosity_column(model: &Model) -> bool {

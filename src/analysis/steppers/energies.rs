@@ -22,6 +22,9 @@ pub struct Energies {
     /// The kinetic energy the ALE remaps took out of the nodal motion (central difference
     /// with `analysis.ale`; 0 without it; docs/theory.md 8.11).
     pub remap_loss: f64,
+    /// The energy Coulomb friction dissipated (central difference with a friction pair; 0
+    /// otherwise: the implicit paths book it in `contact_work`), >= 0.
+    pub friction_work: f64,
 }
 
 /// Nodal kinematic fields beyond the displacement (zero in statics).
@@ -35,7 +38,7 @@ pub struct Motion<'a> {
     pub internal_force: &'a [f64],
 }
 
-/// Relative energy balance error |KE + W_int + W_contact + W_visc + L_ms + L_remap - W_ext - KE_0| /
+/// Relative energy balance error |KE + W_int + W_contact + W_fric + W_visc + L_ms + L_remap - W_ext - KE_0| /
 /// max(KE_0, |W_ext|, |W_elastic|, KE), W_int = W_elastic + W_plastic, W_visc the bulk
 /// viscosity's work, L_ms the mass scaling's loss, L_remap the ALE remaps'. KE is in the scale for a body that starts at
 /// rest under a load: the first step's kinetic energy comes before the external work that
@@ -48,15 +51,21 @@ pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
         .max(energies.internal.abs())
         .max(energies.kinetic)
         .max(f64::MIN_POSITIVE);
-    (energies.kinetic - energies.kinetic_shadow
+    balance_gain(energies, initial_kinetic).abs() / scale
+}
+
+/// The signed residual of the balance, KE + W_int + W_contact + W_fric + W_visc + L_ms + L_remap -
+/// W_ext - KE_0 (see [`balance_error`]): positive where the bodies hold more energy than they
+/// were given and the sinks took (energy created), negative where some was lost.
+fn balance_gain(energies: &Energies, initial_kinetic: f64) -> f64 {
+    energies.kinetic - energies.kinetic_shadow
         + energies.internal
         + energies.plastic_work
         + energies.contact_work
+        + energies.friction_work
         + energies.bulk_viscosity_work
         + energies.mass_scaling_loss
         + energies.remap_loss
         - energies.external_work
-        - initial_kinetic)
-        .abs()
-        / scale
+        - initial_kinetic
 }

@@ -216,7 +216,9 @@ impl<'a> Explicit<'a> {
                 self.v_half[i] += c / h;
             }
         }
-        self.energies.contact_work -= work;
+        // the friction's share is the energy it dissipates, booked apart (theory 7)
+        self.energies.contact_work -= work - step.friction_work;
+        self.energies.friction_work -= step.friction_work;
         self.contact.recycle(step, &self.interfaces, &touched);
     }
 
