@@ -622,8 +622,7 @@ const CREATED_SHARE: f64 = 0.01;
 impl<S: Stepper> Run<'_, S> {
     /// Why an explicit run fails at this step: its contact work, friction's included (energy
     /// taken up by the interfaces, theory 7), is below -CREATED_SHARE of the energy in play,
-    /// the pairs named;
-    /// None otherwise. Explicit runs only: the implicit paths' contact work is the
+    /// the pairs named; None otherwise. Explicit runs only: the implicit paths' contact work is the
     /// trapezoidal work of the multipliers, which gives energy back for a while and takes it
     /// again under the seeds' options (two bars without impact conditions: -5 % at
     /// t = 0.01), and Wilson's interpolated step is not what it books (a plastic block on a
@@ -631,10 +630,7 @@ impl<S: Stepper> Run<'_, S> {
     /// itself is not guarded: central difference's own error at a Courant number near 1 is a
     /// few per cent on the wave problems (strip_wall 2.7 %, theory 7), created by no one.
     fn energy_created(&self) -> Option<String> {
-        let explicit = matches!(&self.model.analysis,
-            crate::scene::model::Analysis::Dynamic(spec)
-                if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference);
-        if !explicit {
+        if !self.model.is_explicit() {
             return None;
         }
         let e = self.stepper.energies();

@@ -886,9 +886,7 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
 /// Whether the history has `friction_work`: central difference with a Coulomb pair (the
 /// implicit paths book the friction's dissipation in `contact_work`).
 pub(super) fn friction_column(model: &Model) -> bool {
-    let explicit = matches!(&model.analysis, crate::scene::model::Analysis::Dynamic(d)
-        if d.integrator == crate::scene::spec::IntegratorKind::CentralDifference);
-    explicit
+    model.is_explicit()
         && (model.contacts.iter()).any(|c| matches!(c.options.friction, Friction::Coulomb { .. }))
 }
 
