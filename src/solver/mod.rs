@@ -1,7 +1,9 @@
 //! Sparse symmetric solves with faer: the symbolic Cholesky analysis once per topology, a
 //! numeric factorization only when K* changes, back-substitutions as often as needed, and the
 //! entries of K*^-1 among the contact equations from paths of the elimination tree
-//! (docs/theory.md 8.6).
+//! (docs/theory.md 8.6). An indefinite K* (a tangent past a limit point) is factored by
+//! L D L^T and kept as L |D|^(1/2) with the signs of D, so the same tree solves serve it
+//! (docs/theory.md 5a).
 //!
 //! The matrix is stored as its lower triangle in compressed sparse columns (`Pattern`); the
 //! assembly writes into `values` through precomputed positions.
@@ -10,6 +12,7 @@ pub mod lanczos;
 
 use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltError as LltFactorError;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
@@ -137,14 +140,20 @@ pub enum SolverError {
         "the stiffness matrix is not positive definite (pivot at free DOF {index}): a mechanism, missing supports or a buckled state"
     )]
     NotPositiveDefinite { index: usize },
+    /// L D L^T met a pivot at round-off of its column's diagonal: K* is singular (a
+    /// mechanism, or missing supports).
+    #[error(
+        "the stiffness matrix is singular (pivot at free DOF {index}): a mechanism or missing supports"
+    )]
+    Singular { index: usize },
     #[error("sparse factorization failed: {0}")]
     Factorization(String),
 }
 
 /// Sparse Cholesky with the symbolic analysis reused and counters for the summary.
 ///
-/// faer's LL^T: the symbolic analysis (AMD ordering, supernodes) once per pattern, the
-/// numeric factor in `values` once per K*.
+/// faer's LL^T (L D L^T where asked and needed, `factor_indefinite`): the symbolic analysis
+/// (AMD ordering, supernodes) once per pattern, the numeric factor in `values` once per K*.
 pub struct Solver {
     /// The matrix's pattern, shared with the system that assembles it.
     pattern: Arc<Pattern>,
@@ -152,6 +161,11 @@ pub struct Solver {
     symbolic: Option<Symbolic>,
     /// The values of L of the last successful factorization (empty: none).
     values: Vec<f64>,
+    /// Where the last factorization was L D L^T (`factor_indefinite`): the signs of D, per
+    /// column of the factor (`signed_root`).
+    signs: Option<Vec<f64>>,
+    /// The negative pivots of the last factorization (0 where L L^T succeeded).
+    pub negative_pivots: usize,
     pub factorizations: usize,
     pub solves: usize,
     /// Entries of K^-1 among the equations the contact rows have named, for the current
@@ -292,6 +306,8 @@ struct Path {
     /// Segment k is `values[ends[k - 1]..ends[k]]` (from 0 for k = 0).
     ends: Vec<usize>,
     values: Vec<f64>,
+    /// S y_a where the factor is of an indefinite matrix (`signed_root`), else empty.
+    signed: Vec<f64>,
 }
 
 impl Path {
@@ -300,13 +316,34 @@ impl Path {
         &self.values[start..self.ends[k]]
     }
 
+    /// S y_a's segment k (y_a's where the factor is definite).
+    fn signed_segment(&self, k: usize) -> &[f64] {
+        if self.signed.is_empty() {
+            return self.segment(k);
+        }
+        let start = if k == 0 { 0 } else { self.ends[k - 1] };
+        &self.signed[start..self.ends[k]]
+    }
+
+    /// Forms S y_a from the signs of the factor's columns.
+    fn sign(&mut self, factor: TreeFactor<'_>, signs: &[f64]) {
+        self.signed = self.values.clone();
+        let mut at = 0;
+        for &block in &self.blocks {
+            for column in factor.columns(block) {
+                self.signed[at] *= signs[column];
+                at += 1;
+            }
+        }
+    }
+
     /// (block, segment of y) along the path.
     fn segments(&self) -> impl Iterator<Item = (usize, &[f64])> {
         (0..self.blocks.len()).map(|k| (self.blocks[k], self.segment(k)))
     }
 }
 
-/// y_a . y_b over the blocks both paths hold, their common ancestors. Two paths to the root
+/// y_a . S y_b over the blocks both paths hold, their common ancestors. Two paths to the root
 /// of a tree share a suffix: from the block where they meet up to the root they are the same
 /// blocks with segments of the same length, and below it they hold none in common. The
 /// suffix's length is found by bisection, and the sum runs over it alone, block by block in
@@ -329,10 +366,15 @@ fn path_dot(a: &Path, b: &Path) -> f64 {
     let (ia, ib) = (na - common, nb - common);
     let from = |p: &Path, k: usize| if k == 0 { 0 } else { p.ends[k - 1] };
     let (sa, sb) = (from(a, ia), from(b, ib));
+    let b_values = if b.signed.is_empty() {
+        &b.values
+    } else {
+        &b.signed
+    };
     if a.values.len() - sa == common {
         // single columns (a simplicial factor): the suffix is one contiguous run
         let mut sum = 0.0;
-        for (x, y) in a.values[sa..].iter().zip(&b.values[sb..]) {
+        for (x, y) in a.values[sa..].iter().zip(&b_values[sb..]) {
             sum += x * y;
         }
         return sum;
@@ -342,7 +384,7 @@ fn path_dot(a: &Path, b: &Path) -> f64 {
         sum += a
             .segment(ia + k)
             .iter()
-            .zip(b.segment(ib + k))
+            .zip(b.signed_segment(ib + k))
             .map(|(x, y)| x * y)
             .sum::<f64>();
     }
@@ -404,6 +446,8 @@ impl Solver {
             pattern: Arc::clone(pattern),
             symbolic,
             values: Vec::new(),
+            signs: None,
+            negative_pivots: 0,
             factorizations: 0,
             solves: 0,
             inverse: InverseEntries::default(),
@@ -420,7 +464,8 @@ impl Solver {
         }
     }
 
-    /// Numeric factorization of the matrix with the given lower-triangle values.
+    /// Numeric factorization of the matrix with the given lower-triangle values, which must
+    /// be positive definite (L L^T).
     pub fn factor(&mut self, values: &[f64]) -> Result<(), SolverError> {
         let start = std::time::Instant::now();
         let result = self.factor_values(values);
@@ -428,25 +473,116 @@ impl Solver {
         result
     }
 
+    /// Numeric factorization of a symmetric matrix that may be indefinite: L L^T, and where
+    /// it meets a non-positive pivot, L D L^T (`factor_ldlt`); singular where a pivot is at
+    /// round-off of its column's diagonal (`singular_where`). A Newton iteration past a limit or bifurcation
+    /// point, or with a perfectly plastic zone held by the supports, has such a tangent; the
+    /// codes users know factor it and report the negative eigenvalues (Abaqus' "negative
+    /// eigenvalues" warning).
+    pub fn factor_indefinite(&mut self, values: &[f64]) -> Result<(), SolverError> {
+        match self.factor(values) {
+            Err(SolverError::NotPositiveDefinite { .. }) => {
+                let start = std::time::Instant::now();
+                let result = self.factor_ldlt(values);
+                crate::profile::add(crate::profile::Phase::Factorization, start);
+                result
+            }
+            Ok(()) => self.singular_where(values, |l| l * l),
+            other => other,
+        }
+    }
+
+    /// Singular where a pivot of the factor in `values` (`pivot` of its column's first
+    /// entry: L_jj^2 of L L^T, |D_j| of `signed_root`'s) is at most `SINGULAR` of its
+    /// column's diagonal in `matrix`: a mechanism whose round-off pivot came out positive
+    /// passes L L^T, and would move without bound.
+    fn singular_where(
+        &mut self,
+        matrix: &[f64],
+        pivot: impl Fn(f64) -> f64,
+    ) -> Result<(), SolverError> {
+        let Some(symbolic) = &self.symbolic else {
+            return Ok(());
+        };
+        let cholesky = &symbolic.cholesky;
+        let forward = cholesky.perm().map(|p| p.arrays().0);
+        let original = |j: usize| forward.map_or(j, |f| f[j] as usize);
+        let mut j = 0;
+        let mut first = None;
+        for_each_column(cholesky, &mut self.values, |entries| {
+            let i = original(j);
+            let diagonal = self.pattern.position(i, i).map_or(0.0, |k| matrix[k].abs());
+            if first.is_none() && pivot(entries[0]) <= SINGULAR * diagonal {
+                first = Some(i);
+            }
+            j += 1;
+        });
+        match first {
+            Some(index) => {
+                self.values.clear();
+                Err(SolverError::Singular { index })
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// L D L^T of `values`, stored as L |D|^(1/2) with the signs of D beside it
+    /// (`signed_root`); singular where a pivot is round-off (`singular_where`).
+    fn factor_ldlt(&mut self, values: &[f64]) -> Result<(), SolverError> {
+        let mut factor = std::mem::take(&mut self.values);
+        let Some(symbolic) = &self.symbolic else {
+            return Ok(());
+        };
+        let cholesky = &symbolic.cholesky;
+        sized(&mut factor, cholesky.len_val())?;
+        let par = faer::get_global_parallelism();
+        let scratch = cholesky.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
+        let mut buffer = workspace(scratch)?;
+        let a = SparseColMatRef::new(self.matrix(), values);
+        cholesky
+            .factorize_numeric_ldlt::<f64>(
+                &mut factor,
+                a,
+                Side::Lower,
+                LdltRegularization::default(),
+                par,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|e| {
+                // (faer's index may be one past the last column)
+                let faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } = e;
+                let index = index.min(cholesky.nrows() - 1);
+                let index = cholesky
+                    .perm()
+                    .map_or(index, |p| p.arrays().0[index] as usize);
+                SolverError::Singular { index }
+            })?;
+        let signs = signed_root(cholesky, &mut factor);
+        self.values = factor;
+        // L~'s diagonal is |D|^(1/2)
+        self.singular_where(values, |root| root * root)?;
+        self.negative_pivots = signs.iter().filter(|s| **s < 0.0).count();
+        self.signs = Some(signs);
+        Ok(())
+    }
+
     fn factor_values(&mut self, values: &[f64]) -> Result<(), SolverError> {
         // the last factor's buffer is reused (one factor in memory at a time); it is left
         // empty, i.e. not factored, until the new factorization succeeds
         let mut factor = std::mem::take(&mut self.values);
         self.inverse.clear();
+        self.signs = None;
+        self.negative_pivots = 0;
         self.factorizations += 1;
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
         };
         let cholesky = &symbolic.cholesky;
-        factor.clear();
-        factor
-            .try_reserve_exact(cholesky.len_val())
-            .map_err(|_| SolverError::Factorization("out of memory for the factor".into()))?;
-        factor.resize(cholesky.len_val(), 0.0);
+        sized(&mut factor, cholesky.len_val())?;
         let par = faer::get_global_parallelism();
         let scratch = cholesky.factorize_numeric_llt_scratch::<f64>(par, Default::default());
-        let mut buffer = MemBuffer::try_new(scratch)
-            .map_err(|_| SolverError::Factorization("out of memory for the workspace".into()))?;
+        let mut buffer = workspace(scratch)?;
         let a = SparseColMatRef::new(self.matrix(), values);
         cholesky
             .factorize_numeric_llt::<f64>(
@@ -489,9 +625,14 @@ impl Solver {
         };
         let start = std::time::Instant::now();
         let inverse_perm = self.permutation().map(|p| p.arrays().1);
+        let signs = self.signs.as_deref();
         let path = |(work, below, grown): &mut (Vec<f64>, Vec<f64>, Path), eq: usize| {
             let row = inverse_perm.map_or(eq, |inv| inv[eq] as usize);
-            forward_path(factor, row, work, below, grown)
+            let mut path = forward_path(factor, row, work, below, grown);
+            if let Some(signs) = signs {
+                path.sign(factor, signs);
+            }
+            path
         };
         let scratch = || (vec![0.0; self.pattern.size], Vec::new(), Path::default());
         let paths: Vec<Path> = if new.len() >= PARALLEL_PATHS_FROM {
@@ -574,6 +715,8 @@ impl Solver {
     /// (K^-1 r)_a = y_a . w                  (y_a = L^-1 P e_a, from know_inverse)
     /// K^-1 (r + sum_a v_a e_a) = P^T L^-T (w + sum_a v_a y_a)
     /// ```
+    /// (with S between: y_a . S w and P^T L~^-T S (...) for an indefinite matrix's factor,
+    /// `signed_root`).
     pub fn forward(&self, rhs: &[f64]) -> Forward {
         let start = std::time::Instant::now();
         let mut x = match self.permutation() {
@@ -594,9 +737,10 @@ impl Solver {
     pub fn solution_entry(&self, w: &Forward, equation: usize) -> f64 {
         let path = &self.inverse.paths[self.inverse_local(equation)];
         let factor = self.tree().expect("equations known: a factor at hand");
-        path.segments()
-            .map(|(block, y)| {
-                let w = &w.0[factor.columns(block)];
+        (0..path.blocks.len())
+            .map(|k| {
+                let w = &w.0[factor.columns(path.blocks[k])];
+                let y = path.signed_segment(k);
                 y.iter().zip(w).map(|(a, b)| a * b).sum::<f64>()
             })
             .sum()
@@ -613,11 +757,15 @@ impl Solver {
         }
     }
 
-    /// The second half of the back-substitution: P^T L^-T w.
+    /// The second half of the back-substitution: P^T L^-T w (P^T L~^-T S w of an indefinite
+    /// matrix's factor, `signed_root`).
     pub fn backward(&mut self, w: Forward) -> Vec<f64> {
         self.solves += 1;
         let start = std::time::Instant::now();
         let mut x = w.0;
+        if let Some(signs) = &self.signs {
+            x.iter_mut().zip(signs).for_each(|(v, s)| *v *= s);
+        }
         match self.tree() {
             Some(TreeFactor::Simplicial(symbolic, values)) => {
                 let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
@@ -666,6 +814,78 @@ impl Solver {
     }
 }
 
+/// Empties `factor` and sizes it to `len` zeros, keeping its allocation where it is large
+/// enough (one factor in memory at a time).
+fn sized(factor: &mut Vec<f64>, len: usize) -> Result<(), SolverError> {
+    factor.clear();
+    factor
+        .try_reserve_exact(len)
+        .map_err(|_| SolverError::Factorization("out of memory for the factor".into()))?;
+    factor.resize(len, 0.0);
+    Ok(())
+}
+
+/// The workspace a numeric factorization asks for.
+fn workspace(scratch: faer::dyn_stack::StackReq) -> Result<MemBuffer, SolverError> {
+    MemBuffer::try_new(scratch)
+        .map_err(|_| SolverError::Factorization("out of memory for the workspace".into()))
+}
+
+/// A pivot of L D L^T at most this share of its column's diagonal is round-off: the matrix
+/// is singular there. A mechanism's pivot is ~1e-16 of the diagonal times the growth of the
+/// elimination (1e-13 on the meshes here); a stiff structure's smallest legitimate ratio is
+/// far above it (nearly incompressible elements without B-bar: 1 - 2 nu ~ 2e-4).
+const SINGULAR: f64 = 1e-11;
+
+/// Turns faer's L D L^T (unit L, D on its diagonal) in `factor` into L |D|^(1/2), a lower
+/// triangle with a positive diagonal like L L^T's, so that the tree solves serve both:
+/// ```text
+/// K = L D L^T = L~ S L~^T,   L~ = L |D|^(1/2),   S = sign(D)
+/// K^-1 = P^T L~^-T S L~^-1 P,    (K^-1)_ab = y_a . S y_b
+/// ```
+/// Returns the signs, per (permuted) column.
+fn signed_root(cholesky: &SymbolicCholesky<Ix>, factor: &mut [f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(cholesky.nrows());
+    for_each_column(cholesky, factor, |entries| {
+        let d = entries[0];
+        let root = d.abs().sqrt();
+        entries[0] = root;
+        entries[1..].iter_mut().for_each(|v| *v *= root);
+        out.push(if d < 0.0 { -1.0 } else { 1.0 });
+    });
+    out
+}
+
+/// Calls `f` with each (permuted) column of the factor's lower triangle in order, its
+/// diagonal entry first, then the entries below it.
+fn for_each_column(
+    cholesky: &SymbolicCholesky<Ix>,
+    factor: &mut [f64],
+    mut f: impl FnMut(&mut [f64]),
+) {
+    match cholesky.raw() {
+        SymbolicCholeskyRaw::Simplicial(simplicial) => {
+            let col_ptr = simplicial.col_ptr();
+            for j in 0..simplicial.nrows() {
+                f(&mut factor[col_ptr[j] as usize..col_ptr[j + 1] as usize]);
+            }
+        }
+        SymbolicCholeskyRaw::Supernodal(supernodal) => {
+            let ptr = supernodal.col_ptr_for_val();
+            for s in 0..supernodal.n_supernodes() {
+                let size =
+                    (supernodal.supernode_end()[s] - supernodal.supernode_begin()[s]) as usize;
+                let block = &mut factor[ptr[s] as usize..ptr[s + 1] as usize];
+                let rows = block.len() / size;
+                // column-major: column c's diagonal entry is at row c
+                for c in 0..size {
+                    f(&mut block[c * rows + c..(c + 1) * rows]);
+                }
+            }
+        }
+    }
+}
+
 /// w = L^-1 P r of `Solver::forward`, in the factor's (permuted) order.
 pub struct Forward(Vec<f64>);
 
@@ -698,6 +918,7 @@ fn forward_path(
         blocks: path.blocks.clone(),
         ends: path.ends.clone(),
         values: path.values.clone(),
+        signed: Vec::new(),
     }
 }
 
@@ -791,6 +1012,92 @@ mod tests {
             }
         }
         (pattern, values)
+    }
+
+    /// Goal: an indefinite matrix (a tangent past a limit point) is factored by L D L^T and
+    /// solved, its inverse entries along the tree paths carry the signs of D, its negative
+    /// pivots count its negative eigenvalues (Sylvester's law of inertia), and a singular
+    /// one is refused. Setup: the grids of `inverse_entries_from_tree_paths_match_whole_solves`
+    /// (supernodal and simplicial factors) with their diagonal shifted down by 21.5, between
+    /// the grid's diagonal entries (20 to 26), so that K has negative and positive
+    /// eigenvalues; a 2-spring chain with a free end's mode (singular). References: the
+    /// residual K x - r from the pattern (`symmetric_product`); whole solves K^-1 e_a; the
+    /// eigenvalues of the dense matrix (nalgebra's symmetric eigen-decomposition).
+    /// Tolerances: the residual 1e-9 of |r| (L D L^T without pivoting has no bound on the
+    /// growth of its pivots: 2e-11 on the larger grid, against 1e-15 for L L^T); the
+    /// inverse entries 1e-10 of the largest (the shift brings an eigenvalue near 0: K^-1's
+    /// entries are large and their forward errors grow with the condition number).
+    #[test]
+    fn indefinite_matrices_are_factored_with_their_inertia() {
+        let mut kinds = Vec::new();
+        for (nx, ny) in [(9, 7), (201, 101)] {
+            let (pattern, mut values) = grid(nx, ny);
+            let size = pattern.size;
+            for j in 0..size {
+                values[pattern.position(j, j).unwrap()] -= 21.5;
+            }
+            let mut solver = Solver::new(&Arc::new(pattern.clone())).unwrap();
+            assert!(solver.factor(&values).is_err(), "L L^T refuses it");
+            solver.factor_indefinite(&values).unwrap();
+            kinds.push(is_supernodal(&solver));
+            let x: Vec<f64> = (0..size).map(|i| (i as f64 * 0.7).cos()).collect();
+            let mut r = vec![0.0; size];
+            pattern.symmetric_product(&values, &x, &mut r);
+            let mut solved = r.clone();
+            solver.solve(&mut solved);
+            let mut back = vec![0.0; size];
+            pattern.symmetric_product(&values, &solved, &mut back);
+            let (residual, scale) = back
+                .iter()
+                .zip(&r)
+                .fold((0.0f64, 0.0f64), |(m, s), (a, b)| {
+                    (m.max((a - b).abs()), s.max(b.abs()))
+                });
+            assert!(
+                residual < 1e-9 * scale,
+                "{nx} x {ny}: residual {residual} of {scale}"
+            );
+            let named: Vec<usize> = (0..12).map(|k| (k * 37 + 5) % size).collect();
+            let (worst, largest) = inverse_errors(&mut solver, size, &named);
+            assert!(
+                worst <= 1e-10 * largest,
+                "{nx} x {ny}: {worst} against {largest}"
+            );
+            if size <= 200 {
+                let mut dense = nalgebra::DMatrix::<f64>::zeros(size, size);
+                for j in 0..size {
+                    for k in pattern.col_ptr[j] as usize..pattern.col_ptr[j + 1] as usize {
+                        let i = pattern.row_idx[k] as usize;
+                        dense[(i, j)] = values[k];
+                        dense[(j, i)] = values[k];
+                    }
+                }
+                let eigen = dense.symmetric_eigenvalues();
+                let negative = eigen.iter().filter(|l| **l < 0.0).count();
+                assert!(negative > 0 && negative < size, "{negative}");
+                assert_eq!(solver.negative_pivots, negative);
+            }
+        }
+        assert!(kinds.contains(&true) && kinds.contains(&false), "{kinds:?}");
+        // two springs in a chain, the far end free and nothing holding the first node's
+        // neighbour: K = [[1, -1], [-1, 1]] has the rigid mode (1, 1)
+        let elements = [vec![Some(0), Some(1)]];
+        let pattern = Pattern::from_elements(2, elements.iter().map(|e| e.as_slice()));
+        let mut values = vec![0.0; pattern.nonzeros()];
+        for (p, v) in pattern
+            .scatter(&elements[0])
+            .iter()
+            .zip([1.0, -1.0, -1.0, 1.0])
+        {
+            if *p != usize::MAX {
+                values[*p] += v;
+            }
+        }
+        let mut solver = Solver::new(&Arc::new(pattern)).unwrap();
+        assert!(matches!(
+            solver.factor_indefinite(&values),
+            Err(SolverError::Singular { .. })
+        ));
     }
 
     /// Goal: the entries of K^-1 from the partial forward solves along the elimination tree
