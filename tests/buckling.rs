@@ -363,6 +363,15 @@ fn load_stepping_perfect_column_loses_definiteness_at_euler_load() {
         ratio > 1.0 && ratio < 1.02,
         "P / P_E = {ratio} at the change"
     );
+    // the crossing is said, not only counted (it once passed silently, status `ok`)
+    assert!(
+        summary
+            .warnings
+            .iter()
+            .any(|w| w.contains("negative pivots went from 0 to 1")),
+        "{:?}",
+        summary.warnings
+    );
     // history.csv: zero negative pivots up to the change, one from there on
     let dir = common::tests_root().join("stepped_perfect");
     let time = common::column(&dir, "time");

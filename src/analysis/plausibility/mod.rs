@@ -211,10 +211,32 @@ pub fn warnings(
 ) -> Vec<String> {
     let mut out = setup::setup_warnings_given(model, first_step);
     if summary.step_cuts > 0 {
+        // statics takes its increments as a count, dynamics as a length
+        let shorter = match model.analysis {
+            Analysis::Static(_) => "more analysis.steps",
+            Analysis::Dynamic(_) => "a smaller analysis.dt",
+        };
         out.push(format!(
-            "{} step cut(s): Newton did not converge in the nominal step there; a smaller \
-             analysis.dt (or analysis.newton settings) avoids them",
+            "{} step cut(s): Newton did not converge in the nominal step there; {shorter} (or \
+             analysis.newton settings) avoids them",
             summary.step_cuts
+        ));
+    }
+    if let Some(b) = &summary.buckling
+        && let (Some(t), Some(from), Some(to), false) = (
+            b.inertia_change_time,
+            b.initial_negative_pivots,
+            b.negative_pivots_at_change,
+            b.stopped,
+        )
+    {
+        out.push(format!(
+            "the tangent's negative pivots went from {from} to {to} at t = {}: the structure \
+             passed a buckling or limit point there, and the run went on along the path it \
+             was on (a perfect structure stays on its unstable primary path; an imperfection, \
+             [analysis.buckling] imperfection, finds the buckled one; on_critical = \"stop\" \
+             ends the run there)",
+            readable(t)
         ));
     }
     let drift = summary.energy.max_relative_drift;

@@ -216,8 +216,8 @@ fn start_speed(model: &Model, body: &Body) -> Option<(f64, f64)> {
 /// What a failed run's state says of its units: a yield strain outside
 /// [`YIELD_STRAIN_RANGE`], a node faster than [`SPEED_SHARE`] of its body's wave speed
 /// (`velocity`, all DOFs),
-/// more than [`MAX_STEPS`] central-difference stable steps to the end time (None: nothing
-/// points to units).
+/// more than [`MAX_STEPS`] central-difference stable steps to the end time of a dynamic run
+/// (None: nothing points to units).
 pub fn units_at_failure(model: &Model, velocity: &[f64]) -> Option<String> {
     let mut signs = Vec::new();
     for body in &model.bodies {
@@ -247,9 +247,11 @@ pub fn units_at_failure(model: &Model, velocity: &[f64]) -> Option<String> {
             ));
         }
     }
+    // (a static run's pseudo time has no stable step to compare with)
+    let dynamic = matches!(model.analysis, crate::scene::model::Analysis::Dynamic(_));
     let first_step = critical_time_step(model).map_or(0.0, |s| s.dt);
     let steps = model.analysis.end_time() / first_step;
-    if first_step > 0.0 && steps > MAX_STEPS {
+    if dynamic && first_step > 0.0 && steps > MAX_STEPS {
         signs.push(format!(
             "the run would take {} stable steps of {} to end_time = {}: the end time and the \
              stable step are in different units",

@@ -742,6 +742,7 @@ impl Attempt<'_> {
             external: &external,
             internal_start: self.last_internal,
             factor_first,
+            predictor: false,
             error_target: self.error_target.map(|fraction| fraction * h),
             contact: Some(Constraints {
                 pairs: self.pairs,

@@ -6,8 +6,9 @@
 //! d          displacement increment since the last converged configuration
 //! ```
 //! An increment that does not converge in `max_iterations` (or meets an inverted element or a
-//! tangent that is not positive definite) is halved, at most `max_cuts` times in a row; then
-//! the run stops `diverged` with its output so far kept. After a cut the step grows back. An
+//! singular tangent) is halved, at most `max_cuts` times in a row; then the run stops
+//! `diverged` with its output so far kept. After a cut the length is kept, and grows by half
+//! after two increments in a row succeed (`StepControl::accept_patiently`). An
 //! event inside an increment ends it early (Erklig 2.1.4: alpha brings the next node exactly
 //! into contact before the boundary conditions change).
 
@@ -141,6 +142,7 @@ impl Increment<'_> {
             external: &external,
             internal_start: self.last_force,
             factor_first: self.factor_first,
+            predictor: true,
             error_target: None,
             contact: Some(Constraints {
                 pairs: &model.contacts,
@@ -228,7 +230,7 @@ impl Stepper for Statics<'_> {
                     energies.plastic_work = self.state.plastic_work;
                     self.last_force = force;
                     self.increments += 1;
-                    self.control.accept(end == target);
+                    self.control.accept_patiently(end == target);
                     return Ok(());
                 }
                 Err(StepFailure(reason)) => {

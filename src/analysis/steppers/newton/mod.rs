@@ -28,7 +28,7 @@ use crate::integrator::StepForm;
 use crate::profile::{self, Phase};
 use crate::scene::Model;
 use crate::scene::spec::{ActiveSetSolve, NewtonSpec, Strategy, Tangent, Updates};
-use crate::solver::Solver;
+use crate::solver::{Solver, SolverError};
 use active_set::ActiveSet;
 use constrained::{Rows, add_constraint_forces, constrained_solve};
 use secant::Secant;
@@ -83,6 +83,8 @@ pub struct Step<'a> {
     pub internal_start: &'a [f64],
     /// Factor at the first iteration (else the solver's factorization is reused).
     pub factor_first: bool,
+    /// Start from the tangent predictor where the step prescribes motion (`Predictor`).
+    pub predictor: bool,
     /// Implicit `dt = "auto"`: a correction size (the largest DOF's, a displacement) below
     /// which the iteration has converged, a fraction of the local error the step may make
     /// (theory 8.2a); the force test still holds. None: Erklig's tests alone.
@@ -285,6 +287,51 @@ fn remaining(eps_last: f64, ratio: f64) -> f64 {
     }
 }
 
+/// The tangent predictor of a step that prescribes motion (theory 5a; the first iteration
+/// of a displacement-controlled increment in Abaqus): the prescribed increment u_p
+/// enters the first correction through the tangent at the step's start,
+/// K_ff delta_f = R_f(0) - K_fp u_p, not through the residual at (0, u_p), where only the
+/// elements beside the prescribed nodes deform: their strain there is u_p over one element,
+/// a spike a mesh-refinement makes larger (the homogeneous J2 block compressed between
+/// rollers yielded in its top row of elements and did not converge from it on 20 x 20
+/// elements, however short the increment). K_fp u_p is the residual's directional
+/// derivative, R_f(0) - (R_f(eps u_p) - R_f(0)) / eps: one evaluation without a matrix.
+struct Predictor {
+    /// The step's start: the prescribed increments zeroed.
+    start: Vec<f64>,
+    /// The start moved by the share `PROBE` of the prescribed increments.
+    probe: Vec<f64>,
+}
+
+/// The share of the prescribed increment the directional derivative moves by: its
+/// truncation error is this share of the increment's strain (1e-8 at 1 % strain), its
+/// round-off 1e-16 |f_int| / (PROBE |K u_p|), below 1e-9 while the stresses stay below
+/// a tenth of E and the increment's strain above 1e-7 of them.
+const PROBE: f64 = 1e-6;
+
+impl Predictor {
+    /// The predictor of the start value `d`, where its free DOFs are zero (not a warm start)
+    /// and some prescribed DOF moves.
+    fn of(d: &[f64], system: &System) -> Option<Predictor> {
+        let free = |dof: usize| system.equation[dof].is_some();
+        let cold = d.iter().enumerate().all(|(dof, v)| !free(dof) || *v == 0.0);
+        if !cold || d.iter().all(|v| *v == 0.0) {
+            return None;
+        }
+        Some(Predictor {
+            start: vec![0.0; d.len()],
+            probe: d.iter().map(|v| PROBE * v).collect(),
+        })
+    }
+
+    /// Turns R_f(0) in `residual` into R_f(0) - K_fp u_p from `moved` = R_f(PROBE u_p).
+    fn extrapolate(&self, residual: &mut [f64], moved: &[f64]) {
+        for (r, m) in residual.iter_mut().zip(moved) {
+            *r += (m - *r) / PROBE;
+        }
+    }
+}
+
 /// Stiffness-proportional damping matrix of the step (the tangent at D = 0), free DOFs.
 struct Damping {
     values: Vec<f64>,
@@ -397,12 +444,18 @@ impl Step<'_> {
         // the remaining correction in absolute terms, for the error target
         let mut correction = f64::INFINITY;
         let mut relaxation = Relaxation::new();
+        let mut predictor = self.predictor.then(|| Predictor::of(&d, system)).flatten();
         for iteration in 0..=newton.max_iterations {
-            let refactor =
-                newton.strategy == Strategy::Full || (iteration == 0 && self.factor_first);
-            let evaluation = self.evaluate(state, &d, refactor.then_some(&mut *system))?;
+            let refactor = newton.strategy == Strategy::Full
+                || (iteration == 0 && (self.factor_first || predictor.is_some()));
+            // the first iteration of a predicted step linearizes about the step's start
+            let at = predictor.as_ref().map_or(&d, |p| &p.start);
+            let evaluation = self.evaluate(state, at, refactor.then_some(&mut *system))?;
             let (mut residual, forces_scale) =
-                self.residual(&d, &evaluation, system, &damping, external_norm);
+                self.residual(at, &evaluation, system, &damping, external_norm);
+            if let Some(p) = &predictor {
+                self.predict(state, p, system, &damping, &mut residual)?;
+            }
             let (rows, settled) = self.contact_rows(&d, system, &mut active_set, &mut forces)?;
             // R alone, without the contact and friction forces: K* is its derivative
             let own = secant.enabled().then(|| residual.clone());
@@ -449,13 +502,9 @@ impl Step<'_> {
             if iteration == newton.max_iterations {
                 break;
             }
-            let stalled = iteration > 0
-                && self.stalled(
-                    iteration,
-                    residual_norm / previous_residual,
-                    residual_norm,
-                    test.scale,
-                );
+            let ratio = residual_norm / previous_residual;
+            let stalled =
+                iteration > 0 && self.stalled(iteration, ratio, residual_norm, test.scale);
             if refactor || stalled || !solver.is_factored() {
                 if !refactor {
                     // the same state again, now with the tangent assembled
@@ -477,6 +526,7 @@ impl Step<'_> {
                 set.take(&forces);
             }
             counters.iterations += 1;
+            predictor = None;
             system.scatter_add(&delta, &mut d);
             (correction, eps_displacement) = correction_sizes(&delta, &d);
             previous_residual = residual_norm;
@@ -486,6 +536,23 @@ impl Step<'_> {
             "no convergence in {} iterations",
             newton.max_iterations
         )))
+    }
+
+    /// Turns the first residual of a predicted step, R_f at its start, into
+    /// R_f(0) - K_fp u_p (`Predictor`).
+    fn predict(
+        &self,
+        state: &State,
+        p: &Predictor,
+        system: &System,
+        damping: &Option<Damping>,
+        residual: &mut [f64],
+    ) -> Result<(), StepFailure> {
+        let probe = self.evaluate(state, &p.probe, None)?;
+        // (the force scale, which the external norm enters, is not needed)
+        let (moved, _) = self.residual(&p.probe, &probe, system, damping, 0.0);
+        p.extrapolate(residual, &moved);
+        Ok(())
     }
 
     /// The stiffness-proportional damping matrix of the step (the tangent at the start),
@@ -552,7 +619,7 @@ impl Step<'_> {
         })
     }
 
-    /// Factors K* from the tangent assembled in `system`.
+    /// Factors K* from the tangent assembled in `system` (indefinite accepted, theory 5a).
     fn factor(
         &self,
         system: &mut System,
@@ -563,9 +630,26 @@ impl Step<'_> {
         // any residual look small next to a rigid motion)
         system.diagonal_max = system.diagonal().fold(0.0, f64::max);
         self.effective(system, damping);
-        solver
-            .factor(&system.values)
-            .map_err(|e| StepFailure(e.to_string()))
+        let result = solver.factor_indefinite(&system.values);
+        result.map_err(|e| match e {
+            SolverError::Singular { index } => StepFailure(format!(
+                "the stiffness matrix is singular at {}: a mechanism or missing supports",
+                self.free_dof(system, index)
+            )),
+            other => StepFailure(other.to_string()),
+        })
+    }
+
+    /// The free equation `index` in the user's words: the body, node and component.
+    fn free_dof(&self, system: &System, index: usize) -> String {
+        match system.equation.iter().position(|e| *e == Some(index)) {
+            Some(dof) => format!(
+                "the {} DOF of {}",
+                ["x", "y"][dof % 2],
+                self.model.describe_node(dof / 2)
+            ),
+            None => format!("free DOF {index}"),
+        }
     }
 
     /// Whether the iteration should refactor: the residual stops contracting (`ratio` of the
