@@ -431,3 +431,32 @@ fn a_given_reference_scores_every_case() {
         approx::assert_relative_eq!(error, (u - exact) / exact.abs(), max_relative = 1e-12);
     }
 }
+
+/// Goal: `--jobs 1` runs one case at a time (it once ran every case at once: a rayon thread
+/// waiting on a case's own one-thread pool stole the next cases meanwhile). Setup: three
+/// two_bars cases (n = 300, 400, 500 rods per bar, 0.1-0.3 s each, well above the sweep's
+/// own work) with `jobs = 1`. Reference: cases run one
+/// after another take, together, no more wall time than the sweep around them (each case's
+/// wall is measured inside it); run at once, their walls overlap and add up to more (the
+/// three-case sweep of taylor_jc: 1.31 s around 0.22 + 0.61 + 1.24 s).
+#[test]
+fn one_job_runs_one_case_at_a_time() {
+    let dir = common::out_dir("sweep_one_job");
+    let p = plan(
+        "two_bars",
+        &[],
+        &[
+            "body.bar1.mesh.n,body.bar2.mesh.n,analysis.dt=300,300,0.0008;400,400,0.0006;500,500,0.0005",
+        ],
+    );
+    let start = std::time::Instant::now();
+    let report = sweep::run(&p, &dir, options(1, None), &[]).unwrap();
+    let around = start.elapsed().as_secs_f64();
+    assert_eq!(report.executed, 3);
+    let cases: f64 = report.rows.iter().map(|r| r.wall_seconds.unwrap()).sum();
+    eprintln!("cases {cases} around {around}");
+    assert!(
+        cases <= around,
+        "cases {cases} s inside a sweep of {around} s"
+    );
+}

@@ -30,7 +30,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use measure::CaseRecord;
 pub use plan::{Case, Plan, Variation};
 pub use qoi::Measure;
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -146,27 +145,45 @@ pub fn run(
     } else {
         ProgressBar::hidden()
     };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.jobs)
-        .build()
-        .map_err(|e| output_error(dir, "start the threads of", std::io::Error::other(e)))?;
-    let results: Vec<Result<(), RunError>> = pool.install(|| {
-        todo.par_iter()
-            .map(|&k| {
-                let result = run_case(plan, &cases[k], &models[k], dir, options.frames);
-                if options.progress != Mode::Off
-                    && let Ok(record) = &result
-                {
-                    let line = case_line(record, cases.len());
-                    if bar.is_hidden() {
-                        console::err(format_args!("{line}"));
-                    } else {
-                        bar.println(line);
-                    }
+    // `jobs` workers take the cases one at a time from a shared counter. Not a rayon pool
+    // over the cases: a case runs inside its own one-thread pool, and a rayon thread that
+    // waits on another pool steals more cases of its own meanwhile, so `--jobs 1` ran every
+    // case at once.
+    let jobs = if options.jobs == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        options.jobs
+    };
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let run_next = || {
+        let mut done = Vec::new();
+        loop {
+            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let Some(&k) = todo.get(i) else {
+                return done;
+            };
+            let result = run_case(plan, &cases[k], &models[k], dir, options.frames);
+            if options.progress != Mode::Off
+                && let Ok(record) = &result
+            {
+                let line = case_line(record, cases.len());
+                if bar.is_hidden() {
+                    console::err(format_args!("{line}"));
+                } else {
+                    bar.println(line);
                 }
-                bar.inc(1);
-                result.map(|_| ())
-            })
+            }
+            bar.inc(1);
+            done.push(result.map(|_| ()));
+        }
+    };
+    let results: Vec<Result<(), RunError>> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..jobs.min(todo.len()))
+            .map(|_| scope.spawn(run_next))
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().expect("a sweep worker panicked"))
             .collect()
     });
     bar.finish_and_clear();
