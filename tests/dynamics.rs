@@ -655,7 +655,43 @@ fn implicit_steps_land_exactly_on_end_time_and_frame_times() {
         for t in &listed {
             assert!(times.contains(t), "dt {dt}: no history row at {t:e}");
         }
+        // each frame file carries its own time (ParaView shows it without the .pvd)
+        for ((_, path), t) in frames.iter().zip(&expected) {
+            assert_eq!(time_value(path), *t, "dt {dt}: {}", path.display());
+        }
     }
+}
+
+/// Goal: `frame_interval` alone replaces the frames per step (it once came on top of them:
+/// 1 783 frames where the interval asked for 7). Setup: `ROUND_OFF_ROD` without its
+/// `frame_every = 0`, dt = 1e-6 (100 steps). Reference: the scene's numbers: the initial
+/// frame, the 33 multiples of 3e-6 up to 1e-4, and the end.
+#[test]
+fn a_frame_interval_replaces_the_frames_per_step() {
+    let text = ROUND_OFF_ROD.replace("frame_every = 0\n", "");
+    assert!(!text.contains("frame_every"));
+    let model = common::model("interval_alone", &text, &["analysis.dt=1e-6"]);
+    common::run("interval_alone", &model);
+    let dir = common::out_dir_of("interval_alone");
+    let frames = impact::output::vtk::read_pvd(&dir.join("interval_alone.pvd")).unwrap();
+    assert_eq!(frames.len(), 1 + 33 + 1);
+}
+
+/// The `TimeValue` field data of a .vtu frame, read from its XML header.
+fn time_value(path: &std::path::Path) -> f64 {
+    let bytes = std::fs::read(path).unwrap();
+    let end = bytes
+        .windows(13)
+        .position(|w| w == b"<AppendedData")
+        .unwrap_or(bytes.len());
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    let at = header
+        .find("Name=\"TimeValue\"")
+        .unwrap_or_else(|| panic!("{}: no TimeValue", path.display()));
+    let rest = &header[at..];
+    let open = rest.find('>').unwrap() + 1;
+    let close = rest.find("</DataArray>").unwrap();
+    rest[open..close].trim().parse().unwrap()
 }
 
 /// A fixed-free rod of `n` lumped-mass elements (E = A = L = 1, rho = 1) started in its first

@@ -209,7 +209,7 @@ impl Series {
         let file_name = format!("{}_{:05}.vtu", self.name, self.frames());
         let path = self.dir.join("vtk").join(&file_name);
         self.check_time(&path, time)?;
-        let payload = payload(&path, grid, fields)?;
+        let payload = payload(&path, grid, fields)?.at_time(time);
         if !self.background {
             write_atomic_parts(&path, &payload.into_parts(self.compression))?;
             self.entries

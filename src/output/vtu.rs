@@ -186,6 +186,9 @@ pub struct Payload {
     /// The point data array named as the active vectors (Warp By Vector picks it).
     vectors: Option<&'static str>,
     arrays: Vec<Array>,
+    /// The frame's time, written as the grid's `TimeValue` field (ParaView's reader shows
+    /// it for a .vtu opened alone, without the .pvd).
+    time: Option<f64>,
 }
 
 impl Payload {
@@ -233,7 +236,14 @@ impl Payload {
             cells: grid.cells(),
             vectors,
             arrays,
+            time: None,
         })
+    }
+
+    /// The payload with the frame's `time` (written as the `TimeValue` field data).
+    pub fn at_time(mut self, time: f64) -> Payload {
+        self.time = Some(time);
+        self
     }
 
     /// The file as consecutive parts (XML header, the arrays' blocks, the closing tags),
@@ -257,6 +267,12 @@ impl Payload {
             header.push_str(&format!(" compressor=\"{compressor}\""));
         }
         header.push_str(">\n  <UnstructuredGrid>\n");
+        if let Some(time) = self.time {
+            // the shortest text that reads back as the same f64 (Rust's Display)
+            header.push_str(&format!(
+                "    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">{time:?}</DataArray>\n    </FieldData>\n"
+            ));
+        }
         header.push_str(&format!(
             "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
             self.points, self.cells
@@ -525,6 +541,8 @@ pub fn read_frame(path: &Path) -> Result<FrameData, OutputError> {
         arrays: Vec::new(),
     };
     let mut section = None;
+    // the grid's field data (the frame's `TimeValue`) is not a frame array
+    let mut field_data = false;
     for tag in header.split('<').skip(1) {
         let tag = tag.split('>').next().unwrap_or_default();
         let (element, rest) = tag.split_once(char::is_whitespace).unwrap_or((tag, ""));
@@ -559,6 +577,9 @@ pub fn read_frame(path: &Path) -> Result<FrameData, OutputError> {
             "CellData" => section = Some(Section::CellData),
             "Points" => section = Some(Section::Points),
             "Cells" => section = Some(Section::Cells),
+            "FieldData" => field_data = true,
+            "/FieldData" => field_data = false,
+            "DataArray" if field_data => {}
             "DataArray" => {
                 let section = section.ok_or_else(|| bad("a DataArray outside a section".into()))?;
                 let name = attribute("Name").unwrap_or_default().to_string();

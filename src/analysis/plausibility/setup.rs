@@ -276,8 +276,8 @@ pub fn expected_frames(model: &Model, auto_step: Option<f64>) -> f64 {
                 .unwrap_or(0.0),
         },
     };
-    let every = if output.frame_every > 0 {
-        (steps / output.frame_every as f64).ceil()
+    let every = if output.frame_every() > 0 {
+        (steps / output.frame_every() as f64).ceil()
     } else {
         0.0
     };

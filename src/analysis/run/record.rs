@@ -84,7 +84,7 @@ impl Recorder {
             action: "create folder",
             source,
         })?;
-        let wanted = model.output.frame_every > 0 || !model.output.frame_times.is_empty();
+        let wanted = model.output.frame_every() > 0 || !model.output.frame_times.is_empty();
         let series = if frames && wanted {
             let mut series = Series::create(dir, &model.name, model.output.compression)?;
             write_obstacles(model, dir)?;
@@ -106,7 +106,7 @@ impl Recorder {
             series,
             history,
             thinning: Thinning::new(model.history_cadence()),
-            frame_every: model.output.frame_every,
+            frame_every: model.output.frame_every(),
             steps_since_frame: 0,
             last_frame_time: None,
             pivots_column,
@@ -175,7 +175,7 @@ impl Recorder {
             series,
             history,
             thinning: Thinning::resume(model.history_cadence(), position.history_window),
-            frame_every: model.output.frame_every,
+            frame_every: model.output.frame_every(),
             steps_since_frame: position.steps_since_frame,
             last_frame_time: position.last_frame_time,
             pivots_column,
