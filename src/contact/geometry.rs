@@ -2,6 +2,7 @@
 //! Greco & Coda 2003, section 2). The solver owns the system; this file only says where the
 //! slaves are, how far from their masters, and along which direction (legend in `contact`).
 
+use super::grid::SegmentGrid;
 use super::mortar::{MortarSurface, master_node_gap, weighted_gap};
 use crate::mesh::plane::{dot, outward, sub};
 
@@ -80,12 +81,16 @@ pub struct PairOptions {
     /// it closed with, so an open slave that starts inside its master counts as penetrating
     /// only when it goes deeper.
     pub persistency: bool,
-    /// A slave beyond the end of its master surface and outside the master body gets its
-    /// distance from that end (`ContactPair::node_gap`), not its distance along the surface's
-    /// extension: the passes of a balanced pair, where every node of both surfaces is a
-    /// slave and those beside the other body must not read its face extended. One-pass pairs
-    /// keep the extension, with which the seeds' scenes were validated.
-    pub distance_beyond_ends: bool,
+    /// The geometry of a balanced pair's passes (`ContactPair::node_gap`), where every node
+    /// of both surfaces is a slave: (1) a slave beyond the end of its master surface and
+    /// outside the master body gets its distance from that end, not its distance along the
+    /// surface's extension (those beside the other body must not read its face extended);
+    /// (2) the row's normal is the master segment's own, the gradient of the gap (the signed
+    /// distance to the master polygon), so the contact force does no work on a slave sliding
+    /// along a closed contact (docs/theory.md 8.3d). One-pass pairs keep the extension and
+    /// the normal interpolated between the master nodes' normals, with which the seeds'
+    /// scenes were validated.
+    pub balanced: bool,
 }
 
 /// The tangential law of a contact pair.
@@ -223,11 +228,26 @@ fn gap_to_segments(
     segment: impl Fn(usize) -> [[f64; 2]; 2],
     inside: impl Fn() -> bool,
 ) -> Option<(usize, f64, f64, [f64; 2])> {
-    // (segment, xi, distance, xi interior)
-    let mut best: Option<(usize, f64, f64, bool)> = None;
+    let mut nearest = Nearest { x, best: None };
     for k in 0..count {
-        let [a, b] = segment(k);
-        if let Some((_, _, db, _)) = best {
+        nearest.offer(k, segment(k));
+    }
+    signed_gap(x, nearest.best?, segment, inside)
+}
+
+/// The nearest of the segments offered to `x`: (segment, xi, distance, xi interior). Within
+/// round-off of a tie the interior projection wins, then the lower index: the segments may
+/// be offered in any order (`SegmentGrid::visit`) and give what offering them in index
+/// order gives.
+struct Nearest {
+    x: [f64; 2],
+    best: Option<(usize, f64, f64, bool)>,
+}
+
+impl Nearest {
+    fn offer(&mut self, k: usize, [a, b]: [[f64; 2]; 2]) {
+        let x = self.x;
+        if let Some((_, _, db, _)) = self.best {
             // a segment whose bounding box lies farther than the best distance (and its tie
             // band) cannot win: skip its projection
             let outside = |lo: f64, hi: f64, v: f64| (lo - v).max(v - hi).max(0.0);
@@ -235,28 +255,46 @@ fn gap_to_segments(
             let by = outside(a[1].min(b[1]), a[1].max(b[1]), x[1]);
             let reach = db * (1.0 + 1e-9);
             if bx * bx + by * by > reach * reach {
-                continue;
+                return;
             }
         }
         let (xi, d) = project(x, a, b);
         let interior = xi > 0.0 && xi < 1.0;
-        let better = match best {
+        let better = match self.best {
             None => true,
-            Some((_, _, db, best_interior)) => {
+            Some((bk, _, db, best_interior)) => {
+                let tie = (d - db).abs() <= 1e-12 * db.max(1e-300);
                 d < db - 1e-12 * db.max(1e-300)
-                    || ((d - db).abs() <= 1e-12 * db.max(1e-300) && interior && !best_interior)
+                    || (tie && interior && !best_interior)
+                    || (tie && interior == best_interior && k < bk)
             }
         };
         if better {
-            best = Some((k, xi, d, interior));
+            self.best = Some((k, xi, d, interior));
         }
     }
-    let (k, xi, d, _) = best?;
+
+    fn reach(&self) -> f64 {
+        self.best.map_or(f64::INFINITY, |(_, _, d, _)| d)
+    }
+}
+
+/// The signed gap and normal of `x` at its nearest segment `best` (`Nearest`).
+fn signed_gap(
+    x: [f64; 2],
+    best: (usize, f64, f64, bool),
+    segment: impl Fn(usize) -> [[f64; 2]; 2],
+    inside: impl Fn() -> bool,
+) -> Option<(usize, f64, f64, [f64; 2])> {
+    let (k, xi, d, _) = best;
     let [a, b] = segment(k);
     let n = outward(a, b);
     let p = [a[0] + xi * (b[0] - a[0]), a[1] + xi * (b[1] - a[1])];
     let along_normal = dot(sub(x, p), n);
-    let (gap, normal) = if xi > 0.0 && xi < 1.0 || d == 0.0 {
+    // a point on the vertex itself (within round-off of the segment's length): the
+    // direction to the vertex is noise, the segment's normal is not
+    let on_vertex = d <= 1e-9 * length(sub(b, a));
+    let (gap, normal) = if xi > 0.0 && xi < 1.0 || on_vertex {
         (along_normal, n)
     } else if inside() {
         // penetrated near a vertex: the segment's own normal. The direction to the vertex
@@ -270,6 +308,10 @@ fn gap_to_segments(
     };
     Some((k, xi, gap, normal))
 }
+
+/// The projection parameter within which a balanced pass's slave is on a master vertex
+/// (`ContactPair::node_gap_on`): round-off of the projection of a node lying on it.
+const VERTEX: f64 = 1e-9;
 
 impl ContactPair {
     /// Whether the pair's impact and release conditions act along its rows, all of them
@@ -328,6 +370,17 @@ impl ContactPair {
     /// there is no master within the search distance: the pointwise gap, also of a mortar
     /// pair's nodes (their penetration).
     pub fn node_gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
+        self.node_gap_on(slave, x, None)
+    }
+
+    /// [`ContactPair::node_gap`], the nearest master segment found on `grid` (the master's
+    /// segments at `x`) when given.
+    pub fn node_gap_on(
+        &self,
+        slave: usize,
+        x: &dyn Fn(usize) -> [f64; 2],
+        grid: Option<&SegmentGrid>,
+    ) -> Option<Gap> {
         let xs = x(slave);
         let result = match &self.master {
             Master::Nodes { nodes, normal, .. } => {
@@ -347,14 +400,22 @@ impl ContactPair {
                 let inside =
                     || inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)]));
                 let segment = |k: usize| [x(edges[k][0]), x(edges[k][1])];
-                let (k, xi, corner_gap, corner_normal) =
-                    gap_to_segments(xs, edges.len(), segment, inside)?;
+                let (k, xi, corner_gap, corner_normal) = match grid {
+                    Some(grid) => {
+                        let nearest = std::cell::RefCell::new(Nearest { x: xs, best: None });
+                        let offer = |k: usize| nearest.borrow_mut().offer(k, segment(k));
+                        let limit = self.options.search_distance;
+                        grid.visit(xs, offer, || nearest.borrow().reach(), limit);
+                        signed_gap(xs, nearest.into_inner().best?, segment, inside)?
+                    }
+                    None => gap_to_segments(xs, edges.len(), segment, inside)?,
+                };
                 let [a, b] = edges[k];
                 let ab = sub(x(b), x(a));
                 let turned =
                     (corner_normal[0] * ab[0] + corner_normal[1] * ab[1]).abs() > 1e-9 * length(ab);
                 let beyond = (xi <= 0.0 || xi >= 1.0) && corner_gap > 0.0 && turned;
-                if beyond && self.options.distance_beyond_ends {
+                if beyond && self.options.balanced {
                     // beyond the master's end and outside its body (the direction from the
                     // end turned off the segment's normal): the distance from the end (the
                     // nodal normal there would read the surface's extension)
@@ -384,10 +445,21 @@ impl ContactPair {
                     (1.0 - xi) * na[1] + xi * nb[1],
                 ];
                 let l = length(raw);
-                let normal = if l > 0.0 {
-                    [raw[0] / l, raw[1] / l]
+                // a balanced pass: the segment's own normal, the gradient of the gap (the
+                // interpolated one is not: its force would work on a sliding slave); on a
+                // vertex itself, where the gap has no gradient, the vertex's normal, which
+                // is the same from either segment (mirror images stay mirror images)
+                // (within round-off of the projection: a slave of matching meshes sits on one)
+                let vertex = if xi <= VERTEX {
+                    Some(na)
                 } else {
-                    outward(x(a), x(b))
+                    (xi >= 1.0 - VERTEX).then_some(nb)
+                };
+                let unit = |n: [f64; 2]| [n[0] / length(n), n[1] / length(n)];
+                let normal = match vertex {
+                    Some(n) if self.options.balanced && length(n) > 0.0 => unit(n),
+                    _ if l > 0.0 && !self.options.balanced => [raw[0] / l, raw[1] / l],
+                    _ => outward(x(a), x(b)),
                 };
                 let p = [
                     (1.0 - xi) * x(a)[0] + xi * x(b)[0],
@@ -575,7 +647,7 @@ pub(super) mod tests {
             split_at_events: true,
             friction: Friction::None,
             persistency: false,
-            distance_beyond_ends: false,
+            balanced: false,
         }
     }
 

@@ -1,4 +1,5 @@
-//! Contact, in one place: detection on the current configuration (`geometry`, `search`),
+//! Contact, in one place: detection on the current configuration (`geometry`, `search`,
+//! the nearest-segment grid of a balanced pair's whole surfaces `grid`),
 //! the status carried between steps (`status`), the event logic of an implicit step
 //! (`step`), Hughes' impact and release conditions (`conditions`) met at a step's events
 //! (`impacts`), the explicit forward-increment multipliers (`explicit`), the
@@ -14,7 +15,9 @@
 //!                master body's boundary edges, or a rigid obstacle), or single nodes with a
 //!                given normal (node-to-node, Hughes II-4)
 //! xi             projection parameter of x_s on the nearest segment, p = (1 - xi) a + xi b
-//! n              unit normal out of the master at p (right of a -> b)
+//! n              unit normal out of the master at p (right of a -> b): interpolated between
+//!                the master nodes' averaged normals in one-pass rows, the segment's own
+//!                (the gap's gradient) in a balanced pair's passes (theory 8.3d)
 //! g              gap (x_s - p) . n: > 0 apart, < 0 penetrated (Hughes II-7: d = x^1 - x^2)
 //! c(S)           winding number -1/(2 pi) sum of the angle increments seen from S over a
 //!                closed boundary (Greco eq 17): 1 inside, 0 outside, alpha/(2 pi) on a
@@ -29,6 +32,7 @@ pub mod conditions;
 pub mod explicit;
 pub mod gap;
 pub mod geometry;
+mod grid;
 pub mod impacts;
 pub mod linearization;
 pub mod mortar;

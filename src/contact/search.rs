@@ -2,7 +2,8 @@
 //! Every question contact asks of the configuration (who penetrates, who touches, how deep,
 //! the gaps written to the frames) walks the slaves through [`slave_gaps`].
 
-use super::geometry::{ContactPair, Gap};
+use super::geometry::{ContactPair, Gap, Master};
+use super::grid::SegmentGrid;
 
 /// A slave node's gap at a configuration.
 #[derive(Debug, Clone)]
@@ -24,12 +25,17 @@ pub fn slave_gaps<'a>(
     skip: &'a dyn Fn(usize, usize) -> bool,
 ) -> impl Iterator<Item = SlaveGap> + 'a {
     pairs.iter().enumerate().flat_map(move |(p, pair)| {
+        let grid = grid(pair, x);
         pair.slaves
             .iter()
             .enumerate()
             .filter(move |(k, _)| !skip(p, *k))
             .filter_map(move |(k, s)| {
-                pair.gap(*s, x).map(|gap| SlaveGap {
+                let gap = match &grid {
+                    Some(grid) => pair.node_gap_on(*s, x, Some(grid)),
+                    None => pair.gap(*s, x),
+                };
+                gap.map(|gap| SlaveGap {
                     pair: p,
                     index: k,
                     node: *s,
@@ -46,6 +52,22 @@ pub fn penetrating<'a>(
     skip: &'a dyn Fn(usize, usize) -> bool,
 ) -> impl Iterator<Item = SlaveGap> + 'a {
     slave_gaps(pairs, x, skip).filter(|s| penetrates(pairs, s, x, skip))
+}
+
+/// The grid of a balanced pass's master segments at `x` (`ContactPair::node_gap_on`), where
+/// its slaves, often a body's whole boundary, are searched against many segments. None for
+/// other pairs, whose slaves look at every master segment, as they were validated, and for
+/// a master of a few segments, which looking at costs less than building a grid.
+fn grid(pair: &ContactPair, x: &dyn Fn(usize) -> [f64; 2]) -> Option<SegmentGrid> {
+    /// Fewer master segments than this are looked at one by one.
+    const GRID_FROM: usize = 32;
+    match &pair.master {
+        Master::Segments { edges, .. } if pair.options.balanced && edges.len() >= GRID_FROM => {
+            let segments: Vec<[[f64; 2]; 2]> = edges.iter().map(|[a, b]| [x(*a), x(*b)]).collect();
+            SegmentGrid::new(&segments)
+        }
+        _ => None,
+    }
 }
 
 /// Whether a slave's gap is a penetration beyond its pair's TOL that no other pass covers

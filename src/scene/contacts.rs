@@ -141,11 +141,12 @@ fn contact(
     if !(tolerance >= 0.0 && tolerance.is_finite()) {
         return Err(cx.err(format!("{key}.tolerance: must be >= 0, got {tolerance}")));
     }
+    let balanced = symmetric(cx, bodies, (k, spec), scene)?;
     let search_distance = match spec.search_distance {
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
+        None if balanced => balanced_reach(cx, bodies, spec),
         None => f64::INFINITY,
     };
-    let balanced = symmetric(cx, bodies, (k, spec), scene)?;
     let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), {
         dynamic(scene) && !balanced
     })?;
@@ -163,7 +164,7 @@ fn contact(
             split_at_events: spec.split_at_events,
             friction,
             persistency: false,
-            distance_beyond_ends: balanced,
+            balanced,
         },
         covered: None,
         balances: None,
@@ -473,6 +474,33 @@ fn friction(cx: &Context, key: &str, spec: &ContactSpec) -> Result<Friction, Inp
 }
 
 /// The diagonal of the bounding box of all nodes.
+/// The search distance of a balanced pair (`spec`) not given one: twice the longest edge of
+/// its two surfaces. A node farther than that from the other body cannot reach it within a
+/// step (a step moves a node far less than an element), and each surface is a whole one (up
+/// to a body's boundary), so looking at the far side of both bodies every step would cost
+/// more than the contact itself.
+fn balanced_reach(cx: &Context, bodies: &[Body], spec: &ContactSpec) -> f64 {
+    let longest = |surface: &SurfaceSpec| -> f64 {
+        let Ok(b) = body_index(cx, bodies, surface.body.as_deref(), "") else {
+            return f64::INFINITY;
+        };
+        let mesh = &bodies[b].mesh;
+        mesh.edge_sets
+            .get(&surface.set)
+            .map_or(f64::INFINITY, |edges| {
+                edges
+                    .iter()
+                    .map(|[a, b]| {
+                        let (p, q) = (mesh.nodes[*a], mesh.nodes[*b]);
+                        (q[0] - p[0]).hypot(q[1] - p[1])
+                    })
+                    .fold(0.0, f64::max)
+            })
+    };
+    let master = spec.master.as_ref().map_or(f64::INFINITY, longest);
+    2.0 * longest(&spec.slave).max(master)
+}
+
 fn model_size(bodies: &[Body]) -> f64 {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];

@@ -31,6 +31,9 @@ pub(super) fn name_boundary(mesh: &mut Mesh, name_of: impl Fn(Point, Point) -> &
     for (name, edges) in sets {
         mesh.add_edge_set(name, chain_order(edges));
     }
+    if !mesh.edge_sets.contains_key("boundary") {
+        mesh.add_edge_set("boundary", chain_order(mesh.boundary_edges()));
+    }
 }
 
 /// The node nearest to `p`.

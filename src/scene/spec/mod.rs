@@ -273,6 +273,9 @@ pub struct ObstacleSpec {
 #[serde(deny_unknown_fields)]
 pub struct SurfaceSpec {
     pub body: Option<String>,
+    /// Default `boundary`: the body's whole exterior, the edge set (and node set) every quad
+    /// mesh has, as Abaqus' general contact takes a body's exterior without being told.
+    #[serde(default = "whole_boundary")]
     pub set: String,
     /// Node-to-node masters only: the master's outward unit normal.
     pub normal: Option<[f64; 2]>,
@@ -364,6 +367,10 @@ pub enum ContactDiscretization {
     /// Segment-to-segment: a weighted gap per slave node over its slave segments (Puso &
     /// Laursen 2004; Yang, Laursen & Meng 2005).
     Mortar,
+}
+
+fn whole_boundary() -> String {
+    "boundary".to_string()
 }
 
 pub(super) fn yes() -> bool {
