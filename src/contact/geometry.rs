@@ -439,27 +439,33 @@ impl ContactPair {
                     }
                     sum
                 };
-                let (na, nb) = (nodal(a), nodal(b));
-                let raw = [
-                    (1.0 - xi) * na[0] + xi * nb[0],
-                    (1.0 - xi) * na[1] + xi * nb[1],
-                ];
-                let l = length(raw);
-                // a balanced pass: the segment's own normal, the gradient of the gap (the
-                // interpolated one is not: its force would work on a sliding slave); on a
-                // vertex itself, where the gap has no gradient, the vertex's normal, which
-                // is the same from either segment (mirror images stay mirror images)
-                // (within round-off of the projection: a slave of matching meshes sits on one)
-                let vertex = if xi <= VERTEX {
-                    Some(na)
+                let normal = if self.options.balanced {
+                    // a balanced pass: the segment's own normal, the gradient of the gap (the
+                    // interpolated one is not: its force would work on a sliding slave); on a
+                    // vertex itself (within round-off of the projection: a slave of matching
+                    // meshes sits on one), where the gap has no gradient, the vertex's
+                    // normal, the same from either segment (mirror images stay mirrored)
+                    let vertex = if xi <= VERTEX {
+                        Some(a)
+                    } else {
+                        (xi >= 1.0 - VERTEX).then_some(b)
+                    };
+                    match vertex.map(nodal).filter(|n| length(*n) > 0.0) {
+                        Some(n) => [n[0] / length(n), n[1] / length(n)],
+                        None => outward(x(a), x(b)),
+                    }
                 } else {
-                    (xi >= 1.0 - VERTEX).then_some(nb)
-                };
-                let unit = |n: [f64; 2]| [n[0] / length(n), n[1] / length(n)];
-                let normal = match vertex {
-                    Some(n) if self.options.balanced && length(n) > 0.0 => unit(n),
-                    _ if l > 0.0 && !self.options.balanced => [raw[0] / l, raw[1] / l],
-                    _ => outward(x(a), x(b)),
+                    let (na, nb) = (nodal(a), nodal(b));
+                    let raw = [
+                        (1.0 - xi) * na[0] + xi * nb[0],
+                        (1.0 - xi) * na[1] + xi * nb[1],
+                    ];
+                    let l = length(raw);
+                    if l > 0.0 {
+                        [raw[0] / l, raw[1] / l]
+                    } else {
+                        outward(x(a), x(b))
+                    }
                 };
                 let p = [
                     (1.0 - xi) * x(a)[0] + xi * x(b)[0],
