@@ -396,89 +396,7 @@ impl ContactPair {
             }
             Master::Segments {
                 edges, boundary, ..
-            } => {
-                let inside =
-                    || inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)]));
-                let segment = |k: usize| [x(edges[k][0]), x(edges[k][1])];
-                let (k, xi, corner_gap, corner_normal) = match grid {
-                    Some(grid) => {
-                        let nearest = std::cell::RefCell::new(Nearest { x: xs, best: None });
-                        let offer = |k: usize| nearest.borrow_mut().offer(k, segment(k));
-                        let limit = self.options.search_distance;
-                        grid.visit(xs, offer, || nearest.borrow().reach(), limit);
-                        signed_gap(xs, nearest.into_inner().best?, segment, inside)?
-                    }
-                    None => gap_to_segments(xs, edges.len(), segment, inside)?,
-                };
-                let [a, b] = edges[k];
-                let ab = sub(x(b), x(a));
-                let turned =
-                    (corner_normal[0] * ab[0] + corner_normal[1] * ab[1]).abs() > 1e-9 * length(ab);
-                let beyond = (xi <= 0.0 || xi >= 1.0) && corner_gap > 0.0 && turned;
-                if beyond && self.options.balanced {
-                    // beyond the master's end and outside its body (the direction from the
-                    // end turned off the segment's normal): the distance from the end (the
-                    // nodal normal there would read the surface's extension)
-                    let end = if xi <= 0.0 { a } else { b };
-                    return Some(Gap {
-                        gap: corner_gap,
-                        normal: corner_normal,
-                        masters: vec![(end, 1.0)],
-                        weight: 1.0,
-                    })
-                    .filter(|g| g.gap <= self.options.search_distance);
-                }
-                // the normal interpolated between the master nodes' averaged normals: it
-                // turns continuously across a vertex, where a dented deformable surface would
-                // otherwise flip the slave's row between its two segments
-                let nodal = |node: usize| -> [f64; 2] {
-                    let mut sum = [0.0; 2];
-                    for [p, q] in edges.iter().filter(|e| e.contains(&node)) {
-                        let n = outward(x(*p), x(*q));
-                        sum = [sum[0] + n[0], sum[1] + n[1]];
-                    }
-                    sum
-                };
-                let normal = if self.options.balanced {
-                    // a balanced pass: the segment's own normal, the gradient of the gap (the
-                    // interpolated one is not: its force would work on a sliding slave); on a
-                    // vertex itself (within round-off of the projection: a slave of matching
-                    // meshes sits on one), where the gap has no gradient, the vertex's
-                    // normal, the same from either segment (mirror images stay mirrored)
-                    let vertex = if xi <= VERTEX {
-                        Some(a)
-                    } else {
-                        (xi >= 1.0 - VERTEX).then_some(b)
-                    };
-                    match vertex.map(nodal).filter(|n| length(*n) > 0.0) {
-                        Some(n) => [n[0] / length(n), n[1] / length(n)],
-                        None => outward(x(a), x(b)),
-                    }
-                } else {
-                    let (na, nb) = (nodal(a), nodal(b));
-                    let raw = [
-                        (1.0 - xi) * na[0] + xi * nb[0],
-                        (1.0 - xi) * na[1] + xi * nb[1],
-                    ];
-                    let l = length(raw);
-                    if l > 0.0 {
-                        [raw[0] / l, raw[1] / l]
-                    } else {
-                        outward(x(a), x(b))
-                    }
-                };
-                let p = [
-                    (1.0 - xi) * x(a)[0] + xi * x(b)[0],
-                    (1.0 - xi) * x(a)[1] + xi * x(b)[1],
-                ];
-                let gap = dot(sub(xs, p), normal);
-                Gap {
-                    gap,
-                    normal,
-                    masters: vec![(a, 1.0 - xi), (b, xi)],
-                    weight: 1.0,
-                }
-            }
+            } => self.segment_gap(xs, (&edges[..], &boundary[..]), x, grid)?,
             Master::Obstacle(o) => {
                 let segments = o.segments();
                 let inside = || {
@@ -511,6 +429,101 @@ impl ContactPair {
             }
         };
         (result.gap <= self.options.search_distance).then_some(result)
+    }
+
+    /// The gap of a slave at `xs` to a master surface of `edges` on a body of `boundary`
+    /// edges (node-to-segment, Hughes II-13..16), the nearest segment found on `grid` when
+    /// given.
+    fn segment_gap(
+        &self,
+        xs: [f64; 2],
+        (edges, boundary): (&[[usize; 2]], &[[usize; 2]]),
+        x: &dyn Fn(usize) -> [f64; 2],
+        grid: Option<&SegmentGrid>,
+    ) -> Option<Gap> {
+        let inside = || inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)]));
+        let segment = |k: usize| [x(edges[k][0]), x(edges[k][1])];
+        let (k, xi, corner_gap, corner_normal) = match grid {
+            Some(grid) => {
+                let nearest = std::cell::RefCell::new(Nearest { x: xs, best: None });
+                let offer = |k: usize| nearest.borrow_mut().offer(k, segment(k));
+                let limit = self.options.search_distance;
+                grid.visit(xs, offer, || nearest.borrow().reach(), limit);
+                signed_gap(xs, nearest.into_inner().best?, segment, inside)?
+            }
+            None => gap_to_segments(xs, edges.len(), segment, inside)?,
+        };
+        let [a, b] = edges[k];
+        let ab = sub(x(b), x(a));
+        let turned =
+            (corner_normal[0] * ab[0] + corner_normal[1] * ab[1]).abs() > 1e-9 * length(ab);
+        let beyond = (xi <= 0.0 || xi >= 1.0) && corner_gap > 0.0 && turned;
+        if beyond && self.options.balanced {
+            // beyond the master's end and outside its body (the direction from the end
+            // turned off the segment's normal): the distance from the end (the nodal normal
+            // there would read the surface's extension)
+            let end = if xi <= 0.0 { a } else { b };
+            return Some(Gap {
+                gap: corner_gap,
+                normal: corner_normal,
+                masters: vec![(end, 1.0)],
+                weight: 1.0,
+            });
+        }
+        let normal = self.row_normal(edges, (a, b, xi), x);
+        let p = [
+            (1.0 - xi) * x(a)[0] + xi * x(b)[0],
+            (1.0 - xi) * x(a)[1] + xi * x(b)[1],
+        ];
+        Some(Gap {
+            gap: dot(sub(xs, p), normal),
+            normal,
+            masters: vec![(a, 1.0 - xi), (b, xi)],
+            weight: 1.0,
+        })
+    }
+
+    /// The normal of a node-to-segment row at `xi` on the master segment `a -> b` of `edges`.
+    /// One pass: interpolated between the master nodes' averaged normals; it turns
+    /// continuously across a vertex, where a dented deformable surface would otherwise flip
+    /// the slave's row between its two segments. A balanced pass: the segment's own normal,
+    /// the gradient of the gap (the interpolated one is not: its force would work on a
+    /// sliding slave); on a vertex itself (within round-off of the projection: a slave of
+    /// matching meshes sits on one), where the gap has no gradient, the vertex's normal, the
+    /// same from either segment (mirror images stay mirrored).
+    fn row_normal(
+        &self,
+        edges: &[[usize; 2]],
+        (a, b, xi): (usize, usize, f64),
+        x: &dyn Fn(usize) -> [f64; 2],
+    ) -> [f64; 2] {
+        let nodal = |node: usize| -> [f64; 2] {
+            let mut sum = [0.0; 2];
+            for [p, q] in edges.iter().filter(|e| e.contains(&node)) {
+                let n = outward(x(*p), x(*q));
+                sum = [sum[0] + n[0], sum[1] + n[1]];
+            }
+            sum
+        };
+        let unit = |n: [f64; 2]| {
+            let l = length(n);
+            (l > 0.0).then(|| [n[0] / l, n[1] / l])
+        };
+        let normal = if self.options.balanced {
+            let vertex = if xi <= VERTEX {
+                Some(a)
+            } else {
+                (xi >= 1.0 - VERTEX).then_some(b)
+            };
+            vertex.and_then(|v| unit(nodal(v)))
+        } else {
+            let (na, nb) = (nodal(a), nodal(b));
+            unit([
+                (1.0 - xi) * na[0] + xi * nb[0],
+                (1.0 - xi) * na[1] + xi * nb[1],
+            ])
+        };
+        normal.unwrap_or_else(|| outward(x(a), x(b)))
     }
 }
 
