@@ -473,7 +473,6 @@ fn friction(cx: &Context, key: &str, spec: &ContactSpec) -> Result<Friction, Inp
     })
 }
 
-/// The diagonal of the bounding box of all nodes.
 /// The search distance of a balanced pair (`spec`) not given one: twice the longest edge of
 /// its two surfaces. A node farther than that from the other body cannot reach it within a
 /// step (a step moves a node far less than an element), and each surface is a whole one (up
@@ -501,6 +500,7 @@ fn balanced_reach(cx: &Context, bodies: &[Body], spec: &ContactSpec) -> f64 {
     2.0 * longest(&spec.slave).max(master)
 }
 
+/// The diagonal of the bounding box of all nodes.
 fn model_size(bodies: &[Body]) -> f64 {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];

@@ -304,7 +304,8 @@ pub struct ContactSpec {
     pub release_fraction: f64,
     /// TOL of Hughes, Taylor & Sackman (1975) II-7 (length). Default 1e-9 of the model's size.
     pub tolerance: Option<f64>,
-    /// Slaves farther than this from the master are skipped (length). Default: no limit.
+    /// Slaves farther than this from the master are skipped (length). Default: no limit;
+    /// for a balanced pair twice the longest face element of its two surfaces.
     pub search_distance: Option<f64>,
     /// Split a step at the first contact event inside it (Erklig, Guzelbey & Cevik 2010,
     /// section 2.1.4). Default true.
