@@ -226,11 +226,20 @@ impl MassScalingSummary {
     }
 }
 
-/// One body in summary.json `bodies`.
+/// One body in summary.json `bodies`: its mass, and its energies at the end (its shares
+/// of `energy`'s totals, as history.csv's per-body columns give them over time).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BodyMass {
     pub name: String,
     pub mass: f64,
+    /// 1/2 v . M v over the body's nodes.
+    #[serde(default)]
+    pub kinetic_energy: f64,
+    /// The work its elements' stresses did less the plastic work: the energy they store.
+    #[serde(default)]
+    pub internal_energy: f64,
+    #[serde(default)]
+    pub plastic_work: f64,
 }
 
 /// The bodies of `model` with their masses (empty where the mass cannot be formed: an
@@ -246,6 +255,9 @@ pub fn body_masses(model: &Model) -> Vec<BodyMass> {
         .map(|(body, mass)| BodyMass {
             name: body.name.clone(),
             mass,
+            kinetic_energy: 0.0,
+            internal_energy: 0.0,
+            plastic_work: 0.0,
         })
         .collect()
 }

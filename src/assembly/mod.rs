@@ -21,7 +21,7 @@ mod scatter;
 
 use kernel::ElementOut;
 pub use kernel::{ElementAt, Kernel};
-pub use mass::{Mass, check_mass};
+pub use mass::{Mass, body_sums, check_mass};
 use scatter::{Scatter, TRANSPOSED};
 
 use crate::element::{KernelError, Strain};
@@ -39,6 +39,25 @@ pub struct BodyState {
     pub points: Vec<PointState>,
     /// Current thickness per point (plane stress); 1 otherwise.
     pub thickness: Vec<f64>,
+    /// The body's share of `State::internal_work` and `State::plastic_work`: the work its
+    /// elements' stresses (and hourglass forces) did, and the plastic part of it.
+    pub work: BodyWork,
+}
+
+/// The accumulated work of one body's elements (history.csv `internal_energy[body]` is
+/// `internal - plastic`, `plastic_work[body]` is `plastic`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BodyWork {
+    /// The work of the internal forces, plastic work and hourglass work included.
+    pub internal: f64,
+    pub plastic: f64,
+}
+
+impl BodyWork {
+    pub fn add(&mut self, other: &BodyWork) {
+        self.internal += other.internal;
+        self.plastic += other.plastic;
+    }
 }
 
 /// The committed state of the whole model.
@@ -95,6 +114,7 @@ impl State {
                         n
                     ],
                     thickness: vec![thickness; n],
+                    work: BodyWork::default(),
                 }
             })
             .collect();
@@ -133,6 +153,8 @@ pub struct Evaluation {
     pub work: f64,
     /// StepIncrement of the plastic work.
     pub plastic_work: f64,
+    /// The increments of each body (model order): their sums are `work` and `plastic_work`.
+    pub body_work: Vec<BodyWork>,
 }
 
 /// DOF numbering, sparsity and scatter positions of one topology.
@@ -282,6 +304,7 @@ pub(crate) fn evaluate_elements(
     let mut strain_zz = Vec::with_capacity(model.bodies.len());
     let mut work = 0.0;
     let mut plastic_work = 0.0;
+    let mut body_work = vec![BodyWork::default(); model.bodies.len()];
     for (b, body) in model.bodies.iter().enumerate() {
         let kernel = Kernel::of(body);
         let ppe = body.points_per_element();
@@ -357,6 +380,8 @@ pub(crate) fn evaluate_elements(
                 body_zz[e * zz..(e + 1) * zz].copy_from_slice(&o[n + matrix..]);
                 work += w.work;
                 plastic_work += w.plastic_work;
+                body_work[b].internal += w.work;
+                body_work[b].plastic += w.plastic_work;
             }
         }
         trial.push(body_trial);
@@ -368,6 +393,7 @@ pub(crate) fn evaluate_elements(
         strain_zz,
         work,
         plastic_work,
+        body_work,
     })
 }
 
@@ -385,6 +411,7 @@ pub fn commit(
         strain_zz,
         work,
         plastic_work: evaluation_plastic_work,
+        body_work,
         ..
     } = evaluation;
     for (b, body) in model.bodies.iter().enumerate() {
@@ -410,6 +437,7 @@ pub fn commit(
             }
         }
         state.bodies[b].points = points;
+        state.bodies[b].work.add(&body_work[b]);
     }
     if geometry == Strain::Finite {
         for (n, x) in state.coordinates.iter_mut().enumerate() {

@@ -395,7 +395,8 @@ impl Units {
             | "hourglass_energy"
             | "bulk_viscosity_work"
             | "mass_scaling_loss"
-            | "remap_loss" => per(self.energy),
+            | "remap_loss"
+            | "friction_work" => per(self.energy),
             "added_mass" => per(self.mass),
             "contact_force" | "tangential_force" => per(self.force),
             "penetration" => self.length.to_string(),

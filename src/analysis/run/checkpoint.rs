@@ -43,7 +43,9 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///     masses and counts in the explicit carry.
 /// 15: the global stable step's element stiffnesses and last estimate in the tight step's
 ///     carry.
-const FORMAT: u32 = 15;
+/// 16: each body's internal and plastic work in the state, each body's energies in the
+///     summary.
+const FORMAT: u32 = 16;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

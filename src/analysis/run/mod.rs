@@ -371,6 +371,9 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Some(added) = self.stepper.added_mass() {
             self.recorder.added_mass = added;
         }
+        if record::body_columns(self.model) {
+            self.recorder.body_kinetic = self.stepper.body_kinetic(self.model);
+        }
         let s = &self.stepper;
         let contact = (self.summary.steps > 0).then(|| s.contact());
         let motion = s.motion();
@@ -450,6 +453,12 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.energy.remap_loss = self.model.analysis.ale().map(|_| energies.remap_loss);
         summary.energy.friction_work =
             record::friction_column(self.model).then_some(energies.friction_work);
+        let kinetic = s.body_kinetic(self.model);
+        for ((entry, body), kinetic) in summary.bodies.iter_mut().zip(&s.state().bodies).zip(kinetic) {
+            entry.kinetic_energy = kinetic;
+            entry.internal_energy = body.work.internal - body.work.plastic;
+            entry.plastic_work = body.work.plastic;
+        }
         summary.ale = s.ale();
         let mass_scaling = s.mass_scaling();
         summary.mass_scaling = mass_scaling

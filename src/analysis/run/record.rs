@@ -60,6 +60,9 @@ pub struct Recorder {
     pub added_mass: f64,
     /// The length of the step the next row ends (column `dt`; 0 on the first row).
     pub step_length: f64,
+    /// Each body's kinetic energy for the next row (the per-body columns of a model of two
+    /// bodies or more; `body_columns`).
+    pub body_kinetic: Vec<f64>,
     /// The probes' values in the last row written (summary.json `probes`).
     last_probes: Vec<f64>,
     /// Point probes the stepper has answered from its own point values for the next row (an
@@ -117,6 +120,7 @@ impl Recorder {
             error_estimate: 0.0,
             added_mass: 0.0,
             step_length: 0.0,
+            body_kinetic: Vec::new(),
             last_probes: Vec::new(),
             point_probes: Vec::new(),
             contact: contact_record(
@@ -186,6 +190,7 @@ impl Recorder {
             error_estimate: 0.0,
             added_mass: 0.0,
             step_length: 0.0,
+            body_kinetic: Vec::new(),
             last_probes: position.probes,
             point_probes: Vec::new(),
             contact: contact_record(model, position.contact.unwrap_or_default()),
@@ -296,6 +301,11 @@ impl Recorder {
         }
         if friction_column(model) {
             row.push(energies.friction_work);
+        }
+        if body_columns(model) {
+            for (body, kinetic) in state.bodies.iter().zip(&self.body_kinetic) {
+                row.extend([*kinetic, body.work.internal - body.work.plastic, body.work.plastic]);
+            }
         }
         let frame = self.frame_due(model, state.time, force_frame, 1);
         let history = &mut self.history;
@@ -880,7 +890,21 @@ fn columns(model: &Model) -> (Vec<String>, bool) {
         // the energy Coulomb friction dissipated (the normal rows' share is contact_work)
         columns.push("friction_work".to_string());
     }
+    if body_columns(model) {
+        // each body's kinetic energy, stored energy and plastic work (the totals' shares)
+        for body in &model.bodies {
+            columns.extend(
+                ["kinetic_energy", "internal_energy", "plastic_work"]
+                    .map(|quantity| format!("{quantity}[{}]", body.name)),
+            );
+        }
+    }
     (columns, pivots_column)
+}
+
+/// Whether the history has each body's energies: a model of two bodies or more.
+pub(super) fn body_columns(model: &Model) -> bool {
+    model.bodies.len() > 1
 }
 
 /// Whether the history has `friction_work`: central difference with a Coulomb pair (the

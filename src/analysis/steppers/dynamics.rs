@@ -875,6 +875,9 @@ impl Report for Dynamics<'_> {
     fn energies(&self) -> &Energies {
         &self.energies
     }
+    fn body_kinetic(&self, model: &Model) -> Vec<f64> {
+        self.mass.body_kinetic_energies(model, &self.kin.velocity)
+    }
     fn initial_kinetic(&self) -> f64 {
         self.initial_kinetic
     }

@@ -60,6 +60,14 @@ pub trait Report {
     fn state(&self) -> &State;
     fn motion(&self) -> Motion<'_>;
     fn energies(&self) -> &Energies;
+    /// Each body's kinetic energy, 1/2 v . M v over its nodes (model order): by default with
+    /// the lumped mass of `motion` (none in statics: zeros).
+    fn body_kinetic(&self, model: &Model) -> Vec<f64> {
+        let Motion { velocity, mass, .. } = self.motion();
+        crate::assembly::body_sums(model, |dof| {
+            0.5 * mass.get(dof).copied().unwrap_or(0.0) * velocity[dof] * velocity[dof]
+        })
+    }
     /// The kinetic energy at t = 0: summary.json `energy.initial` and the drift's reference.
     fn initial_kinetic(&self) -> f64;
     fn contact(&self) -> &ContactState;

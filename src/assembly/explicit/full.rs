@@ -691,6 +691,7 @@ fn step_chunk(
         columns.store(e, &r, omega_squared);
         sums.internal += r.work;
         sums.plastic += r.plastic_work;
+        sums.book(p.model_body, r.work, r.plastic_work);
         sums.viscous += r.viscous_work;
     }
     (sums, None, grown)

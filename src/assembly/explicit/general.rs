@@ -103,6 +103,7 @@ impl ExplicitKernel for General<'_> {
         )?;
         force.copy_from_slice(&evaluation.force);
         let (internal, plastic) = (evaluation.work, evaluation.plastic_work);
+        let bodies = evaluation.body_work.iter().copied().enumerate().collect();
         assembly::commit(self.model, &mut self.state, du, evaluation, self.geometry);
         let (omega_squared, body, element) =
             largest_frequency_bound(self.model, &self.state, &self.masses)?;
@@ -111,6 +112,7 @@ impl ExplicitKernel for General<'_> {
             plastic,
             omega_squared,
             critical_element: self.offsets[body] + element,
+            bodies,
             ..StepWork::default()
         })
     }

@@ -21,7 +21,7 @@ pub use general::General;
 pub use one_point::Reduced;
 
 use super::mass_scaling::ElementScaling;
-use super::{ElementFailure, ElementMasses, StableStep, State};
+use super::{BodyWork, ElementFailure, ElementMasses, StableStep, State};
 use crate::element::Formulation;
 use crate::element::Strain;
 use crate::element::mass_scaling::MassScaling;
@@ -48,7 +48,7 @@ pub(super) const CHUNK: usize = 64;
 const GATHER_CHUNKS_PER_TASK: usize = 8;
 
 /// The sums of one step.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct StepWork {
     /// Work of the stresses and the hourglass forces (includes plastic and hourglass below,
     /// not the bulk viscosity).
@@ -61,6 +61,10 @@ pub struct StepWork {
     /// element (index over the kernel's elements; the lowest among equals).
     pub omega_squared: f64,
     pub critical_element: usize,
+    /// `internal` and `plastic` by model body, in runs of consecutive elements of one body
+    /// (a body's elements are consecutive in a kernel, so a chunk holds one run, or two
+    /// where it crosses a body's end; a body may appear in several runs).
+    pub bodies: Vec<(usize, BodyWork)>,
 }
 
 impl Default for StepWork {
@@ -72,6 +76,7 @@ impl Default for StepWork {
             viscous: 0.0,
             omega_squared: 0.0,
             critical_element: usize::MAX,
+            bodies: Vec::new(),
         }
     }
 }
@@ -87,6 +92,18 @@ impl StepWork {
         }
     }
 
+    /// Takes an element's internal and plastic work into its model body's run.
+    #[inline(always)]
+    pub(super) fn book(&mut self, body: usize, internal: f64, plastic: f64) {
+        match self.bodies.last_mut() {
+            Some((b, work)) if *b == body => {
+                work.internal += internal;
+                work.plastic += plastic;
+            }
+            _ => self.bodies.push((body, BodyWork { internal, plastic })),
+        }
+    }
+
     /// Adds a chunk's sums (in chunk order).
     pub(super) fn add(&mut self, other: &StepWork) {
         self.internal += other.internal;
@@ -94,6 +111,16 @@ impl StepWork {
         self.hourglass += other.hourglass;
         self.viscous += other.viscous;
         self.observe(other.omega_squared, other.critical_element);
+        for (body, work) in &other.bodies {
+            self.book(*body, work.internal, work.plastic);
+        }
+    }
+
+    /// Adds the step's work by body into the state's bodies.
+    pub fn commit_bodies(&self, state: &mut State) {
+        for (body, work) in &self.bodies {
+            state.bodies[*body].work.add(work);
+        }
     }
 }
 
@@ -114,6 +141,8 @@ pub(super) struct BodyParameters {
     pub hourglass_modulus: f64,
     /// The body's first element in the kernel's numbering.
     pub first_element: usize,
+    /// The body's index in the model.
+    pub model_body: usize,
 }
 
 impl BodyParameters {
@@ -195,6 +224,7 @@ impl Layout {
                 wave_lambda,
                 hourglass_modulus: kappa * (wave_lambda + 3.0 * mu) / 24.0,
                 first_element: layout.body.len(),
+                model_body: b,
             });
             let index = (layout.bodies.len() - 1) as u32;
             for e in 0..spec.elements() {

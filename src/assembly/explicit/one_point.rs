@@ -669,6 +669,7 @@ fn step_chunk(
         columns.store(e, &r, omega_squared);
         sums.internal += r.work + r.hourglass_work;
         sums.plastic += r.plastic_work;
+        sums.book(p.model_body, r.work + r.hourglass_work, r.plastic_work);
         sums.hourglass += r.hourglass_work;
         sums.viscous += r.viscous_work;
     }
@@ -901,6 +902,7 @@ mod tests {
             wave_modulus: lambda + 2.0 * mu,
             wave_lambda: lambda,
             first_element: 0,
+            model_body: 0,
         }
     }
 

@@ -282,6 +282,7 @@ impl<'a> Explicit<'a> {
         }
         self.state.internal_work += work.internal;
         self.state.plastic_work += work.plastic;
+        work.commit_bodies(&mut self.state);
         self.energies.bulk_viscosity_work += work.viscous;
         let (body, element) = kernel.locate(work.critical_element);
         Ok(StableStep::of_frequency(work.omega_squared, body, element))

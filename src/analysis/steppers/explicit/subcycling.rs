@@ -501,6 +501,7 @@ impl Explicit<'_> {
             .max(0.5 * span * work.omega_squared.sqrt());
         self.state.internal_work += work.internal;
         self.state.plastic_work += work.plastic;
+        work.commit_bodies(&mut self.state);
         self.energies.bulk_viscosity_work += work.viscous;
         Ok(())
     }
