@@ -417,7 +417,7 @@ pub fn with_unit(label: &str, unit: &str) -> String {
 /// Refuses a measure whose column the scene's history.csv will not have (before any case
 /// runs), naming the columns it will have.
 pub fn check(measures: &[Measure], model: &Model) -> Result<(), String> {
-    let columns = crate::analysis::run::record::column_names(model);
+    let columns = crate::analysis::run::columns::column_names(model);
     for m in measures {
         if !columns.contains(&m.column) {
             return Err(format!(

@@ -20,6 +20,7 @@
 
 pub mod buckling;
 pub mod checkpoint;
+pub mod columns;
 pub mod contact_record;
 mod frame;
 pub mod progress;
@@ -371,7 +372,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Some(added) = self.stepper.added_mass() {
             self.recorder.added_mass = added;
         }
-        if record::body_columns(self.model) {
+        if columns::body_columns(self.model) {
             self.recorder.body_kinetic = self.stepper.body_kinetic(self.model);
         }
         let s = &self.stepper;
@@ -452,7 +453,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             .map(|_| energies.mass_scaling_loss);
         summary.energy.remap_loss = self.model.analysis.ale().map(|_| energies.remap_loss);
         summary.energy.friction_work =
-            record::friction_column(self.model).then_some(energies.friction_work);
+            columns::friction_column(self.model).then_some(energies.friction_work);
         let kinetic = s.body_kinetic(self.model);
         for ((entry, body), kinetic) in summary.bodies.iter_mut().zip(&s.state().bodies).zip(kinetic) {
             entry.kinetic_energy = kinetic;
