@@ -226,7 +226,10 @@ fn hertz_sphere_static_radius_and_pressure() {
 /// (Courant number 0.98). Reference (exact): force 0.1 on 0 < t < 0.2, rebound at -0.1.
 /// Measured: plateau mean 0.09996, every step within 1.7 % from t = 0.025, rebound -0.0970,
 /// 99.2 % of the energy kept; asserted: mean within 1 %, steps within 2 %, release within
-/// 2 dt of 0.2 (the explicit release waits for the gap to open), rebound within 5 %.
+/// 2 dt of 0.2 (the explicit release waits for the gap to open), rebound within 5 %. At
+/// Courant 0.98 the balance of the released bar rings up to 2.75 % above its energy (the
+/// scheme's error at the edge of stability, as models/strip_wall.toml's; docs/theory.md 7),
+/// so the run raises the 1 % guard of energy gained to 5 %.
 #[test]
 fn bar_wall_explicit_forward_increment_contact() {
     let r = run(
@@ -236,6 +239,7 @@ fn bar_wall_explicit_forward_increment_contact() {
             "analysis.integrator=central_difference",
             "analysis.mass=lumped",
             "analysis.dt=0.007",
+            "analysis.energy_gain_limit=0.05",
         ],
     );
     let force = window(&r, "contact_force[wall]", 0.025, 0.18);

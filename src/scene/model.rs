@@ -445,6 +445,9 @@ pub struct DynamicAnalysis {
     pub contact_dynamics: ContactDynamics,
     pub rayleigh: [f64; 2],
     pub allow_unstable: bool,
+    /// The share of the energy in play the balance may gain at any step before the run ends
+    /// (`analysis.energy_gain_limit`; None: not guarded, the integrator's default).
+    pub energy_gain_limit: Option<f64>,
     pub geometry: Strain,
     pub newton: NewtonSpec,
     pub buckling: Option<BucklingSpec>,

@@ -28,12 +28,13 @@ pub mod record;
 
 use super::plausibility;
 use super::steppers::Stepper;
-use super::steppers::energies::{Energies, balance_error};
+use super::steppers::energies::{Energies, relative_gain};
 use super::steppers::newton::Counters;
 use super::summary::{DtLimit, MassScalingSummary, RunError, Status, StepError, Summary};
 use crate::assembly::State;
 use crate::output::readable;
 use crate::profile::{self, Phase};
+use crate::scene::model::Analysis;
 use crate::scene::{InputError, Model};
 use buckling::Monitor;
 use checkpoint::Checkpoint;
@@ -244,8 +245,10 @@ impl<'a, S: Stepper> Run<'a, S> {
             return Err(self.fail_step(e));
         }
         self.summary.steps += 1;
-        let drift = balance_error(self.stepper.energies(), self.stepper.initial_kinetic());
-        self.summary.energy.max_relative_drift = self.summary.energy.max_relative_drift.max(drift);
+        let gain = relative_gain(self.stepper.energies(), self.stepper.initial_kinetic());
+        let energy = &mut self.summary.energy;
+        energy.max_relative_drift = energy.max_relative_drift.max(gain.abs());
+        energy.max_relative_gain = energy.max_relative_gain.max(gain);
         if let Err(e) = self.stepper.verdict() {
             return Err(self.fail_step(e));
         }
@@ -455,7 +458,12 @@ impl<'a, S: Stepper> Run<'a, S> {
         summary.energy.friction_work =
             columns::friction_column(self.model).then_some(energies.friction_work);
         let kinetic = s.body_kinetic(self.model);
-        for ((entry, body), kinetic) in summary.bodies.iter_mut().zip(&s.state().bodies).zip(kinetic) {
+        for ((entry, body), kinetic) in summary
+            .bodies
+            .iter_mut()
+            .zip(&s.state().bodies)
+            .zip(kinetic)
+        {
             entry.kinetic_energy = kinetic;
             entry.internal_energy = body.work.internal - body.work.plastic;
             entry.plastic_work = body.work.plastic;
@@ -630,21 +638,24 @@ fn negative_plastic_work(e: &Energies, initial_kinetic: f64) -> Option<String> {
 const CREATED_SHARE: f64 = 0.01;
 
 impl<S: Stepper> Run<'_, S> {
-    /// Why an explicit run fails at this step: its contact work, friction's included (energy
-    /// taken up by the interfaces, theory 7), is below -CREATED_SHARE of the energy in play,
-    /// the pairs named; None otherwise. Explicit runs only: the implicit paths' contact work is the
-    /// trapezoidal work of the multipliers, which gives energy back for a while and takes it
-    /// again under the seeds' options (two bars without impact conditions: -5 % at
-    /// t = 0.01), and Wilson's interpolated step is not what it books (a plastic block on a
-    /// floor: -67 %); there it stays in the energy balance and its warning. The balance
-    /// itself is not guarded: central difference's own error at a Courant number near 1 is a
-    /// few per cent on the wave problems (strip_wall 2.7 %, theory 7), created by no one.
+    /// Why a dynamic run fails at this step: energy created. (1) An explicit run's contact
+    /// work, friction's included (energy taken up by the interfaces, theory 7), is below
+    /// -CREATED_SHARE of the energy in play: the pairs named. Explicit runs only: the implicit
+    /// paths' contact work is the trapezoidal work of the multipliers, which gives energy back
+    /// for a while and takes it again under the seeds' options (two bars without impact
+    /// conditions: -5 % at t = 0.01), and Wilson's interpolated step is not what it books (a
+    /// plastic block on a floor: -67 %). (2) On every dynamic path, the balance has gained
+    /// more than `analysis.energy_gain_limit` of the energy in play: the bodies hold more than
+    /// they were given and the sinks took, whoever made it. None otherwise, and in statics
+    /// (whose balance measures the trapezoidal rule's error along a load path, not energy
+    /// made).
     fn energy_created(&self) -> Option<String> {
-        if !self.model.is_explicit() {
+        let Analysis::Dynamic(analysis) = &self.model.analysis else {
             return None;
-        }
+        };
         let e = self.stepper.energies();
-        let scale = (self.stepper.initial_kinetic())
+        let initial = self.stepper.initial_kinetic();
+        let scale = initial
             .max(e.external_work.abs())
             .max(e.internal.abs())
             .max(f64::MIN_POSITIVE);
@@ -652,12 +663,15 @@ impl<S: Stepper> Run<'_, S> {
         // split follows the rows at the step's start, and a block held on a floor by friction
         // moves energy between the two columns while the sum takes it)
         let given = -(e.contact_work + e.friction_work);
-        (given > CREATED_SHARE * scale).then(|| {
+        let pairs = || {
             let names: Vec<String> = (self.model.contacts.iter())
                 .filter(|p| p.balances.is_none())
                 .map(|p| format!("`{}`", p.name))
                 .collect();
-            format!(
+            names.join(", ")
+        };
+        if self.model.is_explicit() && given > CREATED_SHARE * scale {
+            return Some(format!(
                 "the contact gave the bodies {} of energy, {:.1} % of the {} in play (more than \
                  {} %): contact {} created energy, so the answer is not the physics'; likely \
                  causes: a step too long for the contact (a shorter dt), master nodes held on \
@@ -667,7 +681,32 @@ impl<S: Stepper> Run<'_, S> {
                 100.0 * given / scale,
                 readable(scale),
                 100.0 * CREATED_SHARE,
-                names.join(", ")
+                pairs()
+            ));
+        }
+        let gain = relative_gain(e, initial);
+        let limit = analysis.energy_gain_limit?;
+        (gain > limit).then(|| {
+            let cause = match (given > 0.0, self.model.contacts.is_empty()) {
+                (true, _) => format!(
+                    "the contact {} gave {} of it: a step too long for the contact, or \
+                     surfaces that do not face each other",
+                    pairs(),
+                    readable(given)
+                ),
+                (false, false) => format!(
+                    "the contact {} took energy, so the bodies made it: a step too long for \
+                     the motion or the contact (a shorter dt), or a penetration pushed out",
+                    pairs()
+                ),
+                (false, true) => "a step too long for the motion (a shorter dt)".to_string(),
+            };
+            format!(
+                "the energy balance gained {:.2} % of the energy in play (more than {} %, \
+                 analysis.energy_gain_limit): the bodies hold more than they were given and \
+                 the sinks took, so the answer is not the physics'; {cause}",
+                100.0 * gain,
+                100.0 * limit,
             )
         })
     }

@@ -308,7 +308,11 @@ impl Recorder {
         }
         if body_columns(model) {
             for (body, kinetic) in state.bodies.iter().zip(&self.body_kinetic) {
-                row.extend([*kinetic, body.work.internal - body.work.plastic, body.work.plastic]);
+                row.extend([
+                    *kinetic,
+                    body.work.internal - body.work.plastic,
+                    body.work.plastic,
+                ]);
             }
         }
         let frame = self.frame_due(model, state.time, force_frame, 1);

@@ -46,12 +46,18 @@ pub struct Motion<'a> {
 /// and against a scale of nothing but that lag the error read 1e300 %; where energy is created
 /// from nothing the error tends to 1 (100 %), still far above the 5 % warning.
 pub fn balance_error(energies: &Energies, initial_kinetic: f64) -> f64 {
+    relative_gain(energies, initial_kinetic).abs()
+}
+
+/// The signed balance error: the residual of the balance over the energy in play (see
+/// [`balance_error`]); positive where energy was created, negative where it was lost.
+pub fn relative_gain(energies: &Energies, initial_kinetic: f64) -> f64 {
     let scale = initial_kinetic
         .max(energies.external_work.abs())
         .max(energies.internal.abs())
         .max(energies.kinetic)
         .max(f64::MIN_POSITIVE);
-    balance_gain(energies, initial_kinetic).abs() / scale
+    balance_gain(energies, initial_kinetic) / scale
 }
 
 /// The signed residual of the balance, KE + W_int + W_contact + W_fric + W_visc + L_ms + L_remap -

@@ -146,6 +146,9 @@ pub struct AnalysisSpec {
     /// as status `unstable`. Default false (refused).
     #[serde(default)]
     pub allow_unstable: bool,
+    /// The share of the energy in play the balance may gain at any step before the run ends
+    /// with exit 3 (energy created). Default 0.01.
+    pub energy_gain_limit: Option<f64>,
     /// The buckling check (Erklig, Guzelbey & Cevik 2010, section 2.1.3). Default: none.
     pub buckling: Option<BucklingSpec>,
     /// Write DIR/checkpoint.bin (the whole run state) at the start and every N converged
