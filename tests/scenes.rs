@@ -40,10 +40,12 @@ fn every_scene_runs_and_writes_the_output_contract() {
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(summary.status, impact::analysis::Status::Ok);
         // a shipped scene warns of nothing but three_rings' energy balance (Hu's numerical
-        // damping takes 10 %, docs/validation.md 4.5); a new warning that fires on a scene
-        // meant to be right is a false alarm
+        // damping takes 10 %, docs/validation.md 4.5) and strip_wall's energy gained (2.7 %:
+        // central difference at Courant 0.98 on purpose, docs/theory.md 7); a new warning
+        // that fires on a scene meant to be right is a false alarm
         let expected: &[&str] = match name.as_str() {
             "three_rings" => &["the energy balance is off"],
+            "strip_wall" => &["the energy balance gained"],
             _ => &[],
         };
         assert_eq!(

@@ -400,3 +400,137 @@ fn still_closed_warns_above_a_tenth_of_the_approach() {
     assert_eq!(above.len(), 1, "{above:?}");
     assert!(above[0].contains("is still closed"), "{}", above[0]);
 }
+
+/// Goal: a hardening modulus at or above Young's modulus and a Johnson-Cook specific heat in
+/// kJ / (kg K) are caught before the run (exit 3 with `--strict`), each naming its key.
+/// Setup: the sphere with hardening_modulus = 3e11 (E = 2.1e11); models/taylor_jc.toml with
+/// specific_heat = 0.46 instead of 460. Reference: metals harden at E / 1000 to E / 10; the
+/// 42CrMo4 rod heats by chi A / (rho c_p) = 0.9 x 806e6 / (7850 x 460) = 201 K per unit of
+/// plastic strain, 0.13 of its 1520 K from room to melting (silent: the shipped scenes give
+/// no warning, above), and 2.0e5 K with the specific heat in kJ, 132 times that span, beyond
+/// the 3 times the check allows.
+#[test]
+fn a_hardening_above_young_and_a_specific_heat_in_kilojoules_are_caught() {
+    let (code, stderr) =
+        impact_on_sphere("check", None, &["material.steel.hardening_modulus=3.0e11"]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(&stderr, &["hardening_modulus", "at or above its young"]);
+    let out = common::impact(&[
+        "check",
+        "models/taylor_jc.toml",
+        "--strict",
+        "--set",
+        "material.42CrMo4.johnson_cook.specific_heat=0.46",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    warned(
+        &stderr,
+        &["material `42CrMo4` would heat by", "kJ / (kg K)"],
+    );
+}
+
+/// Writes the sphere scene with `from` replaced by `to` into the test folder `name`, and
+/// returns its path.
+fn sphere_edited(name: &str, from: &str, to: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(SPHERE).unwrap();
+    assert!(text.contains(from), "{from}");
+    let dir = common::out_dir(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+    path
+}
+
+/// Goal: the same slave surface against the same wall in two pairs is refused, naming both
+/// (before: `check` passed and the run died on a runaway penetration naming neither).
+/// Setup: the sphere with its pair `wall` repeated as `wall2`. Reference: the nodes of one
+/// surface would be held twice in a step; exit 2 with both names (the sphere as it stands
+/// passes `check`: above).
+#[test]
+fn a_contact_pair_given_twice_is_refused() {
+    let pair = "[[contact]]\nname = \"wall\"\nslave = { set = \"arc\" }\nobstacle = \"wall\"\n";
+    let twice = format!(
+        "{pair}\n{}",
+        pair.replace("\"wall\"\nslave", "\"wall2\"\nslave")
+    );
+    let path = sphere_edited("sphere_pair_twice", pair, &twice);
+    let out = common::impact(&["check", path.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("contact `wall2` repeats contact `wall`"),
+        "{stderr}"
+    );
+}
+
+/// Goal: a support that holds nodes in a component in which their body starts moving, an
+/// axisymmetric body given a radial velocity as a whole, and elements of aspect ratio 30 are
+/// each warned before the run (exit 3 with `--strict`). Setup: the sphere with its axis
+/// support fixing y too (its nodes start at -5 m/s in y); the sphere at velocity [-5, 0];
+/// models/taylor_jc.toml at nx = 1, ny = 200 (rod 3.2 x 32.4 mm: elements 3.2 x 0.162 mm,
+/// aspect 19.8).
+/// Reference: a fixed DOF keeps no velocity; x is the radius in axisymmetry; the mesh
+/// guidance of explicit codes (aspect ratio below 10). The sphere and the shipped scenes as
+/// they stand give none of them (above).
+#[test]
+fn a_cancelled_velocity_a_radial_velocity_and_long_elements_are_warned() {
+    let path = sphere_edited(
+        "sphere_axis_held_in_y",
+        "fix = [\"x\"]",
+        "fix = [\"x\", \"y\"]",
+    );
+    let out = common::impact(&["check", path.to_str().unwrap(), "--strict"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    warned(
+        &stderr,
+        &[
+            "body `sphere`",
+            "held in y by a [[support]] start moving in y",
+        ],
+    );
+    let (code, stderr) = impact_on_sphere("check", None, &["body.sphere.velocity=[-5.0, 0.0]"]);
+    assert_eq!(code, 3, "{stderr}");
+    warned(
+        &stderr,
+        &[
+            "axisymmetric body `sphere`",
+            "imploding",
+            "components swapped",
+        ],
+    );
+    let out = common::impact(&[
+        "check",
+        "models/taylor_jc.toml",
+        "--strict",
+        "--set",
+        "body.rod.mesh.nx=1",
+        "--set",
+        "body.rod.mesh.ny=200",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    warned(
+        &stderr,
+        &["body `rod` has 200 element(s) longer than 10 times their width"],
+    );
+}
+
+/// Goal: a `[[node_set]]` point off its body (a sign slip) is refused naming the distance,
+/// not snapped to a node far away. Setup: models/taylor_jc.toml with the node set
+/// `face_centre` at [0, -25.4e-3] instead of on the rod's face (y = 0). Reference: the
+/// point lies 25.4 mm from the rod's nearest node, 160 times the rod's longest element
+/// edge (0.65 mm: 3.2 / 5 mm wide); exit 2 with the key.
+#[test]
+fn a_node_set_point_off_its_body_is_refused() {
+    common::check_refuses_with(
+        "models/taylor_jc.toml",
+        &["node_set.face_centre.nearest=[0.0, -25.4e-3]"],
+        &[
+            "(`face_centre`).nearest",
+            "from the nearest node of body `rod`",
+            "sign or unit slip",
+        ],
+    );
+}

@@ -9,6 +9,7 @@ use super::spec::{BodySpec, FormulationSpec, NodeSetSpec, Scene};
 use crate::element::{Formulation, Voigt, quad4, rod2};
 use crate::material::Material;
 use crate::mesh::{Cells, Mesh};
+use crate::output::readable;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -207,6 +208,23 @@ pub(super) fn add_node_set(
             let distance = |n: &[f64; 2]| (n[0] - p[0]).powi(2) + (n[1] - p[1]).powi(2);
             let best = (0..mesh.nodes.len())
                 .min_by(|a, b| distance(&mesh.nodes[*a]).total_cmp(&distance(&mesh.nodes[*b])));
+            if let Some(n) = best {
+                let (d, h) = (distance(&mesh.nodes[n]).sqrt(), longest_edge(mesh));
+                if d > h {
+                    return Err(cx.err(format!(
+                        "{key}.nearest: [{}, {}] lies {} from the nearest node of body `{}` \
+                         (node {n} at [{}, {}]), farther than its longest element edge ({}): a \
+                         point off the body (a sign or unit slip?); give a point on it",
+                        readable(p[0]),
+                        readable(p[1]),
+                        readable(d),
+                        bodies[b].name,
+                        readable(mesh.nodes[n][0]),
+                        readable(mesh.nodes[n][1]),
+                        readable(h)
+                    )));
+                }
+            }
             best.into_iter().collect()
         }
         (None, Some([x0, y0, x1, y1])) => {
@@ -228,6 +246,22 @@ pub(super) fn add_node_set(
     }
     bodies[b].mesh.add_node_set(&spec.name, nodes);
     Ok(())
+}
+
+/// The longest element edge of a mesh (consecutive corners of each cell).
+fn longest_edge(mesh: &Mesh) -> f64 {
+    let cells = &mesh.cells;
+    (0..cells.len())
+        .flat_map(|e| {
+            let corners = cells.nodes_of(e);
+            let k = corners.len();
+            (0..k).map(move |a| (corners[a], corners[(a + 1) % k]))
+        })
+        .map(|(p, q)| {
+            let (p, q) = (mesh.nodes[p], mesh.nodes[q]);
+            (p[0] - q[0]).hypot(p[1] - q[1])
+        })
+        .fold(0.0, f64::max)
 }
 
 /// Initial velocity per DOF: each body's `velocity`, then the `[[initial_velocity]]` sets in

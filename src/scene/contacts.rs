@@ -27,6 +27,7 @@ pub(super) fn contacts(
         .enumerate()
         .map(|entry| contact(cx, bodies, obstacles, entry, scene))
         .collect::<Result<Vec<_>, _>>()?;
+    refuse_repeated_pairs(cx, &contacts)?;
     let mut contacts = contacts;
     for (k, spec) in scene.contact.iter().enumerate() {
         if spec.two_pass {
@@ -57,6 +58,49 @@ pub(super) fn contacts(
         )));
     }
     Ok(contacts)
+}
+
+/// Refuses a pair that repeats another: the same slave nodes against the same master (an
+/// obstacle by name, or the same master nodes), or the other's surfaces with the roles
+/// swapped. Each node would then be held twice in one step, its corrections added: the
+/// Taylor rod with its face against the wall in two pairs died at 1.43 us on a runaway
+/// penetration that named neither pair.
+fn refuse_repeated_pairs(cx: &Context, pairs: &[ContactPair]) -> Result<(), InputError> {
+    /// The sorted nodes of a surface, or the obstacle's name.
+    #[derive(PartialEq)]
+    enum Side<'a> {
+        Nodes(Vec<usize>),
+        Obstacle(&'a str),
+    }
+    fn sorted<'a>(mut nodes: Vec<usize>) -> Side<'a> {
+        nodes.sort_unstable();
+        nodes.dedup();
+        Side::Nodes(nodes)
+    }
+    /// A pair's slave side and master side.
+    fn sides(pair: &ContactPair) -> (Side<'_>, Side<'_>) {
+        let master = match &pair.master {
+            Master::Segments { edges, .. } => sorted(edges.as_flattened().to_vec()),
+            Master::Nodes { nodes, .. } => sorted(nodes.clone()),
+            Master::Obstacle(o) => Side::Obstacle(&o.name),
+        };
+        (sorted(pair.slaves.clone()), master)
+    }
+    for (j, later) in pairs.iter().enumerate() {
+        let (slave, master) = sides(later);
+        for earlier in &pairs[..j] {
+            let (s, m) = sides(earlier);
+            if (slave == s && master == m) || (slave == m && master == s) {
+                return Err(cx.err(format!(
+                    "contact `{}` repeats contact `{}`: the same surfaces meet in both (the \
+                     same slave nodes against the same master, or the roles swapped), so every \
+                     node would be held twice in a step; remove one of the two pairs",
+                    later.name, earlier.name
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The `[[obstacle]]` polylines: unique names, at least 2 points (3 when closed), finite,

@@ -17,6 +17,7 @@
 //! ```
 
 mod contact;
+mod initial;
 mod setup;
 mod slaves;
 mod units;

@@ -1,6 +1,7 @@
 //! The warnings the scene alone gives, before a step is taken (`impact check` prints them,
 //! a run repeats them): too few steps or too short a run for a wave (with the likely unit
-//! mistake), an obstacle no pair uses, axisymmetric axis nodes left free, too many frames.
+//! mistake), an obstacle no pair uses, axisymmetric axis nodes left free, the bodies' start
+//! (`initial`), too many frames.
 
 use super::slaves::slave_surface_warnings;
 use super::units::{MAX_STEPS, body_size, unit_hint, unit_warnings};
@@ -48,6 +49,7 @@ pub(super) fn setup_warnings_given(model: &Model, first_step: Option<f64>) -> Ve
     out.extend(unit_warnings(model));
     out.extend(slave_surface_warnings(model));
     out.extend(axis_warnings(model));
+    out.extend(super::initial::initial_warnings(model));
     // the automatic step of the initial mesh, found once (a run's whole explicit set-up)
     let auto_step = match &model.analysis {
         Analysis::Dynamic(d) if matches!(d.step, TimeStep::Auto { .. }) => {

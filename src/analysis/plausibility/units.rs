@@ -1,6 +1,7 @@
 //! The unit mistakes a model's numbers point to, in words: the hint the set-up warnings give.
 
 use crate::analysis::steppers::stable::{critical_time_step, wave_speed};
+use crate::material::{Hardening, Material};
 use crate::output::readable;
 use crate::scene::{Body, Model};
 
@@ -113,7 +114,8 @@ pub const MAX_STEPS: f64 = 1e7;
 const FASTEST_SOLID: f64 = 2.5e4;
 
 /// The warnings on material data and speeds that point to mixed units: a yield strain
-/// outside [`YIELD_STRAIN_RANGE`], a wave faster than any solid's with SI moduli (a density
+/// outside [`YIELD_STRAIN_RANGE`], a hardening modulus at or above Young's, an adiabatic
+/// heating beyond [`HEATING_SHARE`], a wave faster than any solid's with SI moduli (a density
 /// in g/cm^3), a body starting faster than [`SPEED_SHARE`] of its wave speed.
 pub(super) fn unit_warnings(model: &Model) -> Vec<String> {
     let mut out = Vec::new();
@@ -127,6 +129,8 @@ pub(super) fn unit_warnings(model: &Model) -> Vec<String> {
         if let Some(problem) = yield_strain_problem(body) {
             out.push(problem);
         }
+        out.extend(hardening_problem(m));
+        out.extend(heating_problem(m));
         if let Some(c) = wave_speed(body)
             && m.elastic.young >= 1e7
             && c.speed > FASTEST_SOLID
@@ -199,6 +203,69 @@ fn yield_strain_problem(body: &Body) -> Option<String> {
         readable(low),
         readable(high)
     ))
+}
+
+/// A linear hardening modulus (isotropic or kinematic) at or above Young's modulus, in
+/// words. Metals harden at about E / 1000 to E / 10 (the plastic modulus d sigma_y / d eps_p:
+/// mild steel 1-2 GPa against 210 GPa); one at E or above, which makes the elastic-plastic
+/// tangent E H / (E + H) more than half of E, is a modulus in other units than `young`
+/// (GPa written as Pa beside E in MPa, or the reverse). A scale-free test: it holds in
+/// every unit system.
+fn hardening_problem(m: &Material) -> Option<String> {
+    let j2 = m.plasticity.as_ref()?;
+    let isotropic = match j2.hardening {
+        Hardening::Linear { modulus } => modulus,
+        _ => 0.0,
+    };
+    let (key, modulus) = match isotropic >= j2.kinematic_modulus {
+        true => ("hardening_modulus", isotropic),
+        false => ("kinematic_modulus", j2.kinematic_modulus),
+    };
+    (modulus >= m.elastic.young).then(|| {
+        format!(
+            "material `{}` hardens with {key} = {} at or above its young = {}: metals harden at \
+             about E / 1000 to E / 10 (the plastic modulus d sigma_y / d eps_p, mild steel 1-2 \
+             GPa beside 210 GPa), so the plastic flow would barely soften the response; a \
+             modulus in other units than young? {CONSISTENT}",
+            m.name,
+            readable(modulus),
+            readable(m.elastic.young)
+        )
+    })
+}
+
+/// The adiabatic heating of one unit of plastic strain at Johnson-Cook's initial yield
+/// stress, chi A / (rho c_p), beyond this share of the span from room to melting
+/// temperature warns. Real metals heat by 0.02 to 0.3 of it (OFHC copper 24 K of 1063 K,
+/// 4340 steel 191 K of 1500 K, Ti-6Al-4V 424 K of 1585 K, tungsten 522 K of 3400 K): three
+/// times the span is ten times the hottest, and a specific heat in kJ / (kg K) beside SI
+/// stresses gives a thousand times the right rise. Scale-free: any consistent units.
+pub const HEATING_SHARE: f64 = 3.0;
+
+/// A Johnson-Cook material whose adiabatic heating is beyond [`HEATING_SHARE`], in words.
+fn heating_problem(m: &Material) -> Option<String> {
+    let law = m.johnson_cook()?;
+    let a = m.plasticity.as_ref()?.yield_stress;
+    let rise = law.temperature_rise(a, m.density);
+    let span = law.melting_temperature - law.room_temperature;
+    (m.density > 0.0 && rise > HEATING_SHARE * span).then(|| {
+        format!(
+            "material `{}` would heat by {} per unit of plastic strain at its yield stress \
+             (taylor_quinney {} x A = {} / (density {} x specific_heat {})), {} times the {} \
+             from room to melting temperature: it would melt at a few per cent of strain, \
+             where metals heat by a tenth to a third of that span per unit strain; a \
+             specific heat in kJ / (kg K) beside SI stresses (steel 477 J / (kg K), not 0.477)? \
+             {CONSISTENT}",
+            m.name,
+            readable(rise),
+            readable(law.taylor_quinney),
+            readable(a),
+            readable(m.density),
+            readable(law.specific_heat),
+            readable(rise / span),
+            readable(span)
+        )
+    })
 }
 
 /// The largest initial speed of a body's nodes and its wave speed (None without density
