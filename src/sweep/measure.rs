@@ -258,7 +258,7 @@ fn row(
         status: record.map_or("missing".to_string(), |r| r.status.clone()),
         integrator,
         dt,
-        h: shortest_edge(model),
+        h: shortest_edge(model, &refined_bodies(&plan.keys())),
         dt_crit,
         wall_seconds: record.map(|r| r.wall_seconds),
         cpu_seconds: record.and_then(|r| r.cpu_seconds),
@@ -599,10 +599,12 @@ fn load(folder: &Path, column: Option<&str>) -> Option<Loaded> {
     })
 }
 
-/// The shortest element edge of the initial mesh over all bodies.
-pub fn shortest_edge(model: &Model) -> f64 {
+/// The shortest element edge of the initial mesh over the bodies named `bodies` (all bodies
+/// when none is named).
+pub fn shortest_edge(model: &Model, bodies: &[String]) -> f64 {
     let mut shortest = f64::INFINITY;
-    for body in &model.bodies {
+    let counted = |name: &String| bodies.is_empty() || bodies.contains(name);
+    for body in model.bodies.iter().filter(|b| counted(&b.name)) {
         let length = |a: usize, b: usize| {
             let (p, q) = (body.mesh.nodes[a], body.mesh.nodes[b]);
             (q[0] - p[0]).hypot(q[1] - p[1])
@@ -623,6 +625,22 @@ pub fn shortest_edge(model: &Model) -> f64 {
         }
     }
     shortest
+}
+
+/// The bodies whose meshes a sweep refines: the names of `body.NAME.mesh.*` when every
+/// varied key is one of those (a study of one body's mesh, the rest kept), else none (h is
+/// then the whole model's shortest edge).
+pub fn refined_bodies(keys: &[String]) -> Vec<String> {
+    let body_of = |key: &String| {
+        let rest = key.strip_prefix("body.")?;
+        let (name, tail) = rest.split_once('.')?;
+        tail.starts_with("mesh.").then(|| name.to_string())
+    };
+    let names: Option<Vec<String>> = keys.iter().map(body_of).collect();
+    let mut names = names.unwrap_or_default();
+    names.sort();
+    names.dedup();
+    names
 }
 
 /// sweep.csv: one row per case; the varied values as given, then the measures, then per
@@ -766,6 +784,22 @@ pub fn series_indices(plan: &Plan, rows: &[Row]) -> Vec<(String, Vec<usize>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Goal: a sweep of one body's mesh measures h on that body. Reference: the keys
+    /// themselves: `body.plate.mesh.*` alone names the plate; a key of anything else (the
+    /// step, another body's material) leaves the whole model; two bodies' meshes name both.
+    #[test]
+    fn a_sweep_of_one_bodys_mesh_refines_that_body() {
+        let keys = |k: &[&str]| k.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let plate = keys(&["body.plate.mesh.nx", "body.plate.mesh.ny"]);
+        assert_eq!(refined_bodies(&plate), ["plate"]);
+        let mixed = keys(&["body.plate.mesh.nx", "analysis.dt"]);
+        assert!(refined_bodies(&mixed).is_empty());
+        let velocity = keys(&["body.plate.velocity"]);
+        assert!(refined_bodies(&velocity).is_empty());
+        let both = keys(&["body.plate.mesh.nx", "body.block.mesh.nx"]);
+        assert_eq!(refined_bodies(&both), ["block", "plate"]);
+    }
 
     /// Richardson on f(h) = 1 + h^2 recovers 1 and order 2 exactly.
     #[test]
