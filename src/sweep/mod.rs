@@ -113,14 +113,23 @@ pub fn run(
     let models = models(plan, &cases, measures)?;
     crate::analysis::create_output_folder(dir)?;
     let plan_path = dir.join("sweep.json");
-    if let Ok(text) = std::fs::read_to_string(&plan_path) {
-        let existing: Option<Plan> = serde_json::from_str(&text).ok();
-        if existing.as_ref() != Some(plan) {
+    let existing: Option<Option<Plan>> = std::fs::read_to_string(&plan_path)
+        .ok()
+        .map(|text| serde_json::from_str(&text).ok());
+    if let Some(existing) = existing {
+        if !existing.as_ref().is_some_and(|e| plan.extends(e)) {
             return Err(InputError::new(
                 &plan_path,
-                "this folder holds another sweep (scene, --set or --vary differ); choose another --out",
+                "this folder holds another sweep (the scene, --set or the varied keys differ, \
+                 or values were dropped; a sweep may add values to its --vary, as a finer \
+                 level); choose another --out",
             )
             .into());
+        }
+        if existing.as_ref() != Some(plan) {
+            // a finer level added: the finished cases keep their folders
+            let text = serde_json::to_string_pretty(plan).expect("the plan serializes");
+            write_atomic(&plan_path, text.as_bytes())?;
         }
     } else {
         let text = serde_json::to_string_pretty(plan).expect("the plan serializes");

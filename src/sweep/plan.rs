@@ -116,6 +116,19 @@ pub struct Case {
 }
 
 impl Plan {
+    /// Whether this plan holds every case of `earlier` and more of the same kind: the same
+    /// scene, `--set` and varied keys, each variation's earlier values among its own (a
+    /// finer level added to a finished study). A case's folder depends on its overrides
+    /// alone, so the earlier cases' folders stay this plan's.
+    pub fn extends(&self, earlier: &Plan) -> bool {
+        self.scene == earlier.scene
+            && self.sets == earlier.sets
+            && self.variations.len() == earlier.variations.len()
+            && (self.variations.iter().zip(&earlier.variations)).all(|(now, then)| {
+                now.keys == then.keys && then.options.iter().all(|o| now.options.contains(o))
+            })
+    }
+
     /// Checks that no key is varied twice.
     pub fn validate(&self) -> Result<(), String> {
         let keys = self.keys();
@@ -196,6 +209,33 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Goal: a study takes a finer level in its own folder. Reference: the plans themselves:
+    /// a value added to a variation extends the plan; a value dropped, another key, another
+    /// `--set` or another scene does not.
+    #[test]
+    fn a_plan_with_a_level_more_extends_the_earlier() {
+        let plan = |values: &str, sets: &[&str]| Plan {
+            scene: PathBuf::from("models/block_on_plate.toml"),
+            sets: sets.iter().map(|s| s.to_string()).collect(),
+            variations: vec![parse_variation(values).unwrap()],
+        };
+        let earlier = plan("body.plate.mesh.nx,body.plate.mesh.ny=40,4;80,8", &[]);
+        let finer = plan(
+            "body.plate.mesh.nx,body.plate.mesh.ny=40,4;80,8;160,16",
+            &[],
+        );
+        assert!(finer.extends(&earlier));
+        assert!(earlier.extends(&earlier));
+        assert!(!earlier.extends(&finer));
+        let other_key = plan("body.plate.mesh.nx=40,80,160", &[]);
+        assert!(!other_key.extends(&earlier));
+        let other_set = plan(
+            "body.plate.mesh.nx,body.plate.mesh.ny=40,4;80,8;160,16",
+            &["analysis.end_time=1e-5"],
+        );
+        assert!(!other_set.extends(&earlier));
+    }
 
     #[test]
     fn parses_single_zipped_and_array_values() {
