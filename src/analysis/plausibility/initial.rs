@@ -87,7 +87,7 @@ fn radial_velocity(body: &Body) -> Option<String> {
     })
 }
 
-/// The most elongated element of `body`, when beyond [`ASPECT_RATIO`].
+/// How elongated `body`'s elements are, when its median element is beyond [`ASPECT_RATIO`].
 fn elongated_elements(body: &Body) -> Option<String> {
     if body.kind.is_rod() {
         return None;
