@@ -90,6 +90,22 @@ pub enum MeshError {
 }
 
 impl Mesh {
+    /// The side lengths of element `e`: a quad's four sides in node order, a rod's length.
+    pub fn edge_lengths(&self, e: usize) -> impl Iterator<Item = f64> + '_ {
+        let corners = self.cells.nodes_of(e);
+        let sides = match self.cells {
+            Cells::Quad4(_) => 4,
+            Cells::Rod2(_) => 1,
+        };
+        (0..sides).map(move |a| {
+            let (p, q) = (
+                self.nodes[corners[a]],
+                self.nodes[corners[(a + 1) % corners.len()]],
+            );
+            (q[0] - p[0]).hypot(q[1] - p[1])
+        })
+    }
+
     /// A mesh with the given nodes and cells and only the `all` element set.
     pub fn new(nodes: Vec<[f64; 2]>, cells: Cells) -> Mesh {
         let all = (0..cells.len()).collect();

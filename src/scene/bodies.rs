@@ -248,19 +248,10 @@ pub(super) fn add_node_set(
     Ok(())
 }
 
-/// The longest element edge of a mesh (consecutive corners of each cell).
+/// The longest element edge of a mesh.
 fn longest_edge(mesh: &Mesh) -> f64 {
-    let cells = &mesh.cells;
-    (0..cells.len())
-        .flat_map(|e| {
-            let corners = cells.nodes_of(e);
-            let k = corners.len();
-            (0..k).map(move |a| (corners[a], corners[(a + 1) % k]))
-        })
-        .map(|(p, q)| {
-            let (p, q) = (mesh.nodes[p], mesh.nodes[q]);
-            (p[0] - q[0]).hypot(p[1] - q[1])
-        })
+    (0..mesh.cells.len())
+        .flat_map(|e| mesh.edge_lengths(e))
         .fold(0.0, f64::max)
 }
 

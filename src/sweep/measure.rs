@@ -20,7 +20,6 @@
 
 use super::plan::{Case, Plan};
 use crate::analysis::steppers::stable::critical_time_step;
-use crate::mesh::Cells;
 use crate::scene::model::{Analysis, Reference};
 use crate::scene::spec::ReferenceKind;
 use crate::scene::{InputError, Model};
@@ -602,29 +601,11 @@ fn load(folder: &Path, column: Option<&str>) -> Option<Loaded> {
 /// The shortest element edge of the initial mesh over the bodies named `bodies` (all bodies
 /// when none is named).
 pub fn shortest_edge(model: &Model, bodies: &[String]) -> f64 {
-    let mut shortest = f64::INFINITY;
     let counted = |name: &String| bodies.is_empty() || bodies.contains(name);
-    for body in model.bodies.iter().filter(|b| counted(&b.name)) {
-        let length = |a: usize, b: usize| {
-            let (p, q) = (body.mesh.nodes[a], body.mesh.nodes[b]);
-            (q[0] - p[0]).hypot(q[1] - p[1])
-        };
-        match &body.mesh.cells {
-            Cells::Quad4(cells) => {
-                for c in cells {
-                    for i in 0..4 {
-                        shortest = shortest.min(length(c[i], c[(i + 1) % 4]));
-                    }
-                }
-            }
-            Cells::Rod2(cells) => {
-                for c in cells {
-                    shortest = shortest.min(length(c[0], c[1]));
-                }
-            }
-        }
-    }
-    shortest
+    (model.bodies.iter())
+        .filter(|b| counted(&b.name))
+        .flat_map(|b| (0..b.mesh.cells.len()).flat_map(|e| b.mesh.edge_lengths(e)))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The bodies whose meshes a sweep refines: the names of `body.NAME.mesh.*` when every

@@ -92,17 +92,9 @@ fn elongated_elements(body: &Body) -> Option<String> {
     if body.kind.is_rod() {
         return None;
     }
-    let cells = &body.mesh.cells;
-    let nodes = &body.mesh.nodes;
     let ratio = |e: usize| {
-        let corners = cells.nodes_of(e);
-        let k = corners.len();
-        let lengths = (0..k).map(|a| {
-            let (p, q) = (nodes[corners[a]], nodes[corners[(a + 1) % k]]);
-            (p[0] - q[0]).hypot(p[1] - q[1])
-        });
-        let (short, long) =
-            lengths.fold((f64::INFINITY, 0.0_f64), |(s, l), d| (s.min(d), l.max(d)));
+        let (short, long) = (body.mesh.edge_lengths(e))
+            .fold((f64::INFINITY, 0.0_f64), |(s, l), d| (s.min(d), l.max(d)));
         long / short
     };
     let mut ratios: Vec<f64> = (0..body.elements()).map(ratio).collect();
