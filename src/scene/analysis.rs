@@ -83,16 +83,10 @@ fn energy_gain_limit(
     spec: &AnalysisSpec,
     integrator: IntegratorKind,
 ) -> Result<Option<f64>, InputError> {
-    let Some(limit) = spec.energy_gain_limit else {
-        return Ok(guarded(integrator).then_some(ENERGY_GAIN_LIMIT));
-    };
-    if !(limit > 0.0 && limit.is_finite()) {
-        return Err(cx.err(format!(
-            "analysis.energy_gain_limit: must be a share > 0 of the energy in play (0.01 is 1 %), \
-             got {limit}"
-        )));
+    match spec.energy_gain_limit {
+        Some(limit) => positive(cx, "analysis.energy_gain_limit", limit).map(Some),
+        None => Ok(guarded(integrator).then_some(ENERGY_GAIN_LIMIT)),
     }
-    Ok(Some(limit))
 }
 
 /// Whether a run of `integrator` is guarded against energy gained by default: central
