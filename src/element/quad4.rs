@@ -448,8 +448,10 @@ pub fn tangent(
 /// K_sigma (and B-bar's correction), upper triangle only.
 fn add_geometric(geom: &QuadValues, stress: &[Voigt; 4], bbar: bool, kt: &mut Mat8) {
     let axisymmetric = geom.formulation == Formulation::Axisymmetric;
-    // the B-bar correction's point matrices M (uu and vv blocks alike), 4 x 4 per point
+    // the B-bar correction's point matrices M: the vv block's (the in-plane gradients), and
+    // the uu block's, which adds the hoop strain's N_i N_j / r^2 in axisymmetry
     let mut ms = [[[0.0; 4]; 4]; 4];
+    let mut hoops = [[[0.0; 4]; 4]; 4];
     for q in 0..4 {
         let p = &geom.points[q];
         let s = &stress[q];
@@ -460,31 +462,32 @@ fn add_geometric(geom: &QuadValues, stress: &[Voigt; 4], bbar: bool, kt: &mut Ma
                 let [xi, yi] = p.dndx[i];
                 let g = xi * sx + yi * sy;
                 let mut guu = g;
-                let mut m = xi * xj + yi * yj;
                 if axisymmetric {
                     let nn = p.shape[i] * p.shape[j] / (p.radius * p.radius);
                     guu += s[2] * nn;
-                    m += nn;
+                    hoops[q][i][j] = nn;
                 }
                 kt[(2 * i, 2 * j)] += p.weight * guu;
                 kt[(2 * i + 1, 2 * j + 1)] += p.weight * g;
-                ms[q][i][j] = m;
+                ms[q][i][j] = xi * xj + yi * yj;
             }
         }
     }
     if bbar {
-        // (tr S / 3) (avg(M) - M) at each point
+        // (tr S / 3) (avg(M) - M) at each point, for the uu and the vv block
         let volume = geom.volume();
+        let correction = |m: &dyn Fn(usize) -> f64| -> f64 {
+            let mean: f64 = (0..4).map(|q| m(q) * geom.points[q].weight / volume).sum();
+            (0..4)
+                .map(|q| (mean - m(q)) * geom.points[q].weight * trace(&stress[q]) / 3.0)
+                .sum()
+        };
         for j in 0..4 {
             for i in 0..=j {
-                let mean: f64 = (0..4)
-                    .map(|q| ms[q][i][j] * geom.points[q].weight / volume)
-                    .sum();
-                let c: f64 = (0..4)
-                    .map(|q| (mean - ms[q][i][j]) * geom.points[q].weight * trace(&stress[q]) / 3.0)
-                    .sum();
-                kt[(2 * i, 2 * j)] += c;
-                kt[(2 * i + 1, 2 * j + 1)] += c;
+                let vv = correction(&|q| ms[q][i][j]);
+                let uu = vv + correction(&|q| hoops[q][i][j]);
+                kt[(2 * i, 2 * j)] += uu;
+                kt[(2 * i + 1, 2 * j + 1)] += vv;
             }
         }
     }
@@ -691,7 +694,14 @@ mod tests {
     #[test]
     fn tangent_matches_finite_differences_of_internal_force() {
         let d = Vec8::from_fn(|i, _| 0.05 * ((i as f64) * 1.7).sin());
-        let s0 = Voigt::new(0.3, -0.2, 0.1, 0.15);
+        // a different initial stress at each point: B-bar makes the trace of D E uniform
+        // over the element, so only a non-uniform tr S exercises its correction's
+        // point-to-point part (where the axisymmetric hoop term once went to both blocks)
+        let s0: [Voigt; 4] = std::array::from_fn(|q| {
+            Voigt::new(0.3, -0.2, 0.1, 0.15) + (q as f64) * Voigt::new(0.1, 0.05, -0.2, 0.03)
+        });
+        let stresses =
+            |e: [Voigt; 4]| -> [Voigt; 4] { std::array::from_fn(|q| stress_of(&e[q], &s0[q])) };
         for form in [
             Formulation::PlaneStrain,
             Formulation::PlaneStress,
@@ -706,13 +716,13 @@ mod tests {
                 let force = |d: &Vec8| {
                     let e = strains(&geom, d, op);
                     let kin = StrainOperators::new(&geom, d, op);
-                    internal_force(&geom, &kin, &e.map(|e| stress_of(&e, &s0)))
+                    internal_force(&geom, &kin, &stresses(e))
                 };
                 let e = strains(&geom, &d, op);
                 let kt = tangent(
                     &geom,
                     &StrainOperators::new(&geom, &d, op),
-                    (&e.map(|e| stress_of(&e, &s0)), &[moduli(); 4]),
+                    (&stresses(e), &[moduli(); 4]),
                     op,
                     GeometricStiffness::Included,
                 );
