@@ -15,7 +15,7 @@ use crate::assembly::State;
 use crate::scene::{InputError, Model};
 use run::checkpoint;
 use std::path::Path;
-use steppers::{dynamics, explicit, statics};
+use steppers::{arc_length, dynamics, explicit, statics};
 
 pub use run::{Outcome, RunOptions, progress};
 pub use summary::{RunError, Status, StepError, Summary};
@@ -125,11 +125,18 @@ fn dispatch(
 ) -> Result<Outcome, RunError> {
     let start = std::time::Instant::now();
     match &model.analysis {
-        crate::scene::model::Analysis::Static(spec) => {
-            let stepper =
-                statics::Statics::new(model, spec).map_err(|e| RunError::setup(out_dir, e))?;
-            run::execute(model, out_dir, options, resume, (stepper, start))
-        }
+        crate::scene::model::Analysis::Static(spec) => match spec.arc_length {
+            Some(settings) => {
+                let stepper = arc_length::ArcLength::new(model, spec, settings)
+                    .map_err(|e| RunError::setup(out_dir, e))?;
+                run::execute(model, out_dir, options, resume, (stepper, start))
+            }
+            None => {
+                let stepper =
+                    statics::Statics::new(model, spec).map_err(|e| RunError::setup(out_dir, e))?;
+                run::execute(model, out_dir, options, resume, (stepper, start))
+            }
+        },
         crate::scene::model::Analysis::Dynamic(spec) => {
             if spec.integrator == crate::scene::spec::IntegratorKind::CentralDifference {
                 let stepper = explicit::Explicit::new(model, spec)?;

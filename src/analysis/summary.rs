@@ -160,6 +160,19 @@ pub struct AleSummary {
     pub boundary_volume_change: f64,
 }
 
+/// summary.json `arc_length` (only with `analysis.arc_length`; docs/theory.md 5b): the
+/// increments taken, the highest load factor on the path and the last, and whether the path
+/// reached the scene's load (factor 1) or stopped where its tangent turned singular (a
+/// collapse: a perfectly plastic mechanism, or a limit point met exactly).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ArcLengthSummary {
+    pub increments: usize,
+    pub peak_load_factor: f64,
+    pub final_load_factor: f64,
+    pub reached_load: bool,
+    pub collapsed: bool,
+}
+
 /// summary.json `subcycling` (only with `analysis.subcycling`; docs/theory.md 8.7c): the
 /// substeps of the finest level, the element steps taken and what stepping every element at
 /// every substep would have taken, the levels of the last major step.
@@ -356,6 +369,10 @@ pub struct Summary {
     /// only then.
     #[serde(skip)]
     pub ale: Option<AleSummary>,
+    /// The arc-length path (with `analysis.arc_length`): summary.json writes it after `ale`
+    /// and only then.
+    #[serde(skip)]
+    pub arc_length: Option<ArcLengthSummary>,
     /// What the scene and the finished run say about the answer (analysis::plausibility):
     /// the scene's own warnings (too few or too many steps, a run shorter than a wave
     /// transit, mixed units, a slave set that misses the surface facing its master, an
@@ -411,6 +428,7 @@ impl Summary {
             mass_scaling: None,
             subcycling: None,
             ale: None,
+            arc_length: None,
             warnings: Vec::new(),
         }
     }

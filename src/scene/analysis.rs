@@ -4,11 +4,11 @@
 use super::InputError;
 use super::context::{Context, positive};
 use super::model::Analysis;
-use super::model::{Ale, DynamicAnalysis, StaticAnalysis, Subcycling};
+use super::model::{Ale, ArcLength, DynamicAnalysis, StaticAnalysis, Subcycling};
 use super::spec::{
-    AdaptiveStep, AleSmoother, AnalysisKind, AnalysisSpec, BucklingSpec, ContactDynamics,
-    DEFAULT_SUBCYCLING_LEVELS, IntegratorKind, MassKind, NewtonSpec, Quadrature, StableStepKind,
-    StepSpec, TimeStep,
+    AdaptiveStep, AleSmoother, AnalysisKind, AnalysisSpec, ArcLengthSpec, BucklingSpec,
+    ContactDynamics, DEFAULT_SUBCYCLING_LEVELS, IntegratorKind, MassKind, NewtonSpec, Quadrature,
+    StableStepKind, StepSpec, TimeStep,
 };
 use crate::element::Strain;
 use crate::element::bulk_viscosity::{self, BulkViscosity};
@@ -69,6 +69,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 geometry: spec.geometry,
                 newton: spec.newton.clone(),
                 buckling: buckling(cx, spec)?,
+                arc_length: arc_length(cx, spec.arc_length.as_ref(), steps)?,
             }))
         }
         AnalysisKind::Dynamic => dynamic(cx, spec).map(Analysis::Dynamic),
@@ -111,9 +112,39 @@ pub const ENERGY_GAIN_LIMIT: f64 = 0.01;
 
 /// A dynamic analysis: its time step, end time and integrator with that integrator's
 /// parameters, mass, damping and quadrature.
+/// `analysis.arc_length`, its defaults filled in (what it may not meet, contact pairs and
+/// prescribed motion, the model checks once it is whole).
+fn arc_length(
+    cx: &Context,
+    spec: Option<&ArcLengthSpec>,
+    steps: usize,
+) -> Result<Option<ArcLength>, InputError> {
+    let Some(spec) = spec else {
+        return Ok(None);
+    };
+    let max_increments = spec.max_increments.unwrap_or(10 * steps);
+    if max_increments == 0 {
+        return Err(cx.err("analysis.arc_length.max_increments: must be at least 1"));
+    }
+    let iterations = spec.iterations.unwrap_or(5);
+    if iterations == 0 {
+        return Err(cx.err("analysis.arc_length.iterations: must be at least 1"));
+    }
+    Ok(Some(ArcLength {
+        max_increments,
+        iterations,
+    }))
+}
+
 fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicAnalysis, InputError> {
     if spec.steps.is_some() {
         return Err(cx.err("analysis.steps: a dynamic analysis takes `dt` and `end_time`"));
+    }
+    if spec.arc_length.is_some() {
+        return Err(cx.err(
+            "analysis.arc_length: does not apply to a dynamic analysis (arc length traces a \
+             static equilibrium path)",
+        ));
     }
     let end_time = positive(
         cx,

@@ -488,6 +488,17 @@ pub struct StaticAnalysis {
     pub geometry: Strain,
     pub newton: NewtonSpec,
     pub buckling: Option<BucklingSpec>,
+    /// Arc-length continuation instead of load stepping (None: load stepping).
+    pub arc_length: Option<ArcLength>,
+}
+
+/// The validated `analysis.arc_length`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcLength {
+    pub max_increments: usize,
+    /// The Newton iterations an increment aims at: the next arc is the last one times
+    /// sqrt(iterations / taken), within [1/2, 2].
+    pub iterations: usize,
 }
 
 impl DynamicAnalysis {

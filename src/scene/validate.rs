@@ -44,6 +44,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     check_mass_scaling(&cx, &analysis, &bodies)?;
     check_dispersion_free(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
+    check_arc_length(&cx, &analysis, &loads, &contacts)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
     let reference = match &scene.reference {
         Some(spec) => Some(reference(&cx, &bodies, &contacts, spec)?),
@@ -219,6 +220,60 @@ fn check_explicit_friction(
             "contact `{}`: return_coefficient is implemented for the implicit integrators and statics; with central_difference use Coulomb's `friction`",
             c.name
         )));
+    }
+    Ok(())
+}
+
+/// Arc-length continuation scales the loads by one factor and has no contact events: the
+/// loads are forces that grow in proportion (a curve through zero, linear in the pseudo
+/// time), nothing is prescribed but the supports, and there are no contact pairs.
+fn check_arc_length(
+    cx: &Context,
+    analysis: &Analysis,
+    loads: &[Load],
+    contacts: &[ContactPair],
+) -> Result<(), InputError> {
+    let Analysis::Static(s) = analysis else {
+        return Ok(());
+    };
+    if s.arc_length.is_none() {
+        return Ok(());
+    }
+    if let Some(c) = contacts.first() {
+        return Err(cx.err(format!(
+            "analysis.arc_length: contact `{}`: arc length takes no contact pairs (their \
+             events cut the load steps); drive the contact by load steps",
+            c.name
+        )));
+    }
+    let end = s.end_time;
+    for (k, load) in loads.iter().enumerate() {
+        let curve = match load {
+            Load::NodalForce { curve, .. }
+            | Load::Traction { curve, .. }
+            | Load::Pressure { curve, .. } => curve,
+            _ => {
+                return Err(cx.err(format!(
+                    "load[{k}]: a prescribed motion under analysis.arc_length, which scales \
+                     forces only; a displacement-driven run passes its limit without it"
+                )));
+            }
+        };
+        let full = curve.value(end);
+        let proportional = full != 0.0
+            && (0..=4).all(|i| {
+                let t = end * i as f64 / 4.0;
+                (curve.value(t) - full * t / end).abs() <= 1e-12 * full.abs()
+            });
+        if !proportional {
+            return Err(cx.err(format!(
+                "load[{k}]: its curve is not a ramp from zero to end_time; \
+                 analysis.arc_length scales the loads by one factor"
+            )));
+        }
+    }
+    if loads.is_empty() {
+        return Err(cx.err("analysis.arc_length: the scene has no load to scale"));
     }
     Ok(())
 }

@@ -171,6 +171,9 @@ pub struct Solver {
     /// Entries of K^-1 among the equations the contact rows have named, for the current
     /// factorization.
     inverse: InverseEntries,
+    /// A pivot at most this share of its column's diagonal is singular (`SINGULAR`, but
+    /// within `factor_indefinite_down_to`).
+    singular: f64,
 }
 
 /// The symbolic factorization and what the partial forward solves need of it.
@@ -451,6 +454,7 @@ impl Solver {
             factorizations: 0,
             solves: 0,
             inverse: InverseEntries::default(),
+            singular: SINGULAR,
         })
     }
 
@@ -492,6 +496,21 @@ impl Solver {
         }
     }
 
+    /// As [`Solver::factor_indefinite`], with pivots down to `threshold` of their column's
+    /// diagonal taken as they are: arc length at a limit point, where the tangent is
+    /// singular and the system bordered by the arc is not (Crisfield 1981: the bordered
+    /// solve stays accurate near it).
+    pub fn factor_indefinite_down_to(
+        &mut self,
+        values: &[f64],
+        threshold: f64,
+    ) -> Result<(), SolverError> {
+        self.singular = threshold;
+        let result = self.factor_indefinite(values);
+        self.singular = SINGULAR;
+        result
+    }
+
     /// Singular where a pivot of the factor in `values` (`pivot` of its column's first
     /// entry: L_jj^2 of L L^T, |D_j| of `signed_root`'s) is at most `SINGULAR` of its
     /// column's diagonal in `matrix`: a mechanism whose round-off pivot came out positive
@@ -512,7 +531,7 @@ impl Solver {
         for_each_column(cholesky, &mut self.values, |entries| {
             let i = original(j);
             let diagonal = self.pattern.position(i, i).map_or(0.0, |k| matrix[k].abs());
-            if first.is_none() && pivot(entries[0]) <= SINGULAR * diagonal {
+            if first.is_none() && pivot(entries[0]) <= self.singular * diagonal {
                 first = Some(i);
             }
             j += 1;

@@ -203,6 +203,28 @@ fn mass_scaling_warnings(model: &Model, report: &MassScalingReport) -> Vec<Strin
     out
 }
 
+/// Why an arc-length path ended short of the scene's load: a collapse (the load stood
+/// still, or the tangent turned singular) or the increments ran out.
+fn arc_length_end(arc: &crate::analysis::summary::ArcLengthSummary) -> String {
+    if arc.collapsed {
+        format!(
+            "the load cannot exceed {} times the scene's load: the path reached a collapse (the \
+             load stood still along it, a plastic mechanism) after {} increments",
+            readable(arc.peak_load_factor),
+            arc.increments
+        )
+    } else {
+        format!(
+            "the arc-length path ended after analysis.arc_length.max_increments = {} \
+             increments at load factor {} (highest {}), short of the scene's load; more \
+             increments, or fewer analysis.steps (longer arcs), take it further",
+            arc.increments,
+            readable(arc.final_load_factor),
+            readable(arc.peak_load_factor)
+        )
+    }
+}
+
 /// A subcycled run that took at least this share of the single step's element steps is
 /// warned about: its bookkeeping (a fifth of the aluminium Taylor rod's subcycled run,
 /// docs/performance.md) eats a saving below a tenth.
@@ -228,6 +250,11 @@ pub fn warnings(
              analysis.newton settings) avoids them",
             summary.step_cuts
         ));
+    }
+    if let Some(arc) = &summary.arc_length
+        && !arc.reached_load
+    {
+        out.push(arc_length_end(arc));
     }
     if let Some(b) = &summary.buckling
         && let (Some(t), Some(from), Some(to), false) = (

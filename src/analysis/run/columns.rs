@@ -68,6 +68,10 @@ pub(super) fn columns(model: &Model) -> (Vec<String>, bool) {
         // the energy Coulomb friction dissipated (the normal rows' share is contact_work)
         columns.push("friction_work".to_string());
     }
+    if load_factor_column(model) {
+        // the share of the scene's loads (at end_time) the arc-length path has reached
+        columns.push("load_factor".to_string());
+    }
     if body_columns(model) {
         // each body's kinetic energy, stored energy and plastic work (the totals' shares)
         for body in &model.bodies {
@@ -90,6 +94,11 @@ pub fn body_columns(model: &Model) -> bool {
 pub fn friction_column(model: &Model) -> bool {
     model.is_explicit()
         && (model.contacts.iter()).any(|c| matches!(c.options.friction, Friction::Coulomb { .. }))
+}
+
+/// Whether the history has `load_factor`: a static run by arc length.
+pub(super) fn load_factor_column(model: &Model) -> bool {
+    matches!(&model.analysis, crate::scene::model::Analysis::Static(s) if s.arc_length.is_some())
 }
 
 pub(super) fn bulk_viscosity_column(model: &Model) -> bool {

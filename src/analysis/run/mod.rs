@@ -375,6 +375,9 @@ impl<'a, S: Stepper> Run<'a, S> {
         if let Some(added) = self.stepper.added_mass() {
             self.recorder.added_mass = added;
         }
+        if let Some(factor) = self.stepper.load_factor() {
+            self.recorder.load_factor = factor;
+        }
         if columns::body_columns(self.model) {
             self.recorder.body_kinetic = self.stepper.body_kinetic(self.model);
         }
@@ -469,6 +472,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             entry.plastic_work = body.work.plastic;
         }
         summary.ale = s.ale();
+        summary.arc_length = s.arc_length();
         let mass_scaling = s.mass_scaling();
         summary.mass_scaling = mass_scaling
             .as_ref()

@@ -4,7 +4,7 @@
 
 use super::columns::{
     body_columns, bulk_viscosity_column, columns, error_column, friction_column, hourglass_column,
-    mass_scaling_columns,
+    load_factor_column, mass_scaling_columns,
 };
 use super::contact_record::{ContactCarry, ContactRecord};
 use super::frame::{PointArrays, cell_fields, point_body_ids};
@@ -62,6 +62,8 @@ pub struct Recorder {
     /// The mass the mass scaling has added, for the next row's `added_mass` (the column is
     /// there with `analysis.mass_scaling`).
     pub added_mass: f64,
+    /// The arc-length path's load factor for the next row (`load_factor`, arc length only).
+    pub load_factor: f64,
     /// The length of the step the next row ends (column `dt`; 0 on the first row).
     pub step_length: f64,
     /// Each body's kinetic energy for the next row (the per-body columns of a model of two
@@ -123,6 +125,7 @@ impl Recorder {
             error_column: error_column(model),
             error_estimate: 0.0,
             added_mass: 0.0,
+            load_factor: 0.0,
             step_length: 0.0,
             body_kinetic: Vec::new(),
             last_probes: Vec::new(),
@@ -193,6 +196,7 @@ impl Recorder {
             error_column: error_column(model),
             error_estimate: 0.0,
             added_mass: 0.0,
+            load_factor: 0.0,
             step_length: 0.0,
             body_kinetic: Vec::new(),
             last_probes: position.probes,
@@ -293,6 +297,28 @@ impl Recorder {
             row.push(contact.map_or(0.0, |c| c.penetration));
         }
         row.extend(averages);
+        self.push_feature_columns(model, state, energies, &mut row);
+        let frame = self.frame_due(model, state.time, force_frame, 1);
+        let history = &mut self.history;
+        self.thinning
+            .offer(&row, force_frame || frame, |r| history.append(r))?;
+        crate::profile::add(crate::profile::Phase::Output, start);
+        self.steps_since_frame += 1;
+        if frame {
+            self.frame(model, state, motion, frame_contact)?;
+        }
+        Ok(())
+    }
+
+    /// The row's columns after the contact averages, those of the features the scene
+    /// turned on (columns::columns' order).
+    fn push_feature_columns(
+        &self,
+        model: &Model,
+        state: &State,
+        energies: &Energies,
+        row: &mut Vec<f64>,
+    ) {
         if bulk_viscosity_column(model) {
             row.push(energies.bulk_viscosity_work);
         }
@@ -306,6 +332,9 @@ impl Recorder {
         if friction_column(model) {
             row.push(energies.friction_work);
         }
+        if load_factor_column(model) {
+            row.push(self.load_factor);
+        }
         if body_columns(model) {
             for (body, kinetic) in state.bodies.iter().zip(&self.body_kinetic) {
                 row.extend([
@@ -315,16 +344,6 @@ impl Recorder {
                 ]);
             }
         }
-        let frame = self.frame_due(model, state.time, force_frame, 1);
-        let history = &mut self.history;
-        self.thinning
-            .offer(&row, force_frame || frame, |r| history.append(r))?;
-        crate::profile::add(crate::profile::Phase::Output, start);
-        self.steps_since_frame += 1;
-        if frame {
-            self.frame(model, state, motion, frame_contact)?;
-        }
-        Ok(())
     }
 
     /// Whether recording the step that ends at `time` reads the element stresses: a stress
@@ -438,6 +457,7 @@ impl Recorder {
             mass_scaling: summary.mass_scaling.as_ref(),
             subcycling: summary.subcycling.as_ref(),
             ale: summary.ale.as_ref(),
+            arc_length: summary.arc_length.as_ref(),
             probes: FinalProbes {
                 columns: &model.probes,
                 values: &self.last_probes,
@@ -450,7 +470,7 @@ impl Recorder {
 
 /// summary.json: the summary's fields, then `max_temperature` when there is one, then
 /// `mass_scaling` with the mass scaling, `subcycling` with the subcycling, `ale` with the ALE
-/// steps, then the probes' last values when the scene has probes.
+/// steps, `arc_length` with arc length, then the probes' last values when the scene has probes.
 #[derive(serde::Serialize)]
 struct SummaryFile<'a> {
     #[serde(flatten)]
@@ -463,6 +483,8 @@ struct SummaryFile<'a> {
     subcycling: Option<&'a crate::analysis::summary::SubcyclingSummary>,
     #[serde(skip_serializing_if = "Option::is_none")]
     ale: Option<&'a crate::analysis::summary::AleSummary>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arc_length: Option<&'a crate::analysis::summary::ArcLengthSummary>,
     #[serde(skip_serializing_if = "FinalProbes::is_empty")]
     probes: FinalProbes<'a>,
 }

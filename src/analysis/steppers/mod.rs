@@ -5,6 +5,7 @@
 //! steppers (`control`). The run scaffold (`analysis::run`) drives a [`Stepper`], reads
 //! its [`Report`] and checkpoints it through [`Resume`]; no stepper knows the scaffold.
 
+pub mod arc_length;
 pub mod carry;
 pub mod clock;
 pub mod control;
@@ -100,6 +101,11 @@ pub trait Report {
     fn added_mass(&self) -> Option<f64> {
         None
     }
+    /// The share of the scene's loads at end_time that the state carries, where it is not
+    /// the pseudo time's (arc length: the history's `load_factor`; None: load stepping).
+    fn load_factor(&self) -> Option<f64> {
+        None
+    }
     /// The mass scaling per body at the end: summary.json `mass_scaling` and its warnings
     /// (None: off).
     fn mass_scaling(&self) -> Option<crate::assembly::mass_scaling::MassScalingReport> {
@@ -107,6 +113,10 @@ pub trait Report {
     }
     /// The ALE steps' counts at the end: summary.json `ale` (None: off).
     fn ale(&self) -> Option<crate::analysis::summary::AleSummary> {
+        None
+    }
+    /// The arc-length path at the end: summary.json `arc_length` (None: load stepping).
+    fn arc_length(&self) -> Option<crate::analysis::summary::ArcLengthSummary> {
         None
     }
     /// The subcycling's counts at the end: summary.json `subcycling` (None: off).

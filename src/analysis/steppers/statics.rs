@@ -61,6 +61,10 @@ pub struct Statics<'a> {
     refresh: bool,
     /// The length of the last increment.
     last_step: f64,
+    /// ||d|| / dt of the first increment of this run (or since a resume) and of the last:
+    /// how far the path has flattened, for the message of a run that stops at a limit load.
+    first_rate: Option<f64>,
+    last_rate: f64,
 }
 
 impl<'a> Statics<'a> {
@@ -84,6 +88,8 @@ impl<'a> Statics<'a> {
             contact: ContactState::new(&model.contacts),
             refresh: model.checkpoint_every > 0,
             last_step: 0.0,
+            first_rate: None,
+            last_rate: 0.0,
             system,
             solver,
         })
@@ -159,6 +165,32 @@ impl Increment<'_> {
     }
 }
 
+/// The flattening of the load-displacement path (the last increment's ||d|| / dt over the
+/// first's) from which a run stopped by its increments is told it may be at its limit load.
+const FLATTENED: f64 = 10.0;
+
+impl Statics<'_> {
+    /// Where the path had flattened (`FLATTENED`) under loads, the limit load as the likely
+    /// cause, and how to pass it; empty otherwise.
+    fn limit_hint(&self) -> String {
+        let Some(first) = self.first_rate else {
+            return String::new();
+        };
+        let forced = loads::has_external_force(self.model);
+        if !forced || self.last_rate < FLATTENED * first {
+            return String::new();
+        }
+        format!(
+            ". The load-displacement path had flattened: the last increment moved {:.0} times \
+             as far per unit load as the first. The load cannot go much beyond t = {}: a \
+             limit load (collapse or snap-through). analysis.arc_length = {{}} traces the path \
+             through it; a prescribed displacement drives the structure past it",
+            self.last_rate / first,
+            readable(self.state.time)
+        )
+    }
+}
+
 impl Stepper for Statics<'_> {
     fn start(&mut self) -> Result<(), String> {
         Ok(())
@@ -219,6 +251,8 @@ impl Stepper for Statics<'_> {
                     let force = evaluation.force.clone();
                     assembly::commit(self.model, &mut self.state, &d, evaluation, spec.geometry);
                     self.last_step = end - self.state.time;
+                    self.last_rate = d.iter().map(|v| v * v).sum::<f64>().sqrt() / self.last_step;
+                    self.first_rate.get_or_insert(self.last_rate);
                     self.state.time = end;
                     let positions = self.state.positions(spec.geometry);
                     self.contact
@@ -235,8 +269,11 @@ impl Stepper for Statics<'_> {
                 }
                 Err(StepFailure(reason)) => {
                     if let Err(why) = self.control.reject(target - self.state.time, counters) {
-                        let message =
-                            format!("increment to t = {} {why}: {reason}", readable(target));
+                        let message = format!(
+                            "increment to t = {} {why}: {reason}{}",
+                            readable(target),
+                            self.limit_hint()
+                        );
                         return Err(StepError::diverged(message));
                     }
                 }

@@ -178,6 +178,22 @@ pub struct AnalysisSpec {
     /// steps, the mesh smoothed and the state remapped every few steps (docs/theory.md 8.11).
     /// Default: none (Lagrangian).
     pub ale: Option<AleSpec>,
+    /// Static: arc-length continuation (Riks 1979, Crisfield 1981), the load factor an
+    /// unknown beside the displacements, so a run follows its equilibrium path past a limit
+    /// point (docs/theory.md 5b). Default: none (load stepping in pseudo time).
+    pub arc_length: Option<ArcLengthSpec>,
+}
+
+/// `analysis.arc_length = { max_increments = 200, iterations = 5 }`: at most
+/// `max_increments` increments (default 10 x `steps`) before the run ends where the path has
+/// got to; each arc grows or shrinks so that an increment takes about `iterations` Newton
+/// iterations (default 5). `arc_length = {}` turns it on with the defaults; `steps` sets the
+/// first increment (1 / steps of the load).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArcLengthSpec {
+    pub max_increments: Option<usize>,
+    pub iterations: Option<usize>,
 }
 
 /// `analysis.ale = { every = 10, smoother = "equipotential", max_move = 0.25, slide_angle = 30 }`:
