@@ -35,17 +35,51 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The text of a file before its `#[cfg(test)]` part with its comments removed and the
-/// characters inside string and character literals replaced by `_` (newlines kept, so line
-/// numbers hold): braces in a `format!` string or a `'{'` no longer count, and a line of a
-/// multi-line string is still a line of code.
+/// The text of a file without its `#[cfg(test)]` items (wherever they sit: code after a
+/// test module counts), with its comments removed and the characters inside string and
+/// character literals replaced by `_` (newlines kept, so line numbers hold): braces in a
+/// `format!` string or a `'{'` no longer count, and a line of a multi-line string is still a
+/// line of code.
 fn code(path: &Path) -> String {
-    let text = std::fs::read_to_string(path).unwrap();
-    let text = match text.find("#[cfg(test)]") {
-        Some(cut) => &text[..cut],
-        None => &text,
-    };
-    strip(text)
+    without_tests(&strip(&std::fs::read_to_string(path).unwrap()))
+}
+
+/// `code` (stripped already) with each `#[cfg(test)]` item blanked, newlines kept: the
+/// attribute, and what follows it to the end of its item, a `;` (`mod tests;`) or the brace
+/// that closes the item's first one (`mod tests { .. }`, a test-only `fn` or `impl`).
+fn without_tests(code: &str) -> String {
+    let mut out: Vec<char> = code.chars().collect();
+    let attribute: Vec<char> = "#[cfg(test)]".chars().collect();
+    let mut i = 0;
+    while i + attribute.len() <= out.len() {
+        if out[i..i + attribute.len()] != attribute[..] {
+            i += 1;
+            continue;
+        }
+        let (mut j, mut depth) = (i + attribute.len(), 0usize);
+        while j < out.len() {
+            match out[j] {
+                ';' if depth == 0 => break,
+                '{' => depth += 1,
+                '}' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        break;
+                    }
+                }
+                _ => {}
+            }
+            j += 1;
+        }
+        let end = (j + 1).min(out.len());
+        for c in &mut out[i..end] {
+            if *c != '\n' {
+                *c = ' ';
+            }
+        }
+        i = end;
+    }
+    out.into_iter().collect()
 }
 
 /// See [`code`].
@@ -189,19 +223,11 @@ fn modules_use_only_lower_layers() {
         if module == "lib" || module == "main" {
             continue;
         }
-        let own = layer(&module).unwrap_or_else(|| panic!("{module} is in no layer of lib.rs"));
-        for used in crate_paths(&code(path)) {
-            if used == module {
-                continue;
-            }
-            let theirs = layer(&used).unwrap_or_else(|| panic!("{used} is in no layer"));
-            if theirs >= own {
-                violations.push(format!(
-                    "{} (layer {own}) uses {used} (layer {theirs})",
-                    path.display()
-                ));
-            }
-        }
+        violations.extend(upward_uses(
+            &module,
+            &code(path),
+            &path.display().to_string(),
+        ));
     }
     assert!(violations.is_empty(), "{violations:#?}");
     // lib.rs states the same order
@@ -211,6 +237,72 @@ fn modules_use_only_lower_layers() {
             assert!(lib.contains(m), "lib.rs does not name {m} (layer {k})");
         }
     }
+}
+
+/// The uses of `code`, a file `name` of the top module `module`, of a module of its own or a
+/// higher layer.
+fn upward_uses(module: &str, code: &str, name: &str) -> Vec<String> {
+    let own = layer(module).unwrap_or_else(|| panic!("{module} is in no layer of lib.rs"));
+    let mut violations = Vec::new();
+    for used in crate_paths(code) {
+        if used == module {
+            continue;
+        }
+        let theirs = layer(&used).unwrap_or_else(|| panic!("{used} is in no layer"));
+        if theirs >= own {
+            violations.push(format!("{name} (layer {own}) uses {used} (layer {theirs})"));
+        }
+    }
+    violations
+}
+
+/// Goal: the layer check and the test-code cut can fail. Setup: planted files: a `contact`
+/// file that names the scene after a test module (where the cut at the first
+/// `#[cfg(test)]` used to hide `contact::surface_nodes(model: &scene::Model)`), the same
+/// use inside a test module, and a lower-layer use. Reference: the layers.
+#[test]
+fn a_planted_upward_use_is_found_wherever_it_sits() {
+    let planted = "use crate::element::Voigt;\n\
+        #[cfg(test)]\nmod tests {\n    use crate::scene::Model;\n    fn f() { let s = \"}\"; }\n}\n\
+        pub fn surface_nodes(model: &crate::scene::Model) -> usize { 0 }\n";
+    let found = upward_uses("contact", &without_tests(&strip(planted)), "planted.rs");
+    assert_eq!(found, ["planted.rs (layer 3) uses scene (layer 4)"]);
+    let inside_tests = "#[cfg(test)]\nmod tests {\n    use crate::scene::Model;\n}\n";
+    assert!(upward_uses("contact", &without_tests(&strip(inside_tests)), "t.rs").is_empty());
+    let test_file_module = "#[cfg(test)]\nmod testing;\nfn g(m: &crate::analysis::Summary) {}\n";
+    let found = upward_uses("element", &without_tests(&strip(test_file_module)), "e.rs");
+    assert_eq!(found, ["e.rs (layer 1) uses analysis (layer 7)"]);
+    // line numbers hold: the cut keeps every newline
+    assert_eq!(
+        without_tests(&strip(planted)).lines().count(),
+        planted.lines().count()
+    );
+}
+
+/// Goal: the cycle search finds a planted cycle of three and none in a chain. Setup: two
+/// planted graphs of files. Reference: the edges as written.
+#[test]
+fn a_planted_cycle_is_found() {
+    let graph = |edges: &[(&str, &str)]| {
+        let mut g: BTreeMap<PathBuf, BTreeSet<PathBuf>> = BTreeMap::new();
+        for (a, b) in edges {
+            g.entry(PathBuf::from(a))
+                .or_default()
+                .insert(PathBuf::from(b));
+        }
+        g
+    };
+    let search = |g: &BTreeMap<PathBuf, BTreeSet<PathBuf>>| {
+        let (mut path, mut finished, mut cycles) = (Vec::new(), BTreeSet::new(), Vec::new());
+        for node in g.keys() {
+            find_cycles(node, g, &mut path, &mut finished, &mut cycles);
+        }
+        cycles
+    };
+    let cycle = graph(&[("a", "b"), ("b", "c"), ("c", "a"), ("c", "d")]);
+    assert_eq!(search(&cycle), ["a -> b -> c -> a"]);
+    let chain = graph(&[("a", "b"), ("b", "c"), ("a", "c")]);
+    assert!(search(&chain).is_empty());
 }
 
 /// The module path of a file under src/: `analysis::steppers::stable` for
@@ -377,13 +469,13 @@ fn folder_modules_are_sources_and_targets_of_the_graph() {
     assert!(named.contains(&stable), "{named:?}");
 }
 
-/// A file's code lines: the lines before `#[cfg(test)]` that hold code (blank lines and
-/// comments not counted).
+/// A file's code lines: the lines outside `#[cfg(test)]` items that hold code (blank lines
+/// and comments not counted).
 fn code_lines(path: &Path) -> usize {
     code(path).lines().filter(|l| !l.trim().is_empty()).count()
 }
 
-/// The functions of a file's code (before `#[cfg(test)]`) and their lengths in lines, from
+/// The functions of a file's code (outside `#[cfg(test)]` items) and their lengths in lines, from
 /// the line of `fn` to the line of the closing brace.
 fn function_lengths(code: &str) -> Vec<(String, usize, usize)> {
     let lines: Vec<&str> = code.lines().collect();
@@ -437,8 +529,8 @@ fn function_lengths(code: &str) -> Vec<(String, usize, usize)> {
 }
 
 /// Goal: a reader holds a file of 800 lines and a function of 120 (docs: DESIGN.md, layout):
-/// longer ones are split by phase or concept. Setup: every file under src/, its code before
-/// `#[cfg(test)]` without comments and blank lines; every function there from its `fn` line
+/// longer ones are split by phase or concept. Setup: every file under src/, its code outside
+/// `#[cfg(test)]` items without comments and blank lines; every function there from its `fn` line
 /// to its closing brace. Reference: the two limits.
 #[test]
 fn files_and_functions_stay_within_what_a_reader_holds() {

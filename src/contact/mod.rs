@@ -274,17 +274,3 @@ mod tests {
         }
     }
 }
-
-/// The nodes of every contact surface (slaves, and the nodes of deformable masters).
-pub fn surface_nodes(model: &crate::scene::Model) -> Vec<bool> {
-    let mut flags = vec![false; model.dofs() / 2];
-    for pair in &model.contacts {
-        pair.slaves.iter().for_each(|s| flags[*s] = true);
-        match &pair.master {
-            Master::Segments { edges, .. } => edges.iter().flatten().for_each(|n| flags[*n] = true),
-            Master::Nodes { nodes, .. } => nodes.iter().for_each(|n| flags[*n] = true),
-            Master::Obstacle(_) => {}
-        }
-    }
-    flags
-}

@@ -12,7 +12,7 @@ use super::spec::{
     AdaptiveStep, BucklingSpec, ContactDynamics, IntegratorKind, MassKind, NewtonSpec, OutputSpec,
     Quadrature, Quantity, ReferenceKind, StableStepKind, Statistic, TimeStep,
 };
-use crate::contact::{BodySurface, ContactPair, Interfaces, Obstacle, Section};
+use crate::contact::{BodySurface, ContactPair, Interfaces, Master, Obstacle, Section};
 use crate::element::bulk_viscosity::BulkViscosity;
 use crate::element::mass_scaling::MassScaling;
 use crate::element::{Formulation, Strain, Voigt};
@@ -725,6 +725,23 @@ impl Model {
         dofs.sort_unstable();
         dofs.dedup();
         dofs
+    }
+
+    /// The nodes of every contact surface (slaves, and the nodes of deformable masters),
+    /// flagged by global node.
+    pub fn contact_surface_nodes(&self) -> Vec<bool> {
+        let mut flags = vec![false; self.dofs() / 2];
+        for pair in &self.contacts {
+            pair.slaves.iter().for_each(|s| flags[*s] = true);
+            match &pair.master {
+                Master::Segments { edges, .. } => {
+                    edges.iter().flatten().for_each(|n| flags[*n] = true)
+                }
+                Master::Nodes { nodes, .. } => nodes.iter().for_each(|n| flags[*n] = true),
+                Master::Obstacle(_) => {}
+            }
+        }
+        flags
     }
 
     pub fn dofs(&self) -> usize {

@@ -191,7 +191,7 @@ impl<'a> Dynamics<'a> {
             }
         }
         if spec.contact_dynamics == ContactDynamics::MassRedistribution {
-            mass = mass.redistributed(model, &crate::contact::surface_nodes(model));
+            mass = mass.redistributed(model, &model.contact_surface_nodes());
         }
         let inverse_mass = mass
             .lumped
@@ -209,7 +209,7 @@ impl<'a> Dynamics<'a> {
         let n = model.dofs();
         let nominal = super::stable::implicit_first_step(model, spec)?;
         let method = integrator(spec);
-        let on_surface = crate::contact::surface_nodes(model);
+        let on_surface = model.contact_surface_nodes();
         let estimated: Vec<bool> = system
             .equation
             .iter()
@@ -610,7 +610,7 @@ impl<'a> Dynamics<'a> {
     /// impact conditions then do to the entries' multipliers (theory 7).
     fn motion_contact_force(&self, internal: &[f64]) -> Vec<f64> {
         let (motion, external) = self.motion_terms(internal);
-        let on = crate::contact::surface_nodes(self.model);
+        let on = self.model.contact_surface_nodes();
         let free = |i: usize| self.system.equation[i].is_some() && on[i / 2];
         (0..self.model.dofs())
             .map(|i| {
@@ -1004,7 +1004,7 @@ end_time = 0.1
         let model = crate::scene::from_str(STACK, Path::new("stack.toml"), &[]).unwrap();
         let mass = Mass::new(&model, MassKind::Consistent)
             .unwrap()
-            .redistributed(&model, &crate::contact::surface_nodes(&model));
+            .redistributed(&model, &model.contact_surface_nodes());
         let coords = model.coordinates();
         for (body, surface_y, nodes_on_surface, total) in [(0, 0.001, 5, 4.0), (1, 0.0, 7, 6.0)] {
             let b = &model.bodies[body];

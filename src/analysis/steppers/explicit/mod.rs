@@ -133,7 +133,8 @@ impl<'a> Explicit<'a> {
             model,
             spec,
             interfaces: model.interfaces(),
-            surface_nodes: crate::contact::surface_nodes(model)
+            surface_nodes: model
+                .contact_surface_nodes()
                 .iter()
                 .enumerate()
                 .filter_map(|(n, on)| on.then_some(n as u32))
