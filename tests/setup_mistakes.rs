@@ -517,6 +517,32 @@ fn a_cancelled_velocity_a_radial_velocity_and_long_elements_are_warned() {
     );
 }
 
+/// Goal: a Taylor rod written as plane stress, its thickness left at the default 1 (m), is
+/// warned before the run. Setup: models/taylor_jc.toml with `formulation = "plane_stress"`
+/// (the rod 3.2 x 32.4 mm). Reference: plane stress is for plates thin against their
+/// in-plane size; 1 m is 31 times the rod's length (the run: plastic work 8069 J
+/// against 96 J). The shipped plane-stress scenes (thickness 0.1 to 1, sizes 5 to 20) give
+/// none (`shipped_scenes_and_the_sphere_give_no_setup_warning`).
+#[test]
+fn a_plane_stress_body_thicker_than_it_is_long_is_warned() {
+    let out = common::impact(&[
+        "check",
+        "models/taylor_jc.toml",
+        "--strict",
+        "--set",
+        "body.rod.formulation=\"plane_stress\"",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    warned(
+        &stderr,
+        &[
+            "body `rod` is plane stress with a thickness of 1",
+            "give `thickness`",
+        ],
+    );
+}
+
 /// Goal: a `[[node_set]]` point off its body (a sign slip) is refused naming the distance,
 /// not snapped to a node far away. Setup: models/taylor_jc.toml with the node set
 /// `face_centre` at [0, -25.4e-3] instead of on the rod's face (y = 0). Reference: the
