@@ -286,14 +286,6 @@ fn the_static_tangent_is_the_derivative_of_the_residual() {
             "axisymmetric",
             "formulation = \"axisymmetric\"\nbbar = false",
         ),
-        (
-            "axisymmetric, B-bar set",
-            "formulation = \"axisymmetric\"\nbbar = true",
-        ),
-        (
-            "plane strain, B-bar set",
-            "formulation = \"plane_strain\"\nbbar = true",
-        ),
     ];
     let dt = 0.1;
     for (law, material) in laws {
