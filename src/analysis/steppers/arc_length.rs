@@ -181,7 +181,7 @@ impl<'a> ArcLength<'a> {
                     singular: true,
                     message: format!(
                         "the stiffness matrix is singular at {}: a mechanism or missing supports",
-                        self.free_dof(index)
+                        super::newton::free_dof(self.model, &self.system, index)
                     ),
                 },
                 other => Failure {
@@ -190,18 +190,6 @@ impl<'a> ArcLength<'a> {
                 },
             })?;
         Ok(evaluation)
-    }
-
-    /// The free equation `index` in the user's words.
-    fn free_dof(&self, index: usize) -> String {
-        match self.system.equation.iter().position(|e| *e == Some(index)) {
-            Some(dof) => format!(
-                "the {} DOF of {}",
-                ["x", "y"][dof % 2],
-                self.model.describe_node(dof / 2)
-            ),
-            None => format!("free DOF {index}"),
-        }
     }
 
     /// K^-1 b with the factored tangent.

@@ -53,6 +53,18 @@ pub struct Counters {
     pub rejected: usize,
 }
 
+/// The free equation `index` of `system` in the user's words: the body, node and component.
+pub(super) fn free_dof(model: &Model, system: &System, index: usize) -> String {
+    match system.equation.iter().position(|e| *e == Some(index)) {
+        Some(dof) => format!(
+            "the {} DOF of {}",
+            ["x", "y"][dof % 2],
+            model.describe_node(dof / 2)
+        ),
+        None => format!("free DOF {index}"),
+    }
+}
+
 /// The step failed to converge: why (reported after the last cut).
 #[derive(Debug, Clone)]
 pub struct StepFailure(pub String);
@@ -634,22 +646,10 @@ impl Step<'_> {
         result.map_err(|e| match e {
             SolverError::Singular { index } => StepFailure(format!(
                 "the stiffness matrix is singular at {}: a mechanism or missing supports",
-                self.free_dof(system, index)
+                free_dof(self.model, system, index)
             )),
             other => StepFailure(other.to_string()),
         })
-    }
-
-    /// The free equation `index` in the user's words: the body, node and component.
-    fn free_dof(&self, system: &System, index: usize) -> String {
-        match system.equation.iter().position(|e| *e == Some(index)) {
-            Some(dof) => format!(
-                "the {} DOF of {}",
-                ["x", "y"][dof % 2],
-                self.model.describe_node(dof / 2)
-            ),
-            None => format!("free DOF {index}"),
-        }
     }
 
     /// Whether the iteration should refactor: the residual stops contracting (`ratio` of the
