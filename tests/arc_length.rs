@@ -99,7 +99,7 @@ const HILL_LIMIT: f64 = 0.800_440;
 /// sigma_y ln(b / a) = 0.80044, by arc length (20 steps: the first arc 1/20 of the load),
 /// then by load stepping (55 steps). Reference: Hill's limit. Tolerances: 1 %, the issue's
 /// (measured +0.057 %: the 20 x 16 mesh and nu = 0.4999); at most 8 Newton iterations an
-/// increment (measured 4.4), no step cut (measured none: the pivots of the plateau's
+/// increment (measured 3.5), no step cut (measured none: the pivots of the plateau's
 /// singular tangent are taken down to 1e-15 of their diagonal, theory 5b).
 #[test]
 fn hill_cylinder_collapses_by_arc_length_at_hills_limit() {

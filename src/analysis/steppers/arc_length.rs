@@ -391,13 +391,16 @@ impl Stepper for ArcLength<'_> {
                     let arc = arc.unwrap_or_else(|| norm(&converged.du));
                     self.commit(converged, arc);
                     self.cuts_in_a_row = 0;
-                    // the next predictor's tangent, factored now: singular, the path ends
-                    let zero = vec![0.0; self.model.dofs()];
-                    let nominal = self.spec.end_time / self.spec.steps as f64;
-                    match self.factor_at(&zero, nominal, self.spec.newton.tangent) {
-                        Ok(_) => self.factored_at_start = true,
-                        Err(f) if f.singular => self.collapsed = true,
-                        Err(_) => {}
+                    // the next predictor's tangent, factored now (where there is a next
+                    // increment): singular, the path ends
+                    if !self.done() {
+                        let zero = vec![0.0; self.model.dofs()];
+                        let nominal = self.spec.end_time / self.spec.steps as f64;
+                        match self.factor_at(&zero, nominal, self.spec.newton.tangent) {
+                            Ok(_) => self.factored_at_start = true,
+                            Err(f) if f.singular => self.collapsed = true,
+                            Err(_) => {}
+                        }
                     }
                     return Ok(());
                 }
@@ -406,7 +409,8 @@ impl Stepper for ArcLength<'_> {
                     counters.cuts += 1;
                     if self.cuts_in_a_row > self.spec.newton.max_cuts {
                         return Err(StepError::diverged(format!(
-                            "arc-length increment {} at load factor {} {} cuts: {reason}",
+                            "arc-length increment {} from load factor {} did not converge \
+                             after {} cuts: {reason}",
                             self.increments + 1,
                             readable(self.factor),
                             self.spec.newton.max_cuts
