@@ -242,6 +242,56 @@ fn an_implicit_pair_that_makes_energy_ends_with_exit_3() {
     assert!(*rows.last().unwrap() < 1.5e-4, "{rows:?}");
 }
 
+/// Goal: an implicit pair whose work goes negative by as much as the bodies gain (so the
+/// balance closes) still ends with exit 3 once the plastic work passes the energy supplied.
+/// Setup: models/block_on_plate.toml on Newmark average acceleration (dt 5e-8) with the facing
+/// sets, one pass, friction 0.2 and a 50 m/s slide, under `contact_dynamics = "persistency"`
+/// (no velocity jumps): by 13 us the contact has given 3158 J. Before this check the run
+/// ended `ok` at 150 us with 9622 J of plastic work against the 4906 J brought in and the
+/// balance within 0.01 %. Reference: plastic work is dissipated for good, so it cannot exceed
+/// the initial kinetic energy (no external work here), 1/2 (7850 x 10e-3 x 5e-3)(50^2 +
+/// 150^2) = 4906.25 J per metre; the run stops at the first step beyond it by more than 1 % of
+/// the energy in play (measured: W_p passes 4906.25 J at 17.3 us).
+#[test]
+fn plastic_work_beyond_the_energy_supplied_ends_with_exit_3() {
+    let dir = common::out_dir("block_on_plate_persistency");
+    let out = common::impact(&[
+        "run",
+        "models/block_on_plate.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "analysis.integrator=average",
+        "--set",
+        "analysis.dt=5e-8",
+        "--set",
+        "analysis.end_time=3e-5",
+        "--set",
+        "analysis.contact_dynamics=persistency",
+        "--set",
+        "body.block.velocity=[50,-150]",
+        "--set",
+        "contact.impact.friction=0.2",
+        "--set",
+        r#"contact.impact.slave={ body = "block", set = "bottom" }"#,
+        "--set",
+        r#"contact.impact.master={ body = "plate", set = "top" }"#,
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("exceeds the energy supplied 4906.25"),
+        "{stderr}"
+    );
+    let rows = common::column(&dir, "time");
+    let end = *rows.last().unwrap();
+    // stopped after W_p passed the supply (17.3 us), before the run's end
+    assert!(end > 1.7e-5 && end < 3e-5, "{end}");
+    let plastic = *common::column(&dir, "plastic_work").last().unwrap();
+    assert!(plastic > 4906.25, "{plastic}");
+}
+
 /// Goal: balanced contact is asked for only where it runs, and never with a one-pass key.
 /// Setup: `impact check` on models/block_on_plate.toml with `roles = "symmetric"` on Newmark,
 /// with `discretization = "mortar"` and with `two_pass`. Reference: exit 2 with the key named.

@@ -473,9 +473,18 @@ fn persistency_and_mass_redistribution_resume_bit_identically() {
         ("plastic_block_persistency", "persistency"),
         ("plastic_block_redistribution", "mass_redistribution"),
     ] {
+        // velocity-level persistency makes energy on this coarse block at dt = 0.002 (the
+        // contact gives 0.74 against the 0.2725 brought in by t = 0.079, where the plastic
+        // work passes the supply): the guard would end the run, and this test measures the
+        // resume, not the physics
+        let limit = match treatment {
+            "persistency" => "analysis.energy_gain_limit=100",
+            _ => "analysis.energy_gain_limit=0.01",
+        };
         let set = [
             format!("analysis.contact_dynamics={treatment}"),
             "analysis.checkpoint_every=20".to_string(),
+            limit.to_string(),
         ];
         let set: Vec<&str> = set.iter().map(String::as_str).collect();
         let full = run_full(name, &text, &set);

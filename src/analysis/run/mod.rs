@@ -650,7 +650,10 @@ impl<S: Stepper> Run<'_, S> {
     /// conditions: -5 % at t = 0.01), and Wilson's interpolated step is not what it books (a
     /// plastic block on a floor: -67 %). (2) On every dynamic path, the balance has gained
     /// more than `analysis.energy_gain_limit` of the energy in play: the bodies hold more than
-    /// they were given and the sinks took, whoever made it. None otherwise, and in statics
+    /// they were given and the sinks took, whoever made it. (3) On every dynamic path, the
+    /// plastic work exceeds the energy supplied by more than that share (an implicit pair
+    /// whose work went negative closes the balance while it makes the energy). None
+    /// otherwise, and in statics
     /// (whose balance measures the trapezoidal rule's error along a load path, not energy
     /// made).
     fn energy_created(&self) -> Option<String> {
@@ -690,6 +693,23 @@ impl<S: Stepper> Run<'_, S> {
         }
         let gain = relative_gain(e, initial);
         let limit = analysis.energy_gain_limit?;
+        // (3) plastic work is dissipated for good: beyond the energy supplied it was made,
+        // even where the balance closes because the contact's work went negative by as much
+        let supplied = initial + e.external_work.max(0.0);
+        if gain <= limit && e.plastic_work > supplied + limit * scale {
+            return Some(format!(
+                "the plastic work {} exceeds the energy supplied {} (initial energy and \
+                 external work) by {:.1} % of the energy in play (more than {} %, \
+                 analysis.energy_gain_limit): energy was created; the contact {} gave {}, so \
+                 the answer is not the physics'",
+                readable(e.plastic_work),
+                readable(supplied),
+                100.0 * (e.plastic_work - supplied) / scale,
+                100.0 * limit,
+                pairs(),
+                readable(given),
+            ));
+        }
         (gain > limit).then(|| {
             let cause = match (given > 0.0, self.model.contacts.is_empty()) {
                 (true, _) => format!(
