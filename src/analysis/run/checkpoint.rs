@@ -45,7 +45,7 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///     carry.
 /// 16: each body's internal and plastic work in the state, each body's energies in the
 ///     summary.
-const FORMAT: u32 = 16;
+const FORMAT: u32 = 17;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -76,6 +76,9 @@ pub struct ExplicitCarry {
     pub tightness: Option<crate::assembly::explicit::tight::Tightness>,
     /// The ALE steps' element masses (remapped) and counts (None without ALE).
     pub ale: Option<AleCarry>,
+    /// The one-point kernel's hourglass forces (2 per element) and their work so far: the
+    /// element state `State` does not hold (None: the 2x2 kernel, which has none).
+    pub hourglass: Option<(Vec<f64>, f64)>,
 }
 
 /// What a run with ALE steps carries: the element masses as the remaps left them (the nodal

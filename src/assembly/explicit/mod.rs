@@ -631,7 +631,7 @@ pub(super) fn stable_step_of(layout: &Layout, work: &StepWork) -> StableStep {
 
 /// The element loop of a central-difference run: the one-point kernel (`reduced`), the 2x2
 /// rate-form kernel on finite-strain Quad4 models, or none (rods, small strain: the general
-/// assembly); and whether the kernel keeps state that `State` does not. With the mass
+/// assembly). With the mass
 /// scaling of `spec` the elements below its target on the configuration of `state` are
 /// scaled (their added mass pending for the run's nodal masses).
 pub fn kernel_for<'a>(
@@ -639,37 +639,28 @@ pub fn kernel_for<'a>(
     spec: &DynamicAnalysis,
     state: &State,
     masses: &ElementMasses,
-) -> (Box<dyn ExplicitKernel + 'a>, bool) {
+) -> Box<dyn ExplicitKernel + 'a> {
     let quads_only = model.bodies.iter().all(|b| !b.kind.is_rod());
     match spec.quadrature {
-        Quadrature::Reduced => (
-            Box::new(
-                Reduced::new(model, state, spec.hourglass, masses)
-                    .with_tight_step(spec.tight_step(), spec.global_step())
-                    .with_bulk_viscosity(spec.bulk_viscosity)
-                    .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
-            ),
-            true,
+        Quadrature::Reduced => Box::new(
+            Reduced::new(model, state, spec.hourglass, masses)
+                .with_tight_step(spec.tight_step(), spec.global_step())
+                .with_bulk_viscosity(spec.bulk_viscosity)
+                .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
         ),
-        Quadrature::Full if quads_only && spec.geometry == Strain::Finite => (
-            Box::new(
-                Full::new(model, state, masses)
-                    .with_tight_step(spec.tight_step(), spec.global_step())
-                    .with_bulk_viscosity(spec.bulk_viscosity)
-                    .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
-            ),
-            false,
+        Quadrature::Full if quads_only && spec.geometry == Strain::Finite => Box::new(
+            Full::new(model, state, masses)
+                .with_tight_step(spec.tight_step(), spec.global_step())
+                .with_bulk_viscosity(spec.bulk_viscosity)
+                .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
         ),
-        Quadrature::Full => (
-            Box::new(General::new(
-                model,
-                state,
-                masses,
-                spec.geometry,
-                spec.newton.tangent,
-            )),
-            false,
-        ),
+        Quadrature::Full => Box::new(General::new(
+            model,
+            state,
+            masses,
+            spec.geometry,
+            spec.newton.tangent,
+        )),
     }
 }
 

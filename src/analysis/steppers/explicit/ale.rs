@@ -345,7 +345,7 @@ impl super::Explicit<'_> {
         // the tight step's ratios: each is taken again when its element's bound has moved by
         // 2 % (8.7), as the smoothed elements' have; the others stand
         let tightness = self.kernel.tightness().cloned();
-        (self.kernel, _) = super::kernel_for(model, self.spec, &self.state, &self.masses);
+        self.kernel = super::kernel_for(model, self.spec, &self.state, &self.masses);
         if let Some((forces, work)) = hourglass {
             // the hourglass forces resisted the hourglass shape of the old mesh, which the
             // smoother took out: kept, they push the material back into it (a rod's foot

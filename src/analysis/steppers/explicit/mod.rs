@@ -62,8 +62,6 @@ pub struct Explicit<'a> {
     /// The one-point kernel keeps its element state in its own arrays (copied into `state`
     /// only when output reads stresses).
     kernel: Box<dyn ExplicitKernel + 'a>,
-    /// Whether the kernel keeps state that `State` does not (the one-point hourglass forces).
-    kernel_has_own_state: bool,
     synced: bool,
     state: State,
     v: Vec<f64>,
@@ -108,7 +106,6 @@ impl<'a> Explicit<'a> {
             masses,
             state,
             mut kernel,
-            kernel_has_own_state,
             clock,
             subcycler,
         } = Start::new(model, spec)?;
@@ -145,7 +142,6 @@ impl<'a> Explicit<'a> {
             inverse_mass,
             dt_crit,
             kernel,
-            kernel_has_own_state,
             synced: false,
             state,
             v: vec![0.0; dofs],
@@ -542,11 +538,21 @@ impl Resume for Explicit<'_> {
         }
         // a kernel with its own arrays starts again from the restored points (and the viscous
         // pressures of the last step, which the next step's work needs)
-        (self.kernel, self.kernel_has_own_state) =
-            kernel_for(self.model, self.spec, &self.state, &self.masses);
+        self.kernel = kernel_for(self.model, self.spec, &self.state, &self.masses);
         if !carry.viscous_pressure.is_empty() {
             self.kernel
                 .restore_viscous_pressure(&carry.viscous_pressure);
+        }
+        // the one-point kernel's hourglass forces and work, which the points do not hold
+        match (self.kernel.hourglass_state().is_some(), carry.hourglass) {
+            (true, Some((forces, work))) => {
+                if forces.len() != self.kernel.elements() * 2 {
+                    return false;
+                }
+                self.kernel.restore_hourglass_state(forces, work);
+            }
+            (false, None) => {}
+            _ => return false,
         }
         // the tight step's ratios as the run had taken them
         if let Some(tightness) = carry.tightness {
@@ -574,12 +580,6 @@ impl Resume for Explicit<'_> {
     }
 
     fn carry(&self) -> Result<Carry, &'static str> {
-        if self.kernel_has_own_state {
-            // its hourglass forces are not in `State`; the scene refuses checkpoint_every
-            return Err(
-                "quadrature = \"reduced\" writes no checkpoint: rerun the scene to continue",
-            );
-        }
         let mut state = self.state.clone();
         self.kernel.write_points(self.model, &mut state);
         Ok(Carry::Explicit(ExplicitCarry {
@@ -604,6 +604,7 @@ impl Resume for Explicit<'_> {
                 masses: self.masses.clone(),
                 summary: m.summary(),
             }),
+            hourglass: self.kernel.hourglass_state(),
         }))
     }
 }

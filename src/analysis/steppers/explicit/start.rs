@@ -21,10 +21,8 @@ pub struct Start<'a> {
     pub dt_crit: Option<f64>,
     pub masses: ElementMasses,
     pub state: State,
-    /// The kernel that steps the run, and whether it keeps element state that `State` does
-    /// not (the one-point hourglass forces).
+    /// The kernel that steps the run.
     pub kernel: Box<dyn ExplicitKernel + 'a>,
-    pub kernel_has_own_state: bool,
     /// The step rule, with the stable step of the initial mesh.
     pub clock: Clock,
     /// Subcycling's levels formed on the initial mesh (None: every element steps together).
@@ -43,7 +41,7 @@ impl<'a> Start<'a> {
         let masses = ElementMasses::new(model)
             .map_err(|err| InputError::new(&model.file, err.to_string()))?;
         let state = State::initial(model);
-        let (mut kernel, kernel_has_own_state) = kernel_for(model, spec, &state, &masses);
+        let mut kernel = kernel_for(model, spec, &state, &masses);
         let exact = dt_crit.unwrap_or(f64::NAN);
         let mut clock = explicit_clock(model, spec, exact, &state, kernel.as_ref())?;
         let subcycler = match spec.subcycling {
@@ -59,7 +57,6 @@ impl<'a> Start<'a> {
             masses,
             state,
             kernel,
-            kernel_has_own_state,
             clock,
             subcycler,
         })
