@@ -205,6 +205,24 @@ fn two_like_rods_stay_mirror_images() {
     }
 }
 
+/// `impact run` of models/block_on_plate.toml into `dir` on Newmark average acceleration,
+/// with the `--set` overrides `sets`.
+fn newmark_run(dir: &std::path::Path, sets: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "run",
+        "models/block_on_plate.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "analysis.integrator=average",
+    ];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    common::impact(&args)
+}
+
 /// Goal: an implicit run that makes energy ends with a numerical failure (exit 3) naming the
 /// pair, not `ok`. Setup: models/block_on_plate.toml on Newmark average acceleration (dt
 /// 1e-7) with one-pass mortar, the roles swapped onto the facing sets (the plate's top the
@@ -217,21 +235,14 @@ fn two_like_rods_stay_mirror_images() {
 #[test]
 fn an_implicit_pair_that_makes_energy_ends_with_exit_3() {
     let dir = common::out_dir("block_on_plate_newmark_swapped");
-    let out = common::impact(&[
-        "run",
-        "models/block_on_plate.toml",
-        "--out",
-        dir.to_str().unwrap(),
-        "--quiet",
-        "--set",
-        "analysis.integrator=average",
-        "--set",
-        "analysis.dt=1e-7",
-        "--set",
-        r#"contact.impact.slave={ body = "plate", set = "top" }"#,
-        "--set",
-        r#"contact.impact.master={ body = "block", set = "bottom" }"#,
-    ]);
+    let out = newmark_run(
+        &dir,
+        &[
+            "analysis.dt=1e-7",
+            r#"contact.impact.slave={ body = "plate", set = "top" }"#,
+            r#"contact.impact.master={ body = "block", set = "bottom" }"#,
+        ],
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{stderr}");
     assert!(stderr.contains("energy balance gained"), "{stderr}");
@@ -255,29 +266,18 @@ fn an_implicit_pair_that_makes_energy_ends_with_exit_3() {
 #[test]
 fn plastic_work_beyond_the_energy_supplied_ends_with_exit_3() {
     let dir = common::out_dir("block_on_plate_persistency");
-    let out = common::impact(&[
-        "run",
-        "models/block_on_plate.toml",
-        "--out",
-        dir.to_str().unwrap(),
-        "--quiet",
-        "--set",
-        "analysis.integrator=average",
-        "--set",
-        "analysis.dt=5e-8",
-        "--set",
-        "analysis.end_time=3e-5",
-        "--set",
-        "analysis.contact_dynamics=persistency",
-        "--set",
-        "body.block.velocity=[50,-150]",
-        "--set",
-        "contact.impact.friction=0.2",
-        "--set",
-        r#"contact.impact.slave={ body = "block", set = "bottom" }"#,
-        "--set",
-        r#"contact.impact.master={ body = "plate", set = "top" }"#,
-    ]);
+    let out = newmark_run(
+        &dir,
+        &[
+            "analysis.dt=5e-8",
+            "analysis.end_time=3e-5",
+            "analysis.contact_dynamics=persistency",
+            "body.block.velocity=[50,-150]",
+            "contact.impact.friction=0.2",
+            r#"contact.impact.slave={ body = "block", set = "bottom" }"#,
+            r#"contact.impact.master={ body = "plate", set = "top" }"#,
+        ],
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{stderr}");
     assert!(
