@@ -30,8 +30,8 @@ fn rod_on_plate(name: &str, overrides: &[&str]) -> Outcome {
         run.summary.warnings
     );
     let last = |column: &str| *common::column(&run.dir, column).last().unwrap();
-    // the work of the normal rows and of the friction together (central difference books
-    // the friction's apart, `friction_work`; the implicit paths keep it in contact_work):
+    // the work of the normal rows and of the friction together (a friction pair books the
+    // friction's apart, `friction_work`; without friction the column is not there):
     // the normal rows' share alone gives back up to 0.45 % of the energy with mu = 0.3
     let contact_work = common::column(&run.dir, "contact_work");
     let header = std::fs::read_to_string(run.dir.join("history.csv")).unwrap();

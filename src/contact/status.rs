@@ -182,6 +182,16 @@ impl ContactState {
         totals
     }
 
+    /// The friction forces alone (all DOFs) at positions `coords`: +f t on the slaves, -w f t
+    /// on their master nodes (None: no pair has Coulomb friction).
+    pub fn friction_forces(&self, pairs: &[ContactPair], coords: &[[f64; 2]]) -> Option<Vec<f64>> {
+        if !(pairs.iter()).any(|p| matches!(p.options.friction, super::Friction::Coulomb { .. })) {
+            return None;
+        }
+        let none: Vec<Vec<f64>> = self.force.iter().map(|f| vec![0.0; f.len()]).collect();
+        Some(self.nodal_forces_of(pairs, coords, &none, &self.tangential))
+    }
+
     /// Total tangential (friction) force along t per pair.
     pub fn pair_tangential_forces(&self) -> Vec<f64> {
         self.tangential.iter().map(|f| f.iter().sum()).collect()

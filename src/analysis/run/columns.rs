@@ -89,10 +89,10 @@ pub fn body_columns(model: &Model) -> bool {
     model.bodies.len() > 1
 }
 
-/// Whether the history has `friction_work`: central difference with a Coulomb pair (the
-/// implicit paths book the friction's dissipation in `contact_work`).
+/// Whether the history has `friction_work`: a dynamic run with a Coulomb pair (statics books
+/// no energy of its contact).
 pub fn friction_column(model: &Model) -> bool {
-    model.is_explicit()
+    matches!(model.analysis, crate::scene::model::Analysis::Dynamic(_))
         && (model.contacts.iter()).any(|c| matches!(c.options.friction, Friction::Coulomb { .. }))
 }
 

@@ -410,6 +410,10 @@ impl<'a> Dynamics<'a> {
     ) {
         let (model, spec) = (self.model, self.spec);
         let h = step.length;
+        // the friction forces the step starts from (the committed contact, start positions)
+        let friction_start = self
+            .contact
+            .friction_forces(&self.interfaces.pairs, &self.state.positions(spec.geometry));
         let d = std::mem::take(&mut step.solution.d);
         let evaluation = std::mem::take(&mut step.solution.evaluation);
         let internal = evaluation.force.clone();
@@ -459,14 +463,24 @@ impl<'a> Dynamics<'a> {
             false => applied.clone(),
         };
         let total = self.total_force(&internal);
+        // the friction's share of the contact forces' work: minus the work of the friction
+        // forces alone, theirs at the step's start and end (theory 7)
+        let friction = friction_start.map_or(0.0, |start| {
+            let end = (self.contact)
+                .friction_forces(&self.interfaces.pairs, &self.state.positions(spec.geometry))
+                .expect("a friction pair");
+            -super::trapezoid_work(&d, &end, &start)
+        });
         let energies = &mut self.energies;
         energies.external_work += super::trapezoid_work(&d, &total, &self.last_total);
         energies.kinetic = self.mass.kinetic_energy(model, &self.kin.velocity);
         // energy taken up by the interface: minus the work of the contact forces on the
-        // bodies, plus what the impact/release conditions removed
+        // bodies, plus what the impact/release conditions removed; the friction's share apart
         energies.contact_work += -super::trapezoid_work(&d, &applied, &self.last_contact)
             + kinetic_before.unwrap_or(energies.kinetic)
-            - energies.kinetic;
+            - energies.kinetic
+            - friction;
+        energies.friction_work += friction;
         energies.internal = self.state.internal_work - self.state.plastic_work;
         energies.plastic_work = self.state.plastic_work;
         self.last_total = total;

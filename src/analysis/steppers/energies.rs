@@ -22,8 +22,8 @@ pub struct Energies {
     /// The kinetic energy the ALE remaps took out of the nodal motion (central difference
     /// with `analysis.ale`; 0 without it; docs/theory.md 8.11).
     pub remap_loss: f64,
-    /// The energy Coulomb friction dissipated (central difference with a friction pair; 0
-    /// otherwise: the implicit paths book it in `contact_work`), >= 0.
+    /// The energy Coulomb friction dissipated (dynamic runs with a friction pair; 0
+    /// otherwise), >= 0 but for the trapezoidal rule's error on the implicit paths.
     pub friction_work: f64,
 }
 
