@@ -45,6 +45,7 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 ///     carry.
 /// 16: each body's internal and plastic work in the state, each body's energies in the
 ///     summary.
+/// 17: the one-point kernel's hourglass forces and their work in the explicit carry.
 const FORMAT: u32 = 17;
 
 /// A whole run at the end of a converged step.

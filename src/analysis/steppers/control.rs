@@ -1,9 +1,14 @@
 //! The step length of the implicit steppers and what they share of the time line: cuts
 //! after a failed Newton, growth back to the nominal step, the local error watch of
-//! `dt = "auto"`, steps snapped onto multiples of the nominal step.
+//! `dt = "auto"` and the probed point values it watches, steps snapped onto multiples of the
+//! nominal step.
 
 use super::newton::Counters;
+use crate::assembly::State;
+use crate::material::PointState;
 use crate::output::readable;
+use crate::scene::Model;
+use crate::scene::spec::Quantity;
 use serde::{Deserialize, Serialize};
 
 /// Rounds a time that is a whole number of nominal steps up to round-off onto that multiple,
@@ -138,6 +143,71 @@ impl StepControl {
 /// that keep history (Houbolt) or a factorization of K*(dt) see one dt.
 pub(super) fn step_length(h: f64, dt: f64) -> f64 {
     if (h - dt).abs() <= 1e-9 * dt { dt } else { h }
+}
+
+/// A point value of the scene's probes (eq_plastic_strain, temperature) that an adaptive
+/// step watches (theory 8.2a): with q its value above `base` at the start and the end of a
+/// step, its share of the estimate is
+/// ```text
+/// eta_q = (|q_{n+1} - q_n| / Q)^2,   Q = max(|q_n|, |q_{n+1}|, floor)
+/// ```
+/// so the step that meets the tolerance changes q by at most sqrt(tol) of its size (the
+/// return map's error over a step grows with the square of the step's increment).
+/// eq_plastic_strain: base 0, floor the yield strain sigma_y / E; temperature: base the
+/// initial temperature, floor the heating of a yield strain's plastic work,
+/// chi sigma_y (sigma_y / E) / (rho c_p).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct WatchedPoint {
+    probe: usize,
+    base: f64,
+    floor: f64,
+}
+
+impl WatchedPoint {
+    /// The point probes of `model` an adaptive step watches.
+    pub(super) fn of(model: &Model) -> Vec<WatchedPoint> {
+        model
+            .probes
+            .iter()
+            .enumerate()
+            .filter_map(|(k, probe)| {
+                let material = &model.bodies[probe.body].material;
+                let yield_stress = material.plasticity.as_ref()?.yield_stress;
+                let yield_strain = yield_stress / material.elastic.young;
+                match probe.quantity {
+                    Quantity::EqPlasticStrain => Some(WatchedPoint {
+                        probe: k,
+                        base: 0.0,
+                        floor: yield_strain,
+                    }),
+                    Quantity::Temperature => material.johnson_cook().map(|law| WatchedPoint {
+                        probe: k,
+                        base: law.initial_temperature,
+                        floor: law.taylor_quinney * yield_stress * yield_strain
+                            / (material.density * law.specific_heat),
+                    }),
+                    _ => None,
+                }
+            })
+            .collect()
+    }
+
+    /// eta_q of a step from the committed `state` to the trial points `trial` (per body).
+    pub(super) fn estimate(&self, model: &Model, state: &State, trial: &[Vec<PointState>]) -> f64 {
+        let probe = &model.probes[self.probe];
+        let ppe = model.bodies[probe.body].points_per_element();
+        let value = |points: &[PointState]| {
+            let f: &(dyn Fn(&PointState) -> f64 + Sync) = match probe.quantity {
+                Quantity::Temperature => &|p| p.temperature,
+                _ => &|p| p.eq_plastic_strain,
+            };
+            probe.of_points(points, ppe, f) - self.base
+        };
+        let q0 = value(&state.bodies[probe.body].points);
+        let q1 = value(&trial[probe.body]);
+        let size = q0.abs().max(q1.abs()).max(self.floor);
+        ((q1 - q0) / size).powi(2)
+    }
 }
 
 #[cfg(test)]

@@ -15,7 +15,9 @@
 //! impact conditions, and the step is split at the first contact event inside it.
 
 use super::carry::{Carry, DynamicCarry};
-use super::control::{ErrorWatch, StepControl, on_ladder, snap, step_factor, step_length};
+use super::control::{
+    ErrorWatch, StepControl, WatchedPoint, on_ladder, snap, step_factor, step_length,
+};
 use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
 use super::{Report, Resume, StepError, Stepper, loads};
@@ -25,10 +27,9 @@ use crate::contact::{ContactResult, ContactState, ImpactMotion, Interfaces, Lump
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
 };
-use crate::material::PointState;
 use crate::output::readable;
 use crate::scene::DynamicAnalysis;
-use crate::scene::spec::{AdaptiveStep, ContactDynamics, IntegratorKind, Quantity, Strategy};
+use crate::scene::spec::{AdaptiveStep, ContactDynamics, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
 use crate::solver::Solver;
 use std::path::Path;
@@ -102,71 +103,6 @@ pub struct Dynamics<'a> {
     watch: ErrorWatch,
     /// `dt = "auto"`: the point values the user probes that the step must resolve.
     watched: Vec<WatchedPoint>,
-}
-
-/// A point value of the scene's probes (eq_plastic_strain, temperature) that an adaptive
-/// step watches (theory 8.2a): with q its value above `base` at the start and the end of a
-/// step, its share of the estimate is
-/// ```text
-/// eta_q = (|q_{n+1} - q_n| / Q)^2,   Q = max(|q_n|, |q_{n+1}|, floor)
-/// ```
-/// so the step that meets the tolerance changes q by at most sqrt(tol) of its size (the
-/// return map's error over a step grows with the square of the step's increment).
-/// eq_plastic_strain: base 0, floor the yield strain sigma_y / E; temperature: base the
-/// initial temperature, floor the heating of a yield strain's plastic work,
-/// chi sigma_y (sigma_y / E) / (rho c_p).
-#[derive(Debug, Clone, Copy)]
-struct WatchedPoint {
-    probe: usize,
-    base: f64,
-    floor: f64,
-}
-
-impl WatchedPoint {
-    /// The point probes of `model` an adaptive step watches.
-    fn of(model: &Model) -> Vec<WatchedPoint> {
-        model
-            .probes
-            .iter()
-            .enumerate()
-            .filter_map(|(k, probe)| {
-                let material = &model.bodies[probe.body].material;
-                let yield_stress = material.plasticity.as_ref()?.yield_stress;
-                let yield_strain = yield_stress / material.elastic.young;
-                match probe.quantity {
-                    Quantity::EqPlasticStrain => Some(WatchedPoint {
-                        probe: k,
-                        base: 0.0,
-                        floor: yield_strain,
-                    }),
-                    Quantity::Temperature => material.johnson_cook().map(|law| WatchedPoint {
-                        probe: k,
-                        base: law.initial_temperature,
-                        floor: law.taylor_quinney * yield_stress * yield_strain
-                            / (material.density * law.specific_heat),
-                    }),
-                    _ => None,
-                }
-            })
-            .collect()
-    }
-
-    /// eta_q of a step from the committed `state` to the trial points `trial` (per body).
-    fn estimate(&self, model: &Model, state: &State, trial: &[Vec<PointState>]) -> f64 {
-        let probe = &model.probes[self.probe];
-        let ppe = model.bodies[probe.body].points_per_element();
-        let value = |points: &[PointState]| {
-            let f: &(dyn Fn(&PointState) -> f64 + Sync) = match probe.quantity {
-                Quantity::Temperature => &|p| p.temperature,
-                _ => &|p| p.eq_plastic_strain,
-            };
-            probe.of_points(points, ppe, f) - self.base
-        };
-        let q0 = value(&state.bodies[probe.body].points);
-        let q1 = value(&trial[probe.body]);
-        let size = q0.abs().max(q1.abs()).max(self.floor);
-        ((q1 - q0) / size).powi(2)
-    }
 }
 
 impl<'a> Dynamics<'a> {

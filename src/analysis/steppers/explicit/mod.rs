@@ -544,7 +544,7 @@ impl Resume for Explicit<'_> {
                 .restore_viscous_pressure(&carry.viscous_pressure);
         }
         // the one-point kernel's hourglass forces and work, which the points do not hold
-        match (self.kernel.hourglass_state().is_some(), carry.hourglass) {
+        match (self.kernel.hourglass_energy().is_some(), carry.hourglass) {
             (true, Some((forces, work))) => {
                 if forces.len() != self.kernel.elements() * 2 {
                     return false;
