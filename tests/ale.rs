@@ -126,7 +126,12 @@ fn ale_is_refused_where_it_does_not_apply() {
             "analysis.mass_scaling",
         ),
         (scene, "analysis.ale.every=0", "analysis.ale.every"),
-        (scene, "analysis.ale.max_move=0.9", "analysis.ale.max_move"),
+        // the message says what the number is, as the user guide defines it
+        (
+            scene,
+            "analysis.ale.max_move=0.9",
+            "analysis.ale.max_move: the share of an element's area",
+        ),
         (
             scene,
             "analysis.ale.slide_angle=60",

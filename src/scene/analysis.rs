@@ -658,7 +658,7 @@ fn ale(
     let max_move = given.max_move.unwrap_or(0.25);
     if !(max_move > 0.0 && max_move <= 0.5) {
         return Err(cx.err(format!(
-            "analysis.ale.max_move: a fraction of a node's shortest edge in (0, 0.5], got {max_move}"
+            "analysis.ale.max_move: the share of an element's area a node's move may sweep in one ALE step, in (0, 0.5], got {max_move}"
         )));
     }
     let slide = given.slide_angle.unwrap_or(30.0);
