@@ -190,8 +190,8 @@ fn impact_mortar_pairs<S>(
 /// entry's (signed coefficient `sliding`) stays mu tau, a sticking one's is held within the
 /// cone. Without it the step's friction force stays that of the uncorrected normal force,
 /// and the accelerations the next step starts from carry a friction beyond Coulomb's cone
-/// (the block on the plate under Newmark: up to 4.6 times mu tau in a pair's totals, and a
-/// slide that slowed more the shorter the step).
+/// (the block on the plate under Newmark: a pair's totals up to T = 23 mu N, and a slide
+/// that slowed more the shorter the step).
 struct Followed<'a> {
     force: f64,
     sliding: f64,
@@ -225,10 +225,10 @@ fn follow_along_row(
         return;
     };
     let change = followed.follow(mu);
-    let s = pair.slaves[k];
     if change == 0.0 {
         return;
     }
+    let s = pair.slaves[k];
     if let Some(gap) = pair.gap(s, x) {
         for (d, c) in gap.tangent_row(s) {
             acceleration[d] += inverse_mass[d] * c * change;

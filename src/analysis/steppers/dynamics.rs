@@ -403,7 +403,7 @@ impl<'a> Dynamics<'a> {
         // forces alone, theirs at the step's start and end (theory 7)
         let friction = friction_start.map_or(0.0, |start| {
             let end = (self.contact)
-                .friction_forces(&self.interfaces.pairs, &self.state.positions(spec.geometry))
+                .friction_forces(&self.interfaces.pairs, &positions)
                 .expect("a friction pair");
             -super::trapezoid_work(&d, &end, &start)
         });
