@@ -560,3 +560,65 @@ fn a_node_set_point_off_its_body_is_refused() {
         ],
     );
 }
+
+/// Goal: a wall shorter than the foot a Taylor rod grows is named when the foot leaves it,
+/// and the run's failure blames that, not the units. Setup: models/taylor_aluminum.toml
+/// (the foot 3.81 mm in radius) with the wall ending at r = 4.0 mm instead of 20 mm,
+/// `--strict`. Reference: the geometry alone: the foot's outer corner (node 5 of the
+/// bottom row, the outermost slave) is the first to cross r = 4.0 mm, so summary.json
+/// `contact.past_end` names that node past (0.004, 0) at r > 4.0 mm. The run then fails
+/// (the contact gives energy at the corner) with exit 3; its message names the end of the
+/// obstacle and says nothing of units (every body started at 0.08 of its wave speed). With
+/// the wall as shipped, no node passes (tests/scenes.rs: the shipped run warns of nothing).
+#[test]
+fn a_wall_shorter_than_the_foot_is_named_when_the_foot_leaves_it() {
+    let dir = common::out_dir("taylor_short_wall");
+    let output = common::impact(&[
+        "run",
+        "models/taylor_aluminum.toml",
+        "--strict",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "obstacle.wall.points=[[0.004, 0.0], [-0.01, 0.0]]",
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(3), "{stderr}");
+    warned(
+        &stderr,
+        &["went past the end (0.004, 0) of obstacle `wall`"],
+    );
+    let json = summary_json(&dir);
+    let past = &json["contact"]["past_end"];
+    assert_eq!(past["node"], 5, "{past}");
+    assert_eq!(past["body"], "rod");
+    assert!(past["position"][0].as_f64().unwrap() > 0.004, "{past}");
+    if json["status"] == "diverged" {
+        let message = json["message"].as_str().unwrap();
+        assert!(message.contains("past the end"), "{message}");
+        assert!(!message.contains("mixed units"), "{message}");
+    }
+}
+
+/// Goal: a node that the run made fast is not blamed on the units when every body started
+/// slow, and a body that started fast still is. Setup: tests/data/sphere_wall_si.toml (the
+/// steel sphere at 5 m/s; its dilatational wave speed sqrt(M / rho) = 6.0 km/s, M = E (1 -
+/// nu) / ((1 + nu) (1 - 2 nu)) = 283 GPa); at the failure one node moves at 3000 m/s.
+/// Reference: 3000 m/s is 0.50 of the wave speed, beyond the quarter solid impacts stay
+/// under, while the start (5 m/s, 0.0008 of it) is far below: the hint says the run made the
+/// speed, not mixed units. The same state with the sphere started at 5000 m/s (0.83 of it)
+/// points to mixed units.
+#[test]
+fn a_node_the_run_made_fast_is_not_blamed_on_the_units() {
+    let model = impact::scene::load(Path::new(SPHERE), &[]).unwrap();
+    let mut velocity = vec![0.0; 2 * model.coordinates().len()];
+    velocity[1] = 3000.0;
+    let hint = plausibility::failure_hint(&model, &velocity).expect("a fast node is named");
+    assert!(hint.contains("not mixed units"), "{hint}");
+    assert!(!hint.contains("points to mixed units"), "{hint}");
+    let edit = ["body.sphere.velocity=[0,-5000.0]".to_string()];
+    let fast = impact::scene::load(Path::new(SPHERE), &edit).unwrap();
+    let hint = plausibility::failure_hint(&fast, &velocity).expect("the start is named");
+    assert!(hint.contains("points to mixed units"), "{hint}");
+}

@@ -3,7 +3,9 @@
 //! against every obstacle of the pairs and every other body's outline. The pairs' own gaps
 //! see only their slaves; a slave set that misses the surface which meets the master (a
 //! sphere's `axis` instead of its `arc`) lets the other nodes through unseen, and this
-//! measure reports them.
+//! measure reports them. Beside it, the first slave that went past the open end of its
+//! obstacle (an obstacle shorter than the surface that meets it: a Taylor rod's foot growing
+//! beyond a short wall), which the run reports when it happens.
 //!
 //! Legend
 //! ```text
@@ -97,6 +99,84 @@ pub fn deepest(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Optio
         }
     }
     best
+}
+
+/// A slave past the open end of its pair's obstacle (`past_an_end`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PastEnd {
+    /// The pair (its index).
+    pub pair: usize,
+    /// The global node.
+    pub node: usize,
+    /// The end of the obstacle it went past.
+    pub end: [f64; 2],
+}
+
+/// summary.json `contact.past_end`: the first slave that went past the open end of its
+/// obstacle, in words.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PastEndNode {
+    /// The end of the step after which it was found there.
+    pub time: f64,
+    pub pair: String,
+    pub obstacle: String,
+    pub body: String,
+    /// The node's number in its body, from 0.
+    pub node: usize,
+    /// Where the node was, and the end of the obstacle.
+    pub position: [f64; 2],
+    pub end: [f64; 2],
+}
+
+/// The first slave of `interfaces`' pairs (in pair order, then slave order) at the positions
+/// `x` that lies past an open end of its pair's obstacle: its nearest point on the polyline
+/// is that end, it lies beyond the end along the end segment, and it is below the end
+/// segment's line extended or less than 45 degrees above it (where a longer obstacle would
+/// meet it). None while every slave is over its obstacle. Closed obstacles have no ends.
+pub fn past_an_end(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> Option<PastEnd> {
+    for (index, pair) in interfaces.pairs.iter().enumerate() {
+        let Master::Obstacle(obstacle) = &pair.master else {
+            continue;
+        };
+        if obstacle.closed || obstacle.points.len() < 2 {
+            continue;
+        }
+        let segments = obstacle.segments();
+        let last = segments.len() - 1;
+        for &node in &pair.slaves {
+            let p = x(node);
+            let Some((k, xi)) = segments
+                .iter()
+                .enumerate()
+                .map(|(k, [a, b])| (k, project(p, *a, *b)))
+                .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
+                .map(|(k, (xi, _))| (k, xi))
+            else {
+                continue;
+            };
+            let [a, b] = segments[k];
+            // the end, and the direction beyond it along its segment
+            let (end, onward) = match (k, xi) {
+                (0, xi) if xi <= 0.0 => (a, sub(a, b)),
+                (k, xi) if k == last && xi >= 1.0 => (b, sub(b, a)),
+                _ => continue,
+            };
+            let length = dot(onward, onward).sqrt();
+            if length == 0.0 {
+                continue;
+            }
+            let beyond = dot(sub(p, end), onward) / length;
+            let above = dot(sub(p, end), outward(a, b));
+            if beyond > 0.0 && above <= beyond {
+                return Some(PastEnd {
+                    pair: index,
+                    node,
+                    end,
+                });
+            }
+        }
+    }
+    None
 }
 
 /// The deepest of `nodes` inside the solid of `obstacle` (depth, node).
@@ -232,5 +312,32 @@ mod tests {
         };
         let deepest = deepest(&interfaces, &x).unwrap();
         assert!((deepest.depth - 0.2).abs() < 1e-15, "{deepest:?}");
+    }
+
+    /// Goal: a slave past the open end of its wall is found, and only there. Setup: the wall
+    /// y = 0 from x = 2 to x = -2 (solid below), one slave node (node 0). Reference (by
+    /// hand): over the wall (x = 1.9, on it or above) nothing; at x = 2.1 on the line, or
+    /// 0.05 below it, past the end (2, 0); at x = -2.1, 0.05 above the line (less than 45
+    /// degrees from it), past the end (-2, 0); at x = 2.1 and 0.2 above (more than 45
+    /// degrees), nothing: a node beside the end, not one that slid off it.
+    #[test]
+    fn a_slave_past_the_end_of_its_wall_is_found() {
+        let wall = Obstacle {
+            name: "wall".into(),
+            points: vec![[2.0, 0.0], [-2.0, 0.0]],
+            closed: false,
+        };
+        let pair = crate::contact::geometry::tests::slave_node_0(Master::Obstacle(wall));
+        let interfaces = Interfaces {
+            pairs: vec![pair],
+            bodies: vec![square(0)],
+        };
+        let at = |p: [f64; 2]| past_an_end(&interfaces, &|_| p).map(|e| e.end);
+        assert_eq!(at([1.9, 0.0]), None);
+        assert_eq!(at([1.9, 0.3]), None);
+        assert_eq!(at([2.1, 0.0]), Some([2.0, 0.0]));
+        assert_eq!(at([2.1, -0.05]), Some([2.0, 0.0]));
+        assert_eq!(at([-2.1, 0.05]), Some([-2.0, 0.0]));
+        assert_eq!(at([2.1, 0.2]), None);
     }
 }

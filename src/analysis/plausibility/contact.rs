@@ -1,10 +1,11 @@
 //! What a finished run says of its contact pairs: a pair that never closed (and how its
-//! slaves moved at the start), a penetration beyond the discretization's own.
+//! slaves moved at the start), a penetration beyond the discretization's own, a slave that
+//! went past the end of its obstacle.
 
 use super::model_size;
 use crate::analysis::steppers::energies::Energies;
 use crate::analysis::{Status, Summary};
-use crate::contact::penetration::DeepestNode;
+use crate::contact::penetration::{DeepestNode, PastEndNode};
 use crate::contact::{ContactPair, Master, penetration_limits};
 use crate::output::readable;
 use crate::scene::model::Analysis;
@@ -95,6 +96,27 @@ pub(super) fn penetration_warning(model: &Model, summary: &Summary) -> Option<St
         readable(bound),
         100.0 * PENETRATION_SHARE
     ))
+}
+
+/// A slave that went past the open end of its obstacle (summary.json `contact.past_end`),
+/// in words: the obstacle is shorter than the surface that meets it. The warning of a run
+/// and a clause of a failure's message.
+pub fn past_end_text(p: &PastEndNode) -> String {
+    format!(
+        "node {} of body `{}` (a slave of contact `{}`) went past the end ({}, {}) of obstacle \
+         `{}` at t = {}, to ({}, {}): the obstacle is shorter than the surface that meets it, \
+         and past its end a slave meets only its last segment's line extended and its corner; \
+         extend the obstacle's points beyond where the body can reach",
+        p.node,
+        p.body,
+        p.pair,
+        readable(p.end[0]),
+        readable(p.end[1]),
+        p.obstacle,
+        readable(p.time),
+        readable(p.position[0]),
+        readable(p.position[1])
+    )
 }
 
 /// Why a node that no pair names as a slave went into an obstacle or a body: the pairs of

@@ -5,7 +5,7 @@
 //! exit 3). Each names the likely cause. The scene's own in `setup` (with the slave sets of
 //! `slaves` and the unit hints of `units`), the pairs' after a run in `contact`, the rest
 //! (step cuts, energies, the step, axis crossings, hourglass, mass scaling) here; a failed
-//! run's message gets [`units_at_failure`].
+//! run's message gets [`failure_hint`].
 //!
 //! Legend
 //! ```text
@@ -22,12 +22,12 @@ mod setup;
 mod slaves;
 mod units;
 
-pub use contact::{COARSE_CONTACT_NODES, PENETRATION_SHARE, STILL_APPROACHING};
+pub use contact::{COARSE_CONTACT_NODES, PENETRATION_SHARE, STILL_APPROACHING, past_end_text};
 pub use setup::{
     AXIS_TOLERANCE, FRAME_BYTES_PER_NODE, MANY_FRAMES, MIN_STEPS, expected_frames, setup_warnings,
 };
 pub use slaves::SLAVE_SHARE;
-pub use units::{MAX_STEPS, SPEED_SHARE, YIELD_STRAIN_RANGE, units_at_failure};
+pub use units::{MAX_STEPS, SPEED_SHARE, YIELD_STRAIN_RANGE, failure_hint};
 
 use super::Summary;
 use super::steppers::energies::Energies;
@@ -332,6 +332,13 @@ pub fn warnings(
     }
     out.extend(contact::never_closed_warnings(model, summary, energies));
     out.extend(contact::penetration_warning(model, summary));
+    out.extend(
+        summary
+            .contact
+            .past_end
+            .as_ref()
+            .map(contact::past_end_text),
+    );
     out.extend(contact::coarse_contact_warnings(model, summary));
     out.extend(energy_created_warning(model, summary, energies));
     out

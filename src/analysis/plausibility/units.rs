@@ -281,12 +281,16 @@ fn start_speed(model: &Model, body: &Body) -> Option<(f64, f64)> {
 }
 
 /// What a failed run's state says of its units: a yield strain outside
-/// [`YIELD_STRAIN_RANGE`], a node faster than [`SPEED_SHARE`] of its body's wave speed
-/// (`velocity`, all DOFs),
-/// more than [`MAX_STEPS`] central-difference stable steps to the end time of a dynamic run
-/// (None: nothing points to units).
-pub fn units_at_failure(model: &Model, velocity: &[f64]) -> Option<String> {
+/// [`YIELD_STRAIN_RANGE`], a body that started faster than [`SPEED_SHARE`] of its wave speed
+/// (its fastest node at the failure named, `velocity` all DOFs), more than [`MAX_STEPS`]
+/// central-difference stable steps to the end time of a dynamic run. A node faster than
+/// that share at the failure in a run whose bodies all started below it is no sign of
+/// units: the run made that speed where it blew up (an element inverting, a penetration
+/// pushed out, a node past an obstacle's end), and the hint says so. None: the state says
+/// nothing.
+pub fn failure_hint(model: &Model, velocity: &[f64]) -> Option<String> {
     let mut signs = Vec::new();
+    let mut local = None;
     for body in &model.bodies {
         if let Some(problem) = yield_strain_problem(body) {
             signs.push(problem);
@@ -294,22 +298,34 @@ pub fn units_at_failure(model: &Model, velocity: &[f64]) -> Option<String> {
         let Some(c) = wave_speed(body).filter(|_| in_known_units(body)) else {
             continue;
         };
-        let fastest = (0..body.mesh.nodes.len())
-            .map(|n| body.global(n))
-            .filter(|n| 2 * n + 1 < velocity.len())
-            .map(|n| (n, velocity[2 * n].hypot(velocity[2 * n + 1])))
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((node, speed)) = fastest
-            && speed > SPEED_SHARE * c.speed
-        {
+        let Some((node, speed)) = fastest_node(body, velocity) else {
+            continue;
+        };
+        if speed <= SPEED_SHARE * c.speed {
+            continue;
+        }
+        let moving = format!(
+            "node {} of body `{}` moves at {}, {} of its wave speed {}",
+            node - body.node_offset,
+            body.name,
+            readable(speed),
+            readable(speed / c.speed),
+            readable(c.speed),
+        );
+        let started = start_speed(model, body).map_or(0.0, |(v, _)| v);
+        if started > SPEED_SHARE * c.speed {
             signs.push(format!(
-                "node {} of body `{}` moves at {}, {} of its wave speed {} (beyond {} of it: a \
-                 velocity in mm/s beside lengths in m, or moduli or density in other units)",
-                node - body.node_offset,
-                body.name,
-                readable(speed),
-                readable(speed / c.speed),
-                readable(c.speed),
+                "{moving}, and the body started at {} (beyond {} of it: a velocity in mm/s \
+                 beside lengths in m, or moduli or density in other units)",
+                readable(started),
+                readable(SPEED_SHARE)
+            ));
+        } else if local.is_none() {
+            local = Some(format!(
+                "{moving}, while the body started at {} (below {} of it): the run made that \
+                 speed where it failed (an element inverting, a penetration pushed out, a node \
+                 past an obstacle's end), not mixed units",
+                readable(started),
                 readable(SPEED_SHARE)
             ));
         }
@@ -327,5 +343,20 @@ pub fn units_at_failure(model: &Model, velocity: &[f64]) -> Option<String> {
             readable(model.analysis.end_time())
         ));
     }
-    (!signs.is_empty()).then(|| format!("the state points to mixed units: {}", signs.join("; ")))
+    match (signs.is_empty(), local) {
+        (false, _) => Some(format!(
+            "the state points to mixed units: {}",
+            signs.join("; ")
+        )),
+        (true, local) => local,
+    }
+}
+
+/// The fastest node of `body` at `velocity` (all DOFs): (global node, speed).
+fn fastest_node(body: &Body, velocity: &[f64]) -> Option<(usize, f64)> {
+    (0..body.mesh.nodes.len())
+        .map(|n| body.global(n))
+        .filter(|n| 2 * n + 1 < velocity.len())
+        .map(|n| (n, velocity[2 * n].hypot(velocity[2 * n + 1])))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }

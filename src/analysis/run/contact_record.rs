@@ -1,7 +1,8 @@
 //! What the run keeps of its contact row by row beyond the contact status: the pairs' forces
 //! averaged over a window of time (history.csv `contact_force_avg[PAIR]`, summary.json
 //! `contact.peak_force`), the most slaves each pair held closed at once, and where the
-//! deepest penetration of a body into an obstacle or another body was.
+//! deepest penetration of a body into an obstacle or another body was, and the first slave
+//! that went past the open end of its obstacle.
 //!
 //! Legend
 //! ```text
@@ -14,9 +15,10 @@
 //!          so it lags the force by about T / 2)
 //! ```
 
-use crate::contact::penetration::{self, DeepestNode, Intruded};
-use crate::contact::{ContactState, ContactSummary, Interfaces};
+use crate::contact::penetration::{self, DeepestNode, Intruded, PastEnd, PastEndNode};
+use crate::contact::{ContactState, ContactSummary, Interfaces, Master};
 use crate::scene::Model;
+use std::borrow::Cow;
 use std::collections::VecDeque;
 
 /// The default window of central difference, in first steps: it spans the step-to-step
@@ -62,18 +64,26 @@ pub struct ContactCarry {
     /// body's node went into an obstacle or another body.
     pub deepest_depth: f64,
     pub deepest: Option<DeepestNode>,
+    /// The first slave found past the open end of its obstacle (after a row's step).
+    pub past_end: Option<PastEndNode>,
 }
 
 /// See the module.
 pub struct ContactRecord {
     interfaces: Interfaces,
+    /// Whether a pair meets an open obstacle (whose ends the record watches).
+    open_ends: bool,
     pub carry: ContactCarry,
 }
 
 impl ContactRecord {
     pub fn new(model: &Model, carry: ContactCarry) -> ContactRecord {
+        let interfaces = model.interfaces();
+        let open_ends = (interfaces.pairs.iter())
+            .any(|p| matches!(&p.master, Master::Obstacle(o) if !o.closed));
         ContactRecord {
-            interfaces: model.interfaces(),
+            interfaces,
+            open_ends,
             carry,
         }
     }
@@ -82,12 +92,12 @@ impl ContactRecord {
     /// forces `forces` and the contact status `contact` (None before the first step), the
     /// nodes at `positions()`; returns the averaged forces of the row (empty without a
     /// window).
-    pub fn row(
+    pub fn row<'s>(
         &mut self,
         model: &Model,
         (time, step): (f64, f64),
         (forces, contact): (&[f64], Option<&ContactState>),
-        positions: impl FnOnce() -> Vec<[f64; 2]>,
+        positions: impl FnOnce() -> Cow<'s, [[f64; 2]]>,
     ) -> Vec<f64> {
         let carry = &mut self.carry;
         if let Some(contact) = contact {
@@ -97,11 +107,18 @@ impl ContactRecord {
             for (widest, active) in carry.closed_at_widest.iter_mut().zip(&contact.active) {
                 *widest = (*widest).max(active.iter().filter(|a| **a).count());
             }
-            if contact.penetration > carry.deepest_depth {
-                carry.deepest_depth = contact.penetration;
+            let deeper = contact.penetration > carry.deepest_depth;
+            let watch = self.open_ends && carry.past_end.is_none();
+            if deeper || watch {
                 let x = positions();
-                if let Some(d) = penetration::deepest(&self.interfaces, &|n| x[n]) {
-                    carry.deepest = Some(named(model, &d, time));
+                if deeper {
+                    carry.deepest_depth = contact.penetration;
+                    if let Some(d) = penetration::deepest(&self.interfaces, &|n| x[n]) {
+                        carry.deepest = Some(named(model, &d, time));
+                    }
+                }
+                if watch && let Some(p) = penetration::past_an_end(&self.interfaces, &|n| x[n]) {
+                    carry.past_end = Some(past_end_named(model, &p, x[p.node], time));
                 }
             }
         }
@@ -146,6 +163,27 @@ impl ContactRecord {
             .map(|(pair, _)| pair.name.clone())
             .collect();
         summary.deepest = carry.deepest.clone();
+        summary.past_end = carry.past_end.clone();
+    }
+}
+
+/// A slave past an obstacle's end in the words of summary.json: the pair, the obstacle and
+/// the body by name, the node by its number in the body.
+fn past_end_named(model: &Model, p: &PastEnd, position: [f64; 2], time: f64) -> PastEndNode {
+    let pair = &model.contacts[p.pair];
+    let body = &model.bodies[pair.slave_body];
+    let obstacle = match &pair.master {
+        Master::Obstacle(o) => o.name.clone(),
+        _ => String::new(),
+    };
+    PastEndNode {
+        time,
+        pair: pair.name.clone(),
+        obstacle,
+        body: body.name.clone(),
+        node: p.node - body.node_offset,
+        position,
+        end: p.end,
     }
 }
 

@@ -158,7 +158,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         let penetration_limits = crate::contact::penetration_limits(&model.contacts, &coordinates);
         let resuming = resume.is_some();
         if !resuming && let Err(message) = stepper.start() {
-            let message = with_units_hint(model, message, stepper.motion().velocity);
+            let message = with_failure_hint(model, message, stepper.motion().velocity);
             let mut run_summary = summary;
             run_summary.status = Status::Diverged;
             run_summary.message = Some(message.clone());
@@ -522,13 +522,19 @@ impl<'a, S: Stepper> Run<'a, S> {
     /// A failed run: the summary is written with its status and message, then returned in
     /// the error.
     fn fail(&mut self, status: Status, message: String) -> RunError {
-        let message = with_units_hint(self.model, message, self.stepper.motion().velocity);
+        let message = with_failure_hint(self.model, message, self.stepper.motion().velocity);
         self.fail_with_cause(status, message)
     }
 
     /// As `fail`, for a failure whose message names its cause already (the state's speeds
-    /// would point to units where the run itself made them).
+    /// would point to units where the run itself made them). A slave that went past the end
+    /// of its obstacle before the failure is named in either.
     fn fail_with_cause(&mut self, status: Status, message: String) -> RunError {
+        let past_end = (self.recorder.contact.as_ref()).and_then(|r| r.carry.past_end.as_ref());
+        let message = match past_end {
+            Some(p) => format!("{message}; before it, {}", plausibility::past_end_text(p)),
+            None => message,
+        };
         self.progress
             .finish(self.stepper.state().time, self.summary.steps);
         // the warnings read how the run ended (a pair that never closed in a run that
@@ -736,10 +742,10 @@ impl<S: Stepper> Run<'_, S> {
     }
 }
 
-/// The message of a numerical failure, with what the state says of mixed units when it
-/// says something (`plausibility::units_at_failure`).
-fn with_units_hint(model: &Model, message: String, velocity: &[f64]) -> String {
-    match plausibility::units_at_failure(model, velocity) {
+/// The message of a numerical failure, with what the state says of mixed units or of a
+/// local blow-up when it says something (`plausibility::failure_hint`).
+fn with_failure_hint(model: &Model, message: String, velocity: &[f64]) -> String {
+    match plausibility::failure_hint(model, velocity) {
         Some(hint) => format!("{message}; {hint}"),
         None => message,
     }

@@ -250,7 +250,7 @@ impl Recorder {
                 model,
                 (state.time, self.step_length),
                 (&forces, contact),
-                || state.positions(model.analysis.geometry()).into_owned(),
+                || state.positions(model.analysis.geometry()),
             ),
             None => Vec::new(),
         };
