@@ -234,16 +234,20 @@ end_time = 2.0e-5
 /// Before: exit 0, ok, the step cuts only in summary.json. Reference: the block's elements
 /// are 6.25 mm square and c = sqrt((lambda + 2 mu) / rho) = 5.8 km/s, so a wave crosses one
 /// in 1.1 microseconds (the element bound puts the stable step at 0.89); the block is in
-/// contact for some 9 microseconds. dt = 30 microseconds is longer than the 20-microsecond
-/// run; dt = 10 microseconds is 11 stable steps and resolves the contact with one step.
-/// dt = 0.2 microseconds (the scene's) warns of nothing.
+/// contact for some 9 microseconds, its flat face meeting the wall at once (a wave front:
+/// the force jumps in the closing step). dt = 30 microseconds is longer than the
+/// 20-microsecond run; dt = 10 microseconds is 11 stable steps and dt = 3 microseconds 3.4
+/// of them: the force reaches its peak in the closing step, drawn by one point (at 3
+/// microseconds the peak is 48 MN/m against 35 at the scene's step: the step, not the
+/// impact, set it). dt = 0.2 microseconds (the scene's) warns of nothing.
 #[test]
 fn steps_too_long_for_the_run_or_the_impact_warn() {
     let scene = out_dir("block_scene").join("block.toml");
     std::fs::write(&scene, BLOCK).unwrap();
     for (dt, word) in [
         ("3e-5", "spans 0.666667 step(s)"),
-        ("1e-5", "contact lasted"),
+        ("1e-5", "rose to its peak in 1.0 steps"),
+        ("3e-6", "is 3.4 times the explicit stable step"),
     ] {
         let dir = out_dir(&format!("block_dt_{dt}"));
         let d = dir.to_str().unwrap().to_string();
@@ -823,16 +827,18 @@ fn penetration_warning_edge_is_five_percent_of_the_slave_spacing_or_tol() {
     }
 }
 
-/// Goal: the implicit-step warning's edges: a step over 10 explicit stable steps of the
-/// median element, on a contact that lasted fewer than 20 steps.
-/// Setup: `ROD` (stable step h / c = 0.01, by hand above); contact from t = 0 to its release
-/// at 5 dt with dt = 0.1 (1 -+ 1e-3), end_time 2 (20 steps: the step count stays out); then dt = 0.2 (20 stable steps, end_time 10) with the
-/// release at 20 dt (1 -+ 1e-3): fewer than 20 steps warns, more does not.
-/// Reference: the user guide: "an implicit `dt` over 10 times the explicit stable step of the
-/// median element when the contact lasted fewer than 20 steps".
+/// Goal: the implicit-step warning's edges: a step over 2 explicit stable steps of the
+/// median element, on a contact whose force rose to its peak in fewer than 10 steps.
+/// Setup: `ROD` (stable step h / c = 0.01, by hand above); contact closed at t = 0 and its
+/// force at its peak 4 steps later (a rise of 5 steps, the closing one counted) with dt =
+/// 0.02 (1 -+ 1e-3), end_time 2 (100 steps: the step count stays out); then dt = 0.2 (20
+/// stable steps, end_time 10) with the peak 9 steps after the closing (1 +- 1e-3): a rise
+/// of fewer than 10 steps warns, more does not. Reference: the user guide: "an implicit
+/// `dt` over 2 times the explicit stable step of the median element when the contact force
+/// rose to its peak in fewer than 10 steps".
 #[test]
-fn impact_step_warning_edges_are_ten_stable_steps_and_twenty_contact_steps() {
-    let at = |dt: f64, contact_steps: f64, end_time: f64| {
+fn impact_step_warning_edges_are_two_stable_steps_and_a_ten_step_rise() {
+    let at = |dt: f64, rise_steps: f64, end_time: f64| {
         let model = common::model(
             "edge_impact_step",
             ROD,
@@ -843,19 +849,20 @@ fn impact_step_warning_edges_are_ten_stable_steps_and_twenty_contact_steps() {
         );
         warnings_with(&model, |s, _| {
             s.contact.first_contact_time = Some(0.0);
-            s.contact.last_release_time = Some(contact_steps * dt);
+            s.contact.peak_force_time = Some((rise_steps - 1.0) * dt);
+            s.contact.last_release_time = Some(end_time);
         })
     };
-    let ratio = 10.0 * 0.01;
+    let ratio = 2.0 * 0.01;
     edge(
         &at(ratio * (1.0 - 1e-3), 5.0, 2.0),
         &at(ratio * (1.0 + 1e-3), 5.0, 2.0),
-        "contact lasted 5.0 steps",
+        "rose to its peak in 5.0 steps",
     );
     edge(
-        &at(0.2, 20.0 * (1.0 + 1e-3), 10.0),
-        &at(0.2, 20.0 * (1.0 - 1e-3), 10.0),
-        "contact lasted 20.0 steps",
+        &at(0.2, 10.0 * (1.0 + 1e-3), 10.0),
+        &at(0.2, 10.0 * (1.0 - 1e-3), 10.0),
+        "rose to its peak in 10.0 steps",
     );
 }
 

@@ -240,6 +240,9 @@ pub struct ContactSummary {
     /// Where the deepest penetration of a body into an obstacle or another body was.
     #[serde(default)]
     pub deepest: Option<penetration::DeepestNode>,
+    /// The end of the step whose raw normal force (the pairs' total) was the largest.
+    #[serde(default)]
+    pub peak_force_time: Option<f64>,
     /// The first slave that went past the open end of its obstacle.
     #[serde(default)]
     pub past_end: Option<penetration::PastEndNode>,

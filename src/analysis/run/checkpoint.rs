@@ -46,7 +46,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 16: each body's internal and plastic work in the state, each body's energies in the
 ///     summary.
 /// 17: the one-point kernel's hourglass forces and their work in the explicit carry.
-/// 18: the first slave past an obstacle's end in the contact record and the summary.
+/// 18: the first slave past an obstacle's end and the time of the peak force in the contact
+///     record and the summary.
 const FORMAT: u32 = 18;
 
 /// A whole run at the end of a converged step.

@@ -66,6 +66,8 @@ pub struct ContactCarry {
     pub deepest: Option<DeepestNode>,
     /// The first slave found past the open end of its obstacle (after a row's step).
     pub past_end: Option<PastEndNode>,
+    /// The largest total of the pairs' raw forces of a row, and the row's time.
+    pub peak_raw: Option<(f64, f64)>,
 }
 
 /// See the module.
@@ -100,6 +102,10 @@ impl ContactRecord {
         positions: impl FnOnce() -> Cow<'s, [[f64; 2]]>,
     ) -> Vec<f64> {
         let carry = &mut self.carry;
+        let total: f64 = forces.iter().sum();
+        if total > carry.peak_raw.map_or(0.0, |(f, _)| f) {
+            carry.peak_raw = Some((total, time));
+        }
         if let Some(contact) = contact {
             carry
                 .closed_at_widest
@@ -164,6 +170,7 @@ impl ContactRecord {
             .collect();
         summary.deepest = carry.deepest.clone();
         summary.past_end = carry.past_end.clone();
+        summary.peak_force_time = carry.peak_raw.map(|(_, t)| t);
     }
 }
 
