@@ -695,9 +695,13 @@ fn plot_history(
         history.with_file_name(format!("plot_{stem}.svg"))
     });
     let title = look.title.unwrap_or_else(|| history.display().to_string());
+    let units = column_units_beside(history);
+    let labelled = |column: &str| {
+        impact::sweep::qoi::with_unit(column, units.get(column).map_or("", String::as_str))
+    };
     let chart = |title: String, y_label: String, series: Vec<Series>| Chart {
         title,
-        x_label: x.to_string(),
+        x_label: labelled(x),
         y_label,
         series,
         log_x: look.log.0,
@@ -713,11 +717,18 @@ fn plot_history(
             .map(|(k, column)| {
                 let own: Vec<Series> = series.iter().skip(k).step_by(y.len()).cloned().collect();
                 let heading = if k == 0 { title.clone() } else { String::new() };
-                chart(heading, column.clone(), own)
+                chart(heading, labelled(column), own)
             })
             .collect()
     } else {
-        vec![chart(title, y.join(", "), series)]
+        // one unit after the columns when they share it, else each column's own
+        let unit_of = |c: &String| units.get(c).cloned().unwrap_or_default();
+        let label = if y.iter().all(|c| unit_of(c) == unit_of(&y[0])) {
+            impact::sweep::qoi::with_unit(&y.join(", "), &unit_of(&y[0]))
+        } else {
+            y.iter().map(|c| labelled(c)).collect::<Vec<_>>().join(", ")
+        };
+        vec![chart(title, label, series)]
     };
     plot::write_panels(&charts, &out).map_err(|e| match e {
         OutputError::Invalid { .. } => bad_input(e),
@@ -725,6 +736,20 @@ fn plot_history(
     })?;
     outln!("{}", out.display());
     Ok(())
+}
+
+/// The units of the history.csv columns of the run whose history is `history`: summary.json
+/// `column_units` in the same folder; none when there is no such summary (a frame's point
+/// arrays, a history moved on its own, a summary of an older run).
+fn column_units_beside(history: &Path) -> std::collections::BTreeMap<String, String> {
+    let summary = history.with_file_name("summary.json");
+    let is_history = history.extension().is_some_and(|e| e == "csv");
+    std::fs::read_to_string(&summary)
+        .ok()
+        .filter(|_| is_history)
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .and_then(|json| serde_json::from_value(json.get("column_units")?.clone()).ok())
+        .unwrap_or_default()
 }
 
 /// One line series per y column of `columns` (x first, then the y columns in order).

@@ -468,3 +468,59 @@ fn cli_plot_draws_a_study_table_on_a_log_axis() {
         "{stderr}"
     );
 }
+
+/// Goal: `impact plot` labels its axes with the units of the run's columns (summary.json
+/// `column_units` beside the history). Setup: models/taylor_aluminum.toml run as shipped,
+/// then kinetic energy and plastic work on one axis, kinetic energy beside a displacement
+/// probe on another. Reference: the scene's material data are SI (density 2700 kg/m^3, E
+/// 70 GPa: the user guide's rule for SI), and the rod is axisymmetric (the full ring: no
+/// "per depth"): energies in J, time in s, displacements in m; one unit after columns that
+/// share it, each column's own where they differ.
+#[test]
+fn cli_plot_labels_its_axes_with_the_run_units() {
+    let dir = common::out_dir("plot_units");
+    let run = impact(&[
+        "run",
+        "models/taylor_aluminum.toml",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(run.status.code(), Some(0));
+    let history = dir.join("history.csv");
+    let plotted = |y: &[&str], name: &str| {
+        let out = dir.join(name);
+        let mut args = vec![
+            "plot",
+            history.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        for column in y {
+            args.extend(["--y", column]);
+        }
+        let run = impact(&args);
+        assert_eq!(
+            run.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let svg = std::fs::read_to_string(&out).unwrap();
+        svg_texts(&svg)
+            .into_iter()
+            .map(String::from)
+            .collect::<Vec<String>>()
+    };
+    let texts = plotted(&["kinetic_energy", "plastic_work"], "energies.svg");
+    assert!(texts.iter().any(|t| t == "time [s]"), "{texts:?}");
+    assert!(
+        texts
+            .iter()
+            .any(|t| t == "kinetic_energy, plastic_work [J]"),
+        "{texts:?}"
+    );
+    let texts = plotted(&["kinetic_energy", "u_y[top_axis]"], "mixed.svg");
+    let mixed = "kinetic_energy [J], u_y[top_axis] [m]";
+    assert!(texts.iter().any(|t| t == mixed), "{texts:?}");
+}

@@ -205,6 +205,46 @@ fn rerun_does_no_work_and_merged_shards_equal_the_whole() {
     assert_eq!(deterministic(&m.csv), deterministic(&first.csv));
 }
 
+/// Goal: a finished study takes a finer level: rerun with the value added, it runs only the
+/// new case; a level run apart merges with the study. Setup: two_bars to t = 0.05, Newmark
+/// at dt = 0.005 and 0.0025 (2 cases), then dt = 0.00125 added; apart: the 2-case study in
+/// one folder and the 3-case plan's shard 2/3 (its dt = 0.00125 case alone) in another.
+/// Reference: the reports' counts of runs (1 executed and 2 skipped on the extension: a
+/// case's folder hashes its own overrides, so the finished ones are found); the merged
+/// table equals the extended study's in every column but the timings (each case runs on one
+/// thread: bitwise the same numbers). Without the extension, the rerun was refused ("this
+/// folder holds another sweep") and so was the merge.
+#[test]
+fn a_study_extended_by_a_level_runs_only_that_level_and_merges() {
+    let two = plan(
+        "two_bars",
+        &["analysis.end_time=0.05"],
+        &["analysis.dt=0.005,0.0025"],
+    );
+    let three = plan(
+        "two_bars",
+        &["analysis.end_time=0.05"],
+        &["analysis.dt=0.005,0.0025,0.00125"],
+    );
+    let study = common::out_dir("sweep_extended");
+    let first = sweep::run(&two, &study, options(1, None), &[]).unwrap();
+    assert_eq!((first.executed, first.skipped), (2, 0));
+    let extended = sweep::run(&three, &study, options(1, None), &[]).unwrap();
+    assert_eq!((extended.executed, extended.skipped), (1, 2));
+    assert_eq!(extended.not_ok, 0);
+    let (apart, level) = (
+        common::out_dir("sweep_apart_study"),
+        common::out_dir("sweep_apart_level"),
+    );
+    sweep::run(&two, &apart, options(1, None), &[]).unwrap();
+    let finer = sweep::run(&three, &level, options(1, Some((2, 3))), &[]).unwrap();
+    assert_eq!(finer.executed, 1);
+    let merged = common::out_dir("sweep_apart_merged");
+    let m = sweep::merge(&[apart, level], &merged, &[]).unwrap();
+    assert_eq!((m.cases, m.not_ok), (3, 0));
+    assert_eq!(deterministic(&m.csv), deterministic(&extended.csv));
+}
+
 /// Goal: bad input to `impact sweep` exits 2 with a message naming what is wrong, before
 /// anything runs; never a panic.
 #[test]
@@ -429,6 +469,61 @@ fn a_given_reference_scores_every_case() {
         let u = row.quantities[0].unwrap();
         let error = row.quantity_errors[0].unwrap();
         approx::assert_relative_eq!(error, (u - exact) / exact.abs(), max_relative = 1e-12);
+    }
+}
+
+/// Goal: two methods' fronts are scored against one answer, and a series that cannot
+/// extrapolate keeps its finest case on the charts. Setup: the unit oscillator to t = 10,
+/// u(10), Newmark average at dt = 0.2, 0.1, 0.05 (three levels: extrapolated) beside
+/// Wilson-theta at dt = 0.1, 0.05 (two levels: none). Reference: sin 10, exact. Before, each
+/// series was scored against its own reference: Wilson's finest case against itself (no
+/// error, off the chart), its other case against it. Now both series carry the same
+/// reference, the average's extrapolation (within its GCI of sin 10, as the GCI study above
+/// shows), and every case has an error against it: Wilson's finest one within that GCI of
+/// its error against sin 10 itself.
+#[test]
+fn two_methods_are_scored_against_one_reference() {
+    let dir = common::out_dir("sweep_common_reference");
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, common::UNIT_OSCILLATOR).unwrap();
+    let p = Plan {
+        scene,
+        sets: Vec::new(),
+        variations: vec![
+            parse_variation(
+                "analysis.integrator,analysis.dt=average,0.2;average,0.1;average,0.05;wilson,0.1;wilson,0.05",
+            )
+            .unwrap(),
+        ],
+    };
+    let measures = [impact::sweep::Measure::parse("u=u_x[end]").unwrap()];
+    let report = sweep::run(&p, &dir.join("sweep"), options(2, None), &measures).unwrap();
+    assert_eq!(report.not_ok, 0);
+    let series = &report.scores[0].series;
+    assert_eq!(series.len(), 2);
+    let (average, wilson) = (&series[0], &series[1]);
+    let e = average.extrapolation.as_ref().unwrap();
+    let (value, gci) = (e.value.unwrap(), e.gci.unwrap());
+    assert!(
+        wilson
+            .extrapolation
+            .as_ref()
+            .is_none_or(|e| e.value.is_none())
+    );
+    let exact = 10f64.sin();
+    assert!((value - exact).abs() <= gci * exact.abs());
+    for s in series {
+        assert_eq!(s.reference, Some(value), "{}", s.series);
+        assert_eq!(s.reference_kind, Some("extrapolated"));
+        assert_eq!(s.reference_series.as_deref(), Some(average.series.as_str()));
+    }
+    for row in &report.rows {
+        let (u, error) = (row.quantities[0].unwrap(), row.quantity_errors[0]);
+        let error = error.unwrap_or_else(|| panic!("{}: no error", row.folder));
+        approx::assert_relative_eq!(error, (u - value) / value.abs(), max_relative = 1e-12);
+        if row.integrator == "wilson" && row.dt == Some(0.05) {
+            assert!((error - (u - exact) / exact.abs()).abs() <= gci, "{error}");
+        }
     }
 }
 

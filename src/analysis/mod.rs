@@ -10,6 +10,7 @@ pub mod plausibility;
 pub mod run;
 pub mod steppers;
 pub mod summary;
+pub mod units;
 
 use crate::assembly::State;
 use crate::scene::{InputError, Model};

@@ -385,6 +385,11 @@ pub struct Summary {
     /// none.
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// The unit of each history.csv column that has one, as the scene's material data tell
+    /// (SI or mm-t-s; `[length]` and the like otherwise; per unit depth in plane strain):
+    /// `impact plot` labels its axes with them.
+    #[serde(default)]
+    pub column_units: std::collections::BTreeMap<String, String>,
 }
 
 impl Summary {
@@ -430,6 +435,7 @@ impl Summary {
             ale: None,
             arc_length: None,
             warnings: Vec::new(),
+            column_units: super::units::column_units(model),
         }
     }
 }

@@ -222,9 +222,14 @@ pub fn write_measures(
             .iter()
             .map(|(label, members)| (label.clone(), members.iter().map(|&i| &rows[i]).collect()))
             .collect();
-        let against = match score.measure.reference {
-            Some(value) => format!("the reference {value}"),
-            None => "the converged value".to_string(),
+        let common = score
+            .series
+            .first()
+            .and_then(|s| s.reference_series.as_ref());
+        let against = match (score.measure.reference, common) {
+            (Some(value), _) => format!("the reference {value}"),
+            (None, Some(from)) => format!("the converged value of {from}"),
+            (None, None) => "the converged value".to_string(),
         };
         let name = format!(
             "|{} error| (relative, against {against})",

@@ -13,8 +13,10 @@
 //!                        value and GCI, or why not (qoi.rs)
 //! DIR/*.png, DIR/*.svg   charts (charts.rs)
 //! ```
-//! A rerun skips finished cases. `--shard i/n` runs the cases k with k mod n = i; `merge`
-//! joins the case folders of several DIRs into one table and charts. Each case runs on one
+//! A rerun skips finished cases, and a rerun whose --vary adds values runs only the new
+//! cases. `--shard i/n` runs the cases k with k mod n = i; `merge`
+//! joins the case folders of several DIRs (shards, or a study and a level run apart) into one
+//! table and charts. Each case runs on one
 //! thread (its element loops in a one-thread pool), so results do not depend on `--jobs`.
 
 pub mod charts;
@@ -292,31 +294,42 @@ fn run_case(
 /// the title font, and the charts add up to 30 (": error against CPU time").
 const TITLE_CHARACTERS: usize = 48;
 
-/// Joins the finished cases of sweeps run into `dirs` (shards of one plan) and writes the
-/// table and charts into `out`.
+/// Joins the finished cases of sweeps run into `dirs` and writes the table and charts into
+/// `out`: shards of one plan, or a study and its extensions (one plan extends every other,
+/// `Plan::extends`: a finer level run apart), under the widest plan.
 pub fn merge(dirs: &[PathBuf], out: &Path, measures: &[Measure]) -> Result<Report, RunError> {
-    let mut plan: Option<Plan> = None;
+    let mut plans: Vec<(PathBuf, Plan)> = Vec::new();
     for dir in dirs {
         let path = dir.join("sweep.json");
         let text = std::fs::read_to_string(&path)
             .map_err(|e| InputError::new(&path, format!("cannot read the sweep's plan: {e}")))?;
         let this: Plan = serde_json::from_str(&text)
             .map_err(|e| InputError::new(&path, format!("not a sweep plan: {e}")))?;
-        match &plan {
-            Some(first) if *first != this => {
-                return Err(InputError::new(
-                    &path,
-                    format!(
-                        "another sweep than {} (scene, --set or --vary differ)",
-                        dirs[0].join("sweep.json").display()
-                    ),
-                )
-                .into());
-            }
-            _ => plan = Some(this),
-        }
+        plans.push((path, this));
     }
-    let plan = plan.ok_or_else(|| InputError::new(out, "--merge: name at least one folder"))?;
+    let widest = plans
+        .iter()
+        .find(|(_, p)| plans.iter().all(|(_, q)| p.extends(q)));
+    let plan = match (widest, plans.first()) {
+        (Some((_, plan)), _) => plan.clone(),
+        (None, None) => {
+            return Err(InputError::new(out, "--merge: name at least one folder").into());
+        }
+        (None, Some((first, p))) => {
+            let (path, _) = (plans.iter())
+                .find(|(_, q)| !p.extends(q) && !q.extends(p))
+                .unwrap_or(&plans[plans.len() - 1]);
+            return Err(InputError::new(
+                path,
+                format!(
+                    "another sweep than {} (scene, --set or the varied keys differ, or neither \
+                     plan holds the other's values; a study and a finer level run apart merge)",
+                    first.display()
+                ),
+            )
+            .into());
+        }
+    };
     let cases = plan.cases();
     let models = models(&plan, &cases, measures)?;
     let folders: Vec<Option<PathBuf>> = cases

@@ -27,7 +27,7 @@
 //! its own (a case is never scored against itself).
 
 use super::measure::Row;
-use crate::element::Formulation;
+pub use crate::analysis::units::Units;
 use crate::scene::Model;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -308,103 +308,6 @@ pub fn extrapolate(h: [f64; 3], f: [f64; 3]) -> Extrapolation {
     out
 }
 
-/// The units a scene's numbers are in, as far as its material data tell (no unit system
-/// is imposed): SI (every density 100 to 3e4, every Young's modulus 1e7 to 1e13: kg/m^3 and
-/// Pa) or mm-t-s (densities 1e-10 to 1e-7 t/mm^3, moduli 1e2 to 1e7 MPa); else the
-/// dimension's name in brackets. Temperatures are in the scene's own scale: C when a
-/// Johnson-Cook room temperature is below 150 (degrees Celsius), else K.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Units {
-    pub length: &'static str,
-    pub time: &'static str,
-    pub force: &'static str,
-    pub energy: &'static str,
-    pub stress: &'static str,
-    pub mass: &'static str,
-    pub temperature: &'static str,
-    /// `/m`, `/mm` (or `/[length]`) for forces and energies of a plane-strain body: per unit
-    /// depth; empty otherwise.
-    pub per_depth: String,
-}
-
-impl Units {
-    pub fn of(model: &Model) -> Units {
-        let all = |density: (f64, f64), young: (f64, f64)| {
-            model.bodies.iter().all(|b| {
-                let (rho, e) = (b.material.density, b.material.elastic.young);
-                (density.0..=density.1).contains(&rho) && (young.0..=young.1).contains(&e)
-            })
-        };
-        let (length, time, force, energy, stress, mass) = if all((100.0, 3e4), (1e7, 1e13)) {
-            ("m", "s", "N", "J", "Pa", "kg")
-        } else if all((1e-10, 1e-7), (1e2, 1e7)) {
-            ("mm", "s", "N", "mJ", "MPa", "t")
-        } else {
-            (
-                "[length]", "[time]", "[force]", "[energy]", "[stress]", "[mass]",
-            )
-        };
-        let celsius = model.bodies.iter().any(|b| {
-            b.material
-                .johnson_cook()
-                .is_some_and(|law| law.room_temperature < 150.0)
-        });
-        let plane_strain = model
-            .bodies
-            .iter()
-            .any(|b| b.kind.formulation() == Some(Formulation::PlaneStrain));
-        Units {
-            length,
-            time,
-            force,
-            energy,
-            stress,
-            mass,
-            temperature: if celsius { "C" } else { "K" },
-            per_depth: if plane_strain {
-                format!("/{length}")
-            } else {
-                String::new()
-            },
-        }
-    }
-
-    /// The unit of a history.csv column of `model` (empty for a count or a strain).
-    pub fn of_column(&self, model: &Model, column: &str) -> String {
-        let per = |unit: &str| format!("{unit}{}", self.per_depth);
-        if let Some(probe) = model.probes.iter().find(|p| p.column == column) {
-            return match probe.quantity.unit() {
-                "m" => self.length.to_string(),
-                "m/s" => format!("{}/{}", self.length, self.time),
-                "m/s^2" => format!("{}/{}^2", self.length, self.time),
-                "N" => per(self.force),
-                "kg m/s" => per(&format!("{} {}", self.force, self.time)),
-                "Pa" => self.stress.to_string(),
-                "K" => self.temperature.to_string(),
-                other => other.to_string(),
-            };
-        }
-        let name = column.split('[').next().unwrap_or(column);
-        match name {
-            "time" | "dt" => self.time.to_string(),
-            "kinetic_energy"
-            | "internal_energy"
-            | "plastic_work"
-            | "external_work"
-            | "contact_work"
-            | "hourglass_energy"
-            | "bulk_viscosity_work"
-            | "mass_scaling_loss"
-            | "remap_loss"
-            | "friction_work" => per(self.energy),
-            "added_mass" => per(self.mass),
-            "contact_force" | "tangential_force" => per(self.force),
-            "penetration" => self.length.to_string(),
-            _ => String::new(),
-        }
-    }
-}
-
 /// `label [unit]`, or the label alone without a unit.
 pub fn with_unit(label: &str, unit: &str) -> String {
     if unit.is_empty() {
@@ -449,6 +352,9 @@ pub struct SeriesScore {
     pub reference_kind: Option<&'static str>,
     /// The finest case's folder when it is the reference (it has no error then).
     pub finest: Option<String>,
+    /// The series whose extrapolation or finest case is the reference of every series of
+    /// the sweep (`common_reference`), None with a given one or a single series.
+    pub reference_series: Option<String>,
     pub extrapolation: Option<Extrapolation>,
 }
 
@@ -472,6 +378,17 @@ impl MeasureScore {
                 Some(format!("{} ({}): {note}", self.measure.name, s.series))
             })
             .collect()
+    }
+}
+
+/// `; errors against X's extrapolated value V` where the series is scored against another
+/// series' reference (`common_reference`), else nothing.
+fn against_another(s: &SeriesScore) -> String {
+    match (&s.reference_series, s.reference, s.reference_kind) {
+        (Some(from), Some(value), Some(kind)) if *from != s.series => {
+            format!("; errors against the {kind} of {from}, {value:.6e}")
+        }
+        _ => String::new(),
     }
 }
 
@@ -504,10 +421,13 @@ pub fn summary_lines(score: &MeasureScore) -> Vec<String> {
                         "{:.3} %",
                         100.0 * g
                     ))
-                ),
-                (_, Some(reference), Some(kind)) => {
-                    format!("{head}: compared with the {kind}, {reference:.6e}{unit}")
-                }
+                ) + &against_another(s),
+                (_, Some(reference), Some(kind)) => match &s.reference_series {
+                    Some(from) if *from != s.series => format!(
+                        "{head}: compared with the {kind} of {from}, {reference:.6e}{unit}"
+                    ),
+                    _ => format!("{head}: compared with the {kind}, {reference:.6e}{unit}"),
+                },
                 _ => format!("{head}: no refinement in this series (neither h nor dt varies)"),
             }
         })
@@ -545,15 +465,91 @@ pub fn score(
     measures
         .iter()
         .enumerate()
-        .map(|(k, measure)| MeasureScore {
-            measure: measure.clone(),
-            unit: measure.unit(&units.of_column(model, &measure.column)),
-            series: series
+        .map(|(k, measure)| {
+            let mut scores: Vec<SeriesScore> = series
                 .iter()
                 .map(|(label, members)| score_series(k, measure, label, rows, members))
-                .collect(),
+                .collect();
+            if measure.reference.is_none() {
+                common_reference(k, &mut scores, rows, series);
+            }
+            MeasureScore {
+                measure: measure.clone(),
+                unit: measure.unit(&units.of_column(model, &measure.column)),
+                series: scores,
+            }
         })
         .collect()
+}
+
+/// One reference for measure `k` across the series, each scored against its own by
+/// `score_series`: the extrapolation of the series with the smallest GCI (the most certain
+/// converged value), else the finest case of all when the series refine the same parameter.
+/// Every series' errors are then against it, so two methods' fronts are measured against the
+/// same answer, and a series without an extrapolation keeps its finest case on the charts.
+/// One series, or series that refine different parameters without an extrapolation, keep
+/// their own.
+fn common_reference(
+    k: usize,
+    scores: &mut [SeriesScore],
+    rows: &mut [Row],
+    series: &[(String, Vec<usize>)],
+) {
+    if scores.len() < 2 {
+        return;
+    }
+    let certainty = |s: &SeriesScore| {
+        let e = s.extrapolation.as_ref()?;
+        Some((e.gci.unwrap_or(f64::INFINITY), e.value?))
+    };
+    let best = (scores.iter().enumerate())
+        .filter_map(|(i, s)| Some((i, certainty(s)?)))
+        .min_by(|a, b| a.1.0.total_cmp(&b.1.0));
+    let (from, reference, kind, skip) = match best {
+        Some((i, (_, value))) => (i, value, "extrapolated", None),
+        None => {
+            let refinement = scores[0].refinement;
+            if refinement.is_none() || scores.iter().any(|s| s.refinement != refinement) {
+                return;
+            }
+            let level = |i: usize| {
+                let r = &rows[i];
+                if refinement == Some("h") {
+                    Some(r.h)
+                } else {
+                    r.dt
+                }
+            };
+            // each series' finest case is its reference (`score_series`): the finest of them
+            let finest = (scores.iter().enumerate())
+                .filter_map(|(s, score)| {
+                    let folder = score.finest.as_ref()?;
+                    let i = rows.iter().position(|r| &r.folder == folder)?;
+                    Some((s, i, level(i)?))
+                })
+                .min_by(|a, b| a.2.total_cmp(&b.2));
+            let Some((s, i, _)) = finest else {
+                return;
+            };
+            let value = rows[i].quantities[k].expect("a reference case has the value");
+            (s, value, "finest case", Some(i))
+        }
+    };
+    let label = scores[from].series.clone();
+    let folder = skip.map(|i| rows[i].folder.clone());
+    for (score, (_, members)) in scores.iter_mut().zip(series) {
+        score.reference = Some(reference);
+        score.reference_kind = Some(kind);
+        score.reference_series = Some(label.clone());
+        score.finest = folder.clone();
+        let usable: Vec<usize> = (members.iter().copied())
+            .filter(|&i| rows[i].status == "ok" && rows[i].quantities[k].is_some())
+            .collect();
+        for &i in &usable {
+            rows[i].quantity_errors[k] = None;
+        }
+        score_against(k, reference, rows, &usable, skip);
+    }
 }
 
 /// Measure `k` on one series: its levels, the extrapolation of the three finest, the errors.
@@ -570,6 +566,7 @@ fn score_series(
         reference: None,
         reference_kind: None,
         finest: None,
+        reference_series: None,
         extrapolation: None,
     };
     let usable: Vec<usize> = members
