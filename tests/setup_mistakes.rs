@@ -622,3 +622,32 @@ fn a_node_the_run_made_fast_is_not_blamed_on_the_units() {
     let hint = plausibility::failure_hint(&fast, &velocity).expect("the start is named");
     assert!(hint.contains("points to mixed units"), "{hint}");
 }
+
+/// Goal: a Johnson-Cook room temperature in degrees Celsius beside a melting temperature in
+/// K is caught before the run (exit 3 with `--strict`). Setup: models/taylor_jc.toml (room
+/// 20 C, melting 1540 C, both Celsius: silent, as every shipped scene above) with the
+/// melting temperature of Ti-6Al-4V in K, 1878, as the user wrote it; and with
+/// 1878 - 273 = 1605 (both Celsius again). Reference: 1878 K is titanium's melting point
+/// (1870-1941 K, ASM Handbook) and no metal's in degrees Celsius (steels end at 1538 C,
+/// titanium starts at 1597 C), while the room temperature 20 reads as Celsius; 1605 is
+/// titanium's in Celsius and is silent.
+#[test]
+fn a_room_temperature_in_celsius_beside_a_melting_point_in_kelvin_is_caught() {
+    let check = |melting: &str| {
+        let set = format!("material.42CrMo4.johnson_cook.melting_temperature={melting}");
+        let out = common::impact(&["check", "models/taylor_jc.toml", "--strict", "--set", &set]);
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        (out.status.code(), stderr)
+    };
+    let (code, stderr) = check("1878.0");
+    assert_eq!(code, Some(3), "{stderr}");
+    warned(
+        &stderr,
+        &[
+            "room_temperature = 20 reads as degrees Celsius",
+            "melting 1604.85",
+        ],
+    );
+    let (code, stderr) = check("1605.0");
+    assert_eq!(code, Some(0), "{stderr}");
+}

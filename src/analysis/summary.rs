@@ -387,7 +387,7 @@ pub struct Summary {
     pub warnings: Vec<String>,
     /// The unit of each history.csv column that has one, as the scene's material data tell
     /// (SI or mm-t-s; `[length]` and the like otherwise; per unit depth in plane strain):
-    /// `impact plot` labels its axes with them.
+    /// `impact plot` labels its axes with them. Filled by the run (`analysis::units`).
     #[serde(default)]
     pub column_units: std::collections::BTreeMap<String, String>,
 }
@@ -435,7 +435,7 @@ impl Summary {
             ale: None,
             arc_length: None,
             warnings: Vec::new(),
-            column_units: super::units::column_units(model),
+            column_units: Default::default(),
         }
     }
 }

@@ -102,11 +102,11 @@ impl Units {
     }
 }
 
-/// Each history.csv column of a run of `model` with a unit, and its unit (summary.json
-/// `column_units`; counts and strains have none and are left out).
-pub fn column_units(model: &Model) -> BTreeMap<String, String> {
+/// Each of the history.csv `columns` of a run of `model` with a unit, and its unit
+/// (summary.json `column_units`; counts and strains have none and are left out).
+pub fn column_units(model: &Model, columns: Vec<String>) -> BTreeMap<String, String> {
     let units = Units::of(model);
-    crate::analysis::run::columns::column_names(model)
+    columns
         .into_iter()
         .filter_map(|column| {
             let unit = units.of_column(model, &column);

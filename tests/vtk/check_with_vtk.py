@@ -1,6 +1,6 @@
 """Reads the frames of `cargo test --release --lib vtk_reader_check -- --ignored` with VTK's own
 XML reader (the reader ParaView uses) and compares every array, bit for bit, with the values the
-test wrote. The expected values are computed here from the test's formula, independently of
+test wrote, and each frame's time (field data TimeValue) with the time it was written at. The expected values are computed here from the test's formula, independently of
 impact's own reader (src/output/vtu.rs).
 
 Usage: python3 tests/vtk/check_with_vtk.py [output/vtk_reader_check]   (needs `pip install vtk`)
@@ -59,6 +59,10 @@ def check(pvd: Path, grid):
         reader.SetFileName(str(pvd.parent / name))
         reader.Update()
         grid_out = reader.GetOutput()
+        # the frame's own time (field data TimeValue), as ParaView shows it for a .vtu alone
+        time = grid_out.GetFieldData().GetArray("TimeValue")
+        assert time is not None, (name, "no TimeValue")
+        assert time.GetNumberOfTuples() == 1 and time.GetValue(0) == TIMES[k], (name, time.GetValue(0))
         assert grid_out.GetNumberOfPoints() == len(points), name
         assert grid_out.GetNumberOfCells() == cells, name
         xyz = vtk_to_numpy(grid_out.GetPoints().GetData())
@@ -85,7 +89,7 @@ def main():
     for compression in ("none", "lz4", "zlib"):
         for series, grid in (("small", small_grid()), ("blocks", block_grid())):
             total += check(root / compression / f"{series}.pvd", grid)
-            print(f"{compression:5s} {series:7s}: 3 frames read by VTK {vtk.vtkVersion.GetVTKVersion()}, every array bit-exact")
+            print(f"{compression:5s} {series:7s}: 3 frames read by VTK {vtk.vtkVersion.GetVTKVersion()}, every array bit-exact, each with its TimeValue")
     print(f"{total} frames checked")
 
 

@@ -131,6 +131,7 @@ pub(super) fn unit_warnings(model: &Model) -> Vec<String> {
         }
         out.extend(hardening_problem(m));
         out.extend(heating_problem(m));
+        out.extend(temperature_scale_problem(m));
         if let Some(c) = wave_speed(body)
             && m.elastic.young >= 1e7
             && c.speed > FASTEST_SOLID
@@ -230,6 +231,62 @@ fn hardening_problem(m: &Material) -> Option<String> {
             m.name,
             readable(modulus),
             readable(m.elastic.young)
+        )
+    })
+}
+
+/// The melting points of the metals impacts are run on, in K (solidus to liquidus where an
+/// alloy spans one): lead 600, magnesium alloys 870-923, aluminium alloys 775-933, brass
+/// and bronze 1150-1300, copper 1356, nickel alloys (Inconel) 1530-1728, irons and steels
+/// 1690-1811, titanium and Ti-6Al-4V 1870-1941, tantalum 3290, tungsten 3695 (handbook
+/// values, e.g. the ASM Handbook vol. 2; Johnson & Cook 1985 table 1 lists OFHC copper 1356,
+/// Armco iron 1811, 4340 steel 1793).
+const MELTING_POINTS_K: [(f64, f64); 10] = [
+    (600.0, 600.0),
+    (775.0, 933.0),
+    (1150.0, 1300.0),
+    (1356.0, 1356.0),
+    (1530.0, 1728.0),
+    (1690.0, 1811.0),
+    (1870.0, 1941.0),
+    (3290.0, 3290.0),
+    (3695.0, 3695.0),
+    (870.0, 923.0),
+];
+
+/// A Johnson-Cook room temperature below this reads as degrees Celsius (`qoi::Units`: no
+/// Taylor test runs colder than liquid nitrogen, 77 K, and none of the shipped or published
+/// ones below room temperature).
+const CELSIUS_BELOW: f64 = 150.0;
+
+/// A Johnson-Cook material whose room and melting temperatures read as two scales: a room
+/// temperature in degrees Celsius (below [`CELSIUS_BELOW`]) beside a melting temperature
+/// that is a metal's melting point in K (within 1 % of [`MELTING_POINTS_K`]) and no metal's
+/// in degrees Celsius. The span from room to melting temperature, which scales the thermal
+/// softening, is then off by 273 (17 % on Ti-6Al-4V).
+fn temperature_scale_problem(m: &Material) -> Option<String> {
+    let law = m.johnson_cook()?;
+    let near = |t: f64, offset: f64| {
+        (MELTING_POINTS_K.iter())
+            .any(|(low, high)| t >= 0.99 * (low - offset) && t <= 1.01 * (high - offset))
+    };
+    let melting = law.melting_temperature;
+    let mixed =
+        law.room_temperature < CELSIUS_BELOW && near(melting, 0.0) && !near(melting, 273.15);
+    mixed.then(|| {
+        format!(
+            "material `{}`: johnson_cook.room_temperature = {} reads as degrees Celsius, while \
+             melting_temperature = {} is a metal's melting point in K and no metal's in \
+             degrees Celsius: give both in one scale (in K: room {}, melting {}; in degrees \
+             Celsius: room {}, melting {}); mixed, the span that scales the thermal softening \
+             is off by 273",
+            m.name,
+            readable(law.room_temperature),
+            readable(melting),
+            readable(law.room_temperature + 273.15),
+            readable(melting),
+            readable(law.room_temperature),
+            readable(melting - 273.15)
         )
     })
 }

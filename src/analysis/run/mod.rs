@@ -31,6 +31,7 @@ use super::steppers::Stepper;
 use super::steppers::energies::{Energies, relative_gain};
 use super::steppers::newton::Counters;
 use super::summary::{DtLimit, MassScalingSummary, RunError, Status, StepError, Summary};
+use super::units;
 use crate::assembly::State;
 use crate::output::readable;
 use crate::profile::{self, Phase};
@@ -147,13 +148,14 @@ impl<'a, S: Stepper> Run<'a, S> {
                 Recorder::create(model, dir, !options.no_frames, window)?
             }
         };
-        let summary = Summary::new(
+        let mut summary = Summary::new(
             model,
             &stepper.integrator(),
             stepper.dt(),
             stepper.end_time(),
             stepper.free_dofs(),
         );
+        summary.column_units = units::column_units(model, columns::column_names(model));
         let coordinates = model.coordinates();
         let penetration_limits = crate::contact::penetration_limits(&model.contacts, &coordinates);
         let resuming = resume.is_some();
