@@ -461,3 +461,154 @@ fn free(row: Vec<(usize, f64)>, system: &System) -> Vec<(usize, f64)> {
         .filter_map(|(dof, v)| system.equation[dof].map(|eq| (eq, v)))
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::{ContactPair, Inside, Master, Obstacle, PairOptions};
+
+    /// Node 0 against the wall y = 0 (solid below), with Coulomb friction `mu` (0: none).
+    fn pair(mu: f64) -> ContactPair {
+        ContactPair {
+            name: "p".into(),
+            slave_body: 0,
+            slaves: vec![0],
+            master: Master::Obstacle(Obstacle {
+                name: "wall".into(),
+                points: vec![[1.0, 0.0], [-1.0, 0.0]],
+                closed: false,
+            }),
+            options: PairOptions {
+                impact_conditions: false,
+                release_conditions: false,
+                release_fraction: 0.0,
+                tolerance: 1e-6,
+                search_distance: f64::INFINITY,
+                split_at_events: false,
+                friction: if mu > 0.0 {
+                    Friction::Coulomb { mu }
+                } else {
+                    Friction::None
+                },
+                persistency: false,
+                balanced: false,
+            },
+            covered: None,
+            balances: None,
+            mortar: None,
+            holds: None,
+        }
+    }
+
+    /// The constraints of `pairs` with node 0 active, as a Newton step sees them.
+    fn constraints<'a>(
+        pairs: &'a [ContactPair],
+        describe: &'a dyn Fn(usize) -> String,
+    ) -> Constraints<'a> {
+        Constraints {
+            pairs,
+            active: &[(0, 0)],
+            start: &[[0.0, 0.0]],
+            forces: vec![0.0],
+            tangential: &[],
+            targets: Vec::new(),
+            inside: Inside::Releases,
+            describe,
+        }
+    }
+
+    fn candidate(normal: f64, tangential: f64, status: Status) -> Candidate {
+        Candidate {
+            pair: 0,
+            index: 0,
+            node: 0,
+            status,
+            normal,
+            tangential,
+        }
+    }
+
+    /// Goal: the slip beyond sticking is the tangential row applied to the increment, plus
+    /// in dynamics the predictor's relative velocity over c_v. Reference (by hand): the row
+    /// (0.6, 0.8) on d = (1, 2) gives 0.6 + 1.6 = 2.2; with v_hat = (3, -1) and c_v = 2,
+    /// 2.2 + (1.8 - 0.8) / 2 = 2.7.
+    #[test]
+    fn the_slip_beyond_sticking_is_the_row_on_the_increment_and_the_predictor() {
+        let row = [(0, 0.6), (1, 0.8)];
+        let d = [1.0, 2.0];
+        assert!((slip_beyond_stick(&row, &d, None) - 2.2).abs() < 1e-15);
+        let dynamic = slip_beyond_stick(&row, &d, Some((&[3.0, -1.0], 2.0)));
+        assert!((dynamic - 2.7).abs() < 1e-15, "{dynamic}");
+    }
+
+    /// Goal: a sticking entry leaves Coulomb's cone exactly when |f| > mu tau, sliding with
+    /// the sign of its force; a frictionless or sliding entry never does. Reference (by
+    /// hand): mu = 0.3, tau = 10: the cone's edge is 3; 2.9 and 3 stay, 3.1 and -3.1 slide
+    /// with +0.3 and -0.3.
+    #[test]
+    fn a_sticking_entry_slides_when_its_force_leaves_the_cone() {
+        let describe = |n: usize| format!("node {n}");
+        let pairs = [pair(0.3)];
+        let c = constraints(&pairs, &describe);
+        let at = |f: f64| leaves_cone(&c, &candidate(10.0, f, Status::Stick));
+        assert_eq!(at(2.9), None);
+        assert_eq!(at(3.0), None);
+        assert_eq!(at(3.1), Some(Status::Slide(0.3)));
+        assert_eq!(at(-3.1), Some(Status::Slide(-0.3)));
+        assert_eq!(
+            leaves_cone(&c, &candidate(10.0, 5.0, Status::Slide(0.3))),
+            None
+        );
+        let frictionless = [pair(0.0)];
+        let c = constraints(&frictionless, &describe);
+        assert_eq!(leaves_cone(&c, &candidate(10.0, 5.0, Status::Stick)), None);
+        assert_eq!(closed_status(&c, 0), Status::Frictionless);
+        assert_eq!(
+            closed_status(&constraints(&pairs, &describe), 0),
+            Status::Stick
+        );
+    }
+
+    /// Goal: a sliding entry sticks again when its sliding force would push along the slip
+    /// (the slip has reversed against the force's sign), and keeps sliding otherwise.
+    /// Setup: node 0 on the wall y = 0 (normal (0, 1), tangent (-1, 0): a slip to -x is
+    /// positive), sliding with +mu. Reference (by hand): d = (-1e-3, 0) is a slip of +1e-3,
+    /// along the force's sign: stick; d = (+1e-3, 0), a slip of -1e-3: slide on; a slip of
+    /// 1e-10, below 1e-3 of TOL (1e-6): slide on.
+    #[test]
+    fn a_sliding_entry_sticks_when_the_slip_turns_along_its_force() {
+        let describe = |n: usize| format!("node {n}");
+        let pairs = [pair(0.3)];
+        let c = constraints(&pairs, &describe);
+        let gap = Gap {
+            gap: 0.0,
+            normal: [0.0, 1.0],
+            masters: Vec::new(),
+            weight: 1.0,
+        };
+        let sliding = Status::Slide(0.3);
+        let next = |d: [f64; 2]| {
+            friction_status(
+                &c,
+                &candidate(10.0, 3.0, sliding),
+                sliding,
+                (&gap, &d),
+                None,
+            )
+        };
+        assert_eq!(next([-1e-3, 0.0]), Status::Stick);
+        assert_eq!(next([1e-3, 0.0]), sliding);
+        assert_eq!(next([-1e-10, 0.0]), sliding);
+    }
+
+    /// Goal: a sticking row is left to the supports when what remains of it after its part
+    /// along the normal row is less than a tenth of the row. Reference (by hand): t = e0
+    /// against n = e1 keeps all of it (1); t = e0 + 0.05 e1 against n = e0 keeps 0.0025 of
+    /// 1.0025; a row with no free DOF keeps nothing.
+    #[test]
+    fn a_sticking_row_along_its_normal_row_is_left_to_the_supports() {
+        assert!(!held_by_support(&[(0, 1.0)], 1.0, &[(1, 1.0)]));
+        assert!(held_by_support(&[(0, 1.0), (1, 0.05)], 1.0025, &[(0, 1.0)]));
+        assert!(held_by_support(&[], 1.0, &[(0, 1.0)]));
+    }
+}
