@@ -22,9 +22,12 @@ fn step_fall(summary: &impact::analysis::Summary) -> f64 {
 /// widened by the Lagrangian runs' own change under one halving of the mesh, +0.65 %
 /// (docs/validation.md 10.2: the face's diameter on 5 x 50 is not converged, and the remap
 /// moves it toward the finer meshes' value; measured 26.521 mm, 11.190 mm). The energy
-/// balance with the remap's term within the 1 % (measured 1.8e-5); the step falls at
-/// most 4 times over the run (the bound; the Lagrangian run's falls 3.5 times on this
-/// rod, 31 times on the aluminium rod's foot).
+/// balance with the remap's term below 6e-5 (measured 1.8e-5; with the remap's kinetic
+/// energy loss left out of the balance, 1.6e-4: the bound tells the two apart, far inside
+/// the 1 %); the step falls at most 2 times over the run (measured 1.35; the
+/// Lagrangian run's falls 3.1 times on this rod, 31 times on the aluminium rod's foot, so
+/// the bound fails with ALE off, which the published band alone would not: the Lagrangian
+/// L_f and D_f lie in it too).
 #[test]
 fn taylor_jc_with_ale_lands_on_the_published_results() {
     let run = run_scene(
@@ -42,9 +45,10 @@ fn taylor_jc_with_ale_lands_on_the_published_results() {
         (11.135 - widen..=11.175 + widen).contains(&diameter),
         "D_f {diameter}"
     );
-    assert!(run.summary.energy.max_relative_drift < 1e-2);
+    let drift = run.summary.energy.max_relative_drift;
+    assert!(drift < 6e-5, "energy balance {drift}");
     assert!(
-        step_fall(&run.summary) <= 4.0,
+        step_fall(&run.summary) <= 2.0,
         "step fell {}",
         step_fall(&run.summary)
     );
@@ -56,7 +60,8 @@ fn taylor_jc_with_ale_lands_on_the_published_results() {
 /// Jacobian without ALE), the copper rod at 400 m/s completes on both kernels with ALE steps.
 /// Setup: models/taylor_copper_ale.toml (5 x 50) on the 2x2 and the one-point kernel; the
 /// one-point kernel also on 10 x 100. Reference: the energy balance with the remap's term
-/// within the 1 % (measured 1.1e-4, 9.3e-5); the hourglass energy of the one-point
+/// below 1e-3 (measured 1.1e-4, 9.3e-5; with the remap's kinetic energy loss left out of
+/// the balance 6.0e-3 and 5.4e-3, which the 1 % let pass); the hourglass energy of the one-point
 /// kernel below the 2 % of the work on 10 x 100 (measured 0.3 %; 2.7 % on 5 x 50,
 /// where five elements span a foot four times the rod's radius); the two kernels' L_f within
 /// 1 % of each other, the 5 x 50 level's spread in the mesh study of docs/validation.md 11
@@ -78,7 +83,8 @@ fn a_copper_rod_at_400_m_s_completes_on_both_kernels_with_ale() {
             "{name}: {:?}",
             run.summary.message
         );
-        assert!(run.summary.energy.max_relative_drift < 1e-2, "{name}");
+        let drift = run.summary.energy.max_relative_drift;
+        assert!(drift < 1e-3, "{name}: energy balance {drift}");
         lengths.push(*column(&run.dir, "extent_y[all]").last().unwrap());
     }
     assert!(
