@@ -267,6 +267,21 @@ mod tests {
         )
     }
 
+    /// The unit square (nodes 0..4) and the wall y = 0 from x = 2 to x = -2 (solid below),
+    /// node 0 its pair's slave.
+    fn square_on_a_wall() -> Interfaces {
+        let wall = Obstacle {
+            name: "wall".into(),
+            points: vec![[2.0, 0.0], [-2.0, 0.0]],
+            closed: false,
+        };
+        let pair = crate::contact::geometry::tests::slave_node_0(Master::Obstacle(wall));
+        Interfaces {
+            pairs: vec![pair],
+            bodies: vec![square(0)],
+        }
+    }
+
     /// Goal: a body through a wall is measured from every boundary node, not only the
     /// slaves. Setup: a unit square [0, 1] x [-0.3, 0.7] against the wall y = 0 (solid below:
     /// points run from x = 2 to x = -2), no slaves at all. Reference: its two lower corners
@@ -274,16 +289,7 @@ mod tests {
     #[test]
     fn a_body_through_a_wall_is_never_zero() {
         let points = [[0.0, -0.3], [1.0, -0.3], [1.0, 0.7], [0.0, 0.7]];
-        let wall = Obstacle {
-            name: "wall".into(),
-            points: vec![[2.0, 0.0], [-2.0, 0.0]],
-            closed: false,
-        };
-        let pair = crate::contact::geometry::tests::slave_node_0(Master::Obstacle(wall));
-        let interfaces = Interfaces {
-            pairs: vec![pair],
-            bodies: vec![square(0)],
-        };
+        let interfaces = square_on_a_wall();
         let deepest = deepest(&interfaces, &|n| points[n]).unwrap();
         assert!((deepest.depth - 0.3).abs() < 1e-15, "{deepest:?}");
         assert_eq!(deepest.into, Intruded::Obstacle("wall".into()));
@@ -322,16 +328,7 @@ mod tests {
     /// degrees), nothing: a node beside the end, not one that slid off it.
     #[test]
     fn a_slave_past_the_end_of_its_wall_is_found() {
-        let wall = Obstacle {
-            name: "wall".into(),
-            points: vec![[2.0, 0.0], [-2.0, 0.0]],
-            closed: false,
-        };
-        let pair = crate::contact::geometry::tests::slave_node_0(Master::Obstacle(wall));
-        let interfaces = Interfaces {
-            pairs: vec![pair],
-            bodies: vec![square(0)],
-        };
+        let interfaces = square_on_a_wall();
         let at = |p: [f64; 2]| past_an_end(&interfaces, &|_| p).map(|e| e.end);
         assert_eq!(at([1.9, 0.0]), None);
         assert_eq!(at([1.9, 0.3]), None);
