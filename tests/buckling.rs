@@ -333,7 +333,9 @@ set = "mid"
 "#;
 
 /// Goal: load stepping a perfect column, the inertia of K_T changes (one negative pivot)
-/// within 2 % of Euler's load. Setup: STEPPED; Newton with the elastic tangent (K_0: the
+/// within 2 % of Euler's load, and the mode that crossed zero is written as a frame: Euler's
+/// half sine across the axis (its correlation with the midline's lateral displacement above
+/// 0.999; a mode of the wrong shape, the second, would correlate 0). Setup: STEPPED; Newton with the elastic tangent (K_0: the
 /// straight path beyond P_E is unstable, K_T indefinite, so Cholesky of K_T would fail;
 /// the check assembles and counts K_T itself). Reference: P_E. Tolerance 2 % (the required accuracy):
 /// this mesh's lambda_1 is 0.7 % above P_E, the prebuckling shortening adds ~0.3 %, and the
@@ -372,8 +374,41 @@ fn load_stepping_perfect_column_loses_definiteness_at_euler_load() {
         "{:?}",
         summary.warnings
     );
-    // history.csv: zero negative pivots up to the change, one from there on
+    // the mode that crossed zero, written as a frame at the change: Euler's first mode of
+    // the pinned column, sin(pi x / L) across the axis (Timoshenko and Gere 2.1)
     let dir = common::tests_root().join("stepped_perfect");
+    assert_eq!(
+        b.critical_mode.as_deref(),
+        Some("stepped_perfect_critical.pvd")
+    );
+    let pvd = std::fs::read_to_string(dir.join("stepped_perfect_critical.pvd")).unwrap();
+    let at: f64 = pvd
+        .split("timestep=\"")
+        .nth(1)
+        .and_then(|r| r.split('"').next())
+        .and_then(|v| v.parse().ok())
+        .expect("the frame's time");
+    assert_eq!(at, t, "{pvd}");
+    let frame =
+        impact::output::vtu::read_frame(&dir.join("vtk/stepped_perfect_critical_00000.vtu"))
+            .expect("the critical mode's frame");
+    let point = impact::output::vtu::Section::PointData;
+    let (_, x) = frame.floats(point, "reference_coordinates").unwrap();
+    let (_, u) = frame.floats(point, "displacement").unwrap();
+    let (mut uu, mut ss, mut us) = (0.0, 0.0, 0.0);
+    for (p, d) in x.chunks_exact(3).zip(u.chunks_exact(3)) {
+        if (p[1] - 0.2).abs() < 1e-9 {
+            let euler = (std::f64::consts::PI * p[0] / 10.0).sin();
+            (uu, ss, us) = (uu + d[1] * d[1], ss + euler * euler, us + d[1] * euler);
+        }
+    }
+    let correlation = us.abs() / (uu * ss).sqrt();
+    eprintln!("critical mode against sin(pi x / L): correlation {correlation}");
+    assert!(
+        correlation > 0.999,
+        "the mode against sin(pi x / L): {correlation}"
+    );
+    // history.csv: zero negative pivots up to the change, one from there on
     let time = common::column(&dir, "time");
     let pivots = common::column(&dir, "tangent_negative_pivots");
     for (t_row, n) in time.iter().zip(&pivots) {

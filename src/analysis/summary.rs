@@ -456,6 +456,10 @@ pub struct BucklingSummary {
     pub negative_pivots_at_change: Option<usize>,
     /// The run stopped there (`on_critical = "stop"`).
     pub stopped: bool,
+    /// The file of the mode that crossed zero there (`NAME_critical.pvd`: one frame at that
+    /// time, the eigenvector of K_T whose eigenvalue is nearest zero), when it was found.
+    #[serde(default)]
+    pub critical_mode: Option<String>,
 }
 
 /// Why a run failed; `exit_code` maps it to the CLI's contract.

@@ -127,6 +127,35 @@ impl InertiaCounter {
             .count();
         Ok(count)
     }
+
+    /// The eigenvector of the matrix last counted (`negative_pivots`) whose eigenvalue lies
+    /// nearest zero, by `iterations` steps of inverse iteration on its L D L^T factor (each
+    /// step divides the other eigenvectors' shares by their eigenvalue's ratio to the
+    /// nearest one), normalized to unit length; None for an empty matrix. Where the count
+    /// has just changed, that eigenvalue is the one that crossed zero, and its vector is the
+    /// critical mode.
+    pub fn nearly_null(&self, iterations: usize) -> Option<Vec<f64>> {
+        let symbolic = self.symbolic.as_ref()?;
+        let n = symbolic.nrows();
+        let factor = faer::sparse::linalg::cholesky::LdltRef::new(symbolic, &self.factor);
+        let mut buffer = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        let mut x = start_vector(n);
+        for _ in 0..iterations {
+            let rhs = faer::MatMut::from_column_major_slice_mut(&mut x, n, 1);
+            factor.solve_in_place_with_conj(
+                faer::Conj::No,
+                rhs,
+                Par::Seq,
+                MemStack::new(&mut buffer),
+            );
+            let norm = dot(&x, &x).sqrt();
+            if !(norm > 0.0 && norm.is_finite()) {
+                return None;
+            }
+            x.iter_mut().for_each(|v| *v /= norm);
+        }
+        Some(x)
+    }
 }
 
 /// K_T of the committed state (d = 0) into `system.values`.

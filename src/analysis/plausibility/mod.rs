@@ -268,12 +268,15 @@ pub fn warnings(
             b.stopped,
         )
     {
+        let mode = b.critical_mode.as_ref().map_or(String::new(), |file| {
+            format!(" (the mode that crossed zero: {file}, one frame at that time)")
+        });
         out.push(format!(
-            "the tangent's negative pivots went from {from} to {to} at t = {}: the structure \
-             passed a buckling or limit point there, and the run went on along the path it \
-             was on (a perfect structure stays on its unstable primary path; an imperfection, \
-             [analysis.buckling] imperfection, finds the buckled one; on_critical = \"stop\" \
-             ends the run there)",
+            "the tangent's negative pivots went from {from} to {to} at t = {}{mode}: the \
+             structure passed a buckling or limit point there, and the run went on along the \
+             path it was on (a perfect structure stays on its unstable primary path; an \
+             imperfection, [analysis.buckling] imperfection, finds the buckled one; \
+             on_critical = \"stop\" ends the run there)",
             readable(t)
         ));
     }

@@ -24,7 +24,7 @@ use crate::scene::Model;
 use crate::scene::spec::OnCritical;
 use crate::scene::spec::Tangent;
 use crate::solver::Solver;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The prebuckling state (see the legend).
 pub fn prebuckling_state(model: &Model) -> Result<State, BucklingError> {
@@ -99,6 +99,25 @@ impl InertiaCheck {
         Ok(InertiaCheck { system, counter })
     }
 
+    /// The eigenvector of the K_T last counted whose eigenvalue lies nearest zero, on all
+    /// DOFs (zero on the prescribed ones), scaled to a largest nodal value of 1; None when it
+    /// cannot be found. Where the count has just changed, the critical mode.
+    pub fn critical_mode(&self, dofs: usize) -> Option<Vec<f64>> {
+        // inverse iteration: 30 steps take a neighbour's share down by (lambda_1 /
+        // lambda_2)^30, 1e-9 for a ratio of 1/2 (a column's first two modes: 1/4)
+        let free = self.counter.nearly_null(30)?;
+        let mut shape = vec![0.0; dofs];
+        for (dof, equation) in self.system.equation.iter().enumerate() {
+            if let Some(eq) = equation {
+                shape[dof] = free[*eq];
+            }
+        }
+        let largest = (shape.chunks_exact(2))
+            .map(|c| c[0].hypot(c[1]))
+            .fold(0.0, f64::max);
+        (largest > 0.0).then(|| shape.iter().map(|v| v / largest).collect())
+    }
+
     /// Negative pivots of K_T (no mass) at the committed state.
     pub fn negative_pivots(
         &mut self,
@@ -114,6 +133,8 @@ impl InertiaCheck {
 pub struct Monitor {
     check: Option<InertiaCheck>,
     on_critical: OnCritical,
+    /// The run's folder (the critical mode's frame goes there).
+    dir: PathBuf,
     pub summary: BucklingSummary,
 }
 
@@ -139,17 +160,19 @@ impl Monitor {
         Ok(Some(Monitor {
             check,
             on_critical: spec.on_critical,
+            dir: dir.to_path_buf(),
             summary,
         }))
     }
 
     /// Checks a committed state: the negative-pivot count (None when `check` is off), and
-    /// whether the run should stop here.
+    /// whether the run should stop here. Where the count first changes, the critical mode
+    /// is written as the one frame of NAME_critical.pvd at that time.
     pub fn observe(
         &mut self,
         model: &Model,
         state: &State,
-    ) -> Result<(Option<usize>, bool), BucklingError> {
+    ) -> Result<(Option<usize>, bool), MonitorError> {
         let Some(check) = &mut self.check else {
             return Ok((None, false));
         };
@@ -163,6 +186,11 @@ impl Monitor {
             s.negative_pivots_at_change = Some(count);
             stop = self.on_critical == OnCritical::Stop;
             s.stopped = stop;
+            if let Some(shape) = check.critical_mode(model.dofs()) {
+                let name = format!("{}_critical", model.name);
+                write_shapes(model, &name, &[(state.time, &shape)], &self.dir)?;
+                s.critical_mode = Some(format!("{name}.pvd"));
+            }
         }
         Ok((Some(count), stop))
     }
@@ -181,12 +209,22 @@ pub enum MonitorError {
 /// (largest nodal value 1). A mode's amplitude is arbitrary, so the points do not move by
 /// it: Warp By Vector shows the shape at the scale the viewer picks.
 pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), OutputError> {
+    let frames: Vec<(f64, &[f64])> = (modes.iter().enumerate())
+        .map(|(i, mode)| ((i + 1) as f64, &mode.shape[..]))
+        .collect();
+    write_shapes(model, &format!("{}_buckling", model.name), &frames, dir)
+}
+
+/// Writes shapes (all DOFs) as the frames of DIR/NAME.pvd at their times: the points the
+/// reference configuration, the `displacement` field the shape.
+fn write_shapes(
+    model: &Model,
+    name: &str,
+    frames: &[(f64, &[f64])],
+    dir: &Path,
+) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|e| OutputError::io(dir, "create folder", e))?;
-    let mut series = Series::create(
-        dir,
-        &format!("{}_buckling", model.name),
-        model.output.compression,
-    )?;
+    let mut series = Series::create(dir, name, model.output.compression)?;
     let grid = record::grid(model);
     let points = grid.points.len();
     let cells = grid.cells();
@@ -195,8 +233,8 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
     let cell_zeros = vec![0.0; cells];
     let stress = vec![[0.0; 6]; cells];
     let body_ids = record::body_ids(model);
-    for (i, mode) in modes.iter().enumerate() {
-        let shape: Vec<[f64; 2]> = mode.shape.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+    for (time, values) in frames {
+        let shape: Vec<[f64; 2]> = values.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
         let fields = Fields {
             displacement: &shape,
             velocity: &zeros2,
@@ -215,7 +253,7 @@ pub fn write_modes(model: &Model, modes: &[Mode], dir: &Path) -> Result<(), Outp
             traction: None,
             strain: None,
         };
-        series.write_frame((i + 1) as f64, &grid, &fields)?;
+        series.write_frame(*time, &grid, &fields)?;
     }
     Ok(())
 }
