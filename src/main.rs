@@ -60,6 +60,10 @@ enum Command {
         /// Exit 3 when the finished run has warnings (summary.json `warnings`).
         #[arg(long)]
         strict: bool,
+        /// A line per Newton iteration on stderr: the step's end time, the residual and its
+        /// share of the force tolerance, the displacement criterion, whether it refactors.
+        #[arg(long)]
+        verbose: bool,
     },
     /// Continue a run from DIR/checkpoint.bin (written with analysis.checkpoint_every, or when
     /// a run is interrupted by Ctrl-C / SIGTERM). The scene is the one stored in the checkpoint.
@@ -178,7 +182,9 @@ fn main() -> ExitCode {
             progress_every,
             checkpoint_every,
             strict,
+            verbose,
         } => {
+            impact::output::console::set_verbose(verbose);
             let mut set = set;
             if let Some(n) = checkpoint_every {
                 set.push(format!("analysis.checkpoint_every={n}"));

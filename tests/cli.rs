@@ -859,3 +859,58 @@ fn adaptive_step_keys_are_refused_where_they_do_not_apply() {
         assert_input_error(name, &dynamic, &extra, needles);
     }
 }
+
+/// Goal: `impact run --verbose` logs every Newton iteration on stderr (the residual, its
+/// share of the force scale against the tolerance, the displacement criterion), and nothing
+/// without it. Setup: models/hill_cylinder.toml (static, 20 load increments, no cut).
+/// Reference: Newton's structure: a step that converges after k solves evaluates its
+/// residual k + 1 times, so the log has summary.json `newton_iterations` + `steps` lines;
+/// the last line of each step is the converged one, its eps_force below the tolerance
+/// (1e-8).
+#[test]
+fn verbose_logs_each_newton_iteration() {
+    let dir = common::out_dir("verbose_hill");
+    let d = dir.to_str().unwrap();
+    let output = impact(&[
+        "run",
+        "models/hill_cylinder.toml",
+        "--quiet",
+        "--verbose",
+        "--out",
+        d,
+    ]);
+    assert_eq!(output.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("newton: step from"))
+        .collect();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["step_cuts"], 0);
+    let (iterations, steps) = (
+        summary["newton_iterations"].as_u64().unwrap(),
+        summary["steps"].as_u64().unwrap(),
+    );
+    assert_eq!(lines.len() as u64, iterations + steps, "{stderr}");
+    let eps = |line: &str| -> f64 {
+        let value = line
+            .split("eps_force = ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap();
+        value.parse().unwrap()
+    };
+    for (k, line) in lines.iter().enumerate() {
+        let last_of_step = lines
+            .get(k + 1)
+            .is_none_or(|next| next.contains("iteration 0:"));
+        if last_of_step {
+            assert!(eps(line) < 1e-8, "{line}");
+        }
+    }
+    let quiet = impact(&["run", "models/hill_cylinder.toml", "--quiet", "--out", d]);
+    assert!(!String::from_utf8_lossy(&quiet.stderr).contains("newton:"));
+}

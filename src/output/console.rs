@@ -9,6 +9,27 @@
 
 use std::fmt::Arguments;
 use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// `impact run --verbose`: the iterations' residuals on stderr (`iteration`).
+static VERBOSE: AtomicBool = AtomicBool::new(false);
+
+/// Turns the per-iteration lines on or off (the CLI's `--verbose`; off by default).
+pub fn set_verbose(on: bool) {
+    VERBOSE.store(on, Ordering::Relaxed);
+}
+
+/// Whether the per-iteration lines are on.
+pub fn verbose() -> bool {
+    VERBOSE.load(Ordering::Relaxed)
+}
+
+/// A line of the iteration log on stderr, when `--verbose` turned it on.
+pub fn iteration(line: Arguments) {
+    if verbose() {
+        err(line);
+    }
+}
 
 /// `line` and a newline on stdout; a closed or failing stdout is ignored.
 pub fn out(line: Arguments) {

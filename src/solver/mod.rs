@@ -614,6 +614,11 @@ impl Solver {
                 Default::default(),
             )
             .map_err(|LltFactorError::NonPositivePivot { index }| {
+                // faer's index is the permuted column's: the equation is its image
+                let index = index.min(cholesky.nrows() - 1);
+                let index = cholesky
+                    .perm()
+                    .map_or(index, |p| p.arrays().0[index] as usize);
                 SolverError::NotPositiveDefinite { index }
             })?;
         self.values = factor;

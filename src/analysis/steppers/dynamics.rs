@@ -31,7 +31,7 @@ use crate::output::readable;
 use crate::scene::DynamicAnalysis;
 use crate::scene::spec::{AdaptiveStep, ContactDynamics, IntegratorKind, Strategy};
 use crate::scene::{InputError, Model};
-use crate::solver::Solver;
+use crate::solver::{Solver, SolverError};
 use std::path::Path;
 
 /// The integrator a scene asks for (implicit ones); the Newmark family's beta and gamma are
@@ -235,7 +235,17 @@ impl<'a> Dynamics<'a> {
             }
             self.solver
                 .factor(&self.system.values)
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| match e {
+                    SolverError::NotPositiveDefinite { index }
+                    | SolverError::Singular { index } => {
+                        format!(
+                            "the mass matrix of the initial accelerations is not positive definite \
+                         at {}: a free DOF without mass",
+                            super::newton::free_dof(model, &self.system, index)
+                        )
+                    }
+                    other => other.to_string(),
+                })?;
             self.solver.solve(&mut free);
             self.system.scatter_add(&free, &mut a);
         }

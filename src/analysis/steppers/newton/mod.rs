@@ -481,6 +481,20 @@ impl Step<'_> {
                 return Err(StepFailure(non_finite(system, &balance, &d)));
             }
             let test = Convergence::of(residual_norm, forces_scale, &d, system.diagonal_max);
+            crate::output::console::iteration(format_args!(
+                "  newton: step from t = {}, iteration {iteration}: |R| = {:.3e}, eps_force = \
+                 {:.3e} (tol {:.1e}), eps_disp = {:.3e}{}",
+                crate::output::readable(state.time),
+                residual_norm,
+                test.eps_force,
+                newton.tol_force,
+                eps_displacement,
+                match (&self.contact, settled) {
+                    (None, _) => "",
+                    (Some(_), true) => ", contact settled",
+                    (Some(_), false) => ", contact statuses changed",
+                }
+            ));
             if iteration > 0 {
                 let ratio = residual_norm / previous_residual;
                 eps_displacement = remaining(eps_displacement, ratio);
@@ -518,6 +532,11 @@ impl Step<'_> {
             let stalled =
                 iteration > 0 && self.stalled(iteration, ratio, residual_norm, test.scale);
             if refactor || stalled || !solver.is_factored() {
+                if stalled {
+                    crate::output::console::iteration(format_args!(
+                        "  newton: the residual contracted by {ratio:.3e}: K* refactored"
+                    ));
+                }
                 if !refactor {
                     // the same state again, now with the tangent assembled
                     self.evaluate(state, &d, Some(&mut *system))?;
