@@ -2,10 +2,13 @@
 //! the nearest-segment grid of a balanced pair's whole surfaces `grid`),
 //! the status carried between steps (`status`), the event logic of an implicit step
 //! (`step`), Hughes' impact and release conditions (`conditions`) met at a step's events
-//! (`impacts`), the explicit forward-increment multipliers (`explicit`), the
-//! set-up checks of a pair (`setup`) and the tractions the frames show (`traction`).
-//! It works on plain arrays (positions, masses, DOF indices) and never sees the model or
-//! the assembled system: the implicit solver receives the rows of the active entries and
+//! (`impacts`), the explicit forward-increment multipliers (`explicit`, with the lumped
+//! multiplier solve both paths share, `multipliers`), the mortar (segment-to-segment)
+//! gaps (`mortar`) and their exact derivatives (`linearization`), the node and gap types
+//! (`gap`), how deep any body went into another or an obstacle and which slave went past
+//! an obstacle's end (`penetration`), the set-up checks of a pair (`setup`) and the
+//! tractions the frames show (`traction`). It works on plain arrays (positions, masses,
+//! DOF indices) and never sees the assembled system: the implicit solver receives the rows of the active entries and
 //! returns their multipliers (Hughes, Taylor & Sackman 1975, section II; Greco & Coda 2003).
 //!
 //! Legend

@@ -2,8 +2,9 @@
 //! and the nodal motion (velocity, acceleration, mass, internal force), and the energy
 //! balance they close (docs/theory.md section 7).
 
-/// Energies of one step (history.csv columns 2-6; `bulk_viscosity_work` when the scene has
-/// the bulk viscosity, `mass_scaling_loss` when it has the mass scaling).
+/// Energies of one step (history.csv columns 2-6; `bulk_viscosity_work`, `mass_scaling_loss`,
+/// `remap_loss` and `friction_work` when the scene has the bulk viscosity, the mass scaling,
+/// ALE steps or a friction pair).
 #[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     pub kinetic: f64,

@@ -1,14 +1,17 @@
 //! The explicit element loops: element data as structure of arrays, the element kernels run
 //! in parallel over fixed chunks, nodal forces gathered in element order (the bits do not
-//! depend on the thread count). Two kernels: the one-point Quad4 with hourglass control
-//! (`one_point`, `quadrature = "reduced"`) and the 2x2 Quad4 in the same rate form (`full`,
-//! `quadrature = "full"` on finite-strain Quad4 models); both give the element frequency
+//! depend on the thread count). Three kernels: the one-point Quad4 with hourglass control
+//! (`one_point`, `quadrature = "reduced"`), the 2x2 Quad4 in the same rate form (`full`,
+//! `quadrature = "full"` on finite-strain Quad4 models), and the general element loop
+//! behind the same interface for the rest (`general`: rods, small strain). The two Quad4
+//! kernels give the element frequency
 //! bound of the end configuration for the stable step, and both carry the optional bulk
 //! viscosity (`element::bulk_viscosity`), whose damping they fold into that bound, and the
 //! optional mass scaling (`element::mass_scaling`, `assembly::mass_scaling`), which raises
 //! the masses of the elements whose bound is below its target as they deform. With
 //! `analysis.stable_step = "tight"` each element's bound is made tight by its ratio to the
-//! element's exact frequency (`tight`).
+//! element's exact frequency (`tight`); `analysis.stable_step = "global"` estimates the
+//! mesh's highest frequency by Lanczos on the element stiffnesses (`global`).
 
 pub mod full;
 pub mod general;
