@@ -708,3 +708,39 @@ fn explicit_coulomb_block_sticks_below_mu_n_and_slides_above() {
         }
     }
 }
+
+/// Goal: an obstacle's corners may be rounded by a radius the scene sets, and a radius that
+/// cannot fit is refused naming the key and the corner. Setup: models/taylor_aluminum.toml
+/// with its wall bent at (0.01, 0) up to (0.02, 0.01) (a corner of 45 degrees).
+/// Reference (by hand): the segments beside the corner are 0.02 and 0.01414 long; a radius
+/// r fits while r tan(22.5 deg) = 0.4142 r <= 0.00707, i.e. r <= 0.01707: 0.01 is taken,
+/// 0.02 refused at point 1, and a radius <= 0 refused as such.
+#[test]
+fn obstacle_corners_are_rounded_where_the_arc_fits() {
+    let scene = "models/taylor_aluminum.toml";
+    let bent = "obstacle.wall.points=[[0.02, 0.01], [0.01, 0.0], [-0.01, 0.0]]";
+    let ok = common::impact(&[
+        "check",
+        scene,
+        "--set",
+        bent,
+        "--set",
+        "obstacle.wall.corner_radius=0.01",
+    ]);
+    assert_eq!(
+        ok.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    common::check_refuses_with(
+        scene,
+        &[bent, "obstacle.wall.corner_radius=0.02"],
+        &["corner_radius", "does not fit at point 1 (0.01, 0)"],
+    );
+    common::check_refuses_with(
+        scene,
+        &[bent, "obstacle.wall.corner_radius=-1.0"],
+        &["obstacle[0] (`wall`).corner_radius"],
+    );
+}

@@ -13,6 +13,8 @@ use crate::contact::{
 };
 use crate::element::Formulation;
 use crate::mesh::Cells;
+use crate::mesh::plane::round_corners;
+use crate::output::readable;
 
 /// The scene's contact pairs in order, their names unique.
 pub(super) fn contacts(
@@ -104,7 +106,7 @@ fn refuse_repeated_pairs(cx: &Context, pairs: &[ContactPair]) -> Result<(), Inpu
 }
 
 /// The `[[obstacle]]` polylines: unique names, at least 2 points (3 when closed), finite,
-/// no two consecutive points equal.
+/// no two consecutive points equal; with `corner_radius` each corner rounded by an arc.
 pub(super) fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, InputError> {
     let mut out: Vec<Obstacle> = Vec::new();
     for (k, o) in scene.obstacle.iter().enumerate() {
@@ -125,9 +127,25 @@ pub(super) fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, In
         if o.points.windows(2).any(|w| w[0] == w[1]) {
             return Err(cx.err(format!("{key}.points: two consecutive points coincide")));
         }
+        let points = match o.corner_radius {
+            None => o.points.clone(),
+            Some(r) => {
+                let radius = positive(cx, &format!("{key}.corner_radius"), r)?;
+                round_corners(&o.points, o.closed, radius).map_err(|k| {
+                    cx.err(format!(
+                        "{key}.corner_radius: an arc of radius {} does not fit at point {k} \
+                         ({}, {}): its tangent length r tan(turn / 2) is more than half a \
+                         segment beside it; a smaller corner_radius",
+                        readable(radius),
+                        readable(o.points[k][0]),
+                        readable(o.points[k][1])
+                    ))
+                })?
+            }
+        };
         out.push(Obstacle {
             name: o.name.clone(),
-            points: o.points.clone(),
+            points,
             closed: o.closed,
         });
     }

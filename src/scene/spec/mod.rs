@@ -266,6 +266,9 @@ pub struct ObstacleSpec {
     /// Default false.
     #[serde(default)]
     pub closed: bool,
+    /// Each corner rounded by an arc of this radius (a length) tangent to its two segments
+    /// (`mesh::plane::round_corners`); default none: sharp corners.
+    pub corner_radius: Option<f64>,
 }
 
 /// A surface of a body: a node set (slaves, node-to-node masters) or an edge set (masters).
