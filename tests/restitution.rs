@@ -88,11 +88,13 @@ fn restitution_falls_with_the_speed_above_thornton() {
 }
 
 /// Goal: the elastic limit: a sphere that does not yield rebounds with e -> 1, the energy it
-/// keeps in vibration its only loss. Setup: the scene at 1 m/s with a yield stress of 1e6 GPa
-/// (never reached). Reference: no plastic work; e^2 = 1 - (the vibration's energy) / KE_0,
-/// so 1 - e^2 equals the energy not in the rebound's rigid motion, (KE_end - e^2 KE_0 +
-/// IE_end) / KE_0, to the balance's 1e-3 (central difference); and e above 0.98 (an elastic
-/// steel sphere at V / c = 1.7e-4 keeps well under 4 % of its energy in vibration).
+/// does not take away in its rebound kept as vibration. Setup: the scene at 1 m/s with a
+/// yield stress of 1e6 GPa (never reached). Reference: no plastic work; e above 0.98 (an
+/// elastic steel sphere at V / c = 1.7e-4 keeps well under 4 % of its energy in vibration);
+/// the energy balance (final kinetic + internal = initial kinetic energy, the frictionless
+/// wall doing no work once released) within 1e-3, central difference's drift over the run.
+/// (A check of 1 - e^2 against the vibration's share, (KE_end - e^2 KE_0 + IE_end) / KE_0,
+/// reduces to that same balance, so it is not made twice.)
 #[test]
 fn elastic_sphere_rebounds_with_its_vibration_the_only_loss() {
     let (e, [kinetic, internal, plastic, kinetic0]) = rebound(
@@ -103,10 +105,6 @@ fn elastic_sphere_rebounds_with_its_vibration_the_only_loss() {
     );
     assert_eq!(plastic, 0.0);
     assert!(e > 0.98 && e <= 1.0 + 1e-9, "e = {e}");
-    let vibration = (kinetic - e * e * kinetic0 + internal) / kinetic0;
-    assert!(
-        (1.0 - e * e - vibration).abs() < 1e-3,
-        "1 - e^2 = {}, vibration {vibration}",
-        1.0 - e * e
-    );
+    let balance = (kinetic + internal) / kinetic0 - 1.0;
+    assert!(balance.abs() < 1e-3, "energy balance {balance}");
 }
