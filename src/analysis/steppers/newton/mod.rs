@@ -481,20 +481,7 @@ impl Step<'_> {
                 return Err(StepFailure(non_finite(system, &balance, &d)));
             }
             let test = Convergence::of(residual_norm, forces_scale, &d, system.diagonal_max);
-            crate::output::console::iteration(format_args!(
-                "  newton: step from t = {}, iteration {iteration}: |R| = {:.3e}, eps_force = \
-                 {:.3e} (tol {:.1e}), eps_disp = {:.3e}{}",
-                crate::output::readable(state.time),
-                residual_norm,
-                test.eps_force,
-                newton.tol_force,
-                eps_displacement,
-                match (&self.contact, settled) {
-                    (None, _) => "",
-                    (Some(_), true) => ", contact settled",
-                    (Some(_), false) => ", contact statuses changed",
-                }
-            ));
+            self.log_iteration(state.time, iteration, &test, eps_displacement, settled);
             if iteration > 0 {
                 let ratio = residual_norm / previous_residual;
                 eps_displacement = remaining(eps_displacement, ratio);
@@ -532,11 +519,6 @@ impl Step<'_> {
             let stalled =
                 iteration > 0 && self.stalled(iteration, ratio, residual_norm, test.scale);
             if refactor || stalled || !solver.is_factored() {
-                if stalled {
-                    crate::output::console::iteration(format_args!(
-                        "  newton: the residual contracted by {ratio:.3e}: K* refactored"
-                    ));
-                }
                 if !refactor {
                     // the same state again, now with the tangent assembled
                     self.evaluate(state, &d, Some(&mut *system))?;
@@ -674,14 +656,46 @@ impl Step<'_> {
     /// Whether the iteration should refactor: the residual stops contracting (`ratio` of the
     /// last two), or contracts too slowly to reach the tolerance within the iterations left
     /// (predicted from that ratio). Refactoring cannot help where the factorized matrix would
-    /// not change: an elastic tangent on linear kinematics.
+    /// not change: an elastic tangent on linear kinematics. Said in the `--verbose` log.
     fn stalled(&self, iteration: usize, ratio: f64, residual_norm: f64, scale: f64) -> bool {
         let newton = self.newton;
         let needed = (newton.tol_force * scale / residual_norm).ln() / ratio.ln();
         let left = (newton.max_iterations - iteration) as f64;
         let refactor_helps =
             newton.tangent == Tangent::Consistent || self.geometry == Strain::Finite;
-        refactor_helps && (ratio > newton.contraction || needed > 0.5 * left)
+        let stalled = refactor_helps && (ratio > newton.contraction || needed > 0.5 * left);
+        if stalled {
+            crate::output::console::iteration(format_args!(
+                "  newton: the residual contracted by {ratio:.3e}: K* refactored"
+            ));
+        }
+        stalled
+    }
+
+    /// The `--verbose` line of an iteration (`console::iteration`): the residual, eps_force
+    /// against its tolerance, eps_disp, and with contact whether its statuses settled.
+    fn log_iteration(
+        &self,
+        time: f64,
+        iteration: usize,
+        test: &Convergence,
+        eps_disp: f64,
+        settled: bool,
+    ) {
+        crate::output::console::iteration(format_args!(
+            "  newton: step from t = {}, iteration {iteration}: |R| = {:.3e}, eps_force = \
+             {:.3e} (tol {:.1e}), eps_disp = {:.3e}{}",
+            crate::output::readable(time),
+            test.residual_norm,
+            test.eps_force,
+            self.newton.tol_force,
+            eps_disp,
+            match (&self.contact, settled) {
+                (None, _) => "",
+                (Some(_), true) => ", contact settled",
+                (Some(_), false) => ", contact statuses changed",
+            }
+        ));
     }
 
     /// R on the free DOFs and the force scale of eps_2.
