@@ -145,13 +145,7 @@ pub fn past_an_end(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> O
         let last = segments.len() - 1;
         for &node in &pair.slaves {
             let p = x(node);
-            let Some((k, xi)) = segments
-                .iter()
-                .enumerate()
-                .map(|(k, [a, b])| (k, project(p, *a, *b)))
-                .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
-                .map(|(k, (xi, _))| (k, xi))
-            else {
+            let Some((k, xi, _)) = nearest_segment(p, &segments) else {
                 continue;
             };
             let [a, b] = segments[k];
@@ -179,6 +173,16 @@ pub fn past_an_end(interfaces: &Interfaces, x: &impl Fn(usize) -> [f64; 2]) -> O
     None
 }
 
+/// The segment of `segments` nearest to `p`: (index, projection parameter, distance).
+fn nearest_segment(p: [f64; 2], segments: &[[[f64; 2]; 2]]) -> Option<(usize, f64, f64)> {
+    (segments.iter().enumerate())
+        .map(|(k, [a, b])| {
+            let (xi, d) = project(p, *a, *b);
+            (k, xi, d)
+        })
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+}
+
 /// The deepest of `nodes` inside the solid of `obstacle` (depth, node).
 fn deepest_in_obstacle(
     nodes: impl Iterator<Item = usize>,
@@ -191,14 +195,7 @@ fn deepest_in_obstacle(
     let mut best: Option<(f64, usize)> = None;
     for node in nodes {
         let p = x(node);
-        let (k, xi, distance) = segments
-            .iter()
-            .enumerate()
-            .map(|(k, [a, b])| {
-                let (xi, d) = project(p, *a, *b);
-                (k, xi, d)
-            })
-            .min_by(|a, b| a.2.total_cmp(&b.2))?;
+        let (k, xi, distance) = nearest_segment(p, &segments)?;
         let inside = if obstacle.closed {
             inside_by_crossings(p, segments.iter().copied()) != cavity
         } else {

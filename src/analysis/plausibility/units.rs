@@ -243,6 +243,7 @@ fn hardening_problem(m: &Material) -> Option<String> {
 /// Armco iron 1811, 4340 steel 1793).
 const MELTING_POINTS_K: [(f64, f64); 10] = [
     (600.0, 600.0),
+    (870.0, 923.0),
     (775.0, 933.0),
     (1150.0, 1300.0),
     (1356.0, 1356.0),
@@ -251,7 +252,6 @@ const MELTING_POINTS_K: [(f64, f64); 10] = [
     (1870.0, 1941.0),
     (3290.0, 3290.0),
     (3695.0, 3695.0),
-    (870.0, 923.0),
 ];
 
 /// A Johnson-Cook room temperature below this reads as degrees Celsius (`qoi::Units`: no
@@ -329,11 +329,7 @@ fn heating_problem(m: &Material) -> Option<String> {
 /// or motion).
 fn start_speed(model: &Model, body: &Body) -> Option<(f64, f64)> {
     let c = wave_speed(body)?.speed;
-    let v = &model.initial_velocity;
-    let speed = (0..body.mesh.nodes.len())
-        .map(|n| body.global(n))
-        .map(|n| v[2 * n].hypot(v[2 * n + 1]))
-        .fold(0.0, f64::max);
+    let (_, speed) = fastest_node(body, &model.initial_velocity)?;
     (speed > 0.0).then_some((speed, c))
 }
 

@@ -107,11 +107,7 @@ impl InertiaCheck {
         // lambda_2)^30, 1e-9 for a ratio of 1/2 (a column's first two modes: 1/4)
         let free = self.counter.nearly_null(30)?;
         let mut shape = vec![0.0; dofs];
-        for (dof, equation) in self.system.equation.iter().enumerate() {
-            if let Some(eq) = equation {
-                shape[dof] = free[*eq];
-            }
-        }
+        self.system.scatter_add(&free, &mut shape);
         let largest = (shape.chunks_exact(2))
             .map(|c| c[0].hypot(c[1]))
             .fold(0.0, f64::max);
