@@ -2,9 +2,9 @@
 //! in parallel over fixed chunks, nodal forces gathered in element order (the bits do not
 //! depend on the thread count). Three kernels: the one-point Quad4 with hourglass control
 //! (`one_point`, `quadrature = "reduced"`), the 2x2 Quad4 in the same rate form (`full`,
-//! `quadrature = "full"` on finite-strain Quad4 models), and the general element loop
-//! behind the same interface for the rest (`general`: rods, small strain). The two Quad4
-//! kernels give the element frequency
+//! `quadrature = "full"` on finite-strain Quad4 models), both rules of the one Quad4 loop
+//! (`skeleton`), and the general element loop behind the same interface for the rest
+//! (`general`: rods, small strain). The two Quad4 kernels give the element frequency
 //! bound of the end configuration for the stable step, and both carry the optional bulk
 //! viscosity (`element::bulk_viscosity`), whose damping they fold into that bound, and the
 //! optional mass scaling (`element::mass_scaling`, `assembly::mass_scaling`), which raises
@@ -17,11 +17,12 @@ pub mod full;
 pub mod general;
 pub mod global;
 pub mod one_point;
+mod skeleton;
 pub mod tight;
 
-pub use full::Full;
+use full::Full;
 pub use general::General;
-pub use one_point::Reduced;
+use one_point::Reduced;
 
 use super::mass_scaling::ElementScaling;
 use super::{BodyWork, ElementFailure, ElementMasses, StableStep, State};
@@ -646,13 +647,13 @@ pub fn kernel_for<'a>(
     let quads_only = model.bodies.iter().all(|b| !b.kind.is_rod());
     match spec.quadrature {
         Quadrature::Reduced => Box::new(
-            Reduced::new(model, state, spec.hourglass, masses)
+            Reduced::new(model, state, masses, spec.hourglass)
                 .with_tight_step(spec.tight_step(), spec.global_step())
                 .with_bulk_viscosity(spec.bulk_viscosity)
                 .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
         ),
         Quadrature::Full if quads_only && spec.geometry == Strain::Finite => Box::new(
-            Full::new(model, state, masses)
+            Full::new(model, state, masses, 0.0)
                 .with_tight_step(spec.tight_step(), spec.global_step())
                 .with_bulk_viscosity(spec.bulk_viscosity)
                 .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
