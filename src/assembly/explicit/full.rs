@@ -29,6 +29,8 @@
 use super::BodyParameters;
 use super::point_step;
 use super::skeleton::{Columns, ElementStep, Rule, Skeleton};
+use crate::assembly::{ElementMasses, State};
+use crate::scene::Model;
 use crate::element::bulk_viscosity::{
     BulkViscosity, ElementScale, damped_frequency_squared, damping_factor, loaded_stress,
     volumetric_increment,
@@ -41,7 +43,7 @@ use std::ops::Deref;
 
 /// The committed state of the four points of one element.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct PointsState {
+pub struct PointsState {
     stress: [[f64; 4]; 4],
     back_stress: [[f64; 4]; 4],
     eq_plastic_strain: [f64; 4],
@@ -53,10 +55,17 @@ pub(super) struct PointsState {
 }
 
 /// The 2x2 rule of the explicit loop (`Skeleton`): four Gauss points, B-bar by option.
-pub(super) struct TwoByTwo;
+pub struct TwoByTwo;
 
 /// The 2x2 explicit kernel over a model's Quad4 bodies.
-pub(super) type Full = Skeleton<TwoByTwo>;
+pub type Full = Skeleton<TwoByTwo>;
+
+impl Full {
+    /// The 2x2 kernel for the Quad4 bodies of `model` from the committed `state`.
+    pub fn new(model: &Model, state: &State, masses: &ElementMasses) -> Full {
+        Skeleton::build(model, state, masses, 0.0)
+    }
+}
 
 /// The increment gradient, strain and spin at one point.
 fn point_increment(p: &quad4::PointValues, u: &Nodes, axisymmetric: bool) -> ([f64; 4], f64) {

@@ -17,12 +17,12 @@ pub mod full;
 pub mod general;
 pub mod global;
 pub mod one_point;
-mod skeleton;
+pub mod skeleton;
 pub mod tight;
 
-use full::Full;
+pub use full::Full;
 pub use general::General;
-use one_point::Reduced;
+pub use one_point::Reduced;
 
 use super::mass_scaling::ElementScaling;
 use super::{BodyWork, ElementFailure, ElementMasses, StableStep, State};
@@ -130,7 +130,7 @@ impl StepWork {
 
 /// What the kernels need of a Quad4 body.
 #[derive(Debug, Clone)]
-pub(super) struct BodyParameters {
+pub struct BodyParameters {
     pub name: String,
     pub material: Material,
     pub formulation: Formulation,
@@ -150,10 +150,10 @@ pub(super) struct BodyParameters {
 }
 
 impl BodyParameters {
-    pub(super) fn plane_stress(&self) -> bool {
+    pub fn plane_stress(&self) -> bool {
         self.formulation == Formulation::PlaneStress
     }
-    pub(super) fn axisymmetric(&self) -> bool {
+    pub fn axisymmetric(&self) -> bool {
         self.formulation == Formulation::Axisymmetric
     }
 }
@@ -647,13 +647,13 @@ pub fn kernel_for<'a>(
     let quads_only = model.bodies.iter().all(|b| !b.kind.is_rod());
     match spec.quadrature {
         Quadrature::Reduced => Box::new(
-            Reduced::new(model, state, masses, spec.hourglass)
+            Reduced::new(model, state, spec.hourglass, masses)
                 .with_tight_step(spec.tight_step(), spec.global_step())
                 .with_bulk_viscosity(spec.bulk_viscosity)
                 .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
         ),
         Quadrature::Full if quads_only && spec.geometry == Strain::Finite => Box::new(
-            Full::new(model, state, masses, 0.0)
+            Full::new(model, state, masses)
                 .with_tight_step(spec.tight_step(), spec.global_step())
                 .with_bulk_viscosity(spec.bulk_viscosity)
                 .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),

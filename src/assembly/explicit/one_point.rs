@@ -16,6 +16,8 @@
 //! ```
 
 use super::skeleton::{Columns, ElementStep, Rule, Skeleton};
+use crate::assembly::{ElementMasses, State};
+use crate::scene::Model;
 use super::{BodyParameters, point_step};
 use crate::element::bulk_viscosity::{
     BulkViscosity, ElementScale, damped_frequency_squared, damping_factor, loaded_stress,
@@ -28,7 +30,7 @@ use std::ops::Deref;
 
 /// The committed state of one element as the kernel reads it.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct ElementState {
+pub struct ElementState {
     /// Cauchy stress [xx yy zz xy].
     pub stress: [f64; 4],
     pub back_stress: [f64; 4],
@@ -46,7 +48,7 @@ pub(super) struct ElementState {
 /// What the one-point kernel knows of an element's mass: the smallest of its lumped nodal
 /// masses (the stable-step bound) and their sum (its density, for the bulk viscosity).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct ElementMass {
+pub struct ElementMass {
     smallest: f64,
     total: f64,
 }
@@ -183,10 +185,18 @@ fn section(p: &BodyParameters, thickness: f64) -> Section {
 
 /// The one-point rule of the explicit loop (`Skeleton`): the centroid's strain and stress,
 /// hourglass forces for the modes the point does not see.
-pub(super) struct OnePoint;
+pub struct OnePoint;
 
 /// The one-point explicit kernel over a model's Quad4 bodies.
-pub(super) type Reduced = Skeleton<OnePoint>;
+pub type Reduced = Skeleton<OnePoint>;
+
+impl Reduced {
+    /// The one-point kernel for the Quad4 bodies of `model` (the scene refuses rods with
+    /// it), starting from the committed `state`; `kappa` is the hourglass coefficient.
+    pub fn new(model: &Model, state: &State, kappa: f64, masses: &ElementMasses) -> Reduced {
+        Skeleton::build(model, state, masses, kappa)
+    }
+}
 
 impl Rule for OnePoint {
     const POINTS: usize = 1;

@@ -41,7 +41,7 @@ use std::ops::Deref;
 
 /// The element state columns of a kernel (see the legend for their widths): owned
 /// (`Vec<f64>`), read (`&[f64]`) or one chunk's to write (`&mut [f64]`).
-pub(super) struct Columns<S> {
+pub struct Columns<S> {
     pub stress: S,
     pub back: S,
     pub eps_p: S,
@@ -53,7 +53,7 @@ pub(super) struct Columns<S> {
 }
 
 /// One element after a step of a rule.
-pub(super) struct ElementStep<S> {
+pub struct ElementStep<S> {
     pub state: S,
     /// Internal force [f1x f1y ... f4x f4y] on the end configuration.
     pub force: [f64; 8],
@@ -73,7 +73,7 @@ pub(super) struct ElementStep<S> {
 }
 
 /// What a Quad4 kernel supplies to the loop: its quadrature and stabilization.
-pub(super) trait Rule {
+pub trait Rule {
     /// The points the kernel keeps per element.
     const POINTS: usize;
     /// The hourglass values it keeps per element (0: none).
@@ -122,7 +122,7 @@ pub(super) trait Rule {
 
 /// An explicit Quad4 kernel: the loop over the elements of a model's Quad4 bodies with the
 /// rule `R`.
-pub(super) struct Skeleton<R: Rule> {
+pub struct Skeleton<R: Rule> {
     layout: Layout,
     /// The lumped masses of each element's nodes (unscaled), and the rule's mass of them.
     lumped: Vec<[f64; 4]>,
@@ -170,7 +170,7 @@ struct Chunk<'a> {
 impl<R: Rule> Skeleton<R> {
     /// The kernel for the Quad4 bodies of `model` (the scene refuses rods with it), starting
     /// from the committed `state`; `kappa` is the hourglass coefficient (one-point rule).
-    pub(super) fn new(
+    pub(super) fn build(
         model: &Model,
         state: &State,
         masses: &ElementMasses,
@@ -225,7 +225,7 @@ impl<R: Rule> Skeleton<R> {
     /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
     /// the exact frequency, `tight`; with `global` the mesh's estimate over them, `global`)
     /// or its elements' bounds (the default).
-    pub(super) fn with_tight_step(self, on: bool, global: bool) -> Skeleton<R> {
+    pub fn with_tight_step(self, on: bool, global: bool) -> Skeleton<R> {
         let tightness = on.then(|| Tightness::new(self.bounds.len(), global));
         Skeleton { tightness, ..self }
     }
@@ -233,7 +233,7 @@ impl<R: Rule> Skeleton<R> {
     /// The kernel with the bulk viscosity `viscosity` (None: off). Its damping folds into the
     /// bounds; the tight ratios are taken against the undamped ones (`damping`, at rest
     /// until the first step).
-    pub(super) fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Skeleton<R> {
+    pub fn with_bulk_viscosity(self, viscosity: Option<BulkViscosity>) -> Skeleton<R> {
         let at_rest = viscosity.map_or(1.0, |v| damping_factor(v.damping_fraction_at_rest()));
         let damping = vec![at_rest; self.bounds.len()];
         Skeleton {
@@ -245,7 +245,7 @@ impl<R: Rule> Skeleton<R> {
 
     /// The kernel with the mass scaling `rule` (None: off), the elements below its target
     /// on the positions `x` scaled (`masses`: the lumped masses the kernel was made with).
-    pub(super) fn with_mass_scaling(
+    pub fn with_mass_scaling(
         mut self,
         rule: Option<MassScaling>,
         model: &Model,
