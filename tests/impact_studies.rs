@@ -179,12 +179,19 @@ fn half_model_matches_the_full_one_and_the_rigid_wall_does_not() {
     assert!((stress / pf[2] - 1.0).abs() > 0.1);
 }
 
-/// Mesh study (not run by default: about 90 s): peak contact force and largest equivalent
-/// plastic strain of the elastoplastic round-end bar on the scene's mesh, 2x and 4x refined.
+/// The mesh study of docs/validation.md 6.4 (not run by default: about 90 s): peak contact
+/// force and largest equivalent plastic strain of the elastoplastic round-end bar on the
+/// scene's mesh, 2x and 4x refined.
 /// `cargo test --release --test impact_studies -- --ignored --nocapture`
+/// References (convergence rates): the peak force's change from 2x to 4x at most a quarter of
+/// its change from 1x to 2x (second order or better; measured 3.8 then 0.23, ratio 17), and
+/// the block's largest plastic strain changing less from 2x to 4x than from 1x to 2x
+/// (measured 0.020, -0.002). The bar's largest plastic strain sits at the tip, a point load on
+/// a perfectly plastic material, and does not converge: not asserted.
 #[test]
 #[ignore]
 fn round_bar_mesh_study() {
+    let mut levels = Vec::new();
     for r in [1usize, 2, 4] {
         let (nx, ny, bx, by) = (
             format!("body.bar.mesh.nx={}", 8 * r),
@@ -204,12 +211,22 @@ fn round_bar_mesh_study() {
                 .copied()
                 .fold(f64::NEG_INFINITY, f64::max)
         };
+        let block = max("max_eq_plastic_strain[block.all]");
         println!(
-            "refinement {r}: peak force {:.4}, max eq. plastic strain bar {:.4} block {:.4}, {:.1} s",
+            "refinement {r}: peak force {:.4}, max eq. plastic strain bar {:.4} block {block:.4}, {:.1} s",
             run.summary.contact.peak_force,
             max("max_eq_plastic_strain[bar.all]"),
-            max("max_eq_plastic_strain[block.all]"),
             run.summary.wall_seconds
         );
+        levels.push([run.summary.contact.peak_force, block]);
     }
+    let change = |k: usize, level: usize| levels[level + 1][k] - levels[level][k];
+    assert!(
+        change(0, 1).abs() <= 0.25 * change(0, 0).abs(),
+        "peak force {levels:?}"
+    );
+    assert!(
+        change(1, 1).abs() < change(1, 0).abs(),
+        "block's plastic strain {levels:?}"
+    );
 }

@@ -632,7 +632,11 @@ impl Step<'_> {
         })
     }
 
-    /// Factors K* from the tangent assembled in `system` (indefinite accepted, theory 5a).
+    /// Factors K* from the tangent assembled in `system`: in statics an indefinite tangent is
+    /// accepted (past a limit point, theory 5a); in dynamics K* = K + M / (beta h^2) is
+    /// positive definite at any step short enough, so an indefinite one fails the step and
+    /// the step is cut (accepting it let a crushed element invert on the round bar's mesh
+    /// refined 4 times, where the cuts find the step that holds).
     fn factor(
         &self,
         system: &mut System,
@@ -643,7 +647,10 @@ impl Step<'_> {
         // any residual look small next to a rigid motion)
         system.diagonal_max = system.diagonal().fold(0.0, f64::max);
         self.effective(system, damping);
-        let result = solver.factor_indefinite(&system.values);
+        let result = match self.inertia {
+            Some(_) => solver.factor(&system.values),
+            None => solver.factor_indefinite(&system.values),
+        };
         result.map_err(|e| match e {
             SolverError::Singular { index } => StepFailure(format!(
                 "the stiffness matrix is singular at {}: a mechanism or missing supports",
