@@ -6,25 +6,6 @@ mod common;
 
 use common::{column, mean};
 
-/// Goal: the micro-benchmark of the reduced kernel (run by hand, no timing assertion):
-/// `cargo test --release -j 1 --test explicit_fast -- --ignored --nocapture`.
-/// Setup: impact::analysis::steppers::explicit::kernel_benchmark_run on a 316 x 316 plane-strain J2
-/// block, 200 steps, 1 and 2 threads.
-#[test]
-#[ignore]
-fn kernel_benchmark_element_updates_per_second() {
-    for threads in [1, 2] {
-        let run =
-            impact::analysis::steppers::explicit::kernel_benchmark_run(316 * 316, 200, threads)
-                .unwrap();
-        println!(
-            "threads {threads}: {:.3e} element-updates/s ({:.1} % of the elements plastic)",
-            run.element_updates_per_second,
-            100.0 * run.plastic_fraction
-        );
-    }
-}
-
 /// The scene models/strip_wall.toml with `analysis.quadrature` set.
 fn strip(quadrature: &str) -> String {
     std::fs::read_to_string("models/strip_wall.toml")

@@ -1034,47 +1034,60 @@ fn rod_pair_with_friction_keeps_its_energy_balance() {
 }
 
 /// Goal: Coulomb friction between two deformable bodies on the implicit path, the statuses
-/// decided inside Newton's iteration: the rod pair with mu = 0.2 on Newmark completes with no
-/// step cut and lands on the explicit pair with the same friction (before: the active set did
-/// not settle and the run diverged at 2.75 us).
-/// Setup: models/rod_on_rod.toml (every contact key at its default but `friction = 0.2`) on
-/// Newmark average, dt = 1e-7, and on central difference (2x2).
-/// Reference: the explicit pair, within the 1 % in L_f and D_f (measured: L_f -0.20 %,
-/// D_f +0.57 % for both rods; by symmetry the faces do not slip, so friction changes nothing
-/// against the frictionless pair: 26.422 / 11.313 mm on Newmark either way), the two rods
-/// within 0.1 % of each other (measured identical to 1e-6 mm).
+/// decided inside Newton's iteration: a rod striking a wider rod (an anvil) with mu = 0.2 on
+/// Newmark completes with no step cut and lands on the explicit pair with the same friction
+/// (before the statuses were decided in the iteration, the active set did not settle and the
+/// rod pair diverged at 2.75 us).
+/// Setup: models/rod_on_rod.toml with the lower rod twice as wide (6.4 mm, 10 elements across)
+/// and both rods at 150 m/s, every contact key at its default but `friction = 0.2`; Newmark
+/// average at dt = 1e-7 and central difference (2x2). The upper rod's foot spreads over the
+/// anvil's face, so its face slides and friction holds it back (the equal rods of the shipped
+/// scene do not slip, by symmetry, and friction changed nothing there).
+/// Reference: the explicit pair with friction, within 1 % in the upper rod's final length and
+/// foot diameter (measured: L -0.21 %, D +0.24 %); and friction's own effect, the foot of
+/// the frictionless explicit pair wider by far more than that (measured 10.26 against 8.74 mm,
+/// 17 %: the test asks for 10 %, ten times the paths' agreement), so the test fails where the
+/// implicit path drops the friction.
 #[test]
 fn rod_pair_with_friction_on_newmark_matches_the_explicit_pair() {
+    let anvil = [
+        "body.lower.mesh.width=6.4e-3",
+        "body.lower.mesh.nx=10",
+        "body.upper.velocity=[0.0, -150.0]",
+        "body.lower.velocity=[0.0, 150.0]",
+    ];
     let friction = "contact.faces.friction=0.2";
     let shape = |name: &str, overrides: &[&str]| {
-        let run = common::run_scene(name, "rod_on_rod", overrides);
+        let overrides: Vec<&str> = anvil.iter().chain(overrides).copied().collect();
+        let run = common::run_scene(name, "rod_on_rod", &overrides);
         assert_eq!(run.summary.status, impact::analysis::Status::Ok, "{name}");
         assert_eq!(run.summary.step_cuts, 0, "{name}");
         let last = |c: &str| *common::column(&run.dir, c).last().unwrap();
-        [
-            last("extent_y[upper.all]"),
-            last("extent_x[upper.all]"),
-            last("extent_y[lower.all]"),
-            last("extent_x[lower.all]"),
-        ]
+        [last("extent_y[upper.all]"), last("extent_x[upper.all]")]
     };
-    let explicit = shape("pair_friction_explicit", &[friction]);
+    let frictionless = shape("anvil_explicit", &[]);
+    let explicit = shape("anvil_friction_explicit", &[friction]);
     let newmark = shape(
-        "pair_friction_newmark",
+        "anvil_friction_newmark",
         &[
             "analysis.integrator=average",
             "analysis.dt=1.0e-7",
             friction,
         ],
     );
-    for k in 0..4 {
+    for k in 0..2 {
         assert!(
             (newmark[k] / explicit[k] - 1.0).abs() < 0.01,
             "{k}: {newmark:?} against {explicit:?}"
         );
     }
-    assert!((newmark[0] / newmark[2] - 1.0).abs() < 1e-3, "{newmark:?}");
-    assert!((newmark[1] / newmark[3] - 1.0).abs() < 1e-3, "{newmark:?}");
+    for foot in [explicit[1], newmark[1]] {
+        assert!(
+            foot < 0.9 * frictionless[1],
+            "friction's foot {foot} against the frictionless {}",
+            frictionless[1]
+        );
+    }
 }
 
 /// A J2 steel block (10 x 5 mm, 20 x 10) striking a plate held at every node (aluminium,
