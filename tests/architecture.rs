@@ -1,6 +1,6 @@
 //! The module order stated in src/lib.rs, checked on the source: a `crate::` path to a module
 //! of the same or a higher layer fails, and so does an import cycle of any length among the
-//! children of a module (folder modules and their mod.rs included); files stay within 800
+//! children of a module (folder modules and their mod.rs included); files stay within 700
 //! code lines and functions within 120 lines.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -528,13 +528,13 @@ fn function_lengths(code: &str) -> Vec<(String, usize, usize)> {
     out
 }
 
-/// Goal: a reader holds a file of 800 lines and a function of 120 (docs: DESIGN.md, layout):
+/// Goal: a reader holds a file of 700 lines and a function of 120 (docs: DESIGN.md, layout):
 /// longer ones are split by phase or concept. Setup: every file under src/, its code outside
 /// `#[cfg(test)]` items without comments and blank lines; every function there from its `fn` line
 /// to its closing brace. Reference: the two limits.
 #[test]
 fn files_and_functions_stay_within_what_a_reader_holds() {
-    const FILE_LINES: usize = 800;
+    const FILE_LINES: usize = 700;
     const FUNCTION_LINES: usize = 120;
     let mut files = Vec::new();
     sources(Path::new("src"), &mut files);

@@ -183,7 +183,10 @@ fn mesh_study_pinned_column() {
     );
     let errors: Vec<f64> = finest.iter().map(|p| p / p_s - 1.0).collect();
     for pair in errors.windows(2) {
-        assert!(pair[0] / pair[1] > 3.0, "errors against Engesser {errors:?}");
+        assert!(
+            pair[0] / pair[1] > 3.0,
+            "errors against Engesser {errors:?}"
+        );
     }
     assert!(errors[3].abs() < 0.005, "8 through the depth: {errors:?}");
 }

@@ -457,4 +457,3 @@ fn taylor_jc_wall_friction_narrows_the_foot_on_both_paths() {
         );
     }
 }
-

@@ -410,20 +410,10 @@ impl Kernel {
                 strain_zz: None,
             },
         )?;
-        let scale: Vec<f64> = (0..n).map(|i| 1.0 / lumped[i / 2].sqrt()).collect();
-        let scaled = |i: usize, j: usize| k[i * n + j] * scale[i] * scale[j];
-        // (A + A^T) / 2; a quad's on the stack (the dynamic matrix's heap and loops made the
-        // set-up of a 5e5-element mesh twice as long)
-        let symmetric = |i: usize, j: usize| (scaled(i, j) + scaled(j, i)) * 0.5;
-        Ok(if n == 8 {
-            nalgebra::SMatrix::<f64, 8, 8>::from_fn(symmetric)
-                .symmetric_eigenvalues()
-                .max()
-        } else {
-            nalgebra::DMatrix::from_fn(n, n, symmetric)
-                .symmetric_eigenvalues()
-                .max()
-        })
+        Ok(crate::element::highest_frequency_squared(
+            |i, j| k[i * n + j],
+            &lumped,
+        ))
     }
 }
 

@@ -23,6 +23,7 @@ pub mod checkpoint;
 pub mod columns;
 pub mod contact_record;
 mod frame;
+mod probes;
 pub mod progress;
 pub mod record;
 

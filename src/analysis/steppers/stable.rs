@@ -15,6 +15,16 @@
 //!            kernel that steps the run (<= dt_crit): the run's automatic step is
 //!            time_step_scale dt_bound, re-evaluated every step (clock.rs)
 //! ```
+//!
+//! From the scene key to the step (`analysis.stable_step`, default `bound`):
+//! `scene::spec::StableStepKind` -> `DynamicAnalysis::tight_step` / `global_step` ->
+//! `assembly::explicit::kernel_for` -> `Skeleton::with_tight_step` (the one Quad4 loop,
+//! `assembly/explicit/skeleton.rs`: each element's bound from its rule, damped by the bulk
+//! viscosity; made tight by `tight::Tightness`, the mesh's estimate `global::Global`; every
+//! exact element frequency from `element::highest_frequency_squared`) -> the kernel's
+//! `stable_step` (the start) and `step` (each step's largest omega^2) -> [`explicit_clock`] ->
+//! `Clock` (clock.rs): dt = time_step_scale 2 / omega_max. dt_crit (`critical_time_step`) is
+//! the element eigenvalues of the assembly's own kernels, through the same routine.
 
 use super::clock::Clock;
 use crate::assembly::explicit::ExplicitKernel;

@@ -30,7 +30,6 @@ use super::BodyParameters;
 use super::point_step;
 use super::skeleton::{Columns, ElementStep, Rule, Skeleton};
 use crate::assembly::{ElementMasses, State};
-use crate::scene::Model;
 use crate::element::bulk_viscosity::{
     BulkViscosity, ElementScale, damped_frequency_squared, damping_factor, loaded_stress,
     volumetric_increment,
@@ -39,6 +38,7 @@ use crate::element::quad4::{self, QuadValues};
 use crate::element::quad4_one_point::{Nodes, rotate};
 use crate::element::{Formulation, KernelError, Voigt};
 use crate::material::{PointState, dissipation};
+use crate::scene::Model;
 use std::ops::Deref;
 
 /// The committed state of the four points of one element.

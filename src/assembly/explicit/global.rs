@@ -50,11 +50,7 @@ impl ElementStiffness {
 /// The largest eigenvalue of M^-1 K for an 8 x 8 element stiffness `k` (symmetrized) and the
 /// lumped nodal masses `lumped` (each for both directions of its node).
 pub fn max_frequency_squared(k: &[[f64; 8]; 8], lumped: &[f64; 4]) -> f64 {
-    let scale: [f64; 8] = std::array::from_fn(|i| 1.0 / lumped[i / 2].sqrt());
-    let a = nalgebra::SMatrix::<f64, 8, 8>::from_fn(|i, j| {
-        0.5 * (k[i][j] + k[j][i]) * scale[i] * scale[j]
-    });
-    a.symmetric_eigenvalues().max()
+    crate::element::highest_frequency_squared(|i, j| k[i][j], lumped)
 }
 
 /// The global estimate's state: the element stiffnesses and what the last estimate found.

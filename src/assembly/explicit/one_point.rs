@@ -16,9 +16,8 @@
 //! ```
 
 use super::skeleton::{Columns, ElementStep, Rule, Skeleton};
-use crate::assembly::{ElementMasses, State};
-use crate::scene::Model;
 use super::{BodyParameters, point_step};
+use crate::assembly::{ElementMasses, State};
 use crate::element::bulk_viscosity::{
     BulkViscosity, ElementScale, damped_frequency_squared, damping_factor, loaded_stress,
     volumetric_increment,
@@ -26,6 +25,7 @@ use crate::element::bulk_viscosity::{
 use crate::element::quad4_one_point::{self as one_point, BoundShape, Nodes, Section, rotate};
 use crate::element::{KernelError, Voigt};
 use crate::material::{PointState, dissipation};
+use crate::scene::Model;
 use std::ops::Deref;
 
 /// The committed state of one element as the kernel reads it.
