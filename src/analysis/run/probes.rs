@@ -221,3 +221,31 @@ fn mass_mean(members: &[usize], mass: &[f64], value: impl Fn(usize) -> f64, c: u
     });
     weighted / total
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_span_of_a_long_run_of_nodes_is_its_ends() {
+        // more nodes than two parts, on three threads, against the ends of the sorted
+        // positions, in each component, over the run of nodes 5..n
+        let n = 2 * RUN_PART + 400;
+        let initial: Vec<[f64; 2]> = (0..n)
+            .map(|k| [(k % 97) as f64, -((k % 89) as f64)])
+            .collect();
+        let displacement: Vec<f64> = (0..2 * n).map(|i| ((i * 31) % 53) as f64 * 0.01).collect();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        for c in 0..2 {
+            let mut x: Vec<f64> = (5..n)
+                .map(|m| initial[m][c] + displacement[2 * m + c])
+                .collect();
+            x.sort_by(f64::total_cmp);
+            let span = pool.install(|| span_of_run(&initial[5..], &displacement, &(5..n), c));
+            assert_eq!(span, (x[0], x[x.len() - 1]));
+        }
+    }
+}
