@@ -359,6 +359,8 @@ impl<R: Rule> Skeleton<R> {
         du: &[f64],
         dt: f64,
     ) -> Result<StepWork, ElementFailure> {
+        // the list and the bounds lent out of the kernel for the loop that writes the rest
+        // of it (put back before an error returns)
         let (all, mut bounds) = (
             std::mem::take(&mut self.all),
             std::mem::take(&mut self.bounds),
