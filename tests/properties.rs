@@ -407,12 +407,18 @@ fn kernel_of(
     tight: bool,
 ) -> Box<dyn impact::assembly::explicit::ExplicitKernel> {
     use impact::assembly::explicit::{Full, Reduced};
+    use impact::scene::spec::StableStepKind;
     let state = impact::assembly::State::initial(model);
     let masses = impact::assembly::ElementMasses::new(model).unwrap();
-    if quadrature == "reduced" {
-        Box::new(Reduced::new(model, &state, kappa, &masses).with_tight_step(tight, false))
+    let kind = if tight {
+        StableStepKind::Tight
     } else {
-        Box::new(Full::new(model, &state, &masses).with_tight_step(tight, false))
+        StableStepKind::Bound
+    };
+    if quadrature == "reduced" {
+        Box::new(Reduced::new(model, &state, kappa, &masses).with_stable_step(kind))
+    } else {
+        Box::new(Full::new(model, &state, &masses).with_stable_step(kind))
     }
 }
 
@@ -516,13 +522,13 @@ fn viscous_tight_kernel(
     if quadrature == "reduced" {
         Box::new(
             Reduced::new(model, &state, kappa, &masses)
-                .with_tight_step(true, false)
+                .with_stable_step(impact::scene::spec::StableStepKind::Tight)
                 .with_bulk_viscosity(Some(viscosity)),
         )
     } else {
         Box::new(
             Full::new(model, &state, &masses)
-                .with_tight_step(true, false)
+                .with_stable_step(impact::scene::spec::StableStepKind::Tight)
                 .with_bulk_viscosity(Some(viscosity)),
         )
     }

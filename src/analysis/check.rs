@@ -50,10 +50,14 @@ fn step_count(model: &Model, spec: &DynamicAnalysis, dt: f64) -> String {
     let steps = (spec.end_time / dt).ceil();
     let count = match spec.step {
         crate::scene::spec::TimeStep::Fixed(_) => format!("{steps:.0} steps to end_time"),
-        crate::scene::spec::TimeStep::Auto { .. } if spec.global_step() => format!(
-            "about {steps:.0} steps of the first step to end_time (the global estimate is taken \
+        crate::scene::spec::TimeStep::Auto { .. }
+            if spec.stable_estimate() == crate::scene::spec::StableStepKind::Global =>
+        {
+            format!(
+                "about {steps:.0} steps of the first step to end_time (the global estimate is taken \
              again as the mesh deforms; the step falls as elements crush)"
-        ),
+            )
+        }
         crate::scene::spec::TimeStep::Auto { .. } => format!(
             "at least {steps:.0} steps to end_time (the automatic step falls as elements deform)"
         ),

@@ -502,35 +502,24 @@ pub struct ArcLength {
 }
 
 impl DynamicAnalysis {
-    /// Whether central difference's automatic step scales the elements' exact frequencies
-    /// (`analysis.stable_step = "tight"`) rather than their bounds (the default). With the
+    /// The estimate of the highest frequency central difference's automatic step scales
+    /// (the one answer to `analysis.stable_step`; docs/theory.md 8.7): the elements' bounds
+    /// (`Bound`, the default, and every step that is not automatic), their exact frequencies
+    /// (`Tight`), or the mesh's highest frequency estimated over those (`Global`). With the
     /// bulk viscosity the ratios are taken against the undamped bounds and scale the damped
-    /// ones; not with the bulk viscosity and the subcycling together (there the bound stands).
-    /// With the mass scaling the elements are scaled by their bounds as without it (more mass
-    /// than the tight step needs); with the subcycling the levels come from the tight
-    /// frequencies.
-    pub fn tight_step(&self) -> bool {
-        let tight = matches!(
-            self.step,
-            TimeStep::Auto {
-                stable: StableStepKind::Tight | StableStepKind::Global,
-                ..
+    /// ones; not with the bulk viscosity and the subcycling together (there the bound
+    /// stands). With the mass scaling the elements are scaled by their bounds as without it
+    /// (more mass than the tight step needs); with the subcycling the levels come from the
+    /// tight frequencies.
+    pub fn stable_estimate(&self) -> StableStepKind {
+        match self.step {
+            TimeStep::Auto { stable, .. }
+                if !(self.bulk_viscosity.is_some() && self.subcycling.is_some()) =>
+            {
+                stable
             }
-        );
-        tight && !(self.bulk_viscosity.is_some() && self.subcycling.is_some())
-    }
-
-    /// Whether the tight elements' step gives way to the estimate of the mesh's highest
-    /// frequency over them (`analysis.stable_step = "global"`; where `tight_step` is).
-    pub fn global_step(&self) -> bool {
-        let global = matches!(
-            self.step,
-            TimeStep::Auto {
-                stable: StableStepKind::Global,
-                ..
-            }
-        );
-        global && self.tight_step()
+            _ => StableStepKind::Bound,
+        }
     }
 
     /// The fixed step (every implicit analysis has one; scene validation refuses `auto`

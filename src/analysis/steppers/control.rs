@@ -8,7 +8,7 @@ use crate::assembly::State;
 use crate::material::PointState;
 use crate::output::readable;
 use crate::scene::Model;
-use crate::scene::spec::Quantity;
+use crate::scene::spec::{AdaptiveStep, Quantity};
 use serde::{Deserialize, Serialize};
 
 /// Rounds a time that is a whole number of nominal steps up to round-off onto that multiple,
@@ -207,6 +207,89 @@ impl WatchedPoint {
         let q1 = value(&trial[probe.body]);
         let size = q0.abs().max(q1.abs()).max(self.floor);
         ((q1 - q0) / size).powi(2)
+    }
+}
+
+/// The error control of an adaptive implicit run (`dt = "auto"`, docs/theory.md 8.2a).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ErrorControl {
+    /// The error tolerance and the shortest and longest step (None: a fixed step).
+    pub(super) adaptive: Option<AdaptiveStep>,
+    /// The method's local error constant (None: no estimate, Wilson and Houbolt).
+    pub(super) constant: Option<f64>,
+}
+
+impl ErrorControl {
+    /// dt_min of an adaptive run (0 without one).
+    pub(super) fn floor(&self) -> f64 {
+        self.adaptive.and_then(|a| a.min).unwrap_or(0.0)
+    }
+
+    pub(super) fn tolerance(&self) -> f64 {
+        self.adaptive.map_or(f64::INFINITY, |a| a.tolerance)
+    }
+
+    /// The local error estimate eta = c h |jump| / V of a step of length `h`: `jump` the
+    /// change of the acceleration over it (`weighted_jump`, scaled to the step), `speed` V
+    /// the run's top speed; 0 for a method without an estimate or a body at rest.
+    pub(super) fn estimate(&self, h: f64, jump: f64, speed: f64) -> f64 {
+        match self.constant {
+            Some(c) if speed > 0.0 => c * h * jump / speed,
+            _ => 0.0,
+        }
+    }
+
+    /// Whether an adaptive run takes the step of length `h` (nominal `nominal`, its estimate
+    /// `estimate`) again, shorter: its estimate is above the tolerance, it was not ended
+    /// early by a contact event (an event is a discontinuity the estimate does not describe),
+    /// and it is longer than dt_min and than `shortest`, the shortest step the control takes
+    /// (the step's nominal over 2^max_cuts and a tenth). At an impact the acceleration jumps
+    /// by the velocity change over the step, so the estimate does not shrink with the step:
+    /// the floor ends the rejections there.
+    pub(super) fn refuses(&self, (h, nominal, estimate): (f64, f64, f64), shortest: f64) -> bool {
+        let Some(adaptive) = self.adaptive else {
+            return false;
+        };
+        let floor = adaptive.min.unwrap_or(0.0).max(shortest);
+        estimate > adaptive.tolerance && h >= nominal * (1.0 - 1e-9) && h > floor * (1.0 + 1e-9)
+    }
+
+    /// The step an adaptive run proposes after an accepted step of length `h` with its
+    /// `estimate`, on the ladder through `first`, within dt_min and dt_max (None: a fixed
+    /// step, or a step `clipped` by an event that met the tolerance: the control's length
+    /// stands).
+    pub(super) fn next_step(
+        &self,
+        first: f64,
+        h: f64,
+        estimate: f64,
+        clipped: bool,
+    ) -> Option<f64> {
+        let a = self.adaptive?;
+        if clipped && estimate <= a.tolerance {
+            return None;
+        }
+        let next = on_ladder(first, h * step_factor(a.tolerance, estimate));
+        let next = next.min(a.max.unwrap_or(f64::INFINITY));
+        Some(next.max(a.min.unwrap_or(0.0)))
+    }
+}
+
+/// The mass-weighted root mean square of `end - start` over the DOFs read, `(read, mass)`:
+/// the change of the acceleration the estimate reads, so that the few light nodes of a mesh
+/// graded to a contact point, ringing at the mesh's highest frequencies, do not set the step
+/// of the whole body (0 where nothing is read).
+pub(super) fn weighted_jump(end: &[f64], start: &[f64], (read, mass): (&[bool], &[f64])) -> f64 {
+    let (mut sum, mut total) = (0.0, 0.0);
+    let dofs = end.iter().zip(start).zip(read).zip(mass);
+    for (((a1, a0), _), m) in dofs.filter(|((_, r), _)| **r) {
+        sum += m * (a1 - a0).powi(2);
+        total += m;
+    }
+    if total > 0.0 {
+        (sum / total).sqrt()
+    } else {
+        0.0
     }
 }
 

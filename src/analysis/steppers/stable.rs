@@ -17,8 +17,8 @@
 //! ```
 //!
 //! From the scene key to the step (`analysis.stable_step`, default `bound`):
-//! `scene::spec::StableStepKind` -> `DynamicAnalysis::tight_step` / `global_step` ->
-//! `assembly::explicit::kernel_for` -> `Skeleton::with_tight_step` (the one Quad4 loop,
+//! `scene::spec::StableStepKind` -> `DynamicAnalysis::stable_estimate` ->
+//! `assembly::explicit::kernel_for` -> `Skeleton::with_stable_step` (the one Quad4 loop,
 //! `assembly/explicit/skeleton.rs`: each element's bound from its rule, damped by the bulk
 //! viscosity; made tight by `tight::Tightness`, the mesh's estimate `global::Global`; every
 //! exact element frequency from `element::highest_frequency_squared`) -> the kernel's

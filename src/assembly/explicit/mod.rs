@@ -648,13 +648,13 @@ pub fn kernel_for<'a>(
     match spec.quadrature {
         Quadrature::Reduced => Box::new(
             Reduced::new(model, state, spec.hourglass, masses)
-                .with_tight_step(spec.tight_step(), spec.global_step())
+                .with_stable_step(spec.stable_estimate())
                 .with_bulk_viscosity(spec.bulk_viscosity)
                 .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
         ),
         Quadrature::Full if quads_only && spec.geometry == Strain::Finite => Box::new(
             Full::new(model, state, masses)
-                .with_tight_step(spec.tight_step(), spec.global_step())
+                .with_stable_step(spec.stable_estimate())
                 .with_bulk_viscosity(spec.bulk_viscosity)
                 .with_mass_scaling(spec.mass_scaling, model, masses, &state.coordinates),
         ),

@@ -35,6 +35,7 @@ use crate::element::{KernelError, Voigt};
 use crate::material::PointState;
 use crate::scene::Model;
 use crate::scene::model::Probe;
+use crate::scene::spec::StableStepKind;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use std::ops::Deref;
@@ -222,11 +223,11 @@ impl<R: Rule> Skeleton<R> {
         }
     }
 
-    /// The kernel whose stable step is tight (`on`: each element's bound times its ratio to
-    /// the exact frequency, `tight`; with `global` the mesh's estimate over them, `global`)
-    /// or its elements' bounds (the default).
-    pub fn with_tight_step(self, on: bool, global: bool) -> Skeleton<R> {
-        let tightness = on.then(|| Tightness::new(self.bounds.len(), global));
+    /// The kernel whose stable step follows the estimate `kind`: its elements' bounds
+    /// (`Bound`), each bound times its ratio to the element's exact frequency (`Tight`,
+    /// `tight.rs`), or the mesh's estimate over those (`Global`, `global.rs`).
+    pub fn with_stable_step(self, kind: StableStepKind) -> Skeleton<R> {
+        let tightness = Tightness::of(kind, self.bounds.len());
         Skeleton { tightness, ..self }
     }
 

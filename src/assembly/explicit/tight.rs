@@ -22,6 +22,7 @@
 
 use super::global::Global;
 pub use super::global::{ElementStiffness, max_frequency_squared};
+use crate::scene::spec::StableStepKind;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +39,16 @@ pub struct Tightness {
 }
 
 impl Tightness {
+    /// The ratios of `elements` elements under the estimate `kind` (None: `Bound`, the
+    /// bounds stand), none taken yet.
+    pub fn of(kind: StableStepKind, elements: usize) -> Option<Tightness> {
+        match kind {
+            StableStepKind::Bound => None,
+            StableStepKind::Tight => Some(Tightness::new(elements, false)),
+            StableStepKind::Global => Some(Tightness::new(elements, true)),
+        }
+    }
+
     /// `elements` elements, no ratio taken yet; `global`: the mesh's highest frequency
     /// estimated over them (`global.rs`).
     pub fn new(elements: usize, global: bool) -> Tightness {

@@ -17,7 +17,8 @@
 mod report;
 
 use super::control::{
-    ErrorWatch, StepControl, WatchedPoint, on_ladder, snap, step_factor, step_length,
+    ErrorControl, ErrorWatch, StepControl, WatchedPoint, on_ladder, snap, step_factor, step_length,
+    weighted_jump,
 };
 use super::energies::Energies;
 use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure};
@@ -94,10 +95,9 @@ pub struct Dynamics<'a> {
     mean_velocity: Option<Vec<f64>>,
     /// The fixed step, or the first of an adaptive run (`stable::implicit_first_step`).
     nominal: f64,
-    /// `dt = "auto"`: the error tolerance and the shortest and longest step.
-    adaptive: Option<AdaptiveStep>,
-    /// The method's local error constant (None: no estimate, Wilson and Houbolt).
-    error_constant: Option<f64>,
+    /// `dt = "auto"`: the error tolerance, the shortest and longest step, and the method's
+    /// local error constant (control.rs).
+    error: ErrorControl,
     /// Per DOF, whether the estimate reads it: the free DOFs off the contact surfaces
     /// (theory 8.2a).
     estimated: Vec<bool>,
@@ -153,22 +153,25 @@ impl<'a> Dynamics<'a> {
             .enumerate()
             .map(|(dof, e)| e.is_some() && !on_surface[dof / 2])
             .collect();
+        let error_constant = method.error_constant();
         Ok(Dynamics {
             model,
             spec,
             interfaces,
             initial: model.coordinates(),
-            error_constant: method.error_constant(),
             estimated,
             method,
             nominal,
             // with contact, dt_min defaults to the first step: shorter steps made the impact
             // conditions' forces (a momentum over the step) run away on every contact scene
             // (validation 10.3a)
-            adaptive: spec.adaptive().map(|a| AdaptiveStep {
-                min: a.min.or((!model.contacts.is_empty()).then_some(nominal)),
-                ..a
-            }),
+            error: ErrorControl {
+                adaptive: spec.adaptive().map(|a| AdaptiveStep {
+                    min: a.min.or((!model.contacts.is_empty()).then_some(nominal)),
+                    ..a
+                }),
+                constant: error_constant,
+            },
             watch: ErrorWatch::default(),
             watched: match spec.adaptive() {
                 Some(_) => WatchedPoint::of(model),
@@ -257,7 +260,7 @@ impl<'a> Dynamics<'a> {
     fn target(&self) -> (f64, f64) {
         let (spec, time) = (self.spec, self.state.time);
         // an adaptive run's current step (whose steps land on no grid of multiples)
-        let dt = match self.adaptive {
+        let dt = match self.error.adaptive {
             Some(_) => self.control.nominal,
             None => self.nominal,
         };
@@ -279,7 +282,7 @@ impl<'a> Dynamics<'a> {
         // other steps end on the multiple of dt they are within round-off of
         let target = if stop - end <= 1e-9 * dt {
             stop
-        } else if self.adaptive.is_some() {
+        } else if self.error.adaptive.is_some() {
             end
         } else {
             snap(end, dt)
@@ -309,6 +312,7 @@ impl<'a> Dynamics<'a> {
             persistent: self.persistent_entries(),
             mean_velocity: self.mean_velocity.as_deref(),
             error_target: self
+                .error
                 .adaptive
                 .map(|a| NEWTON_SHARE * a.tolerance * self.watch.speed),
         };
@@ -458,31 +462,16 @@ impl<'a> Dynamics<'a> {
     /// mesh's highest frequencies, do not set the step of the whole body.
     fn estimate(&self, h: f64, end: &Advance) -> (f64, f64) {
         let speed = self.top_speed(&end.velocity);
-        let Some(c) = self.error_constant else {
+        if self.error.constant.is_none() {
             return (0.0, speed);
-        };
+        }
         let (start, scale) = match &self.previous_acceleration {
             Some(a) if self.last_step > 0.0 => (&a[..], h / (h + self.last_step)),
             _ => (&self.kin.acceleration[..], 1.0),
         };
-        // the mass-weighted root mean square over the DOFs read
-        let (mut sum, mut mass) = (0.0, 0.0);
-        let read = end.acceleration.iter().zip(start).zip(&self.estimated);
-        for (((a1, a0), _), m) in read.zip(&self.mass.lumped).filter(|((_, r), _)| **r) {
-            sum += m * (a1 - a0).powi(2);
-            mass += m;
-        }
-        let jump = if mass > 0.0 {
-            (sum / mass).sqrt() * scale
-        } else {
-            0.0
-        };
-        let estimate = if speed > 0.0 {
-            c * h * jump / speed
-        } else {
-            0.0
-        };
-        (estimate, speed)
+        let read = (&self.estimated[..], &self.mass.lumped[..]);
+        let jump = weighted_jump(&end.acceleration, start, read) * scale;
+        (self.error.estimate(h, jump, speed), speed)
     }
 
     /// The largest share of the watched point values (0 when none is watched).
@@ -491,29 +480,6 @@ impl<'a> Dynamics<'a> {
             .iter()
             .map(|w| w.estimate(self.model, &self.state, &evaluation.trial))
             .fold(0.0, f64::max)
-    }
-
-    /// dt_min of an adaptive run (0 without one).
-    fn dt_floor(&self) -> f64 {
-        self.adaptive.and_then(|a| a.min).unwrap_or(0.0)
-    }
-
-    fn adaptive_tolerance(&self) -> f64 {
-        self.adaptive.map_or(f64::INFINITY, |a| a.tolerance)
-    }
-
-    /// Whether an adaptive run takes the step of length `h` again, shorter: its estimate is
-    /// above the tolerance, it was not ended early by a contact event (an event is a
-    /// discontinuity the estimate does not describe), and it is longer than dt_min and than
-    /// the shortest step the control takes (the step's nominal over 2^max_cuts and a tenth).
-    /// At an impact the acceleration jumps by the velocity change over the step, so the
-    /// estimate does not shrink with the step: the floor ends the rejections there.
-    fn refuses(&self, h: f64, nominal: f64, estimate: f64) -> bool {
-        let Some(adaptive) = self.adaptive else {
-            return false;
-        };
-        let floor = adaptive.min.unwrap_or(0.0).max(self.control.shortest());
-        estimate > adaptive.tolerance && h >= nominal * (1.0 - 1e-9) && h > floor * (1.0 + 1e-9)
     }
 
     /// Velocity-level persistency: the (pair, slave node) entries closed at the start of the
@@ -771,12 +737,12 @@ impl Stepper for Dynamics<'_> {
                     let h = step.length;
                     let (estimate, speed) = self.estimate(h, &advance);
                     let estimate = estimate.max(self.point_estimate(&step.solution.evaluation));
-                    if self.refuses(h, nominal, estimate) {
+                    if (self.error).refuses((h, nominal, estimate), self.control.shortest()) {
                         self.method.reject();
                         counters.rejected += 1;
-                        let shorter = h * step_factor(self.adaptive_tolerance(), estimate);
+                        let shorter = h * step_factor(self.error.tolerance(), estimate);
                         self.control
-                            .retry(on_ladder(self.nominal, shorter).max(self.dt_floor()));
+                            .retry(on_ladder(self.nominal, shorter).max(self.error.floor()));
                         continue;
                     }
                     let clipped = h < self.control.length * (1.0 - 1e-9);
@@ -784,12 +750,8 @@ impl Stepper for Dynamics<'_> {
                     self.watch.speed = speed;
                     self.watch.last = estimate;
                     self.watch.largest = self.watch.largest.max(estimate);
-                    if let Some(a) = self.adaptive
-                        && !(clipped && estimate <= a.tolerance)
-                    {
-                        let next = on_ladder(self.nominal, h * step_factor(a.tolerance, estimate));
-                        let next = next.min(a.max.unwrap_or(f64::INFINITY));
-                        self.control.propose(next.max(a.min.unwrap_or(0.0)));
+                    if let Some(next) = self.error.next_step(self.nominal, h, estimate, clipped) {
+                        self.control.propose(next);
                     }
                     return Ok(());
                 }

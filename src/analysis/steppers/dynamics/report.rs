@@ -58,7 +58,7 @@ impl Report for Dynamics<'_> {
         self.last_step
     }
     fn error_watch(&self) -> Option<ErrorWatch> {
-        self.error_constant.map(|_| self.watch)
+        self.error.constant.map(|_| self.watch)
     }
 }
 
