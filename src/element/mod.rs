@@ -81,12 +81,16 @@ pub enum KernelError {
 
 /// An element's highest frequency squared: the largest eigenvalue of M^-1 K for its n x n
 /// stiffness `k(i, j)` (symmetrized, (K + K^T) / 2) and its lumped nodal masses `lumped` (each
-/// for both directions of its node: n = 2 lumped.len()), from the symmetric M^-1/2 K M^-1/2.
-/// The one routine of the exact element frequency: the eigenvalue stable step (dt_crit) and
-/// the explicit kernels' tight and global steps.
+/// for both directions of its node: n = 2 lumped.len(), at most 8, a quad or a rod), from the
+/// symmetric M^-1/2 K M^-1/2. The one routine of the exact element frequency: the eigenvalue
+/// stable step (dt_crit) and the explicit kernels' tight and global steps.
 pub fn highest_frequency_squared(k: impl Fn(usize, usize) -> f64, lumped: &[f64]) -> f64 {
     let n = 2 * lumped.len();
-    let scale: Vec<f64> = (0..n).map(|i| 1.0 / lumped[i / 2].sqrt()).collect();
+    // on the stack: the tight and global steps call this for every element they re-take
+    let mut scale = [0.0; 8];
+    for (i, s) in scale.iter_mut().enumerate().take(n) {
+        *s = 1.0 / lumped[i / 2].sqrt();
+    }
     let entry = |i: usize, j: usize| 0.5 * (k(i, j) + k(j, i)) * scale[i] * scale[j];
     if n == 8 {
         // a quad's on the stack (a dynamic matrix's heap and loops made the set-up of a

@@ -403,8 +403,8 @@ fn mass_of<R: Rule>(mass: &[R::Mass], scaling: Option<&ElementScaling>, e: usize
     }
 }
 
-/// The columns and the element forces, bounds and damping (`rest`) cut into chunks at the
-/// elements `starts`.
+/// The columns and the element forces, bounds and damping cut into chunks at the elements
+/// `starts`.
 fn chunks_at<'a, R: Rule>(
     columns: &'a mut Columns<Vec<f64>>,
     (forces, bounds, damping): (&'a mut [f64], &'a mut [f64], &'a mut [f64]),
