@@ -19,6 +19,7 @@
 
 mod active_set;
 mod constrained;
+mod line_search;
 mod secant;
 
 use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System};
@@ -456,6 +457,7 @@ impl Step<'_> {
         // the remaining correction in absolute terms, for the error target
         let mut correction = f64::INFINITY;
         let mut relaxation = Relaxation::new();
+        let mut search = line_search::LineSearch::new(self.inertia.is_none());
         let mut predictor = self.predictor.then(|| Predictor::of(&d, system)).flatten();
         for iteration in 0..=newton.max_iterations {
             let refactor = newton.strategy == Strategy::Full
@@ -496,24 +498,18 @@ impl Step<'_> {
                 && rows.worst_gap <= 1.0
                 && settled
             {
-                let tangential = match (&self.contact, &active_set) {
-                    (Some(c), None) => rows.tangential_forces(c.tangential, &forces),
-                    _ => Vec::new(),
-                };
-                forces.truncate(rows.normal);
-                let settled = active_set.map(|set| set.settled());
-                return Ok(Solution {
-                    d,
-                    evaluation,
-                    forces,
-                    tangential,
-                    settled,
-                });
+                return Ok(self.solution((d, evaluation), &rows, forces, active_set));
             }
             // not the answer: its trial states need not sit beside the factor about to be made
             drop(evaluation);
             if iteration == newton.max_iterations {
                 break;
+            }
+            let iterate = (&mut d[..], &mut forces, &mut active_set);
+            if search.search(residual_norm, settled, iterate, system) {
+                // the BFGS pair of the whole correction is not the step taken
+                last = None;
+                continue;
             }
             let ratio = residual_norm / previous_residual;
             let stalled =
@@ -534,6 +530,7 @@ impl Step<'_> {
                 relaxation.restart();
             }
             let (mut delta, tau) = constrained_solve(solver, &rows, residual, &forces, &secant)?;
+            let before = search.watches(iteration).then(|| forces.clone());
             forces = relaxation.relax(&mut delta, &forces, tau);
             if let Some(set) = &mut active_set {
                 set.take(&forces);
@@ -541,6 +538,7 @@ impl Step<'_> {
             counters.iterations += 1;
             predictor = None;
             system.scatter_add(&delta, &mut d);
+            search.took(&delta, residual_norm, before);
             (correction, eps_displacement) = correction_sizes(&delta, &d);
             previous_residual = residual_norm;
             last = own.map(|r| (delta, r));
@@ -549,6 +547,30 @@ impl Step<'_> {
             "no convergence in {} iterations",
             newton.max_iterations
         )))
+    }
+
+    /// The converged step at `d` with its `evaluation`: the normal multipliers of `forces`
+    /// (the last solve's, on `rows`), the tangential forces of the fixed conditions and the
+    /// active set Newton settled on.
+    fn solution(
+        &self,
+        (d, evaluation): (Vec<f64>, Evaluation),
+        rows: &Rows,
+        mut forces: Vec<f64>,
+        active_set: Option<ActiveSet>,
+    ) -> Solution {
+        let tangential = match (&self.contact, &active_set) {
+            (Some(c), None) => rows.tangential_forces(c.tangential, &forces),
+            _ => Vec::new(),
+        };
+        forces.truncate(rows.normal);
+        Solution {
+            d,
+            evaluation,
+            forces,
+            tangential,
+            settled: active_set.map(|set| set.settled()),
+        }
     }
 
     /// Turns the first residual of a predicted step, R_f at its start, into
