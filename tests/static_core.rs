@@ -483,7 +483,7 @@ fn punch_pressure(dir: &std::path::Path) -> Vec<f64> {
 /// circular punch; in his Haar-von Karman state von Mises' k is Y / 2 (docs/validation.md
 /// 2.9). Measured peaks 5.591, 5.781, 5.731 k (-1.7, +1.6, +0.7 %: the mesh error
 /// oscillates as the edge nodes slide off the punch one by one, a drop of about h / a each);
-/// the band, 3 %, asserted on each. No step cut (asserted), 8.1 to 9.6 iterations an
+/// the band, 3 %, asserted on each. No step cut (asserted), 8.1 to 9.7 iterations an
 /// increment (at most 10 asserted). With the defaults (finite strain) the pressure follows
 /// the small-displacement one to 0.3 % up to 0.01 a of travel (1 % asserted) and then keeps
 /// rising as the punch sinks.
