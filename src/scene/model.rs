@@ -507,17 +507,12 @@ impl DynamicAnalysis {
     /// (`Bound`, the default, and every step that is not automatic), their exact frequencies
     /// (`Tight`), or the mesh's highest frequency estimated over those (`Global`). With the
     /// bulk viscosity the ratios are taken against the undamped bounds and scale the damped
-    /// ones; not with the bulk viscosity and the subcycling together (there the bound
-    /// stands). With the mass scaling the elements are scaled by their bounds as without it
+    /// ones. With the mass scaling the elements are scaled by their bounds as without it
     /// (more mass than the tight step needs); with the subcycling the levels come from the
-    /// tight frequencies.
+    /// tight frequencies (damped as the single step's).
     pub fn stable_estimate(&self) -> StableStepKind {
         match self.step {
-            TimeStep::Auto { stable, .. }
-                if !(self.bulk_viscosity.is_some() && self.subcycling.is_some()) =>
-            {
-                stable
-            }
+            TimeStep::Auto { stable, .. } => stable,
             _ => StableStepKind::Bound,
         }
     }

@@ -638,8 +638,10 @@ impl<R: Rule> PartialKernel for Skeleton<R> {
         let bound = self.frequency(x, e)?;
         Ok(match &self.tightness {
             Some(tight) => {
+                // the ratio against the undamped bound scales the damped one, as `apply`
                 let nodes = self.layout.nodes[e].map(|n| x[n as usize]);
-                bound * tight.ratio_for(e, bound, || self.exact_stiffness(&nodes, e))
+                let undamped = bound * self.damping[e];
+                bound * tight.ratio_for(e, undamped, || self.exact_stiffness(&nodes, e))
             }
             None => bound,
         })
@@ -656,7 +658,7 @@ impl<R: Rule> PartialKernel for Skeleton<R> {
         if let Some(mut tight) = self.tightness.take() {
             let end = |e: usize| end_nodes(self.layout.nodes[e], x, du);
             (total.omega_squared, total.critical_element) =
-                tight.apply_subset(elements, omega_squared, |e| {
+                tight.apply_subset(elements, (omega_squared, &self.damping), |e| {
                     self.exact_stiffness(&end(e), e)
                 });
             self.tightness = Some(tight);

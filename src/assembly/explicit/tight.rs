@@ -91,7 +91,7 @@ impl Tightness {
         exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
         let undamped = undamped(bounds, damping);
-        self.refresh(0..bounds.len(), &undamped, exact);
+        self.refresh(0..bounds.len(), |e| undamped[e], exact);
         let largest = self.largest(bounds, |e| self.ratio[e]);
         let Some(global) = self.global.as_mut() else {
             return largest;
@@ -106,19 +106,19 @@ impl Tightness {
         (share * largest.0, largest.1)
     }
 
-    /// Takes again the stale ratios among `elements`, whose bounds are in `bounds` (by element
-    /// index), with `exact(e)` in parallel.
+    /// Takes again the stale ratios among `elements`, whose (undamped) bounds are `bound(e)`,
+    /// with `exact(e)` in parallel.
     fn refresh(
         &mut self,
         elements: impl Iterator<Item = usize>,
-        bounds: &[f64],
+        bound: impl Fn(usize) -> f64,
         exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) {
-        let stale: Vec<usize> = elements.filter(|&e| self.stale(e, bounds[e])).collect();
+        let stale: Vec<usize> = elements.filter(|&e| self.stale(e, bound(e))).collect();
         let fresh: Vec<Option<ElementStiffness>> = stale.par_iter().map(|&e| exact(e)).collect();
         for (&e, stiffness) in stale.iter().zip(fresh) {
-            self.ratio[e] = Tightness::ratio_of(bounds[e], stiffness.as_ref());
-            self.at[e] = bounds[e];
+            self.ratio[e] = Tightness::ratio_of(bound(e), stiffness.as_ref());
+            self.at[e] = bound(e);
             if let Some(global) = self.global.as_mut() {
                 global.keep(e, stiffness);
             }
@@ -152,15 +152,21 @@ impl Tightness {
     }
 
     /// As `apply` over the elements `elements` only (a subcycled substep), whose entries of
-    /// `omega_squared` hold this step's bounds and are made tight; the largest of them and its
+    /// `omega_squared` hold this step's bounds and are made tight (`damping` as `apply`'s: the
+    /// ratios against the undamped bounds scale the damped ones); the largest of them and its
     /// element.
     pub fn apply_subset(
         &mut self,
         elements: &[u32],
-        omega_squared: &mut [f64],
+        (omega_squared, damping): (&mut [f64], &[f64]),
         exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) -> (f64, usize) {
-        self.refresh(elements.iter().map(|&e| e as usize), omega_squared, exact);
+        let bounds: &[f64] = omega_squared;
+        self.refresh(
+            elements.iter().map(|&e| e as usize),
+            |e| bounds[e] * damping[e],
+            exact,
+        );
         let mut best = (0.0, usize::MAX);
         for &e in elements {
             let e = e as usize;
