@@ -442,8 +442,12 @@ fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
             element: e,
         } = analysis::steppers::stable::critical_time_step(&model)?;
         outln!(
-            "  central-difference stability limit: dt_crit = {} (element eigenvalue bound; body `{}`, element {e})",
+            "  central-difference stability limit: dt_crit = {} (element eigenvalue bound{}; body `{}`, element {e})",
             readable(dt_crit),
+            match model.analysis.bulk_viscosity() {
+                Some(_) => ", without the bulk viscosity's damping",
+                None => "",
+            },
             model.bodies[b].name
         );
     }

@@ -27,13 +27,41 @@ fn step_fall(summary: &impact::analysis::Summary) -> f64 {
 /// the 1 %); the step falls at most 2 times over the run (measured 1.35; the
 /// Lagrangian run's falls 3.1 times on this rod, 31 times on the aluminium rod's foot, so
 /// the bound fails with ALE off, which the published band alone would not: the Lagrangian
-/// L_f and D_f lie in it too).
+/// L_f and D_f lie in it too). All of it at the bound's step without the bulk viscosity,
+/// where those figures were measured: the remap's error grows with the motion between two
+/// remaps, so with the defaults (the global step, 1.4 times longer, and the viscosity) the
+/// balance is 1.1e-4 (1.0e-4 at the tight step) and no longer tells the remap's term apart;
+/// the default run is asserted in the bands, its step fall and its balance within 1e-3.
 #[test]
 fn taylor_jc_with_ale_lands_on_the_published_results() {
+    let defaults = run_scene(
+        "ale_taylor_jc_defaults",
+        "taylor_jc",
+        &["analysis.ale={}", "output.frame_every=0"],
+    );
+    assert_eq!(defaults.summary.status, Status::Ok);
+    let last = |c: &str| *column(&defaults.dir, c).last().unwrap();
+    let length = (32.4e-3 + last("u_y[top_axis]")) * 1e3;
+    let diameter = 2.0 * (3.2e-3 + last("u_x[face_edge]")) * 1e3;
+    assert!((26.475..=26.605).contains(&length), "L_f {length}");
+    let widen = 0.0065 * 11.16;
+    assert!(
+        (11.135 - widen..=11.175 + widen).contains(&diameter),
+        "D_f {diameter}"
+    );
+    assert!(defaults.summary.energy.max_relative_drift < 1e-3);
+    // the viscosity's damping grows in the foot's fast compression (measured 2.01; the
+    // Lagrangian run's 4.07 at the same defaults)
+    assert!(step_fall(&defaults.summary) <= 2.5);
     let run = run_scene(
         "ale_taylor_jc",
         "taylor_jc",
-        &["analysis.ale={}", "output.frame_every=0"],
+        &[
+            "analysis.ale={}",
+            "output.frame_every=0",
+            "analysis.stable_step=bound",
+            "analysis.bulk_viscosity=off",
+        ],
     );
     assert_eq!(run.summary.status, Status::Ok);
     let last = |c: &str| *column(&run.dir, c).last().unwrap();
@@ -60,8 +88,11 @@ fn taylor_jc_with_ale_lands_on_the_published_results() {
 /// Jacobian without ALE), the copper rod at 400 m/s completes on both kernels with ALE steps.
 /// Setup: models/taylor_copper_ale.toml (5 x 50) on the 2x2 and the one-point kernel; the
 /// one-point kernel also on 10 x 100. Reference: the energy balance with the remap's term
-/// below 1e-3 (measured 1.1e-4, 9.3e-5; with the remap's kinetic energy loss left out of
-/// the balance 6.0e-3 and 5.4e-3, which the 1 % let pass); the hourglass energy of the one-point
+/// below 1e-3 at the bound's step without the bulk viscosity (measured 1.1e-4, 9.3e-5; with
+/// the remap's kinetic energy loss left out of the balance 6.0e-3 and 5.4e-3, which the
+/// issue's 1 % let pass; with the defaults, the longer global step and the viscosity, 1.2e-3
+/// on one-point: the remap's error grows with the motion between two remaps, and the 10 x
+/// 100 run, at the defaults, is held to the 1 %); the hourglass energy of the one-point
 /// kernel below the 2 % of the work on 10 x 100 (measured 0.3 %; 2.7 % on 5 x 50,
 /// where five elements span a foot four times the rod's radius); the two kernels' L_f within
 /// 1 % of each other, the 5 x 50 level's spread in the mesh study of docs/validation.md 11
@@ -70,10 +101,22 @@ fn taylor_jc_with_ale_lands_on_the_published_results() {
 fn a_copper_rod_at_400_m_s_completes_on_both_kernels_with_ale() {
     let mut lengths = Vec::new();
     for (name, sets) in [
-        ("ale_copper_full", vec!["output.frame_every=0"]),
+        (
+            "ale_copper_full",
+            vec![
+                "output.frame_every=0",
+                "analysis.stable_step=bound",
+                "analysis.bulk_viscosity=off",
+            ],
+        ),
         (
             "ale_copper_reduced",
-            vec!["output.frame_every=0", "analysis.quadrature=\"reduced\""],
+            vec![
+                "output.frame_every=0",
+                "analysis.quadrature=\"reduced\"",
+                "analysis.stable_step=bound",
+                "analysis.bulk_viscosity=off",
+            ],
         ),
     ] {
         let run = run_scene(name, "taylor_copper_ale", &sets);
@@ -102,6 +145,7 @@ fn a_copper_rod_at_400_m_s_completes_on_both_kernels_with_ale() {
         ],
     );
     assert_eq!(fine.summary.status, Status::Ok);
+    assert!(fine.summary.energy.max_relative_drift < 1e-2);
     let last = |c: &str| *column(&fine.dir, c).last().unwrap();
     let work = last("internal_energy") + last("plastic_work");
     assert!(

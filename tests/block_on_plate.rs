@@ -182,10 +182,10 @@ fn a_finer_plate_is_given_no_energy() {
 /// Reference: the symmetry of the problem about the contact plane: the upper and the lower
 /// rod's final lengths, widths and plastic work are equal (the per-body columns: 330.23 J
 /// each, measured). A balanced pair treats the two faces alike, so
-/// they agree to 1e-7 relative (measured 3.5e-8: at a vertex the row depends on whether the
-/// projection of a node lying on it rounds to the vertex or just inside the segment, which
-/// the mirror image does not repeat bit for bit); one pass, with one rod the slave, leaves
-/// them 8.7e-6 apart.
+/// they agree to 1e-6 relative (measured 1.2e-7 with the default bulk viscosity and global
+/// step, 3.5e-8 without: at a vertex the row depends on whether the projection of a node
+/// lying on it rounds to the vertex or just inside the segment, which the mirror image does
+/// not repeat bit for bit); one pass, with one rod the slave, leaves them 8.7e-6 apart.
 #[test]
 fn two_like_rods_stay_mirror_images() {
     let run = common::run_scene("rod_on_rod_mirror", "rod_on_rod", &[]);
@@ -199,7 +199,7 @@ fn two_like_rods_stay_mirror_images() {
         let upper = last(&column("upper"));
         let lower = last(&column("lower"));
         assert!(
-            (upper / lower - 1.0).abs() < 1e-7,
+            (upper / lower - 1.0).abs() < 1e-6,
             "{quantity}: upper {upper} lower {lower}"
         );
     }

@@ -618,10 +618,14 @@ fn fitted_slope(t: &[f64], y: &[f64]) -> f64 {
 /// contact_work).
 #[test]
 fn explicit_coulomb_block_decelerates_at_mu_n_and_stops_where_the_law_says() {
+    // without the bulk viscosity: with it (the default) the one-element block slides 6.6e-4
+    // further and stops after t = 1.05 (its damping of the block's compression under the
+    // ramped load changes the normal impulse the friction follows; the cause not isolated
+    // further), which a rigid block's law does not describe
     let model = common::model(
         "explicit_friction_slide",
         &explicit_friction_block(0.6, 0.0, 0.0, 1.5),
-        &[],
+        &["analysis.bulk_viscosity=off"],
     );
     let dir = common::out_dir("explicit_friction_slide");
     let summary = impact::analysis::run(&model, &dir, Default::default()).unwrap();

@@ -373,7 +373,14 @@ fn point_impact_hourglass_energy_stays_small() {
         "point_impact",
         &point_impact(-0.05),
         0.9,
-        &["analysis.hourglass=0.1", "analysis.energy_gain_limit=0.05"],
+        // the bulk viscosity off: it damps the volumetric ringing, which the hourglass
+        // modes (no volume change at the centre) do not have, so the share below is of the
+        // undamped scheme (with the viscosity the mean share is 14.8 %)
+        &[
+            "analysis.hourglass=0.1",
+            "analysis.energy_gain_limit=0.05",
+            "analysis.bulk_viscosity=off",
+        ],
     );
     let dir = common::out_dir("point_impact");
     impact::analysis::run(&model, &dir, Default::default()).unwrap();
@@ -781,7 +788,10 @@ set = "top"
             );
         }
     }
-    let model = common::model("j2_plane_stress", &text, &[]);
+    // the bulk viscosity off: on this steadily stretched strip its pressure on the constant
+    // in-plane volumetric rate is a viscous stress the rate-independent reference has not
+    // (with it, s_xx ends 4e-4 below the reference)
+    let model = common::model("j2_plane_stress", &text, &["analysis.bulk_viscosity=off"]);
     let dir = common::out_dir("j2_plane_stress");
     let (_, state) = impact::analysis::run_to_state(&model, &dir, Default::default()).unwrap();
     let last = |name: &str| *column(&dir, name).last().unwrap();
@@ -1010,9 +1020,12 @@ fn time_step_scale_scales_the_automatic_step() {
     let first_steps: Vec<f64> = ["0.9", "0.45"]
         .iter()
         .map(|scale| {
+            // the bound's step: the global estimate's longer steps put the first among the
+            // equal steps to the end
             let set = [
                 format!("analysis.time_step_scale={scale}"),
                 "analysis.end_time=2.0e-7".to_string(),
+                "analysis.stable_step=bound".to_string(),
             ];
             let set: Vec<&str> = set.iter().map(String::as_str).collect();
             let model = common::model("scaled_step", PARALLEL_ROD, &set);
@@ -1025,7 +1038,11 @@ fn time_step_scale_scales_the_automatic_step() {
         (first_steps[1] / first_steps[0] - 0.5).abs() < 1e-15,
         "{first_steps:?}"
     );
-    let model = common::model("default_step", PARALLEL_ROD, &["analysis.end_time=2.0e-7"]);
+    let model = common::model(
+        "default_step",
+        PARALLEL_ROD,
+        &["analysis.end_time=2.0e-7", "analysis.stable_step=bound"],
+    );
     let dir = common::out_dir("default_step");
     impact::analysis::run(&model, &dir, Default::default()).unwrap();
     assert_eq!(column(&dir, "dt")[1], first_steps[0]);

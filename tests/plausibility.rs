@@ -292,8 +292,11 @@ fn steps_too_long_for_the_run_or_the_impact_warn() {
 /// counted time_step_scale x the element-eigenvalue limit (taylor_jc: 3.47 steps in 3e-7 s),
 /// while the run scales the kernel's conservative bound, 0.46 of that limit (8 steps).
 /// Reference: the run's own step count; over 3e-7 s (a twentieth of a wave transit of the
-/// rod's radius) the mesh barely deforms, so the steps keep their first length and the run
-/// takes the warned count rounded up (the last step clipped to end_time).
+/// rod's radius) the mesh barely deforms, so the steps keep about their first length and the
+/// run takes the warned count rounded up (the last step clipped to end_time), or one step
+/// more: the bulk viscosity's damping, at rest in the count, grows with the struck face's
+/// compression rate and shortens the steps after the first (measured 3.93 warned, 5 taken,
+/// the last four equal steps to end_time).
 #[test]
 fn the_few_steps_warning_counts_the_steps_the_run_takes() {
     let dir = out_dir("few_steps_taylor");
@@ -318,7 +321,13 @@ fn the_few_steps_warning_counts_the_steps_the_run_takes() {
         .and_then(|rest| rest.split(' ').next())
         .and_then(|n| n.parse().ok())
         .expect("a step count after `spans`");
-    assert_eq!(count.ceil() as usize, summary.steps, "{}", warning[0]);
+    let warned = count.ceil() as usize;
+    assert!(
+        (warned..=warned + 1).contains(&summary.steps),
+        "{} steps: {}",
+        summary.steps,
+        warning[0]
+    );
 }
 
 const ROUND_BAR_SWAP: [&str; 5] = [
@@ -985,8 +994,9 @@ fn block_in_mm(density: &str) -> Vec<String> {
 /// run. Before: the whole impact ran in one stable step (c = 6.0 for steel, dt_crit 0.14
 /// against end_time 3e-5), warnings []. Setup: the steel block in mm, t, s, MPa with
 /// density 7.85e-9 t/mm^3 (correct) and 7850 (the mistake, the only difference; its run
-/// now fails, a face element inverted by steps of a microsecond, and its summary.json keeps
-/// the warnings).
+/// goes through its 30 us in steps of the frames, a microsecond, and ends with the block
+/// still pressing on the wall: the third warning, which says nothing of the units; without
+/// the bulk viscosity a face element inverts by those steps and the run ends with exit 3).
 /// Reference: c = sqrt(M / rho) is 6000 m/s = 6e6 mm/s for steel; 7850 makes it 3e4 times
 /// slower, the step 3e4 times longer than the 0.085 us of the SI scene, and a wave takes
 /// 10 mm / 6.0 = 1.7 s to cross the block against a 30 us run.
@@ -997,22 +1007,23 @@ fn a_density_in_kg_per_m3_beside_mpa_and_mm_warns() {
     assert!(!said.contains("warning"), "{said}");
     assert!(warnings.is_empty(), "{warnings:?}");
     // the run's steps are the frames' (1 us each, the stable step being 0.09 s): the block
-    // crosses the 0.05 mm gap and its face inverts at the wall within the 30 us (exit 3)
+    // crosses the 0.05 mm gap and presses on the wall to the end
     let (said, code, warnings) = check_and_run_ending(
         "units_mm_density",
         "models/steel_block_wall.toml",
         &block_in_mm("7850"),
-        3,
+        0,
     );
     assert_eq!(code, Some(3), "check --strict with warnings: {said}");
-    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert_eq!(warnings.len(), 3, "{warnings:?}");
+    assert!(warnings[2].contains("still closed"), "{warnings:?}");
     assert!(warnings[0].contains("fewer than 10 steps"), "{warnings:?}");
     assert!(
         warnings[0].contains("lengthen analysis.end_time"),
         "{warnings:?}"
     );
     assert!(warnings[1].contains("wave transit"), "{warnings:?}");
-    for w in &warnings {
+    for w in &warnings[..2] {
         assert!(
             said.contains(w.as_str()),
             "check prints what the run warns: {said}"

@@ -346,6 +346,9 @@ fn explicit_mass_scaling_resume_is_bit_identical() {
         "analysis.end_time=0.3",
         "analysis.checkpoint_every=15",
         "analysis.mass_scaling={target=0.006}",
+        // the target sits between the undamped steps above (the bulk viscosity's damping
+        // at rest would put the initial step below it)
+        "analysis.bulk_viscosity=off",
     ];
     let text = frictionless();
     let full = run_full(name, &text, &set);
@@ -510,7 +513,13 @@ fn two_pass_and_axisymmetric_contact_resume_bit_identically() {
     ];
     let explicit = [
         &set[..],
-        &["analysis.integrator=central_difference", "analysis.dt=auto"],
+        // the tight step: two-pass node-to-segment gains 4 % of the energy at the global
+        // step on this bar (1.47 times its rounded tip's element limit), 0.36 % here
+        &[
+            "analysis.integrator=central_difference",
+            "analysis.dt=auto",
+            "analysis.stable_step=tight",
+        ],
     ]
     .concat();
     for (name, set) in [

@@ -102,7 +102,13 @@ fn newmark_lands_on_the_explicit_rod_on_plate_with_and_without_friction() {
         // the explicit reference on the discretization Newmark takes: one pass of mortar
         // (balanced pairs run under central difference only)
         let one_pass = "contact.impact.roles=as_written";
-        let explicit = rod_on_plate(&format!("rop_explicit_{mu}"), &[&friction, one_pass]);
+        // and without the bulk viscosity, which Newmark has not: the axis element of the
+        // plate gathers its strain from the waves that focus there, which the viscosity damps
+        let inviscid = "analysis.bulk_viscosity=off";
+        let explicit = rod_on_plate(
+            &format!("rop_explicit_{mu}"),
+            &[&friction, one_pass, inviscid],
+        );
         let mut steps = vec!["1.0e-7"];
         if auto {
             steps.push("auto");

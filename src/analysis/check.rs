@@ -280,6 +280,13 @@ fn history_line(model: &Model, end_time: f64, dt: Option<f64>) -> String {
     )
 }
 
+/// Whether `spec` is central difference's automatic step scaled from the global estimate.
+fn global_step(spec: &DynamicAnalysis) -> bool {
+    spec.integrator == IntegratorKind::CentralDifference
+        && matches!(spec.step, crate::scene::spec::TimeStep::Auto { .. })
+        && spec.stable_estimate() == crate::scene::spec::StableStepKind::Global
+}
+
 /// `impact check`'s line on the step of `spec` against its integrator's limit.
 fn stability_line(model: &Model, spec: &DynamicAnalysis, stability: StepStability) -> String {
     let name = spec.integrator.name();
@@ -288,10 +295,16 @@ fn stability_line(model: &Model, spec: &DynamicAnalysis, stability: StepStabilit
             dt: Some(dt),
             dt_crit,
         } => format!(
-            "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}; {}{}",
+            "integrator {name}: dt = {}, stability limit dt_crit = {}, dt / dt_crit = {}{}; {}{}",
             readable(dt),
             readable(dt_crit),
             readable(dt / dt_crit),
+            if global_step(spec) {
+                " (dt_crit from the largest element eigenvalue; the global step scales the \
+                 mesh's highest frequency, at or below it by Irons' inequality, so dt may exceed dt_crit)"
+            } else {
+                ""
+            },
             step_count(model, spec, dt),
             if spec.mass == MassKind::Consistent {
                 " (from the lumped-mass frequency bound: the consistent mass's highest \

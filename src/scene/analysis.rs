@@ -7,8 +7,8 @@ use super::model::Analysis;
 use super::model::{Ale, ArcLength, DynamicAnalysis, StaticAnalysis, Subcycling};
 use super::spec::{
     AdaptiveStep, AleSmoother, AnalysisKind, AnalysisSpec, ArcLengthSpec, BucklingSpec,
-    ContactDynamics, DEFAULT_SUBCYCLING_LEVELS, IntegratorKind, MassKind, NewtonSpec, Quadrature,
-    StableStepKind, StepSpec, TimeStep,
+    BulkViscositySetting, BulkViscositySpec, ContactDynamics, DEFAULT_SUBCYCLING_LEVELS,
+    IntegratorKind, MassKind, NewtonSpec, Quadrature, StableStepKind, StepSpec, TimeStep,
 };
 use crate::element::Strain;
 use crate::element::bulk_viscosity::{self, BulkViscosity};
@@ -16,7 +16,13 @@ use crate::element::mass_scaling::MassScaling;
 
 /// `[analysis]`: a static analysis (load steps) or a dynamic one (time steps), checked
 /// against the keys that apply to it.
-pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, InputError> {
+/// `rods`: whether a body is a rod (the explicit Quad4 kernels' options are off by default
+/// there).
+pub(super) fn analysis(
+    cx: &Context,
+    spec: &AnalysisSpec,
+    rods: bool,
+) -> Result<Analysis, InputError> {
     let given = |present: bool, key: &str, kind: &str| {
         if present {
             Err(cx.err(format!(
@@ -72,7 +78,7 @@ pub(super) fn analysis(cx: &Context, spec: &AnalysisSpec) -> Result<Analysis, In
                 arc_length: arc_length(cx, spec.arc_length.as_ref(), steps)?,
             }))
         }
-        AnalysisKind::Dynamic => dynamic(cx, spec).map(Analysis::Dynamic),
+        AnalysisKind::Dynamic => dynamic(cx, spec, rods).map(Analysis::Dynamic),
     }
 }
 
@@ -136,7 +142,7 @@ fn arc_length(
     }))
 }
 
-fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicAnalysis, InputError> {
+fn dynamic(cx: &Context, spec: &AnalysisSpec, rods: bool) -> Result<DynamicAnalysis, InputError> {
     if spec.steps.is_some() {
         return Err(cx.err("analysis.steps: a dynamic analysis takes `dt` and `end_time`"));
     }
@@ -162,7 +168,7 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec) -> Result<DynamicAnalysis, InputEr
     Ok(DynamicAnalysis {
         quadrature,
         hourglass,
-        bulk_viscosity: bulk_viscosity(cx, spec, integrator)?,
+        bulk_viscosity: bulk_viscosity(cx, spec, integrator, rods)?,
         mass_scaling: mass_scaling(cx, spec, integrator, &step)?,
         subcycling: subcycling(cx, spec, integrator, &step)?,
         ale: ale(cx, spec, integrator)?,
@@ -240,7 +246,16 @@ fn time_step(
                 .dt_min
                 .map(|m| positive(cx, "analysis.dt_min", m))
                 .transpose()?;
-            let stable = spec.stable_step.unwrap_or(StableStepKind::Bound);
+            // the mesh's estimate by default; the elements' own under the subcycling, whose
+            // levels are the elements' steps; the bounds under the mass scaling, whose
+            // target is a bound's step (docs/theory.md 8.7)
+            let stable = spec.stable_step.unwrap_or(
+                match (spec.subcycling.is_some(), spec.mass_scaling.is_some()) {
+                    (true, _) => StableStepKind::Tight,
+                    (false, true) => StableStepKind::Bound,
+                    (false, false) => StableStepKind::Global,
+                },
+            );
             if stable == StableStepKind::Global && spec.subcycling.is_some() {
                 return Err(cx.err(
                     "analysis.stable_step: \"global\" estimates one step for the whole mesh, and analysis.subcycling \
@@ -487,13 +502,25 @@ fn quadrature(
 
 /// `analysis.bulk_viscosity`: central difference at finite strain only (it acts in the
 /// explicit Quad4 kernels; the scene's checks refuse it with rod bodies), coefficients >= 0.
+/// Not given, it is on with Abaqus/Explicit's coefficients wherever it applies (central
+/// difference at finite strain without rods: `rods`), as in Abaqus/Explicit and LS-DYNA;
+/// `"off"` turns it off.
 fn bulk_viscosity(
     cx: &Context,
     spec: &AnalysisSpec,
     integrator: IntegratorKind,
+    rods: bool,
 ) -> Result<Option<BulkViscosity>, InputError> {
-    let Some(given) = spec.bulk_viscosity else {
-        return Ok(None);
+    let given = match spec.bulk_viscosity {
+        Some(BulkViscositySetting::Off) => return Ok(None),
+        Some(BulkViscositySetting::On(given)) => given,
+        None if integrator == IntegratorKind::CentralDifference
+            && spec.geometry != Strain::Small
+            && !rods =>
+        {
+            BulkViscositySpec::default()
+        }
+        None => return Ok(None),
     };
     if integrator != IntegratorKind::CentralDifference {
         return Err(cx.err(format!(

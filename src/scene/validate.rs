@@ -25,7 +25,10 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     for (k, spec) in scene.node_set.iter().enumerate() {
         add_node_set(&cx, &mut bodies, k, spec)?;
     }
-    let analysis = analysis(&cx, &scene.analysis)?;
+    let rods = bodies
+        .iter()
+        .any(|b| !matches!(b.kind, BodyKind::Continuum { .. }));
+    let analysis = analysis(&cx, &scene.analysis, rods)?;
     let curves = curves(&cx, &scene)?;
     let default_curve = default_curve(&analysis);
     let fixed_dofs = fixed_dofs(&cx, &scene, &bodies)?;

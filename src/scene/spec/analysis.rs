@@ -164,8 +164,10 @@ pub struct AnalysisSpec {
     /// gives a square element the hourglass stiffness of the fully integrated one. Default 0.1.
     pub hourglass: Option<f64>,
     /// Central difference on Quad4 bodies at finite strain: the bulk viscosity, an artificial
-    /// pressure on the volumetric strain rate (docs/theory.md 8.7a). Default: none (off).
-    pub bulk_viscosity: Option<BulkViscositySpec>,
+    /// pressure on the volumetric strain rate (docs/theory.md 8.7a). Default: on, with
+    /// Abaqus/Explicit's coefficients, where it applies (central difference, finite strain,
+    /// no rod body); `"off"` turns it off.
+    pub bulk_viscosity: Option<BulkViscositySetting>,
     /// Central difference on Quad4 bodies at finite strain with dt = "auto": selective mass
     /// scaling, the elements whose stable step falls below `target` made heavier until it is
     /// the target (docs/theory.md 8.7b). Default: none (off).
@@ -247,11 +249,49 @@ pub struct MassScalingSpec {
 /// `analysis.bulk_viscosity = { linear = 0.06, quadratic = 1.2 }`: the coefficients b_1 and
 /// b_2 of Abaqus/Explicit's bulk viscosity, each >= 0 and defaulting to those values (so
 /// `bulk_viscosity = {}` turns it on with the defaults).
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BulkViscositySpec {
     pub linear: Option<f64>,
     pub quadratic: Option<f64>,
+}
+
+/// `analysis.bulk_viscosity` as written: its coefficients (a table) or the word `off`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BulkViscositySetting {
+    Off,
+    On(BulkViscositySpec),
+}
+
+impl<'de> Deserialize<'de> for BulkViscositySetting {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<BulkViscositySetting, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = BulkViscositySetting;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(
+                    f,
+                    "a table of coefficients ({{ linear = 0.06, quadratic = 1.2 }}) or \"off\""
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<BulkViscositySetting, E> {
+                match v {
+                    "off" => Ok(BulkViscositySetting::Off),
+                    _ => Err(E::custom(format!(
+                        "expected a table of coefficients or \"off\", got \"{v}\""
+                    ))),
+                }
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<BulkViscositySetting, A::Error> {
+                BulkViscositySpec::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(BulkViscositySetting::On)
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// `analysis.dt` as written: a step length or the word `auto`.
