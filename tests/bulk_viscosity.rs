@@ -416,47 +416,15 @@ fn fixed_step_above_the_damped_limit_is_refused() {
     assert!((limit / (undamped * factor) - 1.0).abs() < 1e-5, "{limit}");
 }
 
-/// Goal: central difference runs as Abaqus/Explicit and LS-DYNA do unless told otherwise:
-/// with the bulk viscosity at their coefficients and at the global stable step, so that
-/// every shipped explicit scene steps at nearly its stability limit (issue 68). Setup: every
-/// models/*.toml whose integrator is central difference, as shipped; models/taylor_jc.toml
-/// with `bulk_viscosity = "off"`; models/bar_wall.toml (a rod) run explicit.
-/// Reference: Abaqus/Explicit's default coefficients b_1 = 0.06, b_2 = 1.2 (Abaqus Analysis
-/// User's Guide, "Bulk viscosity"); the issue's floor for the step `impact check` prints,
-/// dt / dt_crit >= 0.85 (dt_crit the element eigenvalue limit with the viscosity's damping at
-/// rest: the bound's step, the old default, gives 0.46-0.53 and fails it); a rod body's
-/// scene keeps the viscosity off and loads (the explicit Quad4 kernels carry it; refused
-/// when asked for, above).
+/// Goal: central difference runs as Abaqus/Explicit and LS-DYNA do unless told otherwise,
+/// with the bulk viscosity at their coefficients (issue 68; the step near its limit on every
+/// shipped explicit scene: tests/scenes.rs). Setup: models/taylor_jc.toml as shipped and with
+/// `bulk_viscosity = "off"`; models/bar_wall.toml (a rod) made explicit. Reference:
+/// Abaqus/Explicit's default coefficients b_1 = 0.06, b_2 = 1.2 (Abaqus Analysis User's
+/// Guide, "Bulk viscosity"); a rod body's scene keeps the viscosity off and loads (the
+/// explicit Quad4 kernels carry it; refused when asked for, above).
 #[test]
-fn central_difference_defaults_are_the_bulk_viscosity_and_the_global_step() {
-    let mut explicit = 0;
-    for entry in std::fs::read_dir("models").unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_none_or(|e| e != "toml") {
-            continue;
-        }
-        let model = impact::scene::load(&path, &[]).unwrap();
-        let impact::scene::model::Analysis::Dynamic(spec) = &model.analysis else {
-            continue;
-        };
-        if spec.integrator != impact::scene::spec::IntegratorKind::CentralDifference {
-            continue;
-        }
-        explicit += 1;
-        let lines = impact::analysis::check::report(&model).unwrap();
-        let line = lines
-            .iter()
-            .find(|l| l.contains("dt / dt_crit = "))
-            .unwrap_or_else(|| panic!("{path:?}: {lines:?}"));
-        let ratio: f64 = line
-            .split("dt / dt_crit = ")
-            .nth(1)
-            .and_then(|r| r.split([';', ' ']).next())
-            .and_then(|r| r.parse().ok())
-            .unwrap();
-        assert!(ratio >= 0.85, "{path:?}: {line}");
-    }
-    assert!(explicit >= 10, "{explicit} explicit scenes");
+fn central_difference_defaults_to_the_bulk_viscosity() {
     let taylor = std::path::Path::new("models/taylor_jc.toml");
     let model = impact::scene::load(taylor, &[]).unwrap();
     let viscosity = model.analysis.bulk_viscosity().expect("on by default");
