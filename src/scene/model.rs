@@ -504,7 +504,7 @@ pub struct ArcLength {
 impl DynamicAnalysis {
     /// The estimate of the highest frequency central difference's automatic step scales
     /// (the one answer to `analysis.stable_step`; docs/theory.md 8.7): the elements' bounds
-    /// (`Bound`, the default, and every step that is not automatic), their exact frequencies
+    /// (`Bound`, and every step that is not automatic), their exact frequencies
     /// (`Tight`), or the mesh's highest frequency estimated over those (`Global`). With the
     /// bulk viscosity the ratios are taken against the undamped bounds and scale the damped
     /// ones. With the mass scaling the elements are scaled by their bounds as without it

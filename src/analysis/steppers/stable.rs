@@ -16,7 +16,7 @@
 //!            time_step_scale dt_bound, re-evaluated every step (clock.rs)
 //! ```
 //!
-//! From the scene key to the step (`analysis.stable_step`, default `bound`):
+//! From the scene key to the step (`analysis.stable_step`, default `global`):
 //! `scene::spec::StableStepKind` -> `DynamicAnalysis::stable_estimate` ->
 //! `assembly::explicit::kernel_for` -> `Skeleton::with_stable_step` (the one Quad4 loop,
 //! `assembly/explicit/skeleton.rs`: each element's bound from its rule, damped by the bulk

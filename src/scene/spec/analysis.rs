@@ -100,10 +100,10 @@ pub struct AnalysisSpec {
     /// `dt = "auto"`: the fraction of the critical step taken, in (0, 1]. Default 0.9.
     pub time_step_scale: Option<f64>,
     /// `dt = "auto"`, central difference: the critical step the scale applies to: `bound`
-    /// (default: the kernels' closed-form frequency bounds), `tight` (each element's exact
-    /// highest frequency, `assembly::explicit::tight`: up to twice the step) or `global`
-    /// (the mesh's highest frequency estimated over the tight elements,
-    /// `assembly::explicit::global`).
+    /// (the kernels' closed-form frequency bounds; the default with the mass scaling),
+    /// `tight` (each element's exact highest frequency, `assembly::explicit::tight`: up to
+    /// twice the step; the default with the subcycling) or `global` (the default: the mesh's
+    /// highest frequency estimated over the tight elements, `assembly::explicit::global`).
     pub stable_step: Option<StableStepKind>,
     /// `dt = "auto"`, central difference: the run stops (status `diverged`) when the step
     /// would fall below this (a time); default no limit. Implicit: the shortest step the
