@@ -580,6 +580,24 @@ mod tests {
         );
         assert!(replay.stress[2].abs() <= 1e-12 * replay.stress.norm());
     }
+
+    /// A return whose start stress lies reversed beyond the end's elastic range is booked by
+    /// the trapezoid where the yield stress fell (it was refused before, which stopped the
+    /// struck faces of Johnson-Cook rods at the longer steps). By hand, deviatoric stresses
+    /// along n = (1, -1, 0, 0): s_n = -a n, s_{n+1} = b n, the trapezoid 1/2 (1 - a / b) W.
+    /// With a = 1.02, b = 1 (the start's von Mises above the end's) it is -0.01 W, returned;
+    /// with a = 1, b = 1.02 (the yield stress grew) 1/2 (1 - 1/1.02) W > 0. (A negative
+    /// trapezoid with the start not above the end is what Cauchy-Schwarz forbids: the refusal
+    /// is left to round-off.)
+    #[test]
+    fn a_reversal_under_a_falling_yield_stress_is_booked_by_the_trapezoid() {
+        let along = |k: f64| Voigt::new(k, -k, 0.0, 0.0);
+        let none = Voigt::zeros();
+        let d = dissipation(&along(-1.02), &along(1.0), &none, 1.0).unwrap();
+        assert!((d - (-0.01)).abs() < 1e-12, "{d}");
+        let d = dissipation(&along(-1.0), &along(1.02), &none, 1.0).unwrap();
+        assert!((d - 0.5 * (1.0 - 1.0 / 1.02)).abs() < 1e-12, "{d}");
+    }
 }
 
 #[cfg(test)]
