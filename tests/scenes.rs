@@ -140,7 +140,7 @@ fn every_scene_runs_and_writes_the_output_contract() {
 /// Reference: the run's own first row of history.csv (its time is the first step); equal to
 /// round-off (1e-12 relative: the same arithmetic, a sum of one term); the floor
 /// dt / dt_crit >= 0.85 (dt_crit the element eigenvalue limit, damped by the bulk viscosity at
-/// rest: the bound's step, the old default, gives 0.46-0.53 and fails it).
+/// rest: the bound's step, the old default, gives 0.46-0.67 and fails it).
 #[test]
 fn check_reports_the_first_step_of_the_run_on_every_explicit_scene() {
     let mut explicit = 0;
