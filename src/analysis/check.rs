@@ -50,9 +50,7 @@ fn step_count(model: &Model, spec: &DynamicAnalysis, dt: f64) -> String {
     let steps = (spec.end_time / dt).ceil();
     let count = match spec.step {
         crate::scene::spec::TimeStep::Fixed(_) => format!("{steps:.0} steps to end_time"),
-        crate::scene::spec::TimeStep::Auto { .. }
-            if spec.stable_estimate() == crate::scene::spec::StableStepKind::Global =>
-        {
+        crate::scene::spec::TimeStep::Auto { .. } if global_step(spec) => {
             format!(
                 "about {steps:.0} steps of the first step to end_time (the global estimate is taken \
              again as the mesh deforms; the step falls as elements crush)"

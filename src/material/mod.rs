@@ -513,19 +513,13 @@ pub fn dissipation(
 ) -> Result<f64, f64> {
     let d = trapezoid_dissipation(start, end, end_back, plastic_work);
     let kinematic = end_back.iter().any(|b| *b != 0.0);
-    let fell = deviatoric_norm(start) > deviatoric_norm(end);
+    // |s_n| > |s_{n+1}|: von Mises' stress is sqrt(3/2) |dev s|
+    let fell = von_mises(start) > von_mises(end);
     if d < 0.0 && d < -1e-9 * plastic_work.abs() && !kinematic && !fell {
         Err(d)
     } else {
         Ok(d)
     }
-}
-
-/// |dev s| of [xx yy zz xy] (the shear counted twice, as in s : s).
-fn deviatoric_norm(s: &Voigt) -> f64 {
-    let p = (s[0] + s[1] + s[2]) / 3.0;
-    let (a, b, c) = (s[0] - p, s[1] - p, s[2] - p);
-    (a * a + b * b + c * c + 2.0 * s[3] * s[3]).sqrt()
 }
 
 /// Von Mises equivalent stress of [xx yy zz xy].
