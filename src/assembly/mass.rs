@@ -126,6 +126,22 @@ impl Mass {
             .sum::<f64>()
     }
 
+    /// The kinetic energy a change of the velocities from `before` to `after` removed, DOF
+    /// by DOF: 1/2 b.M b - 1/2 a.M a = -(a - b).M (a + b) / 2 (M symmetric), whose terms
+    /// are zero where the velocity did not change (under a consistent mass too, where
+    /// 1/2 v_d (M v)_d would move with its neighbours).
+    pub fn kinetic_removed_by_dof(&self, model: &Model, before: &[f64], after: &[f64]) -> Vec<f64> {
+        let mean: Vec<f64> = before
+            .iter()
+            .zip(after)
+            .map(|(b, a)| 0.5 * (a + b))
+            .collect();
+        let momentum = self.product(model, &mean);
+        (before.iter().zip(after).zip(momentum))
+            .map(|((b, a), p)| if a == b { 0.0 } else { -(a - b) * p })
+            .collect()
+    }
+
     /// Each body's 1/2 v . M v over its own nodes (model order; the bodies share no node,
     /// so they sum to `kinetic_energy`).
     pub fn body_kinetic_energies(&self, model: &Model, v: &[f64]) -> Vec<f64> {

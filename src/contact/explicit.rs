@@ -52,10 +52,13 @@ pub struct ExplicitContact {
     /// DOFs): what does the step's contact work on its corrected increment (the friction's
     /// share is the work it dissipates).
     pub step_force: Vec<f64>,
-    /// The work of the friction's share of `step_force`, T^T lambda / h^2, on the corrected
-    /// increment, f_t . (du + delta / 2): minus the energy the friction dissipates in the
-    /// step (0 without a pair with Coulomb friction).
-    pub friction_work: f64,
+    /// `step_force` kept apart by pair (per pair of the interfaces, its (DOF, value) terms:
+    /// its rows' and its master block's), which it is the sum of.
+    pub pair_forces: Vec<Vec<(usize, f64)>>,
+    /// Per pair, the work of the friction's share of its step force, T^T lambda / h^2, on
+    /// the corrected increment, f_t . (du + delta / 2): minus the energy the friction
+    /// dissipates in the step (0 without Coulomb friction).
+    pub friction_work: Vec<f64>,
 }
 
 impl ContactState {
@@ -139,11 +142,14 @@ impl ContactState {
                 self.sliding[*p][*k] = coulomb(*p).unwrap_or(0.0) * c.friction_total[i].signum();
             }
         }
-        let zeroed = zeros(&mut self.scratch.force, step.du.len());
+        let mut step_force = zeros(&mut self.scratch.force, step.du.len());
         let rows = (&step_forces[..], &step_friction[..]);
-        let mut step_force = self.nodal_forces_into(&interfaces.pairs, start, rows, zeroed);
-        for (dof, impulse) in &c.master_impulse {
-            step_force[*dof] += impulse / (h * h);
+        let mut pair_forces = self.pair_force_terms(&interfaces.pairs, start, rows);
+        for (pair, dof, impulse) in &c.master_impulse {
+            pair_forces[*pair].push((*dof, impulse / (h * h)));
+        }
+        for (dof, force) in pair_forces.iter().flatten() {
+            step_force[*dof] += force;
         }
         let increment = |dof: usize| step.du[dof] + 0.5 * c.delta[dof];
         let friction_work =
@@ -151,6 +157,7 @@ impl ContactState {
         ExplicitContact {
             correction: c.delta,
             step_force,
+            pair_forces,
             friction_work,
         }
     }
@@ -168,12 +175,7 @@ impl ContactState {
             force[d] = 0.0;
         }
         for pair in &interfaces.pairs {
-            let masters: &[usize] = match &pair.master {
-                Master::Segments { edges, .. } => edges.as_flattened(),
-                Master::Nodes { nodes, .. } => nodes,
-                Master::Obstacle(_) => &[],
-            };
-            for n in pair.slaves.iter().chain(masters) {
+            for n in pair.surface_nodes() {
                 delta[2 * n..2 * n + 2].fill(0.0);
                 force[2 * n..2 * n + 2].fill(0.0);
             }
@@ -224,10 +226,10 @@ struct Correction {
     lowest: Option<Option<f64>>,
     /// The master block of the mortar pairs: (pair, master node) entries held out of the
     /// slave body, their accumulated multipliers, and the impulse C^T nu they applied as
-    /// (DOF, value) terms.
+    /// (pair, DOF, value) terms.
     masters: Vec<(usize, usize)>,
     nu_total: Vec<f64>,
-    master_impulse: Vec<(usize, f64)>,
+    master_impulse: Vec<(usize, usize, f64)>,
 }
 
 impl Predicted<'_> {
@@ -541,19 +543,20 @@ impl Predicted<'_> {
     /// correction.
     fn apply_masters(&self, c: &mut Correction, rows: &[Vec<(usize, f64)>], nu: &[f64]) {
         let inverse_mass = self.inverse_mass;
-        let mut apply = |row: &[(usize, f64)], value: f64| {
-            for (dof, coefficient) in row {
+        let apply = |c: &mut Correction, i: usize, value: f64| {
+            let pair = c.masters[i].0;
+            for (dof, coefficient) in &rows[i] {
                 c.delta[*dof] += inverse_mass[*dof] * coefficient * value;
-                c.master_impulse.push((*dof, coefficient * value));
+                c.master_impulse.push((pair, *dof, coefficient * value));
             }
         };
-        for (i, row) in rows.iter().enumerate() {
-            apply(row, nu[i]);
-            c.nu_total[i] += nu[i];
+        for (i, nu) in nu.iter().enumerate() {
+            apply(c, i, *nu);
+            c.nu_total[i] += nu;
         }
-        for (i, row) in rows.iter().enumerate() {
+        for i in 0..rows.len() {
             if c.nu_total[i] < 0.0 {
-                apply(row, -c.nu_total[i]);
+                apply(c, i, -c.nu_total[i]);
             }
         }
         let kept: Vec<bool> = c.nu_total.iter().map(|nu| *nu >= 0.0).collect();
@@ -603,7 +606,7 @@ impl Correction {
             }
         }
         let master_impulse = (self.master_impulse.iter().chain(&other.master_impulse))
-            .map(|(dof, value)| (*dof, 0.5 * value))
+            .map(|(pair, dof, value)| (*pair, *dof, 0.5 * value))
             .collect();
         let lowest = match (self.lowest, other.lowest) {
             (Some(a), Some(b)) => Some(match (a, b) {

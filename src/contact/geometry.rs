@@ -314,6 +314,17 @@ fn signed_gap(
 const VERTEX: f64 = 1e-9;
 
 impl ContactPair {
+    /// The nodes of its surfaces: its slaves, then its deformable master's nodes (none on an
+    /// obstacle).
+    pub fn surface_nodes(&self) -> impl Iterator<Item = usize> + '_ {
+        let masters: &[usize] = match &self.master {
+            Master::Segments { edges, .. } => edges.as_flattened(),
+            Master::Nodes { nodes, .. } => nodes,
+            Master::Obstacle(_) => &[],
+        };
+        self.slaves.iter().chain(masters).copied()
+    }
+
     /// Whether the pair's impact and release conditions act along its rows, all of them
     /// together (a mortar pair and its hold pair: rows that share master nodes), rather than
     /// node by node (Hughes II-8, II-11).

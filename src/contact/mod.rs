@@ -32,6 +32,7 @@
 //! ```
 
 pub mod conditions;
+pub mod energy;
 pub mod explicit;
 pub mod gap;
 pub mod geometry;
@@ -249,6 +250,21 @@ pub struct ContactSummary {
     /// The first slave that went past the open end of its obstacle.
     #[serde(default)]
     pub past_end: Option<penetration::PastEndNode>,
+    /// Per pair, in scene order, the energy its contact took and its friction dissipated
+    /// over the run (dynamic runs; empty in statics, which books no contact energy).
+    #[serde(default)]
+    pub pairs: Vec<PairEnergies>,
+}
+
+/// One pair's energies in summary.json `contact.pairs` (history.csv `contact_work[NAME]`,
+/// `friction_work[NAME]`; `energy`'s `contact_work` and `friction_work` are their sums).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PairEnergies {
+    pub name: String,
+    /// The energy its normal rows took from the bodies (>= 0 where nothing is created).
+    pub contact_work: f64,
+    /// The energy its friction dissipated (>= 0; 0 without friction).
+    pub friction_work: f64,
 }
 
 #[cfg(test)]

@@ -36,6 +36,14 @@ pub struct ContactState {
     /// forces (`contact::explicit`). Empty on every other path.
     #[serde(default)]
     pub master_block: Vec<MasterEntry>,
+    /// Per pair: the energy its normal rows took from the bodies so far (history.csv
+    /// `contact_work[pair]`, the pair's share of `contact_work`; dynamic runs; empty in a
+    /// checkpoint written before it was kept).
+    #[serde(default)]
+    pub work: Vec<f64>,
+    /// Per pair: the energy its friction dissipated so far (`friction_work[pair]`).
+    #[serde(default)]
+    pub friction_work: Vec<f64>,
     /// The explicit correction's vectors over all DOFs, kept zero between steps, so that a
     /// step neither allocates nor clears them whole (`contact::explicit`; not in a
     /// checkpoint: zero vectors of the right length either way).
@@ -80,6 +88,8 @@ impl ContactState {
             penetration: 0.0,
             ever_closed: vec![false; pairs.len()],
             master_block: Vec::new(),
+            work: vec![0.0; pairs.len()],
+            friction_work: vec![0.0; pairs.len()],
             scratch: Scratch::default(),
         }
     }
@@ -146,7 +156,6 @@ impl ContactState {
 }
 
 impl ContactState {
-    /// The contact block of summary.json.
     /// The contact block of summary.json for the run's `pairs`.
     pub fn summary(&self, pairs: &[ContactPair]) -> ContactSummary {
         // a second pass closes nothing where its first pass holds the contact: the two
@@ -169,8 +178,29 @@ impl ContactState {
             peak_contact_radius: self.peak_extent,
             min_gap: self.min_gap,
             max_penetration: self.min_gap.map(|_| self.max_penetration),
+            pairs: self.pair_energies(pairs),
             ..ContactSummary::default()
         }
+    }
+
+    /// Each reported pair's energies (a balanced pair's two passes as one).
+    pub fn pair_energies(&self, pairs: &[ContactPair]) -> Vec<super::PairEnergies> {
+        let folded = |values: &[f64]| {
+            let mut values = values.to_vec();
+            values.resize(pairs.len(), 0.0);
+            super::fold_passes(pairs, &values)
+        };
+        let (work, friction) = (folded(&self.work), folded(&self.friction_work));
+        let reported = pairs.iter().filter(|p| p.balances.is_none());
+        (reported.zip(work).zip(friction))
+            .map(
+                |((pair, contact_work), friction_work)| super::PairEnergies {
+                    name: pair.name.clone(),
+                    contact_work,
+                    friction_work,
+                },
+            )
+            .collect()
     }
 
     /// Total normal force per pair (the slave entries' and the master block's).
@@ -238,7 +268,7 @@ impl ContactState {
     }
 
     /// The same, added into `f` (zero over all DOFs).
-    pub(super) fn nodal_forces_into(
+    fn nodal_forces_into(
         &self,
         pairs: &[ContactPair],
         coords: &[[f64; 2]],
@@ -258,25 +288,53 @@ impl ContactState {
         f
     }
 
-    /// The work `tangential`'s forces do on the increment `increment(dof)`, the rows at
-    /// positions `coords`: T^T lambda . du over the active entries, what the forces of
-    /// `nodal_forces_into`'s tangential rows would do.
+    /// Per pair, the terms (DOF, value) that `nodal_forces_into` adds up for it: the forces
+    /// of the rows `normal` and `tangential` (per pair, per slave) of the active entries at
+    /// positions `coords`, in the same order, so that their sum in pair order is its vector
+    /// to the bit.
+    pub(super) fn pair_force_terms(
+        &self,
+        pairs: &[ContactPair],
+        coords: &[[f64; 2]],
+        (normal, tangential): (&[Vec<f64>], &[Vec<f64>]),
+    ) -> Vec<Vec<(usize, f64)>> {
+        let x = |n: usize| coords[n];
+        let mut terms = vec![Vec::new(); pairs.len()];
+        for s in slave_gaps(pairs, &x, &|p, k| !self.active[p][k]) {
+            let (p, k) = (s.pair, s.index);
+            let normal = s
+                .gap
+                .row(s.node)
+                .into_iter()
+                .map(|(d, c)| (d, normal[p][k] * c));
+            terms[p].extend(normal);
+            if tangential[p][k] != 0.0 {
+                let tangent = s.gap.tangent_row(s.node).into_iter();
+                terms[p].extend(tangent.map(|(d, c)| (d, tangential[p][k] * c)));
+            }
+        }
+        terms
+    }
+
+    /// Per pair, the work `tangential`'s forces do on the increment `increment(dof)`, the
+    /// rows at positions `coords`: T^T lambda . du over the pair's active entries, what the
+    /// forces of `nodal_forces_into`'s tangential rows would do.
     pub(super) fn tangential_work(
         &self,
         pairs: &[ContactPair],
         coords: &[[f64; 2]],
         tangential: &[Vec<f64>],
         increment: &dyn Fn(usize) -> f64,
-    ) -> f64 {
+    ) -> Vec<f64> {
         let x = |n: usize| coords[n];
-        slave_gaps(pairs, &x, &|p, k| {
-            !self.active[p][k] || tangential[p][k] == 0.0
-        })
-        .map(|s| {
+        let mut work = vec![0.0; pairs.len()];
+        let skip = |p: usize, k: usize| !self.active[p][k] || tangential[p][k] == 0.0;
+        for s in slave_gaps(pairs, &x, &skip) {
             let row = s.gap.tangent_row(s.node);
-            tangential[s.pair][s.index] * row.iter().map(|(d, c)| c * increment(*d)).sum::<f64>()
-        })
-        .sum()
+            let slip: f64 = row.iter().map(|(d, c)| c * increment(*d)).sum();
+            work[s.pair] += tangential[s.pair][s.index] * slip;
+        }
+        work
     }
 
     /// Per node: the gap and the status of slave nodes (status 1 active, 0 open), zeros

@@ -81,7 +81,27 @@ pub(super) fn columns(model: &Model) -> (Vec<String>, bool) {
             );
         }
     }
+    if pair_columns(model) {
+        // each pair's contact work and, with Coulomb friction, its friction work (the
+        // totals' shares, contact::energy)
+        for pair in reported() {
+            columns.push(format!("contact_work[{}]", pair.name));
+            if matches!(pair.options.friction, Friction::Coulomb { .. }) {
+                columns.push(format!("friction_work[{}]", pair.name));
+            }
+        }
+    }
     (columns, pivots_column)
+}
+
+/// Whether the history has each pair's energies: a dynamic run with two pairs or more (a
+/// balanced pair's passes counted once).
+pub fn pair_columns(model: &Model) -> bool {
+    matches!(model.analysis, crate::scene::model::Analysis::Dynamic(_))
+        && (model.contacts.iter())
+            .filter(|c| c.balances.is_none())
+            .count()
+            > 1
 }
 
 /// Whether the history has each body's energies: a model of two bodies or more.

@@ -482,6 +482,10 @@ impl<'a, S: Stepper> Run<'a, S> {
             .map(|r| MassScalingSummary::of(r, self.model));
         summary.subcycling = s.subcycling();
         summary.contact = s.contact().summary(&self.model.contacts);
+        if !matches!(self.model.analysis, Analysis::Dynamic(_)) {
+            // statics books no energy of its contact
+            summary.contact.pairs.clear();
+        }
         if let Some(record) = &self.recorder.contact {
             record.fill(self.model, &mut summary.contact, s.contact());
         }
@@ -686,6 +690,23 @@ impl<S: Stepper> Run<'_, S> {
                 .collect();
             names.join(", ")
         };
+        // the pairs that gave energy (all of them when none did), with what each gave where
+        // there are several
+        let givers = || {
+            let energies = self.stepper.contact().pair_energies(&self.model.contacts);
+            let gave: Vec<(String, f64)> = (energies.iter())
+                .map(|p| (p.name.clone(), -(p.contact_work + p.friction_work)))
+                .filter(|(_, given)| *given > 0.0)
+                .collect();
+            match gave.len() {
+                0 => pairs(),
+                1 => format!("`{}`", gave[0].0),
+                _ => (gave.iter())
+                    .map(|(name, given)| format!("`{name}` ({})", readable(*given)))
+                    .collect::<Vec<String>>()
+                    .join(", "),
+            }
+        };
         if self.model.is_explicit() && given > CREATED_SHARE * scale {
             return Some(format!(
                 "the contact gave the bodies {} of energy, {:.1} % of the {} in play (more than \
@@ -697,7 +718,7 @@ impl<S: Stepper> Run<'_, S> {
                 100.0 * given / scale,
                 readable(scale),
                 100.0 * CREATED_SHARE,
-                pairs()
+                givers()
             ));
         }
         let gain = relative_gain(e, initial);
@@ -715,7 +736,7 @@ impl<S: Stepper> Run<'_, S> {
                 readable(supplied),
                 100.0 * (e.plastic_work - supplied) / scale,
                 100.0 * limit,
-                pairs(),
+                givers(),
                 readable(given),
             ));
         }
@@ -724,7 +745,7 @@ impl<S: Stepper> Run<'_, S> {
                 (true, _) => format!(
                     "the contact {} gave {} of it: a step too long for the contact, or \
                      surfaces that do not face each other",
-                    pairs(),
+                    givers(),
                     readable(given)
                 ),
                 (false, false) => format!(

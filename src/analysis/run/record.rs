@@ -4,7 +4,7 @@
 
 use super::columns::{
     body_columns, bulk_viscosity_column, columns, error_column, friction_column, hourglass_column,
-    load_factor_column, mass_scaling_columns,
+    load_factor_column, mass_scaling_columns, pair_columns,
 };
 use super::contact_record::{ContactCarry, ContactRecord};
 use super::frame::{PointArrays, cell_fields, point_body_ids};
@@ -296,6 +296,9 @@ impl Recorder {
         }
         row.extend(averages);
         self.push_feature_columns(model, state, energies, &mut row);
+        if pair_columns(model) {
+            row.extend(pair_energies(model, contact));
+        }
         let frame = self.frame_due(model, state.time, force_frame, 1);
         let history = &mut self.history;
         self.thinning
@@ -664,4 +667,26 @@ pub struct RecorderPosition {
     /// The contact record (with contact).
     #[serde(default)]
     pub contact: Option<ContactCarry>,
+}
+
+/// Each reported pair's contact work and, with Coulomb friction, its friction work, in the
+/// order of `columns::pair_columns`' columns (zeros before any contact).
+fn pair_energies(model: &Model, contact: Option<&ContactState>) -> Vec<f64> {
+    let pairs = &model.contacts;
+    let per_pair = |values: Option<&Vec<f64>>| {
+        let mut values = values.cloned().unwrap_or_default();
+        values.resize(pairs.len(), 0.0);
+        fold_passes(pairs, &values)
+    };
+    let work = per_pair(contact.map(|c| &c.work));
+    let friction = per_pair(contact.map(|c| &c.friction_work));
+    let reported = pairs.iter().filter(|c| c.balances.is_none());
+    let mut row = Vec::new();
+    for ((pair, work), friction) in reported.zip(work).zip(friction) {
+        row.push(work);
+        if matches!(pair.options.friction, Friction::Coulomb { .. }) {
+            row.push(friction);
+        }
+    }
+    row
 }

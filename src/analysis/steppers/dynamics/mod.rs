@@ -25,6 +25,7 @@ use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure}
 use super::{StepError, Stepper, loads};
 use crate::analysis::summary::RunError;
 use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System, check_mass};
+use crate::contact::energy::ImplicitStepWork;
 use crate::contact::{ContactResult, ContactState, ImpactMotion, Interfaces, LumpedMass, Pass};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
@@ -362,9 +363,14 @@ impl<'a> Dynamics<'a> {
         let (model, spec) = (self.model, self.spec);
         let h = step.length;
         // the friction forces the step starts from (the committed contact, start positions)
-        let friction_start = self
-            .contact
-            .friction_forces(&self.interfaces.pairs, &self.state.positions(spec.geometry));
+        let pairs = &self.interfaces.pairs;
+        let start_positions = self.state.positions(spec.geometry);
+        let friction_start = self.contact.friction_forces(pairs, &start_positions);
+        let pair_start = (
+            self.contact.pair_force_vectors(pairs, &start_positions),
+            self.contact.pair_friction_forces(pairs, &start_positions),
+        );
+        drop(start_positions);
         let d = std::mem::take(&mut step.solution.d);
         let evaluation = std::mem::take(&mut step.solution.evaluation);
         let internal = evaluation.force.clone();
@@ -394,7 +400,7 @@ impl<'a> Dynamics<'a> {
         // the impact and release conditions change velocities only at a step's events
         let events = &step.events;
         let conditions = !events.closed.is_empty() || !events.released.is_empty();
-        let kinetic_before = conditions.then(|| self.mass.kinetic_energy(model, &kin.velocity));
+        let velocity_before = conditions.then(|| kin.velocity.clone());
         let positions = self.state.positions(spec.geometry);
         let mass = LumpedMass {
             mass: &self.mass.lumped,
@@ -408,6 +414,11 @@ impl<'a> Dynamics<'a> {
         crate::contact::apply_conditions(&self.interfaces, &mut step, &positions, mass, motion);
         self.contact
             .commit(&self.interfaces, &step, self.state.time, &positions);
+        // the kinetic energy the conditions removed, DOF by DOF
+        let removed = velocity_before.map(|before| {
+            self.mass
+                .kinetic_removed_by_dof(model, &before, &self.kin.velocity)
+        });
         // the next step starts from the motion the conditions left
         let next_start = match conditions {
             true => self.motion_contact_force(&internal),
@@ -428,12 +439,18 @@ impl<'a> Dynamics<'a> {
         // energy taken up by the interface: minus the work of the contact forces on the
         // bodies, plus what the impact/release conditions removed; the friction's share apart
         energies.contact_work += -super::trapezoid_work(&d, &applied, &self.last_contact)
-            + kinetic_before.unwrap_or(energies.kinetic)
-            - energies.kinetic
+            + removed.as_ref().map_or(0.0, |r| r.iter().sum())
             - friction;
         energies.friction_work += friction;
         energies.internal = self.state.internal_work - self.state.plastic_work;
         energies.plastic_work = self.state.plastic_work;
+        let work = ImplicitStepWork {
+            increment: &d,
+            applied: (&applied, &self.last_contact),
+            conditions: removed,
+            start: pair_start,
+        };
+        (self.contact).book_implicit_step(&self.interfaces.pairs, &positions, work);
         self.last_total = total;
         self.last_internal = internal;
         self.last_contact = next_start;
@@ -717,7 +734,7 @@ impl Stepper for Dynamics<'_> {
         loop {
             let (target, nominal) = self.target();
             let positions = self.state.positions(self.spec.geometry).into_owned();
-            let kinetic_before_impact = self.mass.kinetic_energy(self.model, &self.kin.velocity);
+            let velocity_before = self.kin.velocity.clone();
             let mass = LumpedMass {
                 mass: &self.mass.lumped,
                 inverse: &self.inverse_mass,
@@ -730,8 +747,15 @@ impl Stepper for Dynamics<'_> {
                 // their impact conditions changed the motion the step starts from
                 self.last_contact = self.motion_contact_force(&self.last_internal);
             }
-            self.energies.contact_work +=
-                kinetic_before_impact - self.mass.kinetic_energy(self.model, &self.kin.velocity);
+            // the kinetic energy their impact conditions removed, booked to the pairs
+            // whose surfaces hold the nodes
+            if !closed.is_empty() {
+                let velocity = &self.kin.velocity;
+                let removed =
+                    (self.mass).kinetic_removed_by_dof(self.model, &velocity_before, velocity);
+                self.energies.contact_work += removed.iter().sum::<f64>();
+                (self.contact).book_by_owner(&self.interfaces.pairs, &removed, &[]);
+            }
             match self.attempt(nominal, &positions, counters) {
                 Ok((step, advance)) => {
                     let h = step.length;

@@ -207,6 +207,8 @@ impl<'a> Explicit<'a> {
         let work = chunked_sum(&touched, &step.step_force, &self.du, |f, u| f * u)
             + 0.5 * chunked_sum(&touched, &step.step_force, &step.correction, |f, c| f * c)
             - 0.5 * held;
+        let held_at = |i: usize| step.correction[i] * mass[i] * a[i];
+        (self.contact).book_explicit_work(&step, (&self.interfaces, &touched), &self.du, &held_at);
         // du += delta and v_half += delta / h at the touched DOFs (the division left to
         // them: elsewhere delta is zero)
         for &i in &touched {
@@ -217,8 +219,9 @@ impl<'a> Explicit<'a> {
             }
         }
         // the friction's share is the energy it dissipates, booked apart (theory 7)
-        self.energies.contact_work -= work - step.friction_work;
-        self.energies.friction_work -= step.friction_work;
+        let friction_work: f64 = step.friction_work.iter().sum();
+        self.energies.contact_work -= work - friction_work;
+        self.energies.friction_work -= friction_work;
         self.contact.recycle(step, &self.interfaces, &touched);
     }
 
