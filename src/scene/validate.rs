@@ -25,10 +25,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     for (k, spec) in scene.node_set.iter().enumerate() {
         add_node_set(&cx, &mut bodies, k, spec)?;
     }
-    let rods = bodies
-        .iter()
-        .any(|b| !matches!(b.kind, BodyKind::Continuum { .. }));
-    let analysis = analysis(&cx, &scene.analysis, rods)?;
+    let analysis = analysis(&cx, &scene.analysis, first_rod(&bodies).is_some())?;
     let curves = curves(&cx, &scene)?;
     let default_curve = default_curve(&analysis);
     let fixed_dofs = fixed_dofs(&cx, &scene, &bodies)?;
@@ -42,9 +39,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let contacts = contacts(&cx, &scene, &bodies, &obstacles)?;
     check_contact_setup(&cx, &scene, &bodies, &contacts)?;
     check_reaction_probes(&cx, &probes, &fixed_dofs, &loads)?;
-    check_reduced_quadrature(&cx, &analysis, &bodies)?;
-    check_bulk_viscosity(&cx, &analysis, &bodies)?;
-    check_mass_scaling(&cx, &analysis, &bodies)?;
+    check_quad4_features(&cx, &analysis, &bodies)?;
     check_dispersion_free(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
     check_arc_length(&cx, &analysis, &loads, &contacts)?;
@@ -114,75 +109,59 @@ fn check_reaction_probes(
     Ok(())
 }
 
-/// One-point quadrature in a dynamic run covers Quad4 bodies only (no rods).
-fn check_reduced_quadrature(
-    cx: &Context,
-    analysis: &Analysis,
-    bodies: &[Body],
-) -> Result<(), InputError> {
-    if let Analysis::Dynamic(d) = analysis
-        && d.quadrature == Quadrature::Reduced
-        && let Some(body) = bodies
-            .iter()
-            .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
-    {
-        return Err(cx.err(format!(
-            "analysis.quadrature: `reduced` covers Quad4 bodies (plane strain, plane stress, axisymmetric); body `{}` is a rod: use quadrature = \"full\"",
-            body.name
-        )));
-    }
-    Ok(())
-}
-
-/// The bulk viscosity acts in the explicit Quad4 kernels, which run on Quad4 bodies only.
-fn check_bulk_viscosity(
-    cx: &Context,
-    analysis: &Analysis,
-    bodies: &[Body],
-) -> Result<(), InputError> {
-    if let Analysis::Dynamic(d) = analysis
-        && d.bulk_viscosity.is_some()
-        && let Some(body) = bodies
-            .iter()
-            .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
-    {
-        return Err(cx.err(format!(
-            "analysis.bulk_viscosity: acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric); body `{}` is a rod: remove bulk_viscosity",
-            body.name
-        )));
-    }
-    Ok(())
-}
-
-/// The mass scaling and the subcycling act in the explicit Quad4 kernels, which run on Quad4
-/// bodies only.
-fn check_mass_scaling(
-    cx: &Context,
-    analysis: &Analysis,
-    bodies: &[Body],
-) -> Result<(), InputError> {
-    let Analysis::Dynamic(d) = analysis else {
-        return Ok(());
-    };
-    let Some(body) = bodies
+/// The first rod body of `bodies` (None: all are Quad4 continua).
+fn first_rod(bodies: &[Body]) -> Option<&Body> {
+    bodies
         .iter()
         .find(|b| !matches!(b.kind, BodyKind::Continuum { .. }))
-    else {
+}
+
+/// The features of the explicit Quad4 kernels (one-point quadrature, the bulk viscosity,
+/// the mass scaling, the subcycling, ALE) are refused in a dynamic run with a rod body,
+/// the first of them named with the rod.
+fn check_quad4_features(
+    cx: &Context,
+    analysis: &Analysis,
+    bodies: &[Body],
+) -> Result<(), InputError> {
+    let (Analysis::Dynamic(d), Some(rod)) = (analysis, first_rod(bodies)) else {
         return Ok(());
     };
-    for (on, key) in [
-        (d.mass_scaling.is_some(), "mass_scaling"),
-        (d.subcycling.is_some(), "subcycling"),
-        (d.ale.is_some(), "ale"),
-    ] {
-        if on {
-            return Err(cx.err(format!(
-                "analysis.{key}: acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric); body `{}` is a rod: remove {key}",
-                body.name
-            )));
-        }
+    let kernels = "acts in the explicit Quad4 kernels (plane strain, plane stress, axisymmetric)";
+    let refused = [
+        (
+            d.quadrature == Quadrature::Reduced,
+            "quadrature",
+            "`reduced` covers Quad4 bodies (plane strain, plane stress, axisymmetric)",
+            "use quadrature = \"full\"",
+        ),
+        (
+            d.bulk_viscosity.is_some(),
+            "bulk_viscosity",
+            kernels,
+            "remove bulk_viscosity",
+        ),
+        (
+            d.mass_scaling.is_some(),
+            "mass_scaling",
+            kernels,
+            "remove mass_scaling",
+        ),
+        (
+            d.subcycling.is_some(),
+            "subcycling",
+            kernels,
+            "remove subcycling",
+        ),
+        (d.ale.is_some(), "ale", kernels, "remove ale"),
+    ];
+    match refused.iter().find(|(on, ..)| *on) {
+        Some((_, key, what, remedy)) => Err(cx.err(format!(
+            "analysis.{key}: {what}; body `{}` is a rod: {remedy}",
+            rod.name
+        ))),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// `mass = "dispersion_free"` is the rod blend: refused for a continuum body (the
