@@ -749,6 +749,16 @@ fn obstacle_corners_are_rounded_where_the_arc_fits() {
     );
 }
 
+/// The energy `bodies` hold at the end of the run in `dir`: their kinetic and stored
+/// energy (history.csv's per-body columns, last row).
+fn held_at_the_end(dir: &Path, bodies: &[&str]) -> f64 {
+    let last =
+        |quantity: &str, body: &str| *column(dir, &format!("{quantity}[{body}]")).last().unwrap();
+    (bodies.iter())
+        .map(|b| last("kinetic_energy", b) + last("internal_energy", b))
+        .sum()
+}
+
 /// Two one-element elastic blocks (1 x 0.5, plane strain, E = 1e5, nu = 0.3, rho = 1: mass
 /// 0.5 each) far apart, each on its own rigid floor through its own pair (`fast` and
 /// `slow`, the pairs named after the blocks) `lift` above it: initial velocities `fast` and `slow`; with
@@ -818,12 +828,7 @@ fn each_pair_books_its_own_friction_and_contact_work() {
         let supplied = 0.5 * 0.5 * v * v;
         let contact = column(&dir, &format!("contact_work[{pair}]"));
         let friction = column(&dir, &format!("friction_work[{pair}]"));
-        let kept = column(&dir, &format!("kinetic_energy[{pair}]"))
-            .last()
-            .unwrap()
-            + column(&dir, &format!("internal_energy[{pair}]"))
-                .last()
-                .unwrap();
+        let kept = held_at_the_end(&dir, &[pair]);
         let (w_c, w_f) = (*contact.last().unwrap(), *friction.last().unwrap());
         approx::assert_relative_eq!(w_c + w_f, supplied - kept, max_relative = 2e-4);
         approx::assert_relative_eq!(w_f, supplied, max_relative = 0.01);
@@ -881,12 +886,7 @@ fn each_pair_books_its_own_impact_on_the_implicit_path() {
     let mut works = Vec::new();
     for (pair, v) in [("fast", 0.6), ("slow", 0.3)] {
         let supplied = 0.5 * 0.5 * v * v;
-        let kept = column(&dir, &format!("kinetic_energy[{pair}]"))
-            .last()
-            .unwrap()
-            + column(&dir, &format!("internal_energy[{pair}]"))
-                .last()
-                .unwrap();
+        let kept = held_at_the_end(&dir, &[pair]);
         let work = *column(&dir, &format!("contact_work[{pair}]"))
             .last()
             .unwrap();
@@ -959,17 +959,7 @@ fn each_pair_books_its_own_work_between_deformable_bodies_on_the_implicit_path()
     assert_eq!(summary.status, impact::analysis::Status::Ok);
     for (pair, bodies, v) in [("fast", ["a", "b"], 0.6), ("slow", ["c", "d"], 0.3)] {
         let supplied = 0.5 * 0.5 * v * v;
-        let kept: f64 = bodies
-            .iter()
-            .map(|b| {
-                column(&dir, &format!("kinetic_energy[{b}]"))
-                    .last()
-                    .unwrap()
-                    + column(&dir, &format!("internal_energy[{b}]"))
-                        .last()
-                        .unwrap()
-            })
-            .sum();
+        let kept = held_at_the_end(&dir, &bodies);
         let work = *column(&dir, &format!("contact_work[{pair}]"))
             .last()
             .unwrap();

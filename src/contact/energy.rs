@@ -1,7 +1,7 @@
 //! The contact's energies pair by pair: each pair's share of the contact work a dynamic step
 //! books and of the energy its friction dissipates (history.csv `contact_work[PAIR]` and
 //! `friction_work[PAIR]`, summary.json `contact.pairs`), as LS-DYNA's RCFORC or Abaqus'
-//! energy output per interaction give them (docs/theory.md 7a).
+//! energy output per interaction give them (docs/theory.md 7, "Per pair").
 //!
 //! Legend (one step)
 //! ```text
@@ -92,7 +92,7 @@ impl ContactState {
     /// friction's share included), `forces` the pairs' force terms at the step's start and
     /// end (their weights, module legend), and `friction` each pair's dissipation in the step
     /// (exact, from its own tangential forces), which its contact work leaves out.
-    pub fn book_implicit_work(
+    fn book_implicit_work(
         &mut self,
         pairs: &[ContactPair],
         (start, end): (&PairForces, &PairForces),
@@ -123,6 +123,9 @@ impl ContactState {
         coords: &[[f64; 2]],
         step: ImplicitStepWork,
     ) {
+        if pairs.is_empty() {
+            return;
+        }
         let (end, end_friction) = (
             self.pair_force_vectors(pairs, coords),
             self.pair_friction_forces(pairs, coords),
