@@ -263,35 +263,17 @@ impl ContactState {
         normal: &[Vec<f64>],
         tangential: &[Vec<f64>],
     ) -> Vec<f64> {
-        let zeros = vec![0.0; 2 * coords.len()];
-        self.nodal_forces_into(pairs, coords, (normal, tangential), zeros)
-    }
-
-    /// The same, added into `f` (zero over all DOFs).
-    fn nodal_forces_into(
-        &self,
-        pairs: &[ContactPair],
-        coords: &[[f64; 2]],
-        (normal, tangential): (&[Vec<f64>], &[Vec<f64>]),
-        mut f: Vec<f64>,
-    ) -> Vec<f64> {
-        let x = |n: usize| coords[n];
-        for s in slave_gaps(pairs, &x, &|p, k| !self.active[p][k]) {
-            let (p, k) = (s.pair, s.index);
-            for (dof, c) in s.gap.row(s.node) {
-                f[dof] += normal[p][k] * c;
-            }
-            for (dof, c) in s.gap.tangent_row(s.node) {
-                f[dof] += tangential[p][k] * c;
-            }
+        let mut f = vec![0.0; 2 * coords.len()];
+        let terms = self.pair_force_terms(pairs, coords, (normal, tangential));
+        for (dof, value) in terms.iter().flatten() {
+            f[*dof] += value;
         }
         f
     }
 
-    /// Per pair, the terms (DOF, value) that `nodal_forces_into` adds up for it: the forces
-    /// of the rows `normal` and `tangential` (per pair, per slave) of the active entries at
-    /// positions `coords`, in the same order, so that their sum in pair order is its vector
-    /// to the bit.
+    /// Per pair, the terms (DOF, value) of the nodal forces of the rows `normal` and
+    /// `tangential` (per pair, per slave) of the active entries at positions `coords`, in
+    /// slave order (their sum in pair order is `nodal_forces_of`).
     pub(super) fn pair_force_terms(
         &self,
         pairs: &[ContactPair],
@@ -318,7 +300,7 @@ impl ContactState {
 
     /// Per pair, the work `tangential`'s forces do on the increment `increment(dof)`, the
     /// rows at positions `coords`: T^T lambda . du over the pair's active entries, what the
-    /// forces of `nodal_forces_into`'s tangential rows would do.
+    /// forces of `pair_force_terms`' tangential rows would do.
     pub(super) fn tangential_work(
         &self,
         pairs: &[ContactPair],

@@ -672,20 +672,14 @@ pub struct RecorderPosition {
 /// Each reported pair's contact work and, with Coulomb friction, its friction work, in the
 /// order of `columns::pair_columns`' columns (zeros before any contact).
 fn pair_energies(model: &Model, contact: Option<&ContactState>) -> Vec<f64> {
-    let pairs = &model.contacts;
-    let per_pair = |values: Option<&Vec<f64>>| {
-        let mut values = values.cloned().unwrap_or_default();
-        values.resize(pairs.len(), 0.0);
-        fold_passes(pairs, &values)
-    };
-    let work = per_pair(contact.map(|c| &c.work));
-    let friction = per_pair(contact.map(|c| &c.friction_work));
-    let reported = pairs.iter().filter(|c| c.balances.is_none());
+    let reported = model.contacts.iter().filter(|c| c.balances.is_none());
+    let energies = contact.map(|c| c.pair_energies(&model.contacts));
     let mut row = Vec::new();
-    for ((pair, work), friction) in reported.zip(work).zip(friction) {
-        row.push(work);
+    for (p, pair) in reported.enumerate() {
+        let e = energies.as_ref().map(|e| &e[p]);
+        row.push(e.map_or(0.0, |e| e.contact_work));
         if matches!(pair.options.friction, Friction::Coulomb { .. }) {
-            row.push(friction);
+            row.push(e.map_or(0.0, |e| e.friction_work));
         }
     }
     row
