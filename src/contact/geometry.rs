@@ -4,6 +4,7 @@
 
 use super::grid::SegmentGrid;
 use super::mortar::{MortarSurface, master_node_gap, weighted_gap};
+use super::own::OwnSurface;
 use crate::mesh::plane::{dot, outward, sub};
 
 pub use super::gap::Gap;
@@ -133,6 +134,9 @@ pub struct ContactPair {
     /// correction solves each pass on its own and applies the mean of the two corrections
     /// (`explicit`); None otherwise.
     pub balances: Option<usize>,
+    /// A pass of a body's contact with itself (`own`): which of its own segments a slave
+    /// may meet and on which side of them it is inside; None between two bodies.
+    pub own: Option<OwnSurface>,
 }
 
 /// See [`ContactPair::holds`].
@@ -407,7 +411,7 @@ impl ContactPair {
             }
             Master::Segments {
                 edges, boundary, ..
-            } => self.segment_gap(xs, (&edges[..], &boundary[..]), x, grid)?,
+            } => self.segment_gap((slave, xs), (&edges[..], &boundary[..]), x, grid)?,
             Master::Obstacle(o) => {
                 let segments = o.segments();
                 let inside = || {
@@ -442,28 +446,78 @@ impl ContactPair {
         (result.gap <= self.options.search_distance).then_some(result)
     }
 
-    /// The gap of a slave at `xs` to a master surface of `edges` on a body of `boundary`
-    /// edges (node-to-segment, Hughes II-13..16), the nearest segment found on `grid` when
-    /// given.
+    /// The gap of slave `slave` at `xs` to a master surface of `edges` on a body of
+    /// `boundary` edges (node-to-segment, Hughes II-13..16), the nearest segment found on
+    /// `grid` when given. A pass of a body's contact with itself looks only at the segments
+    /// its `OwnSurface` admits, and a slave behind one of them that is not inside the body
+    /// has no gap there (`own`).
     fn segment_gap(
         &self,
-        xs: [f64; 2],
+        (slave, xs): (usize, [f64; 2]),
         (edges, boundary): (&[[usize; 2]], &[[usize; 2]]),
         x: &dyn Fn(usize) -> [f64; 2],
         grid: Option<&SegmentGrid>,
     ) -> Option<Gap> {
-        let inside = || inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)]));
+        let own = self.own.as_ref();
         let segment = |k: usize| [x(edges[k][0]), x(edges[k][1])];
-        let (k, xi, corner_gap, corner_normal) = match grid {
+        let own_normal = own.map(|own| own.normal(slave, xs, x));
+        // segment k at `x` when the slave may meet it (`OwnSurface`: placed for this pass and
+        // facing the slave)
+        let admitted = |k: usize| match (own, own_normal) {
+            (Some(own), Some(n)) => own
+                .admits(slave, k, edges[k])
+                .then(|| segment(k))
+                .filter(|[a, b]| OwnSurface::faces(n, outward(*a, *b))),
+            _ => Some(segment(k)),
+        };
+        let mut nearest = Nearest { x: xs, best: None };
+        match grid {
             Some(grid) => {
-                let nearest = std::cell::RefCell::new(Nearest { x: xs, best: None });
-                let offer = |k: usize| nearest.borrow_mut().offer(k, segment(k));
+                let nearest = std::cell::RefCell::new(&mut nearest);
+                let offer = |k: usize| {
+                    if let Some(s) = admitted(k) {
+                        nearest.borrow_mut().offer(k, s);
+                    }
+                };
                 let limit = self.options.search_distance;
                 grid.visit(xs, offer, || nearest.borrow().reach(), limit);
-                signed_gap(xs, nearest.into_inner().best?, segment, inside)?
             }
-            None => gap_to_segments(xs, edges.len(), segment, inside)?,
+            None => (0..edges.len()).for_each(|k| {
+                if let Some(s) = admitted(k) {
+                    nearest.offer(k, s);
+                }
+            }),
+        }
+        let best = nearest.best?;
+        // a slave behind a segment of its own body penetrates it only if it went into the
+        // body, and not deeper than the segment's own depth (`OwnSurface::reaches`): beyond
+        // that depth which side it is on does not matter, and the crossing count is spared
+        let inside = || match own {
+            Some(own) => {
+                OwnSurface::reaches(-best.2, segment(best.0))
+                    && own.probe(slave, xs, x).is_some_and(|probe| {
+                        inside_by_crossings(probe, boundary.iter().map(|[a, b]| [x(*a), x(*b)]))
+                    })
+            }
+            None => inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)])),
         };
+        let gap = self.gap_at(xs, best, (edges, segment), x, &inside)?;
+        let behind_own = own.is_some()
+            && gap.gap < 0.0
+            && !(OwnSurface::reaches(gap.gap, segment(best.0)) && inside());
+        (!behind_own).then_some(gap)
+    }
+
+    /// The gap of a slave at `xs` whose nearest master segment is `best` (`Nearest`).
+    fn gap_at(
+        &self,
+        xs: [f64; 2],
+        best: (usize, f64, f64, bool),
+        (edges, segment): (&[[usize; 2]], impl Fn(usize) -> [[f64; 2]; 2]),
+        x: &dyn Fn(usize) -> [f64; 2],
+        inside: &dyn Fn() -> bool,
+    ) -> Option<Gap> {
+        let (k, xi, corner_gap, corner_normal) = signed_gap(xs, best, segment, inside)?;
         let [a, b] = edges[k];
         let ab = sub(x(b), x(a));
         let turned =
@@ -662,6 +716,7 @@ pub(super) mod tests {
             options: options(),
             covered: None,
             balances: None,
+            own: None,
             mortar: None,
             holds: None,
         }

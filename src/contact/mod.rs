@@ -41,6 +41,7 @@ pub mod impacts;
 pub mod linearization;
 pub mod mortar;
 mod multipliers;
+pub mod own;
 pub mod penetration;
 pub mod search;
 pub mod setup;
@@ -53,6 +54,7 @@ pub use geometry::{
 };
 pub use impacts::{ImpactMotion, LumpedMass, apply_conditions};
 pub use mortar::MortarSurface;
+pub use own::OwnSurface;
 pub use search::{SlaveGap, penetration_limits, runaway_penetration, slave_gaps};
 pub use status::{ContactState, MasterEntry, NodalStatus};
 pub use step::{

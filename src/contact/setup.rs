@@ -89,9 +89,10 @@ fn penetration_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
     ))
 }
 
-/// The slave nearest its master must face it: its outward normal against the master's.
+/// The slave nearest its master must face it: its outward normal against the master's. A
+/// body's contact with itself takes only facing segments row by row (`OwnSurface::faces`).
 fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
-    if matches!(pair.master, Master::Nodes { .. }) {
+    if matches!(pair.master, Master::Nodes { .. }) || pair.own.is_some() {
         return None;
     }
     let x = |n: usize| bodies.coords[n];

@@ -9,7 +9,8 @@ use super::spec::{
     AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Roles, Scene, SurfaceSpec,
 };
 use crate::contact::{
-    ContactPair, Covered, Friction, Holds, Master, MortarSurface, Obstacle, PairOptions, setup,
+    ContactPair, Covered, Friction, Holds, Master, MortarSurface, Obstacle, OwnSurface,
+    PairOptions, setup,
 };
 use crate::element::Formulation;
 use crate::mesh::Cells;
@@ -40,6 +41,12 @@ pub(super) fn contacts(
             let mut reverse = reverse_pair(cx, bodies, k, spec, &contacts[k])?;
             reverse.covered = None;
             reverse.balances = Some(k);
+            // a body against itself: the same surfaces, the segments on the other side
+            if let Some(own) = &contacts[k].own {
+                reverse.slaves = contacts[k].slaves.clone();
+                reverse.master = contacts[k].master.clone();
+                reverse.own = Some(own.reversed());
+            }
             contacts.push(reverse);
         }
         let held = contacts[k]
@@ -204,11 +211,16 @@ fn contact(
         return Err(cx.err(format!("{key}.tolerance: must be >= 0, got {tolerance}")));
     }
     let balanced = symmetric(cx, bodies, (k, spec), scene)?;
+    let own_body = matches!(&master, Master::Segments { body, .. } if *body == slave_body);
     let search_distance = match spec.search_distance {
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
+        // a body against itself: no penetration deeper than half a segment counts
+        // (`OwnSurface::reaches`), and the search looks no farther
+        None if balanced && own_body => 0.25 * balanced_reach(cx, bodies, spec),
         None if balanced => balanced_reach(cx, bodies, spec),
         None => f64::INFINITY,
     };
+    let own = own_surface(cx, bodies, (&key, balanced), (slave_body, &master))?;
     let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), {
         dynamic(scene) && !balanced
     })?;
@@ -230,9 +242,45 @@ fn contact(
         },
         covered: None,
         balances: None,
+        own,
         mortar,
         holds: None,
     })
+}
+
+/// The first pass of a body's contact with itself (slave and master on `slave_body`): a
+/// balanced pair, which runs under central difference only (`key` names the pair). None
+/// for a master on another body or an obstacle.
+fn own_surface(
+    cx: &Context,
+    bodies: &[Body],
+    (key, balanced): (&str, bool),
+    (slave_body, master): (usize, &Master),
+) -> Result<Option<OwnSurface>, InputError> {
+    let Master::Segments { body, edges, .. } = master else {
+        return Ok(None);
+    };
+    if *body != slave_body {
+        return Ok(None);
+    }
+    if !balanced {
+        return Err(cx.err(format!(
+            "{key}.master.body: a body's contact with itself (`{}` against its own edges) is a balanced pair, which runs under central_difference, with `roles` left out and without `two_pass`, `discretization = \"mortar\"` or `hold_master_nodes`",
+            bodies[slave_body].name
+        )));
+    }
+    let b = &bodies[slave_body];
+    let boundary: Vec<[usize; 2]> = b.boundary.iter().map(|e| e.map(|n| b.global(n))).collect();
+    OwnSurface::new(&boundary, edges, true)
+        .map(Some)
+        .map_err(|[p, q]| {
+            cx.err(format!(
+                "{key}.master.set: edge {}-{} of body `{}` is not on its boundary; a body's contact with itself takes boundary edges",
+                p - b.node_offset,
+                q - b.node_offset,
+                b.name
+            ))
+        })
 }
 
 /// Whether pair `k` (`spec`) is balanced (`roles = "symmetric"`): each surface the slave of
@@ -442,6 +490,7 @@ fn reverse_pair(
         mortar: None,
         holds: None,
         balances: None,
+        own: None,
         covered: Some(Covered {
             pair: k,
             slaves: {
@@ -469,9 +518,9 @@ fn master_body(
 ) -> Result<Master, InputError> {
     let mkey = format!("{key}.master");
     let b = body_index(cx, bodies, m.body.as_deref(), &mkey)?;
-    if b == slave_body {
+    if b == slave_body && m.normal.is_some() {
         return Err(cx.err(format!(
-            "{mkey}.body: self-contact is not supported; master and slave must be different bodies"
+            "{mkey}.normal: a body's contact with itself takes an edge set as its master, not nodes with a normal"
         )));
     }
     Ok(match (bodies[b].mesh.edge_sets.get(&m.set), m.normal) {

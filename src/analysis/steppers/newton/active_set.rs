@@ -495,6 +495,7 @@ mod tests {
             },
             covered: None,
             balances: None,
+            own: None,
             mortar: None,
             holds: None,
         }
