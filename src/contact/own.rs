@@ -41,12 +41,19 @@ use std::collections::HashMap;
 /// round-off of a crossing count at the outline, far below any penetration a step allows.
 const EPSILON: f64 = 1e-6;
 
+/// A boundary node's place on its loop (loop, position) and its neighbours there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Place {
+    place: (usize, usize),
+    previous: usize,
+    next: usize,
+}
+
 /// See the module header.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OwnSurface {
-    /// By global node: its (place, previous node, next node) along its loop (None off the
-    /// boundary).
-    places: Vec<Option<((usize, usize), usize, usize)>>,
+    /// By global node: where it is on its loop (None off the boundary).
+    places: Vec<Option<Place>>,
     /// The place of each master edge (the pair's `Master::Segments::edges`, in order).
     edge_places: Vec<(usize, usize)>,
     /// The first pass (segments after the slave) or the reverse one (before it).
@@ -64,11 +71,15 @@ impl OwnSurface {
         later: bool,
     ) -> Result<Self, [usize; 2]> {
         let mut places = Vec::new();
-        let mut set = |node: usize, entry| {
+        let mut set = |node: usize, (place, previous, next)| {
             if places.len() <= node {
                 places.resize(node + 1, None);
             }
-            places[node] = Some(entry);
+            places[node] = Some(Place {
+                place,
+                previous,
+                next,
+            });
         };
         let mut edge_at: HashMap<[usize; 2], (usize, usize)> = HashMap::new();
         let ordered = chain_order(boundary.to_vec());
@@ -122,7 +133,7 @@ impl OwnSurface {
         if edge.contains(&slave) {
             return false;
         }
-        let Some((place, ..)) = self.place(slave) else {
+        let Some(Place { place, .. }) = self.place(slave) else {
             return false;
         };
         if self.later {
@@ -132,15 +143,15 @@ impl OwnSurface {
         }
     }
 
-    /// A node's (place, previous node, next node) along its loop.
-    fn place(&self, node: usize) -> Option<((usize, usize), usize, usize)> {
+    /// A node's place along its loop.
+    fn place(&self, node: usize) -> Option<Place> {
         self.places.get(node).copied().flatten()
     }
 
     /// The slave's own outward normal at `xs` (positions `x`): the sum of its two boundary
     /// segments' unit normals (not unit; zero for a node not on the boundary).
     pub fn normal(&self, slave: usize, xs: [f64; 2], x: &dyn Fn(usize) -> [f64; 2]) -> [f64; 2] {
-        let Some((_, previous, next)) = self.place(slave) else {
+        let Some(Place { previous, next, .. }) = self.place(slave) else {
             return [0.0; 2];
         };
         let (before, after) = (outward(x(previous), xs), outward(xs, x(next)));
@@ -177,7 +188,7 @@ impl OwnSurface {
         xs: [f64; 2],
         x: &dyn Fn(usize) -> [f64; 2],
     ) -> Option<[f64; 2]> {
-        let (_, previous, next) = self.place(slave)?;
+        let Place { previous, next, .. } = self.place(slave)?;
         let (p, q) = (x(previous), x(next));
         let n = self.normal(slave, xs, x);
         let length = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]).hypot(b[1] - a[1]);
@@ -226,11 +237,11 @@ mod tests {
         assert!(admitted(&second, 0).is_empty());
         // each segment not touching a node is in exactly one of the two passes
         for slave in 0..8 {
-            for k in 0..8 {
-                let own = boundary[k].contains(&slave);
+            for (k, edge) in boundary.iter().enumerate() {
+                let own = edge.contains(&slave);
                 let count = [&first, &second]
                     .iter()
-                    .filter(|s| s.admits(slave, k, boundary[k]))
+                    .filter(|s| s.admits(slave, k, *edge))
                     .count();
                 assert_eq!(count, usize::from(!own), "slave {slave}, edge {k}");
             }
