@@ -1,5 +1,6 @@
 //! Contact, in one place: detection on the current configuration (`geometry`, `search`,
-//! the nearest-segment grid of a balanced pair's whole surfaces `grid`),
+//! the nearest-segment grid of a balanced pair's whole surfaces `grid`, the rules of a
+//! body's contact with itself `own`),
 //! the status carried between steps (`status`), the event logic of an implicit step
 //! (`step`), Hughes' impact and release conditions (`conditions`) met at a step's events
 //! (`impacts`), the explicit forward-increment multipliers (`explicit`, with the lumped
