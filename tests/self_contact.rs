@@ -64,6 +64,7 @@ fn without_fold() -> String {
 /// energy (the walls' impact is inelastic) but never give it: its contact work stays >= 0
 /// at every row (round-off allowed: 1e-9 of the 9860 J brought in), and the balance gains
 /// less than the guard's 1 % at every step. Penetration below 5 % of the 0.5 mm element.
+/// summary.json names the pair as the scene does (`fold`, not its passes).
 /// Without the pair the same run ends with the inner face through itself: the check fails
 /// there.
 #[test]
@@ -92,6 +93,11 @@ fn a_tube_crushed_flat_does_not_pass_through_itself() {
     assert!(least_fold_work >= -1e-9 * summary.energy.initial);
     assert!(summary.energy.max_relative_gain < 0.01);
     assert!(summary.contact.max_penetration.unwrap_or(0.0) < 0.05 * 0.5e-3);
+    // the pair is reported under its own name, its two passes as one: it closed, and the
+    // walls are pressed together at the end (its force is not zero on the last row)
+    assert!(summary.contact.never_closed.is_empty());
+    assert!(*fold_force.last().unwrap() > 0.0);
+    assert_eq!(summary.contact.closed_at_end, vec!["fold".to_string()]);
 
     let bare = common::model("tube_crush_without_fold", &without_fold(), &[]);
     let (_, state) = common::run("tube_crush_without_fold", &bare);

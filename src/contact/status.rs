@@ -159,17 +159,17 @@ impl ContactState {
     /// The contact block of summary.json for the run's `pairs`.
     pub fn summary(&self, pairs: &[ContactPair]) -> ContactSummary {
         // a second pass closes nothing where its first pass holds the contact: the two
-        // passes are one contact
+        // passes are one contact; a balanced pair (its reverse pass folded into it, as
+        // everywhere it is reported) closed where either of its passes did
+        let ever = |q: usize| self.ever_closed.get(q).copied().unwrap_or(true);
         let closed = |p: usize| {
             let first = pairs[p].covered.as_ref().map(|c| c.pair);
-            [Some(p), first]
-                .into_iter()
-                .flatten()
-                .any(|q| self.ever_closed.get(q).copied().unwrap_or(true))
+            let reverse = pairs.iter().position(|q| q.balances == Some(p));
+            [Some(p), first, reverse].into_iter().flatten().any(ever)
         };
         ContactSummary {
             never_closed: (0..pairs.len().min(self.ever_closed.len()))
-                .filter(|p| !closed(*p))
+                .filter(|p| pairs[*p].balances.is_none() && !closed(*p))
                 .map(|p| pairs[p].name.clone())
                 .collect(),
             first_contact_time: self.first_contact_time,

@@ -161,13 +161,18 @@ impl ContactRecord {
             summary.peak_force = carry.peak_average;
         }
         summary.closed_at_widest = carry.closed_at_widest.clone();
-        summary.closed_at_end = model
-            .contacts
-            .iter()
-            .zip(&contact.active)
-            .filter(|(_, active)| active.iter().any(|a| *a))
-            .map(|(pair, _)| pair.name.clone())
-            .collect();
+        // a balanced pair's reverse pass under the pair's name, once
+        let mut closed_at_end: Vec<String> = Vec::new();
+        for (pair, active) in model.contacts.iter().zip(&contact.active) {
+            let name = match pair.balances {
+                Some(first) => &model.contacts[first].name,
+                None => &pair.name,
+            };
+            if active.iter().any(|a| *a) && !closed_at_end.contains(name) {
+                closed_at_end.push(name.clone());
+            }
+        }
+        summary.closed_at_end = closed_at_end;
         summary.deepest = carry.deepest.clone();
         summary.past_end = carry.past_end.clone();
         summary.peak_force_time = carry.peak_raw.map(|(_, t)| t);
