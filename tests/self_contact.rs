@@ -66,7 +66,7 @@ fn without_fold() -> String {
 /// less than the guard's 1 % at every step. Penetration below 5 % of the 0.5 mm element.
 /// summary.json names the pair as the scene does (`fold`, not its passes).
 /// Without the pair the same run ends with the inner face through itself: the check fails
-/// there.
+/// there, and the run's warnings say that the body passed through itself.
 #[test]
 fn a_tube_crushed_flat_does_not_pass_through_itself() {
     let text = std::fs::read_to_string("models/tube_crush.toml").unwrap();
@@ -100,13 +100,22 @@ fn a_tube_crushed_flat_does_not_pass_through_itself() {
     assert_eq!(summary.contact.closed_at_end, vec!["fold".to_string()]);
 
     let bare = common::model("tube_crush_without_fold", &without_fold(), &[]);
-    let (_, state) = common::run("tube_crush_without_fold", &bare);
+    let (bare_summary, state) = common::run("tube_crush_without_fold", &bare);
     let crossed = crossings(&bare, &state.coordinates, DEPTH);
     println!(
         "without the pair: {crossed} crossings, {} deeper than 0.1 mm",
         crossings(&bare, &state.coordinates, 1e-4)
     );
     assert!(crossed > 0);
+    // and the run says so, naming the body and the pair that would hold it
+    let warned = &bare_summary.warnings;
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.contains("body `tube` passed through itself")
+                && w.contains(r#"master = { body = "tube" }"#)),
+        "{warned:?}"
+    );
 }
 
 /// Goal: a body's contact with itself is refused where it cannot run, with the reason.

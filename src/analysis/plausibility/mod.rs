@@ -17,6 +17,7 @@
 //! ```
 
 mod contact;
+mod crossings;
 mod initial;
 mod setup;
 mod slaves;
@@ -107,11 +108,13 @@ pub struct EndOfRun<'a> {
 }
 
 /// What the end of a run shows: nodes of an axisymmetric body that ended across the axis
-/// (r < 0), where the hoop strain u_r / r has no meaning; hourglass energy above
+/// (r < 0), where the hoop strain u_r / r has no meaning; a body whose boundary crosses
+/// itself (it passed through itself: `crossings`); hourglass energy above
 /// [`HOURGLASS_SHARE`] of the internal energy; mass scaling that added more than
 /// [`ADDED_MASS_SHARE`] of a body's mass or scaled an element on a contact surface.
 pub fn final_warnings(model: &Model, end: &EndOfRun) -> Vec<String> {
     let mut out = setup::axis_crossings(model, end.positions);
+    out.extend(crossings::self_crossing_warnings(model, end.positions));
     if end.finished {
         out.extend(contact::still_closed_warnings(
             model,
