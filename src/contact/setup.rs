@@ -116,6 +116,9 @@ fn facing_problem(pair: &ContactPair, bodies: &Bodies) -> Option<String> {
 /// ids): for each master node inside that
 /// boundary (an odd number of crossings of a ray), its distance to the nearest boundary edge.
 /// Zero when none is inside. Only master nodes within the slave boundary's bounding box are tested.
+/// Zero for a body's contact with itself: its master nodes lie on the slave body's outline
+/// (at distance zero from it, and undecided by the crossing count), and its passes' own
+/// gaps measure how deep a stretch went into another.
 pub fn master_penetration(
     pair: &ContactPair,
     x: &impl Fn(usize) -> [f64; 2],
@@ -124,6 +127,9 @@ pub fn master_penetration(
     let Master::Segments { edges, .. } = &pair.master else {
         return 0.0;
     };
+    if pair.own.is_some() {
+        return 0.0;
+    }
     let mut nodes: Vec<usize> = edges.iter().flatten().copied().collect();
     nodes.sort_unstable();
     nodes.dedup();
