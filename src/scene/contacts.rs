@@ -265,7 +265,7 @@ fn own_surface(
     }
     if !balanced {
         return Err(cx.err(format!(
-            "{key}.master.body: a body's contact with itself (`{}` against its own edges) is a balanced pair, which runs under central_difference, with `roles` left out and without `two_pass`, `discretization = \"mortar\"` or `hold_master_nodes`",
+            "{key}.master.body: a body's contact with itself (`{}` against its own edges) is a balanced pair, which runs under central_difference, on edge sets (slave and master), with `roles` left out and without `two_pass`, `discretization = \"mortar\"` or `hold_master_nodes`",
             bodies[slave_body].name
         )));
     }
