@@ -140,3 +140,26 @@ fn a_body_against_itself_is_refused_where_it_cannot_run() {
         &["fold", "not nodes with a normal"],
     );
 }
+
+/// Goal: a body's pair with itself is a precaution, not a contact that must happen: a run in
+/// which the body does not fold is not warned that the pair never closed.
+/// Setup: models/tube_crush.toml to 20 us, before the walls meet (about 90 us). Reference:
+/// the pair's own history column, zero at every row (it never closed); no warning names it.
+#[test]
+fn a_body_that_does_not_fold_is_not_warned_of_its_own_pair() {
+    let run = common::run_scene(
+        "tube_crush_early",
+        "tube_crush",
+        &["analysis.end_time=20e-6"],
+    );
+    let fold_force = common::column(&run.dir, "contact_force[fold]");
+    assert!(fold_force.iter().all(|f| *f == 0.0));
+    assert_eq!(run.summary.contact.never_closed, vec!["fold".to_string()]);
+    let named: Vec<&String> = run
+        .summary
+        .warnings
+        .iter()
+        .filter(|w| w.contains("`fold`"))
+        .collect();
+    assert!(named.is_empty(), "{named:?}");
+}

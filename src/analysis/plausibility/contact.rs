@@ -19,7 +19,8 @@ use crate::scene::{Body, Model};
 pub const PENETRATION_SHARE: f64 = 0.05;
 
 /// The warnings of the pairs that never closed, in a run where something moved (initial
-/// kinetic energy or external work), with advice that follows how the run ended.
+/// kinetic energy or external work), with advice that follows how the run ended; not of a
+/// body's pair with itself.
 pub(super) fn never_closed_warnings(
     model: &Model,
     summary: &Summary,
@@ -34,6 +35,9 @@ pub(super) fn never_closed_warnings(
         .never_closed
         .iter()
         .filter_map(|name| model.contacts.iter().find(|p| &p.name == name))
+        // a body's pair with itself holds it where it folds; a body that did not fold needs
+        // none (one that went through itself is warned of by `crossings`)
+        .filter(|pair| pair.own.is_none())
         .map(|pair| never_closed_warning(model, pair, summary))
         .collect()
 }
