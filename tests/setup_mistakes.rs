@@ -366,6 +366,31 @@ fn coarse_contact_warns_at_three_closed_nodes() {
     );
 }
 
+/// Goal: a balanced pair's coarse contact is judged once, under the pair's name, on the
+/// nodes both passes closed. Setup: models/block_on_plate.toml (a balanced pair `impact`
+/// between two plastic bodies, its reverse pass `impact:reverse`), the widest closed counts
+/// set by hand per pass. Reference: the user guide's rule (three closed nodes or fewer
+/// warn), applied to the contact, whose nodes are the two passes' together: 2 + 2 = 4 does
+/// not warn (each pass alone would), 1 + 1 = 2 warns once, naming `impact`.
+#[test]
+fn a_balanced_pair_is_judged_on_both_passes_under_its_name() {
+    let model = impact::scene::load(Path::new("models/block_on_plate.toml"), &[]).unwrap();
+    assert_eq!(model.contacts[1].balances, Some(0));
+    let mut summary = Summary::new(&model, "central_difference", 1e-8, 150e-6, 100);
+    let energies = Energies::default();
+    summary.contact.closed_at_widest = vec![2, 2];
+    let warned = plausibility::warnings(&model, &summary, &energies, None);
+    assert!(warned.is_empty(), "{warned:?}");
+    summary.contact.closed_at_widest = vec![1, 1];
+    let warned = plausibility::warnings(&model, &summary, &energies, None);
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    assert!(
+        warned[0].contains("contact `impact` closed at most 2"),
+        "{}",
+        warned[0]
+    );
+}
+
 /// Goal: the still-closed warning fires when the slave body approaches the wall at more
 /// than a tenth of its approach speed at the start. Setup: the sphere (5 m/s towards the
 /// wall at the start), the pair closed at the end, every node moving towards the wall at

@@ -197,8 +197,9 @@ fn set_named_by<'a>(body: &'a Body, slaves: &[usize]) -> Option<&'a str> {
 pub const COARSE_CONTACT_NODES: usize = 3;
 
 /// The pairs whose contact was resolved by too few slave nodes at its widest (see
-/// [`COARSE_CONTACT_NODES`]): the pair's own slaves and those of its second pass or hold
-/// pair (nodes of the other surface held on it), counted together.
+/// [`COARSE_CONTACT_NODES`]): the pair's own slaves and those of its second pass, hold pair
+/// or balanced reverse pass (nodes of the other surface held on it), counted together, and
+/// judged under the pair's name.
 pub(super) fn coarse_contact_warnings(model: &Model, summary: &Summary) -> Vec<String> {
     if summary.status != Status::Ok {
         // a run that stopped early had no contact to resolve yet
@@ -208,20 +209,24 @@ pub(super) fn coarse_contact_warnings(model: &Model, summary: &Summary) -> Vec<S
     let mut out = Vec::new();
     let widest = &summary.contact.closed_at_widest;
     for (p, pair) in model.contacts.iter().enumerate() {
-        // the slaves of the pair's second pass and hold pair close on the same contact
+        // the slaves of the pair's second pass, hold pair and reverse pass close on the
+        // same contact
         let passes = model
             .contacts
             .iter()
             .enumerate()
-            .filter(|(_, q)| q.covered.as_ref().is_some_and(|c| c.pair == p))
+            .filter(|(_, q)| {
+                q.covered.as_ref().is_some_and(|c| c.pair == p) || q.balances == Some(p)
+            })
             .map(|(q, _)| widest.get(q).copied().unwrap_or(0));
         let closed = &(widest.get(p).copied().unwrap_or(0) + passes.sum::<usize>());
         let master_plastic = match &pair.master {
             Master::Segments { body, .. } | Master::Nodes { body, .. } => plastic(*body),
             Master::Obstacle(_) => false,
         };
-        // a hold pair or a second pass takes its slaves from its first pass, which is judged
-        let derived = pair.holds.is_some() || pair.covered.is_some();
+        // a hold pair, a second pass or a reverse pass takes its slaves from its first pass,
+        // which is judged
+        let derived = pair.holds.is_some() || pair.covered.is_some() || pair.balances.is_some();
         let surface = pair.slaves.len() > COARSE_CONTACT_NODES
             && !model.bodies[pair.slave_body].kind.is_rod()
             && !derived;
