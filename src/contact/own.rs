@@ -1,5 +1,5 @@
 //! A body's contact with itself (a folding lip, a tube crushed flat): the body's boundary is
-//! both the slave and the master of a balanced pair. Two things set it apart from a pair
+//! both the slave and the master of a balanced pair. Four things set it apart from a pair
 //! between two bodies.
 //!
 //! - Which segments a slave may meet. Its own two segments contain it (gap 0 everywhere), so
