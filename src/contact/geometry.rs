@@ -460,15 +460,15 @@ impl ContactPair {
     ) -> Option<Gap> {
         let own = self.own.as_ref();
         let segment = |k: usize| [x(edges[k][0]), x(edges[k][1])];
-        let own_normal = own.map(|own| own.normal(slave, xs, x));
         // segment k at `x` when the slave may meet it (`OwnSurface`: placed for this pass and
-        // facing the slave)
-        let admitted = |k: usize| match (own, own_normal) {
-            (Some(own), Some(n)) => own
+        // facing the slave's own normal `n`)
+        let facing = own.map(|own| (own, own.normal(slave, xs, x)));
+        let admitted = |k: usize| match facing {
+            Some((own, n)) => own
                 .admits(slave, k, edges[k])
                 .then(|| segment(k))
                 .filter(|[a, b]| OwnSurface::faces(n, outward(*a, *b))),
-            _ => Some(segment(k)),
+            None => Some(segment(k)),
         };
         let mut nearest = Nearest { x: xs, best: None };
         match grid {
@@ -492,14 +492,19 @@ impl ContactPair {
         // a slave behind a segment of its own body penetrates it only if it went into the
         // body, and not deeper than the segment's own depth (`OwnSurface::reaches`): beyond
         // that depth which side it is on does not matter, and the crossing count is spared
-        let inside = || match own {
-            Some(own) => {
-                OwnSurface::reaches(-best.2, segment(best.0))
-                    && own.probe(slave, xs, x).is_some_and(|probe| {
-                        inside_by_crossings(probe, boundary.iter().map(|[a, b]| [x(*a), x(*b)]))
-                    })
-            }
-            None => inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)])),
+        // (counted once: the sign of a corner gap and the test below may both ask)
+        let counted = std::cell::OnceCell::new();
+        let inside = || {
+            *counted.get_or_init(|| match own {
+                Some(own) => {
+                    OwnSurface::reaches(-best.2, segment(best.0))
+                        && own.probe(slave, xs, x).is_some_and(|probe| {
+                            let outline = boundary.iter().map(|[a, b]| [x(*a), x(*b)]);
+                            inside_by_crossings(probe, outline)
+                        })
+                }
+                None => inside_by_crossings(xs, boundary.iter().map(|[a, b]| [x(*a), x(*b)])),
+            })
         };
         let gap = self.gap_at(xs, best, (edges, segment), x, &inside)?;
         let behind_own = own.is_some()

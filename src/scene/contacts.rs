@@ -211,16 +211,15 @@ fn contact(
         return Err(cx.err(format!("{key}.tolerance: must be >= 0, got {tolerance}")));
     }
     let balanced = symmetric(cx, bodies, (k, spec), scene)?;
-    let own_body = matches!(&master, Master::Segments { body, .. } if *body == slave_body);
+    let own = own_surface(cx, bodies, (&key, balanced), (slave_body, &master))?;
     let search_distance = match spec.search_distance {
         Some(d) => positive(cx, &format!("{key}.search_distance"), d)?,
         // a body against itself: no penetration deeper than half a segment counts
         // (`OwnSurface::reaches`), and the search looks no farther
-        None if balanced && own_body => 0.25 * balanced_reach(cx, bodies, spec),
+        None if own.is_some() => 0.25 * balanced_reach(cx, bodies, spec),
         None if balanced => balanced_reach(cx, bodies, spec),
         None => f64::INFINITY,
     };
-    let own = own_surface(cx, bodies, (&key, balanced), (slave_body, &master))?;
     let mortar = mortar_surface(cx, bodies, (&key, spec), (slave_body, &master), {
         dynamic(scene) && !balanced
     })?;
