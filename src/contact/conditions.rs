@@ -41,20 +41,45 @@ pub(super) struct Entry<'a> {
     pub pair: &'a ContactPair,
     /// The slave's global node, and its gap to the master at `coords`.
     pub slave: usize,
-    pub gap: &'a Gap,
+    pub gap: Gap,
     pub coords: &'a [[f64; 2]],
     /// The lumped mass per DOF.
     pub lumped: &'a [f64],
 }
 
-impl Entry<'_> {
+impl<'a> Entry<'a> {
+    /// Entry `k` of pair `p` of `interfaces` at the positions `coords` (`lumped`: the mass
+    /// per DOF), with its slave's gap `gap` when the caller has it, else found here; None
+    /// when no master is within reach.
+    pub fn at(
+        interfaces: &'a Interfaces,
+        (p, k): (usize, usize),
+        gap: Option<Gap>,
+        (coords, lumped): (&'a [[f64; 2]], &'a [f64]),
+    ) -> Option<Entry<'a>> {
+        let pair = &interfaces.pairs[p];
+        let slave = pair.slaves[k];
+        let gap = match gap {
+            Some(gap) => gap,
+            None => pair.gap(slave, &|n: usize| coords[n])?,
+        };
+        Some(Entry {
+            interfaces,
+            pair,
+            slave,
+            gap,
+            coords,
+            lumped,
+        })
+    }
+
     /// The master side of the entry; None on a rigid obstacle.
     pub fn master(&self) -> Option<MasterSide> {
         let body = match &self.pair.master {
             Master::Obstacle(_) => return None,
             Master::Segments { body, .. } | Master::Nodes { body, .. } => *body,
         };
-        let gap = self.gap;
+        let gap = &self.gap;
         let mass = gap
             .masters
             .iter()

@@ -38,8 +38,8 @@
 //! ```
 
 use super::Interfaces;
-use super::geometry::{COVERED, Friction, Gap, Master};
-use super::mortar::{MASTER_ALLOWANCE, master_node_gap};
+use super::geometry::{COVERED, Friction, Gap};
+use super::mortar::MASTER_ALLOWANCE;
 use super::search::{SlaveGap, penetrates, slave_gaps};
 use super::status::{ContactState, MasterEntry, Scratch};
 
@@ -372,21 +372,10 @@ impl Predicted<'_> {
             return (Vec::new(), false);
         }
         let x = |node: usize| self.position(&c.delta, node);
-        let surface = |p: usize| {
-            let pair = &self.interfaces.pairs[p];
-            match (&pair.mortar, &pair.master) {
-                (Some(surface), Master::Segments { edges, .. }) => Some((surface, &edges[..])),
-                _ => None,
-            }
-        };
-        let mut master_gaps: Vec<Option<Gap>> = c
-            .masters
-            .iter()
-            .map(|(p, m)| {
-                let (surface, edges) = surface(*p)?;
-                master_node_gap(&surface.edges, edges, *m, MASTER_ALLOWANCE, &x)
-            })
-            .collect();
+        let held_gap =
+            |p: usize, m: usize| self.interfaces.pairs[p].master_node_gap(m, MASTER_ALLOWANCE, &x);
+        let mut master_gaps: Vec<Option<Gap>> =
+            c.masters.iter().map(|(p, m)| held_gap(*p, *m)).collect();
         let tied = |p: usize, m: usize| {
             c.active.iter().zip(gaps).any(|((q, _), g)| {
                 *q == p
@@ -400,9 +389,7 @@ impl Predicted<'_> {
             if c.masters.contains(&(p, m)) || tied(p, m) {
                 continue;
             }
-            let Some(gap) = surface(p)
-                .and_then(|(s, edges)| master_node_gap(&s.edges, edges, m, MASTER_ALLOWANCE, &x))
-            else {
+            let Some(gap) = held_gap(p, m) else {
                 continue;
             };
             if gap.gap < -self.interfaces.pairs[p].options.tolerance {
@@ -639,7 +626,7 @@ fn keep<T>(items: &mut Vec<T>, kept: &[bool]) {
 fn master_candidates(interfaces: &Interfaces) -> Vec<(usize, usize)> {
     let mut candidates = Vec::new();
     for (p, pair) in interfaces.pairs.iter().enumerate() {
-        let (Some(surface), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master) else {
+        let Some((surface, edges)) = pair.mortar() else {
             continue;
         };
         if surface.hold_master_nodes {

@@ -122,13 +122,8 @@ pub struct ContactPair {
     /// pass's row for that node would be the same row again (coincident nodes), and the two
     /// rows would make the multipliers indeterminate.
     pub covered: Option<Covered>,
-    /// Segment-to-segment (mortar) contact: the slave surface whose segments carry the
-    /// weighted gaps (`mortar`); None: node-to-segment, the slave node against the master.
-    pub mortar: Option<MortarSurface>,
-    /// The hold pair of a mortar pair on the implicit paths (`NAME:held`): its slaves are
-    /// the mortar pair's master nodes and its master the mortar pair's slave surface, and a
-    /// slave's gap is `mortar::master_node_gap` (docs/theory.md 8.3a-4). None otherwise.
-    pub holds: Option<Holds>,
+    /// How the pair's rows are written: node-to-segment, mortar, or a mortar pair's hold.
+    pub discretization: Discretization,
     /// The second pass of a balanced pair (`NAME:reverse`, the index of its first pass): the
     /// first pass's master surface as the slave of its slave surface. The explicit
     /// correction solves each pass on its own and applies the mean of the two corrections
@@ -139,7 +134,22 @@ pub struct ContactPair {
     pub own: Option<OwnSurface>,
 }
 
-/// See [`ContactPair::holds`].
+/// How a pair's gaps and rows are written (docs/theory.md 8.3, 8.3a). The passes of a
+/// two-pass or balanced contact are pairs of their own, each with its discretization.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Discretization {
+    /// Each slave node against the master (a segment, a node-to-node master, an obstacle).
+    NodeToSegment,
+    /// Segment-to-segment: the slave surface whose segments carry the weighted gaps
+    /// (`mortar`); the master is an edge set.
+    Mortar(MortarSurface),
+    /// The hold pair of a mortar pair on the implicit paths (`NAME:held`): its slaves are
+    /// the mortar pair's master nodes and its master the mortar pair's slave surface, and a
+    /// slave's gap is `mortar::master_node_gap` (docs/theory.md 8.3a-4).
+    Held(Holds),
+}
+
+/// See [`Discretization::Held`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Holds {
     /// The held mortar pair's master edges (the nodes' own normals); the pair itself is the
@@ -333,7 +343,46 @@ impl ContactPair {
     /// together (a mortar pair and its hold pair: rows that share master nodes), rather than
     /// node by node (Hughes II-8, II-11).
     pub fn joint_conditions(&self) -> bool {
-        self.mortar.is_some() || self.holds.is_some()
+        !matches!(self.discretization, Discretization::NodeToSegment)
+    }
+
+    /// A mortar pair's slave surface and master edges; None for the other discretizations.
+    pub fn mortar(&self) -> Option<(&MortarSurface, &[[usize; 2]])> {
+        match (&self.discretization, &self.master) {
+            (Discretization::Mortar(surface), Master::Segments { edges, .. }) => {
+                Some((surface, edges))
+            }
+            _ => None,
+        }
+    }
+
+    /// Whether the pair holds the master nodes of a mortar pair (`NAME:held`).
+    pub fn is_hold(&self) -> bool {
+        matches!(self.discretization, Discretization::Held(_))
+    }
+
+    /// The gap of a mortar contact's master node `node` against the slave surface at `x`
+    /// (`mortar::master_node_gap`, a node `allowance` past the surface's ends still
+    /// facing it): on a mortar pair, of a node of its master edges; on its hold pair, of one
+    /// of its slaves. None for node-to-segment pairs, or when no slave segment faces the node.
+    pub fn master_node_gap(
+        &self,
+        node: usize,
+        allowance: f64,
+        x: &dyn Fn(usize) -> [f64; 2],
+    ) -> Option<Gap> {
+        let Master::Segments { edges, .. } = &self.master else {
+            return None;
+        };
+        match &self.discretization {
+            Discretization::Mortar(surface) => {
+                master_node_gap(&surface.edges, edges, node, allowance, x)
+            }
+            Discretization::Held(holds) => {
+                master_node_gap(edges, &holds.master_edges, node, allowance, x)
+            }
+            Discretization::NodeToSegment => None,
+        }
     }
 
     /// Whether a slave at `gap` is left to the first pass of a two-pass contact (see
@@ -368,16 +417,13 @@ impl ContactPair {
     /// The gap of slave node `slave` at positions `x` (global node -> position), or None
     /// when there is no master within the search distance.
     pub fn gap(&self, slave: usize, x: &dyn Fn(usize) -> [f64; 2]) -> Option<Gap> {
-        match (&self.mortar, &self.holds, &self.master) {
-            (_, Some(holds), Master::Segments { edges, .. }) => {
-                master_node_gap(edges, &holds.master_edges, slave, 0.0, x)
-                    .filter(|g| g.gap <= self.options.search_distance)
-            }
-            (Some(surface), _, Master::Segments { edges, .. }) => {
-                weighted_gap(surface, edges, slave, x)
-                    .filter(|g| g.gap <= self.options.search_distance)
-            }
-            _ => self.node_gap(slave, x),
+        let within = |g: &Gap| g.gap <= self.options.search_distance;
+        if self.is_hold() {
+            return self.master_node_gap(slave, 0.0, x).filter(within);
+        }
+        match self.mortar() {
+            Some((surface, edges)) => weighted_gap(surface, edges, slave, x).filter(within),
+            None => self.node_gap(slave, x),
         }
     }
 
@@ -722,8 +768,7 @@ pub(super) mod tests {
             covered: None,
             balances: None,
             own: None,
-            mortar: None,
-            holds: None,
+            discretization: Discretization::NodeToSegment,
         }
     }
 

@@ -38,19 +38,13 @@ impl ContactState {
         for SlaveGap {
             pair: p,
             index: k,
-            node: s,
             gap,
+            ..
         } in touching
         {
             let pair = &interfaces.pairs[p];
-            let entry = conditions::Entry {
-                interfaces,
-                pair,
-                slave: s,
-                gap: &gap,
-                coords,
-                lumped,
-            };
+            let entry = conditions::Entry::at(interfaces, (p, k), Some(gap), (coords, lumped))
+                .expect("the entry's gap is given");
             if !conditions::approaching(&entry, velocity) {
                 continue; // touching but not approaching
             }
@@ -298,27 +292,20 @@ fn impact_slaves<S>(
 ) {
     let previous_velocity = motion.previous_velocity;
     let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
-    let x = |n: usize| coords[n];
     for &(p, k) in &step.events.closed {
         let pair = &interfaces.pairs[p];
         if !pair.options.impact_conditions || pair.joint_conditions() {
             continue;
         }
-        let s = pair.slaves[k];
-        let Some(gap) = pair.gap(s, &x) else { continue };
+        let Some(entry) = conditions::Entry::at(interfaces, (p, k), None, (coords, lumped)) else {
+            continue;
+        };
+        let (s, gap) = (entry.slave, &entry.gap);
         let i = step
             .active
             .iter()
             .position(|e| *e == (p, k))
             .expect("closed entries are active");
-        let entry = conditions::Entry {
-            interfaces,
-            pair,
-            slave: s,
-            gap: &gap,
-            coords,
-            lumped,
-        };
         conditions::impact(
             &entry,
             previous_velocity,
@@ -362,23 +349,16 @@ fn release_slaves<S>(
         inverse: inverse_mass,
     } = mass;
     let (velocity, acceleration) = (&mut *motion.velocity, &mut *motion.acceleration);
-    let x = |n: usize| coords[n];
     for &(p, k, tau, friction) in &step.events.released {
         let pair = &interfaces.pairs[p];
         if !pair.options.release_conditions {
             continue;
         }
-        let s = pair.slaves[k];
-        let Some(gap) = pair.gap(s, &x) else { continue };
-        let n = gap.normal;
-        let entry = conditions::Entry {
-            interfaces,
-            pair,
-            slave: s,
-            gap: &gap,
-            coords,
-            lumped,
+        let Some(entry) = conditions::Entry::at(interfaces, (p, k), None, (coords, lumped)) else {
+            continue;
         };
+        let (s, gap) = (entry.slave, &entry.gap);
+        let n = gap.normal;
         let (ms, zs) = entry.slave_mass_and_impedance();
         // the impedance is positive for any node with a contact area (an axis node included)
         debug_assert!(zs > 0.0, "slave {s}: impedance {zs}");

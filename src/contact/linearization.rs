@@ -172,11 +172,11 @@ impl ContactPair {
         let Master::Segments { edges, .. } = &self.master else {
             return None;
         };
-        if self.holds.is_some() {
+        if self.is_hold() {
             // a held master node's gap: its row is the frozen-geometry derivative
             return None;
         }
-        if let Some(surface) = &self.mortar {
+        if let Some((surface, edges)) = self.mortar() {
             return mortar_linearization(surface, edges, slave, x);
         }
         let [(a, _), (b, xi)] = gap.masters[..] else {

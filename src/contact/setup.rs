@@ -142,7 +142,7 @@ pub fn master_penetration(
 /// average over the slave segments. Zero for other pairs, whose slave gaps are pointwise
 /// already.
 pub fn slave_penetration(pair: &ContactPair, x: &impl Fn(usize) -> [f64; 2]) -> f64 {
-    let (Some(_), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master) else {
+    let Some((_, edges)) = pair.mortar() else {
         return 0.0;
     };
     pair.slaves

@@ -2,7 +2,7 @@
 //! run's contact figures (first contact, last release, peak force, penetration), and what
 //! the frames and the history read of it (nodal forces, gaps, pair totals).
 
-use super::geometry::{ContactPair, Master};
+use super::geometry::ContactPair;
 use super::search::slave_gaps;
 use super::{ContactSummary, Interfaces, Section};
 
@@ -234,17 +234,7 @@ impl ContactState {
         let x = |n: usize| coords[n];
         for entry in &self.master_block {
             let pair = &pairs[entry.pair];
-            let (Some(surface), Master::Segments { edges, .. }) = (&pair.mortar, &pair.master)
-            else {
-                continue;
-            };
-            let gap = super::mortar::master_node_gap(
-                &surface.edges,
-                edges,
-                entry.node,
-                super::mortar::MASTER_ALLOWANCE,
-                &x,
-            );
+            let gap = pair.master_node_gap(entry.node, super::mortar::MASTER_ALLOWANCE, &x);
             if let Some(gap) = gap {
                 for (dof, c) in gap.row(entry.node) {
                     f[dof] += entry.force * c;

@@ -9,7 +9,7 @@ use super::spec::{
     AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Roles, Scene, SurfaceSpec,
 };
 use crate::contact::{
-    ContactPair, Covered, Friction, Holds, Master, MortarSurface, Obstacle, OwnSurface,
+    ContactPair, Covered, Discretization, Friction, Holds, Master, MortarSurface, Obstacle, OwnSurface,
     PairOptions, setup,
 };
 use crate::element::Formulation;
@@ -50,9 +50,8 @@ pub(super) fn contacts(
             contacts.push(reverse);
         }
         let held = contacts[k]
-            .mortar
-            .as_ref()
-            .is_some_and(|surface| surface.hold_master_nodes);
+            .mortar()
+            .is_some_and(|(surface, _)| surface.hold_master_nodes);
         if held && implicit_dynamics(scene) {
             let hold = hold_pair(cx, bodies, k, spec, &contacts[k])?;
             contacts.push(hold);
@@ -242,8 +241,7 @@ fn contact(
         covered: None,
         balances: None,
         own,
-        mortar,
-        holds: None,
+        discretization: mortar.map_or(Discretization::NodeToSegment, Discretization::Mortar),
     })
 }
 
@@ -439,7 +437,7 @@ fn hold_pair(
     // frictionless: the mortar pair's rows carry the friction; a second tangential row at
     // the same nodes would count it twice
     hold.options.friction = Friction::None;
-    hold.holds = Some(Holds {
+    hold.discretization = Discretization::Held(Holds {
         master_edges: edges.clone(),
     });
     Ok(hold)
@@ -486,8 +484,7 @@ fn reverse_pair(
             boundary,
         },
         options: pair.options.clone(),
-        mortar: None,
-        holds: None,
+        discretization: Discretization::NodeToSegment,
         balances: None,
         own: None,
         covered: Some(Covered {

@@ -137,7 +137,7 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode) -> String {
     let named: Vec<String> = model
         .contacts
         .iter()
-        .filter(|p| p.slave_body == b && p.covered.is_none() && p.holds.is_none())
+        .filter(|p| p.slave_body == b && p.covered.is_none() && !p.is_hold())
         .map(|p| match set_named_by(body, &p.slaves) {
             Some(set) => format!("`{set}` of pair `{}`", p.name),
             None => format!("the slaves of pair `{}`", p.name),
@@ -226,7 +226,7 @@ pub(super) fn coarse_contact_warnings(model: &Model, summary: &Summary) -> Vec<S
         };
         // a hold pair, a second pass or a reverse pass takes its slaves from its first pass,
         // which is judged
-        let derived = pair.holds.is_some() || pair.covered.is_some() || pair.balances.is_some();
+        let derived = pair.is_hold() || pair.covered.is_some() || pair.balances.is_some();
         let surface = pair.slaves.len() > COARSE_CONTACT_NODES
             && !model.bodies[pair.slave_body].kind.is_rod()
             && !derived;
@@ -290,7 +290,7 @@ pub(super) fn still_closed_warnings(
     let coords = model.coordinates();
     let mut out = Vec::new();
     for pair in model.contacts.iter().filter(|p| closed.contains(&p.name)) {
-        if pair.covered.is_some() || pair.holds.is_some() {
+        if pair.covered.is_some() || pair.is_hold() {
             continue;
         }
         let start = approach(model, pair, (&coords, &model.initial_velocity, mass));

@@ -34,7 +34,7 @@ pub(super) fn slave_surface_warnings(model: &Model) -> Vec<String> {
     let mut out = Vec::new();
     for pair in &model.contacts {
         // a second pass or a hold pair has the slaves its first pass gives it
-        if pair.covered.is_some() || pair.holds.is_some() {
+        if pair.covered.is_some() || pair.is_hold() {
             continue;
         }
         if matches!(pair.master, Master::Nodes { .. }) {

@@ -465,7 +465,7 @@ fn free(row: Vec<(usize, f64)>, system: &System) -> Vec<(usize, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::{ContactPair, Inside, Master, Obstacle, PairOptions};
+    use crate::contact::{ContactPair, Discretization, Inside, Master, Obstacle, PairOptions};
 
     /// Node 0 against the wall y = 0 (solid below), with Coulomb friction `mu` (0: none).
     fn pair(mu: f64) -> ContactPair {
@@ -496,8 +496,7 @@ mod tests {
             covered: None,
             balances: None,
             own: None,
-            mortar: None,
-            holds: None,
+            discretization: Discretization::NodeToSegment,
         }
     }
 

@@ -40,7 +40,7 @@ pub fn active_set_inside(model: &Model, newton: &NewtonSpec) -> bool {
     match newton.active_set {
         Some(ActiveSetSolve::Newton) => true,
         Some(ActiveSetSolve::Passes) => false,
-        None => model.contacts.iter().any(|pair| pair.mortar.is_some()),
+        None => model.contacts.iter().any(|pair| pair.mortar().is_some()),
     }
 }
 
