@@ -51,7 +51,8 @@ pub mod step;
 pub mod traction;
 
 pub use geometry::{
-    ContactPair, Covered, Discretization, Friction, Gap, Holds, Master, Obstacle, PairOptions, winding_number,
+    ContactPair, Covered, Discretization, Friction, Gap, Holds, Master, Obstacle, PairOptions,
+    winding_number,
 };
 pub use impacts::{ImpactMotion, LumpedMass, apply_conditions};
 pub use mortar::MortarSurface;

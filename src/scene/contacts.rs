@@ -9,8 +9,8 @@ use super::spec::{
     AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Roles, Scene, SurfaceSpec,
 };
 use crate::contact::{
-    ContactPair, Covered, Discretization, Friction, Holds, Master, MortarSurface, Obstacle, OwnSurface,
-    PairOptions, setup,
+    ContactPair, Covered, Discretization, Friction, Holds, Master, MortarSurface, Obstacle,
+    OwnSurface, PairOptions, setup,
 };
 use crate::element::Formulation;
 use crate::mesh::Cells;

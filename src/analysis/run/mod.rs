@@ -142,19 +142,20 @@ impl<'a, S: Stepper> Run<'a, S> {
         resume: Option<Checkpoint>,
         (mut stepper, start): (S, Instant),
     ) -> Result<Run<'a, S>, RunError> {
+        let about = stepper.about();
         let mut recorder = match &resume {
             Some(c) => Recorder::resume(model, dir, c.recorder.clone())?,
             None => {
-                let window = contact_record::window(model, stepper.dt());
+                let window = contact_record::window(model, about.dt);
                 Recorder::create(model, dir, !options.no_frames, window)?
             }
         };
         let mut summary = Summary::new(
             model,
-            &stepper.integrator(),
-            stepper.dt(),
-            stepper.end_time(),
-            stepper.free_dofs(),
+            &about.integrator,
+            about.dt,
+            about.end_time,
+            about.free_dofs,
         );
         summary.column_units = units::column_units(model, columns::column_names(model));
         let coordinates = model.coordinates();
@@ -171,7 +172,7 @@ impl<'a, S: Stepper> Run<'a, S> {
                 summary: Box::new(run_summary),
             });
         }
-        let monitor = if stepper.checks_buckling() {
+        let monitor = if about.checks_buckling {
             Monitor::new(model, dir).map_err(|e| monitor_error(model, e))?
         } else {
             None
@@ -369,16 +370,17 @@ impl<'a, S: Stepper> Run<'a, S> {
             self.recorder.point_probes.clear();
             self.stepper.sync_points();
         }
-        if let Some(energy) = self.stepper.hourglass_energy() {
+        let features = self.stepper.row_features();
+        if let Some(energy) = features.hourglass_energy {
             self.recorder.hourglass_energy = energy;
         }
-        if let Some(watch) = self.stepper.error_watch() {
+        if let Some(watch) = features.error_watch {
             self.recorder.error_estimate = watch.last;
         }
-        if let Some(added) = self.stepper.added_mass() {
+        if let Some(added) = features.added_mass {
             self.recorder.added_mass = added;
         }
-        if let Some(factor) = self.stepper.load_factor() {
+        if let Some(factor) = features.load_factor {
             self.recorder.load_factor = factor;
         }
         if columns::body_columns(self.model) {
@@ -439,11 +441,12 @@ impl<'a, S: Stepper> Run<'a, S> {
             s.energies()
         };
         let solver = s.solver();
+        let (row, run) = (s.row_features(), s.run_features());
         let summary = &mut self.summary;
         summary.newton_iterations = self.counters.iterations;
         summary.step_cuts = self.counters.cuts;
         summary.rejected_steps = self.counters.rejected;
-        summary.max_error_estimate = s.error_watch().map(|w| w.largest);
+        summary.max_error_estimate = row.error_watch.map(|w| w.largest);
         summary.factorizations = solver.map_or(0, |s| s.factorizations);
         summary.back_substitutions = solver.map_or(0, |s| s.solves);
         summary.wall_seconds = self.start.elapsed().as_secs_f64();
@@ -474,13 +477,13 @@ impl<'a, S: Stepper> Run<'a, S> {
             entry.internal_energy = body.work.internal - body.work.plastic;
             entry.plastic_work = body.work.plastic;
         }
-        summary.ale = s.ale();
-        summary.arc_length = s.arc_length();
-        let mass_scaling = s.mass_scaling();
+        summary.ale = run.ale;
+        summary.arc_length = run.arc_length;
+        let mass_scaling = run.mass_scaling;
         summary.mass_scaling = mass_scaling
             .as_ref()
             .map(|r| MassScalingSummary::of(r, self.model));
-        summary.subcycling = s.subcycling();
+        summary.subcycling = run.subcycling;
         summary.contact = s.contact().summary(&self.model.contacts);
         if !matches!(self.model.analysis, Analysis::Dynamic(_)) {
             // statics books no energy of its contact
@@ -490,20 +493,20 @@ impl<'a, S: Stepper> Run<'a, S> {
             record.fill(self.model, &mut summary.contact, s.contact());
         }
         summary.buckling = self.monitor.as_ref().map(|m| m.summary.clone());
-        if let Some(report) = s.time_step_report() {
+        if let Some(report) = &run.time_step {
             summary.dt_min = Some(report.shortest);
             summary.dt_max = Some(report.longest);
             summary.dt_limit = Some(DtLimit::of(report.limit, self.model));
         }
         summary.max_temperature = record::max_temperature(self.model, s.state());
-        let first_step = s.time_step_report().map(|report| report.first);
+        let first_step = run.time_step.as_ref().map(|report| report.first);
         summary.warnings = plausibility::warnings(self.model, summary, energies, first_step);
         let positions = s.state().positions(self.model.analysis.geometry());
         let motion = s.motion();
         let end = plausibility::EndOfRun {
             positions: &positions,
             energies,
-            hourglass_energy: s.hourglass_energy(),
+            hourglass_energy: row.hourglass_energy,
             mass_scaling: mass_scaling.as_ref(),
             velocity: motion.velocity,
             mass: motion.mass,

@@ -32,7 +32,7 @@
 use super::carry::Carry;
 use super::energies::{Energies, Motion};
 use super::newton::Counters;
-use super::{Report, Resume, StepError, Stepper, loads};
+use super::{About, Report, Resume, RowFeatures, RunFeatures, StepError, Stepper, loads};
 use crate::analysis::summary::ArcLengthSummary;
 use crate::assembly::{self, Evaluation, State, StepIncrement, System};
 use crate::contact::ContactState;
@@ -429,20 +429,14 @@ impl Stepper for ArcLength<'_> {
 }
 
 impl Report for ArcLength<'_> {
-    fn integrator(&self) -> String {
-        "static".into()
-    }
-    fn dt(&self) -> f64 {
-        self.spec.end_time / self.spec.steps as f64
-    }
-    fn end_time(&self) -> f64 {
-        self.spec.end_time
-    }
-    fn free_dofs(&self) -> usize {
-        self.system.free
-    }
-    fn checks_buckling(&self) -> bool {
-        false
+    fn about(&self) -> About {
+        About {
+            integrator: "static".into(),
+            dt: self.spec.end_time / self.spec.steps as f64,
+            end_time: self.spec.end_time,
+            free_dofs: self.system.free,
+            checks_buckling: false,
+        }
     }
     fn state(&self) -> &State {
         &self.state
@@ -470,17 +464,23 @@ impl Report for ArcLength<'_> {
     fn last_step(&self) -> f64 {
         self.last_step
     }
-    fn load_factor(&self) -> Option<f64> {
-        Some(self.factor)
+    fn row_features(&self) -> RowFeatures {
+        RowFeatures {
+            load_factor: Some(self.factor),
+            ..RowFeatures::default()
+        }
     }
-    fn arc_length(&self) -> Option<ArcLengthSummary> {
-        Some(ArcLengthSummary {
-            increments: self.increments,
-            peak_load_factor: self.peak,
-            final_load_factor: self.factor,
-            reached_load: self.factor >= 1.0 - 1e-12,
-            collapsed: self.collapsed,
-        })
+    fn run_features(&self) -> RunFeatures {
+        RunFeatures {
+            arc_length: Some(ArcLengthSummary {
+                increments: self.increments,
+                peak_load_factor: self.peak,
+                final_load_factor: self.factor,
+                reached_load: self.factor >= 1.0 - 1e-12,
+                collapsed: self.collapsed,
+            }),
+            ..RunFeatures::default()
+        }
     }
 }
 

@@ -48,16 +48,13 @@ pub trait Stepper: Report + Resume {
 }
 
 /// What a stepper says of its run and its state: summary.json, history.csv and the frames
-/// read it.
+/// read it. What is fixed for the run is one struct ([`About`]), and so are what the
+/// optional features add to a history row ([`RowFeatures`]) and to summary.json at the end
+/// ([`RunFeatures`]): a new feature is a field there, filled by the steppers that have it.
 pub trait Report {
-    /// The integrator's name in summary.json.
-    fn integrator(&self) -> String;
-    /// The nominal step and the end time.
-    fn dt(&self) -> f64;
-    fn end_time(&self) -> f64;
-    fn free_dofs(&self) -> usize;
-    /// Whether the run carries the buckling check of `[analysis.buckling]`.
-    fn checks_buckling(&self) -> bool;
+    /// The integrator's name, the nominal step, the end time, the free DOFs and whether the
+    /// run carries the buckling check.
+    fn about(&self) -> About;
     fn state(&self) -> &State;
     fn motion(&self) -> Motion<'_>;
     fn energies(&self) -> &Energies;
@@ -82,47 +79,59 @@ pub trait Report {
     fn point_probe(&self, _probe: &Probe) -> Option<f64> {
         None
     }
-    /// The accumulated hourglass work, for the history column of the one-point kernel.
-    fn hourglass_energy(&self) -> Option<f64> {
-        None
-    }
-    /// The local error estimates of the implicit steps (None: no estimate).
-    fn error_watch(&self) -> Option<ErrorWatch> {
-        None
-    }
     /// The length of the last step (0 before the first).
     fn last_step(&self) -> f64;
-    /// What the time step did (central difference): summary.json `dt_min`, `dt_max`,
-    /// `dt_limit`.
-    fn time_step_report(&self) -> Option<TimeStepReport> {
-        None
+    /// What the optional features add to a history row (none by default).
+    fn row_features(&self) -> RowFeatures {
+        RowFeatures::default()
     }
-    /// The mass the mass scaling has added so far, for the history column (None: off).
-    fn added_mass(&self) -> Option<f64> {
-        None
+    /// What the optional features add to summary.json at the end (none by default).
+    fn run_features(&self) -> RunFeatures {
+        RunFeatures::default()
     }
+}
+
+/// What a stepper is, fixed for its run: the head of summary.json.
+#[derive(Debug, Clone)]
+pub struct About {
+    /// The integrator's name in summary.json.
+    pub integrator: String,
+    /// The nominal step and the end time.
+    pub dt: f64,
+    pub end_time: f64,
+    pub free_dofs: usize,
+    /// Whether the run carries the buckling check of `[analysis.buckling]`.
+    pub checks_buckling: bool,
+}
+
+/// The optional features' values of a history row; None: the feature is off (its column
+/// keeps its default).
+#[derive(Debug, Clone, Default)]
+pub struct RowFeatures {
+    /// The accumulated hourglass work of the one-point kernel.
+    pub hourglass_energy: Option<f64>,
+    /// The local error estimates of the implicit steps (`dt = "auto"`).
+    pub error_watch: Option<ErrorWatch>,
+    /// The mass the mass scaling has added so far.
+    pub added_mass: Option<f64>,
     /// The share of the scene's loads at end_time that the state carries, where it is not
-    /// the pseudo time's (arc length: the history's `load_factor`; None: load stepping).
-    fn load_factor(&self) -> Option<f64> {
-        None
-    }
-    /// The mass scaling per body at the end: summary.json `mass_scaling` and its warnings
-    /// (None: off).
-    fn mass_scaling(&self) -> Option<crate::assembly::mass_scaling::MassScalingReport> {
-        None
-    }
-    /// The ALE steps' counts at the end: summary.json `ale` (None: off).
-    fn ale(&self) -> Option<crate::analysis::summary::AleSummary> {
-        None
-    }
-    /// The arc-length path at the end: summary.json `arc_length` (None: load stepping).
-    fn arc_length(&self) -> Option<crate::analysis::summary::ArcLengthSummary> {
-        None
-    }
-    /// The subcycling's counts at the end: summary.json `subcycling` (None: off).
-    fn subcycling(&self) -> Option<crate::analysis::summary::SubcyclingSummary> {
-        None
-    }
+    /// the pseudo time's (arc length: the history's `load_factor`).
+    pub load_factor: Option<f64>,
+}
+
+/// The optional features' blocks of summary.json at the end of a run; None: off.
+#[derive(Debug, Clone, Default)]
+pub struct RunFeatures {
+    /// What the time step did (central difference): `dt_min`, `dt_max`, `dt_limit`.
+    pub time_step: Option<TimeStepReport>,
+    /// The mass scaling per body: `mass_scaling` and its warnings.
+    pub mass_scaling: Option<crate::assembly::mass_scaling::MassScalingReport>,
+    /// The ALE steps' counts: `ale`.
+    pub ale: Option<crate::analysis::summary::AleSummary>,
+    /// The arc-length path: `arc_length`.
+    pub arc_length: Option<crate::analysis::summary::ArcLengthSummary>,
+    /// The subcycling's counts: `subcycling`.
+    pub subcycling: Option<crate::analysis::summary::SubcyclingSummary>,
 }
 
 /// What a checkpoint keeps of a stepper, and how a resumed stepper takes it back.

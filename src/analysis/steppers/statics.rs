@@ -16,7 +16,7 @@ use super::carry::{Carry, StaticCarry};
 use super::control::{StepControl, snap};
 use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Step, StepFailure};
-use super::{Report, Resume, StepError, Stepper, loads};
+use super::{About, Report, Resume, StepError, Stepper, loads};
 use crate::assembly::{self, State, System};
 use crate::contact::{ContactState, Interfaces, Pass};
 use crate::integrator::StepForm;
@@ -283,22 +283,15 @@ impl Stepper for Statics<'_> {
 }
 
 impl Report for Statics<'_> {
-    fn integrator(&self) -> String {
-        "static".into()
+    fn about(&self) -> About {
+        About {
+            integrator: "static".into(),
+            dt: self.dt,
+            end_time: self.spec.end_time,
+            free_dofs: self.system.free,
+            checks_buckling: true,
+        }
     }
-    fn dt(&self) -> f64 {
-        self.dt
-    }
-    fn end_time(&self) -> f64 {
-        self.spec.end_time
-    }
-    fn free_dofs(&self) -> usize {
-        self.system.free
-    }
-    fn checks_buckling(&self) -> bool {
-        true
-    }
-
     fn state(&self) -> &State {
         &self.state
     }

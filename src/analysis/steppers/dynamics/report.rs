@@ -3,31 +3,23 @@
 
 use super::Dynamics;
 use crate::analysis::steppers::carry::{Carry, DynamicCarry};
-use crate::analysis::steppers::control::ErrorWatch;
 use crate::analysis::steppers::energies::{Energies, Motion};
-use crate::analysis::steppers::{Report, Resume};
+use crate::analysis::steppers::{About, Report, Resume, RowFeatures};
 use crate::assembly::State;
 use crate::contact::ContactState;
 use crate::scene::Model;
 use crate::solver::Solver;
 
 impl Report for Dynamics<'_> {
-    fn integrator(&self) -> String {
-        self.method.name()
+    fn about(&self) -> About {
+        About {
+            integrator: self.method.name(),
+            dt: self.nominal,
+            end_time: self.spec.end_time,
+            free_dofs: self.system.free,
+            checks_buckling: true,
+        }
     }
-    fn dt(&self) -> f64 {
-        self.nominal
-    }
-    fn end_time(&self) -> f64 {
-        self.spec.end_time
-    }
-    fn free_dofs(&self) -> usize {
-        self.system.free
-    }
-    fn checks_buckling(&self) -> bool {
-        true
-    }
-
     fn state(&self) -> &State {
         &self.state
     }
@@ -57,8 +49,11 @@ impl Report for Dynamics<'_> {
     fn last_step(&self) -> f64 {
         self.last_step
     }
-    fn error_watch(&self) -> Option<ErrorWatch> {
-        self.error.constant.map(|_| self.watch)
+    fn row_features(&self) -> RowFeatures {
+        RowFeatures {
+            error_watch: self.error.constant.map(|_| self.watch),
+            ..RowFeatures::default()
+        }
     }
 }
 

@@ -30,10 +30,12 @@ use super::carry::{Carry, ExplicitCarry};
 use super::clock::Clock;
 use super::energies::{Energies, Motion};
 use super::newton::Counters;
-use super::{Report, Resume, StepError, Stepper, TimeStepReport, loads};
+use super::{
+    About, Report, Resume, RowFeatures, RunFeatures, StepError, Stepper, TimeStepReport, loads,
+};
 use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, PartialKernel, kernel_for};
-use crate::assembly::mass_scaling::{AddedAtRest, MassScalingReport, NodalMotion};
+use crate::assembly::mass_scaling::{AddedAtRest, NodalMotion};
 use crate::assembly::{ElementMasses, Mass, StableStep, State, check_mass};
 use crate::contact::explicit::Predicted;
 use crate::contact::{ContactState, Interfaces};
@@ -438,22 +440,15 @@ impl Stepper for Explicit<'_> {
 }
 
 impl Report for Explicit<'_> {
-    fn integrator(&self) -> String {
-        "central_difference".into()
+    fn about(&self) -> About {
+        About {
+            integrator: "central_difference".into(),
+            dt: self.clock.dt0,
+            end_time: self.spec.end_time,
+            free_dofs: self.free.iter().filter(|f| **f).count(),
+            checks_buckling: false,
+        }
     }
-    fn dt(&self) -> f64 {
-        self.clock.dt0
-    }
-    fn end_time(&self) -> f64 {
-        self.spec.end_time
-    }
-    fn free_dofs(&self) -> usize {
-        self.free.iter().filter(|f| **f).count()
-    }
-    fn checks_buckling(&self) -> bool {
-        false
-    }
-
     fn state(&self) -> &State {
         &self.state
     }
@@ -480,36 +475,34 @@ impl Report for Explicit<'_> {
         }
         self.kernel.point_probe(self.model, probe)
     }
-    fn hourglass_energy(&self) -> Option<f64> {
-        self.kernel.hourglass_energy()
-    }
     fn last_step(&self) -> f64 {
         self.clock.last
     }
-    fn added_mass(&self) -> Option<f64> {
-        self.kernel.mass_scaling().map(|s| s.added())
+    fn row_features(&self) -> RowFeatures {
+        RowFeatures {
+            hourglass_energy: self.kernel.hourglass_energy(),
+            added_mass: self.kernel.mass_scaling().map(|s| s.added()),
+            ..RowFeatures::default()
+        }
     }
-    fn mass_scaling(&self) -> Option<MassScalingReport> {
+    fn run_features(&self) -> RunFeatures {
         let kernel = &self.kernel;
-        let scaling = kernel.mass_scaling()?;
-        Some(scaling.report(self.model.bodies.len(), |e| kernel.locate(e)))
-    }
-    fn ale(&self) -> Option<crate::analysis::summary::AleSummary> {
-        self.mesh_motion.as_ref().map(ale::MeshMotion::summary)
-    }
-    fn subcycling(&self) -> Option<crate::analysis::summary::SubcyclingSummary> {
-        let sub = self.subcycler.as_ref()?;
-        Some(sub.summary(self.kernel.elements()))
-    }
-    fn time_step_report(&self) -> Option<TimeStepReport> {
-        let c = &self.clock;
-        let range = c.range()?;
-        Some(TimeStepReport {
+        let mass_scaling = kernel
+            .mass_scaling()
+            .map(|scaling| scaling.report(self.model.bodies.len(), |e| kernel.locate(e)));
+        let time_step = self.clock.range().map(|range| TimeStepReport {
             shortest: range.shortest,
             longest: range.longest,
-            limit: c.limit,
-            first: c.dt0,
-        })
+            limit: self.clock.limit,
+            first: self.clock.dt0,
+        });
+        RunFeatures {
+            time_step,
+            mass_scaling,
+            ale: self.mesh_motion.as_ref().map(ale::MeshMotion::summary),
+            arc_length: None,
+            subcycling: (self.subcycler.as_ref()).map(|sub| sub.summary(kernel.elements())),
+        }
     }
 }
 
