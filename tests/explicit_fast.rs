@@ -526,9 +526,11 @@ fn results_do_not_depend_on_thread_count_above_the_parallel_threshold() {
     }
 }
 
-/// PARALLEL_ROD and beside it a ring (x from 6 to 10 mm) meshed twice as coarse, 20 x 50,
-/// on the same wall: subcycled, the rod's elements step on level 0 and most of the ring's
-/// 1000 on level 1, both levels more than one chunk of the kernels' lists.
+/// PARALLEL_ROD and beside it a ring (x from 6 to 12 mm) meshed three times as coarse, 20 x
+/// 50, on the same wall: subcycled, the rod's elements step on level 0 and most of the
+/// ring's 1000 on level 1 (own steps 3 times the rod's, so level 1 keeps the interfaces'
+/// margin, 2 <= 0.8 x 3, beside the ring's contact nodes on level 0), both levels more than
+/// one chunk of the kernels' lists.
 fn two_level_rods() -> String {
     PARALLEL_ROD
         .replace(
@@ -546,7 +548,7 @@ name = "ring"
 material = "steel"
 formulation = "axisymmetric"
 velocity = [0.0, -200.0]
-mesh = { type = "rectangle", origin = [6.0e-3, 0.0], width = 4.0e-3, height = 20.0e-3, nx = 20, ny = 50 }
+mesh = { type = "rectangle", origin = [6.0e-3, 0.0], width = 6.0e-3, height = 30.0e-3, nx = 20, ny = 50 }
 
 [[contact]]
 name = "ring_face"

@@ -63,13 +63,21 @@ impl Levels {
         pinned: &[bool],
         levels: u32,
     ) -> Levels {
-        Levels::of_element_levels(own_levels(omega_squared, levels), element_nodes, pinned)
+        let own = own_levels(omega_squared, levels);
+        let ratios = step_ratios(omega_squared);
+        Levels::of_element_levels(own, &ratios, element_nodes, pinned)
     }
 
-    /// The levels of elements whose own levels are `own` (k_e): the nodes take the finest
-    /// of their elements (pinned and element-less nodes 0), the elements the finest of
+    /// The levels of elements whose own levels are `own` (k_e) and own steps `ratios` times
+    /// the shortest: the nodes take the finest of their elements (pinned and element-less
+    /// nodes 0), graded at the interfaces (`grade_interfaces`), the elements the finest of
     /// their nodes.
-    pub fn of_element_levels(own: Vec<u8>, element_nodes: &[[u32; 4]], pinned: &[bool]) -> Levels {
+    pub fn of_element_levels(
+        own: Vec<u8>,
+        ratios: &[f64],
+        element_nodes: &[[u32; 4]],
+        pinned: &[bool],
+    ) -> Levels {
         let mut node = vec![u8::MAX; pinned.len()];
         for (nodes, k) in element_nodes.iter().zip(&own) {
             for n in nodes {
@@ -82,6 +90,7 @@ impl Levels {
                 *k = 0;
             }
         }
+        grade_interfaces(&mut node, ratios, element_nodes);
         let top = node.iter().copied().max().unwrap_or(0) as u32;
         let count = top as usize + 1;
         let (mut elements, mut nodes, mut touched) = (
@@ -113,6 +122,86 @@ impl Levels {
             touched,
             top,
             own,
+        }
+    }
+}
+
+/// How far below its own step an element between two levels keeps its coarser nodes' step:
+/// the coarser level's 2^k dt_min at most INTERFACE_MARGIN dt_e (docs/theory.md 8.7c,
+/// "Which layouts grow": stable at 0.8 on every layout tried, not at 0.9).
+pub const INTERFACE_MARGIN: f64 = 0.8;
+
+/// Each element's own stable step over the shortest, dt_e / dt_min (infinite for an element
+/// that does not vibrate).
+pub fn step_ratios(omega_squared: &[f64]) -> Vec<f64> {
+    let largest = omega_squared.iter().copied().fold(0.0, f64::max);
+    omega_squared
+        .iter()
+        .map(|w| {
+            if *w > 0.0 {
+                (largest / w).sqrt()
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect()
+}
+
+/// Lowers node levels until every element whose nodes step on different levels (an
+/// interface) has them on two neighbouring levels, the coarser stepping at most
+/// INTERFACE_MARGIN of the element's own step (`ratios`: dt_e / dt_min): with the levels as
+/// the nodes' finest elements give them, the nodal partition's linear interpolation grew on
+/// some layouts, and graded so it has on none tried (docs/theory.md 8.7c, "Which layouts
+/// grow"). Levels only fall, element by element from a work list, so it ends.
+fn grade_interfaces(node: &mut [u8], ratios: &[f64], element_nodes: &[[u32; 4]]) {
+    // the elements of each node (compressed rows)
+    let mut start = vec![0u32; node.len() + 1];
+    for nodes in element_nodes {
+        for n in nodes {
+            start[*n as usize + 1] += 1;
+        }
+    }
+    for i in 0..node.len() {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut elements_of = vec![0u32; start[node.len()] as usize];
+    for (e, nodes) in element_nodes.iter().enumerate() {
+        for n in nodes {
+            elements_of[fill[*n as usize] as usize] = e as u32;
+            fill[*n as usize] += 1;
+        }
+    }
+    let mut queued = vec![true; element_nodes.len()];
+    let mut work: Vec<u32> = (0..element_nodes.len() as u32).rev().collect();
+    while let Some(e) = work.pop() {
+        let e = e as usize;
+        queued[e] = false;
+        let nodes = element_nodes[e];
+        let levels = nodes.map(|n| node[n as usize]);
+        let (lo, hi) = (*levels.iter().min().unwrap(), *levels.iter().max().unwrap());
+        if lo == hi {
+            continue;
+        }
+        // the finest level whose step keeps the margin: floor(log2(margin dt_e / dt_min))
+        let margin = INTERFACE_MARGIN * ratios[e];
+        let kept = if margin >= 1.0 {
+            margin.log2().floor().min(f64::from(u8::MAX)) as u8
+        } else {
+            0
+        };
+        let allowed = lo.max((lo + 1).min(kept));
+        for n in nodes {
+            let n = n as usize;
+            if node[n] > allowed {
+                node[n] = allowed;
+                for f in &elements_of[start[n] as usize..start[n + 1] as usize] {
+                    if !queued[*f as usize] {
+                        queued[*f as usize] = true;
+                        work.push(*f);
+                    }
+                }
+            }
         }
     }
 }
@@ -258,7 +347,9 @@ impl Subcycler {
     fn reform(&mut self, kernel: &mut dyn PartialKernel) {
         let own = own_levels(&self.omega_squared, self.rule.levels);
         if own != self.levels.own {
-            self.levels = Levels::of_element_levels(own, kernel.element_nodes(), &self.pinned);
+            let ratios = step_ratios(&self.omega_squared);
+            self.levels =
+                Levels::of_element_levels(own, &ratios, kernel.element_nodes(), &self.pinned);
         }
     }
 }
@@ -606,7 +697,8 @@ mod tests {
 
     /// Levels: an element twice as stiff as the rest takes level 0 and drags its nodes'
     /// other elements to it; a pinned node does the same; nodes take the finest of their
-    /// elements.
+    /// elements, then the interfaces are graded: across an element its nodes' levels differ
+    /// by at most one, the coarser within INTERFACE_MARGIN of the element's own step.
     #[test]
     fn levels_follow_the_finest_element_of_each_node() {
         // dt_e: 1, 4, 4, 8 (omega^2 ~ 1 / dt^2)
@@ -617,11 +709,29 @@ mod tests {
         let own = own_levels(&omega, 5);
         assert_eq!(own, vec![0, 2, 2, 3]);
         let levels = Levels::form(&omega, &strip(), &[false; 10], 5);
-        // nodes 0, 1 (5, 6) level 0; 2 (7): min(2, 2) = 2; 3 (8): 2; 4 (9): 3
-        assert_eq!(levels.node, vec![0, 0, 2, 2, 3, 0, 0, 2, 2, 3]);
-        // element 1 has nodes 1 and 2: level 0; element 2: 2; element 3: nodes 3, 4: 2
-        assert_eq!(element_levels(&levels, 4), vec![0, 0, 2, 2]);
-        assert_eq!(levels.top, 3);
+        // the finest of their elements: nodes 0, 1 (5, 6) level 0; 2 (7): min(2, 2) = 2;
+        // 3 (8): 2; 4 (9): 3. Graded: element 1 (dt_e 4: its margin's level is
+        // floor(log2(0.8 * 4)) = 1) joins levels 0 and 2, so node 2 falls to min(0 + 1, 1);
+        // element 2 (margin level 1) then joins 1 and 2: node 3 to 1; element 3 (dt_e 8:
+        // floor(log2 6.4) = 2) joins 1 and 3: node 4 to min(1 + 1, 2) = 2
+        assert_eq!(levels.node, vec![0, 0, 1, 1, 2, 0, 0, 1, 1, 2]);
+        // element 1 has nodes 1 and 2: level 0; element 2: 1; element 3: nodes 3, 4: 1
+        assert_eq!(element_levels(&levels, 4), vec![0, 0, 1, 1]);
+        assert_eq!(levels.top, 2);
+        // where the margin binds: dt_e 1, 2, 8, 8 (own 0, 1, 3, 3): node 2, level 1 by its
+        // elements, sits on element 1 (dt_e 2: floor(log2 1.6) = 0) beside level 0, so it
+        // falls to 0; node 3 (3) beside it on element 2 to 0 + 1; node 4 (3) to 1 + 1
+        let omega: Vec<f64> = [1.0, 2.0, 8.0, 8.0]
+            .iter()
+            .map(|dt| 1.0 / (dt * dt))
+            .collect();
+        assert_eq!(own_levels(&omega, 5), vec![0, 1, 3, 3]);
+        let graded = Levels::form(&omega, &strip(), &[false; 10], 5);
+        assert_eq!(graded.node, vec![0, 0, 0, 1, 2, 0, 0, 0, 1, 2]);
+        let omega: Vec<f64> = [1.0, 4.0, 4.0, 8.0]
+            .iter()
+            .map(|dt| 1.0 / (dt * dt))
+            .collect();
         let mut pinned = [false; 10];
         pinned[3] = true;
         let levels = Levels::form(&omega, &strip(), &pinned, 5);
