@@ -8,7 +8,8 @@
 //! dt_e     element e's own stable step 2 / omega_e (its bound where the levels were formed)
 //! k_e      floor(log2(dt_e / dt_min)), at most `levels`
 //! k_n      min of k_e over node n's elements; 0 on the contact surfaces and for the nodes
-//!          of moving prescribed displacements
+//!          of moving prescribed displacements; then graded: across an element, levels at
+//!          most one apart, the coarser within INTERFACE_MARGIN of the element's own step
 //! l_e      min of k_n over element e's nodes: the level e steps at (l_e <= k_e)
 //! H, h     the major step (the clock's rule on 2^K dt_min, K the largest k_n), h = H / 2^K
 //! node n   velocity Verlet over its own step D_n = 2^k_n h from t_s: v_1/2 = v + D_n/2 a,
