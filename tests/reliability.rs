@@ -602,7 +602,7 @@ fn resume_without_checkpoint_is_bad_input() {
     assert!(stderr.contains("checkpoint.bin"), "{stderr}");
     assert!(stderr.contains("checkpoint_every"), "{stderr}");
     // an older format is refused as such; the current format with a damaged body as damaged
-    for (version, needle) in [(17u32, "checkpoint format 17"), (18, "damaged checkpoint")] {
+    for (version, needle) in [(18u32, "checkpoint format 18"), (19, "damaged checkpoint")] {
         let mut bytes = b"IMPACTCP".to_vec();
         bytes.extend(version.to_le_bytes());
         bytes.extend(b"garbage");

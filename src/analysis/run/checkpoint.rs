@@ -48,7 +48,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 17: the one-point kernel's hourglass forces and their work in the explicit carry.
 /// 18: the first slave past an obstacle's end and the time of the peak force in the contact
 ///     record and the summary.
-const FORMAT: u32 = 18;
+/// 19: the step ratios a subcycled run's levels were graded with in its carry.
+const FORMAT: u32 = 19;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

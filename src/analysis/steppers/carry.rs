@@ -90,11 +90,13 @@ pub struct AleCarry {
 }
 
 /// What a subcycled run carries past a major step: the frequency bound squared of every
-/// element's last step (the next levels are formed from them), the last substep's length,
-/// the substeps and element updates so far.
+/// element's last step (the next levels are formed from them), the step ratios the current
+/// levels' interfaces were graded with (they were formed at an earlier step), the last
+/// substep's length, the substeps and element updates so far.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SubcyclingCarry {
     pub omega_squared: Vec<f64>,
+    pub ratios: Vec<f64>,
     pub last_substep: f64,
     pub substeps: u64,
     pub element_updates: u64,

@@ -52,6 +52,9 @@ pub struct Levels {
     pub top: u32,
     /// The elements' own levels k_e the levels were formed from.
     pub own: Vec<u8>,
+    /// The elements' own steps over the shortest, dt_e / dt_min, the interfaces were graded
+    /// with (`grade_interfaces`).
+    pub ratios: Vec<f64>,
 }
 
 impl Levels {
@@ -123,6 +126,7 @@ impl Levels {
             touched,
             top,
             own,
+            ratios: ratios.to_vec(),
         }
     }
 }
@@ -300,6 +304,7 @@ impl Subcycler {
     pub(super) fn carry(&self) -> SubcyclingCarry {
         SubcyclingCarry {
             omega_squared: self.omega_squared.clone(),
+            ratios: self.levels.ratios.clone(),
             last_substep: self.last_substep,
             substeps: self.substeps,
             element_updates: self.element_updates,
@@ -307,14 +312,16 @@ impl Subcycler {
         }
     }
 
-    /// Takes a checkpoint's carry back: the levels are those its bounds form. False when the
-    /// carry is not of this kernel's elements (a mesh changed since the checkpoint).
+    /// Takes a checkpoint's carry back: the levels are those its bounds' own levels and its
+    /// graded ratios form, as they were. False when the carry is not of this kernel's
+    /// elements (a mesh changed since the checkpoint).
     pub(super) fn restore(
         &mut self,
         carry: SubcyclingCarry,
         kernel: &mut dyn PartialKernel,
     ) -> bool {
-        if carry.omega_squared.len() != self.omega_squared.len() {
+        let elements = self.omega_squared.len();
+        if carry.omega_squared.len() != elements || carry.ratios.len() != elements {
             return false;
         }
         self.omega_squared = carry.omega_squared;
@@ -322,12 +329,9 @@ impl Subcycler {
         self.substeps = carry.substeps;
         self.element_updates = carry.element_updates;
         self.largest_step_ratio = carry.largest_step_ratio;
-        self.levels = Levels::form(
-            &self.omega_squared,
-            kernel.element_nodes(),
-            &self.pinned,
-            self.rule.levels,
-        );
+        let own = own_levels(&self.omega_squared, self.rule.levels);
+        self.levels =
+            Levels::of_element_levels(own, &carry.ratios, kernel.element_nodes(), &self.pinned);
         true
     }
 
