@@ -49,28 +49,34 @@ pub(super) struct Entry<'a> {
 
 impl<'a> Entry<'a> {
     /// Entry `k` of pair `p` of `interfaces` at the positions `coords` (`lumped`: the mass
-    /// per DOF), with its slave's gap `gap` when the caller has it, else found here; None
-    /// when no master is within reach.
-    pub fn at(
+    /// per DOF), its slave's gap `gap`.
+    pub fn new(
         interfaces: &'a Interfaces,
         (p, k): (usize, usize),
-        gap: Option<Gap>,
+        gap: Gap,
         (coords, lumped): (&'a [[f64; 2]], &'a [f64]),
-    ) -> Option<Entry<'a>> {
+    ) -> Entry<'a> {
         let pair = &interfaces.pairs[p];
-        let slave = pair.slaves[k];
-        let gap = match gap {
-            Some(gap) => gap,
-            None => pair.gap(slave, &|n: usize| coords[n])?,
-        };
-        Some(Entry {
+        Entry {
             interfaces,
             pair,
-            slave,
+            slave: pair.slaves[k],
             gap,
             coords,
             lumped,
-        })
+        }
+    }
+
+    /// [`Entry::new`] with the slave's gap found at `coords`; None when no master is within
+    /// reach.
+    pub fn at(
+        interfaces: &'a Interfaces,
+        (p, k): (usize, usize),
+        (coords, lumped): (&'a [[f64; 2]], &'a [f64]),
+    ) -> Option<Entry<'a>> {
+        let pair = &interfaces.pairs[p];
+        let gap = pair.gap(pair.slaves[k], &|n: usize| coords[n])?;
+        Some(Entry::new(interfaces, (p, k), gap, (coords, lumped)))
     }
 
     /// The master side of the entry; None on a rigid obstacle.

@@ -43,8 +43,7 @@ impl ContactState {
         } in touching
         {
             let pair = &interfaces.pairs[p];
-            let entry = conditions::Entry::at(interfaces, (p, k), Some(gap), (coords, lumped))
-                .expect("the entry's gap is given");
+            let entry = conditions::Entry::new(interfaces, (p, k), gap, (coords, lumped));
             if !conditions::approaching(&entry, velocity) {
                 continue; // touching but not approaching
             }
@@ -297,7 +296,7 @@ fn impact_slaves<S>(
         if !pair.options.impact_conditions || pair.joint_conditions() {
             continue;
         }
-        let Some(entry) = conditions::Entry::at(interfaces, (p, k), None, (coords, lumped)) else {
+        let Some(entry) = conditions::Entry::at(interfaces, (p, k), (coords, lumped)) else {
             continue;
         };
         let (s, gap) = (entry.slave, &entry.gap);
@@ -354,7 +353,7 @@ fn release_slaves<S>(
         if !pair.options.release_conditions {
             continue;
         }
-        let Some(entry) = conditions::Entry::at(interfaces, (p, k), None, (coords, lumped)) else {
+        let Some(entry) = conditions::Entry::at(interfaces, (p, k), (coords, lumped)) else {
             continue;
         };
         let (s, gap) = (entry.slave, &entry.gap);
