@@ -69,8 +69,13 @@ impl ElementScale {
 /// L_e = A / D_max (see the legend).
 #[inline(always)]
 pub fn characteristic_length(x: &Nodes) -> f64 {
-    let diagonal = |a: usize, b: usize| (x[b][0] - x[a][0]).hypot(x[b][1] - x[a][1]);
-    area(x) / diagonal(0, 2).max(diagonal(1, 3))
+    // the longer diagonal's square first, one root (hypot per diagonal was a tenth of the
+    // one-point step: libm's hypot guards against overflow no element length comes near)
+    let squared = |a: usize, b: usize| {
+        let (dx, dy) = (x[b][0] - x[a][0], x[b][1] - x[a][1]);
+        dx * dx + dy * dy
+    };
+    area(x) / squared(0, 2).max(squared(1, 3)).sqrt()
 }
 
 impl BulkViscosity {
