@@ -8,6 +8,7 @@
 //! explicit: central difference at dt = 0.5 h / c (below its limit h / c for these squares).
 //! Each case is a child `impact run` so that its peak memory is its own.
 
+pub mod bound;
 mod scenes;
 mod taylor;
 
@@ -102,6 +103,10 @@ pub struct Row {
     /// Element updates per second of the assembly phase alone (evaluation and scatter): the
     /// element cost, where `element_updates_per_second` is the throughput of whole steps.
     pub assembly_updates_per_second: f64,
+    /// One-point explicit rows: the memory bound of the same step on this machine
+    /// (`bound`: the bytes of one update, the copy rate, the updates a second it allows).
+    #[serde(default)]
+    pub memory_bound: Option<bound::Bound>,
     pub newton_iterations: usize,
     pub factorizations: usize,
     pub back_substitutions: usize,
@@ -373,6 +378,12 @@ pub fn run(
         progress(&row);
         rows.push(row);
     }
+    // timed after the children, on this thread alone: nothing runs beside the copy
+    for row in rows.iter_mut() {
+        if row.method == Method::ExplicitReduced && row.status == "ok" {
+            row.memory_bound = Some(bound::measure(row.elements, row.dofs / 2, 5));
+        }
+    }
     let text = serde_json::to_string_pretty(&rows).expect("rows serialize");
     write_atomic(&dir.join("bench.json"), text.as_bytes())?;
     charts(dir, &rows)?;
@@ -430,6 +441,7 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
         } else {
             0.0
         },
+        memory_bound: None,
         newton_iterations: s.newton_iterations,
         factorizations: s.factorizations,
         back_substitutions: s.back_substitutions,
@@ -441,11 +453,12 @@ fn read_row(case: &Case, out: &Path, code: Option<i32>) -> Result<Row, OutputErr
 /// The table printed by `impact bench`.
 pub fn table(rows: &[Row]) -> String {
     let mut s = format!(
-        "{:<36} {:>8} {:>8} {:>9} {:>8} {:>7} {:>6} {:>5} {:>8} {:>9} | {:>5} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}\n",
+        "{:<36} {:>8} {:>8} {:>9} {:>6} {:>8} {:>7} {:>6} {:>5} {:>8} {:>9} | {:>5} {:>5} {:>5} {:>5} {:>5} {:>5} {:>5}\n",
         "case",
         "DOFs",
         "steps/s",
         "elem/s",
+        "of mem",
         "wall s",
         "setup s",
         "iter",
@@ -463,11 +476,15 @@ pub fn table(rows: &[Row]) -> String {
     for r in rows {
         let p = |x: f64| format!("{:>4.0}%", 100.0 * x);
         s.push_str(&format!(
-            "{:<36} {:>8} {:>8.1} {:>9.2e} {:>8.2} {:>7.2} {:>6} {:>5} {:>8} {:>9} | {} {} {} {} {} {} {}{}\n",
+            "{:<36} {:>8} {:>8.1} {:>9.2e} {:>6} {:>8.2} {:>7.2} {:>6} {:>5} {:>8} {:>9} | {} {} {} {} {} {} {}{}\n",
             r.name,
             r.dofs,
             r.steps_per_second,
             r.element_updates_per_second,
+            r.memory_bound.map_or("-".into(), |b| format!(
+                "{:.3}",
+                r.element_updates_per_second / b.updates_per_second
+            )),
             r.wall_seconds,
             r.setup_seconds,
             r.newton_iterations,
@@ -487,6 +504,14 @@ pub fn table(rows: &[Row]) -> String {
             } else {
                 format!("  ({})", r.status)
             }
+        ));
+    }
+    if let Some(b) = rows.iter().filter_map(|r| r.memory_bound).next_back() {
+        s.push_str(&format!(
+            "of mem: element updates/s over the memory bound of the one-point step, a copy of its {:.0} bytes an update on one thread ({:.1} GB/s here: {:.2e} updates/s; src/bench/bound.rs)\n",
+            b.bytes_per_update,
+            b.copy_bytes_per_second / 1e9,
+            b.updates_per_second
         ));
     }
     s
