@@ -481,10 +481,14 @@ pub fn table(rows: &[Row]) -> String {
             r.dofs,
             r.steps_per_second,
             r.element_updates_per_second,
-            r.memory_bound.map_or("-".into(), |b| format!(
-                "{:.3}",
-                r.element_updates_per_second / b.updates_per_second
-            )),
+            // (the copy is one thread's: rows that step on more threads are not set
+            // against it)
+            r.memory_bound
+                .filter(|_| r.threads == Some(1))
+                .map_or("-".into(), |b| format!(
+                    "{:.3}",
+                    r.element_updates_per_second / b.updates_per_second
+                )),
             r.wall_seconds,
             r.setup_seconds,
             r.newton_iterations,
@@ -508,7 +512,7 @@ pub fn table(rows: &[Row]) -> String {
     }
     if let Some(b) = rows.iter().filter_map(|r| r.memory_bound).next_back() {
         s.push_str(&format!(
-            "of mem: element updates/s over the memory bound of the one-point step, a copy of its {:.0} bytes an update on one thread ({:.1} GB/s here: {:.2e} updates/s; src/bench/bound.rs)\n",
+            "of mem (one-thread rows): element updates/s over the memory bound of the one-point step, a copy of its {:.0} bytes an update on one thread ({:.1} GB/s here: {:.2e} updates/s; src/bench/bound.rs)\n",
             b.bytes_per_update,
             b.copy_bytes_per_second / 1e9,
             b.updates_per_second
