@@ -263,6 +263,9 @@ impl J2 {
     /// path): dl from ||eta_tr|| - (2 mu + 2/3 H_kin) dl = sqrt(2/3) sigma_y(sqrt(2/3) dl)
     /// and the returned state; None when the trial state is elastic (at the flow stress of a
     /// zero increment).
+    /// (Inlined, the elastic check with it; the return itself is `plastic_return`, out of
+    /// line: most points of an explicit step are elastic.)
+    #[inline(always)]
     pub fn radial(&self, trial: &Voigt, mu: f64, back: &Voigt, start: FlowStart) -> Option<Radial> {
         // dev of the difference: the pushed-forward back stress need not stay traceless
         let eta = deviator(&(trial - back));
@@ -273,12 +276,26 @@ impl J2 {
         if sy >= 0.0 && 1.5 * eta_squared <= sy * sy {
             return None;
         }
+        Some(self.plastic_return((trial, back), (&eta, eta_squared), mu, &flow, sy))
+    }
+
+    /// The return of `radial` past its elastic check: the trial stress and back stress
+    /// `(trial, back)`, eta and ||eta||^2, the flow stress `sy` of a zero increment.
+    #[inline(never)]
+    fn plastic_return(
+        &self,
+        (trial, back): (&Voigt, &Voigt),
+        (eta, eta_squared): (&Voigt, f64),
+        mu: f64,
+        flow: &Flow,
+        sy: f64,
+    ) -> Radial {
+        let start = flow.start;
         let eta_norm = eta_squared.sqrt();
         let h_kin = self.kinematic_modulus;
-        let (dl, h_iso) =
-            self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, &flow, sy);
+        let (dl, h_iso) = self.plastic_multiplier(eta_norm, 2.0 * mu + 2.0 / 3.0 * h_kin, flow, sy);
         let n = eta / eta_norm;
-        Some(Radial {
+        Radial {
             stress: trial - n * (2.0 * mu * dl),
             back_stress: back + n * (2.0 / 3.0 * h_kin * dl),
             eq_plastic_strain: start.eq_plastic_strain + SQRT_2_3 * dl,
@@ -286,7 +303,7 @@ impl J2 {
             multiplier: dl,
             eta_norm,
             slope: h_iso,
-        })
+        }
     }
 
     /// One-dimensional return for rods, None when the trial stress is elastic.
