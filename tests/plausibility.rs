@@ -755,7 +755,7 @@ fn warnings_with(model: &Model, edit: impl FnOnce(&mut Summary, &mut Energies)) 
     let mut summary = Summary::new(model, "average", 0.005, 0.4, 10);
     let mut energies = Energies::default();
     edit(&mut summary, &mut energies);
-    plausibility::warnings(model, &summary, &energies, None)
+    plausibility::warnings(model, &summary, &energies, (None, None))
 }
 
 /// `below` holds no warning; `above` exactly one, containing `words`.

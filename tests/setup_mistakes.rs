@@ -335,7 +335,7 @@ fn kinetic_energy_gain_warns_above_one_per_cent() {
             kinetic,
             ..Energies::default()
         };
-        plausibility::warnings(&model, &summary, &energies, None)
+        plausibility::warnings(&model, &summary, &energies, (None, None))
     };
     assert!(at(1.01 * (1.0 - 1e-3)).is_empty());
     let above = at(1.01 * (1.0 + 1e-3));
@@ -355,9 +355,9 @@ fn coarse_contact_warns_at_three_closed_nodes() {
     let (model, mut summary) = sphere_summary();
     let energies = Energies::default();
     summary.contact.closed_at_widest = vec![4];
-    assert!(plausibility::warnings(&model, &summary, &energies, None).is_empty());
+    assert!(plausibility::warnings(&model, &summary, &energies, (None, None)).is_empty());
     summary.contact.closed_at_widest = vec![3];
-    let warned = plausibility::warnings(&model, &summary, &energies, None);
+    let warned = plausibility::warnings(&model, &summary, &energies, (None, None));
     assert_eq!(warned.len(), 1, "{warned:?}");
     assert!(
         warned[0].contains("resolved by 2 segment(s)"),
@@ -379,10 +379,10 @@ fn a_balanced_pair_is_judged_on_both_passes_under_its_name() {
     let mut summary = Summary::new(&model, "central_difference", 1e-8, 150e-6, 100);
     let energies = Energies::default();
     summary.contact.closed_at_widest = vec![2, 2];
-    let warned = plausibility::warnings(&model, &summary, &energies, None);
+    let warned = plausibility::warnings(&model, &summary, &energies, (None, None));
     assert!(warned.is_empty(), "{warned:?}");
     summary.contact.closed_at_widest = vec![1, 1];
-    let warned = plausibility::warnings(&model, &summary, &energies, None);
+    let warned = plausibility::warnings(&model, &summary, &energies, (None, None));
     assert_eq!(warned.len(), 1, "{warned:?}");
     assert!(
         warned[0].contains("contact `impact` closed at most 2"),

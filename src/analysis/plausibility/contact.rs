@@ -44,9 +44,14 @@ pub(super) fn never_closed_warnings(
 
 /// A penetration deeper than [`PENETRATION_SHARE`] of the slave node spacing (a lone
 /// slave's element) and than the pairs' TOL, with where it was and its likely cause: a node
-/// no pair holds (a slave set that misses the surface meeting the master), or a slave or
-/// master node of one-pass contact.
-pub(super) fn penetration_warning(model: &Model, summary: &Summary) -> Option<String> {
+/// no pair holds (a slave set that misses the surface meeting the master, or, where the
+/// end positions `end` show its body crossing itself, a node that came through the body's
+/// own boundary), or a slave or master node of one-pass contact.
+pub(super) fn penetration_warning(
+    model: &Model,
+    summary: &Summary,
+    end: Option<&[[f64; 2]]>,
+) -> Option<String> {
     let depth = summary.contact.max_penetration?;
     let coords = model.coordinates();
     let limits = penetration_limits(&model.contacts, &coords);
@@ -75,7 +80,7 @@ pub(super) fn penetration_warning(model: &Model, summary: &Summary) -> Option<St
         return None;
     }
     let cause = match &summary.contact.deepest {
-        Some(d) if !d.slave => unheld_node_cause(model, d),
+        Some(d) if !d.slave => unheld_node_cause(model, d, end),
         Some(d) => format!(
             "node {} of body `{}` (a slave) went {} into {} at t = {}: a slave node one-pass \
              contact did not hold, or a master node sinking into the slave body, which one-pass \
@@ -124,8 +129,11 @@ pub fn past_end_text(p: &PastEndNode) -> String {
 }
 
 /// Why a node that no pair names as a slave went into an obstacle or a body: the pairs of
-/// its body name slave sets that miss it; the sets of its body that hold it.
-fn unheld_node_cause(model: &Model, d: &DeepestNode) -> String {
+/// its body name slave sets that miss it; the sets of its body that hold it. Where its body
+/// crosses itself at the end positions `end`, the node came through the body's own
+/// boundary (a tube crushed flat: its inner face through the wall beneath it), which no
+/// slave set mends: a pair of the body with itself does.
+fn unheld_node_cause(model: &Model, d: &DeepestNode, end: Option<&[[f64; 2]]>) -> String {
     let Some((b, body)) = model
         .bodies
         .iter()
@@ -134,6 +142,21 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode) -> String {
     else {
         return String::new();
     };
+    if end.is_some_and(|x| super::crossings::passed_through_itself(body, x)) {
+        return format!(
+            "node {} of body `{}` went {} into {} at t = {}, and no contact pair names it as a \
+             slave; the body's boundary crosses itself at the end (its own warning says \
+             where): the node most likely came through the body's own boundary, which a \
+             slave set does not mend; under central_difference a pair with the body as both \
+             slave and master holds it (slave = {{ body = \"{1}\" }}, master = {{ body = \
+             \"{1}\" }})",
+            d.node,
+            d.body,
+            readable(d.depth),
+            d.into,
+            readable(d.time)
+        );
+    }
     let named: Vec<String> = model
         .contacts
         .iter()

@@ -10,7 +10,7 @@
 //! ```
 
 use crate::output::readable;
-use crate::scene::Model;
+use crate::scene::{Body, Model};
 
 /// The share of the shorter edge by which two edges must cross to count.
 const DEPTH: f64 = 1e-3;
@@ -21,18 +21,9 @@ const DEPTH: f64 = 1e-3;
 pub(super) fn self_crossing_warnings(model: &Model, x: &[[f64; 2]]) -> Vec<String> {
     let mut out = Vec::new();
     for (b, body) in model.bodies.iter().enumerate() {
-        let edges: Vec<[usize; 2]> = body
-            .boundary
-            .iter()
-            .map(|e| e.map(|n| body.global(n)))
-            .collect();
-        let crossed = crossings(&edges, &|n| x[n]);
+        let crossed = run_crossings(body, x);
         if crossed.is_empty() {
             continue;
-        }
-        let initial = |n: usize| body.mesh.nodes[n - body.node_offset];
-        if !crossings(&edges, &initial).is_empty() {
-            continue; // a mesh that crosses itself from the start: not the run's doing
         }
         let ([p, q], [r, s]) = crossed[0];
         let local = |n: usize| n - body.node_offset;
@@ -67,6 +58,28 @@ pub(super) fn self_crossing_warnings(model: &Model, x: &[[f64; 2]]) -> Vec<Strin
         ));
     }
     out
+}
+
+/// Whether `body`'s boundary crosses itself at the positions `x` and did not in its mesh:
+/// the body passed through itself in the run.
+pub(super) fn passed_through_itself(body: &Body, x: &[[f64; 2]]) -> bool {
+    !run_crossings(body, x).is_empty()
+}
+
+/// The pairs of `body`'s boundary edges (global nodes) that cross at the positions `x`, none
+/// when its mesh crosses itself from the start (not the run's doing).
+fn run_crossings(body: &Body, x: &[[f64; 2]]) -> Vec<([usize; 2], [usize; 2])> {
+    let edges: Vec<[usize; 2]> = body
+        .boundary
+        .iter()
+        .map(|e| e.map(|n| body.global(n)))
+        .collect();
+    let crossed = crossings(&edges, &|n| x[n]);
+    let initial = |n: usize| body.mesh.nodes[n - body.node_offset];
+    if crossed.is_empty() || !crossings(&edges, &initial).is_empty() {
+        return Vec::new();
+    }
+    crossed
 }
 
 /// The pairs of `edges` that cross at positions `x` (see the module legend).

@@ -238,12 +238,14 @@ fn arc_length_end(arc: &crate::analysis::summary::ArcLengthSummary) -> String {
 const SUBCYCLING_GAIN: f64 = 0.9;
 
 /// The warnings of a run that ended with `summary` and the last `energies`; `first_step` is
-/// the step the run started with where it reports it (the set-up warnings find it otherwise).
+/// the step the run started with where it reports it (the set-up warnings find it otherwise);
+/// `end` the node positions at the end, where the caller has them (the penetration's cause
+/// reads them).
 pub fn warnings(
     model: &Model,
     summary: &Summary,
     energies: &Energies,
-    first_step: Option<f64>,
+    (first_step, end): (Option<f64>, Option<&[[f64; 2]]>),
 ) -> Vec<String> {
     let mut out = setup::setup_warnings_given(model, first_step);
     if summary.step_cuts > 0 {
@@ -341,7 +343,7 @@ pub fn warnings(
         ));
     }
     out.extend(contact::never_closed_warnings(model, summary, energies));
-    out.extend(contact::penetration_warning(model, summary));
+    out.extend(contact::penetration_warning(model, summary, end));
     out.extend(
         summary
             .contact

@@ -500,8 +500,13 @@ impl<'a, S: Stepper> Run<'a, S> {
         }
         summary.max_temperature = record::max_temperature(self.model, s.state());
         let first_step = run.time_step.as_ref().map(|report| report.first);
-        summary.warnings = plausibility::warnings(self.model, summary, energies, first_step);
         let positions = s.state().positions(self.model.analysis.geometry());
+        summary.warnings = plausibility::warnings(
+            self.model,
+            summary,
+            energies,
+            (first_step, Some(&positions)),
+        );
         let motion = s.motion();
         let end = plausibility::EndOfRun {
             positions: &positions,
