@@ -270,6 +270,13 @@ impl J2 {
         // dev of the difference: the pushed-forward back stress need not stay traceless
         let eta = deviator(&(trial - back));
         let eta_squared = squared_norm(&eta);
+        // below a floor of the flow stress that takes no powf: elastic, as the exact check
+        // below would find (the floor is at most the flow stress, bit for bit)
+        if let Some(floor) = self.cheap_flow_floor(&start)
+            && 1.5 * eta_squared <= floor * floor
+        {
+            return None;
+        }
         let flow = Flow::new(self, start);
         let sy = flow.at_start();
         // f = sqrt(3/2) ||eta|| - sigma_y <= 0 without the root (most points are elastic)
@@ -277,6 +284,25 @@ impl J2 {
             return None;
         }
         Some(self.plastic_return((trial, back), (&eta, eta_squared), mu, &flow, sy))
+    }
+
+    /// A floor of the flow stress of a zero increment from `start` that takes no powf, for
+    /// Johnson-Cook with m >= 1 (its two powf, eps_p^n and T*^m, were a fifth of the Johnson-
+    /// Cook rod pair's run): (A + B eps_p^n)(1 - T*^m) >= A (1 - T*), as B >= 0 and T*^m <= T*
+    /// on [0, 1], less 1e-12 on the factor (absolute) and on the product (relative), which
+    /// covers the rounding of the exact value (a few units in the last place). None for the
+    /// other laws (their flow stress is cheap), for m < 1, and where the floor is not
+    /// positive.
+    #[inline(always)]
+    fn cheap_flow_floor(&self, start: &FlowStart) -> Option<f64> {
+        let Hardening::JohnsonCook(law) = &self.hardening else {
+            return None;
+        };
+        if law.m < 1.0 || !(self.yield_stress > 0.0) {
+            return None;
+        }
+        let factor = 1.0 - law.homologous_temperature(start.temperature) - 1e-12;
+        (factor > 0.0).then(|| self.yield_stress * factor * (1.0 - 1e-12))
     }
 
     /// The return of `radial` past its elastic check: the trial stress and back stress
