@@ -86,7 +86,7 @@ const TABLES: [([f64; 4], [[f64; 2]; 4]); 4] = [
 
 /// Shape-function derivatives, radii and point volumes on the reference configuration `x`.
 /// `thickness` is per Gauss point and used only in plane stress.
-#[inline]
+#[inline(always)]
 pub fn values(
     x: &Coords,
     formulation: Formulation,
