@@ -465,6 +465,7 @@ pub struct UniaxialResponse {
 /// S_{n+1} : d eps_p the difference 1/2 (S_{n+1} - S_n) : d eps_p >= 0 is lost every plastic
 /// step). It is never negative: |s_n : n| <= sigma_y,n <= s_{n+1} : n under hardening.
 /// The heating of Johnson-Cook keeps the return's own S_{n+1} : d eps_p.
+#[inline]
 pub fn trapezoid_dissipation(
     start: &Voigt,
     end: &Voigt,
@@ -505,6 +506,7 @@ pub fn trapezoid_dissipation(
 /// negative; its total is the run's to check. For the explicit kernels, whose every step is
 /// final; Newton's iterates may pass through such states, and the implicit run checks its
 /// committed total instead.
+#[inline]
 pub fn dissipation(
     start: &Voigt,
     end: &Voigt,
