@@ -595,6 +595,62 @@ mod tests {
         }
     }
 
+    /// Goal: the Johnson-Cook floor of the elastic check (`cheap_flow_floor`) never lies
+    /// above the flow stress of a zero increment, so `radial` decides as the exact check
+    /// does, and it is only taken where it holds (m >= 1).
+    /// Setup: the 42CrMo4 law of models/taylor_jc.toml (A 806 MPa, B 614 MPa, n 0.168,
+    /// m 1.1, 20 to 1540 C) and the same with m = 1 and m = 0.5; eps_p from 0 to 3, T from
+    /// room to melting. Reference: the law written out here, (A + B eps^n)(1 - T*^m), and
+    /// T*^m <= T* on [0, 1] for m >= 1. A trial von Mises stress at the written-out flow
+    /// stress less 1e-9 of it is elastic; 1e-9 above it, plastic (the floor lies below both
+    /// where the point is hot and has hardened: a floor of A alone, without the factor
+    /// (1 - T*), fails the first assertion at the hot points).
+    #[test]
+    fn johnson_cook_floor_lies_below_the_flow_stress() {
+        let shape = deviator(&Voigt::new(1.4, -0.3, 0.2, 0.6));
+        let shape = shape / (1.5 * squared_norm(&shape)).sqrt();
+        for m in [1.1, 1.0, 0.5] {
+            let j2 = johnson_cook([806e6, 614e6, 0.168, 0.0089, m], [20.0, 1540.0]);
+            for (eps_p, temperature, _) in itertools(
+                &[0.0, 1e-9, 1e-3, 0.1, 1.0, 3.0],
+                &[20.0, 21.0, 400.0, 1000.0, 1539.0, 1540.0],
+                &[0.0],
+            ) {
+                let homologous = (temperature - 20.0) / 1520.0;
+                let exact = (806e6 + 614e6 * eps_p.powf(0.168)) * (1.0 - homologous.powf(m));
+                let start = FlowStart {
+                    eq_plastic_strain: eps_p,
+                    temperature,
+                    dt: f64::INFINITY,
+                };
+                let floor = j2.cheap_flow_floor(&start);
+                assert_eq!(
+                    floor.is_some(),
+                    m >= 1.0 && homologous < 1.0,
+                    "m {m} T {temperature}"
+                );
+                if let Some(floor) = floor {
+                    assert!(
+                        floor <= exact,
+                        "m {m} eps {eps_p} T {temperature}: {floor} > {exact}"
+                    );
+                }
+                if exact <= 0.0 {
+                    continue; // melted: every deviator is plastic
+                }
+                for (over, plastic) in [(1.0 - 1e-9, false), (1.0 + 1e-9, true)] {
+                    let trial = shape * (over * exact);
+                    let r = j2.radial(&trial, 80e9, &Voigt::zeros(), start);
+                    assert_eq!(
+                        r.is_some(),
+                        plastic,
+                        "m {m} eps {eps_p} T {temperature} x{over}"
+                    );
+                }
+            }
+        }
+    }
+
     /// Every combination of the three lists.
     fn itertools(a: &[f64], b: &[f64], c: &[f64]) -> Vec<(f64, f64, f64)> {
         a.iter()
