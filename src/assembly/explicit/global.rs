@@ -24,6 +24,7 @@
 //! does not depend on the thread count.
 
 use crate::solver::lanczos::{start_vector, tridiagonal_eigen};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Lanczos steps of an estimate (the first from the pseudo-random vector alone takes twice).
@@ -126,22 +127,16 @@ impl Global {
                 [w, w]
             })
             .collect();
-        let stiffness = &self.stiffness;
-        let apply = |q: &[f64], out: &mut [f64]| {
-            out.iter_mut().for_each(|v| *v = 0.0);
-            for (e, element) in nodes.iter().enumerate() {
-                let Some(k) = stiffness[e].as_ref() else {
-                    continue;
-                };
-                let s = scale(e);
-                let dofs: [usize; 8] = std::array::from_fn(|i| 2 * element[i / 2] as usize + i % 2);
-                let v: [f64; 8] = std::array::from_fn(|i| q[dofs[i]] * weight[dofs[i]]);
-                for i in 0..8 {
-                    let row: f64 = (0..8).map(|j| k.k[i][j] * v[j]).sum();
-                    out[dofs[i]] += s * row * weight[dofs[i]];
-                }
-            }
+        let scales: Vec<f64> = (0..nodes.len()).map(&scale).collect();
+        let product = Product {
+            nodes,
+            stiffness: &self.stiffness,
+            scales: &scales,
+            weight: &weight,
+            entries: NodeEntries::new(nodes, count),
         };
+        let mut contributions = vec![0.0; 8 * nodes.len()];
+        let apply = |q: &[f64], out: &mut [f64]| product.apply(q, out, &mut contributions);
         let mut start = start_vector(2 * count);
         let iterations = if self.vector.len() == start.len() {
             let norm = dot(&start, &start).sqrt();
@@ -158,11 +153,96 @@ impl Global {
     }
 }
 
+/// Elements a task of the estimate's product takes, and vector entries a task of its
+/// updates.
+const TASK: usize = 2048;
+
+/// A global node's entries in the element contributions of `Product`, in element order: the
+/// offsets 8 e + 2 a of its elements e (a: its place in e), node n's at
+/// `offsets[start[n]..start[n + 1]]`.
+struct NodeEntries {
+    start: Vec<usize>,
+    offsets: Vec<usize>,
+}
+
+impl NodeEntries {
+    fn new(nodes: &[[u32; 4]], count: usize) -> NodeEntries {
+        let mut start = vec![0; count + 1];
+        for &n in nodes.iter().flatten() {
+            start[n as usize + 1] += 1;
+        }
+        for n in 0..count {
+            start[n + 1] += start[n];
+        }
+        let mut next = start.clone();
+        let mut offsets = vec![0; start[count]];
+        for (e, element) in nodes.iter().enumerate() {
+            for (a, &n) in element.iter().enumerate() {
+                offsets[next[n as usize]] = 8 * e + 2 * a;
+                next[n as usize] += 1;
+            }
+        }
+        NodeEntries { start, offsets }
+    }
+}
+
+/// The product A q of the estimate (module docs), in parallel: each element's contribution
+/// s_e W K_e W q on its own, then each DOF the sum of its elements' in element order, which is
+/// the order, and so the bits, of a loop adding the elements into A q one after another.
+struct Product<'a> {
+    nodes: &'a [[u32; 4]],
+    stiffness: &'a [Option<ElementStiffness>],
+    /// s_e.
+    scales: &'a [f64],
+    /// D^-1/2 per DOF.
+    weight: &'a [f64],
+    entries: NodeEntries,
+}
+
+impl Product<'_> {
+    /// `out` = A q, the element contributions written into `contributions` (8 a element).
+    fn apply(&self, q: &[f64], out: &mut [f64], contributions: &mut [f64]) {
+        let weight = self.weight;
+        contributions
+            .par_chunks_mut(8)
+            .enumerate()
+            .with_min_len(TASK)
+            .for_each(|(e, c)| {
+                let Some(k) = self.stiffness[e].as_ref() else {
+                    c.fill(0.0);
+                    return;
+                };
+                let element = self.nodes[e];
+                let s = self.scales[e];
+                let dofs: [usize; 8] = std::array::from_fn(|i| 2 * element[i / 2] as usize + i % 2);
+                let v: [f64; 8] = std::array::from_fn(|i| q[dofs[i]] * weight[dofs[i]]);
+                for i in 0..8 {
+                    let row: f64 = (0..8).map(|j| k.k[i][j] * v[j]).sum();
+                    c[i] = s * row * weight[dofs[i]];
+                }
+            });
+        let (start, offsets) = (&self.entries.start, &self.entries.offsets);
+        out.par_chunks_mut(2)
+            .enumerate()
+            .with_min_len(TASK)
+            .for_each(|(n, d)| {
+                let (mut x, mut y) = (0.0, 0.0);
+                for &o in &offsets[start[n]..start[n + 1]] {
+                    x += contributions[o];
+                    y += contributions[o + 1];
+                }
+                d.copy_from_slice(&[x, y]);
+            });
+    }
+}
+
 /// The largest Ritz value of at most `iterations` Lanczos steps on the symmetric operator
 /// `apply` from `start` (full reorthogonalization), its residual norm and its unit Ritz
-/// vector; the steps stop early once the residual is below `TOLERANCE` of the value.
+/// vector; the steps stop early once the residual is below `TOLERANCE` of the value. The
+/// vector updates run in parallel (each entry on its own: the bits of a serial loop); the
+/// dot products stay serial sums, whose order sets their bits.
 pub fn lanczos(
-    apply: impl Fn(&[f64], &mut [f64]),
+    mut apply: impl FnMut(&[f64], &mut [f64]),
     start: Vec<f64>,
     iterations: usize,
 ) -> Option<(f64, f64, Vec<f64>)> {
@@ -182,7 +262,9 @@ pub fn lanczos(
         for _ in 0..2 {
             for q in &basis {
                 let c = dot(&w, q);
-                w.iter_mut().zip(q).for_each(|(w, q)| *w -= c * q);
+                (w.par_iter_mut().zip(q))
+                    .with_min_len(TASK)
+                    .for_each(|(w, q)| *w -= c * q);
             }
         }
         let b = dot(&w, &w).sqrt();
@@ -194,7 +276,7 @@ pub fn lanczos(
                 break (theta, residual, s);
             }
         }
-        basis.push(w.iter().map(|v| v / b).collect());
+        basis.push(w.par_iter().with_min_len(TASK).map(|v| v / b).collect());
     };
     let (theta, residual, s) = ritz;
     let mut vector = vec![0.0; n];
