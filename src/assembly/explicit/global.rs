@@ -20,8 +20,9 @@
 //! two, the element step its safety net. Between two estimates the step follows the tight
 //! element maximum at the ratio last found (`lambda / max_e omega_e^2`); an estimate is taken
 //! again every `EVERY` steps and whenever that maximum has moved by more than the tight
-//! step's `DRIFT`. Everything here runs on the stepping thread in a fixed order: the estimate
-//! does not depend on the thread count.
+//! step's `DRIFT`. The product and the vector updates run in parallel, every sum in a fixed
+//! order (`Product`; the dot products serial): the estimate does not depend on the thread
+//! count.
 
 use crate::solver::lanczos::{start_vector, tridiagonal_eigen};
 use rayon::prelude::*;
