@@ -143,19 +143,7 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode, end: Option<&[[f64; 2]]>) -
         return String::new();
     };
     if end.is_some_and(|x| super::crossings::passed_through_itself(body, x)) {
-        return format!(
-            "node {} of body `{}` went {} into {} at t = {}, and no contact pair names it as a \
-             slave; the body's boundary crosses itself at the end (its own warning says \
-             where): the node most likely came through the body's own boundary, which a \
-             slave set does not mend; under central_difference a pair with the body as both \
-             slave and master holds it (slave = {{ body = \"{1}\" }}, master = {{ body = \
-             \"{1}\" }})",
-            d.node,
-            d.body,
-            readable(d.depth),
-            d.into,
-            readable(d.time)
-        );
+        return through_own_body_cause(d);
     }
     let named: Vec<String> = model
         .contacts
@@ -194,6 +182,27 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode, end: Option<&[[f64; 2]]>) -
         } else {
             sets.join(", ")
         }
+    )
+}
+
+/// The cause of `unheld_node_cause` for a node whose body crossed itself: it came through
+/// the body's own boundary, and the body's pair with itself would hold it.
+fn through_own_body_cause(d: &DeepestNode) -> String {
+    let pair = format!(
+        r#"slave = {{ body = "{0}" }}, master = {{ body = "{0}" }}"#,
+        d.body
+    );
+    format!(
+        "node {} of body `{}` went {} into {} at t = {}, and no contact pair names it as a \
+         slave; the body's boundary crosses itself at the end (its own warning says where): \
+         the node most likely came through the body's own boundary, which a slave set does \
+         not mend; under central_difference a pair with the body as both slave and master \
+         holds it ({pair})",
+        d.node,
+        d.body,
+        readable(d.depth),
+        d.into,
+        readable(d.time)
     )
 }
 
