@@ -7,7 +7,7 @@
 //! layers (tests/architecture.rs checks it on the source).
 //! ```text
 //! 1  profile, reference, mesh, output,  timing, closed forms, meshes, writers, the ALE
-//!    ale                                smoother and remap on plain arrays
+//!    ale, curve                         smoother and remap on plain arrays, time curves
 //! 2  element                            pure kernels and the small fixed-size types
 //! 3  material, kinematics               constitutive update, objective push-forward
 //! 4  contact, solver, integrator        contact on plain arrays, faer, step coefficients
@@ -26,6 +26,7 @@ pub mod assembly;
 pub mod bench;
 pub mod buckling;
 pub mod contact;
+pub mod curve;
 pub mod element;
 pub mod integrator;
 pub mod kinematics;

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 /// The layers of src/lib.rs, from the ground up: a module may use only lower layers.
 const LAYERS: [&[&str]; 10] = [
-    &["profile", "reference", "mesh", "output", "ale"],
+    &["profile", "reference", "mesh", "output", "ale", "curve"],
     &["element"],
     &["material", "kinematics"],
     &["contact", "solver", "integrator"],

@@ -45,7 +45,7 @@ impl ContactState {
     /// driver's W = sum_d f_d (du_d + delta_d / 2) - held(d) / 2, held(d) = delta_d (M a_n)_d
     /// (`touched`: the DOFs where f or delta is not zero; `du` the predicted increment),
     /// pair p takes f_p . (du + delta / 2) and |f_p,d| / sum_q |f_q,d| of held(d) (module
-    /// legend).
+    /// legend), less the work its moving obstacle does (supplied, not taken).
     pub fn book_explicit_work(
         &mut self,
         step: &ExplicitContact,
@@ -72,7 +72,7 @@ impl ContactState {
                     value * (du[d] + 0.5 * delta[d]) - 0.5 * share * held(d)
                 })
                 .sum();
-            self.work[p] -= work - step.friction_work[p];
+            self.work[p] -= work - step.friction_work[p] - step.obstacle_work[p];
             self.friction_work[p] -= step.friction_work[p];
         }
         let unweighted = |d: usize| weight.get(&d).is_none_or(|w| *w == 0.0);

@@ -38,6 +38,7 @@
 //! ```
 
 use super::Interfaces;
+use super::geometry::ContactPair;
 use super::geometry::{COVERED, Friction, Gap};
 use super::mortar::MASTER_ALLOWANCE;
 use super::search::{SlaveGap, penetrates, slave_gaps};
@@ -59,6 +60,10 @@ pub struct ExplicitContact {
     /// the corrected increment, f_t . (du + delta / 2): minus the energy the friction
     /// dissipates in the step (0 without Coulomb friction).
     pub friction_work: Vec<f64>,
+    /// Per pair, the work its moving obstacle does on the bodies in the step: the pair's
+    /// force terms on the obstacle's translation over the step (0 for an obstacle at rest
+    /// and between bodies), energy supplied, not taken by the contact.
+    pub obstacle_work: Vec<f64>,
 }
 
 impl ContactState {
@@ -154,11 +159,13 @@ impl ContactState {
         let increment = |dof: usize| step.du[dof] + 0.5 * c.delta[dof];
         let friction_work =
             self.tangential_work(&interfaces.pairs, start, &step_friction, &increment);
+        let obstacle_work = obstacle_work(&interfaces.pairs, &pair_forces, (time - h, time));
         ExplicitContact {
             correction: c.delta,
             step_force,
             pair_forces,
             friction_work,
+            obstacle_work,
         }
     }
 }
@@ -182,6 +189,26 @@ impl ContactState {
         }
         self.scratch = Scratch { delta, force };
     }
+}
+
+/// Per pair, the work of its force terms `pair_forces` (on the slaves) on its obstacle's
+/// translation from `t0` to `t1`: a rigid translation moves every point of the obstacle by
+/// the same increment, so the pair's forces do sum_d f_d dx_(d mod 2) on it.
+fn obstacle_work(
+    pairs: &[ContactPair],
+    pair_forces: &[Vec<(usize, f64)>],
+    (t0, t1): (f64, f64),
+) -> Vec<f64> {
+    (pairs.iter().zip(pair_forces))
+        .map(|(pair, terms)| match pair.moving_obstacle() {
+            None => 0.0,
+            Some(m) => {
+                let (a, b) = (m.at(t0), m.at(t1));
+                let dx = [b[0] - a[0], b[1] - a[1]];
+                terms.iter().map(|(d, f)| f * dx[d % 2]).sum()
+            }
+        })
+        .collect()
 }
 
 /// `buffer` (zero, or empty) as a zero vector of length `len`.

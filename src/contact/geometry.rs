@@ -5,21 +5,59 @@
 use super::grid::SegmentGrid;
 use super::mortar::{MortarSurface, master_node_gap, weighted_gap};
 use super::own::OwnSurface;
+use crate::curve::Curve;
 use crate::mesh::plane::{dot, outward, sub};
 
 pub use super::gap::Gap;
 use std::f64::consts::PI;
 
-/// A rigid obstacle: a fixed polyline, solid on its left (a closed counter-clockwise polygon
-/// is a finite obstacle, a clockwise one a cavity, an open polyline a half-space boundary).
+/// A rigid obstacle: a polyline, solid on its left (a closed counter-clockwise polygon is a
+/// finite obstacle, a clockwise one a cavity, an open polyline a half-space boundary). Its
+/// `points` are where it is now: a moving obstacle's are placed at each time a step reads
+/// (`place`); the gaps read the points only.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Obstacle {
     pub name: String,
     pub points: Vec<[f64; 2]>,
     pub closed: bool,
+    /// A prescribed rigid translation; None: the obstacle stays where it was put.
+    pub motion: Option<ObstacleMotion>,
+}
+
+/// The prescribed translation of an obstacle: its points at time t are `base` +
+/// `displacement` times `curve`(t) (the curve 0 at t = 0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObstacleMotion {
+    pub base: Vec<[f64; 2]>,
+    pub displacement: [f64; 2],
+    pub curve: Curve,
+}
+
+impl ObstacleMotion {
+    /// The translation at time `t`.
+    pub fn at(&self, t: f64) -> [f64; 2] {
+        let f = self.curve.value(t);
+        [f * self.displacement[0], f * self.displacement[1]]
+    }
+
+    /// The velocity at time `t` (`Curve::slope`).
+    pub fn velocity(&self, t: f64) -> [f64; 2] {
+        let f = self.curve.slope(t);
+        [f * self.displacement[0], f * self.displacement[1]]
+    }
 }
 
 impl Obstacle {
+    /// Moves a moving obstacle's points to where its motion has it at time `t`.
+    pub fn place(&mut self, t: f64) {
+        if let Some(m) = &self.motion {
+            let d = m.at(t);
+            for (p, b) in self.points.iter_mut().zip(&m.base) {
+                *p = [b[0] + d[0], b[1] + d[1]];
+            }
+        }
+    }
+
     /// Whether a closed polygon runs clockwise (a cavity: its solid lies outside the loop).
     pub fn is_cavity(&self) -> bool {
         let n = self.points.len();
@@ -328,6 +366,14 @@ fn signed_gap(
 const VERTEX: f64 = 1e-9;
 
 impl ContactPair {
+    /// The motion of the pair's obstacle, when it has one that moves.
+    pub fn moving_obstacle(&self) -> Option<&ObstacleMotion> {
+        match &self.master {
+            Master::Obstacle(o) => o.motion.as_ref(),
+            _ => None,
+        }
+    }
+
     /// The nodes of its surfaces: its slaves, then its deformable master's nodes (none on an
     /// obstacle).
     pub fn surface_nodes(&self) -> impl Iterator<Item = usize> + '_ {
@@ -692,6 +738,7 @@ pub(super) mod tests {
             name: "box".into(),
             points: vec![[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]],
             closed: true,
+            motion: None,
         };
         assert!(cavity.is_cavity());
         let pair = slave_node_0(Master::Obstacle(cavity));
@@ -794,6 +841,7 @@ pub(super) mod tests {
             name: "w".into(),
             points: vec![[2.0, 0.0], [-2.0, 0.0]],
             closed: false,
+            motion: None,
         };
         let pair = slave_node_0(Master::Obstacle(wall));
         for (y, expected) in [(0.3, 0.3), (-0.2, -0.2)] {

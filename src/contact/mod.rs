@@ -51,8 +51,8 @@ pub mod step;
 pub mod traction;
 
 pub use geometry::{
-    ContactPair, Covered, Discretization, Friction, Gap, Holds, Master, Obstacle, PairOptions,
-    winding_number,
+    ContactPair, Covered, Discretization, Friction, Gap, Holds, Master, Obstacle, ObstacleMotion,
+    PairOptions, winding_number,
 };
 pub use impacts::{ImpactMotion, LumpedMass, apply_conditions};
 pub use mortar::MortarSurface;
@@ -140,6 +140,30 @@ pub enum Share {
     Consistent,
 }
 
+/// Whether an obstacle of `pairs` moves.
+pub fn obstacles_move(pairs: &[ContactPair]) -> bool {
+    pairs.iter().any(|p| p.moving_obstacle().is_some())
+}
+
+/// Places the moving obstacles of `pairs` at time `t`.
+pub fn place_obstacles(pairs: &mut [ContactPair], t: f64) {
+    for pair in pairs {
+        if let Master::Obstacle(o) = &mut pair.master {
+            o.place(t);
+        }
+    }
+}
+
+/// `pairs` with their moving obstacles at time `t`: the pairs themselves where none moves.
+pub fn placed(pairs: &[ContactPair], t: f64) -> std::borrow::Cow<'_, [ContactPair]> {
+    if !obstacles_move(pairs) {
+        return std::borrow::Cow::Borrowed(pairs);
+    }
+    let mut moved = pairs.to_vec();
+    place_obstacles(&mut moved, t);
+    std::borrow::Cow::Owned(moved)
+}
+
 /// The contact problem of a model: its pairs and, per body, its surface data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Interfaces {
@@ -148,6 +172,11 @@ pub struct Interfaces {
 }
 
 impl Interfaces {
+    /// Places the moving obstacles of the pairs at time `t` (`Obstacle::place`).
+    pub fn place_obstacles(&mut self, t: f64) {
+        place_obstacles(&mut self.pairs, t);
+    }
+
     /// The impedance rho c A of global node `node` of body `body` (A: its tributary contact
     /// area at the positions `coords`: the half of each boundary edge next to the node, times
     /// the thickness in plane bodies; in axisymmetry the surface of revolution of those

@@ -271,6 +271,7 @@ mod tests {
             name: "wall".into(),
             points: vec![[2.0, 0.0], [-2.0, 0.0]],
             closed: false,
+            motion: None,
         };
         let pair = crate::contact::geometry::tests::slave_node_0(Master::Obstacle(wall));
         Interfaces {

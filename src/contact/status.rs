@@ -288,6 +288,19 @@ impl ContactState {
         terms
     }
 
+    /// The force the bodies exert on pair `p`'s master through its closed rows at the
+    /// positions `coords`: minus the sum of the rows' forces on the slaves (the master of an
+    /// obstacle: its reaction).
+    pub fn master_force(&self, pairs: &[ContactPair], p: usize, coords: &[[f64; 2]]) -> [f64; 2] {
+        let rows = (&self.force[..], &self.tangential[..]);
+        let terms = self.pair_force_terms(pairs, coords, rows);
+        let mut force = [0.0; 2];
+        for (dof, value) in &terms[p] {
+            force[dof % 2] -= value;
+        }
+        force
+    }
+
     /// Per pair, the work `tangential`'s forces do on the increment `increment(dof)`, the
     /// rows at positions `coords`: T^T lambda . du over the pair's active entries, what the
     /// forces of `pair_force_terms`' tangential rows would do.

@@ -11,10 +11,10 @@
 //! fell below `release_fraction` of the last step's are released; dynamics then applies the
 //! impact and release conditions (`impacts`).
 
-use super::Interfaces;
 use super::geometry::{ContactPair, Friction};
 use super::search;
 use super::status::ContactState;
+use super::{Interfaces, placed};
 
 /// The shortest fraction of a step an event split may leave: an event closer to the step
 /// start than this closes in the full step (Hughes II-7) instead.
@@ -141,22 +141,24 @@ enum Slip {
     Return(f64),
 }
 
-/// The inactive slaves that penetrate at the end of a solve (positions `end`), and the
-/// fraction alpha = g_0 / (g_0 - g_1) of the step at which the first of them touched
-/// (Erklig 2.1.4); 0 when one was already within TOL at the start or the pair does not split.
+/// The inactive slaves that penetrate at the end of a solve (positions `end`, against the
+/// pairs `at_end`), and the fraction alpha = g_0 / (g_0 - g_1) of the step at which the first
+/// of them touched (Erklig 2.1.4; g_0 at `start` against the pairs `at_start`, which differ
+/// where an obstacle moves); 0 when one was already within TOL at the start or the pair does
+/// not split.
 fn first_event(
-    pairs: &[ContactPair],
+    (at_start, at_end): (&[ContactPair], &[ContactPair]),
     start: &[[f64; 2]],
     end: &dyn Fn(usize) -> [f64; 2],
     entries: &[(usize, usize)],
 ) -> (Vec<(usize, usize)>, f64) {
     let search = std::time::Instant::now();
-    let at_start = |n: usize| start[n];
+    let start_position = |n: usize| start[n];
     let mut penetrating = Vec::new();
     let mut alpha = 1.0f64;
-    for s in search::penetrating(pairs, end, &|p, k| entries.contains(&(p, k))) {
-        let options = &pairs[s.pair].options;
-        let g0 = pairs[s.pair].gap(s.node, &at_start).map_or(0.0, |g| g.gap);
+    for s in search::penetrating(at_end, end, &|p, k| entries.contains(&(p, k))) {
+        let options = &at_end[s.pair].options;
+        let g0 = (at_start[s.pair].gap(s.node, &start_position)).map_or(0.0, |g| g.gap);
         if options.persistency && g0 < 0.0 && s.gap.gap >= g0 - options.tolerance {
             continue; // the gap a persistent pair closed with, not deeper
         }
@@ -178,6 +180,8 @@ fn first_event(
 /// active set (`inside`; with `Releases` and `Closures` the entries and conditions are where
 /// the iteration starts).
 pub struct Pass<'a> {
+    /// The pairs at the end of the pass's length (a moving obstacle placed there).
+    pub pairs: &'a [ContactPair],
     pub length: f64,
     pub active: &'a [(usize, usize)],
     pub forces: Vec<f64>,
@@ -214,15 +218,17 @@ impl ContactState {
         }
     }
 
-    /// Runs one step with contact from the positions `start`: `solve` solves the step for
-    /// each [`Pass`] (a length and an active set) until the active set settles.
+    /// Runs one step with contact from the positions `start` at time `time`: `solve` solves
+    /// the step for each [`Pass`] (a length and an active set, the pairs placed at its end)
+    /// until the active set settles.
     pub fn step<S: ConstrainedSolution, E: From<Unsettled>>(
         &self,
-        pairs: &[ContactPair],
+        (pairs, time): (&[ContactPair], f64),
         start: &[[f64; 2]],
         length: f64,
         mut solve: impl FnMut(Pass<'_>) -> Result<S, E>,
     ) -> Result<ContactResult<S>, E> {
+        let at_start = placed(pairs, time);
         let (mut entries, mut forces) = self.entries();
         let mut slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(pairs, *e)).collect();
         let mut returned = false;
@@ -235,7 +241,10 @@ impl ContactState {
                 .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
                 .collect();
             let tangential = tangential_conditions(&slips);
+            let at_end = placed(pairs, time + length);
+            let pairs = &at_end[..];
             let solution = solve(Pass {
+                pairs,
                 length,
                 active: &nodes,
                 forces: forces.clone(),
@@ -257,7 +266,7 @@ impl ContactState {
                 continue;
             }
             let end = |n: usize| [start[n][0] + d[2 * n], start[n][1] + d[2 * n + 1]];
-            let (penetrating, alpha) = first_event(pairs, start, &end, &entries);
+            let (penetrating, alpha) = first_event((&at_start, pairs), start, &end, &entries);
             if penetrating.is_empty() {
                 // friction: Greco's return targets from this (frictionless) slip, once per
                 // step; Coulomb stick <-> slide switches. A cycling status is accepted after
@@ -337,11 +346,12 @@ impl ContactState {
     /// slaves free to close (`Inside::Closures`).
     pub fn step_inside<S: ConstrainedSolution, E: From<Unsettled>>(
         &self,
-        pairs: &[ContactPair],
+        (pairs, time): (&[ContactPair], f64),
         start: &[[f64; 2]],
         length: f64,
         mut solve: impl FnMut(Pass<'_>) -> Result<S, E>,
     ) -> Result<ContactResult<S>, E> {
+        let at_start = placed(pairs, time);
         let (entries, forces) = self.entries();
         let slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(pairs, *e)).collect();
         let nodes: Vec<(usize, usize)> = entries
@@ -354,7 +364,10 @@ impl ContactState {
         let mut inside = Inside::Releases;
         let mut warm: Option<Vec<f64>> = None;
         loop {
+            let at_end = placed(pairs, time + length);
+            let pairs = &at_end[..];
             let solution = solve(Pass {
+                pairs,
                 length,
                 active: &nodes,
                 forces: forces.clone(),
@@ -369,7 +382,7 @@ impl ContactState {
             let end = |n: usize| [start[n][0] + d[2 * n], start[n][1] + d[2 * n + 1]];
             let (penetrating, alpha) = match inside {
                 Inside::Closures => (Vec::new(), 1.0),
-                _ => first_event(pairs, start, &end, &settled.entries),
+                _ => first_event((&at_start, pairs), start, &end, &settled.entries),
             };
             if penetrating.is_empty() {
                 let rows = ConvergedRows {

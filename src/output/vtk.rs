@@ -19,9 +19,10 @@
 //!             body (Int64: the index of the cell's body in the scene, from 0; only when
 //!             given), temperature (only when given)
 //! ```
-//! The rigid obstacles, which do not move, go beside the series once: DIR/NAME_obstacles.pvd
-//! listing DIR/vtk/NAME_obstacles.vtu, their segments as lines with the cell array
-//! `obstacle` (`write_obstacles`).
+//! The rigid obstacles go beside the series: at rest, once, DIR/NAME_obstacles.pvd listing
+//! DIR/vtk/NAME_obstacles.vtu, their segments as lines with the cell array `obstacle`
+//! (`write_obstacles`); where one moves, a file per frame, NAME_obstacles_KKKK.vtu, all
+//! listed in that .pvd (`write_obstacle_frame`).
 //!
 //! `displacement` is the active vectors array, so ParaView's Warp By Vector picks it by
 //! default (to exaggerate the motion of a frame drawn in the reference configuration);
@@ -394,7 +395,7 @@ pub struct Polyline<'a> {
 /// Writes the rigid obstacles beside the bodies' series: DIR/vtk/NAME_obstacles.vtu, their
 /// segments as lines (VTK_LINE) with the cell array `obstacle` (Int64: the obstacle's index
 /// in the scene, from 0), and DIR/NAME_obstacles.pvd listing it at time 0, so ParaView shows
-/// them at every time of the bodies' series (obstacles do not move). Returns the .pvd's path.
+/// them at every time of the bodies' series (obstacles at rest). Returns the .pvd's path.
 pub fn write_obstacles(
     dir: &Path,
     name: &str,
@@ -402,7 +403,41 @@ pub fn write_obstacles(
     compression: Compression,
 ) -> Result<PathBuf, OutputError> {
     let file_name = format!("{name}_obstacles.vtu");
-    let path = dir.join("vtk").join(&file_name);
+    write_obstacle_file(dir, &file_name, obstacles, compression)?;
+    let pvd = dir.join(format!("{name}_obstacles.pvd"));
+    let entry = pvd_entry(0.0, &format!("vtk/{file_name}"));
+    write_atomic(&pvd, collection(&[entry]).as_bytes())?;
+    Ok(pvd)
+}
+
+/// Writes the obstacles where they are at a frame of a scene whose obstacles move:
+/// DIR/vtk/NAME_obstacles_KKKK.vtu (K: the `index`-th such frame, from 0; the arrays of
+/// `write_obstacles`), adds it to `listed` (time, file relative to DIR) and rewrites
+/// DIR/NAME_obstacles.pvd with every listed file. Returns the .pvd's path.
+pub fn write_obstacle_frame(
+    dir: &Path,
+    name: &str,
+    (index, time): (usize, f64),
+    obstacles: &[Polyline],
+    (compression, listed): (Compression, &mut Vec<(f64, String)>),
+) -> Result<PathBuf, OutputError> {
+    let file_name = format!("{name}_obstacles_{index:04}.vtu");
+    write_obstacle_file(dir, &file_name, obstacles, compression)?;
+    listed.push((time, format!("vtk/{file_name}")));
+    let entries: Vec<String> = listed.iter().map(|(t, f)| pvd_entry(*t, f)).collect();
+    let pvd = dir.join(format!("{name}_obstacles.pvd"));
+    write_atomic(&pvd, collection(&entries).as_bytes())?;
+    Ok(pvd)
+}
+
+/// DIR/vtk/FILE_NAME: the obstacles' segments as lines with their `obstacle` index.
+fn write_obstacle_file(
+    dir: &Path,
+    file_name: &str,
+    obstacles: &[Polyline],
+    compression: Compression,
+) -> Result<(), OutputError> {
+    let path = dir.join("vtk").join(file_name);
     fs::create_dir_all(dir.join("vtk"))
         .map_err(|e| OutputError::io(&dir.join("vtk"), "create folder", e))?;
     let mut grid = Grid {
@@ -432,11 +467,7 @@ pub fn write_obstacles(
         width: 1,
     };
     let payload = Payload::new(&path, &grid, &[ids_field], None)?;
-    write_atomic_parts(&path, &payload.into_parts(compression))?;
-    let pvd = dir.join(format!("{name}_obstacles.pvd"));
-    let entry = pvd_entry(0.0, &format!("vtk/{file_name}"));
-    write_atomic(&pvd, collection(&[entry]).as_bytes())?;
-    Ok(pvd)
+    write_atomic_parts(&path, &payload.into_parts(compression))
 }
 
 /// One `<DataSet>` line of the .pvd; `file` is relative to the .pvd, with forward slashes.

@@ -4,18 +4,20 @@
 
 use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
-use super::model::{Body, BodyKind};
+use super::model::{Body, BodyKind, Curve};
 use super::spec::{
-    AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Roles, Scene, SurfaceSpec,
+    AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, ObstacleMotionSpec, Roles,
+    Scene, SurfaceSpec,
 };
 use crate::contact::{
     ContactPair, Covered, Discretization, Friction, Holds, Master, MortarSurface, Obstacle,
-    OwnSurface, PairOptions, setup,
+    ObstacleMotion, OwnSurface, PairOptions, setup,
 };
 use crate::element::Formulation;
 use crate::mesh::Cells;
 use crate::mesh::plane::round_corners;
 use crate::output::readable;
+use std::collections::BTreeMap;
 
 /// The scene's contact pairs in order, their names unique.
 pub(super) fn contacts(
@@ -112,8 +114,13 @@ fn refuse_repeated_pairs(cx: &Context, pairs: &[ContactPair]) -> Result<(), Inpu
 }
 
 /// The `[[obstacle]]` polylines: unique names, at least 2 points (3 when closed), finite,
-/// no two consecutive points equal; with `corner_radius` each corner rounded by an arc.
-pub(super) fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, InputError> {
+/// no two consecutive points equal; with `corner_radius` each corner rounded by an arc; a
+/// `motion` resolved against the named `curves` (its default a ramp over `end_time`).
+pub(super) fn obstacles(
+    cx: &Context,
+    scene: &Scene,
+    (curves, end_time): (&BTreeMap<String, Curve>, f64),
+) -> Result<Vec<Obstacle>, InputError> {
     let mut out: Vec<Obstacle> = Vec::new();
     for (k, o) in scene.obstacle.iter().enumerate() {
         let key = format!("obstacle[{k}] (`{}`)", o.name);
@@ -149,13 +156,48 @@ pub(super) fn obstacles(cx: &Context, scene: &Scene) -> Result<Vec<Obstacle>, In
                 })?
             }
         };
+        let motion = match &o.motion {
+            None => None,
+            Some(m) => Some(motion(cx, m, &points, (curves, end_time), &key)?),
+        };
         out.push(Obstacle {
             name: o.name.clone(),
             points,
             closed: o.closed,
+            motion,
         });
     }
     Ok(out)
+}
+
+/// An obstacle's `motion` from its `points`: a finite displacement, its curve named among
+/// `curves` (default: 0 at t = 0, 1 at `end_time`), 0 at t = 0 (the obstacle starts where
+/// its points are).
+fn motion(
+    cx: &Context,
+    spec: &ObstacleMotionSpec,
+    points: &[[f64; 2]],
+    (curves, end_time): (&BTreeMap<String, Curve>, f64),
+    key: &str,
+) -> Result<ObstacleMotion, InputError> {
+    let key = format!("{key}.motion");
+    finite(cx, &format!("{key}.displacement"), &spec.displacement)?;
+    let ramp = Curve {
+        points: vec![[0.0, 0.0], [end_time, 1.0]],
+    };
+    let curve = super::loads::curve(cx, curves, &ramp, &spec.curve, &key)?;
+    if curve.value(0.0) != 0.0 {
+        return Err(cx.err(format!(
+            "{key}.curve: the curve is {} at t = 0, so the obstacle would jump there from its \
+             points; a motion starts at 0 (write the start position in `points`)",
+            readable(curve.value(0.0))
+        )));
+    }
+    Ok(ObstacleMotion {
+        base: points.to_vec(),
+        displacement: spec.displacement,
+        curve,
+    })
 }
 
 /// One `[[contact]]` pair (the k-th, `spec`): its slave nodes (global), its master and its

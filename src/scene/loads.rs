@@ -92,7 +92,7 @@ pub(super) fn curves(cx: &Context, scene: &Scene) -> Result<BTreeMap<String, Cur
 }
 
 /// The curve a load names, or the default one.
-fn curve(
+pub(super) fn curve(
     cx: &Context,
     curves: &BTreeMap<String, Curve>,
     default: &Curve,

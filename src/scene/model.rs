@@ -165,27 +165,7 @@ impl Body {
     }
 }
 
-/// A piecewise-linear curve, constant beyond its ends.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Curve {
-    pub points: Vec<[f64; 2]>,
-}
-
-impl Curve {
-    pub fn value(&self, t: f64) -> f64 {
-        let p = &self.points;
-        if t <= p[0][0] {
-            return p[0][1];
-        }
-        for w in p.windows(2) {
-            if t <= w[1][0] {
-                let s = (t - w[0][0]) / (w[1][0] - w[0][0]);
-                return w[0][1] + s * (w[1][1] - w[0][1]);
-            }
-        }
-        p[p.len() - 1][1]
-    }
-}
+pub use crate::curve::Curve;
 
 #[derive(Debug, Clone)]
 pub enum Load {

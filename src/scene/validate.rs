@@ -14,7 +14,7 @@ use super::model::{Analysis, Body, BodyKind, Load, Model, Probe, SceneSource};
 use super::probes::{check_force_window, check_history_cadence, frame_times, probes};
 use super::reference::reference;
 use super::spec::{IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene};
-use crate::contact::{ContactPair, Friction};
+use crate::contact::{ContactPair, Friction, Master};
 use std::path::Path;
 
 /// The model of a scene; `file` names it in messages, `base_dir` anchors relative mesh files.
@@ -35,13 +35,14 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     let frame_times = frame_times(&cx, &scene.output, analysis.end_time())?;
     check_force_window(&cx, scene.output.contact_force_window)?;
     check_history_cadence(&cx, &scene.output)?;
-    let obstacles = obstacles(&cx, &scene)?;
+    let obstacles = obstacles(&cx, &scene, (&curves, analysis.end_time()))?;
     let contacts = contacts(&cx, &scene, &bodies, &obstacles)?;
     check_contact_setup(&cx, &scene, &bodies, &contacts)?;
     check_reaction_probes(&cx, &probes, &fixed_dofs, &loads)?;
     check_quad4_features(&cx, &analysis, &bodies)?;
     check_dispersion_free(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
+    check_moving_obstacles(&cx, &analysis, &contacts)?;
     check_arc_length(&cx, &analysis, &loads, &contacts)?;
     check_arc_length_extras(&cx, &analysis, scene.analysis.checkpoint_every)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
@@ -201,6 +202,55 @@ fn check_explicit_friction(
     {
         return Err(cx.err(format!(
             "contact `{}`: return_coefficient is implemented for the implicit integrators and statics; with central_difference use Coulomb's `friction`",
+            c.name
+        )));
+    }
+    Ok(())
+}
+
+/// A moving obstacle is placed where its motion has it at each step of statics and of
+/// central difference without subcycling or ALE; the other paths read an obstacle at rest
+/// (the implicit integrators' impact conditions give a slave the master's velocity, zero
+/// for an obstacle; a subcycled substep and an ALE slide read its start position), and a
+/// pair's friction measures the slip of a slave, not its slip along a moving wall.
+fn check_moving_obstacles(
+    cx: &Context,
+    analysis: &Analysis,
+    contacts: &[ContactPair],
+) -> Result<(), InputError> {
+    let Some(pair) = contacts.iter().find(|c| c.moving_obstacle().is_some()) else {
+        return Ok(());
+    };
+    let Master::Obstacle(obstacle) = &pair.master else {
+        return Ok(());
+    };
+    let key = format!(
+        "obstacle `{}`.motion (contact `{}`)",
+        obstacle.name, pair.name
+    );
+    let path = match analysis {
+        Analysis::Static(_) => None,
+        Analysis::Dynamic(d) if d.integrator != IntegratorKind::CentralDifference => {
+            Some("an implicit integrator (its impact conditions take the obstacle at rest)")
+        }
+        Analysis::Dynamic(d) if d.subcycling.is_some() => Some("analysis.subcycling"),
+        Analysis::Dynamic(d) if d.ale.is_some() => Some("analysis.ale"),
+        Analysis::Dynamic(_) => None,
+    };
+    if let Some(path) = path {
+        return Err(cx.err(format!(
+            "{key}: a moving obstacle runs under statics and central_difference (without \
+             subcycling or ALE), not under {path}"
+        )));
+    }
+    if let Some(c) = contacts
+        .iter()
+        .find(|c| c.moving_obstacle().is_some() && !matches!(c.options.friction, Friction::None))
+    {
+        return Err(cx.err(format!(
+            "contact `{}`: friction against a moving obstacle is not implemented (the slip \
+             would be the slave's own, not its slip along the obstacle); leave out `friction` \
+             and `return_coefficient`, or hold the obstacle and move the body",
             c.name
         )));
     }

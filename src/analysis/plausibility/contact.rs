@@ -325,8 +325,8 @@ pub(super) fn still_closed_warnings(
         if pair.covered.is_some() || pair.is_hold() {
             continue;
         }
-        let start = approach(model, pair, (&coords, &model.initial_velocity, mass));
-        let end = approach(model, pair, (positions, end_velocity, mass));
+        let start = approach(model, pair, (&coords, &model.initial_velocity, mass), 0.0);
+        let end = approach(model, pair, (positions, end_velocity, mass), d.end_time);
         if let (Some(start), Some(end)) = (start, end)
             && start > 0.0
             && end > STILL_APPROACHING * start
@@ -348,13 +348,17 @@ pub(super) fn still_closed_warnings(
 }
 
 /// The speed at which the slave body's centre of mass approaches the master's (an
-/// obstacle: at rest) along the master's normal at the slave nearest it, at positions `x`
-/// with velocities `v` and masses `mass` per DOF (None when no slave has a master in reach).
+/// obstacle: its motion's velocity) along the master's normal at the slave nearest it, at
+/// positions `x` with velocities `v` and masses `mass` per DOF at time `t` (None when no
+/// slave has a master in reach).
 fn approach(
     model: &Model,
     pair: &ContactPair,
     (x, v, mass): (&[[f64; 2]], &[f64], &[f64]),
+    t: f64,
 ) -> Option<f64> {
+    let placed = crate::contact::placed(std::slice::from_ref(pair), t);
+    let pair = &placed[0];
     let nearest = pair
         .slaves
         .iter()
@@ -374,7 +378,7 @@ fn approach(
     let slave = centre(pair.slave_body);
     let master = match &pair.master {
         Master::Segments { body, .. } | Master::Nodes { body, .. } => centre(*body),
-        Master::Obstacle(_) => [0.0; 2],
+        Master::Obstacle(o) => o.motion.as_ref().map_or([0.0; 2], |m| m.velocity(t)),
     };
     let n = nearest.normal;
     // the master's normal points out of it, towards the slave: approaching is -(v_s - v_m).n

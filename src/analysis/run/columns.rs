@@ -1,7 +1,7 @@
 //! history.csv's columns: which a model's run writes, in order (the output contract of
 //! docs/user-guide.md section 5; columns are only ever added at the end).
 
-use crate::contact::Friction;
+use crate::contact::{Friction, Master};
 use crate::scene::Model;
 
 /// The history.csv columns a run of `model` writes, in order.
@@ -91,7 +91,29 @@ pub(super) fn columns(model: &Model) -> (Vec<String>, bool) {
             }
         }
     }
+    for obstacle in moving_obstacles(model) {
+        // a moving obstacle's prescribed displacement and the force the bodies exert on it
+        columns.extend(
+            [
+                "obstacle_u_x",
+                "obstacle_u_y",
+                "obstacle_force_x",
+                "obstacle_force_y",
+            ]
+            .map(|quantity| format!("{quantity}[{}]", obstacle.name)),
+        );
+    }
     (columns, pivots_column)
+}
+
+/// The obstacles of the scene that move and that a pair uses, in the scene's order: each
+/// has its displacement and force columns.
+pub(super) fn moving_obstacles(model: &Model) -> impl Iterator<Item = &crate::contact::Obstacle> {
+    model.obstacles.iter().filter(|o| {
+        o.motion.is_some()
+            && (model.contacts.iter())
+                .any(|p| matches!(&p.master, Master::Obstacle(m) if m.name == o.name))
+    })
 }
 
 /// Whether the history has each pair's energies: a dynamic run with two pairs or more (a

@@ -301,7 +301,7 @@ impl<'a, S: Stepper> Run<'a, S> {
                 .state()
                 .positions(self.model.analysis.geometry());
             crate::contact::runaway_penetration(
-                &self.model.contacts,
+                &crate::contact::placed(&self.model.contacts, time),
                 &positions,
                 &self.penetration_limits,
             )
@@ -612,10 +612,8 @@ impl<'a, S: Stepper> Run<'a, S> {
             .stepper
             .state()
             .positions(self.model.analysis.geometry());
-        let contact_force = self
-            .stepper
-            .contact()
-            .nodal_forces(&self.model.contacts, &positions);
+        let pairs = crate::contact::placed(&self.model.contacts, self.stepper.state().time);
+        let contact_force = self.stepper.contact().nodal_forces(&pairs, &positions);
         Ok(Outcome {
             summary: self.summary.clone(),
             state: self.stepper.state().clone(),

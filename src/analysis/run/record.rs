@@ -13,10 +13,10 @@ use super::probes::{is_reaction, probe_value, reactions};
 use crate::analysis::steppers::energies::{Energies, Motion};
 use crate::analysis::summary::Summary;
 use crate::assembly::State;
-use crate::contact::ContactState;
 use crate::contact::Friction;
 use crate::contact::Interfaces;
 use crate::contact::fold_passes;
+use crate::contact::{ContactPair, ContactState, Master};
 use crate::mesh::Cells;
 use crate::output::history::History;
 use crate::output::thinning::{Thinning, Window};
@@ -38,6 +38,9 @@ pub struct Recorder {
     point_body_ids: Vec<i64>,
     /// The contact surfaces, for the frames' tractions (None without contact pairs).
     interfaces: Option<Interfaces>,
+    /// Where an obstacle moves and frames are written: the obstacle frames written (time,
+    /// file), each frame adding one; None otherwise.
+    obstacle_frames: Option<Vec<(f64, String)>>,
     series: Option<Series>,
     history: History,
     /// Which steps' rows history.csv gets.
@@ -92,9 +95,10 @@ impl Recorder {
             source,
         })?;
         let wanted = model.output.frame_every() > 0 || !model.output.frame_times.is_empty();
+        let mut obstacle_frames = None;
         let series = if frames && wanted {
             let mut series = Series::create(dir, &model.name, model.output.compression)?;
-            write_obstacles(model, dir)?;
+            obstacle_frames = write_obstacles(model, dir, None)?;
             // frames are encoded and written off the stepping thread
             series.set_background(true);
             Some(series)
@@ -109,6 +113,7 @@ impl Recorder {
             body_ids: body_ids(model),
             point_body_ids: point_body_ids(model),
             interfaces: (!model.contacts.is_empty()).then(|| model.interfaces()),
+            obstacle_frames,
             reference: model.coordinates(),
             series,
             history,
@@ -163,10 +168,11 @@ impl Recorder {
         dir: &Path,
         position: RecorderPosition,
     ) -> Result<Recorder, OutputError> {
+        let mut obstacle_frames = None;
         let series = match position.series {
             Some(p) => {
                 let mut series = Series::resume(dir, &model.name, model.output.compression, p)?;
-                write_obstacles(model, dir)?;
+                obstacle_frames = write_obstacles(model, dir, position.last_frame_time)?;
                 series.set_background(true);
                 Some(series)
             }
@@ -180,6 +186,7 @@ impl Recorder {
             body_ids: body_ids(model),
             point_body_ids: point_body_ids(model),
             interfaces: (!model.contacts.is_empty()).then(|| model.interfaces()),
+            obstacle_frames,
             reference: model.coordinates(),
             series,
             history,
@@ -299,6 +306,7 @@ impl Recorder {
         if pair_columns(model) {
             row.extend(pair_energies(model, contact));
         }
+        row.extend(obstacle_values(model, state, contact));
         let frame = self.frame_due(model, state.time, force_frame, 1);
         let history = &mut self.history;
         self.thinning
@@ -396,15 +404,15 @@ impl Recorder {
         let positions = state.positions(model.analysis.geometry());
         let (contact_force, gap, status) = match contact {
             Some(c) => {
-                let nodal = c.nodal_status(&model.contacts, &positions);
-                (
-                    c.nodal_forces(&model.contacts, &positions),
-                    nodal.gap,
-                    nodal.status,
-                )
+                let pairs = crate::contact::placed(&model.contacts, state.time);
+                let nodal = c.nodal_status(&pairs, &positions);
+                (c.nodal_forces(&pairs, &positions), nodal.gap, nodal.status)
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };
+        if let Some(interfaces) = self.interfaces.as_mut() {
+            interfaces.place_obstacles(state.time);
+        }
         let tractions = contact
             .zip(self.interfaces.as_ref())
             .map(|(c, interfaces)| c.tractions(interfaces, &positions));
@@ -435,6 +443,20 @@ impl Recorder {
         self.grid.points.clear();
         self.grid.points.extend_from_slice(points);
         series.write_frame(state.time, &self.grid, &fields)?;
+        if let Some(listed) = self.obstacle_frames.as_mut() {
+            let mut obstacles = model.obstacles.clone();
+            obstacles.iter_mut().for_each(|o| o.place(state.time));
+            let frame = (listed.len(), state.time);
+            let options = (model.output.compression, listed);
+            let lines = polylines(&obstacles);
+            crate::output::vtk::write_obstacle_frame(
+                &self.dir,
+                &model.name,
+                frame,
+                &lines,
+                options,
+            )?;
+        }
         self.steps_since_frame = 0;
         self.last_frame_time = Some(state.time);
         Ok(())
@@ -598,21 +620,73 @@ pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -
     out
 }
 
-/// The scene's rigid obstacles beside the frames (`vtk::write_obstacles`), when it has any.
-fn write_obstacles(model: &Model, dir: &Path) -> Result<(), OutputError> {
-    if model.obstacles.is_empty() {
-        return Ok(());
+/// Per moving obstacle (`columns::moving_obstacles`), its displacement at the state's time
+/// and the force the bodies exert on it through the pairs against it (zeros before any
+/// contact).
+fn obstacle_values(model: &Model, state: &State, contact: Option<&ContactState>) -> Vec<f64> {
+    let mut values = Vec::new();
+    let pairs = crate::contact::placed(&model.contacts, state.time);
+    let positions = state.positions(model.analysis.geometry());
+    for obstacle in super::columns::moving_obstacles(model) {
+        let u = obstacle
+            .motion
+            .as_ref()
+            .map_or([0.0; 2], |m| m.at(state.time));
+        let mut force = [0.0; 2];
+        if let Some(c) = contact {
+            let against = |p: &ContactPair| matches!(&p.master, Master::Obstacle(o) if o.name == obstacle.name);
+            for (p, _) in pairs.iter().enumerate().filter(|(_, p)| against(p)) {
+                let f = c.master_force(&pairs, p, &positions);
+                force = [force[0] + f[0], force[1] + f[1]];
+            }
+        }
+        values.extend([u[0], u[1], force[0], force[1]]);
     }
-    let polylines: Vec<Polyline> = model
-        .obstacles
-        .iter()
+    values
+}
+
+/// The scene's rigid obstacles beside the frames, when it has any: at rest, written once
+/// (`vtk::write_obstacles`, None); where one moves, each frame writes them
+/// (`write_obstacle_frame`): the list of obstacle frames already written (up to
+/// `resumed_at`, read back from the .pvd, when a run resumes).
+fn write_obstacles(
+    model: &Model,
+    dir: &Path,
+    resumed_at: Option<f64>,
+) -> Result<Option<Vec<(f64, String)>>, OutputError> {
+    if model.obstacles.is_empty() {
+        return Ok(None);
+    }
+    if model.obstacles.iter().any(|o| o.motion.is_some()) {
+        let Some(until) = resumed_at else {
+            return Ok(Some(Vec::new()));
+        };
+        let pvd = dir.join(format!("{}_obstacles.pvd", model.name));
+        let listed = crate::output::vtk::read_pvd(&pvd).unwrap_or_default();
+        let relative = |p: &Path| {
+            p.file_name()
+                .map(|f| format!("vtk/{}", f.to_string_lossy()))
+        };
+        return Ok(Some(
+            (listed.iter())
+                .filter(|(t, _)| *t <= until)
+                .filter_map(|(t, p)| relative(p).map(|f| (*t, f)))
+                .collect(),
+        ));
+    }
+    let polylines = polylines(&model.obstacles);
+    crate::output::vtk::write_obstacles(dir, &model.name, &polylines, model.output.compression)?;
+    Ok(None)
+}
+
+/// The obstacles as the frames draw them.
+fn polylines(obstacles: &[crate::contact::Obstacle]) -> Vec<Polyline<'_>> {
+    (obstacles.iter())
         .map(|o| Polyline {
             points: &o.points,
             closed: o.closed,
         })
-        .collect();
-    crate::output::vtk::write_obstacles(dir, &model.name, &polylines, model.output.compression)?;
-    Ok(())
+        .collect()
 }
 
 /// Per cell of [`grid`], the index of its body in the scene (quads first, then rods).

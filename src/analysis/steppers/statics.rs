@@ -119,6 +119,7 @@ impl Increment<'_> {
         counters: &mut Counters,
     ) -> Result<super::newton::Solution, StepFailure> {
         let Pass {
+            pairs,
             length: h,
             active,
             forces,
@@ -151,7 +152,7 @@ impl Increment<'_> {
             predictor: true,
             error_target: None,
             contact: Some(Constraints {
-                pairs: &model.contacts,
+                pairs,
                 active,
                 start: self.positions,
                 forces,
@@ -233,7 +234,8 @@ impl Stepper for Statics<'_> {
             };
             let (system, solver) = (&mut self.system, &mut self.solver);
             let solve = |pass: Pass<'_>| increment.attempt(pass, system, solver, counters);
-            let (pairs, length) = (&self.model.contacts, target - self.state.time);
+            let pairs = (&self.model.contacts[..], self.state.time);
+            let length = target - self.state.time;
             let outcome = if super::newton::active_set_inside(self.model, &spec.newton) {
                 self.contact.step_inside(pairs, &positions, length, solve)
             } else {
@@ -255,6 +257,7 @@ impl Stepper for Statics<'_> {
                     self.first_rate.get_or_insert(self.last_rate);
                     self.state.time = end;
                     let positions = self.state.positions(spec.geometry);
+                    self.interfaces.place_obstacles(self.state.time);
                     self.contact
                         .commit(&self.interfaces, &step, self.state.time, &positions);
                     // the work of all nodal forces (loads, reactions and contact forces)

@@ -256,7 +256,7 @@ pub struct AffineSpec {
     pub curve: Option<String>,
 }
 
-/// A rigid obstacle: a fixed polyline with the solid on its left (counter-clockwise closed
+/// A rigid obstacle: a polyline with the solid on its left (counter-clockwise closed
 /// polygon: a finite obstacle; clockwise: a cavity; open: the boundary of a half-space).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -269,6 +269,17 @@ pub struct ObstacleSpec {
     /// Each corner rounded by an arc of this radius (a length) tangent to its two segments
     /// (`mesh::plane::round_corners`); default none: sharp corners.
     pub corner_radius: Option<f64>,
+    /// A prescribed rigid translation; default none: the obstacle does not move.
+    pub motion: Option<ObstacleMotionSpec>,
+}
+
+/// An obstacle's prescribed translation: `displacement` times the curve (default: a ramp
+/// from 0 at t = 0 to 1 at the end time, a constant speed).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleMotionSpec {
+    pub displacement: [f64; 2],
+    pub curve: Option<String>,
 }
 
 /// A surface of a body: a node set (slaves, node-to-node masters) or an edge set (masters).

@@ -320,7 +320,7 @@ impl<'a> Dynamics<'a> {
         let (system, solver, factored_for) =
             (&mut self.system, &mut self.solver, &mut self.factored_for);
         let solve = |pass: Pass<'_>| attempt.solve(pass, system, solver, factored_for, counters);
-        let pairs = &self.interfaces.pairs;
+        let pairs = (&self.interfaces.pairs[..], self.state.time);
         let mut step = if super::newton::active_set_inside(self.model, &self.spec.newton) {
             self.contact.step_inside(pairs, positions, nominal, solve)?
         } else {
@@ -626,6 +626,7 @@ impl Attempt<'_> {
         counters: &mut Counters,
     ) -> Result<Solution, StepFailure> {
         let Pass {
+            pairs: _,
             length: h,
             active,
             forces,

@@ -174,6 +174,7 @@ impl<'a> Explicit<'a> {
     /// step of length `h` after one of length `last`; `moving`: the nodes that step (None:
     /// all; a subcycled substep moves its finest level's, among them every contact node).
     fn contact_correction(&mut self, (h, last): (f64, f64), time: f64, moving: Option<&[u32]>) {
+        self.interfaces.place_obstacles(time);
         let positions = self.state.positions(self.spec.geometry);
         let predicted = Predicted {
             interfaces: &self.interfaces,
@@ -220,10 +221,13 @@ impl<'a> Explicit<'a> {
                 self.v_half[i] += c / h;
             }
         }
-        // the friction's share is the energy it dissipates, booked apart (theory 7)
+        // the friction's share is the energy it dissipates, booked apart (theory 7); a moving
+        // obstacle's share is work done on the bodies, an external work
         let friction_work: f64 = step.friction_work.iter().sum();
-        self.energies.contact_work -= work - friction_work;
+        let obstacle_work: f64 = step.obstacle_work.iter().sum();
+        self.energies.contact_work -= work - friction_work - obstacle_work;
         self.energies.friction_work -= friction_work;
+        self.energies.external_work += obstacle_work;
         self.contact.recycle(step, &self.interfaces, &touched);
     }
 

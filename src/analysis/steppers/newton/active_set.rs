@@ -477,6 +477,7 @@ mod tests {
                 name: "wall".into(),
                 points: vec![[1.0, 0.0], [-1.0, 0.0]],
                 closed: false,
+                motion: None,
             }),
             options: PairOptions {
                 impact_conditions: false,
