@@ -38,7 +38,6 @@
 //! ```
 
 use super::Interfaces;
-use super::geometry::ContactPair;
 use super::geometry::{COVERED, Friction, Gap};
 use super::mortar::MASTER_ALLOWANCE;
 use super::search::{SlaveGap, penetrates, slave_gaps};
@@ -157,9 +156,14 @@ impl ContactState {
             step_force[*dof] += force;
         }
         let increment = |dof: usize| step.du[dof] + 0.5 * c.delta[dof];
-        let friction_work =
-            self.tangential_work(&interfaces.pairs, start, &step_friction, &increment);
-        let obstacle_work = obstacle_work(&interfaces.pairs, &pair_forces, (time - h, time));
+        let carried = |p: usize, row: &[(usize, f64)]| step.carried(p, row);
+        let friction_work = self.tangential_work(
+            &interfaces.pairs,
+            start,
+            &step_friction,
+            (&increment, &carried),
+        );
+        let obstacle_work = obstacle_work(&pair_forces, step.obstacle_steps);
         ExplicitContact {
             correction: c.delta,
             step_force,
@@ -192,21 +196,14 @@ impl ContactState {
 }
 
 /// Per pair, the work of its force terms `pair_forces` (on the slaves) on its obstacle's
-/// translation from `t0` to `t1`: a rigid translation moves every point of the obstacle by
-/// the same increment, so the pair's forces do sum_d f_d dx_(d mod 2) on it.
-fn obstacle_work(
-    pairs: &[ContactPair],
-    pair_forces: &[Vec<(usize, f64)>],
-    (t0, t1): (f64, f64),
-) -> Vec<f64> {
-    (pairs.iter().zip(pair_forces))
-        .map(|(pair, terms)| match pair.moving_obstacle() {
+/// translation in the step, `steps` (per pair; empty where no obstacle moves): a rigid
+/// translation moves every point of the obstacle by the same increment dx, so the pair's
+/// forces do sum_d f_d dx_(d mod 2) on it.
+fn obstacle_work(pair_forces: &[Vec<(usize, f64)>], steps: &[[f64; 2]]) -> Vec<f64> {
+    (pair_forces.iter().enumerate())
+        .map(|(p, terms)| match steps.get(p) {
             None => 0.0,
-            Some(m) => {
-                let (a, b) = (m.at(t0), m.at(t1));
-                let dx = [b[0] - a[0], b[1] - a[1]];
-                terms.iter().map(|(d, f)| f * dx[d % 2]).sum()
-            }
+            Some(dx) => terms.iter().map(|(d, f)| f * dx[d % 2]).sum(),
         })
         .collect()
 }
@@ -237,6 +234,9 @@ pub struct Predicted<'a> {
     pub start: &'a [[f64; 2]],
     pub du: &'a [f64],
     pub inverse_mass: &'a [f64],
+    /// Per pair, the translation of its obstacle in the step (`moving_obstacle_steps`);
+    /// empty where no obstacle moves.
+    pub obstacle_steps: &'a [[f64; 2]],
 }
 
 /// The correction of a step: delta, the active entries and their accumulated normal (mu)
@@ -259,7 +259,33 @@ struct Correction {
     master_impulse: Vec<(usize, usize, f64)>,
 }
 
+/// Per pair of `interfaces`, the translation of its obstacle from `t0` to `t1` (zero for a
+/// pair whose master does not move); empty where no obstacle moves.
+pub fn moving_obstacle_steps(interfaces: &Interfaces, (t0, t1): (f64, f64)) -> Vec<[f64; 2]> {
+    if !super::obstacles_move(&interfaces.pairs) {
+        return Vec::new();
+    }
+    (interfaces.pairs.iter())
+        .map(|pair| match pair.moving_obstacle() {
+            None => [0.0; 2],
+            Some(m) => {
+                let (a, b) = (m.at(t0), m.at(t1));
+                [b[0] - a[0], b[1] - a[1]]
+            }
+        })
+        .collect()
+}
+
 impl Predicted<'_> {
+    /// The slip along the tangential row `row` of pair `p` that its obstacle's own motion
+    /// carries in the step, t . dx (a moving obstacle's rows are on the slave alone): the
+    /// slip of a slave relative to the obstacle is T (du + delta) less this.
+    fn carried(&self, p: usize, row: &[(usize, f64)]) -> f64 {
+        self.obstacle_steps
+            .get(p)
+            .map_or(0.0, |dx| row.iter().map(|(d, c)| c * dx[d % 2]).sum())
+    }
+
     fn position(&self, delta: &[f64], node: usize) -> [f64; 2] {
         [
             self.start[node][0] + self.du[2 * node] + delta[2 * node],
@@ -345,16 +371,20 @@ impl Predicted<'_> {
                     coulomb(interfaces, *p).map(|_| g.tangent_row(interfaces.pairs[*p].slaves[*k]))
                 })
                 .collect();
+            let carried: Vec<f64> = (c.active.iter().zip(&tangent_rows))
+                .map(|((p, _), row)| row.as_deref().map_or(0.0, |row| self.carried(*p, row)))
+                .collect();
+            let tangent_rows = (&tangent_rows[..], &carried[..]);
             // the master nodes are looked at once the slaves have settled: before, the
             // pass is about to move them anyway
-            let slaves_settled = !changed && self.settled(&c, &gaps, &tangent_rows);
+            let slaves_settled = !changed && self.settled(&c, &gaps, tangent_rows);
             let looked_at = if slaves_settled { &candidates[..] } else { &[] };
             let (master_gaps, masters_joined) = self.look_at_masters(&mut c, looked_at, &gaps);
             if slaves_settled && !masters_joined && self.masters_settled(&c, &master_gaps) {
                 c.lowest = Some(lowest);
                 break;
             }
-            self.pass(&mut c, (&gaps, &master_gaps), &tangent_rows);
+            self.pass(&mut c, (&gaps, &master_gaps), tangent_rows);
         }
         c
     }
@@ -439,13 +469,11 @@ impl Predicted<'_> {
     }
 
     /// Whether the active entries' gaps are within TOL and the sticking entries' slips too
-    /// (those a multiplier can move: a held node's slip is its support's).
-    fn settled(
-        &self,
-        c: &Correction,
-        gaps: &[Gap],
-        tangent_rows: &[Option<Vec<(usize, f64)>>],
-    ) -> bool {
+    /// (those a multiplier can move: a held node's slip is its support's), each slip its
+    /// row's T (du + delta) less what its obstacle carries (`tangent_rows`: the rows and
+    /// those slips).
+    fn settled(&self, c: &Correction, gaps: &[Gap], tangent_rows: TangentRows) -> bool {
+        let (tangent_rows, carried) = tangent_rows;
         let tolerance = |p: usize| {
             self.interfaces.pairs[p]
                 .options
@@ -469,7 +497,8 @@ impl Predicted<'_> {
                     let slip: f64 = row
                         .iter()
                         .map(|(dof, coefficient)| coefficient * (self.du[*dof] + c.delta[*dof]))
-                        .sum();
+                        .sum::<f64>()
+                        - carried[i];
                     slip.abs() / tolerance(*p)
                 })
             })
@@ -484,7 +513,7 @@ impl Predicted<'_> {
         &self,
         c: &mut Correction,
         (gaps, master_gaps): (&[Gap], &[Option<Gap>]),
-        tangent_rows: &[Option<Vec<(usize, f64)>>],
+        tangent_rows: TangentRows,
     ) {
         let (interfaces, inverse_mass) = (self.interfaces, self.inverse_mass);
         let master_gaps = self.drop_lost_masters(c, master_gaps);
@@ -666,16 +695,21 @@ fn master_candidates(interfaces: &Interfaces) -> Vec<(usize, usize)> {
     candidates
 }
 
+/// The tangential rows of the active entries (those with friction) and, per entry, the slip
+/// its obstacle's own motion carries in the step (0 where the master does not move).
+type TangentRows<'r> = (&'r [Option<Vec<(usize, f64)>>], &'r [f64]);
+
 /// Coulomb's return of the tangential multipliers of the entries with friction (those with
 /// a row in `tangent_rows`, coefficient `coefficients[i]`): the stick increment that undoes
-/// the slip T (du + delta) left by the step so far, (T M^-1 T^T) d_lambda = -T (du + delta),
+/// the slip s = T (du + delta) - carried left by the step so far (relative to a moving
+/// obstacle), (T M^-1 T^T) d_lambda = -s,
 /// then the total lambda + d_lambda clamped to the cone |lambda| <= mu_f max(mu, 0) (slide);
 /// the change of lambda is added to `delta` through M^-1 T^T. A row on prescribed DOFs only
 /// (T M^-1 T^T = 0: an axis node held in x against a wall whose tangent is x) is satisfied
 /// by its support and takes no multiplier; it is left out, so that it cannot make the
 /// rows it shares DOFs with singular.
 fn friction_correction(
-    tangent_rows: &[Option<Vec<(usize, f64)>>],
+    (tangent_rows, carried): TangentRows,
     (coefficients, mu_total): (&[f64], &[f64]),
     friction_total: &mut [f64],
     (du, delta): (&[f64], &mut [f64]),
@@ -695,12 +729,12 @@ fn friction_correction(
         .iter()
         .map(|i| tangent_rows[*i].clone().expect("filtered above"))
         .collect();
-    let slips: Vec<f64> = rows
-        .iter()
-        .map(|row| {
+    let slips: Vec<f64> = (rows.iter().zip(&entries))
+        .map(|(row, &i)| {
             row.iter()
                 .map(|(dof, c)| c * (du[*dof] + delta[*dof]))
-                .sum()
+                .sum::<f64>()
+                - carried[i]
         })
         .collect();
     let stick = super::multipliers::lumped_multipliers(&rows, &slips, inverse_mass);

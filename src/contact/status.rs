@@ -301,22 +301,28 @@ impl ContactState {
         force
     }
 
-    /// Per pair, the work `tangential`'s forces do on the increment `increment(dof)`, the
-    /// rows at positions `coords`: T^T lambda . du over the pair's active entries, what the
-    /// forces of `pair_force_terms`' tangential rows would do.
+    /// Per pair, the work `tangential`'s forces do on the increment `increment(dof)` relative
+    /// to the master, the rows at positions `coords`: lambda (T du - carried) over the pair's
+    /// active entries, `carried(pair, row)` the slip a moving obstacle's own motion carries
+    /// along the row (0 otherwise): what the forces of `pair_force_terms`' tangential rows
+    /// dissipate.
     pub(super) fn tangential_work(
         &self,
         pairs: &[ContactPair],
         coords: &[[f64; 2]],
         tangential: &[Vec<f64>],
-        increment: &dyn Fn(usize) -> f64,
+        (increment, carried): (
+            &dyn Fn(usize) -> f64,
+            &dyn Fn(usize, &[(usize, f64)]) -> f64,
+        ),
     ) -> Vec<f64> {
         let x = |n: usize| coords[n];
         let mut work = vec![0.0; pairs.len()];
         let skip = |p: usize, k: usize| !self.active[p][k] || tangential[p][k] == 0.0;
         for s in slave_gaps(pairs, &x, &skip) {
             let row = s.gap.tangent_row(s.node);
-            let slip: f64 = row.iter().map(|(d, c)| c * increment(*d)).sum();
+            let slip: f64 =
+                row.iter().map(|(d, c)| c * increment(*d)).sum::<f64>() - carried(s.pair, &row);
             work[s.pair] += tangential[s.pair][s.index] * slip;
         }
         work

@@ -37,7 +37,7 @@ use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, PartialKernel, kernel_for};
 use crate::assembly::mass_scaling::{AddedAtRest, NodalMotion};
 use crate::assembly::{ElementMasses, Mass, StableStep, State, check_mass};
-use crate::contact::explicit::Predicted;
+use crate::contact::explicit::{Predicted, moving_obstacle_steps};
 use crate::contact::{ContactState, Interfaces};
 use crate::output::readable;
 use crate::scene::DynamicAnalysis;
@@ -175,12 +175,14 @@ impl<'a> Explicit<'a> {
     /// all; a subcycled substep moves its finest level's, among them every contact node).
     fn contact_correction(&mut self, (h, last): (f64, f64), time: f64, moving: Option<&[u32]>) {
         self.interfaces.place_obstacles(time);
+        let obstacle_steps = moving_obstacle_steps(&self.interfaces, (time - h, time));
         let positions = self.state.positions(self.spec.geometry);
         let predicted = Predicted {
             interfaces: &self.interfaces,
             start: &positions,
             du: &self.du,
             inverse_mass: &self.inverse_mass,
+            obstacle_steps: &obstacle_steps,
         };
         let step = self.contact.explicit_step(&predicted, h, last, time);
         // the contact work that closes the discrete balance of the step (theory 7): with f =
