@@ -105,16 +105,50 @@ impl std::fmt::Display for Unsettled {
     }
 }
 
-/// The tangential conditions of the entries' friction status, in entry order.
-fn tangential_conditions(slips: &[Slip]) -> Vec<Tangential> {
+/// The tangential conditions of the entries' friction status, in entry order; `carried`:
+/// per entry, the slip its obstacle's own motion carries in the step (a stick holds the
+/// slave on the moving obstacle: T d = carried).
+fn tangential_conditions(slips: &[Slip], carried: &[f64]) -> Vec<Tangential> {
     slips
         .iter()
         .enumerate()
         .filter_map(|(entry, s)| match *s {
             Slip::Free => None,
-            Slip::Stick => Some(Tangential::Fixed { entry, target: 0.0 }),
-            Slip::Return(target) => Some(Tangential::Fixed { entry, target }),
+            Slip::Stick => Some(Tangential::Fixed {
+                entry,
+                target: carried[entry],
+            }),
+            Slip::Return(target) => Some(Tangential::Fixed {
+                entry,
+                target: target + carried[entry],
+            }),
             Slip::Slide(coefficient) => Some(Tangential::Sliding { entry, coefficient }),
+        })
+        .collect()
+}
+
+/// Per entry (pair, slave index), the slip t . dx that its obstacle's translation dx from
+/// `time` to `time + length` carries along the slave's tangent at `start` (against the
+/// pairs there, `at_start`): zero where the master does not move. The slip Coulomb's law
+/// and Greco's return read is T d less this.
+fn carried_slips(
+    at_start: &[ContactPair],
+    entries: &[(usize, usize)],
+    start: &[[f64; 2]],
+    (time, length): (f64, f64),
+) -> Vec<f64> {
+    let position = |n: usize| start[n];
+    (entries.iter())
+        .map(|&(p, k)| {
+            let Some(m) = at_start[p].moving_obstacle() else {
+                return 0.0;
+            };
+            let (a, b) = (m.at(time), m.at(time + length));
+            let s = at_start[p].slaves[k];
+            at_start[p].gap(s, &position).map_or(0.0, |g| {
+                let t = g.tangent();
+                t[0] * (b[0] - a[0]) + t[1] * (b[1] - a[1])
+            })
         })
         .collect()
 }
@@ -240,7 +274,8 @@ impl ContactState {
                 .iter()
                 .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
                 .collect();
-            let tangential = tangential_conditions(&slips);
+            let carried = carried_slips(&at_start, &entries, start, (time, length));
+            let tangential = tangential_conditions(&slips, &carried);
             let at_end = placed(pairs, time + length);
             let pairs = &at_end[..];
             let solution = solve(Pass {
@@ -275,7 +310,11 @@ impl ContactState {
                     let (p, k) = entries[i];
                     let s = pairs[p].slaves[k];
                     pairs[p].gap(s, &end).map_or(0.0, |g| {
-                        g.tangent_row(s).iter().map(|(dof, c)| c * d[*dof]).sum()
+                        g.tangent_row(s)
+                            .iter()
+                            .map(|(dof, c)| c * d[*dof])
+                            .sum::<f64>()
+                            - carried[i]
                     })
                 };
                 let forces_t = per_entry(&slips, solution.tangential_forces());
@@ -358,7 +397,8 @@ impl ContactState {
             .iter()
             .map(|(p, k)| (*p, pairs[*p].slaves[*k]))
             .collect();
-        let tangential = tangential_conditions(&slips);
+        // the active set inside Newton is refused against a moving obstacle with friction
+        let tangential = tangential_conditions(&slips, &vec![0.0; slips.len()]);
         let mut length = length;
         let mut split = false;
         let mut inside = Inside::Releases;

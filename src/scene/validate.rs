@@ -13,7 +13,9 @@ use super::materials::materials;
 use super::model::{Analysis, Body, BodyKind, Load, Model, Probe, SceneSource};
 use super::probes::{check_force_window, check_history_cadence, frame_times, probes};
 use super::reference::reference;
-use super::spec::{IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene};
+use super::spec::{
+    ActiveSetSolve, IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene,
+};
 use crate::contact::{ContactPair, Friction, Master};
 use std::path::Path;
 
@@ -212,8 +214,8 @@ fn check_explicit_friction(
 /// central difference without subcycling or ALE; the other paths read an obstacle at rest
 /// (the implicit integrators' impact conditions give a slave the master's velocity, zero
 /// for an obstacle; a subcycled substep and an ALE slide read its start position). Friction
-/// against it measures the slip relative to it under central difference; the static
-/// stick and slide read the slave's own slip.
+/// against it reads the slip relative to it, in central difference and in the passes of a
+/// static contact step, not in the active set inside Newton.
 fn check_moving_obstacles(
     cx: &Context,
     analysis: &Analysis,
@@ -244,17 +246,26 @@ fn check_moving_obstacles(
              subcycling or ALE), not under {path}"
         )));
     }
-    let statics = matches!(analysis, Analysis::Static(_));
-    if statics
+    // the stick and slide of the active set inside Newton (theory 8.3b) read the slave's
+    // own slip; the passes read the slip relative to the obstacle
+    let inside = match analysis {
+        Analysis::Static(s) => match s.newton.active_set {
+            Some(ActiveSetSolve::Newton) => true,
+            Some(ActiveSetSolve::Passes) => false,
+            None => contacts.iter().any(|pair| pair.mortar().is_some()),
+        },
+        Analysis::Dynamic(_) => false,
+    };
+    if inside
         && let Some(c) = contacts.iter().find(|c| {
             c.moving_obstacle().is_some() && !matches!(c.options.friction, Friction::None)
         })
     {
         return Err(cx.err(format!(
-            "contact `{}`: friction against a moving obstacle runs under central_difference, \
-             not in statics (its stick and slide would read the slave's own slip, not its slip \
-             along the obstacle); leave out `friction` and `return_coefficient`, or hold the \
-             obstacle and move the body",
+            "contact `{}`: friction against a moving obstacle with the active set decided \
+             inside Newton's iteration (analysis.newton.active_set `newton`, or a mortar pair \
+             in the scene), whose stick and slide read the slave's own slip, not its slip \
+             along the obstacle; set analysis.newton.active_set to `passes`",
             c.name
         )));
     }
