@@ -226,56 +226,10 @@ fn friction_on_a_wall_that_slides_is_friction_in_the_walls_frame() {
     assert!(last(&oblique.dir, "friction_work") > 0.05 * last(&oblique.dir, "plastic_work"));
 }
 
-/// A steel block (plane strain, 20 x 10 mm, J2 with hardening) on a held bottom, pressed
-/// 50 um and sheared 20 um by a rough platen (Coulomb, mu = 0.3) in 10 static increments.
-const PLATEN: &str = r#"
-title = "A steel block pressed and sheared by a rough platen"
-
-[[material]]
-name = "steel"
-young = 210e9
-poisson = 0.3
-density = 7850.0
-yield_stress = 250e6
-hardening_modulus = 1e9
-
-[[body]]
-name = "block"
-material = "steel"
-formulation = "plane_strain"
-mesh = { type = "rectangle", width = 0.02, height = 0.01, nx = 10, ny = 5 }
-
-[[support]]
-set = "bottom"
-fix = ["x", "y"]
-
-[[obstacle]]
-name = "platen"
-points = [[-0.01, 0.01], [0.03, 0.01]]
-motion = { displacement = [2e-5, -5e-5] }
-
-[[contact]]
-name = "platen"
-slave = { set = "top" }
-obstacle = "platen"
-friction = 0.3
-
-[analysis]
-type = "static"
-steps = 10
-
-[[output.probe]]
-quantity = "reaction_x"
-set = "bottom"
-
-[[output.probe]]
-quantity = "reaction_y"
-set = "bottom"
-"#;
-
 /// Goal: in statics a moving obstacle with friction drags the body as a body pushed under an
-/// obstacle at rest is dragged. Setup: `PLATEN` (the defaults: finite strain, the contact
-/// passes), against the same block with the platen at rest and the bottom moved by
+/// obstacle at rest is dragged. Setup: models/rough_platen.toml (a J2 steel block, plane
+/// strain, on a held bottom, pressed 50 um and sheared 20 um by a rough platen, mu = 0.3, in
+/// 10 increments with the defaults: finite strain, the contact passes), against the same block with the platen at rest and the bottom moved by
 /// (-20, +50) um. Reference: the two are one problem seen from frames a translation apart
 /// (updated Lagrangian statics is invariant under it): the bottom's reactions agree
 /// (measured 1e-8 relative, Newton's tolerance; 1e-6 asserted), and the force on the platen
@@ -284,42 +238,38 @@ set = "bottom"
 /// normal force (asserted above 0.5 %), so the relative slip is what the stick holds.
 #[test]
 fn a_rough_platen_that_moves_drags_the_block_as_the_pushed_block_is_dragged() {
-    let driven = common::model("platen_driven", PLATEN, &[]);
-    let pushed = common::model(
+    let driven = common::run_scene("platen_driven", "rough_platen", &[]);
+    let pushed = common::run_scene(
         "platen_pushed",
-        PLATEN,
+        "rough_platen",
         &[
             "obstacle.platen.motion={ displacement = [0.0, 0.0] }",
             "support=[]",
             "load=[{ type = \"displacement\", set = \"bottom\", x = -2e-5, y = 5e-5 }]",
         ],
     );
-    for (name, model) in [("platen_driven", &driven), ("platen_pushed", &pushed)] {
-        let (summary, _) = common::run(name, model);
-        assert_eq!(summary.status, Status::Ok, "{name}");
+    for run in [&driven, &pushed] {
+        assert_eq!(run.summary.status, Status::Ok);
     }
-    let (a, b) = (
-        common::out_dir_of("platen_driven"),
-        common::out_dir_of("platen_pushed"),
-    );
+    let (a, b) = (&driven.dir, &pushed.dir);
     let last = |dir: &std::path::Path, name: &str| *common::column(dir, name).last().unwrap();
     for name in ["reaction_x[bottom]", "reaction_y[bottom]", "plastic_work"] {
-        let (x, y) = (last(&a, name), last(&b, name));
+        let (x, y) = (last(a, name), last(b, name));
         assert!((x - y).abs() < 1e-6 * x.abs(), "{name}: {x} against {y}");
     }
     for (reaction, force) in [
         ("reaction_x[bottom]", "obstacle_force_x[platen]"),
         ("reaction_y[bottom]", "obstacle_force_y[platen]"),
     ] {
-        let (r, f) = (last(&a, reaction), last(&a, force));
+        let (r, f) = (last(a, reaction), last(a, force));
         assert!(
-            (r - f).abs() < 1e-6 * last(&a, "reaction_y[bottom]"),
+            (r - f).abs() < 1e-6 * last(a, "reaction_y[bottom]"),
             "{r} against {f}"
         );
     }
-    let shear = last(&a, "reaction_x[bottom]").abs();
+    let shear = last(a, "reaction_x[bottom]").abs();
     assert!(
-        shear > 5e-3 * last(&a, "reaction_y[bottom]"),
+        shear > 5e-3 * last(a, "reaction_y[bottom]"),
         "shear reaction {shear}"
     );
 }
