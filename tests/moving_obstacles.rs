@@ -311,6 +311,17 @@ fn moving_obstacles_are_refused_where_they_would_be_read_at_rest() {
         &[motion],
         &["moving obstacle", "implicit"],
     );
+    // the closed form of bar_wall's [reference] reads the bar's speed against a wall at rest
+    common::check_refuses_with(
+        "models/bar_wall.toml",
+        &[
+            motion,
+            "analysis.integrator=central_difference",
+            "analysis.mass=lumped",
+            "analysis.dt=0.004",
+        ],
+        &["reference.kind", "at rest"],
+    );
     common::check_refuses_with(
         "models/shield_punch.toml",
         &[

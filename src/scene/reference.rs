@@ -114,8 +114,10 @@ fn bars(bodies: &[Body], pair: &ContactPair, wrong: &Needs) -> Result<Reference,
 /// `rod_wall`: a rod against a rigid obstacle (reference::rod_wall_impact).
 fn rod_wall(bodies: &[Body], pair: &ContactPair, wrong: &Needs) -> Result<Reference, InputError> {
     let slave = &bodies[pair.slave_body];
-    if !matches!(pair.master, Master::Obstacle(_)) {
-        return Err(wrong("a rigid obstacle as master"));
+    if !matches!(pair.master, Master::Obstacle(_)) || pair.moving_obstacle().is_some() {
+        return Err(wrong(
+            "a rigid obstacle at rest as master (the closed form reads the body's speed against it)",
+        ));
     }
     let (density, young, area, length) = rod(slave).ok_or_else(|| wrong("a rod as slave body"))?;
     let (force, duration) =
@@ -136,8 +138,10 @@ fn hertz_impact(
     wrong: &Needs,
 ) -> Result<Reference, InputError> {
     let slave = &bodies[pair.slave_body];
-    if !matches!(pair.master, Master::Obstacle(_)) {
-        return Err(wrong("a rigid obstacle as master"));
+    if !matches!(pair.master, Master::Obstacle(_)) || pair.moving_obstacle().is_some() {
+        return Err(wrong(
+            "a rigid obstacle at rest as master (the closed form reads the body's speed against it)",
+        ));
     }
     if !matches!(
         slave.kind,
