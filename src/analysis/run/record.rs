@@ -625,6 +625,9 @@ pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -
 /// contact).
 fn obstacle_values(model: &Model, state: &State, contact: Option<&ContactState>) -> Vec<f64> {
     let mut values = Vec::new();
+    if super::columns::moving_obstacles(model).next().is_none() {
+        return values;
+    }
     let pairs = crate::contact::placed(&model.contacts, state.time);
     let positions = state.positions(model.analysis.geometry());
     for obstacle in super::columns::moving_obstacles(model) {
