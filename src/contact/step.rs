@@ -340,20 +340,7 @@ impl ContactState {
                     warm = None;
                     continue;
                 }
-                let forces = normal.to_vec();
-                let sliding = slips
-                    .iter()
-                    .map(|s| match s {
-                        Slip::Slide(c) => *c,
-                        _ => 0.0,
-                    })
-                    .collect();
-                let rows = ConvergedRows {
-                    entries,
-                    forces,
-                    tangential: forces_t,
-                    sliding,
-                };
+                let rows = ConvergedRows::of_passes(entries, (normal.to_vec(), forces_t), &slips);
                 return Ok(self.finish(pairs, solution, length, rows));
             }
             if !split && alpha > MIN_SPLIT && alpha < 1.0 {
@@ -526,6 +513,29 @@ struct ConvergedRows {
     forces: Vec<f64>,
     tangential: Vec<f64>,
     sliding: Vec<f64>,
+}
+
+impl ConvergedRows {
+    /// The rows the passes converged to: the entries, their normal and tangential forces,
+    /// and the sliding coefficient of each entry's slip status.
+    fn of_passes(
+        entries: Vec<(usize, usize)>,
+        (forces, tangential): (Vec<f64>, Vec<f64>),
+        slips: &[Slip],
+    ) -> ConvergedRows {
+        let sliding = (slips.iter())
+            .map(|s| match s {
+                Slip::Slide(c) => *c,
+                _ => 0.0,
+            })
+            .collect();
+        ConvergedRows {
+            entries,
+            forces,
+            tangential,
+            sliding,
+        }
+    }
 }
 
 /// Coulomb stick <-> slide switches of a converged pass: a sticking entry whose friction
