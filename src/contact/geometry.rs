@@ -22,6 +22,30 @@ pub struct Obstacle {
     pub closed: bool,
     /// A prescribed rigid translation; None: the obstacle stays where it was put.
     pub motion: Option<ObstacleMotion>,
+    /// A rigid body of its own that the contact forces alone move (a projectile); None: the
+    /// obstacle is fixed or prescribed.
+    pub projectile: Option<Projectile>,
+}
+
+/// A rigid projectile: an obstacle with a mass and an initial velocity that translates under
+/// the contact forces (no rotation). Its translation u_R is an unknown of each explicit step:
+/// the driver carries it as two DOFs of a node of their own, the `carrier`, whose position is
+/// u_R (the obstacle's points stay at `base`, where u_R = 0). A slave's gap against it is
+/// then the gap of x_s - u_R against the points at `base`, and its rows hold the carrier's
+/// DOFs with weight 1 (`Gap::masters`): every row against the projectile shares them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Projectile {
+    /// Its number among the model's projectiles (`ContactState::flights`).
+    pub index: usize,
+    /// The mass, counted as the bodies' lumped masses are: per unit depth in plane strain,
+    /// through the thickness in plane stress, the full ring in axisymmetry.
+    pub mass: f64,
+    /// The velocity at t = 0.
+    pub velocity: [f64; 2],
+    pub base: Vec<[f64; 2]>,
+    /// The node whose position is u_R in the explicit driver's vectors; None outside it
+    /// (the points are placed at u_R instead, `Obstacle::place_at`).
+    pub carrier: Option<usize>,
 }
 
 /// The prescribed translation of an obstacle: its points at time t are `base` +
@@ -54,6 +78,15 @@ impl Obstacle {
             let d = m.at(t);
             for (p, b) in self.points.iter_mut().zip(&m.base) {
                 *p = [b[0] + d[0], b[1] + d[1]];
+            }
+        }
+    }
+
+    /// Moves the obstacle's points to `base` + `u` (a projectile at translation `u`).
+    pub fn place_at(&mut self, u: [f64; 2]) {
+        if let Some(p) = &self.projectile {
+            for (x, b) in self.points.iter_mut().zip(&p.base) {
+                *x = [b[0] + u[0], b[1] + u[1]];
             }
         }
     }
@@ -374,6 +407,14 @@ impl ContactPair {
         }
     }
 
+    /// The pair's projectile, when its master is one.
+    pub fn projectile(&self) -> Option<&Projectile> {
+        match &self.master {
+            Master::Obstacle(o) => o.projectile.as_ref(),
+            _ => None,
+        }
+    }
+
     /// The nodes of its surfaces: its slaves, then its deformable master's nodes (none on an
     /// obstacle).
     pub fn surface_nodes(&self) -> impl Iterator<Item = usize> + '_ {
@@ -505,6 +546,13 @@ impl ContactPair {
                 edges, boundary, ..
             } => self.segment_gap((slave, xs), (&edges[..], &boundary[..]), x, grid)?,
             Master::Obstacle(o) => {
+                // a projectile carried by a node: the slave relative to it, the points at
+                // its base (module `Projectile`)
+                let carrier = o.projectile.as_ref().and_then(|p| p.carrier);
+                let xs = match carrier {
+                    Some(c) => sub(xs, x(c)),
+                    None => xs,
+                };
                 let segments = o.segments();
                 let inside = || {
                     if o.closed {
@@ -530,7 +578,7 @@ impl ContactPair {
                 Gap {
                     gap,
                     normal,
-                    masters: Vec::new(),
+                    masters: carrier.map(|c| vec![(c, 1.0)]).unwrap_or_default(),
                     weight: 1.0,
                 }
             }
@@ -739,6 +787,7 @@ pub(super) mod tests {
             points: vec![[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]],
             closed: true,
             motion: None,
+            projectile: None,
         };
         assert!(cavity.is_cavity());
         let pair = slave_node_0(Master::Obstacle(cavity));
@@ -842,6 +891,7 @@ pub(super) mod tests {
             points: vec![[2.0, 0.0], [-2.0, 0.0]],
             closed: false,
             motion: None,
+            projectile: None,
         };
         let pair = slave_node_0(Master::Obstacle(wall));
         for (y, expected) in [(0.3, 0.3), (-0.2, -0.2)] {

@@ -52,7 +52,7 @@ pub mod traction;
 
 pub use geometry::{
     ContactPair, Covered, Discretization, Friction, Gap, Holds, Master, Obstacle, ObstacleMotion,
-    PairOptions, winding_number,
+    PairOptions, Projectile, winding_number,
 };
 pub use impacts::{ImpactMotion, LumpedMass, apply_conditions};
 pub use mortar::MortarSurface;
@@ -155,6 +155,7 @@ pub fn place_obstacles(pairs: &mut [ContactPair], t: f64) {
 }
 
 /// `pairs` with their moving obstacles at time `t`: the pairs themselves where none moves.
+/// A projectile stays at its base: `ContactState::placed` places it where the run has it.
 pub fn placed(pairs: &[ContactPair], t: f64) -> std::borrow::Cow<'_, [ContactPair]> {
     if !obstacles_move(pairs) {
         return std::borrow::Cow::Borrowed(pairs);
@@ -162,6 +163,57 @@ pub fn placed(pairs: &[ContactPair], t: f64) -> std::borrow::Cow<'_, [ContactPai
     let mut moved = pairs.to_vec();
     place_obstacles(&mut moved, t);
     std::borrow::Cow::Owned(moved)
+}
+
+/// Where a projectile is (`geometry::Projectile`): its translation u_R and its velocity.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Flight {
+    pub displacement: [f64; 2],
+    pub velocity: [f64; 2],
+}
+
+impl ContactState {
+    /// Places the obstacles of `pairs` where the run has them at time `t`: the prescribed
+    /// ones by their motion, the projectiles at their flights' translations.
+    pub fn place(&self, pairs: &mut [ContactPair], t: f64) {
+        place_obstacles(pairs, t);
+        for pair in pairs {
+            if let Master::Obstacle(o) = &mut pair.master
+                && let Some(p) = &o.projectile
+                && let Some(flight) = self.flights.get(p.index)
+            {
+                let u = flight.displacement;
+                o.place_at(u);
+            }
+        }
+    }
+
+    /// `pairs` with their obstacles where the run has them at time `t` (`place`): the pairs
+    /// themselves where none moves.
+    pub fn placed<'p>(
+        &self,
+        pairs: &'p [ContactPair],
+        t: f64,
+    ) -> std::borrow::Cow<'p, [ContactPair]> {
+        if !obstacles_move(pairs) && pairs.iter().all(|p| p.projectile().is_none()) {
+            return std::borrow::Cow::Borrowed(pairs);
+        }
+        let mut moved = pairs.to_vec();
+        self.place(&mut moved, t);
+        std::borrow::Cow::Owned(moved)
+    }
+
+    /// The velocity of the obstacle of `pair` at time `t` (zero for one at rest).
+    pub fn obstacle_velocity(&self, pair: &ContactPair, t: f64) -> [f64; 2] {
+        match &pair.master {
+            Master::Obstacle(o) => match (&o.motion, &o.projectile) {
+                (Some(m), _) => m.velocity(t),
+                (None, Some(p)) => self.flights.get(p.index).map_or(p.velocity, |f| f.velocity),
+                (None, None) => [0.0; 2],
+            },
+            _ => [0.0; 2],
+        }
+    }
 }
 
 /// The contact problem of a model: its pairs and, per body, its surface data.

@@ -272,6 +272,7 @@ mod tests {
             points: vec![[2.0, 0.0], [-2.0, 0.0]],
             closed: false,
             motion: None,
+            projectile: None,
         };
         let pair = crate::contact::geometry::tests::slave_node_0(Master::Obstacle(wall));
         Interfaces {

@@ -44,6 +44,10 @@ pub struct ContactState {
     /// Per pair: the energy its friction dissipated so far (`friction_work[pair]`).
     #[serde(default)]
     pub friction_work: Vec<f64>,
+    /// Per projectile (`Projectile::index`), where it is and how fast it moves (empty
+    /// without projectiles; the explicit driver keeps it).
+    #[serde(default)]
+    pub flights: Vec<super::Flight>,
     /// The explicit correction's vectors over all DOFs, kept zero between steps, so that a
     /// step neither allocates nor clears them whole (`contact::explicit`; not in a
     /// checkpoint: zero vectors of the right length either way).
@@ -90,6 +94,7 @@ impl ContactState {
             master_block: Vec::new(),
             work: vec![0.0; pairs.len()],
             friction_work: vec![0.0; pairs.len()],
+            flights: Vec::new(),
             scratch: Scratch::default(),
         }
     }

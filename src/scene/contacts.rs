@@ -6,12 +6,12 @@ use super::InputError;
 use super::context::{Context, body_index, edge_set, finite, node_set, positive};
 use super::model::{Body, BodyKind, Curve};
 use super::spec::{
-    AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, ObstacleMotionSpec, Roles,
-    Scene, SurfaceSpec,
+    AnalysisKind, ContactDiscretization, ContactSpec, FormulationSpec, IntegratorKind,
+    ObstacleMotionSpec, ProjectileSpec, Roles, Scene, SurfaceSpec,
 };
 use crate::contact::{
     ContactPair, Covered, Discretization, Friction, Holds, Master, MortarSurface, Obstacle,
-    ObstacleMotion, OwnSurface, PairOptions, setup,
+    ObstacleMotion, OwnSurface, PairOptions, Projectile, setup,
 };
 use crate::element::Formulation;
 use crate::mesh::Cells;
@@ -160,11 +160,23 @@ pub(super) fn obstacles(
             None => None,
             Some(m) => Some(motion(cx, m, &points, (curves, end_time), &key)?),
         };
+        let index = out.iter().filter(|o| o.projectile.is_some()).count();
+        let projectile = match &o.projectile {
+            None => None,
+            Some(p) => Some(projectile(cx, scene, p, (&points, index), &key)?),
+        };
+        if motion.is_some() && projectile.is_some() {
+            return Err(cx.err(format!(
+                "{key}: both `motion` and `projectile`: an obstacle is either driven (motion) \
+                 or moved by the contact forces (projectile); remove one"
+            )));
+        }
         out.push(Obstacle {
             name: o.name.clone(),
             points,
             closed: o.closed,
             motion,
+            projectile,
         });
     }
     Ok(out)
@@ -197,6 +209,36 @@ fn motion(
         base: points.to_vec(),
         displacement: spec.displacement,
         curve,
+    })
+}
+
+/// An obstacle's `projectile` from its `points`, the `index`-th of the scene: a positive
+/// mass, a finite velocity, along the axis in axisymmetry (a ring cannot translate radially
+/// as a rigid body).
+fn projectile(
+    cx: &Context,
+    scene: &Scene,
+    spec: &ProjectileSpec,
+    (points, index): (&[[f64; 2]], usize),
+    key: &str,
+) -> Result<Projectile, InputError> {
+    let key = format!("{key}.projectile");
+    let mass = positive(cx, &format!("{key}.mass"), spec.mass)?;
+    finite(cx, &format!("{key}.velocity"), &spec.velocity)?;
+    let axisymmetric = (scene.body.iter()).any(|b| b.formulation == FormulationSpec::Axisymmetric);
+    if axisymmetric && spec.velocity[0] != 0.0 {
+        return Err(cx.err(format!(
+            "{key}.velocity: {} across the axis in an axisymmetric scene; a projectile there \
+             is a body of revolution and moves along the axis only (velocity = [0, vy])",
+            readable(spec.velocity[0])
+        )));
+    }
+    Ok(Projectile {
+        index,
+        mass,
+        velocity: spec.velocity,
+        base: points.to_vec(),
+        carrier: None,
     })
 }
 

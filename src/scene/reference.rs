@@ -114,7 +114,10 @@ fn bars(bodies: &[Body], pair: &ContactPair, wrong: &Needs) -> Result<Reference,
 /// `rod_wall`: a rod against a rigid obstacle (reference::rod_wall_impact).
 fn rod_wall(bodies: &[Body], pair: &ContactPair, wrong: &Needs) -> Result<Reference, InputError> {
     let slave = &bodies[pair.slave_body];
-    if !matches!(pair.master, Master::Obstacle(_)) || pair.moving_obstacle().is_some() {
+    if !matches!(pair.master, Master::Obstacle(_))
+        || pair.moving_obstacle().is_some()
+        || pair.projectile().is_some()
+    {
         return Err(wrong(
             "a rigid obstacle at rest as master (the closed form reads the body's speed against it)",
         ));
@@ -138,7 +141,10 @@ fn hertz_impact(
     wrong: &Needs,
 ) -> Result<Reference, InputError> {
     let slave = &bodies[pair.slave_body];
-    if !matches!(pair.master, Master::Obstacle(_)) || pair.moving_obstacle().is_some() {
+    if !matches!(pair.master, Master::Obstacle(_))
+        || pair.moving_obstacle().is_some()
+        || pair.projectile().is_some()
+    {
         return Err(wrong(
             "a rigid obstacle at rest as master (the closed form reads the body's speed against it)",
         ));

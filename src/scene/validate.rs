@@ -16,7 +16,7 @@ use super::reference::reference;
 use super::spec::{
     ActiveSetSolve, IntegratorKind, MassKind, OutputSpec, Quadrature, Quantity, Scene,
 };
-use crate::contact::{ContactPair, Friction, Master};
+use crate::contact::{ContactPair, Friction, Master, Obstacle};
 use std::path::Path;
 
 /// The model of a scene; `file` names it in messages, `base_dir` anchors relative mesh files.
@@ -45,6 +45,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     check_dispersion_free(&cx, &analysis, &bodies)?;
     check_explicit_friction(&cx, &analysis, &contacts)?;
     check_moving_obstacles(&cx, &analysis, &contacts)?;
+    check_projectiles(&cx, &analysis, &obstacles)?;
     check_arc_length(&cx, &analysis, &loads, &contacts)?;
     check_arc_length_extras(&cx, &analysis, scene.analysis.checkpoint_every)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
@@ -270,6 +271,37 @@ fn check_moving_obstacles(
         )));
     }
     Ok(())
+}
+
+/// A projectile's translation is an unknown of the explicit step (its carrier's DOFs in the
+/// forward-increment correction): central difference without subcycling or ALE, whose
+/// substeps and slides do not carry it; statics has no mass to move it, and the implicit
+/// integrators' contact rows do not hold it.
+fn check_projectiles(
+    cx: &Context,
+    analysis: &Analysis,
+    obstacles: &[Obstacle],
+) -> Result<(), InputError> {
+    let Some(obstacle) = obstacles.iter().find(|o| o.projectile.is_some()) else {
+        return Ok(());
+    };
+    let path = match analysis {
+        Analysis::Static(_) => Some("statics (nothing but the contact would hold it)"),
+        Analysis::Dynamic(d) if d.integrator != IntegratorKind::CentralDifference => {
+            Some("an implicit integrator")
+        }
+        Analysis::Dynamic(d) if d.subcycling.is_some() => Some("analysis.subcycling"),
+        Analysis::Dynamic(d) if d.ale.is_some() => Some("analysis.ale"),
+        Analysis::Dynamic(_) => None,
+    };
+    match path {
+        Some(path) => Err(cx.err(format!(
+            "obstacle `{}`.projectile: a projectile runs under central_difference (without \
+             subcycling or ALE), not under {path}",
+            obstacle.name
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// Arc-length continuation scales the loads by one factor and has no contact events: the

@@ -6,7 +6,7 @@ use super::model_size;
 use crate::analysis::steppers::energies::Energies;
 use crate::analysis::{Status, Summary};
 use crate::contact::penetration::{DeepestNode, PastEndNode};
-use crate::contact::{ContactPair, Master, penetration_limits};
+use crate::contact::{ContactPair, ContactState, Master, penetration_limits};
 use crate::output::readable;
 use crate::scene::model::Analysis;
 use crate::scene::{Body, Model};
@@ -312,6 +312,7 @@ pub(super) fn still_closed_warnings(
     model: &Model,
     closed: &[String],
     (positions, end_velocity, mass): (&[[f64; 2]], &[f64], &[f64]),
+    contact: Option<&ContactState>,
 ) -> Vec<String> {
     let Analysis::Dynamic(d) = &model.analysis else {
         return Vec::new();
@@ -325,8 +326,17 @@ pub(super) fn still_closed_warnings(
         if pair.covered.is_some() || pair.is_hold() {
             continue;
         }
-        let start = approach(model, pair, (&coords, &model.initial_velocity, mass), 0.0);
-        let end = approach(model, pair, (positions, end_velocity, mass), d.end_time);
+        // a projectile's flight at the start, and where the run has it at the end
+        let at_start = ContactState::new(&[]);
+        let at_start = (&at_start, 0.0);
+        let start = approach(
+            model,
+            pair,
+            (&coords, &model.initial_velocity, mass),
+            at_start,
+        );
+        let at_end = (contact.unwrap_or(at_start.0), d.end_time);
+        let end = approach(model, pair, (positions, end_velocity, mass), at_end);
         if let (Some(start), Some(end)) = (start, end)
             && start > 0.0
             && end > STILL_APPROACHING * start
@@ -355,9 +365,9 @@ fn approach(
     model: &Model,
     pair: &ContactPair,
     (x, v, mass): (&[[f64; 2]], &[f64], &[f64]),
-    t: f64,
+    (contact, t): (&ContactState, f64),
 ) -> Option<f64> {
-    let placed = crate::contact::placed(std::slice::from_ref(pair), t);
+    let placed = contact.placed(std::slice::from_ref(pair), t);
     let pair = &placed[0];
     let nearest = pair
         .slaves
@@ -378,7 +388,7 @@ fn approach(
     let slave = centre(pair.slave_body);
     let master = match &pair.master {
         Master::Segments { body, .. } | Master::Nodes { body, .. } => centre(*body),
-        Master::Obstacle(o) => o.motion.as_ref().map_or([0.0; 2], |m| m.velocity(t)),
+        Master::Obstacle(_) => contact.obstacle_velocity(pair, t),
     };
     let n = nearest.normal;
     // the master's normal points out of it, towards the slave: approaching is -(v_s - v_m).n

@@ -105,6 +105,8 @@ pub struct EndOfRun<'a> {
     /// whether the run reached its end time (a failed or stopped run ended early).
     pub closed_at_end: &'a [String],
     pub finished: bool,
+    /// The contact status at the end (where its projectiles are; None in statics).
+    pub contact: Option<&'a crate::contact::ContactState>,
 }
 
 /// What the end of a run shows: nodes of an axisymmetric body that ended across the axis
@@ -120,6 +122,7 @@ pub fn final_warnings(model: &Model, end: &EndOfRun) -> Vec<String> {
             model,
             end.closed_at_end,
             (end.positions, end.velocity, end.mass),
+            end.contact,
         ));
     }
     if let Some(report) = end.mass_scaling {

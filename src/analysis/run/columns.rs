@@ -92,11 +92,14 @@ pub(super) fn columns(model: &Model) -> (Vec<String>, bool) {
         }
     }
     for obstacle in moving_obstacles(model) {
-        // a moving obstacle's prescribed displacement and the force the bodies exert on it
+        // a moving obstacle's displacement (prescribed, or a projectile's flight), its
+        // velocity and the force the bodies exert on it
         columns.extend(
             [
                 "obstacle_u_x",
                 "obstacle_u_y",
+                "obstacle_v_x",
+                "obstacle_v_y",
                 "obstacle_force_x",
                 "obstacle_force_y",
             ]
@@ -106,11 +109,11 @@ pub(super) fn columns(model: &Model) -> (Vec<String>, bool) {
     (columns, pivots_column)
 }
 
-/// The obstacles of the scene that move and that a pair uses, in the scene's order: each
-/// has its displacement and force columns.
+/// The obstacles of the scene that move (driven, or projectiles) and that a pair uses, in
+/// the scene's order: each has its displacement, velocity and force columns.
 pub(super) fn moving_obstacles(model: &Model) -> impl Iterator<Item = &crate::contact::Obstacle> {
     model.obstacles.iter().filter(|o| {
-        o.motion.is_some()
+        (o.motion.is_some() || o.projectile.is_some())
             && (model.contacts.iter())
                 .any(|p| matches!(&p.master, Master::Obstacle(m) if m.name == o.name))
     })

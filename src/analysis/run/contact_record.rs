@@ -116,7 +116,7 @@ impl ContactRecord {
             let deeper = contact.penetration > carry.deepest_depth;
             let watch = self.open_ends && carry.past_end.is_none();
             if deeper || watch {
-                self.interfaces.place_obstacles(time);
+                contact.place(&mut self.interfaces.pairs, time);
                 let x = positions();
                 if deeper {
                     carry.deepest_depth = contact.penetration;

@@ -301,7 +301,7 @@ impl<'a, S: Stepper> Run<'a, S> {
                 .state()
                 .positions(self.model.analysis.geometry());
             crate::contact::runaway_penetration(
-                &crate::contact::placed(&self.model.contacts, time),
+                &self.stepper.contact().placed(&self.model.contacts, time),
                 &positions,
                 &self.penetration_limits,
             )
@@ -517,6 +517,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             mass: motion.mass,
             closed_at_end: &summary.contact.closed_at_end,
             finished: summary.status == Status::Ok && s.done(),
+            contact: Some(s.contact()),
         };
         let more = plausibility::final_warnings(self.model, &end);
         summary.warnings.extend(more);
@@ -612,8 +613,9 @@ impl<'a, S: Stepper> Run<'a, S> {
             .stepper
             .state()
             .positions(self.model.analysis.geometry());
-        let pairs = crate::contact::placed(&self.model.contacts, self.stepper.state().time);
-        let contact_force = self.stepper.contact().nodal_forces(&pairs, &positions);
+        let contact = self.stepper.contact();
+        let pairs = contact.placed(&self.model.contacts, self.stepper.state().time);
+        let contact_force = contact.nodal_forces(&pairs, &positions);
         Ok(Outcome {
             summary: self.summary.clone(),
             state: self.stepper.state().clone(),

@@ -404,14 +404,17 @@ impl Recorder {
         let positions = state.positions(model.analysis.geometry());
         let (contact_force, gap, status) = match contact {
             Some(c) => {
-                let pairs = crate::contact::placed(&model.contacts, state.time);
+                let pairs = c.placed(&model.contacts, state.time);
                 let nodal = c.nodal_status(&pairs, &positions);
                 (c.nodal_forces(&pairs, &positions), nodal.gap, nodal.status)
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };
         if let Some(interfaces) = self.interfaces.as_mut() {
-            interfaces.place_obstacles(state.time);
+            match contact {
+                Some(c) => c.place(&mut interfaces.pairs, state.time),
+                None => interfaces.place_obstacles(state.time),
+            }
         }
         let tractions = contact
             .zip(self.interfaces.as_ref())
@@ -445,7 +448,14 @@ impl Recorder {
         series.write_frame(state.time, &self.grid, &fields)?;
         if let Some(listed) = self.obstacle_frames.as_mut() {
             let mut obstacles = model.obstacles.clone();
-            obstacles.iter_mut().for_each(|o| o.place(state.time));
+            for o in &mut obstacles {
+                o.place(state.time);
+                let flight = (o.projectile.as_ref())
+                    .and_then(|p| contact.and_then(|c| c.flights.get(p.index)));
+                if let Some(f) = flight {
+                    o.place_at(f.displacement);
+                }
+            }
             let frame = (listed.len(), state.time);
             let options = (model.output.compression, listed);
             let lines = polylines(&obstacles);
@@ -620,21 +630,34 @@ pub(crate) fn cell_strains(model: &Model, initial: &[[f64; 2]], state: &State) -
     out
 }
 
-/// Per moving obstacle (`columns::moving_obstacles`), its displacement at the state's time
-/// and the force the bodies exert on it through the pairs against it (zeros before any
-/// contact).
+/// Per moving obstacle (`columns::moving_obstacles`), its displacement and velocity at the
+/// state's time (a projectile's: where the run has it) and the force the bodies exert on it
+/// through the pairs against it (zeros before any contact).
 fn obstacle_values(model: &Model, state: &State, contact: Option<&ContactState>) -> Vec<f64> {
     let mut values = Vec::new();
     if super::columns::moving_obstacles(model).next().is_none() {
         return values;
     }
-    let pairs = crate::contact::placed(&model.contacts, state.time);
+    let at_rest = ContactState::new(&[]);
+    let c = contact.unwrap_or(&at_rest);
+    let pairs = c.placed(&model.contacts, state.time);
     let positions = state.positions(model.analysis.geometry());
     for obstacle in super::columns::moving_obstacles(model) {
-        let u = obstacle
-            .motion
+        let flight = obstacle
+            .projectile
             .as_ref()
-            .map_or([0.0; 2], |m| m.at(state.time));
+            .and_then(|p| c.flights.get(p.index));
+        let (u, v) = match (&obstacle.motion, flight) {
+            (Some(m), _) => (m.at(state.time), m.velocity(state.time)),
+            (None, Some(f)) => (f.displacement, f.velocity),
+            (None, None) => (
+                [0.0; 2],
+                obstacle
+                    .projectile
+                    .as_ref()
+                    .map_or([0.0; 2], |p| p.velocity),
+            ),
+        };
         let mut force = [0.0; 2];
         if let Some(c) = contact {
             let against = |p: &ContactPair| matches!(&p.master, Master::Obstacle(o) if o.name == obstacle.name);
@@ -643,7 +666,7 @@ fn obstacle_values(model: &Model, state: &State, contact: Option<&ContactState>)
                 force = [force[0] + f[0], force[1] + f[1]];
             }
         }
-        values.extend([u[0], u[1], force[0], force[1]]);
+        values.extend([u[0], u[1], v[0], v[1], force[0], force[1]]);
     }
     values
 }
@@ -660,7 +683,7 @@ fn write_obstacles(
     if model.obstacles.is_empty() {
         return Ok(None);
     }
-    if model.obstacles.iter().any(|o| o.motion.is_some()) {
+    if (model.obstacles.iter()).any(|o| o.motion.is_some() || o.projectile.is_some()) {
         let Some(until) = resumed_at else {
             return Ok(Some(Vec::new()));
         };

@@ -271,6 +271,20 @@ pub struct ObstacleSpec {
     pub corner_radius: Option<f64>,
     /// A prescribed rigid translation; default none: the obstacle does not move.
     pub motion: Option<ObstacleMotionSpec>,
+    /// A rigid projectile: the obstacle has a mass and an initial velocity and translates
+    /// under the contact forces (central difference); default none.
+    pub projectile: Option<ProjectileSpec>,
+}
+
+/// A rigid projectile's mass (as the bodies' lumped masses count it: per unit depth in plane
+/// strain, through the thickness in plane stress, the full ring in axisymmetry) and its
+/// initial velocity.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProjectileSpec {
+    pub mass: f64,
+    #[serde(default)]
+    pub velocity: [f64; 2],
 }
 
 /// An obstacle's prescribed translation: `displacement` times the curve (default: a ramp

@@ -13,6 +13,7 @@
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
 mod ale;
+mod projectiles;
 mod start;
 mod subcycling;
 mod vectors;
@@ -87,6 +88,9 @@ pub struct Explicit<'a> {
     subcycler: Option<subcycling::Subcycler>,
     /// The ALE steps (None: Lagrangian).
     mesh_motion: Option<ale::MeshMotion>,
+    /// The rigid projectiles, whose carrier nodes' DOFs follow the model's in the driver's
+    /// vectors (`projectiles`).
+    carriers: projectiles::Carriers,
     // the step's vectors, allocated once
     v_half: Vec<f64>,
     du: Vec<f64>,
@@ -127,19 +131,23 @@ impl<'a> Explicit<'a> {
             // the elements below the target at the start: the initial velocities move them
             scaling.add_pending(&mut m);
         }
-        let inverse_mass = (0..model.dofs())
+        let carriers = projectiles::Carriers::of(model);
+        carriers.extend_masses(&mut free, &mut m);
+        let dofs = free.len();
+        let inverse_mass = (0..dofs)
             .map(|i| if free[i] { 1.0 / m[i] } else { 0.0 })
             .collect();
-        let dofs = model.dofs();
+        let mut interfaces = model.interfaces();
+        carriers.attach(&mut interfaces);
+        let mut contact = ContactState::new(&model.contacts);
+        contact.flights = carriers.initial_flights();
         Ok(Explicit {
             model,
             spec,
-            interfaces: model.interfaces(),
-            surface_nodes: model
-                .contact_surface_nodes()
-                .iter()
-                .enumerate()
+            interfaces,
+            surface_nodes: (model.contact_surface_nodes().iter().enumerate())
                 .filter_map(|(n, on)| on.then_some(n as u32))
+                .chain(carriers.nodes())
                 .collect(),
             initial: model.coordinates(),
             free,
@@ -159,10 +167,11 @@ impl<'a> Explicit<'a> {
             step: 0,
             clock,
             masses,
-            contact: ContactState::new(&model.contacts),
+            contact,
             forces_applied: loads::has_external_force(model),
             subcycler,
             mesh_motion: spec.ale.map(|a| ale::MeshMotion::new(model, a)),
+            carriers,
             v_half: vec![0.0; dofs],
             du: vec![0.0; dofs],
             external: vec![0.0; dofs],
@@ -176,7 +185,8 @@ impl<'a> Explicit<'a> {
     fn contact_correction(&mut self, (h, last): (f64, f64), time: f64, moving: Option<&[u32]>) {
         self.interfaces.place_obstacles(time);
         let obstacle_steps = moving_obstacle_steps(&self.interfaces, (time - h, time));
-        let positions = self.state.positions(self.spec.geometry);
+        let mut positions = self.state.positions(self.spec.geometry);
+        (self.carriers).extend_positions(&mut positions, &self.contact.flights);
         let predicted = Predicted {
             interfaces: &self.interfaces,
             start: &positions,
@@ -282,10 +292,12 @@ impl<'a> Explicit<'a> {
     /// `move_state`: the displacements and positions move by du here (else the caller moves
     /// them, in the pass of the step's end).
     fn internal_force(&mut self, h: f64, move_state: bool) -> Result<StableStep, String> {
-        let (du, kernel) = (&self.du, &mut self.kernel);
+        // the model's DOFs: the carriers' follow them (`projectiles`)
+        let n = self.model.dofs();
+        let (du, kernel) = (&self.du[..n], &mut self.kernel);
         let work = crate::profile::time(crate::profile::Phase::Assembly, || {
             crate::profile::count_elements(kernel.elements());
-            kernel.step(&self.state.coordinates, du, h, &mut self.internal)
+            kernel.step(&self.state.coordinates, du, h, &mut self.internal[..n])
         })
         .map_err(|e| e.to_string())?;
         if move_state {
@@ -303,17 +315,17 @@ impl<'a> Explicit<'a> {
 impl Stepper for Explicit<'_> {
     fn start(&mut self) -> Result<(), String> {
         let model = self.model;
-        let zero = vec![0.0; model.dofs()];
-        let mut first = zero.clone();
+        let n = model.dofs();
         self.kernel
-            .internal_force(&self.state.coordinates, &mut first)
+            .internal_force(&self.state.coordinates, &mut self.internal[..n])
             .map_err(|err| err.to_string())?;
-        self.internal = first;
         let system_free = &self.free;
         let (m, a_r) = (&self.mass, self.spec.rayleigh[0]);
-        let v = super::initial_velocity(model, system_free, self.clock.dt0);
-        let external = loads::external_force(model, &self.state, &self.initial, 0.0);
-        self.a = (0..model.dofs())
+        let mut v = super::initial_velocity(model, &system_free[..n], self.clock.dt0);
+        self.carriers.extend_velocity(&mut v);
+        let mut external = loads::external_force(model, &self.state, &self.initial, 0.0);
+        external.resize(v.len(), 0.0);
+        self.a = (0..v.len())
             .map(|i| {
                 if system_free[i] {
                     (external[i] - self.internal[i] - a_r * m[i] * v[i]) / m[i]
@@ -398,6 +410,9 @@ impl Stepper for Explicit<'_> {
             (&mut self.a, &mut self.v, &mut self.total),
             fused.then(|| StateMotion::of(&mut self.state, spec.geometry)),
         );
+        if !self.carriers.is_empty() {
+            (self.carriers).track(&mut self.contact.flights, &self.du, &self.v);
+        }
         let added = self.add_scaled_mass();
         self.energies.mass_scaling_loss += added.loss;
         std::mem::swap(&mut self.last_total, &mut self.total);
@@ -459,11 +474,13 @@ impl Report for Explicit<'_> {
         &self.state
     }
     fn motion(&self) -> Motion<'_> {
+        // the model's DOFs (the projectiles' carriers follow them)
+        let n = self.model.dofs();
         Motion {
-            velocity: &self.v,
-            acceleration: &self.a,
-            mass: &self.mass,
-            internal_force: &self.internal,
+            velocity: &self.v[..n],
+            acceleration: &self.a[..n],
+            mass: &self.mass[..n],
+            internal_force: &self.internal[..n],
         }
     }
     fn energies(&self) -> &Energies {

@@ -155,10 +155,14 @@ impl StepEnd<'_> {
     ) -> (f64, f64, f64) {
         let (h, a_r) = (self.h, self.a_r);
         let chunks = a.len().div_ceil(DOF_CHUNK);
-        let (coordinates, displacement) = match motion {
+        let (mut coordinates, mut displacement) = match motion {
             Some(motion) => motion.chunks(),
             None => (0..chunks).map(|_| Default::default()).unzip(),
         };
+        // DOFs past the state's (a projectile's carrier, `explicit::projectiles`) move no
+        // state: their chunks' state slices are empty
+        coordinates.resize_with(chunks, Default::default);
+        displacement.resize_with(chunks, Default::default);
         let sums: Vec<(f64, f64, f64)> = (
             a.par_chunks_mut(DOF_CHUNK),
             v.par_chunks_mut(DOF_CHUNK),
