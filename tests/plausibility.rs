@@ -1284,6 +1284,7 @@ fn hourglass_warning_edge_is_ten_percent_of_stored_plus_plastic() {
             mass: &[],
             closed_at_end: &[],
             finished: true,
+            contact: None,
         };
         plausibility::final_warnings(&model, &end)
     };

@@ -220,3 +220,20 @@ fn projectiles_are_refused_where_no_step_carries_them() {
         &["projectile.velocity", "along the axis"],
     );
 }
+
+/// Goal: `impact check` says what the projectile brings before a run. Setup:
+/// models/mass_on_bar.toml. Reference: the bar's mass rho A L = 0.01 x 1 x 10 = 0.1, the
+/// mass's M = 0.1 (a ratio of 1) and its kinetic energy M V^2 / 2 = 5e-4.
+#[test]
+fn check_names_the_projectile_and_what_it_brings() {
+    let out = common::impact(&["check", "models/mass_on_bar.toml"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text
+        .lines()
+        .find(|l| l.contains("obstacle `mass`"))
+        .unwrap_or_else(|| panic!("{text}"));
+    for words in ["mass 0.1 (1 times the bodies')", "kinetic energy 5e-4"] {
+        assert!(line.contains(words), "{line}");
+    }
+}

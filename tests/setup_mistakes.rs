@@ -417,6 +417,7 @@ fn still_closed_warns_above_a_tenth_of_the_approach() {
             mass: &mass,
             closed_at_end: &closed,
             finished: true,
+            contact: None,
         };
         plausibility::final_warnings(&model, &end)
     };

@@ -176,6 +176,23 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
             parts.join("; ")
         ));
     }
+    let total: f64 = masses.iter().map(|m| m.mass).sum();
+    for o in &model.obstacles {
+        if let Some(p) = &o.projectile {
+            let v = p.velocity;
+            lines.push(format!(
+                "obstacle `{}`: a rigid projectile of mass {} ({} times the bodies'), velocity \
+                 ({}, {}), kinetic energy {}; it translates under the contact forces, without \
+                 rotating",
+                o.name,
+                readable(p.mass),
+                readable(p.mass / total),
+                readable(v[0]),
+                readable(v[1]),
+                readable(0.5 * p.mass * (v[0] * v[0] + v[1] * v[1]))
+            ));
+        }
+    }
     if let crate::scene::model::Analysis::Dynamic(spec) = &model.analysis {
         // a central-difference run's start, formed once as the run forms it
         let start = match spec.integrator {

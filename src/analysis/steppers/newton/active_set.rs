@@ -478,6 +478,7 @@ mod tests {
                 points: vec![[1.0, 0.0], [-1.0, 0.0]],
                 closed: false,
                 motion: None,
+                projectile: None,
             }),
             options: PairOptions {
                 impact_conditions: false,
