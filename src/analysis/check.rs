@@ -180,16 +180,29 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
     for o in &model.obstacles {
         if let Some(p) = &o.projectile {
             let v = p.velocity;
+            let (spin, rotation) = match &p.spin {
+                Some(s) => (
+                    0.5 * s.inertia * s.angular_velocity * s.angular_velocity,
+                    format!(
+                        "and rotates about its centre ({}, {}) with the moment of inertia {} \
+                         from an angular velocity {}",
+                        readable(s.centre[0]),
+                        readable(s.centre[1]),
+                        readable(s.inertia),
+                        readable(s.angular_velocity)
+                    ),
+                ),
+                None => (0.0, "without rotating".to_string()),
+            };
             lines.push(format!(
                 "obstacle `{}`: a rigid projectile of mass {} ({} times the bodies'), velocity \
-                 ({}, {}), kinetic energy {}; it translates under the contact forces, without \
-                 rotating",
+                 ({}, {}), kinetic energy {}; it translates under the contact forces {rotation}",
                 o.name,
                 readable(p.mass),
                 readable(p.mass / total),
                 readable(v[0]),
                 readable(v[1]),
-                readable(0.5 * p.mass * (v[0] * v[0] + v[1] * v[1]))
+                readable(0.5 * p.mass * (v[0] * v[0] + v[1] * v[1]) + spin)
             ));
         }
     }

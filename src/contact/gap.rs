@@ -11,6 +11,10 @@ pub struct Gap {
     /// The slave node's weight: 1, or for a weighted (mortar) gap the share of its support
     /// that a master covers (the master weights sum to it).
     pub weight: f64,
+    /// A rotating projectile's spin node and the slave's arm r from the projectile's centre:
+    /// the rotation theta (the node's first DOF) moves the obstacle's point under the slave
+    /// by theta e_z x r, so a row along d holds -(r x d) on it (None elsewhere).
+    pub lever: Option<(usize, [f64; 2])>,
 }
 
 impl Gap {
@@ -39,6 +43,9 @@ impl Gap {
         for (m, w) in &self.masters {
             row.push((2 * m, -w * d[0]));
             row.push((2 * m + 1, -w * d[1]));
+        }
+        if let Some((spin, r)) = self.lever {
+            row.push((2 * spin, -(r[0] * d[1] - r[1] * d[0])));
         }
         row
     }

@@ -9,6 +9,7 @@ use crate::curve::Curve;
 use crate::mesh::plane::{dot, outward, sub};
 
 pub use super::gap::Gap;
+pub use super::projectile::Projectile;
 use std::f64::consts::PI;
 
 /// A rigid obstacle: a polyline, solid on its left (a closed counter-clockwise polygon is a
@@ -25,27 +26,6 @@ pub struct Obstacle {
     /// A rigid body of its own that the contact forces alone move (a projectile); None: the
     /// obstacle is fixed or prescribed.
     pub projectile: Option<Projectile>,
-}
-
-/// A rigid projectile: an obstacle with a mass and an initial velocity that translates under
-/// the contact forces (no rotation). Its translation u_R is an unknown of each explicit step:
-/// the driver carries it as two DOFs of a node of their own, the `carrier`, whose position is
-/// u_R (the obstacle's points stay at `base`, where u_R = 0). A slave's gap against it is
-/// then the gap of x_s - u_R against the points at `base`, and its rows hold the carrier's
-/// DOFs with weight 1 (`Gap::masters`): every row against the projectile shares them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Projectile {
-    /// Its number among the model's projectiles (`ContactState::flights`).
-    pub index: usize,
-    /// The mass, counted as the bodies' lumped masses are: per unit depth in plane strain,
-    /// through the thickness in plane stress, the full ring in axisymmetry.
-    pub mass: f64,
-    /// The velocity at t = 0.
-    pub velocity: [f64; 2],
-    pub base: Vec<[f64; 2]>,
-    /// The node whose position is u_R in the explicit driver's vectors; None outside it
-    /// (the points are placed at u_R instead, `Obstacle::place_at`).
-    pub carrier: Option<usize>,
 }
 
 /// The prescribed translation of an obstacle: its points at time t are `base` +
@@ -82,11 +62,11 @@ impl Obstacle {
         }
     }
 
-    /// Moves the obstacle's points to `base` + `u` (a projectile at translation `u`).
-    pub fn place_at(&mut self, u: [f64; 2]) {
+    /// Moves a projectile's points to translation `u` and rotation `theta` from its base.
+    pub fn place_at(&mut self, u: [f64; 2], theta: f64) {
         if let Some(p) = &self.projectile {
             for (x, b) in self.points.iter_mut().zip(&p.base) {
-                *x = [b[0] + u[0], b[1] + u[1]];
+                *x = p.placed(*b, u, theta);
             }
         }
     }
@@ -540,19 +520,18 @@ impl ContactPair {
                     normal: *normal,
                     masters: vec![(m, 1.0)],
                     weight: 1.0,
+                    lever: None,
                 }
             }
             Master::Segments {
                 edges, boundary, ..
             } => self.segment_gap((slave, xs), (&edges[..], &boundary[..]), x, grid)?,
             Master::Obstacle(o) => {
-                // a projectile carried by a node: the slave relative to it, the points at
-                // its base (module `Projectile`)
-                let carrier = o.projectile.as_ref().and_then(|p| p.carrier);
-                let xs = match carrier {
-                    Some(c) => sub(xs, x(c)),
-                    None => xs,
-                };
+                // a projectile carried by nodes: the slave in its base frame, where its
+                // points are (module `projectile`)
+                let frame = o.projectile.as_ref().and_then(|p| p.frame(x));
+                let world = xs;
+                let xs = frame.map_or(xs, |f| f.to_base(xs));
                 let segments = o.segments();
                 let inside = || {
                     if o.closed {
@@ -577,9 +556,10 @@ impl ContactPair {
                     gap_to_segments(xs, segments.len(), |k| segments[k], inside)?;
                 Gap {
                     gap,
-                    normal,
-                    masters: carrier.map(|c| vec![(c, 1.0)]).unwrap_or_default(),
+                    normal: frame.map_or(normal, |f| f.to_world(normal)),
+                    masters: frame.map(|f| vec![(f.carrier, 1.0)]).unwrap_or_default(),
                     weight: 1.0,
+                    lever: frame.and_then(|f| f.lever(world)),
                 }
             }
         };
@@ -678,6 +658,7 @@ impl ContactPair {
                 normal: corner_normal,
                 masters: vec![(end, 1.0)],
                 weight: 1.0,
+                lever: None,
             });
         }
         let normal = self.row_normal(edges, (a, b, xi), x);
@@ -690,6 +671,7 @@ impl ContactPair {
             normal,
             masters: vec![(a, 1.0 - xi), (b, xi)],
             weight: 1.0,
+            lever: None,
         })
     }
 

@@ -44,6 +44,7 @@ pub mod mortar;
 mod multipliers;
 pub mod own;
 pub mod penetration;
+pub mod projectile;
 pub mod search;
 pub mod setup;
 pub mod status;
@@ -170,6 +171,11 @@ pub fn placed(pairs: &[ContactPair], t: f64) -> std::borrow::Cow<'_, [ContactPai
 pub struct Flight {
     pub displacement: [f64; 2],
     pub velocity: [f64; 2],
+    /// The rotation theta about its centre and its rate (zero for one that translates only).
+    #[serde(default)]
+    pub rotation: f64,
+    #[serde(default)]
+    pub angular_velocity: f64,
 }
 
 impl ContactState {
@@ -182,8 +188,8 @@ impl ContactState {
                 && let Some(p) = &o.projectile
                 && let Some(flight) = self.flights.get(p.index)
             {
-                let u = flight.displacement;
-                o.place_at(u);
+                let (u, theta) = (flight.displacement, flight.rotation);
+                o.place_at(u, theta);
             }
         }
     }

@@ -67,6 +67,7 @@ pub fn weighted_gap(
         normal: w.normal,
         masters: w.masters,
         weight: w.share,
+        lever: None,
     })
 }
 
@@ -300,6 +301,7 @@ pub fn master_node_gap(
         normal,
         masters: vec![(a, 1.0 - xi), (b, xi)],
         weight: 1.0,
+        lever: None,
     })
 }
 

@@ -11,6 +11,7 @@ mod context;
 mod loads;
 mod materials;
 pub mod model;
+mod obstacles;
 pub mod overrides;
 mod probes;
 mod reference;

@@ -6,11 +6,12 @@
 use super::InputError;
 use super::analysis::analysis;
 use super::bodies::{add_node_set, bodies, initial_velocity};
-use super::contacts::{check_contact_setup, contacts, obstacles};
+use super::contacts::{check_contact_setup, contacts};
 use super::context::Context;
 use super::loads::{curves, default_curve, fixed_dofs, loads};
 use super::materials::materials;
 use super::model::{Analysis, Body, BodyKind, Load, Model, Probe, SceneSource};
+use super::obstacles::obstacles;
 use super::probes::{check_force_window, check_history_cadence, frame_times, probes};
 use super::reference::reference;
 use super::spec::{

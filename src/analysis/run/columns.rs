@@ -105,6 +105,17 @@ pub(super) fn columns(model: &Model) -> (Vec<String>, bool) {
             ]
             .map(|quantity| format!("{quantity}[{}]", obstacle.name)),
         );
+        // a rotating projectile's rotation about its centre and its rate
+        if obstacle
+            .projectile
+            .as_ref()
+            .is_some_and(|p| p.spin.is_some())
+        {
+            columns.extend(
+                ["obstacle_rotation", "obstacle_omega"]
+                    .map(|quantity| format!("{quantity}[{}]", obstacle.name)),
+            );
+        }
     }
     (columns, pivots_column)
 }

@@ -453,7 +453,7 @@ impl Recorder {
                 let flight = (o.projectile.as_ref())
                     .and_then(|p| contact.and_then(|c| c.flights.get(p.index)));
                 if let Some(f) = flight {
-                    o.place_at(f.displacement);
+                    o.place_at(f.displacement, f.rotation);
                 }
             }
             let frame = (listed.len(), state.time);
@@ -667,6 +667,10 @@ fn obstacle_values(model: &Model, state: &State, contact: Option<&ContactState>)
             }
         }
         values.extend([u[0], u[1], v[0], v[1], force[0], force[1]]);
+        if let Some(p) = obstacle.projectile.as_ref().filter(|p| p.spin.is_some()) {
+            let spin = p.spin.as_ref().map_or(0.0, |s| s.angular_velocity);
+            values.extend(flight.map_or([0.0, spin], |f| [f.rotation, f.angular_velocity]));
+        }
     }
     values
 }

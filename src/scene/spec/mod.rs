@@ -285,6 +285,12 @@ pub struct ProjectileSpec {
     pub mass: f64,
     #[serde(default)]
     pub velocity: [f64; 2],
+    /// The moment of inertia about `centre`; default none: the projectile translates only.
+    pub inertia: Option<f64>,
+    /// The angular velocity at t = 0 (rad per time, counter-clockwise); default 0.
+    pub angular_velocity: Option<f64>,
+    /// The centre of mass; default the centroid of a closed polygon.
+    pub centre: Option<[f64; 2]>,
 }
 
 /// An obstacle's prescribed translation: `displacement` times the curve (default: a ramp

@@ -587,6 +587,7 @@ mod tests {
             normal: [0.0, 1.0],
             masters: Vec::new(),
             weight: 1.0,
+            lever: None,
         };
         let sliding = Status::Slide(0.3);
         let next = |d: [f64; 2]| {
