@@ -182,15 +182,24 @@ impl ContactState {
     /// Places the obstacles of `pairs` where the run has them at time `t`: the prescribed
     /// ones by their motion, the projectiles at their flights' translations.
     pub fn place(&self, pairs: &mut [ContactPair], t: f64) {
-        place_obstacles(pairs, t);
         for pair in pairs {
-            if let Master::Obstacle(o) = &mut pair.master
-                && let Some(p) = &o.projectile
-                && let Some(flight) = self.flights.get(p.index)
-            {
-                let (u, theta) = (flight.displacement, flight.rotation);
-                o.place_at(u, theta);
+            if let Master::Obstacle(o) = &mut pair.master {
+                self.place_obstacle(o, t);
             }
+        }
+    }
+
+    /// Places obstacle `o` where the run has it at time `t` (see `place`).
+    pub fn place_obstacle(&self, o: &mut Obstacle, t: f64) {
+        o.place(t);
+        let flight = (o.projectile.as_ref()).and_then(|p| self.flights.get(p.index));
+        if let Some(&Flight {
+            displacement,
+            rotation,
+            ..
+        }) = flight
+        {
+            o.place_at(displacement, rotation);
         }
     }
 

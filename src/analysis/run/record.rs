@@ -449,11 +449,9 @@ impl Recorder {
         if let Some(listed) = self.obstacle_frames.as_mut() {
             let mut obstacles = model.obstacles.clone();
             for o in &mut obstacles {
-                o.place(state.time);
-                let flight = (o.projectile.as_ref())
-                    .and_then(|p| contact.and_then(|c| c.flights.get(p.index)));
-                if let Some(f) = flight {
-                    o.place_at(f.displacement, f.rotation);
+                match contact {
+                    Some(c) => c.place_obstacle(o, state.time),
+                    None => o.place(state.time),
                 }
             }
             let frame = (listed.len(), state.time);
