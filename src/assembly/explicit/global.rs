@@ -20,8 +20,8 @@
 //! two, the element step its safety net. Between two estimates the step follows the tight
 //! element maximum at the ratio last found (`lambda / max_e omega_e^2`); an estimate is taken
 //! again every `EVERY` steps and whenever that maximum has moved by more than the tight
-//! step's `DRIFT`. The product and the vector updates run in parallel, every sum in a fixed
-//! order (`Product`; the dot products serial): the estimate does not depend on the thread
+//! step's `DRIFT`. The product, the dot products and the vector updates run in parallel,
+//! every sum in a fixed order (`Product`, `dot`): the estimate does not depend on the thread
 //! count.
 
 use crate::solver::lanczos::{start_vector, tridiagonal_eigen};
@@ -240,8 +240,9 @@ impl Product<'_> {
 /// The largest Ritz value of at most `iterations` Lanczos steps on the symmetric operator
 /// `apply` from `start` (full reorthogonalization), its residual norm and its unit Ritz
 /// vector; the steps stop early once the residual is below `TOLERANCE` of the value. The
-/// vector updates run in parallel (each entry on its own: the bits of a serial loop); the
-/// dot products stay serial sums, whose order sets their bits.
+/// reorthogonalization is classical Gram-Schmidt twice; its dot products and vector updates
+/// run in parallel over blocks of `TASK` entries in a fixed order (`dot`, `dots`,
+/// `subtract`), so the bits do not depend on the thread count.
 pub fn lanczos(
     mut apply: impl FnMut(&[f64], &mut [f64]),
     start: Vec<f64>,
@@ -260,13 +261,11 @@ pub fn lanczos(
         let j = alpha.len();
         apply(&basis[j], &mut w);
         alpha.push(dot(&w, &basis[j]));
+        // classical Gram-Schmidt twice ("twice is enough": Giraud, Langou & Rozloznik 2005):
+        // all of a pass's coefficients in one sweep over the basis
         for _ in 0..2 {
-            for q in &basis {
-                let c = dot(&w, q);
-                (w.par_iter_mut().zip(q))
-                    .with_min_len(TASK)
-                    .for_each(|(w, q)| *w -= c * q);
-            }
+            let c = dots(&w, &basis);
+            subtract(&mut w, &c, &basis);
         }
         let b = dot(&w, &w).sqrt();
         beta.push(b);
@@ -281,9 +280,8 @@ pub fn lanczos(
     };
     let (theta, residual, s) = ritz;
     let mut vector = vec![0.0; n];
-    for (q, c) in basis.iter().zip(s.iter()) {
-        vector.iter_mut().zip(q).for_each(|(v, q)| *v += c * q);
-    }
+    let minus: Vec<f64> = s.iter().map(|c| -c).collect();
+    subtract(&mut vector, &minus, &basis);
     Some((theta, residual, vector))
 }
 
@@ -310,8 +308,55 @@ fn largest_ritz(alpha: &[f64], beta: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
     theta.is_finite().then_some((theta, residual, s))
 }
 
+/// a . b: each block of `TASK` entries summed on its own task ([`block_dot`]), the blocks'
+/// sums then in block order, so the bits do not depend on the thread count.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
+    let blocks: Vec<f64> = (a.par_chunks(TASK).zip(b.par_chunks(TASK)))
+        .map(|(a, b)| block_dot(a, b))
+        .collect();
+    blocks.iter().sum()
+}
+
+/// a . b over one block (b at least as long as a) in four interleaved sums, which do not wait
+/// on each other's additions as one running sum does.
+fn block_dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut sums = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b[..a.len()].chunks_exact(4));
+    let (a_rest, b_rest) = (a4.remainder(), b4.remainder());
+    for (a, b) in a4.zip(b4) {
+        for k in 0..4 {
+            sums[k] += a[k] * b[k];
+        }
+    }
+    let rest: f64 = a_rest.iter().zip(b_rest).map(|(a, b)| a * b).sum();
+    (sums[0] + sums[1]) + (sums[2] + sums[3]) + rest
+}
+
+/// q . w for every q of `basis`, in one sweep: the blocks as in [`dot`].
+fn dots(w: &[f64], basis: &[Vec<f64>]) -> Vec<f64> {
+    let blocks: Vec<Vec<f64>> = w
+        .par_chunks(TASK)
+        .enumerate()
+        .map(|(k, w)| {
+            let at = k * TASK;
+            basis.iter().map(|q| block_dot(w, &q[at..])).collect()
+        })
+        .collect();
+    let mut sums = vec![0.0; basis.len()];
+    for block in &blocks {
+        sums.iter_mut().zip(block).for_each(|(s, b)| *s += b);
+    }
+    sums
+}
+
+/// w -= sum_q c_q q, each entry taking the q in basis order.
+fn subtract(w: &mut [f64], c: &[f64], basis: &[Vec<f64>]) {
+    w.par_chunks_mut(TASK).enumerate().for_each(|(k, w)| {
+        let at = k * TASK;
+        for (c, q) in c.iter().zip(basis) {
+            w.iter_mut().zip(&q[at..]).for_each(|(w, q)| *w -= c * q);
+        }
+    });
 }
 
 #[cfg(test)]
