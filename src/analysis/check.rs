@@ -177,35 +177,7 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
         ));
     }
     let total: f64 = masses.iter().map(|m| m.mass).sum();
-    for o in &model.obstacles {
-        if let Some(p) = &o.projectile {
-            let v = p.velocity;
-            let (spin, rotation) = match &p.spin {
-                Some(s) => (
-                    0.5 * s.inertia * s.angular_velocity * s.angular_velocity,
-                    format!(
-                        "and rotates about its centre ({}, {}) with the moment of inertia {} \
-                         from an angular velocity {}",
-                        readable(s.centre[0]),
-                        readable(s.centre[1]),
-                        readable(s.inertia),
-                        readable(s.angular_velocity)
-                    ),
-                ),
-                None => (0.0, "without rotating".to_string()),
-            };
-            lines.push(format!(
-                "obstacle `{}`: a rigid projectile of mass {} ({} times the bodies'), velocity \
-                 ({}, {}), kinetic energy {}; it translates under the contact forces {rotation}",
-                o.name,
-                readable(p.mass),
-                readable(p.mass / total),
-                readable(v[0]),
-                readable(v[1]),
-                readable(0.5 * p.mass * (v[0] * v[0] + v[1] * v[1]) + spin)
-            ));
-        }
-    }
+    lines.extend(projectile_lines(model, total));
     if let crate::scene::model::Analysis::Dynamic(spec) = &model.analysis {
         // a central-difference run's start, formed once as the run forms it
         let start = match spec.integrator {
@@ -246,6 +218,42 @@ pub fn report(model: &Model) -> Result<Vec<String>, InputError> {
         }
     }
     Ok(lines)
+}
+
+/// A line for each rigid projectile: its mass against the bodies' `total`, its velocity and
+/// kinetic energy, and its rotation where it has one.
+fn projectile_lines(model: &Model, total: f64) -> Vec<String> {
+    let mut lines = Vec::new();
+    for o in &model.obstacles {
+        if let Some(p) = &o.projectile {
+            let v = p.velocity;
+            let (spin, rotation) = match &p.spin {
+                Some(s) => (
+                    0.5 * s.inertia * s.angular_velocity * s.angular_velocity,
+                    format!(
+                        "and rotates about its centre ({}, {}) with the moment of inertia {} \
+                         from an angular velocity {}",
+                        readable(s.centre[0]),
+                        readable(s.centre[1]),
+                        readable(s.inertia),
+                        readable(s.angular_velocity)
+                    ),
+                ),
+                None => (0.0, "without rotating".to_string()),
+            };
+            lines.push(format!(
+                "obstacle `{}`: a rigid projectile of mass {} ({} times the bodies'), velocity \
+                 ({}, {}), kinetic energy {}; it translates under the contact forces {rotation}",
+                o.name,
+                readable(p.mass),
+                readable(p.mass / total),
+                readable(v[0]),
+                readable(v[1]),
+                readable(0.5 * p.mass * (v[0] * v[0] + v[1] * v[1]) + spin)
+            ));
+        }
+    }
+    lines
 }
 
 /// `impact check`'s line on the ALE steps: how often, by which smoother, and per body the nodes

@@ -27,6 +27,7 @@ pub struct Projectile {
     pub velocity: [f64; 2],
     /// The rotation, when the scene gives a moment of inertia (None: it translates only).
     pub spin: Option<Spin>,
+    /// The points at t = 0, from which a translation and a turn place them (`place_at`).
     pub base: Vec<[f64; 2]>,
     /// The node whose position is u_R in the explicit driver's vectors; None outside it
     /// (the points are placed instead, `Obstacle::place_at`).
