@@ -30,11 +30,12 @@ impl Moments {
 
 /// The moments of the polygon `points` (counter-clockwise: positive volume), weighted by the
 /// radius x when `axisymmetric`.
-pub fn moments<const N: usize>(points: &[[f64; 2]; N], axisymmetric: bool) -> Moments {
+pub fn moments(points: &[[f64; 2]], axisymmetric: bool) -> Moments {
+    let n = points.len();
     let mut m = Moments::default();
-    for i in 0..N {
+    for i in 0..n {
         let [x0, y0] = points[i];
-        let [x1, y1] = points[(i + 1) % N];
+        let [x1, y1] = points[(i + 1) % n];
         let c = x0 * y1 - x1 * y0;
         if axisymmetric {
             m.volume += (x0 + x1) * c / 6.0;

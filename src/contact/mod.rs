@@ -155,17 +155,6 @@ pub fn place_obstacles(pairs: &mut [ContactPair], t: f64) {
     }
 }
 
-/// `pairs` with their moving obstacles at time `t`: the pairs themselves where none moves.
-/// A projectile stays at its base: `ContactState::placed` places it where the run has it.
-pub fn placed(pairs: &[ContactPair], t: f64) -> std::borrow::Cow<'_, [ContactPair]> {
-    if !obstacles_move(pairs) {
-        return std::borrow::Cow::Borrowed(pairs);
-    }
-    let mut moved = pairs.to_vec();
-    place_obstacles(&mut moved, t);
-    std::borrow::Cow::Owned(moved)
-}
-
 /// Where a projectile is (`geometry::Projectile`): its translation u_R and its velocity.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Flight {
@@ -218,15 +207,17 @@ impl ContactState {
         std::borrow::Cow::Owned(moved)
     }
 
-    /// The velocity of the obstacle of `pair` at time `t` (zero for one at rest).
-    pub fn obstacle_velocity(&self, pair: &ContactPair, t: f64) -> [f64; 2] {
-        match &pair.master {
-            Master::Obstacle(o) => match (&o.motion, &o.projectile) {
-                (Some(m), _) => m.velocity(t),
-                (None, Some(p)) => self.flights.get(p.index).map_or(p.velocity, |f| f.velocity),
-                (None, None) => [0.0; 2],
-            },
-            _ => [0.0; 2],
+    /// The translation and velocity of obstacle `o` at time `t`: prescribed by its motion, a
+    /// projectile's where the run has it (its start before a step has tracked it), zero for
+    /// one at rest.
+    pub fn obstacle_motion(&self, o: &Obstacle, t: f64) -> ([f64; 2], [f64; 2]) {
+        match (&o.motion, &o.projectile) {
+            (Some(m), _) => (m.at(t), m.velocity(t)),
+            (None, Some(p)) => self
+                .flights
+                .get(p.index)
+                .map_or(([0.0; 2], p.velocity), |f| (f.displacement, f.velocity)),
+            (None, None) => ([0.0; 2], [0.0; 2]),
         }
     }
 }

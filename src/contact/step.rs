@@ -11,10 +11,10 @@
 //! fell below `release_fraction` of the last step's are released; dynamics then applies the
 //! impact and release conditions (`impacts`).
 
+use super::Interfaces;
 use super::geometry::{ContactPair, Friction};
 use super::search;
 use super::status::ContactState;
-use super::{Interfaces, placed};
 
 /// The shortest fraction of a step an event split may leave: an event closer to the step
 /// start than this closes in the full step (Hughes II-7) instead.
@@ -262,7 +262,7 @@ impl ContactState {
         length: f64,
         mut solve: impl FnMut(Pass<'_>) -> Result<S, E>,
     ) -> Result<ContactResult<S>, E> {
-        let at_start = placed(pairs, time);
+        let at_start = self.placed(pairs, time);
         let (mut entries, mut forces) = self.entries();
         let mut slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(pairs, *e)).collect();
         let mut returned = false;
@@ -276,7 +276,7 @@ impl ContactState {
                 .collect();
             let carried = carried_slips(&at_start, &entries, start, (time, length));
             let tangential = tangential_conditions(&slips, &carried);
-            let at_end = placed(pairs, time + length);
+            let at_end = self.placed(pairs, time + length);
             let pairs = &at_end[..];
             let solution = solve(Pass {
                 pairs,
@@ -377,7 +377,7 @@ impl ContactState {
         length: f64,
         mut solve: impl FnMut(Pass<'_>) -> Result<S, E>,
     ) -> Result<ContactResult<S>, E> {
-        let at_start = placed(pairs, time);
+        let at_start = self.placed(pairs, time);
         let (entries, forces) = self.entries();
         let slips: Vec<Slip> = entries.iter().map(|e| self.slip_start(pairs, *e)).collect();
         let nodes: Vec<(usize, usize)> = entries
@@ -391,7 +391,7 @@ impl ContactState {
         let mut inside = Inside::Releases;
         let mut warm: Option<Vec<f64>> = None;
         loop {
-            let at_end = placed(pairs, time + length);
+            let at_end = self.placed(pairs, time + length);
             let pairs = &at_end[..];
             let solution = solve(Pass {
                 pairs,

@@ -174,7 +174,7 @@ fn spin(
             finite(cx, &format!("{key}.centre"), &c)?;
             c
         }
-        (None, true) => centroid(points),
+        (None, true) => crate::ale::geometry::moments(points, false).centroid(),
         (None, false) => {
             return Err(cx.err(format!(
                 "{key}.centre: a rotating projectile on an open polyline needs its centre of \
@@ -188,18 +188,4 @@ fn spin(
         centre,
         node: None,
     }))
-}
-
-/// The area centroid of a closed polygon (either orientation).
-fn centroid(points: &[[f64; 2]]) -> [f64; 2] {
-    let n = points.len();
-    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
-    for i in 0..n {
-        let (p, q) = (points[i], points[(i + 1) % n]);
-        let cross = p[0] * q[1] - q[0] * p[1];
-        a += cross;
-        cx += (p[0] + q[0]) * cross;
-        cy += (p[1] + q[1]) * cross;
-    }
-    [cx / (3.0 * a), cy / (3.0 * a)]
 }

@@ -388,7 +388,7 @@ fn approach(
     let slave = centre(pair.slave_body);
     let master = match &pair.master {
         Master::Segments { body, .. } | Master::Nodes { body, .. } => centre(*body),
-        Master::Obstacle(_) => contact.obstacle_velocity(pair, t),
+        Master::Obstacle(o) => contact.obstacle_motion(o, t).1,
     };
     let n = nearest.normal;
     // the master's normal points out of it, towards the slave: approaching is -(v_s - v_m).n

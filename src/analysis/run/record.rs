@@ -410,11 +410,11 @@ impl Recorder {
             }
             None => (vec![0.0; 2 * n], vec![0.0; n], vec![0.0; n]),
         };
+        // the obstacles where the run has them (a run without contact: their motions alone)
+        let at_rest = ContactState::new(&[]);
+        let placing = contact.unwrap_or(&at_rest);
         if let Some(interfaces) = self.interfaces.as_mut() {
-            match contact {
-                Some(c) => c.place(&mut interfaces.pairs, state.time),
-                None => interfaces.place_obstacles(state.time),
-            }
+            placing.place(&mut interfaces.pairs, state.time);
         }
         let tractions = contact
             .zip(self.interfaces.as_ref())
@@ -449,10 +449,7 @@ impl Recorder {
         if let Some(listed) = self.obstacle_frames.as_mut() {
             let mut obstacles = model.obstacles.clone();
             for o in &mut obstacles {
-                match contact {
-                    Some(c) => c.place_obstacle(o, state.time),
-                    None => o.place(state.time),
-                }
+                placing.place_obstacle(o, state.time);
             }
             let frame = (listed.len(), state.time);
             let options = (model.output.compression, listed);
@@ -641,21 +638,7 @@ fn obstacle_values(model: &Model, state: &State, contact: Option<&ContactState>)
     let pairs = c.placed(&model.contacts, state.time);
     let positions = state.positions(model.analysis.geometry());
     for obstacle in super::columns::moving_obstacles(model) {
-        let flight = obstacle
-            .projectile
-            .as_ref()
-            .and_then(|p| c.flights.get(p.index));
-        let (u, v) = match (&obstacle.motion, flight) {
-            (Some(m), _) => (m.at(state.time), m.velocity(state.time)),
-            (None, Some(f)) => (f.displacement, f.velocity),
-            (None, None) => (
-                [0.0; 2],
-                obstacle
-                    .projectile
-                    .as_ref()
-                    .map_or([0.0; 2], |p| p.velocity),
-            ),
-        };
+        let (u, v) = c.obstacle_motion(obstacle, state.time);
         let mut force = [0.0; 2];
         if let Some(c) = contact {
             let against = |p: &ContactPair| matches!(&p.master, Master::Obstacle(o) if o.name == obstacle.name);
@@ -665,9 +648,13 @@ fn obstacle_values(model: &Model, state: &State, contact: Option<&ContactState>)
             }
         }
         values.extend([u[0], u[1], v[0], v[1], force[0], force[1]]);
-        if let Some(p) = obstacle.projectile.as_ref().filter(|p| p.spin.is_some()) {
-            let spin = p.spin.as_ref().map_or(0.0, |s| s.angular_velocity);
-            values.extend(flight.map_or([0.0, spin], |f| [f.rotation, f.angular_velocity]));
+        if let Some(p) = obstacle.projectile.as_ref()
+            && let Some(spin) = &p.spin
+        {
+            let flight = c.flights.get(p.index);
+            values.extend(flight.map_or([0.0, spin.angular_velocity], |f| {
+                [f.rotation, f.angular_velocity]
+            }));
         }
     }
     values

@@ -15,7 +15,6 @@
 
 use crate::contact::{Flight, Interfaces, Master, Projectile};
 use crate::scene::Model;
-use crate::scene::model::BodyKind;
 use std::borrow::Cow;
 
 /// The model's projectiles, in the order of their index (`Projectile::index`).
@@ -52,15 +51,7 @@ impl Carriers {
             });
             node += if spin.is_some() { 2 } else { 1 };
         }
-        let axisymmetric = model.bodies.iter().any(|b| {
-            matches!(
-                b.kind,
-                BodyKind::Continuum {
-                    formulation: crate::element::Formulation::Axisymmetric,
-                    ..
-                }
-            )
-        });
+        let axisymmetric = model.bodies.iter().any(|b| b.is_axisymmetric());
         Carriers { list, axisymmetric }
     }
 
