@@ -416,10 +416,11 @@ set = "end"
 /// of t / R = 0.1 left out. Measured: the peak 1.035 P at a deflection of 0.043 R, falling to
 /// 0.991 P at 0.1 R; the peak moves to 1.029 and 1.014 P at 8 x 80 and 8 x 160 elements (the
 /// 2x2 element's bending stiffness on a wall of four: the column study of validation 5.1), so
-/// the band is 5 %. No step cut (asserted), 7.92 Newton iterations an increment (at most 10
-/// asserted). The same on 8 x 80 (8.55 an increment, peak 1.029 P): before the static
-/// Newton's line search (newton/line_search.rs) that ring cut its increment 4 times, which
-/// the no-cut assertion catches.
+/// the band is 5 %. No step cut (asserted), 4.2 Newton iterations an increment with the
+/// extrapolated start (theory 5a; 7.95 from zero starts); at most 8 asserted, the issue's
+/// figure for static runs. The same on 8 x 80 (4.4 an increment, 8.55 from zero starts, peak
+/// 1.029 P): before the static Newton's line search (newton/line_search.rs) that ring cut its
+/// increment 4 times, which the no-cut assertion catches.
 #[test]
 fn a_thick_ring_is_crushed_past_its_hinge_load_with_the_defaults() {
     for (name, overrides) in [
@@ -439,7 +440,7 @@ fn crush_ring(name: &str, overrides: &[&str]) {
     assert_eq!(summary.step_cuts, 0, "{name}");
     let iterations = summary.newton_iterations as f64 / summary.steps as f64;
     assert!(
-        iterations <= 10.0,
+        iterations <= 8.0,
         "{name}: {iterations} iterations an increment"
     );
     let (sigma_y, t, radius) = (250e6, 0.01, 0.1);
@@ -483,10 +484,13 @@ fn punch_pressure(dir: &std::path::Path) -> Vec<f64> {
 /// circular punch; in his Haar-von Karman state von Mises' k is Y / 2 (docs/validation.md
 /// 2.9). Measured peaks 5.591, 5.781, 5.731 k (-1.7, +1.6, +0.7 %: the mesh error
 /// oscillates as the edge nodes slide off the punch one by one, a drop of about h / a each);
-/// the band, 3 %, asserted on each. No step cut (asserted), 8.1 to 9.7 iterations an
-/// increment (at most 10 asserted). With the defaults (finite strain) the pressure follows
-/// the small-displacement one to 0.3 % up to 0.01 a of travel (1 % asserted) and then keeps
-/// rising as the punch sinks.
+/// the band, 3 %, asserted on each. No step cut (asserted); 4.4, 5.2 and 6.5
+/// iterations an increment, each increment started from the last one's increment scaled
+/// (`analysis.newton.extrapolate`, theory 5a); at most 8 asserted, the figure, which
+/// levels 1 and 2 miss from zero starts (8.6 and 10.0, `extrapolate = false`). With the
+/// defaults (finite strain) the pressure follows the small-displacement one to 0.3 % up to
+/// 0.01 a of travel (1 % asserted) and then keeps rising as the punch sinks. A dynamic
+/// analysis refuses `extrapolate` (its steps start from the integrator's prediction).
 #[test]
 fn shields_punch_reaches_its_limit_pressure() {
     let runs: Vec<_> = std::thread::scope(|s| {
@@ -506,7 +510,7 @@ fn shields_punch_reaches_its_limit_pressure() {
         assert_eq!(run.summary.step_cuts, 0, "level {level}");
         let iterations = run.summary.newton_iterations as f64 / run.summary.steps as f64;
         assert!(
-            iterations <= 10.0,
+            iterations <= 8.0,
             "level {level}: {iterations} an increment"
         );
         let peak = punch_pressure(&run.dir)
@@ -517,6 +521,11 @@ fn shields_punch_reaches_its_limit_pressure() {
             "level {level}: peak {peak} k"
         );
     }
+    common::check_refuses(&[(
+        "models/strip_wall.toml",
+        "analysis.newton.extrapolate=true",
+        "analysis.newton.extrapolate: does not apply to a dynamic analysis",
+    )]);
     let shipped = common::run_scene("shield_punch_defaults", "shield_punch", &[]);
     assert_eq!(shipped.summary.status, Status::Ok);
     assert_eq!(shipped.summary.step_cuts, 0);

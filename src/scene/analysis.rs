@@ -152,6 +152,12 @@ fn dynamic(cx: &Context, spec: &AnalysisSpec, rods: bool) -> Result<DynamicAnaly
              static equilibrium path)",
         ));
     }
+    if spec.newton.extrapolate.is_some() {
+        return Err(cx.err(
+            "analysis.newton.extrapolate: does not apply to a dynamic analysis (a time step \
+             starts from its integrator's prediction)",
+        ));
+    }
     let end_time = positive(
         cx,
         "analysis.end_time",

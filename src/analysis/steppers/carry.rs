@@ -26,6 +26,8 @@ pub struct StaticCarry {
     pub control: StepControl,
     pub increments: usize,
     pub contact: ContactState,
+    /// The last increment's displacement increment and length (the next one's start).
+    pub previous: Option<(Vec<f64>, f64)>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -18,7 +18,7 @@ use super::energies::{Energies, Motion};
 use super::newton::{Constraints, Counters, Step, StepFailure};
 use super::{About, Report, Resume, StepError, Stepper, loads};
 use crate::assembly::{self, State, System};
-use crate::contact::{ContactState, Interfaces, Pass};
+use crate::contact::{ContactResult, ContactState, Interfaces, Pass};
 use crate::integrator::StepForm;
 use crate::output::readable;
 use crate::scene::Model;
@@ -65,6 +65,9 @@ pub struct Statics<'a> {
     /// how far the path has flattened, for the message of a run that stops at a limit load.
     first_rate: Option<f64>,
     last_rate: f64,
+    /// The last increment's displacement increment and length, from which the next one
+    /// starts (`NewtonSpec::extrapolates`).
+    previous: Option<(Vec<f64>, f64)>,
 }
 
 impl<'a> Statics<'a> {
@@ -90,6 +93,7 @@ impl<'a> Statics<'a> {
             last_step: 0.0,
             first_rate: None,
             last_rate: 0.0,
+            previous: None,
             system,
             solver,
         })
@@ -107,6 +111,8 @@ struct Increment<'s> {
     positions: &'s [[f64; 2]],
     target: f64,
     factor_first: bool,
+    /// The last increment's displacement increment and length, to start from.
+    previous: Option<(&'s [f64], f64)>,
 }
 
 impl Increment<'_> {
@@ -133,8 +139,20 @@ impl Increment<'_> {
         } else {
             state.time + h
         };
-        // zero, or the increment the last active set converged to
-        let mut d = warm.map_or_else(|| vec![0.0; model.dofs()], <[f64]>::to_vec);
+        // the increment the last active set converged to, or the last increment's scaled to
+        // this one's length (linear extrapolation), or zero
+        let mut d = match (warm, self.previous) {
+            (Some(warm), _) => warm.to_vec(),
+            (None, Some((last, length))) => {
+                let scale = (end - state.time) / length;
+                let free = |dof: usize| system.equation[dof].is_some();
+                last.iter()
+                    .enumerate()
+                    .map(|(dof, v)| if free(dof) { scale * v } else { 0.0 })
+                    .collect()
+            }
+            (None, None) => vec![0.0; model.dofs()],
+        };
         for (dof, value) in loads::prescribed(model, self.initial, end) {
             d[dof] = value - state.displacement[dof];
         }
@@ -171,6 +189,39 @@ impl Increment<'_> {
 const FLATTENED: f64 = 10.0;
 
 impl Statics<'_> {
+    /// Takes the converged increment `step` of an increment aimed at `target` (shorter where
+    /// a contact event ended it): the state, the contact status, the energies and the start
+    /// of the next increment.
+    fn commit(&mut self, mut step: ContactResult<super::newton::Solution>, target: f64) {
+        let geometry = self.spec.geometry;
+        let end = if self.state.time + step.length >= target {
+            target
+        } else {
+            self.state.time + step.length
+        };
+        let d = std::mem::take(&mut step.solution.d);
+        self.previous = Some((d.clone(), end - self.state.time));
+        let evaluation = std::mem::take(&mut step.solution.evaluation);
+        let force = evaluation.force.clone();
+        assembly::commit(self.model, &mut self.state, &d, evaluation, geometry);
+        self.last_step = end - self.state.time;
+        self.last_rate = d.iter().map(|v| v * v).sum::<f64>().sqrt() / self.last_step;
+        self.first_rate.get_or_insert(self.last_rate);
+        self.state.time = end;
+        let positions = self.state.positions(geometry);
+        self.interfaces.place_obstacles(self.state.time);
+        self.contact
+            .commit(&self.interfaces, &step, self.state.time, &positions);
+        // the work of all nodal forces (loads, reactions and contact forces)
+        let energies = &mut self.energies;
+        energies.external_work += super::trapezoid_work(&d, &force, &self.last_force);
+        energies.internal = self.state.internal_work - self.state.plastic_work;
+        energies.plastic_work = self.state.plastic_work;
+        self.last_force = force;
+        self.increments += 1;
+        self.control.accept_patiently(end == target);
+    }
+
     /// Where the path had flattened (`FLATTENED`) under loads, the limit load as the likely
     /// cause, and how to pass it; empty otherwise.
     fn limit_hint(&self) -> String {
@@ -202,6 +253,9 @@ impl Stepper for Statics<'_> {
     }
 
     fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError> {
+        // an increment that ran out of iterations from the extrapolated start is tried again
+        // from zero before it is cut
+        let mut from_zero = false;
         loop {
             let spec = self.spec;
             let target = snap(
@@ -211,6 +265,7 @@ impl Stepper for Statics<'_> {
             let positions = self.state.positions(spec.geometry).into_owned();
             let refresh_now = std::mem::take(&mut self.refresh);
             let factor_first = refresh_now
+                || from_zero
                 || match spec.newton.strategy {
                     Strategy::Full => true,
                     Strategy::Modified => {
@@ -231,7 +286,14 @@ impl Stepper for Statics<'_> {
                 positions: &positions,
                 target,
                 factor_first,
+                previous: self
+                    .previous
+                    .as_ref()
+                    .filter(|_| spec.newton.extrapolates() && !from_zero)
+                    .filter(|_| !self.control.after_cut())
+                    .map(|(d, h)| (&d[..], *h)),
             };
+            let extrapolated = increment.previous.is_some();
             let (system, solver) = (&mut self.system, &mut self.solver);
             let solve = |pass: Pass<'_>| increment.attempt(pass, system, solver, counters);
             let pairs = (&self.model.contacts[..], self.state.time);
@@ -242,33 +304,18 @@ impl Stepper for Statics<'_> {
                 self.contact.step(pairs, &positions, length, solve)
             };
             match outcome {
-                Ok(mut step) => {
-                    let end = if self.state.time + step.length >= target {
-                        target
-                    } else {
-                        self.state.time + step.length
-                    };
-                    let d = std::mem::take(&mut step.solution.d);
-                    let evaluation = std::mem::take(&mut step.solution.evaluation);
-                    let force = evaluation.force.clone();
-                    assembly::commit(self.model, &mut self.state, &d, evaluation, spec.geometry);
-                    self.last_step = end - self.state.time;
-                    self.last_rate = d.iter().map(|v| v * v).sum::<f64>().sqrt() / self.last_step;
-                    self.first_rate.get_or_insert(self.last_rate);
-                    self.state.time = end;
-                    let positions = self.state.positions(spec.geometry);
-                    self.interfaces.place_obstacles(self.state.time);
-                    self.contact
-                        .commit(&self.interfaces, &step, self.state.time, &positions);
-                    // the work of all nodal forces (loads, reactions and contact forces)
-                    let energies = &mut self.energies;
-                    energies.external_work += super::trapezoid_work(&d, &force, &self.last_force);
-                    energies.internal = self.state.internal_work - self.state.plastic_work;
-                    energies.plastic_work = self.state.plastic_work;
-                    self.last_force = force;
-                    self.increments += 1;
-                    self.control.accept_patiently(end == target);
+                Ok(step) => {
+                    self.commit(step, target);
                     return Ok(());
+                }
+                // (not after an inverted element: on the finest finite-strain punch, the
+                // retry from zero failed there too, and cut more often than the cut alone)
+                Err(failure) if extrapolated && failure.ran_out() => {
+                    crate::output::console::iteration(format_args!(
+                        "  newton: {} from the extrapolated start: the increment again from zero",
+                        failure.0
+                    ));
+                    from_zero = true;
                 }
                 Err(StepFailure(reason)) => {
                     if let Err(why) = self.control.reject(target - self.state.time, counters) {
@@ -338,6 +385,7 @@ impl Resume for Statics<'_> {
         self.control = carry.control;
         self.increments = carry.increments;
         self.contact = carry.contact;
+        self.previous = carry.previous;
         true
     }
 
@@ -349,6 +397,7 @@ impl Resume for Statics<'_> {
             control: self.control.clone(),
             increments: self.increments,
             contact: self.contact.clone(),
+            previous: self.previous.clone(),
         }))
     }
 

@@ -514,6 +514,14 @@ pub struct NewtonSpec {
     /// pair (contact between two bodies), `passes` otherwise.
     #[serde(default)]
     pub active_set: Option<ActiveSetSolve>,
+    /// Statics: each increment starts from the last one's displacement increment, scaled to
+    /// its length (linear extrapolation, Abaqus/Standard's default), instead of from zero
+    /// with the tangent predictor; an increment that does not converge from there is tried
+    /// again from zero before it is cut (docs/theory.md 5a). Default true, false with
+    /// `strategy = "initial"` (the seeds' algorithm starts each increment from the
+    /// converged state).
+    #[serde(default)]
+    pub extrapolate: Option<bool>,
 }
 
 /// See [`NewtonSpec::active_set`].
@@ -539,7 +547,16 @@ impl Default for NewtonSpec {
             updates: Updates::default(),
             refactor_every: None,
             active_set: None,
+            extrapolate: None,
         }
+    }
+}
+
+impl NewtonSpec {
+    /// Whether a static increment starts from the last one's, scaled (`extrapolate`).
+    pub fn extrapolates(&self) -> bool {
+        self.extrapolate
+            .unwrap_or(self.strategy != Strategy::Initial)
     }
 }
 

@@ -70,6 +70,17 @@ pub(super) fn free_dof(model: &Model, system: &System, index: usize) -> String {
 #[derive(Debug, Clone)]
 pub struct StepFailure(pub String);
 
+/// How the message of an iteration that ran out of iterations begins.
+const NOT_CONVERGED: &str = "no convergence in";
+
+impl StepFailure {
+    /// Whether the iteration ran out of iterations (rather than meeting an inverted element,
+    /// a singular matrix or a non-finite residual).
+    pub fn ran_out(&self) -> bool {
+        self.0.starts_with(NOT_CONVERGED)
+    }
+}
+
 impl From<Unsettled> for StepFailure {
     fn from(e: Unsettled) -> StepFailure {
         StepFailure(e.to_string())
@@ -544,7 +555,7 @@ impl Step<'_> {
             last = own.map(|r| (delta, r));
         }
         Err(StepFailure(format!(
-            "no convergence in {} iterations",
+            "{NOT_CONVERGED} {} iterations",
             newton.max_iterations
         )))
     }
