@@ -370,8 +370,11 @@ fn run(
         }
     };
     if !quiet {
+        let median = summary
+            .newton_iterations_median
+            .map_or(String::new(), |m| format!(" (median {m} a step)"));
         outln!(
-            "{}: {}, {}, {}, t = {}, {:.2} s -> {}",
+            "{}: {}, {}{median}, {}, t = {}, {:.2} s -> {}",
             model.name,
             count(summary.steps, "step"),
             count(summary.newton_iterations, "Newton iteration"),

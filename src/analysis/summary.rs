@@ -320,6 +320,14 @@ pub struct Summary {
     pub free_dofs: usize,
     pub wall_seconds: f64,
     pub newton_iterations: usize,
+    /// The implicit and static paths: the median of the Newton iterations a converged step
+    /// (increment) took, its cut attempts' and contact passes' included; null in explicit
+    /// runs.
+    #[serde(default)]
+    pub newton_iterations_median: Option<f64>,
+    /// The most Newton iterations a converged step took (as the median counts them).
+    #[serde(default)]
+    pub newton_iterations_max: Option<usize>,
     pub factorizations: usize,
     pub back_substitutions: usize,
     pub step_cuts: usize,
@@ -416,6 +424,8 @@ impl Summary {
             free_dofs,
             wall_seconds: 0.0,
             newton_iterations: 0,
+            newton_iterations_median: None,
+            newton_iterations_max: None,
             factorizations: 0,
             back_substitutions: 0,
             step_cuts: 0,

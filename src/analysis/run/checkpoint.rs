@@ -14,6 +14,7 @@
 //! resumed one alike, so both take the same path (one extra factorization per checkpoint).
 
 use super::record::RecorderPosition;
+use super::tally::StepIterations;
 use crate::analysis::steppers::carry::Carry;
 use crate::analysis::steppers::newton::Counters;
 use crate::analysis::summary::{BucklingSummary, Summary};
@@ -49,7 +50,9 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 18: the first slave past an obstacle's end and the time of the peak force in the contact
 ///     record and the summary.
 /// 19: the step ratios a subcycled run's levels were graded with in its carry.
-const FORMAT: u32 = 19;
+/// 20: the last increment, the next one's start, in the static carry; the Newton iterations
+///     of each step, tallied.
+const FORMAT: u32 = 20;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -60,6 +63,7 @@ pub struct Checkpoint {
     /// The summary so far (steps, drift, counters are filled from `counters` at the end).
     pub summary: Summary,
     pub counters: Counters,
+    pub step_iterations: StepIterations,
     pub factorizations: usize,
     pub back_substitutions: usize,
     pub wall_seconds: f64,

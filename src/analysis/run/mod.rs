@@ -26,6 +26,7 @@ mod frame;
 mod probes;
 pub mod progress;
 pub mod record;
+pub mod tally;
 
 use super::plausibility;
 use super::steppers::Stepper;
@@ -45,6 +46,7 @@ use record::{Recorder, Snapshot};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
+use tally::StepIterations;
 
 /// Options of a run that are not part of the scene.
 #[derive(Debug, Clone, Copy, Default)]
@@ -103,6 +105,7 @@ struct Run<'a, S: Stepper> {
     recorder: Recorder,
     summary: Summary,
     counters: Counters,
+    step_iterations: StepIterations,
     monitor: Option<Monitor>,
     start: Instant,
     progress: Progress,
@@ -184,6 +187,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             recorder,
             summary,
             counters: Counters::default(),
+            step_iterations: StepIterations::default(),
             monitor,
             start,
             progress: Progress::new(
@@ -232,6 +236,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         }
         self.summary = checkpoint.summary;
         self.counters = checkpoint.counters;
+        self.step_iterations = checkpoint.step_iterations;
         if let Some(solver) = self.stepper.solver_mut() {
             solver.factorizations = checkpoint.factorizations;
             solver.solves = checkpoint.back_substitutions;
@@ -245,9 +250,12 @@ impl<'a, S: Stepper> Run<'a, S> {
 
     /// One step and its bookkeeping, and whether the run goes on.
     fn step(&mut self) -> Result<Next, RunError> {
+        let before = self.counters.iterations;
         if let Err(e) = self.stepper.advance(&mut self.counters) {
             return Err(self.fail_step(e));
         }
+        self.step_iterations
+            .record(self.counters.iterations - before);
         self.summary.steps += 1;
         let gain = relative_gain(self.stepper.energies(), self.stepper.initial_kinetic());
         let energy = &mut self.summary.energy;
@@ -416,6 +424,7 @@ impl<'a, S: Stepper> Run<'a, S> {
             source: self.model.source.clone(),
             summary: self.summary.clone(),
             counters: self.counters,
+            step_iterations: self.step_iterations.clone(),
             factorizations: solver.map_or(0, |s| s.factorizations),
             back_substitutions: solver.map_or(0, |s| s.solves),
             wall_seconds: self.start.elapsed().as_secs_f64(),
@@ -444,6 +453,8 @@ impl<'a, S: Stepper> Run<'a, S> {
         let (row, run) = (s.row_features(), s.run_features());
         let summary = &mut self.summary;
         summary.newton_iterations = self.counters.iterations;
+        summary.newton_iterations_median = self.step_iterations.median();
+        summary.newton_iterations_max = self.step_iterations.max();
         summary.step_cuts = self.counters.cuts;
         summary.rejected_steps = self.counters.rejected;
         summary.max_error_estimate = row.error_watch.map(|w| w.largest);
