@@ -196,62 +196,26 @@ fn houbolt_modified_newton_resume_is_bit_identical() {
     assert_same_output(&full, &resumed, name);
 }
 
-/// A J2 block compressed between rollers in 20 static increments at finite strain, a
-/// checkpoint every 5, frames every 2.
-const STATIC_BLOCK: &str = r#"
-title = "J2 block compressed between rollers"
-
-[[material]]
-name = "al"
-young = 70e9
-poisson = 0.3
-density = 2700
-yield_stress = 100e6
-hardening_modulus = 500e6
-
-[[body]]
-name = "block"
-material = "al"
-formulation = "plane_strain"
-mesh = { type = "rectangle", width = 0.01, height = 0.01, nx = 10, ny = 10 }
-
-[[support]]
-set = "bottom"
-fix = ["y"]
-
-[[support]]
-set = "left"
-fix = ["x"]
-
-[[load]]
-type = "displacement"
-set = "top"
-y = -0.002
-
-[analysis]
-type = "static"
-steps = 20
-checkpoint_every = 5
-
-[output]
-frame_every = 2
-
-[[output.probe]]
-quantity = "reaction_y"
-set = "top"
-"#;
-
 /// Goal: a static run resumes bit-identically, its next increment starting where the run
-/// straight through starts it (from the last increment, scaled: theory 5a). Setup:
-/// STATIC_BLOCK halted at increment 13 (checkpoint at 10). Reference: the uninterrupted run;
+/// straight through starts it (from the last increment, scaled: theory 5a). Setup: the J2
+/// block compressed between rollers (`common::J2_BLOCK_ON_ROLLERS`, 20 increments at finite
+/// strain) on 10 x 10 elements, a checkpoint every 5 increments and a frame every 2, halted
+/// at increment 13. Reference: the uninterrupted run;
 /// a checkpoint without the last increment would start increment 11 from zero and take other
 /// iterates (summary.json's Newton counts and history.csv's last bits would differ).
 #[test]
 fn static_resume_is_bit_identical() {
     let name = "static_block";
-    let full = run_full(name, STATIC_BLOCK, &[]);
+    let text = common::J2_BLOCK_ON_ROLLERS;
+    let set = [
+        "body.block.mesh.nx=10",
+        "body.block.mesh.ny=10",
+        "analysis.checkpoint_every=5",
+        "output.frame_every=2",
+    ];
+    let full = run_full(name, text, &set);
     assert!(common::column(&full, "plastic_work").last().unwrap() > &0.0);
-    let resumed = run_killed_and_resumed(name, STATIC_BLOCK, &[], 13);
+    let resumed = run_killed_and_resumed(name, text, &set, 13);
     assert_same_output(&full, &resumed, name);
 }
 

@@ -5,50 +5,7 @@ mod common;
 
 use impact::analysis::{self, RunOptions, Status};
 
-/// A 10 x 10 mm plane-strain J2 block (E 70 GPa, nu 0.3, sigma_y 100 MPa, H 500 MPa) on
-/// rollers at its bottom and left edges, its top pushed down by a prescribed displacement:
-/// a homogeneous plane-strain compression (sigma_xx = 0, eps_zz = 0).
-const BLOCK: &str = r#"
-title = "homogeneous J2 compression between rollers"
-
-[[material]]
-name = "al"
-young = 70e9
-poisson = 0.3
-density = 2700
-yield_stress = 100e6
-hardening_modulus = 500e6
-
-[[body]]
-name = "block"
-material = "al"
-formulation = "plane_strain"
-mesh = { type = "rectangle", width = 0.01, height = 0.01, nx = 20, ny = 20 }
-
-[[support]]
-set = "bottom"
-fix = ["y"]
-
-[[support]]
-set = "left"
-fix = ["x"]
-
-[[load]]
-type = "displacement"
-set = "top"
-y = -0.002
-
-[analysis]
-type = "static"
-steps = 20
-
-[output]
-frame_every = 0
-
-[[output.probe]]
-quantity = "reaction_y"
-set = "top"
-"#;
+use common::J2_BLOCK_ON_ROLLERS as BLOCK;
 
 const YOUNG: f64 = 70e9;
 const POISSON: f64 = 0.3;
