@@ -13,7 +13,9 @@
 //! a+ = (M_s a_s + M_m a_m) / (M_s + M_m),  tau+ = tau + M_s (a+ - a_s)
 //! v_s,n += tau / Z_s,  v_m,n -= tau / Z_m,  a_s,n -= tau / M_s,  a_m,n += tau / M_m
 //! ```
-//! A rigid obstacle is a master of infinite mass and impedance at rest.
+//! A rigid obstacle is a master of infinite mass and impedance, at rest or moving with the
+//! velocity its prescribed motion has at the conditions' time (its acceleration taken as
+//! zero: the motion's curve is piecewise linear).
 
 use super::Interfaces;
 use super::geometry::{ContactPair, Friction, Gap, Master};
@@ -103,6 +105,13 @@ impl<'a> Entry<'a> {
         })
     }
 
+    /// The component along `direction` of the velocity of the entry's obstacle (zero for a
+    /// master that is a body, or an obstacle at rest).
+    pub fn obstacle_velocity(&self, direction: [f64; 2]) -> f64 {
+        let w = self.pair.obstacle_velocity();
+        w[0] * direction[0] + w[1] * direction[1]
+    }
+
     /// The slave's lumped mass and impedance.
     pub fn slave_mass_and_impedance(&self) -> (f64, f64) {
         let s = self.slave;
@@ -121,7 +130,7 @@ pub(super) fn approaching(entry: &Entry, velocity: &[f64]) -> bool {
     let master = entry.master();
     let vm = master
         .as_ref()
-        .map_or(0.0, |m| interpolated(velocity, m, n));
+        .map_or(entry.obstacle_velocity(n), |m| interpolated(velocity, m, n));
     normal_component(velocity, entry.slave, n) - vm < 0.0
 }
 
@@ -159,7 +168,8 @@ fn tangential_impact(
 ) {
     let (pair, s, lumped) = (entry.pair, entry.slave, entry.lumped);
     let t = entry.gap.tangent();
-    let vm = master.map_or(0.0, |m| interpolated(velocity, m, t));
+    let obstacle = entry.obstacle_velocity(t);
+    let vm = master.map_or(obstacle, |m| interpolated(velocity, m, t));
     let relative = normal_component(velocity, s, t) - vm;
     let change = match pair.options.friction {
         Friction::None => return,
@@ -169,7 +179,7 @@ fn tangential_impact(
         Friction::Coulomb { mu } => {
             // towards the tangential velocity before the step, and no further
             let before = normal_component(previous_velocity, s, t)
-                - master.map_or(0.0, |m| interpolated(previous_velocity, m, t));
+                - master.map_or(obstacle, |m| interpolated(previous_velocity, m, t));
             let limit = -mu * normal_change;
             (before - relative).clamp(-limit, limit)
         }
@@ -201,7 +211,7 @@ pub(super) fn impact(
     );
     let master = entry.master();
     let (v_plus, a_plus) = match &master {
-        None => (0.0, 0.0),
+        None => (entry.obstacle_velocity(n), 0.0),
         Some(side) => {
             let vm_prev = interpolated(previous_velocity, side, n);
             let am_now = interpolated(acceleration, side, n);

@@ -31,6 +31,9 @@ pub type PairForces = Vec<Vec<(usize, f64)>>;
 pub struct ImplicitStepWork<'a> {
     /// The step's displacement increment.
     pub increment: &'a [f64],
+    /// The slip the friction forces work on: the increment, less a moving obstacle's
+    /// travel at its slaves.
+    pub slip: &'a [f64],
     /// The contact forces the integrator applied at the step's end, and at its start.
     pub applied: (&'a [f64], &'a [f64]),
     /// Per DOF, the kinetic energy the step's impact and release conditions removed (None:
@@ -142,7 +145,7 @@ impl ContactState {
                 let work: f64 = start
                     .iter()
                     .chain(end)
-                    .map(|(d, f)| increment[*d] * f)
+                    .map(|(d, f)| step.slip[*d] * f)
                     .sum();
                 -0.5 * work
             })

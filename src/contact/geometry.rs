@@ -35,6 +35,8 @@ pub struct ObstacleMotion {
     pub base: Vec<[f64; 2]>,
     pub displacement: [f64; 2],
     pub curve: Curve,
+    /// The time `Obstacle::place` last put the points at (0 until then).
+    pub placed: f64,
 }
 
 impl ObstacleMotion {
@@ -54,7 +56,8 @@ impl ObstacleMotion {
 impl Obstacle {
     /// Moves a moving obstacle's points to where its motion has it at time `t`.
     pub fn place(&mut self, t: f64) {
-        if let Some(m) = &self.motion {
+        if let Some(m) = &mut self.motion {
+            m.placed = t;
             let d = m.at(t);
             for (p, b) in self.points.iter_mut().zip(&m.base) {
                 *p = [b[0] + d[0], b[1] + d[1]];
@@ -385,6 +388,14 @@ impl ContactPair {
             Master::Obstacle(o) => o.motion.as_ref(),
             _ => None,
         }
+    }
+
+    /// The velocity of the pair's obstacle where it was last placed (`Obstacle::place`):
+    /// zero for a master that is a body or an obstacle at rest (the implicit integrators'
+    /// impact conditions give a slave the master's velocity, theory 8.3f).
+    pub fn obstacle_velocity(&self) -> [f64; 2] {
+        self.moving_obstacle()
+            .map_or([0.0; 2], |m| m.velocity(m.placed))
     }
 
     /// The pair's projectile, when its master is one.

@@ -155,6 +155,34 @@ pub fn place_obstacles(pairs: &mut [ContactPair], t: f64) {
     }
 }
 
+/// Per DOF, the component of `quantity` of the moving obstacle of the first pair that holds
+/// the DOF's node as a slave (0 elsewhere); None where no obstacle of `pairs` moves. The
+/// implicit driver books with it what a moving obstacle supplies (theory 8.3f).
+pub fn obstacle_by_dof(
+    pairs: &[ContactPair],
+    dofs: usize,
+    quantity: impl Fn(&ObstacleMotion) -> [f64; 2],
+) -> Option<Vec<f64>> {
+    if !obstacles_move(pairs) {
+        return None;
+    }
+    let mut out = vec![0.0; dofs];
+    let mut held = vec![false; dofs / 2];
+    for pair in pairs {
+        let Some(motion) = pair.moving_obstacle() else {
+            continue;
+        };
+        let value = quantity(motion);
+        for &s in &pair.slaves {
+            if !std::mem::replace(&mut held[s], true) {
+                out[2 * s] = value[0];
+                out[2 * s + 1] = value[1];
+            }
+        }
+    }
+    Some(out)
+}
+
 /// Where a projectile is (`geometry::Projectile`): its translation u_R and its velocity.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Flight {

@@ -107,6 +107,7 @@ fn motion(
         base: points.to_vec(),
         displacement: spec.displacement,
         curve,
+        placed: 0.0,
     })
 }
 

@@ -212,10 +212,10 @@ fn check_explicit_friction(
     Ok(())
 }
 
-/// A moving obstacle is placed where its motion has it at each step of statics and of
-/// central difference without subcycling or ALE; the other paths read an obstacle at rest
-/// (the implicit integrators' impact conditions give a slave the master's velocity, zero
-/// for an obstacle; a subcycled substep and an ALE slide read its start position). Friction
+/// A moving obstacle is placed where its motion has it at each step of statics, of the
+/// implicit integrators (whose impact conditions give a slave its velocity) and of central
+/// difference without subcycling or ALE (a subcycled substep and an ALE slide read its
+/// start position). Friction
 /// against it reads the slip relative to it, in central difference and in the passes of a
 /// static contact step, not in the active set inside Newton.
 fn check_moving_obstacles(
@@ -235,29 +235,30 @@ fn check_moving_obstacles(
     );
     let path = match analysis {
         Analysis::Static(_) => None,
-        Analysis::Dynamic(d) if d.integrator != IntegratorKind::CentralDifference => {
-            Some("an implicit integrator (its impact conditions take the obstacle at rest)")
-        }
         Analysis::Dynamic(d) if d.subcycling.is_some() => Some("analysis.subcycling"),
         Analysis::Dynamic(d) if d.ale.is_some() => Some("analysis.ale"),
         Analysis::Dynamic(_) => None,
     };
     if let Some(path) = path {
         return Err(cx.err(format!(
-            "{key}: a moving obstacle runs under statics and central_difference (without \
-             subcycling or ALE), not under {path}"
+            "{key}: a moving obstacle runs under statics and every integrator (central \
+             difference without subcycling or ALE), not under {path}"
         )));
     }
     // the stick and slide of the active set inside Newton (theory 8.3b) read the slave's
     // own slip; the passes read the slip relative to the obstacle
-    let inside = match analysis {
-        Analysis::Static(s) => match s.newton.active_set {
-            Some(ActiveSetSolve::Newton) => true,
-            Some(ActiveSetSolve::Passes) => false,
-            None => contacts.iter().any(|pair| pair.mortar().is_some()),
-        },
-        Analysis::Dynamic(_) => false,
+    let newton = match analysis {
+        Analysis::Static(s) => Some(&s.newton),
+        Analysis::Dynamic(d) if d.integrator != IntegratorKind::CentralDifference => {
+            Some(&d.newton)
+        }
+        Analysis::Dynamic(_) => None,
     };
+    let inside = newton.is_some_and(|newton| match newton.active_set {
+        Some(ActiveSetSolve::Newton) => true,
+        Some(ActiveSetSolve::Passes) => false,
+        None => contacts.iter().any(|pair| pair.mortar().is_some()),
+    });
     if inside
         && let Some(c) = contacts.iter().find(|c| {
             c.moving_obstacle().is_some() && !matches!(c.options.friction, Friction::None)

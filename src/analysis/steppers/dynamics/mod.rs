@@ -14,7 +14,10 @@
 //! times in a row); a slave that touches its master at the start of a step closes with the
 //! impact conditions, and the step is split at the first contact event inside it.
 
+mod energy;
 mod report;
+
+use energy::{Booked, placed_at};
 
 use super::control::{
     ErrorControl, ErrorWatch, StepControl, WatchedPoint, on_ladder, snap, step_factor, step_length,
@@ -25,7 +28,6 @@ use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure}
 use super::{StepError, Stepper, loads};
 use crate::analysis::summary::RunError;
 use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System, check_mass};
-use crate::contact::energy::ImplicitStepWork;
 use crate::contact::{ContactResult, ContactState, ImpactMotion, Interfaces, LumpedMass, Pass};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
@@ -382,6 +384,12 @@ impl<'a> Dynamics<'a> {
             self.state.time + h
         };
         self.last_step = self.state.time - start;
+        // a moving obstacle where the conditions below read it, and its travel in the step
+        self.interfaces.place_obstacles(self.state.time);
+        let travel = crate::contact::obstacle_by_dof(&self.interfaces.pairs, d.len(), |m| {
+            let (a, b) = (m.at(start), m.at(self.state.time));
+            [b[0] - a[0], b[1] - a[1]]
+        });
         // the next step's predictor (theory 8.2)
         self.mean_velocity = Some(d.iter().map(|x| x / h).collect());
         let kin = &mut self.kin;
@@ -401,7 +409,7 @@ impl<'a> Dynamics<'a> {
         let events = &step.events;
         let conditions = !events.closed.is_empty() || !events.released.is_empty();
         let velocity_before = conditions.then(|| kin.velocity.clone());
-        let positions = self.state.positions(spec.geometry);
+        let positions = self.state.positions(spec.geometry).into_owned();
         let mass = LumpedMass {
             mass: &self.mass.lumped,
             inverse: &self.inverse_mass,
@@ -414,46 +422,16 @@ impl<'a> Dynamics<'a> {
         crate::contact::apply_conditions(&self.interfaces, &mut step, &positions, mass, motion);
         self.contact
             .commit(&self.interfaces, &step, self.state.time, &positions);
-        // the kinetic energy the conditions removed, DOF by DOF
-        let removed = velocity_before.map(|before| {
-            self.mass
-                .kinetic_removed_by_dof(model, &before, &self.kin.velocity)
-        });
-        // the next step starts from the motion the conditions left
-        let next_start = match conditions {
-            true => self.motion_contact_force(&internal),
-            false => applied.clone(),
+        let booked = Booked {
+            increment: d,
+            travel,
+            applied,
+            internal,
+            velocity_before,
+            friction_start,
+            pair_start,
         };
-        let total = self.total_force(&internal);
-        // the friction's share of the contact forces' work: minus the work of the friction
-        // forces alone, theirs at the step's start and end (theory 7)
-        let friction = friction_start.map_or(0.0, |start| {
-            let end = (self.contact)
-                .friction_forces(&self.interfaces.pairs, &positions)
-                .expect("a friction pair");
-            -super::trapezoid_work(&d, &end, &start)
-        });
-        let energies = &mut self.energies;
-        energies.external_work += super::trapezoid_work(&d, &total, &self.last_total);
-        energies.kinetic = self.mass.kinetic_energy(model, &self.kin.velocity);
-        // energy taken up by the interface: minus the work of the contact forces on the
-        // bodies, plus what the impact/release conditions removed; the friction's share apart
-        energies.contact_work += -super::trapezoid_work(&d, &applied, &self.last_contact)
-            + removed.as_ref().map_or(0.0, |r| r.iter().sum())
-            - friction;
-        energies.friction_work += friction;
-        energies.internal = self.state.internal_work - self.state.plastic_work;
-        energies.plastic_work = self.state.plastic_work;
-        let work = ImplicitStepWork {
-            increment: &d,
-            applied: (&applied, &self.last_contact),
-            conditions: removed,
-            start: pair_start,
-        };
-        (self.contact).book_implicit_step(&self.interfaces.pairs, &positions, work);
-        self.last_total = total;
-        self.last_internal = internal;
-        self.last_contact = next_start;
+        self.book_step(booked, &positions);
         self.increments += 1;
         self.control.accept(true);
     }
@@ -598,19 +576,30 @@ impl Attempt<'_> {
     /// The end-of-step gap of each persistent entry (pair, slave node), where the others'
     /// is 0 (the gap constraint): the start gap plus the increment that makes the relative
     /// normal velocity at the solve point zero: with v* = c_v D + v_hat,
-    /// n . (c_v D_rel + v_hat_rel) = 0, so g_end = g_start - n . v_hat_rel / c_v.
-    fn targets(&self, form: &StepForm) -> Vec<((usize, usize), f64)> {
+    /// n . (c_v D_rel + v_hat_rel) = 0, so g_end = g_start - n . v_hat_rel / c_v. Against an
+    /// obstacle moving at w, which travels dx to the solve time `t_solve`, the relative
+    /// velocity is the slave's less w and the gap also loses n . dx:
+    /// g_end = g_start - n . (v_hat_s - w) / c_v - n . dx.
+    fn targets(&self, form: &StepForm, t_solve: f64) -> Vec<((usize, usize), f64)> {
         let x = |n: usize| self.positions[n];
         self.persistent
             .iter()
             .filter_map(|&(pair, slave)| {
                 let gap = self.pairs[pair].gap(slave, &x)?;
-                let relative: f64 = gap
+                let mut relative: f64 = gap
                     .row(slave)
                     .iter()
                     .map(|(dof, c)| c * form.velocity_offset[*dof])
                     .sum();
-                Some(((pair, slave), gap.gap - relative / form.damping_coefficient))
+                let n = gap.normal;
+                let mut travel = 0.0;
+                if let Some(m) = self.pairs[pair].moving_obstacle() {
+                    let (w, a, b) = (m.velocity(t_solve), m.at(self.state.time), m.at(t_solve));
+                    relative -= n[0] * w[0] + n[1] * w[1];
+                    travel = n[0] * (b[0] - a[0]) + n[1] * (b[1] - a[1]);
+                }
+                let target = gap.gap - relative / form.damping_coefficient - travel;
+                Some(((pair, slave), target))
             })
             .collect()
     }
@@ -626,7 +615,7 @@ impl Attempt<'_> {
         counters: &mut Counters,
     ) -> Result<Solution, StepFailure> {
         let Pass {
-            pairs: _,
+            pairs,
             length: h,
             active,
             forces,
@@ -637,6 +626,14 @@ impl Attempt<'_> {
         let (model, spec, state) = (self.model, self.spec, self.state);
         let form = self.method.form(h, self.kin);
         let solve_time = state.time + form.solve_fraction * h;
+        // Wilson's extrapolated solve meets a moving obstacle where it is at the solve time
+        let moved: Vec<crate::contact::ContactPair>;
+        let pairs = if form.solve_fraction != 1.0 && crate::contact::obstacles_move(pairs) {
+            moved = placed_at(pairs, solve_time);
+            &moved[..]
+        } else {
+            pairs
+        };
         // the predictor: the last step's mean velocity over this step (the end velocity at
         // the first step, and for Wilson's extrapolated solve; theory 8.2), or the increment
         // the last active set converged to
@@ -690,12 +687,13 @@ impl Attempt<'_> {
             predictor: false,
             error_target: self.error_target.map(|fraction| fraction * h),
             contact: Some(Constraints {
-                pairs: self.pairs,
+                // (a moving obstacle placed at the pass's end)
+                pairs,
                 active,
                 start: self.positions,
                 forces,
                 tangential,
-                targets: self.targets(&form),
+                targets: self.targets(&form, solve_time),
                 inside,
                 describe: &|node| model.describe_node(node),
             }),
@@ -734,6 +732,8 @@ impl Stepper for Dynamics<'_> {
     fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError> {
         loop {
             let (target, nominal) = self.target();
+            // (a moving obstacle where the closures read it)
+            self.interfaces.place_obstacles(self.state.time);
             let positions = self.state.positions(self.spec.geometry).into_owned();
             let velocity_before = self.kin.velocity.clone();
             let mass = LumpedMass {
@@ -751,10 +751,9 @@ impl Stepper for Dynamics<'_> {
             // the kinetic energy their impact conditions removed, booked to the pairs
             // whose surfaces hold the nodes
             if !closed.is_empty() {
-                let velocity = &self.kin.velocity;
-                let removed =
-                    (self.mass).kinetic_removed_by_dof(self.model, &velocity_before, velocity);
+                let (removed, supplied) = self.taken_by_conditions(&velocity_before);
                 self.energies.contact_work += removed.iter().sum::<f64>();
+                self.energies.external_work += supplied;
                 (self.contact).book_by_owner(&self.interfaces.pairs, &removed, &[]);
             }
             match self.attempt(nominal, &positions, counters) {
