@@ -159,8 +159,8 @@ fn truss_refused(edit: impl Fn(&str) -> String) -> String {
 
 /// Goal: arc length is refused where it cannot apply, with the key named (bad input, exit
 /// 2): in a dynamic analysis, beside a prescribed displacement, with a load curve that is
-/// not a ramp from zero, with checkpoints or the buckling check it would leave out, and with
-/// a contact pair.
+/// not a ramp from zero, with the buckling check it would leave out, and with a contact
+/// pair.
 #[test]
 fn arc_length_is_refused_where_it_cannot_apply() {
     let dynamic = truss_refused(|t| {
@@ -190,12 +190,6 @@ fn arc_length_is_refused_where_it_cannot_apply() {
     assert!(
         curve.contains("load[0]: its curve is not a ramp"),
         "{curve}"
-    );
-    let checkpoints =
-        truss_refused(|t| t.replace("[analysis]\n", "[analysis]\ncheckpoint_every = 5\n"));
-    assert!(
-        checkpoints.contains("analysis.checkpoint_every: an arc-length run"),
-        "{checkpoints}"
     );
     let buckling = truss_refused(|t| t.replace("[output]", "[analysis.buckling]\n\n[output]"));
     assert!(

@@ -219,6 +219,30 @@ fn static_resume_is_bit_identical() {
     assert_same_output(&full, &resumed, name);
 }
 
+/// Goal: an arc-length run resumes bit-identically past its limit point: the load factor,
+/// the next arc, the first arc's share (the pseudo time's unit) and the last increment's
+/// direction are in the checkpoint. Setup: models/von_mises_truss.toml (the shallow truss
+/// snapping through under 1.56 times its limit load), a checkpoint every 4 increments,
+/// halted at increment 27, on the falling branch past the limit. Reference: the
+/// uninterrupted run, byte for byte. A checkpoint without the direction would turn the
+/// resumed path back up at the next predictor (the sign of the load increment follows it),
+/// one without the arc would restart it at the first arc's length.
+#[test]
+fn arc_length_resume_is_bit_identical() {
+    let name = "arc_length_truss";
+    let text = std::fs::read_to_string("models/von_mises_truss.toml").unwrap();
+    let set = ["analysis.checkpoint_every=4", "output.frame_every=3"];
+    let full = run_full(name, &text, &set);
+    let factor = common::column(&full, "load_factor");
+    let peak = factor.iter().fold(0.0f64, |m, f| m.max(*f));
+    assert!(
+        factor[27] < 0.9 * peak,
+        "increment 27 is before the limit: {factor:?}"
+    );
+    let resumed = run_killed_and_resumed(name, &text, &set, 27);
+    assert_same_output(&full, &resumed, name);
+}
+
 /// PLASTIC_BLOCK without its friction (the explicit runs below were set up frictionless).
 fn frictionless() -> String {
     PLASTIC_BLOCK.replace("friction = 0.2\n", "")
@@ -625,7 +649,7 @@ fn resume_without_checkpoint_is_bad_input() {
     assert!(stderr.contains("checkpoint.bin"), "{stderr}");
     assert!(stderr.contains("checkpoint_every"), "{stderr}");
     // an older format is refused as such; the current format with a damaged body as damaged
-    for (version, needle) in [(19u32, "checkpoint format 19"), (20, "damaged checkpoint")] {
+    for (version, needle) in [(20u32, "checkpoint format 20"), (21, "damaged checkpoint")] {
         let mut bytes = b"IMPACTCP".to_vec();
         bytes.extend(version.to_le_bytes());
         bytes.extend(b"garbage");

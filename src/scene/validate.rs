@@ -48,7 +48,7 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     check_moving_obstacles(&cx, &analysis, &contacts)?;
     check_projectiles(&cx, &analysis, &obstacles)?;
     check_arc_length(&cx, &analysis, &loads, &contacts)?;
-    check_arc_length_extras(&cx, &analysis, scene.analysis.checkpoint_every)?;
+    check_arc_length_extras(&cx, &analysis)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
     let reference = match &scene.reference {
         Some(spec) => Some(reference(&cx, &bodies, &contacts, spec)?),
@@ -361,24 +361,13 @@ fn check_arc_length(
 }
 
 /// What an arc-length run does not carry, refused rather than left out silently: the
-/// checkpoints (the path's state is not in them) and the buckling check (its load steps are
-/// not the path's).
-fn check_arc_length_extras(
-    cx: &Context,
-    analysis: &Analysis,
-    checkpoint_every: usize,
-) -> Result<(), InputError> {
+/// buckling check (its load steps are not the path's).
+fn check_arc_length_extras(cx: &Context, analysis: &Analysis) -> Result<(), InputError> {
     let Analysis::Static(s) = analysis else {
         return Ok(());
     };
     if s.arc_length.is_none() {
         return Ok(());
-    }
-    if checkpoint_every > 0 {
-        return Err(cx.err(
-            "analysis.checkpoint_every: an arc-length run writes no checkpoints; remove it or \
-             analysis.arc_length",
-        ));
     }
     if s.buckling.is_some() {
         return Err(cx.err(

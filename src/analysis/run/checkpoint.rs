@@ -52,7 +52,8 @@ const MAGIC: &[u8; 8] = b"IMPACTCP";
 /// 19: the step ratios a subcycled run's levels were graded with in its carry.
 /// 20: the last increment, the next one's start, in the static carry; the Newton iterations
 ///     of each step, tallied.
-const FORMAT: u32 = 20;
+/// 21: the arc-length carry (an arc-length run writes checkpoints).
+const FORMAT: u32 = 21;
 
 /// A whole run at the end of a converged step.
 #[derive(Debug, Clone, Serialize, Deserialize)]

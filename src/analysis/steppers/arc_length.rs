@@ -29,7 +29,7 @@
 //! each later one in proportion to its arc, so it grows as the path goes), `load_factor`
 //! is lambda; the loads' curves are ramps from zero (the scene refuses others).
 
-use super::carry::Carry;
+use super::carry::{ArcLengthCarry, Carry};
 use super::energies::{Energies, Motion};
 use super::newton::Counters;
 use super::{About, Report, Resume, RowFeatures, RunFeatures, StepError, Stepper, loads};
@@ -488,10 +488,56 @@ impl Resume for ArcLength<'_> {
     fn kind(&self) -> &'static str {
         "arc-length"
     }
-    fn restore(&mut self, _carry: Carry) -> bool {
-        false
+
+    fn restore(&mut self, carry: Carry) -> bool {
+        let Carry::ArcLength(c) = carry else {
+            return false;
+        };
+        self.state = c.state;
+        self.energies = c.energies;
+        self.last_force = c.last_force;
+        self.contact = c.contact;
+        self.factor = c.factor;
+        self.peak = c.peak;
+        self.arc = c.arc;
+        self.first_arc = c.first_arc;
+        self.first_share = c.first_share;
+        self.direction = c.direction;
+        self.increments = c.increments;
+        self.last_step = c.last_step;
+        self.flat_in_a_row = c.flat_in_a_row;
+        self.collapsed = c.collapsed;
+        // the committed state's tangent, the next predictor's, is factored again
+        self.factored_at_start = false;
+        true
     }
+
     fn carry(&self) -> Result<Carry, &'static str> {
-        Err("an arc-length run writes no checkpoints")
+        Ok(Carry::ArcLength(ArcLengthCarry {
+            state: self.state.clone(),
+            energies: self.energies,
+            last_force: self.last_force.clone(),
+            contact: self.contact.clone(),
+            factor: self.factor,
+            peak: self.peak,
+            arc: self.arc,
+            first_arc: self.first_arc,
+            first_share: self.first_share,
+            direction: self.direction.clone(),
+            increments: self.increments,
+            last_step: self.last_step,
+            flat_in_a_row: self.flat_in_a_row,
+            collapsed: self.collapsed,
+        }))
+    }
+
+    /// A resumed run factors the committed tangent again (`restore`); so does the run
+    /// that wrote the checkpoint, so both go on from the same factor and the same counts.
+    fn after_checkpoint(&mut self) {
+        self.factored_at_start = false;
+    }
+
+    fn solver_mut(&mut self) -> Option<&mut Solver> {
+        Some(&mut self.solver)
     }
 }

@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub enum Carry {
     Static(StaticCarry),
+    ArcLength(ArcLengthCarry),
     Dynamic(DynamicCarry),
     Explicit(ExplicitCarry),
 }
@@ -28,6 +29,27 @@ pub struct StaticCarry {
     pub contact: ContactState,
     /// The last increment's displacement increment and length (the next one's start).
     pub previous: Option<(Vec<f64>, f64)>,
+}
+
+/// Where an arc-length path has got to (theory 5b): the state, the load factor and the
+/// highest so far, the next arc, the first arc and share (the pseudo time's unit), the last
+/// increment's direction (which way the next one goes), the counts of flat increments.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ArcLengthCarry {
+    pub state: State,
+    pub energies: Energies,
+    pub last_force: Vec<f64>,
+    pub contact: ContactState,
+    pub factor: f64,
+    pub peak: f64,
+    pub arc: Option<f64>,
+    pub first_arc: f64,
+    pub first_share: f64,
+    pub direction: Vec<f64>,
+    pub increments: usize,
+    pub last_step: f64,
+    pub flat_in_a_row: usize,
+    pub collapsed: bool,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
