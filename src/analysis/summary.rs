@@ -464,6 +464,10 @@ pub struct BucklingSummary {
     /// differed from the initial one, and the count then.
     pub inertia_change_time: Option<f64>,
     pub negative_pivots_at_change: Option<usize>,
+    /// The load factor there, on an arc-length path (whose `time` is the path's pseudo
+    /// time, not the load); null elsewhere.
+    #[serde(default)]
+    pub load_factor_at_change: Option<f64>,
     /// The run stopped there (`on_critical = "stop"`).
     pub stopped: bool,
     /// The file of the mode that crossed zero there (`NAME_critical.pvd`: one frame at that

@@ -48,7 +48,6 @@ pub fn build(scene: Scene, file: &Path, base_dir: &Path) -> Result<Model, InputE
     check_moving_obstacles(&cx, &analysis, &contacts)?;
     check_projectiles(&cx, &analysis, &obstacles)?;
     check_arc_length(&cx, &analysis, &loads, &contacts)?;
-    check_arc_length_extras(&cx, &analysis)?;
     let initial_velocity = initial_velocity(&cx, &scene, &bodies, node_count)?;
     let reference = match &scene.reference {
         Some(spec) => Some(reference(&cx, &bodies, &contacts, spec)?),
@@ -356,24 +355,6 @@ fn check_arc_length(
     }
     if loads.is_empty() {
         return Err(cx.err("analysis.arc_length: the scene has no load to scale"));
-    }
-    Ok(())
-}
-
-/// What an arc-length run does not carry, refused rather than left out silently: the
-/// buckling check (its load steps are not the path's).
-fn check_arc_length_extras(cx: &Context, analysis: &Analysis) -> Result<(), InputError> {
-    let Analysis::Static(s) = analysis else {
-        return Ok(());
-    };
-    if s.arc_length.is_none() {
-        return Ok(());
-    }
-    if s.buckling.is_some() {
-        return Err(cx.err(
-            "analysis.buckling: the buckling check follows load steps, not an arc-length \
-             path; remove it or analysis.arc_length (the path itself passes limit points)",
-        ));
     }
     Ok(())
 }

@@ -279,13 +279,16 @@ pub fn warnings(
         let mode = b.critical_mode.as_ref().map_or(String::new(), |file| {
             format!(" (the mode that crossed zero: {file}, one frame at that time)")
         });
+        let at = match b.load_factor_at_change {
+            Some(factor) => format!("load factor {} (t = {})", readable(factor), readable(t)),
+            None => format!("t = {}", readable(t)),
+        };
         out.push(format!(
-            "the tangent's negative pivots went from {from} to {to} at t = {}{mode}: the \
+            "the tangent's negative pivots went from {from} to {to} at {at}{mode}: the \
              structure passed a buckling or limit point there, and the run went on along the \
              path it was on (a perfect structure stays on its unstable primary path; an \
              imperfection, [analysis.buckling] imperfection, finds the buckled one; \
-             on_critical = \"stop\" ends the run there)",
-            readable(t)
+             on_critical = \"stop\" ends the run there)"
         ));
     }
     let (drift, gain) = (

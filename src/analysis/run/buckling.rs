@@ -161,13 +161,15 @@ impl Monitor {
         }))
     }
 
-    /// Checks a committed state: the negative-pivot count (None when `check` is off), and
-    /// whether the run should stop here. Where the count first changes, the critical mode
-    /// is written as the one frame of NAME_critical.pvd at that time.
+    /// Checks a committed state, at the load factor `load_factor` on an arc-length path:
+    /// the negative-pivot count (None when `check` is off), and whether the run should stop
+    /// here. Where the count first changes, the critical mode is written as the one frame of
+    /// NAME_critical.pvd at that time.
     pub fn observe(
         &mut self,
         model: &Model,
         state: &State,
+        load_factor: Option<f64>,
     ) -> Result<(Option<usize>, bool), MonitorError> {
         let Some(check) = &mut self.check else {
             return Ok((None, false));
@@ -180,6 +182,7 @@ impl Monitor {
         if count != initial && s.inertia_change_time.is_none() {
             s.inertia_change_time = Some(state.time);
             s.negative_pivots_at_change = Some(count);
+            s.load_factor_at_change = load_factor;
             stop = self.on_critical == OnCritical::Stop;
             s.stopped = stop;
             if let Some(shape) = check.critical_mode(model.dofs()) {

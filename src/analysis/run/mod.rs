@@ -205,8 +205,9 @@ impl<'a, S: Stepper> Run<'a, S> {
             Some(checkpoint) => run.restore(checkpoint, dir)?,
             None => {
                 if let Some(m) = &mut run.monitor {
+                    let factor = run.stepper.row_features().load_factor;
                     run.recorder.negative_pivots = m
-                        .observe(model, run.stepper.state())
+                        .observe(model, run.stepper.state(), factor)
                         .map_err(|e| monitor_error(model, e.into()))?
                         .0;
                 }
@@ -351,7 +352,8 @@ impl<'a, S: Stepper> Run<'a, S> {
         let Some(m) = &mut self.monitor else {
             return Ok(false);
         };
-        match m.observe(self.model, self.stepper.state()) {
+        let factor = self.stepper.row_features().load_factor;
+        match m.observe(self.model, self.stepper.state(), factor) {
             Ok((count, halt)) => {
                 self.recorder.negative_pivots = count;
                 Ok(halt)

@@ -435,7 +435,7 @@ impl Report for ArcLength<'_> {
             dt: self.spec.end_time / self.spec.steps as f64,
             end_time: self.spec.end_time,
             free_dofs: self.system.free,
-            checks_buckling: false,
+            checks_buckling: true,
         }
     }
     fn state(&self) -> &State {
