@@ -531,10 +531,12 @@ impl Resume for ArcLength<'_> {
         }))
     }
 
-    /// A resumed run factors the committed tangent again (`restore`); so does the run
-    /// that wrote the checkpoint, so both go on from the same factor and the same counts.
+    /// A resumed run factors the committed tangent again (`restore`), with a fresh solver;
+    /// so does the run that wrote the checkpoint, so both go on from the same factor and
+    /// the same counts.
     fn after_checkpoint(&mut self) {
         self.factored_at_start = false;
+        self.solver.forget_inertia();
     }
 
     fn solver_mut(&mut self) -> Option<&mut Solver> {

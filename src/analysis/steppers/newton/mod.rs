@@ -452,6 +452,9 @@ impl Step<'_> {
         counters: &mut Counters,
     ) -> Result<Solution, StepFailure> {
         let newton = self.newton;
+        // (L D L^T at once only after this solve's own indefinite factors: a solve never
+        // spans a checkpoint, so a resumed run factors as the run straight through)
+        solver.forget_inertia();
         let mut forces = self.initial_multipliers();
         let mut active_set = self.contact.as_ref().and_then(|c| match c.inside {
             Inside::Fixed => None,
