@@ -476,14 +476,9 @@ impl Step<'_> {
         for iteration in 0..=newton.max_iterations {
             let refactor = newton.strategy == Strategy::Full
                 || (iteration == 0 && (self.factor_first || predictor.is_some()));
-            // the first iteration of a predicted step linearizes about the step's start
-            let at = predictor.as_ref().map_or(&d, |p| &p.start);
-            let evaluation = self.evaluate(state, at, refactor.then_some(&mut *system))?;
-            let (mut residual, forces_scale) =
-                self.residual(at, &evaluation, system, &damping, external_norm);
-            if let Some(p) = &predictor {
-                self.predict(state, p, system, &damping, &mut residual)?;
-            }
+            let iterate = (&d[..], predictor.as_ref());
+            let (evaluation, mut residual, forces_scale) =
+                self.iterate_residual(state, iterate, refactor, system, (&damping, external_norm))?;
             let (rows, settled) = self.contact_rows(&d, system, &mut active_set, &mut forces)?;
             // R alone, without the contact and friction forces: K* is its derivative
             let own = secant.enabled().then(|| residual.clone());
@@ -585,6 +580,27 @@ impl Step<'_> {
             tangential,
             settled: active_set.map(|set| set.settled()),
         }
+    }
+
+    /// The evaluation of the iterate `d`, its residual and force scale (`residual`); the
+    /// first iteration of a predicted step linearizes about the step's start and takes the
+    /// predictor's jump (`predict`). `refactor`: the tangent assembled into `system` too.
+    fn iterate_residual(
+        &self,
+        state: &State,
+        (d, predictor): (&[f64], Option<&Predictor>),
+        refactor: bool,
+        system: &mut System,
+        (damping, external_norm): (&Option<Damping>, f64),
+    ) -> Result<(Evaluation, Vec<f64>, f64), StepFailure> {
+        let at = predictor.map_or(d, |p| &p.start[..]);
+        let evaluation = self.evaluate(state, at, refactor.then_some(&mut *system))?;
+        let (mut residual, forces_scale) =
+            self.residual(at, &evaluation, system, damping, external_norm);
+        if let Some(p) = predictor {
+            self.predict(state, p, system, damping, &mut residual)?;
+        }
+        Ok((evaluation, residual, forces_scale))
     }
 
     /// Turns the first residual of a predicted step, R_f at its start, into
