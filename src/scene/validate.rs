@@ -214,9 +214,9 @@ fn check_explicit_friction(
 /// A moving obstacle is placed where its motion has it at each step of statics, of the
 /// implicit integrators (whose impact conditions give a slave its velocity) and of central
 /// difference without subcycling or ALE (a subcycled substep and an ALE slide read its
-/// start position). Friction
-/// against it reads the slip relative to it, in central difference and in the passes of a
-/// static contact step, not in the active set inside Newton.
+/// start position). Friction against it reads the slip relative to it, in central
+/// difference and in the contact passes of statics and the implicit integrators, not in
+/// the active set inside Newton.
 fn check_moving_obstacles(
     cx: &Context,
     analysis: &Analysis,

@@ -278,18 +278,14 @@ impl Solver {
     /// eigenvalues" warning).
     ///
     /// Where the last factorization found negative pivots, L D L^T is taken at once: the
-    /// tangents of one iteration, or of increments in a row, keep their inertia, and an
-    /// L L^T that stops at its first non-positive pivot is work thrown away (on the finest
+    /// tangents of one Newton solve keep their inertia, and an L L^T that stops at its
+    /// first non-positive pivot is work thrown away (on the finest
     /// finite-strain Shield punch, 252 factorizations, the factorization time fell by a
     /// fifth; docs/performance.md). A matrix found definite again brings back L L^T first.
     /// L D L^T without pivoting is as accurate as L L^T on a definite matrix.
     pub fn factor_indefinite(&mut self, values: &[f64]) -> Result<(), SolverError> {
         let result = if std::mem::take(&mut self.ldlt_first) {
-            self.values.clear();
-            self.inverse.clear();
-            self.signs = None;
-            self.negative_pivots = 0;
-            self.factorizations += 1;
+            self.begin_factorization();
             self.timed_ldlt(values)
         } else {
             match self.factor(values) {
@@ -407,14 +403,20 @@ impl Solver {
         Ok(())
     }
 
-    fn factor_values(&mut self, values: &[f64]) -> Result<(), SolverError> {
-        // the last factor's buffer is reused (one factor in memory at a time); it is left
-        // empty, i.e. not factored, until the new factorization succeeds
-        let mut factor = std::mem::take(&mut self.values);
+    /// A new factorization begins: the last one's inverse entries, signs and negative
+    /// pivots go, and it is counted.
+    fn begin_factorization(&mut self) {
         self.inverse.clear();
         self.signs = None;
         self.negative_pivots = 0;
         self.factorizations += 1;
+    }
+
+    fn factor_values(&mut self, values: &[f64]) -> Result<(), SolverError> {
+        // the last factor's buffer is reused (one factor in memory at a time); it is left
+        // empty, i.e. not factored, until the new factorization succeeds
+        let mut factor = std::mem::take(&mut self.values);
+        self.begin_factorization();
         let Some(symbolic) = &self.symbolic else {
             return Ok(());
         };
