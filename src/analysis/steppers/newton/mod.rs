@@ -708,6 +708,21 @@ impl Step<'_> {
                 "the stiffness matrix is singular at {}: a mechanism or missing supports",
                 free_dof(self.model, system, index)
             )),
+            SolverError::NotPositiveDefinite { index } if self.inertia.is_some() => {
+                StepFailure(format!(
+                    "the effective stiffness K* (the mass term plus K_T) is not positive \
+                     definite at {}: the tangent stiffness there is more negative than the \
+                     mass term holds (a crushed element, a softening material, or a node \
+                     without mass: `contact_dynamics = \"mass_redistribution\"` leaves the \
+                     contact surfaces' nodes none); a shorter analysis.dt raises the mass term",
+                    free_dof(self.model, system, index)
+                ))
+            }
+            SolverError::NotPositiveDefinite { index } => StepFailure(format!(
+                "the stiffness matrix is not positive definite at {}: a mechanism, missing \
+                 supports or a buckled state",
+                free_dof(self.model, system, index)
+            )),
             other => StepFailure(other.to_string()),
         })
     }
