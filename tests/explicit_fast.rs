@@ -1091,3 +1091,53 @@ fn point_probes_from_the_kernel_match_the_copied_points() {
         assert_eq!(copied, own, "{quadrature}: the probes differ");
     }
 }
+
+/// Goal: an explicit run the user gives no thread count takes as many threads as its mesh
+/// keeps busy, not every core. Setup: `analysis::threads_for` of the shipped Taylor rods on a
+/// pool of 16 threads. Reference: the 16-core measurements of docs/performance.md ("Fewer
+/// hand-overs per step"): the one-point aluminium rod of 20 x 120 (2400 elements) ran
+/// fastest on 8 threads (9.65 s against 10.9 s on 16); its 2x2 form and the one-point
+/// Johnson-Cook rod of 20 x 200 kept gaining towards 16 (about 4x and 6x there), so they
+/// keep at least 12; the shipped 5 x 30 rod (150 elements) runs on one thread; a count the
+/// user sets (`RAYON_NUM_THREADS`), and an implicit run, take the whole pool.
+#[test]
+fn the_thread_count_follows_the_mesh_size() {
+    let load = |scene: &str, overrides: &[&str]| {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let path = std::path::PathBuf::from(format!("models/{scene}.toml"));
+        impact::scene::load(&path, &overrides).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let threads = |model: &impact::scene::Model, user_set: bool| {
+        impact::analysis::threads_for(model, 16, user_set)
+    };
+    let rod = ["body.rod.mesh.nx=20", "body.rod.mesh.ny=120"];
+    let aluminium = load("taylor_aluminum", &rod);
+    assert_eq!(aluminium.elements(), 2400);
+    assert_eq!(threads(&aluminium, false), 8);
+    assert_eq!(threads(&aluminium, true), 16);
+    let full = load(
+        "taylor_aluminum",
+        &[rod[0], rod[1], "analysis.quadrature=full"],
+    );
+    assert!(threads(&full, false) >= 12);
+    let jc = load(
+        "taylor_jc",
+        &[
+            "body.rod.mesh.nx=20",
+            "body.rod.mesh.ny=200",
+            "analysis.quadrature=reduced",
+        ],
+    );
+    assert!(threads(&jc, false) >= 12);
+    assert_eq!(threads(&load("taylor_aluminum", &[]), false), 1);
+    let implicit = load(
+        "taylor_jc",
+        &[
+            "body.rod.mesh.nx=20",
+            "body.rod.mesh.ny=200",
+            "analysis.integrator=average",
+            "analysis.dt=1e-8",
+        ],
+    );
+    assert_eq!(threads(&implicit, false), 16);
+}

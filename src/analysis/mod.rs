@@ -84,10 +84,12 @@ fn run_from(
     })?;
     let model = imperfect.as_ref().unwrap_or(model);
     // a small model pays more for handing work to threads than the threads give back: it
-    // runs on the calling thread (the results are the same bits either way)
-    if model.elements() < parallel_from(model) && rayon::current_num_threads() > 1 {
+    // runs on the calling thread, and an explicit one of a few thousand elements on as many
+    // threads as its points keep busy (the results are the same bits either way)
+    let threads = threads_for(model, rayon::current_num_threads(), user_set_threads());
+    if threads < rayon::current_num_threads() {
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
+            .num_threads(threads)
             .build()
             .map_err(|e| RunError::setup(out_dir, e))?;
         return pool.install(|| dispatch(model, out_dir, options, resume));
@@ -107,6 +109,38 @@ pub const PARALLEL_FROM_ELEMENTS: usize = 4000;
 /// short vector loops on its own thread (docs/performance.md, "Fewer hand-overs per step": a
 /// 1000-element rod 1.3-1.5 times faster on two threads than on one).
 pub const PARALLEL_FROM_ELEMENTS_EXPLICIT: usize = 1000;
+
+/// Material points per thread from which central difference keeps a thread busy: on a
+/// 16-core machine (docs/performance.md, "Fewer hand-overs per step") the one-point
+/// aluminium rod of 2400 elements ran fastest on 8 threads (9.65 s against 10.9 s on 16),
+/// while its 2x2 form (9600 points) and the 4000-element Johnson-Cook rod gained up to 16.
+pub const POINTS_PER_THREAD_EXPLICIT: usize = 300;
+
+/// Whether the user chose the thread count (`RAYON_NUM_THREADS`).
+fn user_set_threads() -> bool {
+    std::env::var_os("RAYON_NUM_THREADS").is_some_and(|v| !v.is_empty())
+}
+
+/// The threads a run of `model` uses out of the pool's `available`: one below
+/// [`parallel_from`]'s element count; an explicit run the user has not given a thread count
+/// (`user_set`) at most one per [`POINTS_PER_THREAD_EXPLICIT`] material points (Quad4 2x2
+/// counts 4 points an element, one-point and rods 1), and at least 2; otherwise all.
+pub fn threads_for(model: &Model, available: usize, user_set: bool) -> usize {
+    if model.elements() < parallel_from(model) {
+        return 1;
+    }
+    if !model.is_explicit() || user_set {
+        return available;
+    }
+    let reduced = matches!(&model.analysis,
+        crate::scene::model::Analysis::Dynamic(d) if d.quadrature == crate::scene::spec::Quadrature::Reduced);
+    let points: usize = (model.bodies.iter())
+        .map(|b| b.elements() * if reduced { 1 } else { b.points_per_element() })
+        .sum();
+    (points / POINTS_PER_THREAD_EXPLICIT)
+        .clamp(2, available.max(2))
+        .min(available)
+}
 
 /// The element count from which `model` runs on the pool.
 pub fn parallel_from(model: &Model) -> usize {
