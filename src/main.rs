@@ -61,7 +61,8 @@ enum Command {
         #[arg(long)]
         strict: bool,
         /// A line per Newton iteration on stderr: the step's end time, the residual and its
-        /// share of the force tolerance, the displacement criterion, whether it refactors.
+        /// share of the force tolerance, the displacement criterion, whether it refactors;
+        /// and why a step or increment is cut.
         #[arg(long)]
         verbose: bool,
     },

@@ -914,3 +914,44 @@ fn verbose_logs_each_newton_iteration() {
     let quiet = impact(&["run", "models/hill_cylinder.toml", "--quiet", "--out", d]);
     assert!(!String::from_utf8_lossy(&quiet.stderr).contains("newton:"));
 }
+
+/// Goal: `--verbose` says why an increment was cut, at each cut. Setup:
+/// models/column_buckling.toml with modified Newton (the scene names full Newton; modified
+/// cuts its increments near the critical load). Reference: the cut count summary.json
+/// reports (`step_cuts`, at least one): one "is cut:" line per cut, each naming the
+/// increment's end time and a reason (an inverted element names its body and element).
+#[test]
+fn verbose_says_why_each_cut_was_made() {
+    let dir = common::out_dir("verbose_cuts");
+    let d = dir.to_str().unwrap();
+    let output = impact(&[
+        "run",
+        "models/column_buckling.toml",
+        "--quiet",
+        "--verbose",
+        "--set",
+        "analysis.newton.strategy=modified",
+        "--set",
+        "output.frame_every=0",
+        "--out",
+        d,
+    ]);
+    assert_eq!(output.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let cuts: Vec<&str> = stderr.lines().filter(|l| l.contains("is cut:")).collect();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let counted = summary["step_cuts"].as_u64().unwrap();
+    assert!(counted > 0, "the run must cut to test this");
+    assert_eq!(cuts.len() as u64, counted, "{stderr}");
+    for line in cuts {
+        let reason = line.split("is cut:").nth(1).unwrap().trim();
+        assert!(
+            line.contains("increment to t = ") && !reason.is_empty(),
+            "{line}"
+        );
+        if reason.contains("Jacobian") {
+            assert!(reason.contains("body `column`, element"), "{line}");
+        }
+    }
+}

@@ -318,6 +318,10 @@ impl Stepper for Statics<'_> {
                     from_zero = true;
                 }
                 Err(StepFailure(reason)) => {
+                    crate::output::console::iteration(format_args!(
+                        "  newton: the increment to t = {} is cut: {reason}",
+                        readable(target)
+                    ));
                     if let Err(why) = self.control.reject(target - self.state.time, counters) {
                         let message = format!(
                             "increment to t = {} {why}: {reason}{}",

@@ -780,6 +780,10 @@ impl Stepper for Dynamics<'_> {
                     return Ok(());
                 }
                 Err(StepFailure(reason)) => {
+                    crate::output::console::iteration(format_args!(
+                        "  newton: the step to t = {} is cut: {reason}",
+                        readable(target)
+                    ));
                     self.method.reject();
                     if let Err(why) = self.control.reject(nominal, counters) {
                         let message = format!("step to t = {} {why}: {reason}", readable(target));
