@@ -53,6 +53,11 @@ pub struct ContactState {
     /// checkpoint: zero vectors of the right length either way).
     #[serde(skip)]
     pub(super) scratch: Scratch,
+    /// The last resort of an implicit step whose active set did not settle at any length
+    /// the cuts tried: an entry that cycles between tension and penetration stays open
+    /// (`ContactState::step`); set by the driver for that step's last attempt only.
+    #[serde(skip)]
+    pub accept_cycles: bool,
 }
 
 /// Vectors over all DOFs, zero between uses (`ContactState::scratch`).
@@ -96,6 +101,7 @@ impl ContactState {
             friction_work: vec![0.0; pairs.len()],
             flights: Vec::new(),
             scratch: Scratch::default(),
+            accept_cycles: false,
         }
     }
 

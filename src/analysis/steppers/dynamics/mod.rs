@@ -28,6 +28,7 @@ use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure}
 use super::{StepError, Stepper, loads};
 use crate::analysis::summary::RunError;
 use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System, check_mass};
+use crate::contact::step::Unsettled;
 use crate::contact::{ContactResult, ContactState, ImpactMotion, Interfaces, LumpedMass, Pass};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
@@ -758,6 +759,7 @@ impl Stepper for Dynamics<'_> {
             }
             match self.attempt(nominal, &positions, counters) {
                 Ok((step, advance)) => {
+                    self.contact.accept_cycles = false;
                     let h = step.length;
                     let (estimate, speed) = self.estimate(h, &advance);
                     let estimate = estimate.max(self.point_estimate(&step.solution.evaluation));
@@ -786,6 +788,12 @@ impl Stepper for Dynamics<'_> {
                     ));
                     self.method.reject();
                     if let Err(why) = self.control.reject(nominal, counters) {
+                        if Unsettled::is(&reason) && !self.contact.accept_cycles {
+                            // the last resort, at the same length: an entry cycling between
+                            // tension and penetration stays open (theory 8.3)
+                            self.contact.accept_cycles = true;
+                            continue;
+                        }
                         let message = format!("step to t = {} {why}: {reason}", readable(target));
                         return Err(StepError::diverged(message));
                     }
