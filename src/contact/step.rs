@@ -182,6 +182,34 @@ enum Slip {
     Return(f64),
 }
 
+/// The entries a contact step released in tension, each with the active set it left and the
+/// step's length then. One that penetrates again when the others are as they were cycles:
+/// held, it pulls; free, it penetrates (seen with friction under HHT, an entry at a corner,
+/// 28 nm inside, at every step length the cuts tried). In a step's last attempt
+/// (`ContactState::accept_cycles`) it stays open, its small penetration reported like any
+/// other.
+#[derive(Default)]
+struct Pulled(Vec<((usize, usize), Vec<(usize, usize)>, f64)>);
+
+impl Pulled {
+    fn sorted(entries: &[(usize, usize)]) -> Vec<(usize, usize)> {
+        let mut set = entries.to_vec();
+        set.sort_unstable();
+        set
+    }
+
+    /// `entry` was released, leaving `entries` active, at step length `length`.
+    fn record(&mut self, entry: (usize, usize), entries: &[(usize, usize)], length: f64) {
+        self.0.push((entry, Self::sorted(entries), length));
+    }
+
+    /// Whether `entry`, penetrating with `entries` active at `length`, closes such a cycle.
+    fn cycles(&self, entry: (usize, usize), entries: &[(usize, usize)], length: f64) -> bool {
+        let now = Self::sorted(entries);
+        (self.0.iter()).any(|(e, set, h)| *e == entry && *set == now && *h == length)
+    }
+}
+
 /// The passes of a contact step before it is given up as unsettled; in its second half a
 /// cycling friction status is accepted as it stands, and with `ContactState::accept_cycles`
 /// an entry that cycles between tension and penetration stays open.
@@ -281,14 +309,7 @@ impl ContactState {
         let mut length = length;
         let mut split = false;
         let mut warm: Option<Vec<f64>> = None;
-        // the entries this step released in tension, each with the active set and the step
-        // length it left
-        let mut pulled: Vec<((usize, usize), Vec<(usize, usize)>, f64)> = Vec::new();
-        let sorted = |entries: &[(usize, usize)]| {
-            let mut set = entries.to_vec();
-            set.sort_unstable();
-            set
-        };
+        let mut pulled = Pulled::default();
         for pass in 0..PASSES {
             let nodes: Vec<(usize, usize)> = entries
                 .iter()
@@ -314,9 +335,8 @@ impl ContactState {
                 .filter(|i| normal[*i] < 0.0)
                 .min_by(|a, b| normal[*a].total_cmp(&normal[*b]))
             {
-                let entry = entries[worst];
-                entries.remove(worst);
-                pulled.push((entry, sorted(&entries), length));
+                let entry = entries.remove(worst);
+                pulled.record(entry, &entries, length);
                 slips.remove(worst);
                 forces = normal.to_vec();
                 forces.remove(worst);
@@ -325,15 +345,8 @@ impl ContactState {
             let end = |n: usize| [start[n][0] + d[2 * n], start[n][1] + d[2 * n + 1]];
             let (mut penetrating, alpha) = first_event((&at_start, pairs), start, &end, &entries);
             if self.accept_cycles && pass >= PASSES / 2 {
-                // held, the entry pulls; free, it penetrates, the others as they were when it
-                // was released: the two statuses cycle (seen with friction under HHT, an entry
-                // at a corner, 28 nm inside, at every step length the cuts tried). As the last
-                // resort before the run stops, the entry stays open, its small penetration
-                // reported like any other
-                let now = sorted(&entries);
-                penetrating.retain(|e| {
-                    !(pulled.iter()).any(|(p, set, h)| p == e && *set == now && *h == length)
-                });
+                // the last resort before the run stops (`Pulled`)
+                penetrating.retain(|e| !pulled.cycles(*e, &entries, length));
             }
             if penetrating.is_empty() {
                 // friction: Greco's return targets from this (frictionless) slip, once per
