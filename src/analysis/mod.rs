@@ -132,14 +132,11 @@ pub fn threads_for(model: &Model, available: usize, user_set: bool) -> usize {
     if !model.is_explicit() || user_set {
         return available;
     }
-    let reduced = matches!(&model.analysis,
-        crate::scene::model::Analysis::Dynamic(d) if d.quadrature == crate::scene::spec::Quadrature::Reduced);
+    let one_point = model.analysis.one_point();
     let points: usize = (model.bodies.iter())
-        .map(|b| b.elements() * if reduced { 1 } else { b.points_per_element() })
+        .map(|b| b.elements() * if one_point { 1 } else { b.points_per_element() })
         .sum();
-    (points / POINTS_PER_THREAD_EXPLICIT)
-        .clamp(2, available.max(2))
-        .min(available)
+    (points / POINTS_PER_THREAD_EXPLICIT).max(2).min(available)
 }
 
 /// The element count from which `model` runs on the pool.

@@ -99,13 +99,6 @@ pub struct Settled {
 #[derive(Debug, Clone, Copy)]
 pub struct Unsettled;
 
-impl Unsettled {
-    /// Whether a step's failure `reason` is this one.
-    pub fn is(reason: &str) -> bool {
-        reason == Unsettled.to_string()
-    }
-}
-
 impl std::fmt::Display for Unsettled {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "the contact active set did not settle in 100 passes")
@@ -189,7 +182,14 @@ enum Slip {
 /// (`ContactState::accept_cycles`) it stays open, its small penetration reported like any
 /// other.
 #[derive(Default)]
-struct Pulled(Vec<((usize, usize), Vec<(usize, usize)>, f64)>);
+struct Pulled(Vec<Release>);
+
+/// One release in tension: the entry, the active set it left (sorted) and the step length.
+struct Release {
+    entry: (usize, usize),
+    left: Vec<(usize, usize)>,
+    length: f64,
+}
 
 impl Pulled {
     fn sorted(entries: &[(usize, usize)]) -> Vec<(usize, usize)> {
@@ -200,13 +200,18 @@ impl Pulled {
 
     /// `entry` was released, leaving `entries` active, at step length `length`.
     fn record(&mut self, entry: (usize, usize), entries: &[(usize, usize)], length: f64) {
-        self.0.push((entry, Self::sorted(entries), length));
+        let left = Self::sorted(entries);
+        self.0.push(Release {
+            entry,
+            left,
+            length,
+        });
     }
 
     /// Whether `entry`, penetrating with `entries` active at `length`, closes such a cycle.
     fn cycles(&self, entry: (usize, usize), entries: &[(usize, usize)], length: f64) -> bool {
         let now = Self::sorted(entries);
-        (self.0.iter()).any(|(e, set, h)| *e == entry && *set == now && *h == length)
+        (self.0.iter()).any(|r| r.entry == entry && r.left == now && r.length == length)
     }
 }
 

@@ -577,6 +577,12 @@ impl Analysis {
             Analysis::Dynamic(s) => s.mass_scaling.as_ref(),
         }
     }
+
+    /// Whether central difference's Quad4 kernel is the one-point one (`quadrature =
+    /// "reduced"`).
+    pub fn one_point(&self) -> bool {
+        matches!(self, Analysis::Dynamic(d) if d.quadrature == crate::scene::spec::Quadrature::Reduced)
+    }
 }
 
 #[derive(Debug, Clone)]

@@ -170,6 +170,5 @@ pub(super) fn error_column(model: &Model) -> bool {
 }
 
 pub(super) fn hourglass_column(model: &Model) -> bool {
-    matches!(&model.analysis, crate::scene::model::Analysis::Dynamic(d)
-        if d.quadrature == crate::scene::spec::Quadrature::Reduced)
+    model.analysis.one_point()
 }

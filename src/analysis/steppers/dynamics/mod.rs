@@ -28,7 +28,6 @@ use super::newton::{Constraints, Counters, Inertia, Solution, Step, StepFailure}
 use super::{StepError, Stepper, loads};
 use crate::analysis::summary::RunError;
 use crate::assembly::{self, Evaluation, Mass, State, StepIncrement, System, check_mass};
-use crate::contact::step::Unsettled;
 use crate::contact::{ContactResult, ContactState, ImpactMotion, Interfaces, LumpedMass, Pass};
 use crate::integrator::{
     Advance, GeneralizedAlpha, Houbolt, Integrator, MotionState, StepForm, Wilson,
@@ -781,20 +780,22 @@ impl Stepper for Dynamics<'_> {
                     }
                     return Ok(());
                 }
-                Err(StepFailure(reason)) => {
+                Err(failure) => {
                     crate::output::console::iteration(format_args!(
-                        "  newton: the step to t = {} is cut: {reason}",
-                        readable(target)
+                        "  newton: the step to t = {} is cut: {}",
+                        readable(target),
+                        failure.0
                     ));
                     self.method.reject();
                     if let Err(why) = self.control.reject(nominal, counters) {
-                        if Unsettled::is(&reason) && !self.contact.accept_cycles {
+                        if failure.unsettled() && !self.contact.accept_cycles {
                             // the last resort, at the same length: an entry cycling between
                             // tension and penetration stays open (theory 8.3)
                             self.contact.accept_cycles = true;
                             continue;
                         }
-                        let message = format!("step to t = {} {why}: {reason}", readable(target));
+                        let message =
+                            format!("step to t = {} {why}: {}", readable(target), failure.0);
                         return Err(StepError::diverged(message));
                     }
                 }

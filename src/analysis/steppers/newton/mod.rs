@@ -79,6 +79,11 @@ impl StepFailure {
     pub fn ran_out(&self) -> bool {
         self.0.starts_with(NOT_CONVERGED)
     }
+
+    /// Whether the contact active set did not settle (`Unsettled`).
+    pub fn unsettled(&self) -> bool {
+        self.0 == Unsettled.to_string()
+    }
 }
 
 impl From<Unsettled> for StepFailure {
