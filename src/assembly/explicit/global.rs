@@ -154,9 +154,15 @@ impl Global {
     }
 }
 
-/// Elements a task of the estimate's product takes, and vector entries a task of its
-/// updates.
+/// Vector entries a block of the estimate's dot products sums (the blocks fix the order of
+/// the additions, and so the bits).
 const TASK: usize = 2048;
+
+/// Elements, nodes or vector entries a task of the loops whose entries do not depend on how
+/// they are split (the product, the updates) takes at least: short enough that a mesh of a
+/// few thousand elements shares them between two threads (with 2048 such a mesh's estimate
+/// ran on the stepping thread alone).
+const SPLIT: usize = 256;
 
 /// A global node's entries in the element contributions of `Product`, in element order: the
 /// offsets 8 e + 2 a of its elements e (a: its place in e), node n's at
@@ -207,7 +213,7 @@ impl Product<'_> {
         contributions
             .par_chunks_mut(8)
             .enumerate()
-            .with_min_len(TASK)
+            .with_min_len(SPLIT)
             .for_each(|(e, c)| {
                 let Some(k) = self.stiffness[e].as_ref() else {
                     c.fill(0.0);
@@ -225,7 +231,7 @@ impl Product<'_> {
         let (start, offsets) = (&self.entries.start, &self.entries.offsets);
         out.par_chunks_mut(2)
             .enumerate()
-            .with_min_len(TASK)
+            .with_min_len(SPLIT)
             .for_each(|(n, d)| {
                 let (mut x, mut y) = (0.0, 0.0);
                 for &o in &offsets[start[n]..start[n + 1]] {
@@ -276,7 +282,7 @@ pub fn lanczos(
                 break (theta, residual, s);
             }
         }
-        basis.push(w.par_iter().with_min_len(TASK).map(|v| v / b).collect());
+        basis.push(w.par_iter().with_min_len(SPLIT).map(|v| v / b).collect());
     };
     let (theta, residual, s) = ritz;
     let mut vector = vec![0.0; n];
@@ -351,8 +357,8 @@ fn dots(w: &[f64], basis: &[Vec<f64>]) -> Vec<f64> {
 
 /// w -= sum_q c_q q, each entry taking the q in basis order.
 fn subtract(w: &mut [f64], c: &[f64], basis: &[Vec<f64>]) {
-    w.par_chunks_mut(TASK).enumerate().for_each(|(k, w)| {
-        let at = k * TASK;
+    w.par_chunks_mut(SPLIT).enumerate().for_each(|(k, w)| {
+        let at = k * SPLIT;
         for (c, q) in c.iter().zip(basis) {
             w.iter_mut().zip(&q[at..]).for_each(|(w, q)| *w -= c * q);
         }

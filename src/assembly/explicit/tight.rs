@@ -107,17 +107,22 @@ impl Tightness {
     }
 
     /// Takes again the stale ratios among `elements`, whose (undamped) bounds are `bound(e)`,
-    /// with `exact(e)` in parallel.
+    /// with `exact(e)` and its eigenvalue in parallel.
     fn refresh(
         &mut self,
         elements: impl Iterator<Item = usize>,
-        bound: impl Fn(usize) -> f64,
+        bound: impl Fn(usize) -> f64 + Sync,
         exact: impl Fn(usize) -> Option<ElementStiffness> + Sync,
     ) {
         let stale: Vec<usize> = elements.filter(|&e| self.stale(e, bound(e))).collect();
-        let fresh: Vec<Option<ElementStiffness>> = stale.par_iter().map(|&e| exact(e)).collect();
-        for (&e, stiffness) in stale.iter().zip(fresh) {
-            self.ratio[e] = Tightness::ratio_of(bound(e), stiffness.as_ref());
+        let fresh: Vec<(f64, Option<ElementStiffness>)> = (stale.par_iter())
+            .map(|&e| {
+                let stiffness = exact(e);
+                (Tightness::ratio_of(bound(e), stiffness.as_ref()), stiffness)
+            })
+            .collect();
+        for (&e, (ratio, stiffness)) in stale.iter().zip(fresh) {
+            self.ratio[e] = ratio;
             self.at[e] = bound(e);
             if let Some(global) = self.global.as_mut() {
                 global.keep(e, stiffness);

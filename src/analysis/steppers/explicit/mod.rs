@@ -13,6 +13,7 @@
 //! energy, the external work, or the internal energy at the first step, whichever is largest).
 
 mod ale;
+mod awake;
 mod projectiles;
 mod start;
 mod subcycling;
@@ -91,6 +92,9 @@ pub struct Explicit<'a> {
     /// The rigid projectiles, whose carrier nodes' DOFs follow the model's in the driver's
     /// vectors (`projectiles`).
     carriers: projectiles::Carriers,
+    /// The pool's other threads kept awake between the step's parallel loops (None: one
+    /// thread).
+    awake: Option<awake::Awake>,
     // the step's vectors, allocated once
     v_half: Vec<f64>,
     du: Vec<f64>,
@@ -172,6 +176,7 @@ impl<'a> Explicit<'a> {
             subcycler,
             mesh_motion: spec.ale.map(|a| ale::MeshMotion::new(model, a)),
             carriers,
+            awake: awake::Awake::new(),
             v_half: vec![0.0; dofs],
             du: vec![0.0; dofs],
             external: vec![0.0; dofs],
@@ -357,6 +362,9 @@ impl Stepper for Explicit<'_> {
     fn advance(&mut self, _: &mut Counters) -> Result<(), StepError> {
         let (model, spec) = (self.model, self.spec);
         let step = self.step + 1;
+        if let Some(awake) = &self.awake {
+            awake.keep();
+        }
         let clock_step = self.clock.next(model, spec, self.state.time, step)?;
         if let Some(sub) = self.subcycler.take() {
             return self.advance_subcycled(sub, clock_step);
