@@ -159,13 +159,16 @@ mod tests {
             let shared = Arc::clone(&awake.shared);
             drop(awake);
             assert!(!DRIVING.get());
+            // the pool kept busy with other work, so that only the run's end sends the
+            // helper away (idle, it would leave anyway)
             let start = Instant::now();
             while shared.present.load(Ordering::Acquire) > 0 {
                 assert!(
                     start.elapsed() < Duration::from_secs(2),
                     "a helper outlived the run"
                 );
-                std::thread::sleep(Duration::from_micros(200));
+                rayon::spawn(|| std::thread::sleep(Duration::from_micros(100)));
+                std::thread::sleep(Duration::from_micros(50));
             }
         });
         let single = rayon::ThreadPoolBuilder::new()
