@@ -436,6 +436,11 @@ fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
         model.elements(),
         model.dofs()
     );
+    outln!(
+        "  threads: {} of {} (docs/user-guide.md, \"Threads\")",
+        analysis::run_threads(&model),
+        rayon::current_num_threads()
+    );
     for line in report {
         outln!("  {line}");
     }

@@ -140,6 +140,9 @@ pub struct Timing {
     pub element_updates: u64,
     /// Peak resident memory of the process (bytes, Linux VmHWM), null where unknown.
     pub peak_memory_bytes: Option<u64>,
+    /// The threads of the pool the run stepped on (`analysis::run_threads`).
+    #[serde(default)]
+    pub threads: usize,
 }
 
 /// The counters now.
@@ -155,6 +158,8 @@ pub fn snapshot() -> Timing {
         setup: s(Phase::Setup),
         element_updates: ELEMENT_UPDATES.load(Ordering::Relaxed),
         peak_memory_bytes: peak_memory(),
+        // called inside the run: its pool
+        threads: rayon::current_num_threads(),
     }
 }
 

@@ -955,3 +955,81 @@ fn verbose_says_why_each_cut_was_made() {
         }
     }
 }
+
+/// A plane-strain steel block of 40 x 25 = 1000 elements struck downwards, central
+/// difference for a few steps: the smallest explicit model that runs on the pool.
+const THOUSAND_ELEMENTS: &str = r#"
+[[material]]
+name = "steel"
+young = 200e9
+poisson = 0.3
+density = 7800.0
+
+[[body]]
+name = "block"
+material = "steel"
+formulation = "plane_strain"
+velocity = [0.0, -10.0]
+mesh = { type = "rectangle", width = 0.04, height = 0.025, nx = 40, ny = 25 }
+
+[[support]]
+set = "bottom"
+fix = ["y"]
+
+[analysis]
+type = "dynamic"
+integrator = "central_difference"
+end_time = 2e-7
+
+[output]
+frame_every = 0
+"#;
+
+/// `impact` with `RAYON_NUM_THREADS` set to `threads`.
+fn impact_on(threads: &str, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_impact"))
+        .env("RAYON_NUM_THREADS", threads)
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// Goal: summary.json says how many threads a run stepped on, and `impact check` says it
+/// beforehand: the count the user set for a model on the pool, one below its size.
+/// Setup: a 16-element beam and a 1000-element explicit block, `RAYON_NUM_THREADS=3`.
+/// Reference: the user's 3, and 1 for a model below `PARALLEL_FROM_ELEMENTS_EXPLICIT`
+/// (the documented rule, not the code's count).
+#[test]
+fn the_thread_count_is_reported() {
+    let dir = common::out_dir("cli_threads");
+    for (name, text, expected) in [("beam", BEAM, 1), ("block", THOUSAND_ELEMENTS, 3)] {
+        let scene = write_scene(&dir, name, text);
+        let out = dir.join(name);
+        let o = impact_on(
+            "3",
+            &[
+                "run",
+                scene.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+        );
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(
+            summary["timing"]["threads"], expected,
+            "{name}: summary.json"
+        );
+        let check = impact_on("3", &["check", scene.to_str().unwrap()]);
+        let said = String::from_utf8_lossy(&check.stdout);
+        assert!(
+            said.contains(&format!("threads: {expected} of 3")),
+            "{name}: check says\n{said}"
+        );
+    }
+}

@@ -86,7 +86,7 @@ fn run_from(
     // a small model pays more for handing work to threads than the threads give back: it
     // runs on the calling thread, and an explicit one of a few thousand elements on as many
     // threads as its points keep busy (the results are the same bits either way)
-    let threads = threads_for(model, rayon::current_num_threads(), user_set_threads());
+    let threads = run_threads(model);
     if threads < rayon::current_num_threads() {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -115,6 +115,12 @@ pub const PARALLEL_FROM_ELEMENTS_EXPLICIT: usize = 1000;
 /// aluminium rod of 2400 elements ran fastest on 8 threads (9.65 s against 10.9 s on 16),
 /// while its 2x2 form (9600 points) and the 4000-element Johnson-Cook rod gained up to 16.
 pub const POINTS_PER_THREAD_EXPLICIT: usize = 300;
+
+/// The threads a run of `model` started here steps on ([`threads_for`] of this pool), as
+/// summary.json's `timing.threads` then reports them and `impact check` tells beforehand.
+pub fn run_threads(model: &Model) -> usize {
+    threads_for(model, rayon::current_num_threads(), user_set_threads())
+}
 
 /// Whether the user chose the thread count (`RAYON_NUM_THREADS`).
 fn user_set_threads() -> bool {
