@@ -997,8 +997,8 @@ fn impact_on(threads: &str, args: &[&str]) -> std::process::Output {
 /// Goal: summary.json says how many threads a run stepped on, and `impact check` says it
 /// beforehand: the count the user set for a model on the pool, one below its size.
 /// Setup: a 16-element beam and a 1000-element explicit block, `RAYON_NUM_THREADS=3`.
-/// Reference: the user's 3, and 1 for a model below `PARALLEL_FROM_ELEMENTS_EXPLICIT`
-/// (the documented rule, not the code's count).
+/// Reference: the user's 3, and 1 for the static beam, below the 4000 elements from which
+/// a static run uses the pool (the user guide's rule, not the code's count).
 #[test]
 fn the_thread_count_is_reported() {
     let dir = common::out_dir("cli_threads");
