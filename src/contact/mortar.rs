@@ -48,6 +48,17 @@ pub struct MortarSurface {
     pub hold_master_nodes: bool,
 }
 
+/// A master segment lies across a slave segment when their outward normals are opposed
+/// within 60 degrees (-n_m . n_s above this). A segment turned further is beside the slave rather than across it: the plate's
+/// surface that rises beside a block's flank would otherwise pair with the flank while it
+/// still faces up, and the flank's rows, flipping in and out over Newton's iterates, stopped
+/// the whole-boundary block on Newmark in its first microseconds (docs/theory.md 8.3a).
+const FACING: f64 = 0.5;
+
+/// A slave node is a corner when its two segments' outward normals turn by more than 30
+/// degrees (their cosine below this).
+const CORNER: f64 = 0.866;
+
 /// The two-point Gauss rule on [0, 1]: positions and weights.
 const GAUSS: [(f64, f64); 2] = [
     (0.211_324_865_405_187_1, 0.5),
@@ -115,10 +126,13 @@ pub(super) fn weighted<T: Scalar>(
     let own = &own[..count];
     let mut master_normal = [zero; 2];
     let mut masters: Vec<(usize, T)> = Vec::with_capacity(4);
-    // D_jj over the whole support, and int Phi_j dA over the overlaps
+    // D_jj over the whole support, and int Phi_j dA over the overlaps; per own segment, its
+    // D part, its int Phi_j dA and its outward normal (`corner`)
     let mut full = zero;
     let mut covered = zero;
-    for [a, b] in own {
+    let mut parts = [(zero, zero, [zero; 2]); 2];
+    for (k, [a, b]) in own.iter().enumerate() {
+        let covered_before = covered;
         let (xa, xb) = (x(*a), x(*b));
         let ab = sub_t(xb, xa);
         let length2 = dot_t(ab, ab);
@@ -149,7 +163,7 @@ pub(super) fn weighted<T: Scalar>(
                 continue;
             }
             let across = outward_t(xp, xq);
-            if dot_t(across, facing).re() >= 0.0 {
+            if dot_t(across, facing).re() >= -FACING {
                 continue;
             }
             let (eta_p, eta_q) = (along_p / length2, along_q / length2);
@@ -175,7 +189,9 @@ pub(super) fn weighted<T: Scalar>(
                 master_normal[1] + overlap * across[1],
             ];
         }
+        parts[k] = (d, covered - covered_before, facing);
     }
+    let (slave_normal, full) = corner(&parts[..count]).unwrap_or((slave_normal, full));
     let share = covered / full;
     if !(share.re() > 0.0) {
         return None;
@@ -207,6 +223,40 @@ pub(super) fn weighted<T: Scalar>(
         masters,
         share,
     })
+}
+
+/// The normal and D_j of a corner node from its segments' `parts` (D part, int Phi_j dA over
+/// the overlaps, outward normal), or None for a node that is not a corner (one segment, or
+/// two turning by less than 30 degrees: its normal and D_j stay the whole support's). At a
+/// corner each segment counts in proportion to how much of it a master covers, in full from
+/// half its D part on: a face with nothing across it (a block's flank while its bottom
+/// strikes) neither tilts the node's normal towards itself nor dilutes its share, so the
+/// corner node is the end of the face in contact, as it is when the slave set is that face
+/// alone; a face that comes into contact enters gradually.
+fn corner<T: Scalar>(parts: &[(T, T, [T; 2])]) -> Option<([T; 2], T)> {
+    let [(_, _, n0), (_, _, n1)] = parts else {
+        return None;
+    };
+    if dot_t(*n0, *n1).re() >= CORNER {
+        return None;
+    }
+    let zero = T::from(0.0);
+    let mut normal = [zero; 2];
+    let mut full = zero;
+    for (d, covered, outward) in parts {
+        let ratio = *covered / *d * 2.0;
+        let w = if ratio.re() >= 1.0 {
+            T::from(1.0)
+        } else if ratio.re() > 0.0 {
+            ratio
+        } else {
+            continue;
+        };
+        normal = [normal[0] - w * outward[0], normal[1] - w * outward[1]];
+        full += w * *d;
+    }
+    let l = dot_t(normal, normal).sqrt();
+    (l.re() > 0.0).then(|| ([normal[0] / l, normal[1] / l], full))
 }
 
 /// The overlap [low, high] of the master's projections `eta_p`, `eta_q` with [0, 1].
@@ -486,5 +536,41 @@ mod tests {
         assert!(
             master_node_gap(&surface.edges, &master, 3, MASTER_ALLOWANCE, &x(&nodes)).is_none()
         );
+    }
+
+    /// Goal: a corner of the slave surface whose one face strikes a flat master (a block's
+    /// bottom-left corner on its whole boundary, the flank free) is the end of that face:
+    /// its gap is its height above the master, along the master's normal, with the full
+    /// share, whether the corner is above or inside the master. Reference: plane geometry
+    /// (a flat master y = 0, solid below; the corner at (0, h) with its bottom edge along +x
+    /// and its flank along +y): g = h, n = (0, 1), as the bottom edge alone gives. Without
+    /// the corner rule the normal was the mean of the bottom's and the flank's, (0.38, 0.92),
+    /// and the share 2/3: g = 0.62 h.
+    #[test]
+    fn a_corner_whose_flank_is_free_is_the_end_of_its_face() {
+        // slave: flank 2 -> 0 (down the left side), bottom 0 -> 1; the solid on their left
+        let surface = MortarSurface {
+            edges: vec![[2, 0], [0, 1]],
+            axisymmetric: false,
+            hold_master_nodes: false,
+        };
+        // master y = 0 from x = 1 to x = -1 (solid below), its segments 6-3-4-5-7
+        let master = [[6, 3], [3, 4], [4, 5], [5, 7]];
+        for h in [1e-6, -1e-5, -5e-5] {
+            let nodes = [
+                [0.0, h],
+                [0.5e-3, h],
+                [0.0, 0.25e-3 + h],
+                [0.5e-3, 0.0],
+                [0.0, 0.0],
+                [-0.5e-3, 0.0],
+                [1.0e-3, 0.0],
+                [-1.0e-3, 0.0],
+            ];
+            let g = weighted_gap(&surface, &master, 0, &|n: usize| nodes[n]).expect("a gap");
+            assert_relative_eq!(g.gap, h, max_relative = 1e-12);
+            assert_relative_eq!(g.normal[1], 1.0, max_relative = 1e-12);
+            assert_relative_eq!(g.weight, 1.0, max_relative = 1e-12);
+        }
     }
 }
