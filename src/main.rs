@@ -441,7 +441,7 @@ fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
         analysis::run_threads(&model),
         rayon::current_num_threads()
     );
-    for line in report {
+    for line in analysis::check::roles(&model).into_iter().chain(report) {
         outln!("  {line}");
     }
     if model.bodies.iter().all(|b| b.material.density > 0.0) {

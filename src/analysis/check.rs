@@ -36,6 +36,21 @@ pub enum StepStability {
     WilsonBelowLimit { dt: f64, dt_crit_explicit: f64 },
 }
 
+/// Per contact pair between two bodies, which surface is the slave and why: the code's
+/// choice (`scene::roles`) or a balanced pair's two passes.
+pub fn roles(model: &Model) -> Vec<String> {
+    (model.contacts.iter())
+        .filter_map(|pair| match &pair.chosen_roles {
+            Some(why) => Some(format!("contact `{}`: {why}", pair.name)),
+            None if pair.options.balanced && pair.balances.is_none() => Some(format!(
+                "contact `{}`: balanced, each surface the slave of the other (docs/theory.md 8.3d)",
+                pair.name
+            )),
+            None => None,
+        })
+        .collect()
+}
+
 /// Element updates per second per core of the explicit kernels through the whole driver,
 /// as `impact bench` measured them on the 2-core development machine (docs/performance.md:
 /// one-point 5.2-5.9e6 on the rod pair and rod, 2x2 with J2 1.9e6; Johnson-Cook is slower):

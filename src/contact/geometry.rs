@@ -186,6 +186,10 @@ pub struct ContactPair {
     /// A pass of a body's contact with itself (`own`): which of its own segments a slave
     /// may meet and on which side of them it is inside; None between two bodies.
     pub own: Option<OwnSurface>,
+    /// Why the pair has its roles, where the code chose them (a one-pass pair between two
+    /// bodies whose scene names none: `impact check` says it); None where the scene's roles
+    /// stand.
+    pub chosen_roles: Option<String>,
 }
 
 /// How a pair's gaps and rows are written (docs/theory.md 8.3, 8.3a). The passes of a
@@ -858,6 +862,7 @@ pub(super) mod tests {
             balances: None,
             own: None,
             discretization: Discretization::NodeToSegment,
+            chosen_roles: None,
         }
     }
 

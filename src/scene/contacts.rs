@@ -5,6 +5,7 @@
 use super::InputError;
 use super::context::{Context, body_index, edge_set, node_set, positive};
 use super::model::{Body, BodyKind};
+use super::roles::with_roles;
 use super::spec::{
     AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Roles, Scene, SurfaceSpec,
 };
@@ -22,15 +23,21 @@ pub(super) fn contacts(
     bodies: &[Body],
     obstacles: &[Obstacle],
 ) -> Result<Vec<ContactPair>, InputError> {
-    let contacts = scene
-        .contact
-        .iter()
-        .enumerate()
-        .map(|entry| contact(cx, bodies, obstacles, entry, scene))
+    // each pair with the roles it runs with (the code's where the scene names none)
+    let specs = (scene.contact.iter().enumerate())
+        .map(|entry| with_roles(cx, bodies, entry, scene))
+        .collect::<Result<Vec<_>, _>>()?;
+    let contacts = (specs.iter().enumerate())
+        .map(|(k, (spec, why))| {
+            let mut pair = contact(cx, bodies, obstacles, (k, spec), scene)?;
+            pair.chosen_roles = why.clone();
+            Ok(pair)
+        })
         .collect::<Result<Vec<_>, _>>()?;
     refuse_repeated_pairs(cx, &contacts)?;
     let mut contacts = contacts;
-    for (k, spec) in scene.contact.iter().enumerate() {
+    for (k, (spec, _)) in specs.iter().enumerate() {
+        let spec: &ContactSpec = spec;
         if spec.two_pass {
             let reverse = reverse_pair(cx, bodies, k, spec, &contacts[k])?;
             contacts.push(reverse);
@@ -193,6 +200,7 @@ fn contact(
         balances: None,
         own,
         discretization: mortar.map_or(Discretization::NodeToSegment, Discretization::Mortar),
+        chosen_roles: None,
     })
 }
 
@@ -260,7 +268,7 @@ fn symmetric(
     ];
     match spec.roles {
         None => Ok(explicit(scene) && between_bodies && one_pass.iter().all(|(on, _)| !on)),
-        Some(Roles::AsWritten) => Ok(false),
+        Some(Roles::AsWritten | Roles::Automatic) => Ok(false),
         Some(Roles::Symmetric) => {
             if !explicit(scene) {
                 return Err(cx.err(format!(
@@ -438,6 +446,7 @@ fn reverse_pair(
         discretization: Discretization::NodeToSegment,
         balances: None,
         own: None,
+        chosen_roles: None,
         covered: Some(Covered {
             pair: k,
             slaves: {

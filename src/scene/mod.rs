@@ -15,6 +15,7 @@ mod obstacles;
 pub mod overrides;
 mod probes;
 mod reference;
+mod roles;
 pub mod spec;
 pub mod validate;
 

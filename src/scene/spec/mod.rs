@@ -363,7 +363,7 @@ pub struct ContactSpec {
     /// `node_to_segment` (each slave node against the master) or `mortar` (segment-to-segment:
     /// the gap weighted over the slave surface; a slave and a master edge set on two
     /// deformable bodies). Default: `mortar` for such a pair in a dynamic analysis with one
-    /// pass (`roles = "as_written"`: the implicit integrators, or by choice), and
+    /// pass (the implicit integrators, or `roles = "as_written"` or `"automatic"`), and
     /// `node_to_segment` otherwise (a balanced pair's two passes, statics, obstacles,
     /// node-to-node, `two_pass`).
     pub discretization: Option<ContactDiscretization>,
@@ -377,8 +377,9 @@ pub struct ContactSpec {
     /// Which surface is the slave of a pair between two bodies' edge sets: `symmetric` (a
     /// balanced pair: each surface the slave of the other in a pass of its own, node to
     /// segment, the explicit correction the mean of the two; the default under central
-    /// difference, refused elsewhere) or `as_written` (one pass: the slave set the slave;
-    /// the default on the implicit and static paths).
+    /// difference, refused elsewhere), `automatic` (one pass, the slave chosen by the code:
+    /// the default on the implicit and static paths) or `as_written` (one pass: the slave
+    /// set the slave).
     pub roles: Option<Roles>,
 }
 
@@ -391,6 +392,9 @@ pub enum Roles {
     Symmetric,
     /// The slave set is the slave, the master set the master (one pass).
     AsWritten,
+    /// One pass, the slave chosen by the code: the shorter surface, else the finer, else the
+    /// body listed later (`scene::roles`); the default on the implicit and static paths.
+    Automatic,
 }
 
 /// How a contact pair's constraints are discretized.

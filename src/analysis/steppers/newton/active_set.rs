@@ -495,6 +495,7 @@ mod tests {
                 persistency: false,
                 balanced: false,
             },
+            chosen_roles: None,
             covered: None,
             balances: None,
             own: None,
