@@ -252,12 +252,7 @@ fn symmetric(
     scene: &Scene,
 ) -> Result<bool, InputError> {
     let key = format!("contact[{k}] (`{}`).roles", spec.name);
-    let edge_set_of = |surface: &SurfaceSpec| {
-        surface.normal.is_none()
-            && body_index(cx, bodies, surface.body.as_deref(), &key)
-                .is_ok_and(|b| bodies[b].mesh.edge_sets.contains_key(&surface.set))
-    };
-    let between_bodies = spec.master.as_ref().is_some_and(edge_set_of) && edge_set_of(&spec.slave);
+    let between_bodies = edge_sets_on_both(cx, bodies, spec).is_some();
     let one_pass = [
         (spec.two_pass, "`two_pass`"),
         (
@@ -288,6 +283,25 @@ fn symmetric(
             Ok(true)
         }
     }
+}
+
+/// The slave's and the master's bodies of pair `spec` when both its surfaces are edge sets
+/// of bodies (the same body for a body's contact with itself); None otherwise (an obstacle,
+/// a node-to-node master, a node set).
+pub(super) fn edge_sets_on_both(
+    cx: &Context,
+    bodies: &[Body],
+    spec: &ContactSpec,
+) -> Option<(usize, usize)> {
+    let edge_set_of = |surface: &SurfaceSpec| {
+        let b = body_index(cx, bodies, surface.body.as_deref(), "").ok()?;
+        (surface.normal.is_none() && bodies[b].mesh.edge_sets.contains_key(&surface.set))
+            .then_some(b)
+    };
+    Some((
+        edge_set_of(&spec.slave)?,
+        edge_set_of(spec.master.as_ref()?)?,
+    ))
 }
 
 /// The slave surface of a `discretization = "mortar"` pair (`key`, `spec`): the slave set's

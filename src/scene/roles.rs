@@ -14,6 +14,7 @@
 //!    component is the master).
 
 use super::InputError;
+use super::contacts::edge_sets_on_both;
 use super::context::{Context, edge_set};
 use super::model::Body;
 use super::spec::{ContactSpec, IntegratorKind, Roles, Scene};
@@ -31,7 +32,7 @@ pub(super) fn with_roles<'s>(
     (k, spec): (usize, &'s ContactSpec),
     scene: &Scene,
 ) -> Result<(Cow<'s, ContactSpec>, Option<String>), InputError> {
-    if !chosen_by_the_code(bodies, spec, scene) {
+    if !chosen_by_the_code(cx, bodies, spec, scene) {
         return Ok((Cow::Borrowed(spec), None));
     }
     let Some(master) = &spec.master else {
@@ -65,25 +66,15 @@ pub(super) fn with_roles<'s>(
 /// Whether the code chooses pair `spec`'s roles: `roles = "automatic"`, or `roles` left out
 /// on the implicit and static paths (central difference balances such a pair instead), for
 /// a pair between two bodies' edge sets that is not two-pass.
-fn chosen_by_the_code(bodies: &[Body], spec: &ContactSpec, scene: &Scene) -> bool {
-    let edge_set_of = |surface: &super::spec::SurfaceSpec| {
-        surface.normal.is_none()
-            && surface.body.as_deref().is_some_and(|name| {
-                (bodies.iter().find(|b| b.name == name))
-                    .is_some_and(|b| b.mesh.edge_sets.contains_key(&surface.set))
-            })
-    };
-    let between_bodies = spec.obstacle.is_none()
-        && spec.master.as_ref().is_some_and(edge_set_of)
-        && edge_set_of(&spec.slave)
-        && spec.master.as_ref().and_then(|m| m.body.as_deref()) != spec.slave.body.as_deref();
+fn chosen_by_the_code(cx: &Context, bodies: &[Body], spec: &ContactSpec, scene: &Scene) -> bool {
+    let two_bodies = edge_sets_on_both(cx, bodies, spec).is_some_and(|(s, m)| s != m);
     let explicit = scene.analysis.integrator == Some(IntegratorKind::CentralDifference);
     let asked = match spec.roles {
         Some(Roles::Automatic) => true,
         None => !explicit,
         Some(_) => false,
     };
-    asked && between_bodies && !spec.two_pass
+    asked && two_bodies && !spec.two_pass
 }
 
 /// A contact surface as the rule reads it: its body's name and index, its edge set, its
