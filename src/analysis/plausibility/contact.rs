@@ -79,23 +79,32 @@ pub(super) fn penetration_warning(
     if depth <= bound {
         return None;
     }
+    // what checks both surfaces: a balanced pair under central difference; elsewhere one
+    // pass is all there is
+    let remedy = if model.is_explicit() {
+        "a balanced pair, `roles = \"symmetric\"`, checks both surfaces: the default under \
+         central difference; or refine both surfaces"
+    } else {
+        "the implicit and static paths take one pass (docs/theory.md 8.3d): refine the \
+         surface that was entered where the other body's corners or finer nodes meet it, \
+         or run central difference, whose balanced pair checks both surfaces"
+    };
     let cause = match &summary.contact.deepest {
         Some(d) if !d.slave => unheld_node_cause(model, d, end),
         Some(d) => format!(
             "node {} of body `{}` (a slave) went {} into {} at t = {}: a slave node one-pass \
              contact did not hold, or a master node sinking into the slave body, which one-pass \
-             contact does not see (a balanced pair, `roles = \"symmetric\"`, checks both \
-             surfaces: the default under central difference; or refine both surfaces)",
+             contact does not see ({remedy})",
             d.node,
             d.body,
             readable(d.depth),
             d.into,
             readable(d.time)
         ),
-        None => "a master node sinking into the slave body is not seen by one-pass contact: \
-                 a balanced pair (`roles = \"symmetric\"`, the default under central \
-                 difference) checks both surfaces; or refine both surfaces"
-            .to_string(),
+        None => format!(
+            "a master node sinking into the slave body is not seen by one-pass contact: \
+             {remedy}"
+        ),
     };
     Some(format!(
         "contact: a node went {} deep into the other body, beyond {} (the larger of TOL and {} % \
@@ -145,6 +154,14 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode, end: Option<&[[f64; 2]]>) -
     if end.is_some_and(|x| super::crossings::passed_through_itself(body, x)) {
         return through_own_body_cause(d);
     }
+    let global = body.global(d.node);
+    let master_of = (model.contacts.iter()).find(|p| {
+        matches!(&p.master, Master::Segments { body: m, edges, .. }
+            if *m == b && edges.as_flattened().contains(&global))
+    });
+    if let Some(pair) = master_of {
+        return master_node_cause(model, d, pair);
+    }
     let named: Vec<String> = model
         .contacts
         .iter()
@@ -182,6 +199,38 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode, end: Option<&[[f64; 2]]>) -
         } else {
             sets.join(", ")
         }
+    )
+}
+
+/// The cause of `unheld_node_cause` for a master node of one-pass `pair`: one pass holds the
+/// slave's nodes only, and what mends it depends on the path and on who chose the roles.
+fn master_node_cause(model: &Model, d: &DeepestNode, pair: &ContactPair) -> String {
+    let remedy = match (model.is_explicit(), pair.chosen_roles.is_some()) {
+        (true, _) => {
+            "leave `roles` out: under central difference the pair is then balanced, \
+                      each surface the slave of the other (docs/theory.md 8.3d)"
+        }
+        (false, false) => {
+            "leave `roles` out: the code then makes the shorter surface the \
+                           slave, whose ends the other's corners cannot enter (docs/theory.md \
+                           8.3d), or refine the slave surface where this node meets it"
+        }
+        (false, true) => {
+            "the code chose these roles (`impact check` says why): refine the \
+                          slave surface where this node meets it, or run central difference, \
+                          whose balanced pair checks both surfaces"
+        }
+    };
+    format!(
+        "node {} of body `{}` went {} into {} at t = {}: it is a master node of contact `{}`, \
+         and one pass holds the slave's nodes only, so a master node that enters the slave \
+         body is not seen; {remedy}",
+        d.node,
+        d.body,
+        readable(d.depth),
+        d.into,
+        readable(d.time),
+        pair.name
     )
 }
 
