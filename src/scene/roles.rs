@@ -113,40 +113,29 @@ impl<'s> Surface<'s> {
     }
 }
 
-/// Whether the rule swaps the scene's `slave` and `master`, and why.
+/// Whether the rule swaps the scene's `slave` and `master`, and why: the first measure
+/// (length, then mean edge) on which the two differ makes the smaller one's surface the slave.
 fn rule(slave: &Surface, master: &Surface) -> (bool, String) {
-    let differs = |a: f64, b: f64| a < DIFFERS * b || b < DIFFERS * a;
-    if differs(slave.length, master.length) {
-        let swap = master.length < slave.length;
-        let (short, long) = if swap {
-            (master, slave)
-        } else {
-            (slave, master)
-        };
-        return (
-            swap,
-            format!(
-                "the shorter surface is the slave ({} long against {})",
-                readable(short.length),
-                readable(long.length)
-            ),
-        );
-    }
-    if differs(slave.mean_edge, master.mean_edge) {
-        let swap = master.mean_edge < slave.mean_edge;
-        let (fine, coarse) = if swap {
-            (master, slave)
-        } else {
-            (slave, master)
-        };
-        return (
-            swap,
-            format!(
-                "the surfaces are as long; the finer is the slave (edges of {} against {})",
-                readable(fine.mean_edge),
-                readable(coarse.mean_edge)
-            ),
-        );
+    let steps: [(fn(&Surface) -> f64, &str); 2] = [
+        (
+            |s| s.length,
+            "the shorter surface is the slave ({} long against {})",
+        ),
+        (
+            |s| s.mean_edge,
+            "the surfaces are as long; the finer is the slave (edges of {} against {})",
+        ),
+    ];
+    for (measure, why) in steps {
+        let (a, b) = (measure(slave), measure(master));
+        if a < DIFFERS * b || b < DIFFERS * a {
+            let swap = b < a;
+            let (small, large) = if swap { (b, a) } else { (a, b) };
+            let why = why
+                .replacen("{}", &readable(small), 1)
+                .replacen("{}", &readable(large), 1);
+            return (swap, why);
+        }
     }
     (
         master.body > slave.body,
