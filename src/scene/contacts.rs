@@ -3,7 +3,7 @@
 //! options and friction.
 
 use super::InputError;
-use super::context::{Context, body_index, edge_set, node_set, positive};
+use super::context::{Context, body_index, edge_set, edge_sets_on_both, node_set, positive};
 use super::model::{Body, BodyKind};
 use super::roles::with_roles;
 use super::spec::{
@@ -283,25 +283,6 @@ fn symmetric(
             Ok(true)
         }
     }
-}
-
-/// The slave's and the master's bodies of pair `spec` when both its surfaces are edge sets
-/// of bodies (the same body for a body's contact with itself); None otherwise (an obstacle,
-/// a node-to-node master, a node set).
-pub(super) fn edge_sets_on_both(
-    cx: &Context,
-    bodies: &[Body],
-    spec: &ContactSpec,
-) -> Option<(usize, usize)> {
-    let edge_set_of = |surface: &SurfaceSpec| {
-        let b = body_index(cx, bodies, surface.body.as_deref(), "").ok()?;
-        (surface.normal.is_none() && bodies[b].mesh.edge_sets.contains_key(&surface.set))
-            .then_some(b)
-    };
-    Some((
-        edge_set_of(&spec.slave)?,
-        edge_set_of(spec.master.as_ref()?)?,
-    ))
 }
 
 /// The slave surface of a `discretization = "mortar"` pair (`key`, `spec`): the slave set's

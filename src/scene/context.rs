@@ -3,6 +3,7 @@
 
 use super::InputError;
 use super::model::{Body, BodyKind};
+use super::spec::{ContactSpec, SurfaceSpec};
 use std::path::Path;
 
 /// The scene being validated: every message names its file.
@@ -100,4 +101,23 @@ pub(super) fn edge_set(
         .map(|e| e.map(|n| bodies[b].global(n)))
         .collect();
     Ok((b, global))
+}
+
+/// The slave's and the master's bodies of pair `spec` when both its surfaces are edge sets
+/// of bodies (the same body for a body's contact with itself); None otherwise (an obstacle,
+/// a node-to-node master, a node set).
+pub(super) fn edge_sets_on_both(
+    cx: &Context,
+    bodies: &[Body],
+    spec: &ContactSpec,
+) -> Option<(usize, usize)> {
+    let edge_set_of = |surface: &SurfaceSpec| {
+        let b = body_index(cx, bodies, surface.body.as_deref(), "").ok()?;
+        (surface.normal.is_none() && bodies[b].mesh.edge_sets.contains_key(&surface.set))
+            .then_some(b)
+    };
+    Some((
+        edge_set_of(&spec.slave)?,
+        edge_set_of(spec.master.as_ref()?)?,
+    ))
 }

@@ -14,8 +14,7 @@
 //!    component is the master).
 
 use super::InputError;
-use super::contacts::edge_sets_on_both;
-use super::context::{Context, edge_set};
+use super::context::{Context, edge_set, edge_sets_on_both};
 use super::model::Body;
 use super::spec::{ContactSpec, IntegratorKind, Roles, Scene};
 use crate::output::readable;
@@ -56,10 +55,9 @@ pub(super) fn with_roles<'s>(
         return Ok((Cow::Borrowed(spec), Some(why)));
     }
     let mut swapped = spec.clone();
-    std::mem::swap(
-        &mut swapped.slave,
-        swapped.master.as_mut().expect("a master surface"),
-    );
+    if let Some(master) = swapped.master.as_mut() {
+        std::mem::swap(&mut swapped.slave, master);
+    }
     Ok((Cow::Owned(swapped), Some(why)))
 }
 
