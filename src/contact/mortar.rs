@@ -49,10 +49,11 @@ pub struct MortarSurface {
 }
 
 /// A master segment lies across a slave segment when their outward normals are opposed
-/// within 60 degrees (-n_m . n_s above this). A segment turned further is beside the slave rather than across it: the plate's
-/// surface that rises beside a block's flank would otherwise pair with the flank while it
-/// still faces up, and the flank's rows, flipping in and out over Newton's iterates, stopped
-/// the whole-boundary block on Newmark in its first microseconds (docs/theory.md 8.3a).
+/// within 60 degrees (-n_m . n_s above this). A segment turned further is beside the slave
+/// rather than across it: the plate's surface that rises beside a block's flank would
+/// otherwise pair with the flank while it still faces up, and the flank's rows, flipping in
+/// and out over Newton's iterates, stopped the whole-boundary block on Newmark in its first
+/// microseconds (docs/theory.md 8.3a).
 const FACING: f64 = 0.5;
 
 /// A slave node is a corner when its two segments' outward normals turn by more than 30

@@ -3,7 +3,9 @@
 //! options and friction.
 
 use super::InputError;
-use super::context::{Context, body_index, edge_set, edge_sets_on_both, node_set, positive};
+use super::context::{
+    Context, body_index, edge_lengths, edge_set, edge_sets_on_both, node_set, positive,
+};
 use super::model::{Body, BodyKind};
 use super::roles::with_roles;
 use super::spec::{
@@ -545,18 +547,8 @@ fn balanced_reach(cx: &Context, bodies: &[Body], spec: &ContactSpec) -> f64 {
         let Ok(b) = body_index(cx, bodies, surface.body.as_deref(), "") else {
             return f64::INFINITY;
         };
-        let mesh = &bodies[b].mesh;
-        mesh.edge_sets
-            .get(&surface.set)
-            .map_or(f64::INFINITY, |edges| {
-                edges
-                    .iter()
-                    .map(|[a, b]| {
-                        let (p, q) = (mesh.nodes[*a], mesh.nodes[*b]);
-                        (q[0] - p[0]).hypot(q[1] - p[1])
-                    })
-                    .fold(0.0, f64::max)
-            })
+        edge_lengths(&bodies[b], &surface.set)
+            .map_or(f64::INFINITY, |lengths| lengths.fold(0.0, f64::max))
     };
     let master = spec.master.as_ref().map_or(f64::INFINITY, longest);
     2.0 * longest(&spec.slave).max(master)

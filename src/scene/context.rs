@@ -121,3 +121,17 @@ pub(super) fn edge_sets_on_both(
         edge_set_of(spec.master.as_ref()?)?,
     ))
 }
+
+/// The lengths of the edges of `body`'s edge set `set` in the initial configuration (None:
+/// the body has no such set).
+pub(super) fn edge_lengths<'b>(
+    body: &'b Body,
+    set: &str,
+) -> Option<impl Iterator<Item = f64> + 'b> {
+    let mesh = &body.mesh;
+    let edges = mesh.edge_sets.get(set)?;
+    Some(edges.iter().map(|[a, b]| {
+        let (p, q) = (mesh.nodes[*a], mesh.nodes[*b]);
+        (q[0] - p[0]).hypot(q[1] - p[1])
+    }))
+}

@@ -14,7 +14,7 @@
 //!    component is the master).
 
 use super::InputError;
-use super::context::{Context, edge_set, edge_sets_on_both};
+use super::context::{Context, edge_lengths, edge_set, edge_sets_on_both};
 use super::model::Body;
 use super::spec::{ContactSpec, IntegratorKind, Roles, Scene};
 use crate::output::readable;
@@ -92,21 +92,19 @@ impl<'s> Surface<'s> {
         spec: &'s super::spec::SurfaceSpec,
         key: &str,
     ) -> Result<Surface<'s>, InputError> {
-        let (body, edges) = edge_set(cx, bodies, spec.body.as_deref(), &spec.set, key)?;
+        // the set checked (and a missing one named) as everywhere else
+        let (body, _) = edge_set(cx, bodies, spec.body.as_deref(), &spec.set, key)?;
         let b = &bodies[body];
-        let at = |n: usize| b.mesh.nodes[n - b.node_offset];
-        let length: f64 = (edges.iter())
-            .map(|[p, q]| {
-                let (a, c) = (at(*p), at(*q));
-                (c[0] - a[0]).hypot(c[1] - a[1])
-            })
-            .sum();
+        let (length, count) = edge_lengths(b, &spec.set)
+            .into_iter()
+            .flatten()
+            .fold((0.0, 0usize), |(sum, n), l| (sum + l, n + 1));
         Ok(Surface {
             name: &b.name,
             body,
             set: &spec.set,
             length,
-            mean_edge: length / edges.len().max(1) as f64,
+            mean_edge: length / count.max(1) as f64,
         })
     }
 }

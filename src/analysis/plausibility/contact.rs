@@ -205,21 +205,18 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode, end: Option<&[[f64; 2]]>) -
 /// The cause of `unheld_node_cause` for a master node of one-pass `pair`: one pass holds the
 /// slave's nodes only, and what mends it depends on the path and on who chose the roles.
 fn master_node_cause(model: &Model, d: &DeepestNode, pair: &ContactPair) -> String {
+    const BALANCED: &str = "leave `roles` out: under central difference the pair is then \
+        balanced, each surface the slave of the other (docs/theory.md 8.3d)";
+    const CHOSEN: &str = "leave `roles` out: the code then makes the shorter surface the slave, \
+        whose ends the other's corners cannot enter (docs/theory.md 8.3d), or refine the slave \
+        surface where this node meets it";
+    const ALREADY: &str = "the code chose these roles (`impact check` says why): refine the \
+        slave surface where this node meets it, or run central difference, whose balanced \
+        pair checks both surfaces";
     let remedy = match (model.is_explicit(), pair.chosen_roles.is_some()) {
-        (true, _) => {
-            "leave `roles` out: under central difference the pair is then balanced, \
-                      each surface the slave of the other (docs/theory.md 8.3d)"
-        }
-        (false, false) => {
-            "leave `roles` out: the code then makes the shorter surface the \
-                           slave, whose ends the other's corners cannot enter (docs/theory.md \
-                           8.3d), or refine the slave surface where this node meets it"
-        }
-        (false, true) => {
-            "the code chose these roles (`impact check` says why): refine the \
-                          slave surface where this node meets it, or run central difference, \
-                          whose balanced pair checks both surfaces"
-        }
+        (true, _) => BALANCED,
+        (false, false) => CHOSEN,
+        (false, true) => ALREADY,
     };
     format!(
         "node {} of body `{}` went {} into {} at t = {}: it is a master node of contact `{}`, \
