@@ -99,19 +99,21 @@ impl<S: Stepper> Run<'_, S> {
         })
     }
 
-    /// Why a dynamic run fails at this step: energy created. (1) The guarded pairs' work,
-    /// friction's included (energy taken up by the interfaces, theory 7), is below a share
-    /// of the energy in play (`contact_gave`): the pairs named. Elsewhere the implicit
-    /// contact work is the trapezoidal work of the multipliers, which gives energy back for a
-    /// while and takes it again (two bars without impact conditions: -5 % at t = 0.01), and
-    /// Wilson's interpolated step is not what it books (a plastic block on a floor: -67 %). (2) On every dynamic path, the balance has gained
-    /// more than `analysis.energy_gain_limit` of the energy in play: the bodies hold more than
-    /// they were given and the sinks took, whoever made it. (3) On every dynamic path, the
-    /// plastic work exceeds the energy supplied by more than that share (an implicit pair
-    /// whose work went negative closes the balance while it makes the energy). None
-    /// otherwise, and in statics
-    /// (whose balance measures the trapezoidal rule's error along a load path, not energy
-    /// made).
+    /// Why a dynamic run fails at this step: energy created.
+    /// (1) The guarded pairs' work, friction's included (energy taken up by the interfaces,
+    /// theory 7), is below a share of the energy in play (`contact_gave`): the pairs named.
+    /// Elsewhere the implicit contact work is the trapezoidal work of the multipliers, which
+    /// gives energy back for a while and takes it again (two bars without impact conditions:
+    /// -5 % at t = 0.01), and Wilson's interpolated step is not what it books (a plastic
+    /// block on a floor: -67 %).
+    /// (2) On every dynamic path, the balance has gained more than
+    /// `analysis.energy_gain_limit` of the energy in play: the bodies hold more than they
+    /// were given and the sinks took, whoever made it.
+    /// (3) On every dynamic path, the plastic work exceeds the energy supplied by more than
+    /// that share (an implicit pair whose work went negative closes the balance while it
+    /// makes the energy).
+    /// None otherwise, and in statics (whose balance measures the trapezoidal rule's error
+    /// along a load path, not energy made).
     pub(super) fn energy_created(&self) -> Option<String> {
         let Analysis::Dynamic(analysis) = &self.model.analysis else {
             return None;
