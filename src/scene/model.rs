@@ -662,10 +662,10 @@ impl Model {
     /// every step (`Run::energy_created`): on central difference, and on the implicit
     /// integrators whose balance is guarded by default (not the linear acceleration method,
     /// Wilson-theta or Houbolt, whose full-step energy is not their invariant) with the
-    /// seeds' contact treatment (`contact_dynamics = "hughes"`), where only the mortar pairs
-    /// and their holds are read (`guards_pair`). The balance alone misses energy that the
-    /// contact makes where the bodies take it up as plastic work or an integrator's damping
-    /// takes as much.
+    /// seeds' contact treatment (`contact_dynamics = "hughes"`) and a pair that `guards_pair`
+    /// names (the mortar pairs and their holds, the only ones read there). The balance alone
+    /// misses energy that the contact makes where the bodies take it up as plastic work or an
+    /// integrator's damping takes as much.
     pub fn guards_contact_work(&self) -> bool {
         let Analysis::Dynamic(d) = &self.analysis else {
             return false;
@@ -673,7 +673,10 @@ impl Model {
         match d.integrator {
             IntegratorKind::CentralDifference => true,
             IntegratorKind::Linear | IntegratorKind::Wilson | IntegratorKind::Houbolt => false,
-            _ => d.contact_dynamics == ContactDynamics::Hughes,
+            _ => {
+                d.contact_dynamics == ContactDynamics::Hughes
+                    && self.contacts.iter().any(|p| self.guards_pair(p))
+            }
         }
     }
 

@@ -112,14 +112,22 @@ impl<'s> Surface<'s> {
 /// Whether the rule swaps the scene's `slave` and `master`, and why: the first measure
 /// (length, then mean edge) on which the two differ makes the smaller one's surface the slave.
 fn rule(slave: &Surface, master: &Surface) -> (bool, String) {
-    let steps: [(fn(&Surface) -> f64, &str); 2] = [
+    type Why = fn(String, String) -> String;
+    let steps: [(fn(&Surface) -> f64, Why); 2] = [
         (
             |s| s.length,
-            "the shorter surface is the slave ({} long against {})",
+            |small, large| {
+                format!("the shorter surface is the slave ({small} long against {large})")
+            },
         ),
         (
             |s| s.mean_edge,
-            "the surfaces are as long; the finer is the slave (edges of {} against {})",
+            |small, large| {
+                format!(
+                    "the surfaces are as long; the finer is the slave (edges of {small} against \
+                 {large})"
+                )
+            },
         ),
     ];
     for (measure, why) in steps {
@@ -127,10 +135,7 @@ fn rule(slave: &Surface, master: &Surface) -> (bool, String) {
         if a < DIFFERS * b || b < DIFFERS * a {
             let swap = b < a;
             let (small, large) = if swap { (b, a) } else { (a, b) };
-            let why = why
-                .replacen("{}", &readable(small), 1)
-                .replacen("{}", &readable(large), 1);
-            return (swap, why);
+            return (swap, why(readable(small), readable(large)));
         }
     }
     (
