@@ -155,7 +155,18 @@ impl ContactState {
         for (dof, force) in pair_forces.iter().flatten() {
             step_force[*dof] += force;
         }
-        let increment = |dof: usize| step.du[dof] + 0.5 * c.delta[dof];
+        // the friction's share of the driver's balance f . (du + delta / 2) - delta . F_n / 2
+        // (f = M delta / h^2 at a free DOF, so its share of delta . F_n is f_t h^2 a_n): with
+        // du = h v_n + h^2 a_n / 2, the work of f_t on h v_n + delta / 2, v_n the velocity at
+        // t_n. On du + delta / 2 alone it read the slip on the predicted velocity, which
+        // carries a_n h / 2 more: a first-order excess the normal rows' work gave back
+        let increment = |dof: usize| {
+            let other_forces = match step.inverse_mass[dof] > 0.0 {
+                true => 0.5 * h * h * step.acceleration[dof],
+                false => 0.0,
+            };
+            step.du[dof] + 0.5 * c.delta[dof] - other_forces
+        };
         let carried = |p: usize, row: &[(usize, f64)]| step.carried(p, row);
         let friction_work = self.tangential_work(
             &interfaces.pairs,
@@ -234,6 +245,9 @@ pub struct Predicted<'a> {
     pub start: &'a [[f64; 2]],
     pub du: &'a [f64],
     pub inverse_mass: &'a [f64],
+    /// a_n = M^-1 F_n: the acceleration of the other forces at the step's start, which `du`
+    /// carries (du = h v_n + h^2 a_n / 2; the friction's dissipation is read on v_n).
+    pub acceleration: &'a [f64],
     /// Per pair, the translation of its obstacle in the step (`moving_obstacle_steps`);
     /// empty where no obstacle moves.
     pub obstacle_steps: &'a [[f64; 2]],

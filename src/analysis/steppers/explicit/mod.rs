@@ -197,6 +197,7 @@ impl<'a> Explicit<'a> {
             start: &positions,
             du: &self.du,
             inverse_mass: &self.inverse_mass,
+            acceleration: &self.a,
             obstacle_steps: &obstacle_steps,
         };
         let step = self.contact.explicit_step(&predicted, h, last, time);
