@@ -176,6 +176,60 @@ fn a_finer_plate_is_given_no_energy() {
     );
 }
 
+/// Goal: an element folded by a sharp corner sliding over a finer mesh is named as such, with
+/// the corner, and the remedy the message gives runs the same mesh past the fold.
+/// Setup: models/block_on_plate.toml with the block at [50, -150] m/s, frictionless, the plate
+/// at 240 x 24 (0.167 mm), to 6 us. Reference: the scene's geometry: the block's bottom-right
+/// corner, its node 20 (the bottom row of its 21 x 11 nodes), starts at x = 25 mm over the
+/// plate's top node at x = 25 mm, node 24 x 241 + 150 = 5934; the corner drags that node along
+/// and with the 2x2 kernel the plate element holding it folds when the corner has slid an
+/// element's width (measured 3.4 us; docs/validation.md 4.15). The message names both nodes and
+/// the one-point kernel, and the one-point kernel runs past 6 us. Without the hint the message
+/// names the element alone and the check fails.
+#[test]
+fn a_corner_that_folds_a_finer_plate_is_named() {
+    let sets = [
+        "body.block.velocity=[50.0, -150.0]",
+        "body.plate.mesh.nx=240",
+        "body.plate.mesh.ny=24",
+        "analysis.end_time=6e-6",
+        "output.frame_interval=1",
+    ];
+    let run = |name: &str, extra: &[&str]| {
+        let dir = common::out_dir(name);
+        let mut args = vec![
+            "run",
+            "models/block_on_plate.toml",
+            "--out",
+            dir.to_str().unwrap(),
+        ];
+        args.push("--quiet");
+        for set in sets.iter().chain(extra) {
+            args.extend(["--set", set]);
+        }
+        common::impact(&args)
+    };
+    let folded = run("block_on_plate_corner_fold", &[]);
+    let stderr = String::from_utf8_lossy(&folded.stderr);
+    assert_eq!(folded.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("body `plate`, element"), "{stderr}");
+    assert!(
+        stderr
+            .contains("node 5934 of the element sits on the corner of body `block` (its node 20)"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("analysis.quadrature = \"reduced\""),
+        "{stderr}"
+    );
+    let one_point = run(
+        "block_on_plate_corner_one_point",
+        &["analysis.quadrature=reduced"],
+    );
+    let stderr = String::from_utf8_lossy(&one_point.stderr);
+    assert_eq!(one_point.status.code(), Some(0), "{stderr}");
+}
+
 /// Goal: two like rods striking each other stay each other's mirror image.
 /// Setup: models/rod_on_rod.toml as shipped (two 42CrMo4 rods, 5 x 50 each, at +-287 m/s; the
 /// pair balanced by default).

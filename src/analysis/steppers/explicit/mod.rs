@@ -38,7 +38,7 @@ use super::{
 use crate::analysis::summary::{RunError, Status};
 use crate::assembly::explicit::{ExplicitKernel, PartialKernel, kernel_for};
 use crate::assembly::mass_scaling::{AddedAtRest, NodalMotion};
-use crate::assembly::{ElementMasses, Mass, StableStep, State, check_mass};
+use crate::assembly::{ElementFailure, ElementMasses, Mass, StableStep, State, check_mass};
 use crate::contact::explicit::{Predicted, moving_obstacle_steps};
 use crate::contact::{ContactState, Interfaces};
 use crate::output::readable;
@@ -305,7 +305,7 @@ impl<'a> Explicit<'a> {
             crate::profile::count_elements(kernel.elements());
             kernel.step(&self.state.coordinates, du, h, &mut self.internal[..n])
         })
-        .map_err(|e| e.to_string())?;
+        .map_err(|failure| element_failure_text(self.model, &self.state, du, &failure))?;
         if move_state {
             commit_kernel_step(&mut self.state, du, self.spec.geometry);
         }
@@ -647,4 +647,24 @@ fn partial_of<'k>(kernel: &'k mut Box<dyn ExplicitKernel + '_>) -> &'k mut dyn P
     kernel
         .partial()
         .expect("a subcycled run has a partial kernel")
+}
+
+/// The message of an element that failed in a step's kernel pass, with the cause that a
+/// corner of another body sitting on one of its nodes gives it (`plausibility::fold_hint`),
+/// read at the positions the kernel saw (the state moved by the step's `du`).
+fn element_failure_text(
+    model: &Model,
+    state: &State,
+    du: &[f64],
+    failure: &ElementFailure,
+) -> String {
+    let mut x = state.positions(model.analysis.geometry()).into_owned();
+    for (p, d) in x.iter_mut().zip(du.chunks_exact(2)) {
+        p[0] += d[0];
+        p[1] += d[1];
+    }
+    match crate::analysis::plausibility::fold_hint(model, &x, failure) {
+        Some(hint) => format!("{failure}; {hint}"),
+        None => failure.to_string(),
+    }
 }
