@@ -18,14 +18,12 @@
 
 mod contact;
 mod crossings;
-mod folds;
 mod initial;
 mod setup;
 mod slaves;
 mod units;
 
 pub use contact::{COARSE_CONTACT_NODES, PENETRATION_SHARE, STILL_APPROACHING, past_end_text};
-pub use folds::fold_hint;
 pub use setup::{
     AXIS_TOLERANCE, FRAME_BYTES_PER_NODE, MANY_FRAMES, MIN_STEPS, expected_frames, setup_warnings,
 };

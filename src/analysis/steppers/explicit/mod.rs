@@ -14,6 +14,7 @@
 
 mod ale;
 mod awake;
+mod folds;
 mod projectiles;
 mod start;
 mod subcycling;
@@ -650,7 +651,7 @@ fn partial_of<'k>(kernel: &'k mut Box<dyn ExplicitKernel + '_>) -> &'k mut dyn P
 }
 
 /// The message of an element that failed in a step's kernel pass, with the cause that a
-/// corner of another body sitting on one of its nodes gives it (`plausibility::fold_hint`),
+/// corner of another body sitting on one of its nodes gives it (`folds::fold_hint`),
 /// read at the positions the kernel saw (the state moved by the step's `du`).
 fn element_failure_text(
     model: &Model,
@@ -663,7 +664,7 @@ fn element_failure_text(
         p[0] += d[0];
         p[1] += d[1];
     }
-    match crate::analysis::plausibility::fold_hint(model, &x, failure) {
+    match folds::fold_hint(model, &x, failure) {
         Some(hint) => format!("{failure}; {hint}"),
         None => failure.to_string(),
     }

@@ -22,7 +22,7 @@ const CORNER_TURN: f64 = std::f64::consts::FRAC_PI_4;
 /// positions `x` the kernel saw (global nodes): the corner of a body in contact with the
 /// element's body that carries one of its nodes, and what to do. None when the failure is
 /// not an inverted element or no corner sits on its nodes.
-pub fn fold_hint(model: &Model, x: &[[f64; 2]], failure: &ElementFailure) -> Option<String> {
+pub(super) fn fold_hint(model: &Model, x: &[[f64; 2]], failure: &ElementFailure) -> Option<String> {
     if !matches!(failure.error, KernelError::NegativeJacobian { .. }) {
         return None;
     }
