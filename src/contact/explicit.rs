@@ -161,11 +161,12 @@ impl ContactState {
         // t_n. On du + delta / 2 alone it read the slip on the predicted velocity, which
         // carries a_n h / 2 more: a first-order excess the normal rows' work gave back
         let increment = |dof: usize| {
-            let other_forces = match step.inverse_mass[dof] > 0.0 {
-                true => 0.5 * h * h * step.acceleration[dof],
-                false => 0.0,
+            let held = if step.inverse_mass[dof] > 0.0 {
+                0.5 * h * h * step.acceleration[dof]
+            } else {
+                0.0
             };
-            step.du[dof] + 0.5 * c.delta[dof] - other_forces
+            step.du[dof] + 0.5 * c.delta[dof] - held
         };
         let carried = |p: usize, row: &[(usize, f64)]| step.carried(p, row);
         let friction_work = self.tangential_work(
