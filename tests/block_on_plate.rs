@@ -197,13 +197,8 @@ fn a_corner_that_folds_a_finer_plate_is_named() {
     ];
     let run = |name: &str, extra: &[&str]| {
         let dir = common::out_dir(name);
-        let mut args = vec![
-            "run",
-            "models/block_on_plate.toml",
-            "--out",
-            dir.to_str().unwrap(),
-        ];
-        args.push("--quiet");
+        let mut args = vec!["run", "models/block_on_plate.toml", "--quiet", "--out"];
+        args.push(dir.to_str().unwrap());
         for set in sets.iter().chain(extra) {
             args.extend(["--set", set]);
         }

@@ -5,6 +5,7 @@
 //! (docs/validation.md 4.15, "the 2x2 kernel's limit").
 
 use crate::assembly::ElementFailure;
+use crate::assembly::explicit::tight::shortest_edge;
 use crate::contact::Master;
 use crate::element::KernelError;
 use crate::scene::{Body, Model};
@@ -27,10 +28,9 @@ pub(super) fn fold_hint(model: &Model, x: &[[f64; 2]], failure: &ElementFailure)
         return None;
     }
     let (index, body) = (model.bodies.iter().enumerate()).find(|(_, b)| b.name == failure.body)?;
-    let nodes: Vec<usize> = (body.mesh.cells.nodes_of(failure.element).iter())
-        .map(|&n| body.global(n))
-        .collect();
-    let edge = shortest_edge(x, &nodes);
+    let nodes: [usize; 4] = body.mesh.cells.nodes_of(failure.element).try_into().ok()?;
+    let nodes = nodes.map(|n| body.global(n));
+    let edge = shortest_edge(&nodes.map(|n| x[n]));
     let (node, other, corner) = touching_bodies(model, index).find_map(|other| {
         let other_body = &model.bodies[other];
         corners(other_body, x).find_map(|corner| {
@@ -86,12 +86,6 @@ fn corners<'a>(body: &'a Body, x: &'a [[f64; 2]]) -> impl Iterator<Item = usize>
         let turn = (d1[0] * d2[1] - d1[1] * d2[0]).atan2(d1[0] * d2[0] + d1[1] * d2[1]);
         (turn > CORNER_TURN).then_some(c)
     })
-}
-
-fn shortest_edge(x: &[[f64; 2]], nodes: &[usize]) -> f64 {
-    (0..nodes.len())
-        .map(|k| distance(x[nodes[k]], x[nodes[(k + 1) % nodes.len()]]))
-        .fold(f64::INFINITY, f64::min)
 }
 
 fn distance(p: [f64; 2], q: [f64; 2]) -> f64 {
