@@ -25,6 +25,7 @@
 //! count.
 
 use crate::solver::lanczos::{start_vector, tridiagonal_eigen};
+use multiversion::multiversion;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -209,25 +210,10 @@ struct Product<'a> {
 impl Product<'_> {
     /// `out` = A q, the element contributions written into `contributions` (8 a element).
     fn apply(&self, q: &[f64], out: &mut [f64], contributions: &mut [f64]) {
-        let weight = self.weight;
         contributions
-            .par_chunks_mut(8)
+            .par_chunks_mut(8 * SPLIT)
             .enumerate()
-            .with_min_len(SPLIT)
-            .for_each(|(e, c)| {
-                let Some(k) = self.stiffness[e].as_ref() else {
-                    c.fill(0.0);
-                    return;
-                };
-                let element = self.nodes[e];
-                let s = self.scales[e];
-                let dofs: [usize; 8] = std::array::from_fn(|i| 2 * element[i / 2] as usize + i % 2);
-                let v: [f64; 8] = std::array::from_fn(|i| q[dofs[i]] * weight[dofs[i]]);
-                for i in 0..8 {
-                    let row: f64 = (0..8).map(|j| k.k[i][j] * v[j]).sum();
-                    c[i] = s * row * weight[dofs[i]];
-                }
-            });
+            .for_each(|(b, c)| contributions_from(self, b * SPLIT, q, c));
         let (start, offsets) = (&self.entries.start, &self.entries.offsets);
         out.par_chunks_mut(2)
             .enumerate()
@@ -240,6 +226,29 @@ impl Product<'_> {
                 }
                 d.copy_from_slice(&[x, y]);
             });
+    }
+}
+
+/// The element contributions s_e W K_e W q of the elements from `first` on, 8 each, into
+/// `contributions` (one task's block of `Product::apply`). Compiled twice (module
+/// `explicit`, "Wider registers").
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn contributions_from(product: &Product, first: usize, q: &[f64], contributions: &mut [f64]) {
+    let weight = product.weight;
+    for (i, c) in contributions.chunks_exact_mut(8).enumerate() {
+        let e = first + i;
+        let Some(k) = product.stiffness[e].as_ref() else {
+            c.fill(0.0);
+            continue;
+        };
+        let element = product.nodes[e];
+        let s = product.scales[e];
+        let dofs: [usize; 8] = std::array::from_fn(|i| 2 * element[i / 2] as usize + i % 2);
+        let v: [f64; 8] = std::array::from_fn(|i| q[dofs[i]] * weight[dofs[i]]);
+        for i in 0..8 {
+            let row: f64 = (0..8).map(|j| k.k[i][j] * v[j]).sum();
+            c[i] = s * row * weight[dofs[i]];
+        }
     }
 }
 
@@ -324,7 +333,9 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// a . b over one block (b at least as long as a) in four interleaved sums, which do not wait
-/// on each other's additions as one running sum does.
+/// on each other's additions as one running sum does. Compiled twice (module `explicit`,
+/// "Wider registers").
+#[multiversion(targets("x86_64+avx2+fma"))]
 fn block_dot(a: &[f64], b: &[f64]) -> f64 {
     let mut sums = [0.0; 4];
     let (a4, b4) = (a.chunks_exact(4), b[..a.len()].chunks_exact(4));
@@ -357,12 +368,16 @@ fn dots(w: &[f64], basis: &[Vec<f64>]) -> Vec<f64> {
 
 /// w -= sum_q c_q q, each entry taking the q in basis order.
 fn subtract(w: &mut [f64], c: &[f64], basis: &[Vec<f64>]) {
-    w.par_chunks_mut(SPLIT).enumerate().for_each(|(k, w)| {
-        let at = k * SPLIT;
-        for (c, q) in c.iter().zip(basis) {
-            w.iter_mut().zip(&q[at..]).for_each(|(w, q)| *w -= c * q);
-        }
-    });
+    (w.par_chunks_mut(SPLIT).enumerate()).for_each(|(k, w)| subtract_block(w, k * SPLIT, c, basis));
+}
+
+/// `subtract` on the entries of `w` from `at` on (one task's block). Compiled twice (module
+/// `explicit`, "Wider registers").
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn subtract_block(w: &mut [f64], at: usize, c: &[f64], basis: &[Vec<f64>]) {
+    for (c, q) in c.iter().zip(basis) {
+        w.iter_mut().zip(&q[at..]).for_each(|(w, q)| *w -= c * q);
+    }
 }
 
 #[cfg(test)]

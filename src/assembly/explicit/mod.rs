@@ -12,6 +12,14 @@
 //! `analysis.stable_step = "tight"` each element's bound is made tight by its ratio to the
 //! element's exact frequency (`tight`); `analysis.stable_step = "global"` estimates the
 //! mesh's highest frequency by Lanczos on the element stiffnesses (`global`).
+//!
+//! **Wider registers.** The loops that carry a step's arithmetic (the element steps of a
+//! chunk, the tight step's element stiffnesses, the global estimate's product, dot products
+//! and updates) are compiled twice by `multiversion`: for the baseline x86-64 of the release
+//! build and for the level with AVX2 and FMA, chosen at run time where the processor has it.
+//! Rust never fuses a multiply and an add on its own, so the two builds do the same
+//! operations in the same order and give the same bits (docs/performance.md, "Wider
+//! registers where the processor has them").
 
 pub mod full;
 pub mod general;

@@ -36,6 +36,7 @@ use crate::material::PointState;
 use crate::scene::Model;
 use crate::scene::model::Probe;
 use crate::scene::spec::StableStepKind;
+use multiversion::multiversion;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use std::ops::Deref;
@@ -289,12 +290,7 @@ impl<R: Rule> Skeleton<R> {
         let p = self.parameters(e);
         let fresh = R::fresh(&self.state_of(e));
         let mass = self.mass_of(e);
-        let h = 1e-7 * shortest_edge(xe);
-        let k = stiffness_by_differences(h, |u| {
-            R::step(p, (xe, u), &fresh, mass, (1.0, None))
-                .ok()
-                .map(|r| r.force)
-        })?;
+        let k = stiffness_at::<R>(p, xe, &fresh, mass)?;
         Some(ElementStiffness {
             k,
             lumped: self.lumped_of(e),
@@ -343,10 +339,7 @@ impl<R: Rule> Skeleton<R> {
             .into_par_iter()
             .zip(elements.par_chunks(CHUNK))
             .with_max_len(1)
-            .map(|(mut chunk, list)| {
-                let list = list.iter().map(|e| *e as usize);
-                step_chunk::<R>(&reads, &mut chunk, list, motion, (dt, grow))
-            })
+            .map(|(mut chunk, list)| step_chunk::<R>(&reads, &mut chunk, list, motion, (dt, grow)))
             .collect();
         let scaling = self.scaling.as_mut().filter(|_| grow);
         fold_chunks(results, &self.layout, scaling)
@@ -403,6 +396,24 @@ fn mass_of<R: Rule>(mass: &[R::Mass], scaling: Option<&ElementScaling>, e: usize
     }
 }
 
+/// The stiffness of an element of body `p` at the nodes `xe` in the stress-free state
+/// `fresh` (`Skeleton::exact_stiffness`): the rule's forces differenced. Compiled twice
+/// (module `explicit`, "Wider registers").
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn stiffness_at<R: Rule>(
+    p: &BodyParameters,
+    xe: &Nodes,
+    fresh: &R::State,
+    mass: R::Mass,
+) -> Option<[[f64; 8]; 8]> {
+    let h = 1e-7 * shortest_edge(xe);
+    stiffness_by_differences(h, |u| {
+        R::step(p, (xe, u), fresh, mass, (1.0, None))
+            .ok()
+            .map(|r| r.force)
+    })
+}
+
 /// The columns and the element forces, bounds and damping cut into chunks at the elements
 /// `starts`.
 fn chunks_at<'a, R: Rule>(
@@ -447,19 +458,20 @@ fn chunks_at<'a, R: Rule>(
 
 /// Steps the elements `elements` of `chunk` from the positions and increments `(x, du)`:
 /// their sums in element order, the first that failed, and (with `grow`, under the mass
-/// scaling) the elements whose mass factor grew.
-#[inline(always)]
+/// scaling) the elements whose mass factor grew. Compiled twice (module `explicit`, "Wider
+/// registers").
+#[multiversion(targets("x86_64+avx2+fma"))]
 fn step_chunk<R: Rule>(
     reads: &Reads<R::Mass>,
     chunk: &mut Chunk,
-    elements: impl Iterator<Item = usize>,
+    elements: &[u32],
     (x, du): (&[[f64; 2]], &[f64]),
     (dt, grow): (f64, bool),
 ) -> ChunkResult {
     let layout = reads.layout;
     let mut sums = StepWork::default();
     let mut grown = Vec::new();
-    for e in elements {
+    for e in elements.iter().map(|&e| e as usize) {
         let (xe, ue) = element_motion(layout.nodes[e], x, du);
         let p = &layout.bodies[layout.body[e] as usize];
         let mass = mass_of::<R>(reads.mass, reads.scaling, e);

@@ -208,7 +208,9 @@ fn undamped<'a>(bounds: &'a [f64], damping: &[f64]) -> std::borrow::Cow<'a, [f64
 /// The stiffness of an element's nodal forces `force(u)` (u: a nodal increment from the
 /// stress-free state; forces linear in it) by central differences with step `h` (a small
 /// fraction of the element's shortest edge: the forces are linear to O(h^2 / L^2)). None when
-/// a force could not be formed.
+/// a force could not be formed. (Inlined, so that it takes the target features of its
+/// caller: `skeleton::stiffness_at`.)
+#[inline(always)]
 pub fn stiffness_by_differences(
     h: f64,
     force: impl Fn(&[[f64; 2]; 4]) -> Option<[f64; 8]>,
