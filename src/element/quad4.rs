@@ -22,6 +22,7 @@
 use super::{
     Formulation, GeometricStiffness, KernelError, Mat4, Mat8, Moduli, Strain, Vec8, Voigt,
 };
+use multiversion::multiversion;
 use nalgebra::{Matrix2, SMatrix};
 use std::f64::consts::PI;
 
@@ -215,7 +216,8 @@ fn stretches(theta: &[f64; 4], hoop: f64) -> (Matrix2<f64>, f64) {
 
 /// A point's displacement gradient, strain and B operator, written into `out`, whose
 /// operator entries that stay zero (the hoop row off the axisymmetric case, the v columns of
-/// the hoop row) must be zero already.
+/// the hoop row) must be zero already. Compiled twice, as `tangent` is.
+#[multiversion(targets("x86_64+avx2+fma"))]
 fn point_strain_into(
     p: &PointValues,
     d: &Vec8,
@@ -409,7 +411,10 @@ pub fn internal_force(geom: &QuadValues, kin: &StrainOperators, stress: &[Voigt;
 
 /// Tangent K_T = K_0 + K_sigma (Erklig eqs 32-34), the exact derivative of `internal_force`
 /// for the points' stresses and material moduli dS/dE (`points`); K_sigma only when
-/// `geometric` includes it.
+/// `geometric` includes it. Compiled twice by `multiversion`, for baseline x86-64 and for
+/// AVX2 and FMA, chosen at run time: the same operations in the same order, the same bits
+/// (docs/performance.md, "Wider registers where the processor has them").
+#[multiversion(targets("x86_64+avx2+fma"))]
 pub fn tangent(
     geom: &QuadValues,
     kin: &StrainOperators,
@@ -445,7 +450,9 @@ pub fn tangent(
     kt
 }
 
-/// K_sigma (and B-bar's correction), upper triangle only.
+/// K_sigma (and B-bar's correction), upper triangle only. (Inlined into `tangent`, whose
+/// target features it then takes.)
+#[inline(always)]
 fn add_geometric(geom: &QuadValues, stress: &[Voigt; 4], bbar: bool, kt: &mut Mat8) {
     let axisymmetric = geom.formulation == Formulation::Axisymmetric;
     // the B-bar correction's point matrices M: the vv block's (the in-plane gradients), and
