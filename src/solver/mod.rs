@@ -661,9 +661,15 @@ impl Solver {
     }
 }
 
-/// Empties `factor` and sizes it to `len` zeros, keeping its allocation where it is large
-/// enough (one factor in memory at a time).
+/// Sizes `factor` to `len` entries, keeping its allocation where it is large enough (one
+/// factor in memory at a time). A factor of that length already (the last one's) is kept as
+/// it is: faer's numeric factorizations write every entry of L (the supernodal ones zero
+/// them first themselves, the simplicial ones write each entry of the pattern), so zeroing
+/// it here was a second pass over the whole factor at every factorization.
 fn sized(factor: &mut Vec<f64>, len: usize) -> Result<(), SolverError> {
+    if factor.len() == len {
+        return Ok(());
+    }
     factor.clear();
     factor
         .try_reserve_exact(len)
