@@ -437,9 +437,10 @@ fn check(path: &Path, set: &[String]) -> Result<usize, RunError> {
         model.dofs()
     );
     outln!(
-        "  threads: {} of {} (docs/user-guide.md, \"Threads\")",
+        "  threads: {} of {}, registers: {} (docs/user-guide.md, \"Threads\")",
         analysis::run_threads(&model),
-        rayon::current_num_threads()
+        rayon::current_num_threads(),
+        impact::profile::registers()
     );
     for line in analysis::check::roles(&model).into_iter().chain(report) {
         outln!("  {line}");

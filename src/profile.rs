@@ -143,6 +143,23 @@ pub struct Timing {
     /// The threads of the pool the run stepped on (`analysis::run_threads`).
     #[serde(default)]
     pub threads: usize,
+    /// The build of the loops compiled twice (`registers`) that this processor runs:
+    /// "avx2+fma" or "baseline".
+    #[serde(default)]
+    pub registers: String,
+}
+
+/// Which of the two builds of the multiversioned loops this processor runs (the explicit
+/// element steps, the stable step's estimates, the implicit element tangent;
+/// docs/performance.md, "Wider registers where the processor has them"): "avx2+fma" where
+/// it has both features, the test `multiversion` makes for its target "x86_64+avx2+fma",
+/// else "baseline". The two give the same bits; the name tells timings apart.
+pub fn registers() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        return "avx2+fma";
+    }
+    "baseline"
 }
 
 /// The counters now.
@@ -160,6 +177,7 @@ pub fn snapshot() -> Timing {
         peak_memory_bytes: peak_memory(),
         // called inside the run: its pool
         threads: rayon::current_num_threads(),
+        registers: registers().to_string(),
     }
 }
 

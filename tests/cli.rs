@@ -995,10 +995,12 @@ fn impact_on(threads: &str, args: &[&str]) -> std::process::Output {
 }
 
 /// Goal: summary.json says how many threads a run stepped on, and `impact check` says it
-/// beforehand: the count the user set for a model on the pool, one below its size.
+/// beforehand: the count the user set for a model on the pool, one below its size; both
+/// name the build of the twice-compiled loops the processor runs.
 /// Setup: a 16-element beam and a 1000-element explicit block, `RAYON_NUM_THREADS=3`.
 /// Reference: the user's 3, and 1 for the static beam, below the 4000 elements from which
-/// a static run uses the pool (the user guide's rule, not the code's count).
+/// a static run uses the pool (the user guide's rule, not the code's count); the build
+/// from this processor's features as the standard library detects them.
 #[test]
 fn the_thread_count_is_reported() {
     let dir = common::out_dir("cli_threads");
@@ -1031,5 +1033,24 @@ fn the_thread_count_is_reported() {
             said.contains(&format!("threads: {expected} of 3")),
             "{name}: check says\n{said}"
         );
+        let registers = registers_here();
+        assert_eq!(
+            summary["timing"]["registers"], registers,
+            "{name}: summary.json"
+        );
+        assert!(
+            said.contains(&format!("registers: {registers}")),
+            "{name}: check says\n{said}"
+        );
     }
+}
+
+/// The build of the loops compiled twice that this processor should run: AVX2 and FMA
+/// where it has both (the target the loops are compiled for), else the baseline.
+fn registers_here() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        return "avx2+fma";
+    }
+    "baseline"
 }

@@ -518,6 +518,10 @@ pub fn table(rows: &[Row]) -> String {
             b.updates_per_second
         ));
     }
+    s.push_str(&format!(
+        "registers: {} (the build of the loops compiled twice that this processor runs; docs/performance.md, \"Wider registers where the processor has them\")\n",
+        crate::profile::registers()
+    ));
     s
 }
 
