@@ -1,6 +1,8 @@
 //! Arc-length continuation (`analysis.arc_length`, docs/theory.md 5b): a snap-through and a
 //! plastic collapse traced past their limit points, against their closed forms; the load
-//! stepping's message at a limit load; the scenes arc length refuses.
+//! stepping's message at a limit load; the scenes arc length refuses. Bodies held by their
+//! contact alone and pressed by loads (theory 5c): Hertz's sphere by load stepping and by
+//! arc length, Shield's punch by arc length to its limit.
 
 mod common;
 
@@ -243,9 +245,204 @@ fn arc_length_is_refused_where_it_cannot_apply() {
         curve.contains("load[0]: its curve is not a ramp"),
         "{curve}"
     );
+    // the Hertz sphere is pushed by its flat's displacement, a prescribed motion
     common::check_refuses_with(
         "models/hertz_sphere.toml",
         &["analysis.arc_length={}"],
-        &["analysis.arc_length", "contact"],
+        &["load[0]: a prescribed motion"],
+    );
+    // arc length's contact pairs are frictionless
+    let text = hertz_by_force_text();
+    let edited = text.replace(
+        "obstacle = \"plane\"\n",
+        "obstacle = \"plane\"\nfriction = 0.3\n",
+    );
+    assert_ne!(edited, text, "the edit must change the scene");
+    let arc = ["analysis.arc_length={}".to_string()];
+    let rough = impact::scene::from_str(&edited, std::path::Path::new("rough.toml"), &arc)
+        .map(|_| ())
+        .expect_err("friction under arc length")
+        .to_string();
+    assert!(
+        rough.contains("contact `plane`: arc length takes frictionless pairs only"),
+        "{rough}"
+    );
+}
+
+/// The total force of `hertz_by_force_text`'s pressure on the flat face of radius R = 8:
+/// the force of the displacement-driven scene's last increment (1202.2, validation 4.4).
+const HERTZ_PRESSURE: f64 = 5.979;
+
+/// models/hertz_sphere.toml pressed onto its plane by a pressure `HERTZ_PRESSURE` on its
+/// flat face instead of the flat's prescribed displacement: the sphere is held by the
+/// contact alone (its axis is fixed in x only).
+fn hertz_by_force_text() -> String {
+    let text = std::fs::read_to_string("models/hertz_sphere.toml").unwrap();
+    let edited = text
+        .replace("type = \"displacement\"", "type = \"pressure\"")
+        .replace("y = -0.4", &format!("pressure = {HERTZ_PRESSURE}"));
+    assert_eq!(edited.matches("pressure").count(), 2, "the load edited");
+    edited
+}
+
+/// Goal: a body held by its contact alone and pressed by a load runs, by load stepping and
+/// by arc length: the slaves resting on the obstacle at the start close, and the tangent,
+/// singular by itself (the sphere's rigid motion along the axis), is factored with its
+/// diagonal raised by 1e-8 of itself (theory 5c). Setup: `hertz_by_force_text` (the 830-node
+/// axisymmetric sphere R = 8, E = 1000, nu = 0.3, 8 steps; arc length lands on the load).
+/// References: equilibrium, the contact force equal to the load P = p pi R^2 (to 1e-6: the
+/// Newton tolerance is 1e-8 of the force scale); Hertz for P, a = (3 P R / (4 E*))^(1/3),
+/// p0 = 3 P / (2 pi a^2), the pole pressure from its nodal force over its consistent area
+/// pi h^2 / 3, within 5 % (validation 4.4: the displacement-driven run meets it at -2.9 %
+/// and -0.3 %). Without the closure and the shift both runs stop: "the stiffness matrix is
+/// singular at the y DOF of node 634" (load stepping), no convergence (arc length).
+#[test]
+fn a_sphere_pressed_by_a_load_and_held_by_its_contact_meets_hertz() {
+    let text = hertz_by_force_text();
+    let load = HERTZ_PRESSURE * std::f64::consts::PI * 64.0;
+    for (name, sets) in [
+        ("hertz_load_stepping", &[][..]),
+        ("hertz_arc_length", &["analysis.arc_length={}"][..]),
+    ] {
+        let model = common::model(name, &text, sets);
+        let outcome = analysis::run_outcome(&model, &common::out_dir(name), RunOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let summary = &outcome.summary;
+        assert_eq!(summary.status, Status::Ok, "{name}: {:?}", summary.message);
+        assert_eq!(summary.step_cuts, 0, "{name}");
+        if let Some(arc) = &summary.arc_length {
+            assert!(arc.reached_load, "{name}: {arc:?}");
+        }
+        let force = summary.contact.peak_force;
+        approx::assert_relative_eq!(force, load, max_relative = 1e-6);
+        let (a, p0) = impact::reference::hertz_static(8.0, 1000.0, 0.3, force);
+        let body = &model.bodies[0];
+        let mut arc: Vec<usize> = body.mesh.node_sets["arc"]
+            .iter()
+            .map(|n| body.global(*n))
+            .collect();
+        let x = |n: usize| model.coordinates()[n];
+        arc.sort_by(|a, b| x(*a)[0].total_cmp(&x(*b)[0]));
+        let h = x(arc[1])[0] - x(arc[0])[0];
+        let pole = outcome.contact_force[2 * arc[0] + 1] / (std::f64::consts::PI * h * h / 3.0);
+        eprintln!(
+            "{name}: contact radius {:.4} against {a:.4}, pole pressure {pole:.2} against \
+             {p0:.2}, {} increments, {} iterations",
+            summary.contact.peak_contact_radius, summary.steps, summary.newton_iterations
+        );
+        approx::assert_relative_eq!(summary.contact.peak_contact_radius, a, max_relative = 0.05);
+        approx::assert_relative_eq!(pole, p0, max_relative = 0.05);
+    }
+}
+
+/// The pressure on the bottom of models/shield_punch.toml's cylinder (radius 10 a) whose
+/// total, over the punch's pi a^2, is 1.2 times Shield's mean pressure 2.845 Y: 8.5 MPa.
+const PUNCH_BOTTOM_PRESSURE: f64 = 8.5e6;
+
+/// Goal: the textbook limit load of contact plasticity under load control: Shield's punch
+/// with the cylinder pressed onto it by a pressure on its bottom (held by the punch alone in
+/// y), traced by arc length to its plateau, gives the limit that displacement control gives
+/// (validation 2.9). Setup: models/shield_punch.toml on its coarsest mesh (24 x 20,
+/// meshes/punch0.msh), the bottom's displacement replaced by `PUNCH_BOTTOM_PRESSURE`,
+/// small displacements (Shield's limit is the small-displacement one), 10 steps (the first
+/// increment 1/10 of the load), at most 150 increments. Reference: Shield (1955), 5.69 k
+/// (k = Y / 2). Tolerance: 3 %, the issue's, as the displacement-driven levels assert
+/// (that level reads -1.7 %, still rising); and equilibrium: the punch's force equals the
+/// load factor times the bottom's load, to 1e-6. Median Newton iterations at most 8.
+#[test]
+fn shields_punch_pressed_by_a_load_reaches_its_limit_by_arc_length() {
+    let text = std::fs::read_to_string("models/shield_punch.toml").unwrap();
+    let probe = text.find("[[output.probe]]").expect("the reaction probe");
+    let edited = text[..probe]
+        .replace("type = \"displacement\"", "type = \"pressure\"")
+        .replace("y = 40e-6", &format!("pressure = {PUNCH_BOTTOM_PRESSURE}"))
+        .replace("meshes/punch1.msh", "../models/meshes/punch0.msh");
+    let sets = [
+        "analysis.geometry=linear",
+        "analysis.steps=10",
+        "analysis.arc_length={ max_increments = 150 }",
+    ];
+    let model = common::model("punch_by_load", &edited, &sets);
+    let (summary, _) = common::run("punch_by_load", &model);
+    assert_eq!(summary.status, Status::Ok, "{:?}", summary.message);
+    assert_eq!(summary.step_cuts, 0);
+    let median = summary.newton_iterations_median.expect("a median");
+    assert!(median <= 8.0, "median {median} iterations an increment");
+    let arc = summary.arc_length.as_ref().expect("an arc-length summary");
+    let a = 1e-3;
+    let bottom = PUNCH_BOTTOM_PRESSURE * std::f64::consts::PI * (10.0 * a) * (10.0 * a);
+    let k = 250e6 / 2.0;
+    let limit = arc.peak_load_factor * bottom / (std::f64::consts::PI * a * a) / k;
+    eprintln!(
+        "limit mean pressure {limit:.4} k ({:+.2} % of Shield's 5.69 k), {} increments",
+        100.0 * (limit / 5.69 - 1.0),
+        arc.increments
+    );
+    approx::assert_relative_eq!(limit, 5.69, max_relative = 0.03);
+    let dir = common::out_dir_of("punch_by_load");
+    let factor = common::column(&dir, "load_factor");
+    let punch = common::column(&dir, "contact_force[punch]");
+    let last = factor.len() - 1;
+    approx::assert_relative_eq!(punch[last], factor[last] * bottom, max_relative = 1e-6);
+}
+
+/// A block resting on a frictionless floor (an obstacle), with no support: pressed straight
+/// down, its contact holds it; pushed along the floor too, nothing does.
+const BLOCK_ON_FLOOR: &str = r#"
+[[material]]
+name = "m"
+young = 1000.0
+poisson = 0.3
+
+[[body]]
+name = "block"
+material = "m"
+formulation = "plane_strain"
+mesh = { type = "rectangle", origin = [0.0, 0.0], width = 2.0, height = 1.0, nx = 4, ny = 2 }
+
+[[load]]
+type = "pressure"
+set = "top"
+pressure = 1.0
+
+[[obstacle]]
+name = "floor"
+points = [[10.0, 0.0], [-10.0, 0.0]]
+
+[[contact]]
+name = "floor"
+slave = { set = "bottom" }
+obstacle = "floor"
+
+[analysis]
+type = "static"
+steps = 4
+geometry = "linear"
+"#;
+
+/// Goal: a body held by its contact alone in one direction only (theory 5c): pressed straight
+/// down it runs, and the floor carries the whole load; pushed sideways as well it has no
+/// equilibrium, and the run stops (exit 3) with a message that says the body is held by its
+/// contact alone and what to do. Setup: `BLOCK_ON_FLOOR` (2 x 1, pressure 1 on its top), then
+/// with a traction of -0.1 on its right side. Reference: equilibrium, the floor's force equal
+/// to the pressure times the width, 2, to 1e-9 (a linear elastic block: Newton's tolerance).
+#[test]
+fn a_body_its_contact_holds_in_one_direction_only_runs_or_says_why() {
+    let model = common::model("block_on_floor", BLOCK_ON_FLOOR, &[]);
+    let (summary, _) = common::run("block_on_floor", &model);
+    assert_eq!(summary.status, Status::Ok, "{:?}", summary.message);
+    approx::assert_relative_eq!(summary.contact.peak_force, 2.0, max_relative = 1e-9);
+    let pushed = format!(
+        "{BLOCK_ON_FLOOR}\n[[load]]\ntype = \"traction\"\nset = \"right\"\ntraction = [-0.1, 0.0]\n"
+    );
+    let model = common::model("block_pushed", &pushed, &[]);
+    let out = common::out_dir("block_pushed");
+    let message = match analysis::run_to_state(&model, &out, RunOptions::default()) {
+        Ok((summary, _)) => panic!("ran to {:?}", summary.status),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        message.contains("held by its contact alone") && message.contains("support the body"),
+        "{message}"
     );
 }

@@ -170,6 +170,9 @@ pub struct System {
     pub values: Vec<f64>,
     /// The largest diagonal entry of the last factored matrix (a stiffness scale).
     pub diagonal_max: f64,
+    /// The share by which a static tangent's diagonal is raised before it is factored
+    /// (`regularize`): 0, unless a body is held by its contact alone (docs/theory.md 5c).
+    pub held: f64,
 }
 
 /// Global DOFs of element e of body b.
@@ -223,6 +226,20 @@ impl System {
             scatter,
             values,
             diagonal_max: 0.0,
+            held: 0.0,
+        }
+    }
+
+    /// Raises each diagonal entry of the assembled matrix by the share `held` (none when 0):
+    /// a body held by its contact alone has a rigid motion that only the contact rows hold,
+    /// so its tangent is singular by itself, and the Schur complement needs it factored
+    /// (docs/theory.md 5c). Newton's residual stays exact, so the shift moves the converged
+    /// answer by nothing but a slower contraction.
+    pub fn regularize(&mut self) {
+        if self.held > 0.0 {
+            for j in 0..self.free {
+                self.values[self.pattern.col_ptr[j] as usize] *= 1.0 + self.held;
+            }
         }
     }
 

@@ -305,9 +305,37 @@ fn check_projectiles(
     }
 }
 
-/// Arc-length continuation scales the loads by one factor and has no contact events: the
-/// loads are forces that grow in proportion (a curve through zero, linear in the pseudo
-/// time), nothing is prescribed but the supports, and there are no contact pairs.
+/// The contact pairs arc length takes: frictionless (Coulomb's stick and slide between
+/// loads that all scale together is not built), against still obstacles (a moving one is a
+/// prescribed motion), with the active set decided by passes (not a mortar pair's Newton).
+fn check_arc_length_contacts(
+    cx: &Context,
+    newton: &super::spec::NewtonSpec,
+    contacts: &[ContactPair],
+) -> Result<(), InputError> {
+    for c in contacts {
+        let why = if !c.frictionless() {
+            "arc length takes frictionless pairs only (friction's stick and slide along a \
+             path whose loads all scale together is not built); drive the contact by load \
+             steps or a prescribed displacement"
+        } else if c.moving_obstacle().is_some() {
+            "its obstacle moves, a prescribed motion, which arc length does not scale"
+        } else if c.mortar().is_some() || matches!(newton.active_set, Some(ActiveSetSolve::Newton))
+        {
+            "arc length decides the active set by passes; set the pair's discretization to \
+             `node_to_segment` and analysis.newton.active_set to `passes`"
+        } else {
+            continue;
+        };
+        return Err(cx.err(format!("analysis.arc_length: contact `{}`: {why}", c.name)));
+    }
+    Ok(())
+}
+
+/// Arc-length continuation scales the loads by one factor: the loads are forces that grow
+/// in proportion (a curve through zero, linear in the pseudo time) and nothing is
+/// prescribed but the supports. Its contact pairs are frictionless and still (theory 5b):
+/// their active set changes between the passes of an increment, not inside Newton.
 fn check_arc_length(
     cx: &Context,
     analysis: &Analysis,
@@ -320,13 +348,7 @@ fn check_arc_length(
     if s.arc_length.is_none() {
         return Ok(());
     }
-    if let Some(c) = contacts.first() {
-        return Err(cx.err(format!(
-            "analysis.arc_length: contact `{}`: arc length takes no contact pairs (their \
-             events cut the load steps); drive the contact by load steps",
-            c.name
-        )));
-    }
+    check_arc_length_contacts(cx, &s.newton, contacts)?;
     let end = s.end_time;
     for (k, load) in loads.iter().enumerate() {
         let curve = match load {

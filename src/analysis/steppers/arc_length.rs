@@ -31,11 +31,13 @@
 
 use super::carry::{ArcLengthCarry, Carry};
 use super::energies::{Energies, Motion};
-use super::newton::Counters;
+use super::newton::{Bordered, Constraints, Counters, StepFailure};
 use super::{About, Report, Resume, RowFeatures, RunFeatures, StepError, Stepper, loads};
 use crate::analysis::summary::ArcLengthSummary;
 use crate::assembly::{self, Evaluation, State, StepIncrement, System};
-use crate::contact::ContactState;
+use crate::contact::{
+    ConstrainedSolution, ContactResult, ContactState, Inside, Interfaces, Pass, Settled,
+};
 use crate::output::readable;
 use crate::scene::model::ArcLength as Settings;
 use crate::scene::spec::Tangent;
@@ -66,6 +68,7 @@ pub struct ArcLength<'a> {
     model: &'a Model,
     spec: &'a StaticAnalysis,
     settings: Settings,
+    interfaces: Interfaces,
     initial: Vec<[f64; 2]>,
     system: System,
     solver: Solver,
@@ -105,14 +108,35 @@ struct Failure {
     message: String,
 }
 
-/// A converged increment.
+/// A converged increment (one pass of its contact step).
 struct Converged {
+    /// Delta u on the free DOFs, and on all DOFs.
     du: Vec<f64>,
+    d: Vec<f64>,
     dlambda: f64,
     evaluation: Evaluation,
     iterations: usize,
     /// Taken at lambda = 1 (load control), not on its arc.
     landing: bool,
+    /// The arc it was taken on (None: the first increment, whose arc is its length).
+    arc: Option<f64>,
+    /// The normal multipliers of the active contact entries.
+    forces: Vec<f64>,
+}
+
+impl ConstrainedSolution for Converged {
+    fn increment(&self) -> &[f64] {
+        &self.d
+    }
+    fn normal_forces(&self) -> &[f64] {
+        &self.forces
+    }
+    fn tangential_forces(&self) -> &[f64] {
+        &[]
+    }
+    fn settled(&self) -> Option<&Settled> {
+        None
+    }
 }
 
 impl<'a> ArcLength<'a> {
@@ -127,6 +151,7 @@ impl<'a> ArcLength<'a> {
             model,
             spec,
             settings,
+            interfaces: model.interfaces(),
             initial: model.coordinates(),
             zeros: vec![0.0; model.dofs()],
             state: State::initial(model),
@@ -155,156 +180,71 @@ impl<'a> ArcLength<'a> {
         self.spec.end_time * self.first_share * arc / self.first_arc
     }
 
-    /// Assembles the tangent (`tangent`) at the increment `d` (all DOFs) and factors it; the
-    /// evaluation's internal force comes back.
-    fn factor_at(&mut self, d: &[f64], dt: f64, tangent: Tangent) -> Result<Evaluation, Failure> {
-        let step = StepIncrement {
-            d,
-            dt,
-            geometry: self.spec.geometry,
-        };
-        let evaluation = assembly::evaluate(
-            self.model,
-            &self.state,
-            step,
-            Some(&mut self.system),
-            tangent,
-        )
-        .map_err(|e| Failure {
-            singular: false,
-            message: e.to_string(),
-        })?;
-        self.solver
-            .factor_indefinite_down_to(&self.system.values, NEAR_SINGULAR)
-            .map_err(|e| match e {
-                SolverError::Singular { index } => Failure {
-                    singular: true,
-                    message: format!(
-                        "the stiffness matrix is singular at {}: a mechanism or missing supports",
-                        super::newton::free_dof(self.model, &self.system, index)
-                    ),
-                },
-                other => Failure {
-                    singular: false,
-                    message: other.to_string(),
-                },
-            })?;
-        Ok(evaluation)
-    }
-
-    /// K^-1 b with the factored tangent.
-    fn solve(&mut self, b: &[f64]) -> Vec<f64> {
-        let mut x = b.to_vec();
-        self.solver.solve(&mut x);
-        x
-    }
-
-    /// One increment on the arc `arc` (the first: `None`, 1 / steps of the load): Newton on
-    /// (Delta u, Delta lambda) from the tangent predictor; `landing`: at lambda = 1 instead
-    /// (Newton on Delta u alone, load control).
-    fn increment(
+    /// One increment on the next arc (`landing`: at lambda = 1 instead), with the contact
+    /// pairs' passes where the scene has any (`ContactState::step`: the active set changes
+    /// between passes, and an event inside the increment shortens its arc to the event).
+    fn attempt(
         &mut self,
-        arc: Option<f64>,
         landing: bool,
         counters: &mut Counters,
-    ) -> Result<Converged, String> {
-        let newton = self.spec.newton.clone();
-        let q = {
-            let end = self.spec.end_time;
-            let all = loads::external_force(self.model, &self.state, &self.initial, end);
-            self.system.gather(&all)
+    ) -> Result<ContactResult<Converged>, StepFailure> {
+        let positions = self.state.positions(self.spec.geometry).into_owned();
+        let increment = Increment {
+            model: self.model,
+            spec: self.spec,
+            state: &self.state,
+            initial: &self.initial,
+            positions: &positions,
+            factor: self.factor,
+            direction: &self.direction,
+            first_share: self.first_share,
+            arc: self.arc,
+            first_arc: self.first_arc,
+            landing,
         };
-        let q_norm = norm(&q);
-        if q_norm == 0.0 {
-            return Err("the loads vanish on the free DOFs: nothing to scale".into());
-        }
-        let zero = vec![0.0; self.model.dofs()];
-        let nominal = self.spec.end_time / self.spec.steps as f64;
-        if !std::mem::take(&mut self.factored_at_start) {
-            self.factor_at(&zero, nominal, newton.tangent)
-                .map_err(|f| f.message)?;
-        }
-        let mut ut = self.solve(&q);
-        let arc = arc.unwrap_or_else(|| norm(&ut) * self.first_share);
-        let rising = dot(&self.direction, &ut) >= 0.0;
-        let step = arc / norm(&ut);
-        let mut dlambda = if landing {
-            1.0 - self.factor
-        } else if rising {
-            step
-        } else {
-            -step
+        let (system, solver) = (&mut self.system, &mut self.solver);
+        let fresh = &mut self.factored_at_start;
+        let solve = |pass: Pass<'_>| {
+            let length = pass.length;
+            increment.solve(Some(pass), length, (system, solver), fresh, counters)
         };
-        let mut du: Vec<f64> = ut.iter().map(|v| dlambda * v).collect();
-        let dt = if self.arc.is_some() {
-            self.pseudo_time(arc)
-        } else {
-            nominal * self.first_share * self.spec.steps as f64
-        };
-        for iteration in 1..=newton.max_iterations {
-            counters.iterations += 1;
-            let mut d = zero.clone();
-            self.system.scatter_add(&du, &mut d);
-            // a singular consistent tangent at an iterate (a plastic zone past its collapse
-            // mechanism, overshot) is passed with the elastic moduli and K_sigma for that
-            // iteration, not cut
-            let evaluation = match self.factor_at(&d, dt, newton.tangent) {
-                Err(f) if f.singular && newton.tangent == Tangent::Consistent => {
-                    self.factor_at(&d, dt, Tangent::ElasticGeometric)
-                }
-                other => other,
-            }
-            .map_err(|f| f.message)?;
-            let lambda = self.factor + dlambda;
-            let internal = self.system.gather(&evaluation.force);
-            let r: Vec<f64> = q
-                .iter()
-                .zip(&internal)
-                .map(|(q, f)| lambda * q - f)
-                .collect();
-            let scale = q_norm * lambda.abs().max(dlambda.abs()).max(1e-3);
-            if norm(&r) <= newton.tol_force * scale {
-                return Ok(Converged {
-                    du,
-                    dlambda,
-                    evaluation,
-                    iterations: iteration,
-                    landing,
-                });
-            }
-            let du_r = self.solve(&r);
-            ut = self.solve(&q);
-            let dl = if landing {
-                0.0
-            } else {
-                constrained_step(&du, &du_r, &ut, arc)
-            };
-            for ((u, r), t) in du.iter_mut().zip(&du_r).zip(&ut) {
-                *u += r + dl * t;
-            }
-            dlambda += dl;
+        if self.model.contacts.is_empty() {
+            let converged = increment.solve(None, 1.0, (system, solver), fresh, counters)?;
+            return Ok(ContactResult {
+                solution: converged,
+                length: 1.0,
+                active: Vec::new(),
+                forces: Vec::new(),
+                tangential: Vec::new(),
+                sliding: Vec::new(),
+                events: Default::default(),
+            });
         }
-        Err(format!(
-            "no convergence in {} iterations",
-            newton.max_iterations
-        ))
+        // the pass's length is the share of the arc (1, or the fraction to an event)
+        let pairs = (&self.model.contacts[..], self.state.time);
+        self.contact.step(pairs, &positions, 1.0, solve)
     }
 
-    /// Commits a converged increment on the arc `arc`.
-    fn commit(&mut self, c: Converged, arc: f64) {
-        let mut d = vec![0.0; self.model.dofs()];
-        self.system.scatter_add(&c.du, &mut d);
-        let force = c.evaluation.force.clone();
+    /// Commits a converged increment (`step`, its contact outcome with it).
+    fn commit(&mut self, mut step: ContactResult<Converged>) {
+        let c = &mut step.solution;
+        let arc = c.arc.unwrap_or_else(|| norm(&c.du));
+        let d = std::mem::take(&mut c.d);
+        let evaluation = std::mem::take(&mut c.evaluation);
+        let force = evaluation.force.clone();
         assembly::commit(
             self.model,
             &mut self.state,
             &d,
-            c.evaluation,
+            evaluation,
             self.spec.geometry,
         );
         if self.arc.is_none() {
             self.first_arc = arc;
+            // a first increment ended early by a contact event took that share of the load
+            self.first_share *= step.length;
         }
+        let c = &step.solution;
         let length = norm(&c.du);
         self.last_step = self.pseudo_time(if c.landing { length } else { arc });
         self.state.time += self.last_step;
@@ -317,16 +257,277 @@ impl<'a> ArcLength<'a> {
             self.flat_in_a_row = 0;
         }
         self.collapsed = self.flat_in_a_row >= FLAT_INCREMENTS;
+        if !self.model.contacts.is_empty() {
+            let positions = self.state.positions(self.spec.geometry);
+            self.contact
+                .commit(&self.interfaces, &step, self.state.time, &positions);
+        }
         self.energies.external_work += super::trapezoid_work(&d, &force, &self.last_force);
         self.energies.internal = self.state.internal_work - self.state.plastic_work;
         self.energies.plastic_work = self.state.plastic_work;
         self.last_force = force;
-        self.direction = c.du;
         let target = self.settings.iterations as f64;
-        let grow = (target / c.iterations as f64).sqrt().clamp(0.5, 2.0);
+        let grow = (target / step.solution.iterations as f64)
+            .sqrt()
+            .clamp(0.5, 2.0);
+        self.direction = step.solution.du;
         self.arc = Some((arc * grow).min(LONGEST * self.first_arc));
         self.increments += 1;
     }
+}
+
+/// Assembles the tangent (`tangent`) of `state` at the increment `d` (all DOFs) into
+/// `system` and factors it; the evaluation's internal force comes back.
+fn factor_at(
+    (model, spec, state): (&Model, &StaticAnalysis, &State),
+    (system, solver): (&mut System, &mut Solver),
+    (d, dt): (&[f64], f64),
+    tangent: Tangent,
+) -> Result<Evaluation, Failure> {
+    let step = StepIncrement {
+        d,
+        dt,
+        geometry: spec.geometry,
+    };
+    let evaluation =
+        assembly::evaluate(model, state, step, Some(&mut *system), tangent).map_err(|e| {
+            Failure {
+                singular: false,
+                message: e.to_string(),
+            }
+        })?;
+    system.regularize();
+    solver
+        .factor_indefinite_down_to(&system.values, NEAR_SINGULAR)
+        .map_err(|e| match e {
+            SolverError::Singular { index } => Failure {
+                singular: true,
+                message: format!(
+                    "the stiffness matrix is singular at {}: a mechanism or missing supports",
+                    super::newton::free_dof(model, system, index)
+                ),
+            },
+            other => Failure {
+                singular: false,
+                message: other.to_string(),
+            },
+        })?;
+    Ok(evaluation)
+}
+
+/// What the passes of one increment share: the committed path and the increment's arc.
+struct Increment<'s> {
+    model: &'s Model,
+    spec: &'s StaticAnalysis,
+    state: &'s State,
+    initial: &'s [[f64; 2]],
+    /// The committed positions (the contact rows' start).
+    positions: &'s [[f64; 2]],
+    factor: f64,
+    direction: &'s [f64],
+    first_share: f64,
+    /// The next arc (None before the first increment) and the first (the pseudo time's
+    /// unit).
+    arc: Option<f64>,
+    first_arc: f64,
+    landing: bool,
+}
+
+/// Where an increment's Newton iteration stands: Delta u on the free DOFs, Delta lambda and
+/// the contact multipliers.
+struct Iterate {
+    du: Vec<f64>,
+    dlambda: f64,
+    forces: Vec<f64>,
+}
+
+impl Increment<'_> {
+    /// Newton on (Delta u, Delta lambda) from the tangent predictor on `share` of the arc
+    /// (the first increment: of 1 / steps of the load), with the contact rows of `pass`
+    /// (theory 5b); `landing`: at lambda = 1 instead (Newton on Delta u alone, load control).
+    /// `fresh`: the tangent of the committed state is factored already.
+    fn solve(
+        &self,
+        pass: Option<Pass<'_>>,
+        share: f64,
+        (system, solver): (&mut System, &mut Solver),
+        fresh: &mut bool,
+        counters: &mut Counters,
+    ) -> Result<Converged, StepFailure> {
+        let (model, spec, state) = (self.model, self.spec, self.state);
+        let newton = &spec.newton;
+        let q = self.load(system)?;
+        let q_norm = norm(&q);
+        let describe = |node: usize| model.describe_node(node);
+        let constraints = pass.as_ref().map(|p| Constraints {
+            pairs: p.pairs,
+            active: p.active,
+            start: self.positions,
+            forces: p.forces.clone(),
+            tangential: p.tangential,
+            targets: Vec::new(),
+            inside: Inside::Fixed,
+            describe: &describe,
+        });
+        let forces = pass.map_or(Vec::new(), |p| p.forces);
+        let zero = vec![0.0; model.dofs()];
+        let nominal = spec.end_time / spec.steps as f64;
+        let parts = (model, spec, state);
+        if !std::mem::take(fresh) {
+            factor_at(parts, (system, solver), (&zero, nominal), newton.tangent)
+                .map_err(|f| StepFailure(f.message))?;
+        }
+        let mut bordered = Bordered::at(constraints.as_ref(), &zero, system)?;
+        let (ut, tau_t) = bordered.solve_load(solver, q.clone(), &forces)?;
+        let arc = match self.arc {
+            Some(arc) => arc * share,
+            None => norm(&ut) * self.first_share * share,
+        };
+        // with contact the first increment takes its share of the load (load control): its
+        // arc would be sized on a stiffness that the closures inside it change (a body held
+        // at one node at the start, by many at the end)
+        let first_load = (self.arc.is_none() && constraints.is_some()).then_some(self.first_share);
+        let load_controlled = self.landing || first_load.is_some();
+        let mut at = self.predictor((ut, tau_t), forces, (arc, share), first_load);
+        let dt = match self.arc {
+            Some(_) => spec.end_time * self.first_share * arc / self.first_arc,
+            None => nominal * self.first_share * spec.steps as f64,
+        };
+        for iteration in 1..=newton.max_iterations {
+            counters.iterations += 1;
+            let mut d = zero.clone();
+            system.scatter_add(&at.du, &mut d);
+            let evaluation = factor_iterate(parts, (system, solver), (&d, dt))?;
+            let lambda = self.factor + at.dlambda;
+            let internal = system.gather(&evaluation.force);
+            let r: Vec<f64> = (q.iter().zip(&internal))
+                .map(|(q, f)| lambda * q - f)
+                .collect();
+            bordered = Bordered::at(constraints.as_ref(), &d, system)?;
+            let scale = q_norm * lambda.abs().max(at.dlambda.abs()).max(1e-3);
+            let residual = norm(&bordered.balance(&r, &at.forces));
+            self.log(
+                iteration,
+                (residual, newton.tol_force * scale),
+                lambda,
+                &bordered,
+            );
+            if residual <= newton.tol_force * scale && bordered.hold() {
+                let Iterate {
+                    du,
+                    dlambda,
+                    mut forces,
+                } = at;
+                forces.truncate(bordered.normal());
+                return Ok(Converged {
+                    du,
+                    d,
+                    dlambda,
+                    evaluation,
+                    iterations: iteration,
+                    landing: self.landing,
+                    arc: self.arc.map(|_| arc),
+                    forces,
+                });
+            }
+            let (du_r, tau_r) = bordered.solve(solver, r, &at.forces)?;
+            let (ut, tau_t) = bordered.solve_load(solver, q.clone(), &at.forces)?;
+            let dl = if load_controlled {
+                0.0
+            } else {
+                constrained_step(&at.du, &du_r, &ut, arc)
+            };
+            for ((u, r), t) in at.du.iter_mut().zip(&du_r).zip(&ut) {
+                *u += r + dl * t;
+            }
+            at.dlambda += dl;
+            at.forces = (tau_r.iter().zip(&tau_t))
+                .map(|(r, t)| r + dl * t)
+                .collect();
+        }
+        Err(StepFailure(format!(
+            "no convergence in {} iterations",
+            newton.max_iterations
+        )))
+    }
+
+    /// q: the scene's loads at end_time on the free DOFs (refused when they vanish there).
+    fn load(&self, system: &System) -> Result<Vec<f64>, StepFailure> {
+        let (model, end) = (self.model, self.spec.end_time);
+        let q = system.gather(&loads::external_force(model, self.state, self.initial, end));
+        if norm(&q) == 0.0 {
+            return Err(StepFailure(
+                "the loads vanish on the free DOFs: nothing to scale".into(),
+            ));
+        }
+        Ok(q)
+    }
+
+    /// The predictor Delta lambda u_t from the constrained tangent displacement `ut` and its
+    /// multipliers `tau_t` (`(ut, tau_t)`), on the arc `arc` (`share` of the increment's):
+    /// Delta lambda |u_t| = arc, rising where u_t goes the way of the last increment; at
+    /// lambda = 1 when landing, the share `first_load` of the load for a first increment
+    /// with contact. The multipliers `forces` move with it by Delta lambda tau_t.
+    fn predictor(
+        &self,
+        (ut, tau_t): (Vec<f64>, Vec<f64>),
+        forces: Vec<f64>,
+        (arc, share): (f64, f64),
+        first_load: Option<f64>,
+    ) -> Iterate {
+        let rising = dot(self.direction, &ut) >= 0.0;
+        let step = arc / norm(&ut);
+        let dlambda = if self.landing {
+            (1.0 - self.factor) * share
+        } else if let Some(first) = first_load {
+            first * share
+        } else if rising {
+            step
+        } else {
+            -step
+        };
+        Iterate {
+            du: ut.iter().map(|v| dlambda * v).collect(),
+            dlambda,
+            forces: (forces.iter().zip(&tau_t))
+                .map(|(f, t)| f + dlambda * t)
+                .collect(),
+        }
+    }
+
+    /// The `--verbose` line of an iteration: the residual with the contact forces against
+    /// its tolerance (`(residual, tolerance)`), the load factor, the contact rows.
+    fn log(&self, iteration: usize, (residual, tolerance): (f64, f64), lambda: f64, b: &Bordered) {
+        crate::output::console::iteration(format_args!(
+            "  arc length: increment from load factor {}, iteration {iteration}: |R| = \
+             {residual:.3e} (tol {tolerance:.1e}), load factor {}, {} contact rows{}",
+            readable(self.factor),
+            readable(lambda),
+            b.normal(),
+            if b.hold() {
+                ""
+            } else {
+                ", a gap open beyond TOL"
+            }
+        ));
+    }
+}
+
+/// The tangent at the iterate `d` assembled and factored (`factor_at` with the scene's
+/// tangent): a singular consistent tangent (a plastic zone past its collapse mechanism,
+/// overshot) is passed with the elastic moduli and K_sigma for that iteration, not cut.
+fn factor_iterate(
+    parts: (&Model, &StaticAnalysis, &State),
+    (system, solver): (&mut System, &mut Solver),
+    (d, dt): (&[f64], f64),
+) -> Result<Evaluation, StepFailure> {
+    let tangent = parts.1.newton.tangent;
+    let mut factor = |tangent| factor_at(parts, (&mut *system, &mut *solver), (d, dt), tangent);
+    match factor(tangent) {
+        Err(f) if f.singular && tangent == Tangent::Consistent => factor(Tangent::ElasticGeometric),
+        other => other,
+    }
+    .map_err(|f| StepFailure(f.message))
 }
 
 /// The root d lambda of ||du + du_r + d lambda ut|| = arc that keeps the corrected increment
@@ -364,7 +565,16 @@ fn norm(a: &[f64]) -> f64 {
 }
 
 impl Stepper for ArcLength<'_> {
+    /// A body that its contact alone holds closes its touching slaves before the path
+    /// starts (`statics::hold_by_contact`): the bordered solves need a tangent to factor.
     fn start(&mut self) -> Result<(), String> {
+        let spec = self.spec;
+        super::statics::hold_by_contact(
+            (self.model, &self.state, spec.end_time / spec.steps as f64),
+            (spec.geometry, spec.newton.tangent),
+            (&mut self.system, &mut self.solver),
+            &mut self.contact,
+        );
         Ok(())
     }
 
@@ -376,27 +586,29 @@ impl Stepper for ArcLength<'_> {
 
     fn advance(&mut self, counters: &mut Counters) -> Result<(), StepError> {
         loop {
-            let arc = self.arc;
             // an arc that carries the path past the scene's load rising is taken again
             // to land on it
-            let attempt = self.increment(arc, false, counters).and_then(|c| {
-                if c.dlambda > 0.0 && self.factor + c.dlambda > 1.0 {
-                    self.increment(arc, true, counters)
+            let attempt = self.attempt(false, counters).and_then(|c| {
+                let dlambda = c.solution.dlambda;
+                if dlambda > 0.0 && self.factor + dlambda > 1.0 {
+                    self.attempt(true, counters)
                 } else {
                     Ok(c)
                 }
             });
             match attempt {
                 Ok(converged) => {
-                    let arc = arc.unwrap_or_else(|| norm(&converged.du));
-                    self.commit(converged, arc);
+                    self.commit(converged);
                     self.cuts_in_a_row = 0;
                     // the next predictor's tangent, factored now (where there is a next
                     // increment): singular, the path ends
                     if !self.done() {
                         let zero = vec![0.0; self.model.dofs()];
                         let nominal = self.spec.end_time / self.spec.steps as f64;
-                        match self.factor_at(&zero, nominal, self.spec.newton.tangent) {
+                        let parts = (self.model, self.spec, &self.state);
+                        let solving = (&mut self.system, &mut self.solver);
+                        match factor_at(parts, solving, (&zero, nominal), self.spec.newton.tangent)
+                        {
                             Ok(_) => self.factored_at_start = true,
                             Err(f) if f.singular => self.collapsed = true,
                             Err(_) => {}
@@ -404,16 +616,17 @@ impl Stepper for ArcLength<'_> {
                     }
                     return Ok(());
                 }
-                Err(reason) => {
+                Err(StepFailure(reason)) => {
                     self.cuts_in_a_row += 1;
                     counters.cuts += 1;
                     if self.cuts_in_a_row > self.spec.newton.max_cuts {
                         return Err(StepError::diverged(format!(
                             "arc-length increment {} from load factor {} did not converge \
-                             after {} cuts: {reason}",
+                             after {} cuts: {reason}{}",
                             self.increments + 1,
                             readable(self.factor),
-                            self.spec.newton.max_cuts
+                            self.spec.newton.max_cuts,
+                            super::statics::held_hint(&self.system)
                         )));
                     }
                     // the first arc is not known until its predictor: its share of the
@@ -507,6 +720,7 @@ impl Resume for ArcLength<'_> {
         self.last_step = c.last_step;
         self.flat_in_a_row = c.flat_in_a_row;
         self.collapsed = c.collapsed;
+        self.system.held = c.held;
         // the committed state's tangent, the next predictor's, is factored again
         self.factored_at_start = false;
         true
@@ -528,6 +742,7 @@ impl Resume for ArcLength<'_> {
             last_step: self.last_step,
             flat_in_a_row: self.flat_in_a_row,
             collapsed: self.collapsed,
+            held: self.system.held,
         }))
     }
 

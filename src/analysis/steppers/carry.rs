@@ -29,6 +29,9 @@ pub struct StaticCarry {
     pub contact: ContactState,
     /// The last increment's displacement increment and length (the next one's start).
     pub previous: Option<(Vec<f64>, f64)>,
+    /// `System::held`: the diagonal shift of a body held by its contact alone.
+    #[serde(default)]
+    pub held: f64,
 }
 
 /// Where an arc-length path has got to (theory 5b): the state, the load factor and the
@@ -50,6 +53,9 @@ pub struct ArcLengthCarry {
     pub last_step: f64,
     pub flat_in_a_row: usize,
     pub collapsed: bool,
+    /// `System::held`: the diagonal shift of a body held by its contact alone.
+    #[serde(default)]
+    pub held: f64,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

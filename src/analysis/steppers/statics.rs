@@ -15,7 +15,7 @@
 use super::carry::{Carry, StaticCarry};
 use super::control::{StepControl, snap};
 use super::energies::{Energies, Motion};
-use super::newton::{Constraints, Counters, Step, StepFailure};
+use super::newton::{Constraints, Counters, SINGULAR_STIFFNESS, Step, StepFailure};
 use super::{About, Report, Resume, StepError, Stepper, loads};
 use crate::assembly::{self, State, System};
 use crate::contact::{ContactResult, ContactState, Interfaces, Pass};
@@ -232,15 +232,83 @@ impl Statics<'_> {
         if !forced || self.last_rate < FLATTENED * first {
             return String::new();
         }
+        let arc_length = match self.model.contacts.iter().all(|c| c.frictionless()) {
+            true => "analysis.arc_length = {} traces the path through it",
+            false => {
+                "analysis.arc_length = {} would trace the path through it with \
+                      frictionless contact (it takes no friction)"
+            }
+        };
         format!(
             ". The load-displacement path had flattened: the last increment moved {:.0} times \
              as far per unit load as the first. The load cannot go much beyond t = {}: a \
-             limit load (collapse or snap-through). analysis.arc_length = {{}} traces the path \
-             through it; a prescribed displacement drives the structure past it",
+             limit load (collapse or snap-through). {arc_length}; a prescribed displacement \
+             drives the structure past it",
             self.last_rate / first,
             readable(self.state.time)
         )
     }
+}
+
+/// The share by which the tangent's diagonal is raised where a body is held by its contact
+/// alone (`System::regularize`): far above round-off, so the rigid motion's pivot is
+/// resolved, and far below any stiffness, so Newton's contraction hardly changes.
+const HELD_SHIFT: f64 = 1e-8;
+
+/// What a run that stopped should know when its body is held by its contact alone.
+pub(super) fn held_hint(system: &System) -> &'static str {
+    match system.held > 0.0 {
+        true => {
+            ". The body is held by its contact alone (its resting slaves closed at the \
+                 start, theory 5c); a motion the contact does not hold, such as sliding on a \
+                 frictionless support under a load along it, has no equilibrium: support the \
+                 body there"
+        }
+        false => "",
+    }
+}
+
+/// A body that its contact alone holds (docs/theory.md 5c): where the tangent of the
+/// committed `state` is singular (a mechanism at the solver's usual threshold) and open
+/// slaves touch their masters, those slaves close and `system` raises the diagonal of every
+/// tangent it factors from then on (`HELD_SHIFT`). How many slaves closed: 0 where the
+/// tangent is regular, the system holds already, or nothing touches (a mechanism the
+/// contact does not hold, reported as one).
+pub(super) fn hold_by_contact(
+    (model, state, dt): (&Model, &State, f64),
+    (geometry, tangent): (crate::element::Strain, crate::scene::spec::Tangent),
+    (system, solver): (&mut System, &mut Solver),
+    contact: &mut ContactState,
+) -> usize {
+    if model.contacts.is_empty() || system.held > 0.0 {
+        return 0;
+    }
+    let zero = vec![0.0; model.dofs()];
+    let step = assembly::StepIncrement {
+        d: &zero,
+        dt,
+        geometry,
+    };
+    if assembly::evaluate(model, state, step, Some(&mut *system), tangent).is_err() {
+        return 0;
+    }
+    let singular = matches!(
+        solver.factor_indefinite(&system.values),
+        Err(crate::solver::SolverError::Singular { .. })
+    );
+    if !singular {
+        return 0;
+    }
+    let positions = state.positions(geometry);
+    let closed = contact.close_resting(&model.contacts, &|n| positions[n]);
+    if closed > 0 {
+        system.held = HELD_SHIFT;
+        crate::output::console::iteration(format_args!(
+            "  the tangent is singular and {closed} slave(s) touch their master: they start \
+             closed and hold the body (its diagonal raised by {HELD_SHIFT:e} of itself)"
+        ));
+    }
+    closed
 }
 
 impl Stepper for Statics<'_> {
@@ -318,15 +386,31 @@ impl Stepper for Statics<'_> {
                     from_zero = true;
                 }
                 Err(StepFailure(reason)) => {
+                    // a first increment on a singular tangent: a body its contact alone holds?
+                    if self.increments == 0
+                        && reason.starts_with(SINGULAR_STIFFNESS)
+                        && hold_by_contact(
+                            (self.model, &self.state, self.dt),
+                            (spec.geometry, spec.newton.tangent),
+                            (&mut self.system, &mut self.solver),
+                            &mut self.contact,
+                        ) > 0
+                    {
+                        continue;
+                    }
                     crate::output::console::iteration(format_args!(
                         "  newton: the increment to t = {} is cut: {reason}",
                         readable(target)
                     ));
                     if let Err(why) = self.control.reject(target - self.state.time, counters) {
+                        // a limit load is the likelier cause where the path had flattened
+                        let mut hint = self.limit_hint();
+                        if hint.is_empty() {
+                            hint = held_hint(&self.system).to_string();
+                        }
                         let message = format!(
-                            "increment to t = {} {why}: {reason}{}",
-                            readable(target),
-                            self.limit_hint()
+                            "increment to t = {} {why}: {reason}{hint}",
+                            readable(target)
                         );
                         return Err(StepError::diverged(message));
                     }
@@ -390,6 +474,7 @@ impl Resume for Statics<'_> {
         self.increments = carry.increments;
         self.contact = carry.contact;
         self.previous = carry.previous;
+        self.system.held = carry.held;
         true
     }
 
@@ -402,6 +487,7 @@ impl Resume for Statics<'_> {
             increments: self.increments,
             contact: self.contact.clone(),
             previous: self.previous.clone(),
+            held: self.system.held,
         }))
     }
 

@@ -234,6 +234,70 @@ impl Constraints<'_> {
     }
 }
 
+/// The contact rows of an arc-length iterate and the two constrained solves of its
+/// bordered step on the factored tangent (theory 5b): the residual with the rows' gaps, and
+/// the load with the gaps held where they are, so that `du_R + d lambda u_t` keeps the rows'
+/// linearized gaps closed for any `d lambda`, and its multipliers are `tau_R + d lambda tau_t`.
+pub struct Bordered {
+    rows: Rows,
+}
+
+impl Bordered {
+    /// The rows of `constraints` at the increment `d` (all DOFs); none without contact.
+    pub fn at(
+        constraints: Option<&Constraints<'_>>,
+        d: &[f64],
+        system: &System,
+    ) -> Result<Bordered, StepFailure> {
+        let rows = match constraints {
+            Some(c) => c.rows(d, system)?,
+            None => Rows::empty(),
+        };
+        Ok(Bordered { rows })
+    }
+
+    /// R + C^T tau: the residual `residual` with the contact forces `forces`.
+    pub fn balance(&self, residual: &[f64], forces: &[f64]) -> Vec<f64> {
+        let mut balance = residual.to_vec();
+        add_constraint_forces(&self.rows, forces, &mut balance);
+        balance
+    }
+
+    /// Whether every row holds its gap within its pair's tolerance (Hughes II-7).
+    pub fn hold(&self) -> bool {
+        self.rows.worst_gap <= 1.0
+    }
+
+    /// The number of normal rows (the first multipliers).
+    pub fn normal(&self) -> usize {
+        self.rows.normal
+    }
+
+    /// (du_R, tau_R): K du_R = R + C^T tau_R and C du_R = -g; `forces` the multipliers so far.
+    pub fn solve(
+        &self,
+        solver: &mut Solver,
+        residual: Vec<f64>,
+        forces: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
+        constrained_solve(solver, &self.rows, residual, forces, &Secant::new(false))
+    }
+
+    /// (u_t, tau_t): K u_t = q + C^T tau_t and C u_t = 0, for the load `load` (q).
+    pub fn solve_load(
+        &mut self,
+        solver: &mut Solver,
+        load: Vec<f64>,
+        forces: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
+        let held = vec![0.0; self.rows.gaps.len()];
+        let gaps = std::mem::replace(&mut self.rows.gaps, held);
+        let solved = self.solve(solver, load, forces);
+        self.rows.gaps = gaps;
+        solved
+    }
+}
+
 /// sum_i tau_i C_i^T added into a free-DOF vector.
 pub(super) fn add_constraint_forces(rows: &Rows, forces: &[f64], target: &mut [f64]) {
     for (row, tau) in rows.rows.iter().zip(forces) {

@@ -31,6 +31,7 @@ use crate::scene::Model;
 use crate::scene::spec::{ActiveSetSolve, NewtonSpec, Strategy, Tangent, Updates};
 use crate::solver::{Solver, SolverError};
 use active_set::ActiveSet;
+pub use constrained::Bordered;
 use constrained::{Rows, add_constraint_forces, constrained_solve};
 use secant::Secant;
 
@@ -73,11 +74,20 @@ pub struct StepFailure(pub String);
 /// How the message of an iteration that ran out of iterations begins.
 const NOT_CONVERGED: &str = "no convergence in";
 
+/// How the message of a singular tangent begins.
+pub const SINGULAR_STIFFNESS: &str = "the stiffness matrix is singular at";
+
 impl StepFailure {
     /// Whether the iteration ran out of iterations (rather than meeting an inverted element,
     /// a singular matrix or a non-finite residual).
     pub fn ran_out(&self) -> bool {
         self.0.starts_with(NOT_CONVERGED)
+    }
+
+    /// Whether the tangent was singular (a mechanism, or a body that its contact alone
+    /// would hold).
+    pub fn singular(&self) -> bool {
+        self.0.starts_with(SINGULAR_STIFFNESS)
     }
 
     /// Whether the contact active set did not settle (`Unsettled`).
@@ -706,11 +716,14 @@ impl Step<'_> {
         self.effective(system, damping);
         let result = match self.inertia {
             Some(_) => solver.factor(&system.values),
-            None => solver.factor_indefinite(&system.values),
+            None => {
+                system.regularize();
+                solver.factor_indefinite(&system.values)
+            }
         };
         result.map_err(|e| match e {
             SolverError::Singular { index } => StepFailure(format!(
-                "the stiffness matrix is singular at {}: a mechanism or missing supports",
+                "{SINGULAR_STIFFNESS} {}: a mechanism or missing supports",
                 free_dof(self.model, system, index)
             )),
             SolverError::NotPositiveDefinite { index } if self.inertia.is_some() => {
