@@ -386,15 +386,6 @@ fn signed_gap(
 const VERTEX: f64 = 1e-9;
 
 impl ContactPair {
-    /// Whether the pair has no tangential force (no friction law, or one with a zero
-    /// coefficient).
-    pub fn frictionless(&self) -> bool {
-        matches!(
-            self.options.friction,
-            Friction::None | Friction::Coulomb { mu: 0.0 } | Friction::Return { r: 0.0 }
-        )
-    }
-
     /// The motion of the pair's obstacle, when it has one that moves.
     pub fn moving_obstacle(&self) -> Option<&ObstacleMotion> {
         match &self.master {

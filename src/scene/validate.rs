@@ -305,8 +305,7 @@ fn check_projectiles(
     }
 }
 
-/// The contact pairs arc length takes: frictionless (Coulomb's stick and slide between
-/// loads that all scale together is not built), against still obstacles (a moving one is a
+/// The contact pairs arc length takes: against still obstacles (a moving one is a
 /// prescribed motion), with the active set decided by passes (not a mortar pair's Newton).
 fn check_arc_length_contacts(
     cx: &Context,
@@ -314,10 +313,9 @@ fn check_arc_length_contacts(
     contacts: &[ContactPair],
 ) -> Result<(), InputError> {
     for c in contacts {
-        let why = if !c.frictionless() {
-            "arc length takes frictionless pairs only (friction's stick and slide along a \
-             path whose loads all scale together is not built); drive the contact by load \
-             steps or a prescribed displacement"
+        let why = if matches!(c.options.friction, Friction::Return { .. }) {
+            "return_coefficient's target is the slip of the same increment solved without \
+             friction, whose load factor an arc does not keep; use Coulomb's `friction`"
         } else if c.moving_obstacle().is_some() {
             "its obstacle moves, a prescribed motion, which arc length does not scale"
         } else if c.mortar().is_some() || matches!(newton.active_set, Some(ActiveSetSolve::Newton))
@@ -334,8 +332,9 @@ fn check_arc_length_contacts(
 
 /// Arc-length continuation scales the loads by one factor: the loads are forces that grow
 /// in proportion (a curve through zero, linear in the pseudo time) and nothing is
-/// prescribed but the supports. Its contact pairs are frictionless and still (theory 5b):
-/// their active set changes between the passes of an increment, not inside Newton.
+/// prescribed but the supports. Its contact pairs are still, with Coulomb's friction or
+/// none (theory 5b): their active set changes between the passes of an increment, not
+/// inside Newton.
 fn check_arc_length(
     cx: &Context,
     analysis: &Analysis,

@@ -120,8 +120,10 @@ struct Converged {
     landing: bool,
     /// The arc it was taken on (None: the first increment, whose arc is its length).
     arc: Option<f64>,
-    /// The normal multipliers of the active contact entries.
+    /// The normal multipliers of the active contact entries, and the tangential forces of
+    /// the pass's friction conditions (in their order).
     forces: Vec<f64>,
+    tangential: Vec<f64>,
 }
 
 impl ConstrainedSolution for Converged {
@@ -132,7 +134,7 @@ impl ConstrainedSolution for Converged {
         &self.forces
     }
     fn tangential_forces(&self) -> &[f64] {
-        &[]
+        &self.tangential
     }
     fn settled(&self) -> Option<&Settled> {
         None
@@ -369,7 +371,8 @@ impl Increment<'_> {
             inside: Inside::Fixed,
             describe: &describe,
         });
-        let forces = pass.map_or(Vec::new(), |p| p.forces);
+        let tangential = pass.as_ref().map_or(&[][..], |p| p.tangential);
+        let mut forces = pass.map_or(Vec::new(), |p| p.forces);
         let zero = vec![0.0; model.dofs()];
         let nominal = spec.end_time / spec.steps as f64;
         let parts = (model, spec, state);
@@ -378,6 +381,8 @@ impl Increment<'_> {
                 .map_err(|f| StepFailure(f.message))?;
         }
         let mut bordered = Bordered::at(constraints.as_ref(), &zero, system)?;
+        // the sticking entries' tangential multipliers start from zero
+        forces.resize(bordered.len(), 0.0);
         let (ut, tau_t) = bordered.solve_load(solver, q.clone(), &forces)?;
         let arc = match self.arc {
             Some(arc) => arc * share,
@@ -400,10 +405,12 @@ impl Increment<'_> {
             let evaluation = factor_iterate(parts, (system, solver), (&d, dt))?;
             let lambda = self.factor + at.dlambda;
             let internal = system.gather(&evaluation.force);
-            let r: Vec<f64> = (q.iter().zip(&internal))
+            let mut r: Vec<f64> = (q.iter().zip(&internal))
                 .map(|(q, f)| lambda * q - f)
                 .collect();
             bordered = Bordered::at(constraints.as_ref(), &d, system)?;
+            // sliding friction: known forces from the last solve's normal multipliers
+            bordered.add_sliding_forces(&at.forces, &mut r);
             let scale = q_norm * lambda.abs().max(at.dlambda.abs()).max(1e-3);
             let residual = norm(&bordered.balance(&r, &at.forces));
             self.log(
@@ -418,6 +425,7 @@ impl Increment<'_> {
                     dlambda,
                     mut forces,
                 } = at;
+                let tangential = bordered.tangential_forces(tangential, &forces);
                 forces.truncate(bordered.normal());
                 return Ok(Converged {
                     du,
@@ -428,6 +436,7 @@ impl Increment<'_> {
                     landing: self.landing,
                     arc: self.arc.map(|_| arc),
                     forces,
+                    tangential,
                 });
             }
             let (du_r, tau_r) = bordered.solve(solver, r, &at.forces)?;

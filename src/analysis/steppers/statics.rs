@@ -232,18 +232,11 @@ impl Statics<'_> {
         if !forced || self.last_rate < FLATTENED * first {
             return String::new();
         }
-        let arc_length = match self.model.contacts.iter().all(|c| c.frictionless()) {
-            true => "analysis.arc_length = {} traces the path through it",
-            false => {
-                "analysis.arc_length = {} would trace the path through it with \
-                      frictionless contact (it takes no friction)"
-            }
-        };
         format!(
             ". The load-displacement path had flattened: the last increment moved {:.0} times \
              as far per unit load as the first. The load cannot go much beyond t = {}: a \
-             limit load (collapse or snap-through). {arc_length}; a prescribed displacement \
-             drives the structure past it",
+             limit load (collapse or snap-through). analysis.arc_length = {{}} traces the path \
+             through it; a prescribed displacement drives the structure past it",
             self.last_rate / first,
             readable(self.state.time)
         )

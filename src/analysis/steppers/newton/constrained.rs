@@ -273,6 +273,23 @@ impl Bordered {
         self.rows.normal
     }
 
+    /// The number of rows: the normal ones, then the fixed tangential ones (sticking).
+    pub fn len(&self) -> usize {
+        self.rows.rows.len()
+    }
+
+    /// Adds the sliding entries' friction forces for the multipliers `forces` (known forces
+    /// of the iteration, as in Newton's) into `residual`.
+    pub fn add_sliding_forces(&self, forces: &[f64], residual: &mut [f64]) {
+        self.rows.add_sliding_forces(forces, residual);
+    }
+
+    /// The tangential forces of the conditions `tangential` (in their order) for the
+    /// multipliers `forces`.
+    pub fn tangential_forces(&self, tangential: &[Tangential], forces: &[f64]) -> Vec<f64> {
+        self.rows.tangential_forces(tangential, forces)
+    }
+
     /// (du_R, tau_R): K du_R = R + C^T tau_R and C du_R = -g; `forces` the multipliers so far.
     pub fn solve(
         &self,
