@@ -243,6 +243,29 @@ fn arc_length_resume_is_bit_identical() {
     assert_same_output(&full, &resumed, name);
 }
 
+/// Goal: a body held by its contact alone (docs/theory.md 5c) resumes as it ran, by load
+/// stepping and by arc length: the checkpoint carries the tangent's diagonal shift and the
+/// closed entries. Setup: models/hertz_sphere.toml pressed by a pressure of 5.979 on its flat
+/// face instead of the flat's displacement (tests/arc_length.rs), a checkpoint every 2
+/// increments, halted after 5. Reference: the uninterrupted run, byte for byte. A checkpoint
+/// without the shift has the resumed run factor a singular tangent and stop.
+#[test]
+fn a_body_held_by_its_contact_resumes_bit_identically() {
+    let text = std::fs::read_to_string("models/hertz_sphere.toml")
+        .unwrap()
+        .replace("type = \"displacement\"", "type = \"pressure\"")
+        .replace("y = -0.4", "pressure = 5.979");
+    for (name, arc) in [
+        ("held_stepping", "analysis.steps=8"),
+        ("held_arc", "analysis.arc_length={}"),
+    ] {
+        let set = ["analysis.checkpoint_every=2", "output.frame_every=2", arc];
+        let full = run_full(name, &text, &set);
+        let resumed = run_killed_and_resumed(name, &text, &set, 5);
+        assert_same_output(&full, &resumed, name);
+    }
+}
+
 /// PLASTIC_BLOCK without its friction (the explicit runs below were set up frictionless).
 fn frictionless() -> String {
     PLASTIC_BLOCK.replace("friction = 0.2\n", "")
