@@ -464,3 +464,89 @@ fn a_body_its_contact_holds_in_one_direction_only_runs_or_says_why() {
         "{message}"
     );
 }
+
+/// An elastic-perfectly plastic block (2 x 1, plane strain, sigma_y = 5) pressed by a
+/// pressure of 12 onto a plate of the same material (4 x 1, its bottom held), node to
+/// segment between the two bodies without friction; the block's left side is held in x
+/// only, so the contact alone holds it in y.
+const BLOCK_ON_PLATE: &str = r#"
+[[material]]
+name = "m"
+young = 1000.0
+poisson = 0.3
+yield_stress = 5.0
+
+[[body]]
+name = "block"
+material = "m"
+formulation = "plane_strain"
+mesh = { type = "rectangle", origin = [1.0, 0.0], width = 2.0, height = 1.0, nx = 6, ny = 3 }
+
+[[body]]
+name = "plate"
+material = "m"
+formulation = "plane_strain"
+mesh = { type = "rectangle", origin = [0.0, -1.0], width = 4.0, height = 1.0, nx = 12, ny = 3 }
+
+[[support]]
+body = "plate"
+set = "bottom"
+fix = ["x", "y"]
+
+[[support]]
+body = "block"
+set = "left"
+fix = ["x"]
+
+[[load]]
+type = "pressure"
+body = "block"
+set = "top"
+pressure = 12.0
+
+[[contact]]
+name = "c"
+slave = { body = "block", set = "bottom" }
+master = { body = "plate", set = "top" }
+
+[analysis]
+type = "static"
+steps = 10
+geometry = "linear"
+arc_length = { max_increments = 100 }
+"#;
+
+/// Goal: arc length through a contact between two deformable bodies (the rows' exact
+/// linearization on a deformable master, theory 8.6b, in both bordered solves) to a plastic
+/// collapse, the pressed body held by that contact alone. Setup: `BLOCK_ON_PLATE`.
+/// Reference: the block's free lateral expansion makes its collapse plane-strain uniaxial
+/// compression, sigma_yy = -2 sigma_y / sqrt 3 = -5.7735 at flow (von Mises with sigma_zz at
+/// the mean of the in-plane stresses, Hill 1950), far below the plate's indentation limit
+/// ((2 + pi) sigma_y / sqrt 3 = 14.8, Prandtl): the load factor's peak times 12. Tolerance:
+/// 1 % (measured +0.16 %: the plate's elastic dishing under the block and the interface's
+/// node-to-segment discretization make the block's state not quite uniform); equilibrium,
+/// the contact force equal to the pressure times the block's width at the last increment,
+/// to 1e-5 (measured 2.3e-6: the column sums the entries' normal forces, and the plate's
+/// surface under the block is not quite level); the plate stays elastic (its plastic work
+/// 0).
+#[test]
+fn a_block_pressed_onto_a_plate_collapses_by_arc_length_at_its_yield_pressure() {
+    let model = common::model("block_on_plate_arc", BLOCK_ON_PLATE, &[]);
+    let (summary, _) = common::run("block_on_plate_arc", &model);
+    assert_eq!(summary.status, Status::Ok, "{:?}", summary.message);
+    let arc = summary.arc_length.as_ref().expect("an arc-length summary");
+    let limit = 2.0 * 5.0 / 3f64.sqrt();
+    let peak = arc.peak_load_factor * 12.0;
+    eprintln!(
+        "collapse pressure {peak:.5} against {limit:.5} ({:+.2} %)",
+        100.0 * (peak / limit - 1.0)
+    );
+    approx::assert_relative_eq!(peak, limit, max_relative = 0.01);
+    let dir = common::out_dir_of("block_on_plate_arc");
+    let factor = common::column(&dir, "load_factor");
+    let force = common::column(&dir, "contact_force[c]");
+    let last = factor.len() - 1;
+    approx::assert_relative_eq!(force[last], factor[last] * 12.0 * 2.0, max_relative = 1e-5);
+    let plate = common::column(&dir, "plastic_work[plate]");
+    assert_eq!(plate[last], 0.0, "the plate yielded");
+}
