@@ -31,7 +31,7 @@
 
 use super::carry::{ArcLengthCarry, Carry};
 use super::energies::{Energies, Motion};
-use super::newton::{Bordered, Constraints, Counters, StepFailure};
+use super::newton::{Bordered, Constraints, Counters, SINGULAR_STIFFNESS, StepFailure};
 use super::{About, Report, Resume, RowFeatures, RunFeatures, StepError, Stepper, loads};
 use crate::analysis::summary::ArcLengthSummary;
 use crate::assembly::{self, Evaluation, State, StepIncrement, System};
@@ -305,7 +305,7 @@ fn factor_at(
             SolverError::Singular { index } => Failure {
                 singular: true,
                 message: format!(
-                    "the stiffness matrix is singular at {}: a mechanism or missing supports",
+                    "{SINGULAR_STIFFNESS} {}: a mechanism or missing supports",
                     super::newton::free_dof(model, system, index)
                 ),
             },
