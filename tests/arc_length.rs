@@ -400,6 +400,26 @@ fn punch_by_load(name: &str, mu: f64) -> f64 {
     let factor = common::column(&dir, "load_factor");
     let punch = common::column(&dir, "contact_force[punch]");
     let last = factor.len() - 1;
+    // the path ends on max_increments, and its warning gives the load factor's last change,
+    // the same as history.csv's last 11 rows give it
+    let window = &factor[last - 10..];
+    let (low, high) = window
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), f| (l.min(*f), h.max(*f)));
+    approx::assert_relative_eq!(
+        arc.recent_change,
+        (high - low) / factor[last],
+        max_relative = 1e-12
+    );
+    let moved = format!(
+        "moved by {:.2} % over its last 10 increments",
+        100.0 * arc.recent_change
+    );
+    assert!(
+        summary.warnings.iter().any(|w| w.contains(&moved)),
+        "{moved}: {:?}",
+        summary.warnings
+    );
     approx::assert_relative_eq!(punch[last], factor[last] * bottom, max_relative = 1e-6);
     limit
 }

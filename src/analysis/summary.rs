@@ -171,7 +171,15 @@ pub struct ArcLengthSummary {
     pub final_load_factor: f64,
     pub reached_load: bool,
     pub collapsed: bool,
+    /// How far the load factor moved over the path's last `RECENT` increments (fewer on a
+    /// shorter path), (largest - smallest) / |last|: small on a plateau at a limit load that
+    /// the collapse test does not see (it asks the load to stand still).
+    #[serde(default)]
+    pub recent_change: f64,
 }
+
+/// The increments `ArcLengthSummary::recent_change` looks back over.
+pub const RECENT: usize = 10;
 
 /// summary.json `subcycling` (only with `analysis.subcycling`; docs/theory.md 8.7c): the
 /// substeps of the finest level, the element steps taken and what stepping every element at

@@ -226,11 +226,17 @@ fn arc_length_end(arc: &crate::analysis::summary::ArcLengthSummary) -> String {
     } else {
         format!(
             "the arc-length path ended after analysis.arc_length.max_increments = {} \
-             increments at load factor {} (highest {}), short of the scene's load; more \
-             increments, or fewer analysis.steps (longer arcs), take it further",
+             increments at load factor {} (highest {}), short of the scene's load, its load \
+             factor having moved by {:.2} % over its last {} increments (where that is small \
+             the path is on a plateau near its limit load, which the collapse test, the load \
+             standing still, misses where it moves a little, as when surface nodes slide off \
+             an edge one at a time); more increments, or fewer analysis.steps (longer arcs), \
+             take it further",
             arc.increments,
             readable(arc.final_load_factor),
-            readable(arc.peak_load_factor)
+            readable(arc.peak_load_factor),
+            100.0 * arc.recent_change,
+            arc.increments.min(crate::analysis::summary::RECENT)
         )
     }
 }

@@ -33,7 +33,7 @@ use super::carry::{ArcLengthCarry, Carry};
 use super::energies::{Energies, Motion};
 use super::newton::{Bordered, Constraints, Counters, SINGULAR_STIFFNESS, StepFailure};
 use super::{About, Report, Resume, RowFeatures, RunFeatures, StepError, Stepper, loads};
-use crate::analysis::summary::ArcLengthSummary;
+use crate::analysis::summary::{ArcLengthSummary, RECENT};
 use crate::assembly::{self, Evaluation, State, StepIncrement, System};
 use crate::contact::{
     ConstrainedSolution, ContactResult, ContactState, Inside, Interfaces, Pass, Settled,
@@ -99,6 +99,8 @@ pub struct ArcLength<'a> {
     /// The path stops at a collapse: a perfectly plastic mechanism (the load stood still
     /// for `FLAT_INCREMENTS` increments) or a tangent singular at a committed state.
     collapsed: bool,
+    /// The load factors of the last `RECENT` increments and the state before them.
+    recent: Vec<f64>,
 }
 
 /// Why an assembly and factorization failed: a singular tangent (a mechanism, or a limit
@@ -172,6 +174,7 @@ impl<'a> ArcLength<'a> {
             factored_at_start: false,
             flat_in_a_row: 0,
             collapsed: false,
+            recent: vec![0.0],
             system,
             solver,
         })
@@ -252,6 +255,10 @@ impl<'a> ArcLength<'a> {
         self.state.time += self.last_step;
         self.factor += c.dlambda;
         self.peak = self.peak.max(self.factor);
+        self.recent.push(self.factor);
+        if self.recent.len() > RECENT + 1 {
+            self.recent.remove(0);
+        }
         let stiffness = self.first_share / self.first_arc;
         if c.dlambda.abs() < FLAT * stiffness * arc {
             self.flat_in_a_row += 1;
@@ -565,6 +572,20 @@ fn constrained_step(du: &[f64], du_r: &[f64], ut: &[f64], arc: f64) -> f64 {
     }
 }
 
+/// (largest - smallest) / |last| of the load factors `factors` (0 for a path at zero).
+fn recent_change(factors: &[f64]) -> f64 {
+    let last = factors.last().copied().unwrap_or(0.0);
+    if last == 0.0 {
+        return 0.0;
+    }
+    let (low, high) = factors
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), f| {
+            (l.min(*f), h.max(*f))
+        });
+    (high - low) / last.abs()
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -700,6 +721,7 @@ impl Report for ArcLength<'_> {
                 final_load_factor: self.factor,
                 reached_load: self.factor >= 1.0 - 1e-12,
                 collapsed: self.collapsed,
+                recent_change: recent_change(&self.recent),
             }),
             ..RunFeatures::default()
         }
@@ -730,6 +752,7 @@ impl Resume for ArcLength<'_> {
         self.flat_in_a_row = c.flat_in_a_row;
         self.collapsed = c.collapsed;
         self.system.held = c.held;
+        self.recent = c.recent;
         // the committed state's tangent, the next predictor's, is factored again
         self.factored_at_start = false;
         true
@@ -752,6 +775,7 @@ impl Resume for ArcLength<'_> {
             flat_in_a_row: self.flat_in_a_row,
             collapsed: self.collapsed,
             held: self.system.held,
+            recent: self.recent.clone(),
         }))
     }
 

@@ -56,6 +56,9 @@ pub struct ArcLengthCarry {
     /// `System::held`: the diagonal shift of a body held by its contact alone.
     #[serde(default)]
     pub held: f64,
+    /// The load factors of the last increments (`ArcLengthSummary::recent_change`).
+    #[serde(default)]
+    pub recent: Vec<f64>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
