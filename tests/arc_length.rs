@@ -283,8 +283,8 @@ fn hertz_by_force_text() -> String {
     edited
 }
 
-/// Goal: a body held by its contact alone and pressed by a load runs, by load stepping and
-/// by arc length: the slaves resting on the obstacle at the start close, and the tangent,
+/// Goal: a body held by its contact alone and pressed by a load runs, by load stepping (the
+/// active set decided by passes, and inside Newton) and by arc length: the slaves resting on the obstacle at the start close, and the tangent,
 /// singular by itself (the sphere's rigid motion along the axis), is factored with its
 /// diagonal raised by 1e-8 of itself (theory 5c). Setup: `hertz_by_force_text` (the 830-node
 /// axisymmetric sphere R = 8, E = 1000, nu = 0.3, 8 steps; arc length lands on the load).
@@ -300,6 +300,8 @@ fn a_sphere_pressed_by_a_load_and_held_by_its_contact_meets_hertz() {
     let load = HERTZ_PRESSURE * std::f64::consts::PI * 64.0;
     for (name, sets) in [
         ("hertz_load_stepping", &[][..]),
+        // the active set decided inside Newton's iteration (theory 8.3b)
+        ("hertz_inside", &["analysis.newton.active_set=newton"][..]),
         ("hertz_arc_length", &["analysis.arc_length={}"][..]),
     ] {
         let model = common::model(name, &text, sets);
