@@ -284,25 +284,37 @@ fn hertz_by_force_text() -> String {
 }
 
 /// Goal: a body held by its contact alone and pressed by a load runs, by load stepping (the
-/// active set decided by passes, and inside Newton) and by arc length: the slaves resting on the obstacle at the start close, and the tangent,
+/// active set decided by passes, and inside Newton) and by arc length, at small and at
+/// finite strain: the slaves resting on the obstacle at the start close, and the tangent,
 /// singular by itself (the sphere's rigid motion along the axis), is factored with its
 /// diagonal raised by 1e-8 of itself (theory 5c). Setup: `hertz_by_force_text` (the 830-node
 /// axisymmetric sphere R = 8, E = 1000, nu = 0.3, 8 steps; arc length lands on the load).
 /// References: equilibrium, the contact force equal to the load P = p pi R^2 (to 1e-6: the
-/// Newton tolerance is 1e-8 of the force scale); Hertz for P, a = (3 P R / (4 E*))^(1/3),
+/// Newton tolerance is 1e-8 of the force scale; 2 % at finite strain, where the pressure
+/// acts on the flat face as it widens: measured +1.0 %); Hertz for P, a = (3 P R / (4 E*))^(1/3),
 /// p0 = 3 P / (2 pi a^2), the pole pressure from its nodal force over its consistent area
 /// pi h^2 / 3, within 5 % (validation 4.4: the displacement-driven run meets it at -2.9 %
-/// and -0.3 %). Without the closure and the shift both runs stop: "the stiffness matrix is
+/// and -0.3 %); at finite strain the radius alone (-4.1 %): Hertz's is a small-strain
+/// theory, and at p0 / E* = 0.15 the pole's pressure read over its undeformed area is 13 %
+/// below it. Without the closure and the shift both runs stop: "the stiffness matrix is
 /// singular at the y DOF of node 634" (load stepping), no convergence (arc length).
 #[test]
 fn a_sphere_pressed_by_a_load_and_held_by_its_contact_meets_hertz() {
     let text = hertz_by_force_text();
     let load = HERTZ_PRESSURE * std::f64::consts::PI * 64.0;
+    let finite = "analysis.geometry=nonlinear";
     for (name, sets) in [
         ("hertz_load_stepping", &[][..]),
         // the active set decided inside Newton's iteration (theory 8.3b)
         ("hertz_inside", &["analysis.newton.active_set=newton"][..]),
         ("hertz_arc_length", &["analysis.arc_length={}"][..]),
+        // at finite strain the pole alone turns its elements inside out: more resting
+        // slaves close on the first increment's failure (theory 5c)
+        ("hertz_finite", &[finite][..]),
+        (
+            "hertz_finite_arc_length",
+            &[finite, "analysis.arc_length={}"][..],
+        ),
     ] {
         let model = common::model(name, &text, sets);
         let outcome = analysis::run_outcome(&model, &common::out_dir(name), RunOptions::default())
@@ -314,7 +326,9 @@ fn a_sphere_pressed_by_a_load_and_held_by_its_contact_meets_hertz() {
             assert!(arc.reached_load, "{name}: {arc:?}");
         }
         let force = summary.contact.peak_force;
-        approx::assert_relative_eq!(force, load, max_relative = 1e-6);
+        // at finite strain the pressure acts on the flat face as it widens (measured +1.0 %)
+        let equilibrium = if sets.contains(&finite) { 0.02 } else { 1e-6 };
+        approx::assert_relative_eq!(force, load, max_relative = equilibrium);
         let (a, p0) = impact::reference::hertz_static(8.0, 1000.0, 0.3, force);
         let body = &model.bodies[0];
         let mut arc: Vec<usize> = body.mesh.node_sets["arc"]
@@ -331,7 +345,9 @@ fn a_sphere_pressed_by_a_load_and_held_by_its_contact_meets_hertz() {
             summary.contact.peak_contact_radius, summary.steps, summary.newton_iterations
         );
         approx::assert_relative_eq!(summary.contact.peak_contact_radius, a, max_relative = 0.05);
-        approx::assert_relative_eq!(pole, p0, max_relative = 0.05);
+        if !sets.contains(&finite) {
+            approx::assert_relative_eq!(pole, p0, max_relative = 0.05);
+        }
     }
 }
 

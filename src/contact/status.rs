@@ -105,17 +105,23 @@ impl ContactState {
         }
     }
 
-    /// Closes the open slaves of `pairs` that touch their master at positions `x` (|g| <=
-    /// TOL), with no force yet; how many. A static body held by its contact alone (a load
-    /// pressing it onto its support) is otherwise a free body in its first solve, whose
-    /// rigid motion nothing holds (docs/theory.md 5c).
-    pub fn close_resting(&mut self, pairs: &[ContactPair], x: &dyn Fn(usize) -> [f64; 2]) -> usize {
+    /// Closes the open slaves of `pairs` that rest on their master at positions `x` (|g| <=
+    /// `band` TOL: 1 for those that touch), with no force yet; how many. A static body held
+    /// by its contact alone (a load pressing it onto its support) is otherwise a free body in
+    /// its first solve, whose rigid motion nothing holds (docs/theory.md 5c).
+    pub fn close_resting(
+        &mut self,
+        pairs: &[ContactPair],
+        x: &dyn Fn(usize) -> [f64; 2],
+        band: f64,
+    ) -> usize {
         let active = &self.active;
         let open = |p: usize, k: usize| active[p][k];
         let touching: Vec<(usize, usize)> = slave_gaps(pairs, x, &open)
             .filter(|s| {
                 let pair = &pairs[s.pair];
-                s.gap.gap.abs() <= pair.options.tolerance && !pair.covers(pairs, &s.gap, x, &open)
+                s.gap.gap.abs() <= band * pair.options.tolerance
+                    && !pair.covers(pairs, &s.gap, x, &open)
             })
             .map(|s| (s.pair, s.index))
             .collect();

@@ -101,6 +101,9 @@ pub struct ArcLength<'a> {
     collapsed: bool,
     /// The load factors of the last `RECENT` increments and the state before them.
     recent: Vec<f64>,
+    /// The bands of resting slaves a held body's first increment has closed
+    /// (`statics::widen_resting`).
+    bands_tried: usize,
 }
 
 /// Why an assembly and factorization failed: a singular tangent (a mechanism, or a limit
@@ -175,6 +178,7 @@ impl<'a> ArcLength<'a> {
             flat_in_a_row: 0,
             collapsed: false,
             recent: vec![0.0],
+            bands_tried: 0,
             system,
             solver,
         })
@@ -647,6 +651,17 @@ impl Stepper for ArcLength<'_> {
                     return Ok(());
                 }
                 Err(StepFailure(reason)) => {
+                    // a held body's first increment: more of its resting slaves closed
+                    if self.increments == 0
+                        && self.system.held > 0.0
+                        && super::statics::widen_resting(
+                            (self.model, &self.state, self.spec.geometry),
+                            &mut self.contact,
+                            &mut self.bands_tried,
+                        )
+                    {
+                        continue;
+                    }
                     self.cuts_in_a_row += 1;
                     counters.cuts += 1;
                     if self.cuts_in_a_row > self.spec.newton.max_cuts {

@@ -68,6 +68,9 @@ pub struct Statics<'a> {
     /// The last increment's displacement increment and length, from which the next one
     /// starts (`NewtonSpec::extrapolates`).
     previous: Option<(Vec<f64>, f64)>,
+    /// The bands of resting slaves a held body's first increment has closed
+    /// (`widen_resting`).
+    bands_tried: usize,
 }
 
 impl<'a> Statics<'a> {
@@ -94,6 +97,7 @@ impl<'a> Statics<'a> {
             first_rate: None,
             last_rate: 0.0,
             previous: None,
+            bands_tried: 0,
             system,
             solver,
         })
@@ -248,6 +252,36 @@ impl Statics<'_> {
 /// resolved, and far below any stiffness, so Newton's contraction hardly changes.
 const HELD_SHIFT: f64 = 1e-8;
 
+/// The bands, in multiples of a pair's TOL (1e-9 of the model's size by default: 1e-3, 1e-2
+/// and 1e-1 of it), within which a held body's slaves close when its first increment fails
+/// with the touching ones alone (`widen_resting`).
+const RESTING_BANDS: [f64; 3] = [1e6, 1e7, 1e8];
+
+/// A held body's first increment that failed with only its touching slaves closed (a
+/// sphere at its pole: at finite strain the one node's load turns the elements around it
+/// inside out before the pass can close the others): the open slaves within the next of
+/// `RESTING_BANDS` of their master close too, those that then pull opening again in the
+/// passes (theory 5c). `tried`: the bands tried so far. Whether any slave closed.
+pub(super) fn widen_resting(
+    (model, state, geometry): (&Model, &State, crate::element::Strain),
+    contact: &mut ContactState,
+    tried: &mut usize,
+) -> bool {
+    let positions = state.positions(geometry);
+    while let Some(band) = RESTING_BANDS.get(*tried) {
+        *tried += 1;
+        let closed = contact.close_resting(&model.contacts, &|n| positions[n], *band);
+        if closed > 0 {
+            crate::output::console::iteration(format_args!(
+                "  the first increment failed with the touching slaves alone: {closed} more \
+                 within {band:e} TOL of their master start closed"
+            ));
+            return true;
+        }
+    }
+    false
+}
+
 /// What a run that stopped should know when its body is held by its contact alone.
 pub(super) fn held_hint(system: &System) -> &'static str {
     match system.held > 0.0 {
@@ -293,7 +327,7 @@ pub(super) fn hold_by_contact(
         return 0;
     }
     let positions = state.positions(geometry);
-    let closed = contact.close_resting(&model.contacts, &|n| positions[n]);
+    let closed = contact.close_resting(&model.contacts, &|n| positions[n], 1.0);
     if closed > 0 {
         system.held = HELD_SHIFT;
         crate::output::console::iteration(format_args!(
@@ -388,6 +422,17 @@ impl Stepper for Statics<'_> {
                             (&mut self.system, &mut self.solver),
                             &mut self.contact,
                         ) > 0
+                    {
+                        continue;
+                    }
+                    // held, but not by the touching slaves alone
+                    if self.increments == 0
+                        && self.system.held > 0.0
+                        && widen_resting(
+                            (self.model, &self.state, spec.geometry),
+                            &mut self.contact,
+                            &mut self.bands_tried,
+                        )
                     {
                         continue;
                     }
