@@ -114,13 +114,18 @@ impl InertiaCheck {
         (largest > 0.0).then(|| shape.iter().map(|v| v / largest).collect())
     }
 
-    /// Negative pivots of K_T (no mass) at the committed state.
+    /// Negative pivots of K_T (no mass) at the committed state, its diagonal raised by the
+    /// share `held` as the run raises its own (a body held by its contact alone, theory 5c:
+    /// its rigid motion's pivot is round-off otherwise, of either sign).
     pub fn negative_pivots(
         &mut self,
         model: &Model,
         state: &State,
+        held: f64,
     ) -> Result<usize, BucklingError> {
         buckling::assemble_tangent(model, state, &mut self.system)?;
+        self.system.held = held;
+        self.system.regularize();
         Ok(self.counter.negative_pivots(&self.system.values)?)
     }
 }
@@ -132,6 +137,8 @@ pub struct Monitor {
     /// The run's folder (the critical mode's frame goes there).
     dir: PathBuf,
     pub summary: BucklingSummary,
+    /// The diagonal shift the count's baseline (`initial_negative_pivots`) was taken with.
+    baseline_held: f64,
 }
 
 impl Monitor {
@@ -158,24 +165,39 @@ impl Monitor {
             on_critical: spec.on_critical,
             dir: dir.to_path_buf(),
             summary,
+            baseline_held: 0.0,
         }))
+    }
+
+    /// Goes on from a checkpoint's `summary`, its baseline taken with the shift `held` the
+    /// resumed run factors with.
+    pub fn resume(&mut self, summary: BucklingSummary, held: f64) {
+        self.summary = summary;
+        self.baseline_held = held;
     }
 
     /// Checks a committed state, at the load factor `load_factor` on an arc-length path:
     /// the negative-pivot count (None when `check` is off), and whether the run should stop
     /// here. Where the count first changes, the critical mode is written as the one frame of
-    /// NAME_critical.pvd at that time.
+    /// NAME_critical.pvd at that time. `held`: the run's diagonal shift (`System::held`);
+    /// where it changes (a body found held by its contact in the first increment), the
+    /// count's baseline is taken again, with the tangent as the run now factors it.
     pub fn observe(
         &mut self,
         model: &Model,
         state: &State,
         load_factor: Option<f64>,
+        held: f64,
     ) -> Result<(Option<usize>, bool), MonitorError> {
         let Some(check) = &mut self.check else {
             return Ok((None, false));
         };
-        let count = check.negative_pivots(model, state)?;
+        let count = check.negative_pivots(model, state, held)?;
         let s = &mut self.summary;
+        if held != self.baseline_held {
+            self.baseline_held = held;
+            s.initial_negative_pivots = Some(count);
+        }
         let initial = *s.initial_negative_pivots.get_or_insert(count);
         s.final_negative_pivots = Some(count);
         let mut stop = false;

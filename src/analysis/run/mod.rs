@@ -209,7 +209,7 @@ impl<'a, S: Stepper> Run<'a, S> {
                 if let Some(m) = &mut run.monitor {
                     let factor = run.stepper.row_features().load_factor;
                     run.recorder.negative_pivots = m
-                        .observe(model, run.stepper.state(), factor)
+                        .observe(model, run.stepper.state(), factor, run.stepper.held())
                         .map_err(|e| monitor_error(model, e.into()))?
                         .0;
                 }
@@ -246,7 +246,7 @@ impl<'a, S: Stepper> Run<'a, S> {
         }
         self.start = resumed_start(checkpoint.wall_seconds);
         if let (Some(m), Some(b)) = (&mut self.monitor, checkpoint.buckling) {
-            m.summary = b;
+            m.resume(b, self.stepper.held());
         }
         Ok(())
     }
@@ -355,7 +355,12 @@ impl<'a, S: Stepper> Run<'a, S> {
             return Ok(false);
         };
         let factor = self.stepper.row_features().load_factor;
-        match m.observe(self.model, self.stepper.state(), factor) {
+        match m.observe(
+            self.model,
+            self.stepper.state(),
+            factor,
+            self.stepper.held(),
+        ) {
             Ok((count, halt)) => {
                 self.recorder.negative_pivots = count;
                 Ok(halt)

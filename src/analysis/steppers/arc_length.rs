@@ -722,6 +722,9 @@ impl Report for ArcLength<'_> {
     fn last_step(&self) -> f64 {
         self.last_step
     }
+    fn held(&self) -> f64 {
+        self.system.held
+    }
     fn row_features(&self) -> RowFeatures {
         RowFeatures {
             load_factor: Some(self.factor),

@@ -81,6 +81,11 @@ pub trait Report {
     }
     /// The length of the last step (0 before the first).
     fn last_step(&self) -> f64;
+    /// The share by which the run raises its tangents' diagonal (`System::held`): 0 but
+    /// where a static body is held by its contact alone (theory 5c).
+    fn held(&self) -> f64 {
+        0.0
+    }
     /// What the optional features add to a history row (none by default).
     fn row_features(&self) -> RowFeatures {
         RowFeatures::default()

@@ -494,6 +494,9 @@ impl Report for Statics<'_> {
     fn last_step(&self) -> f64 {
         self.last_step
     }
+    fn held(&self) -> f64 {
+        self.system.held
+    }
 }
 
 impl Resume for Statics<'_> {
