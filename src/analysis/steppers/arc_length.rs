@@ -197,7 +197,7 @@ impl<'a> ArcLength<'a> {
         landing: bool,
         counters: &mut Counters,
     ) -> Result<ContactResult<Converged>, StepFailure> {
-        let positions = self.state.positions(self.spec.geometry).into_owned();
+        let positions = self.state.positions(self.spec.geometry);
         let increment = Increment {
             model: self.model,
             spec: self.spec,
@@ -601,14 +601,16 @@ fn norm(a: &[f64]) -> f64 {
 impl Stepper for ArcLength<'_> {
     /// A body that its contact alone holds closes its touching slaves before the path
     /// starts (`statics::hold_by_contact`): the bordered solves need a tangent to factor.
+    /// A regular tangent found so is the first predictor's, factored already.
     fn start(&mut self) -> Result<(), String> {
         let spec = self.spec;
-        super::statics::hold_by_contact(
+        let hold = super::statics::hold_by_contact(
             (self.model, &self.state, spec.end_time / spec.steps as f64),
             (spec.geometry, spec.newton.tangent),
             (&mut self.system, &mut self.solver),
             &mut self.contact,
         );
+        self.factored_at_start = hold == super::statics::Hold::Regular;
         Ok(())
     }
 

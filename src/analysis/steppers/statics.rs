@@ -295,20 +295,30 @@ pub(super) fn held_hint(system: &System) -> &'static str {
     }
 }
 
+/// What `hold_by_contact` found of the committed state's tangent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Hold {
+    /// Regular: it is factored now, at no increment.
+    Regular,
+    /// Singular, and this many resting slaves closed to hold the body.
+    Closed(usize),
+    /// Singular with nothing resting on a master (a mechanism), or not evaluable.
+    Unheld,
+}
+
 /// A body that its contact alone holds (docs/theory.md 5c): where the tangent of the
 /// committed `state` is singular (a mechanism at the solver's usual threshold) and open
 /// slaves touch their masters, those slaves close and `system` raises the diagonal of every
-/// tangent it factors from then on (`HELD_SHIFT`). How many slaves closed: 0 where the
-/// tangent is regular, the system holds already, or nothing touches (a mechanism the
-/// contact does not hold, reported as one).
+/// tangent it factors from then on (`HELD_SHIFT`). Without contact pairs, or where the
+/// system holds already, nothing is evaluated (`Unheld`).
 pub(super) fn hold_by_contact(
     (model, state, dt): (&Model, &State, f64),
     (geometry, tangent): (crate::element::Strain, crate::scene::spec::Tangent),
     (system, solver): (&mut System, &mut Solver),
     contact: &mut ContactState,
-) -> usize {
+) -> Hold {
     if model.contacts.is_empty() || system.held > 0.0 {
-        return 0;
+        return Hold::Unheld;
     }
     let zero = vec![0.0; model.dofs()];
     let step = assembly::StepIncrement {
@@ -317,25 +327,24 @@ pub(super) fn hold_by_contact(
         geometry,
     };
     if assembly::evaluate(model, state, step, Some(&mut *system), tangent).is_err() {
-        return 0;
+        return Hold::Unheld;
     }
-    let singular = matches!(
-        solver.factor_indefinite(&system.values),
-        Err(crate::solver::SolverError::Singular { .. })
-    );
-    if !singular {
-        return 0;
+    match solver.factor_indefinite(&system.values) {
+        Ok(()) => return Hold::Regular,
+        Err(crate::solver::SolverError::Singular { .. }) => {}
+        Err(_) => return Hold::Unheld,
     }
     let positions = state.positions(geometry);
     let closed = contact.close_resting(&model.contacts, &|n| positions[n], 1.0);
-    if closed > 0 {
-        system.held = HELD_SHIFT;
-        crate::output::console::iteration(format_args!(
-            "  the tangent is singular and {closed} slave(s) touch their master: they start \
-             closed and hold the body (its diagonal raised by {HELD_SHIFT:e} of itself)"
-        ));
+    if closed == 0 {
+        return Hold::Unheld;
     }
-    closed
+    system.held = HELD_SHIFT;
+    crate::output::console::iteration(format_args!(
+        "  the tangent is singular and {closed} slave(s) touch their master: they start \
+         closed and hold the body (its diagonal raised by {HELD_SHIFT:e} of itself)"
+    ));
+    Hold::Closed(closed)
 }
 
 impl Stepper for Statics<'_> {
@@ -416,12 +425,15 @@ impl Stepper for Statics<'_> {
                     // a first increment on a singular tangent: a body its contact alone holds?
                     if self.increments == 0
                         && reason.starts_with(SINGULAR_STIFFNESS)
-                        && hold_by_contact(
-                            (self.model, &self.state, self.dt),
-                            (spec.geometry, spec.newton.tangent),
-                            (&mut self.system, &mut self.solver),
-                            &mut self.contact,
-                        ) > 0
+                        && matches!(
+                            hold_by_contact(
+                                (self.model, &self.state, self.dt),
+                                (spec.geometry, spec.newton.tangent),
+                                (&mut self.system, &mut self.solver),
+                                &mut self.contact,
+                            ),
+                            Hold::Closed(_)
+                        )
                     {
                         continue;
                     }
