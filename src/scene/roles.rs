@@ -4,7 +4,16 @@
 //! run does not depend on which of them the scene calls the slave (Abaqus/Standard's general
 //! contact likewise assigns pure master-slave roles itself).
 //!
-//! The rule, in order, each step deciding when its measures differ by more than 1 %:
+//! A mortar pair of an implicit dynamic run, whose master nodes a hold pair can keep out of
+//! the slave body (8.3a-4), first reads the meshes:
+//! 0. where one surface's mean edge is below `UNLIKE` of the other's, the finer surface is the
+//!    slave (mortar's own choice: the side that carries the multipliers; a coarser slave lets
+//!    the finer master's nodes through between its own) and its master's nodes are held (the
+//!    coarse master's corners are what would enter it: the block on a plate three times finer,
+//!    exit 3 on Newmark with either surface the slave alone, completes so; validation 4.15).
+//!
+//! Then, and on every other path, each step deciding when its measures differ by more than
+//! 1 %:
 //! 1. the shorter surface (total length of its edges) is the slave: its ends lie within the
 //!    other's span, so the other's corners never enter it, while the longer surface's
 //!    corners would enter a slave that runs past them (the block on the plate: with the
@@ -16,12 +25,17 @@
 use super::InputError;
 use super::context::{Context, edge_lengths, edge_set, edge_sets_on_both};
 use super::model::Body;
-use super::spec::{ContactSpec, IntegratorKind, Roles, Scene};
+use super::spec::{AnalysisKind, ContactDiscretization, ContactSpec, IntegratorKind, Roles, Scene};
 use crate::output::readable;
 use std::borrow::Cow;
 
 /// Two measures differ when one is below this fraction of the other.
 const DIFFERS: f64 = 0.99;
+
+/// Two meshes are of unlike size when one surface's mean edge is below this fraction of the
+/// other's (step 0): 20 % apart, well beyond the spread of a graded or fitted mesh's edges
+/// on meshes the scene means alike, and below the 3x of the issue's unlike meshes.
+const UNLIKE: f64 = 0.8;
 
 /// Pair `k` (`spec`) with the roles it runs with, and why where the code chose them: the
 /// scene's spec (None) where its roles stand, or the one the rule gives (swapped or not).
@@ -40,25 +54,34 @@ pub(super) fn with_roles<'s>(
     let key = format!("contact[{k}] (`{}`)", spec.name);
     let slave = Surface::of(cx, bodies, &spec.slave, &format!("{key}.slave"))?;
     let master = Surface::of(cx, bodies, master, &format!("{key}.master"))?;
-    let (swap, why) = rule(&slave, &master);
+    let held = holds_master_nodes(spec, scene);
+    let (swap, why, hold) = rule(&slave, &master, held);
     let (s, m) = if swap {
         (&master, &slave)
     } else {
         (&slave, &master)
     };
+    let held = if hold {
+        "; the master's nodes held where they enter the slave (`hold_master_nodes`)"
+    } else {
+        ""
+    };
     let why = format!(
         "the roles chosen by the code (one pass): slave `{}` (set `{}`), master `{}` (set \
-         `{}`): {why}; `roles = \"as_written\"` keeps the scene's",
+         `{}`): {why}{held}; `roles = \"as_written\"` keeps the scene's",
         s.name, s.set, m.name, m.set
     );
-    if !swap {
+    if !swap && !hold {
         return Ok((Cow::Borrowed(spec), Some(why)));
     }
-    let mut swapped = spec.clone();
-    if let Some(master) = swapped.master.as_mut() {
-        std::mem::swap(&mut swapped.slave, master);
+    let mut chosen = spec.clone();
+    if swap && let Some(master) = chosen.master.as_mut() {
+        std::mem::swap(&mut chosen.slave, master);
     }
-    Ok((Cow::Owned(swapped), Some(why)))
+    if hold {
+        chosen.hold_master_nodes = Some(true);
+    }
+    Ok((Cow::Owned(chosen), Some(why)))
 }
 
 /// Whether the code chooses pair `spec`'s roles: `roles = "automatic"`, or `roles` left out
@@ -73,6 +96,21 @@ fn chosen_by_the_code(cx: &Context, bodies: &[Body], spec: &ContactSpec, scene: 
         Some(_) => false,
     };
     asked && two_bodies && !spec.two_pass
+}
+
+/// Whether pair `spec`, its roles chosen by the code, may hold its master nodes (step 0): a
+/// mortar pair (the default between two bodies in dynamics, unless the scene asks for node
+/// to segment or Greco's return) of an implicit dynamic run whose scene leaves
+/// `hold_master_nodes` out. Statics holds the weighted gaps alone, and central difference
+/// balances such a pair instead.
+fn holds_master_nodes(spec: &ContactSpec, scene: &Scene) -> bool {
+    let implicit_dynamics = scene.analysis.kind == AnalysisKind::Dynamic
+        && scene.analysis.integrator != Some(IntegratorKind::CentralDifference);
+    let mortar = spec
+        .discretization
+        .is_none_or(|d| d == ContactDiscretization::Mortar)
+        && spec.return_coefficient.is_none();
+    implicit_dynamics && mortar && spec.hold_master_nodes.is_none()
 }
 
 /// A contact surface as the rule reads it: its body's name and index, its edge set, its
@@ -109,38 +147,49 @@ impl<'s> Surface<'s> {
     }
 }
 
-/// Whether the rule swaps the scene's `slave` and `master`, and why: the first measure
-/// (length, then mean edge) on which the two differ makes the smaller one's surface the slave.
-fn rule(slave: &Surface, master: &Surface) -> (bool, String) {
+/// Whether the rule swaps the scene's `slave` and `master`, why, and whether the master's
+/// nodes are held: step 0 where `held` (the pair may hold them) and the meshes are unlike,
+/// else the first measure (length, then mean edge) on which the two differ makes the smaller
+/// one's surface the slave.
+fn rule(slave: &Surface, master: &Surface, held: bool) -> (bool, String, bool) {
     type Why = fn(String, String) -> String;
-    let steps: [(fn(&Surface) -> f64, Why); 2] = [
+    let finer: Why = |small, large| {
+        format!("the meshes are unlike; the finer is the slave (edges of {small} against {large})")
+    };
+    let steps: [(fn(&Surface) -> f64, f64, Why, bool); 3] = [
+        (|s| s.mean_edge, UNLIKE, finer, true),
         (
             |s| s.length,
+            DIFFERS,
             |small, large| {
                 format!("the shorter surface is the slave ({small} long against {large})")
             },
+            false,
         ),
         (
             |s| s.mean_edge,
+            DIFFERS,
             |small, large| {
                 format!(
                     "the surfaces are as long; the finer is the slave (edges of {small} against \
                  {large})"
                 )
             },
+            false,
         ),
     ];
-    for (measure, why) in steps {
+    for (measure, differs, why, hold) in steps.into_iter().skip(usize::from(!held)) {
         let (a, b) = (measure(slave), measure(master));
-        if a < DIFFERS * b || b < DIFFERS * a {
+        if a < differs * b || b < differs * a {
             let swap = b < a;
             let (small, large) = if swap { (b, a) } else { (a, b) };
-            return (swap, why(readable(small), readable(large)));
+            return (swap, why(readable(small), readable(large)), hold);
         }
     }
     (
         master.body > slave.body,
         "the surfaces are alike; the body listed later in the scene is the slave".into(),
+        false,
     )
 }
 
@@ -174,12 +223,41 @@ mod tests {
             (surface(0, 10e-3, 20), surface(1, 10e-3, 20), 1),
         ];
         for (a, b, slave) in cases {
-            let (swap, _) = rule(&a, &b);
+            let (swap, _, hold) = rule(&a, &b, false);
             let chosen = if swap { b.body } else { a.body };
             assert_eq!(chosen, slave, "as written");
-            let (swap, _) = rule(&b, &a);
+            assert!(!hold, "statics holds no master node");
+            let (swap, _, _) = rule(&b, &a, false);
             let chosen = if swap { a.body } else { b.body };
             assert_eq!(chosen, slave, "swapped");
+        }
+    }
+
+    /// Goal: where the pair can hold its master's nodes (implicit dynamics, mortar), unlike
+    /// meshes make the finer surface the slave with the hold, whichever name it has, and
+    /// meshes within `UNLIKE` of each other keep the length rule without it. Reference: step 0
+    /// of the module docs on the block's 10 mm bottom (20 edges) against the plate's 40 mm top
+    /// three times finer (240 edges), and the plate's like mesh (80 edges).
+    #[test]
+    fn unlike_meshes_make_the_finer_surface_the_slave_where_its_master_is_held() {
+        let cases = [
+            (surface(0, 10e-3, 20), surface(1, 40e-3, 240), 1, true),
+            (surface(0, 10e-3, 60), surface(1, 40e-3, 80), 0, true),
+            (surface(0, 10e-3, 20), surface(1, 40e-3, 80), 0, false),
+            // 10 % apart: alike, the shorter
+            (surface(0, 10e-3, 22), surface(1, 40e-3, 80), 0, false),
+        ];
+        for (a, b, slave, held) in cases {
+            for (x, y) in [(&a, &b), (&b, &a)] {
+                let (swap, _, hold) = rule(x, y, true);
+                let chosen = if swap { y.body } else { x.body };
+                assert_eq!(
+                    (chosen, hold),
+                    (slave, held),
+                    "{} edges slave",
+                    x.length / x.mean_edge
+                );
+            }
         }
     }
 }
