@@ -480,27 +480,49 @@ fn newmark_makes_a_finer_plate_the_slave_and_holds_the_block() {
 }
 
 /// Goal: `impact check` says which surface the code made the slave, and why, whichever the
-/// scene names. Setup: models/block_on_plate.toml on Newmark, as shipped and swapped.
-/// Reference: the rule (theory 8.3d): the block's boundary (30 mm) is shorter than the
-/// plate's (88 mm), so the block is the slave either way.
+/// scene names. Setup: models/block_on_plate.toml on Newmark, as shipped and swapped, and
+/// with the plate three times finer (240 x 24). Reference: the rule (theory 8.3d): on like
+/// meshes the block's boundary (30 mm) is shorter than the plate's (88 mm), so the block is
+/// the slave either way; on the finer plate the meshes are unlike (edges of 0.167 mm against
+/// 0.5 mm, below 0.8 of each other) and both surfaces are whole boundaries, so the plate is
+/// the slave and the block's nodes are held.
 #[test]
 fn check_names_the_roles_the_code_chose() {
-    for names in [&[][..], &SWAPPED[..]] {
-        let mut args = vec!["check", "models/block_on_plate.toml"];
-        for set in ["analysis.integrator=average", "analysis.dt=1e-7"]
-            .iter()
-            .chain(names)
-        {
-            args.extend(["--set", set]);
+    let finer: [&str; 2] = ["body.plate.mesh.nx=240", "body.plate.mesh.ny=24"];
+    let cases: [(&[&str], &[&str]); 2] = [
+        (
+            &[],
+            &[
+                "the roles chosen by the code (one pass): slave `block`",
+                "the shorter surface is the slave (0.03 long against 0.088)",
+            ],
+        ),
+        (
+            &finer,
+            &[
+                "the roles chosen by the code (one pass): slave `plate`",
+                "the meshes are unlike; the finer is the slave (edges of 1.66667e-4 against 5e-4)",
+                "the master's nodes held where they enter the slave",
+            ],
+        ),
+    ];
+    for (meshes, said) in cases {
+        for names in [&[][..], &SWAPPED[..]] {
+            let mut args = vec!["check", "models/block_on_plate.toml"];
+            for set in ["analysis.integrator=average", "analysis.dt=1e-7"]
+                .iter()
+                .chain(meshes)
+                .chain(names)
+            {
+                args.extend(["--set", set]);
+            }
+            let out = common::impact(&args);
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            assert!(out.status.success(), "{stdout}");
+            for line in said {
+                assert!(stdout.contains(line), "{line}: {stdout}");
+            }
         }
-        let out = common::impact(&args);
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(out.status.success(), "{stdout}");
-        assert!(
-            stdout.contains("the roles chosen by the code (one pass): slave `block`")
-                && stdout.contains("the shorter surface is the slave (0.03 long against 0.088)"),
-            "{stdout}"
-        );
     }
 }
 
