@@ -59,21 +59,21 @@ pub(super) fn with_roles<'s>(
     let key = format!("contact[{k}] (`{}`)", spec.name);
     let slave = Surface::of(cx, bodies, &spec.slave, &format!("{key}.slave"))?;
     let master = Surface::of(cx, bodies, master, &format!("{key}.master"))?;
-    let held = holds_master_nodes(spec, scene) && slave.closed && master.closed;
-    let (swap, why, hold) = rule(&slave, &master, held);
+    let may_hold = holds_master_nodes(spec, scene) && slave.closed && master.closed;
+    let (swap, why, hold) = rule(&slave, &master, may_hold);
     let (s, m) = if swap {
         (&master, &slave)
     } else {
         (&slave, &master)
     };
-    let held = if hold {
+    let hold_said = if hold {
         "; the master's nodes held where they enter the slave (`hold_master_nodes`)"
     } else {
         ""
     };
     let why = format!(
         "the roles chosen by the code (one pass): slave `{}` (set `{}`), master `{}` (set \
-         `{}`): {why}{held}; `roles = \"as_written\"` keeps the scene's",
+         `{}`): {why}{hold_said}; `roles = \"as_written\"` keeps the scene's",
         s.name, s.set, m.name, m.set
     );
     if !swap && !hold {
@@ -163,10 +163,10 @@ fn closed(edges: &[[usize; 2]]) -> bool {
 }
 
 /// Whether the rule swaps the scene's `slave` and `master`, why, and whether the master's
-/// nodes are held: step 0 where `held` (the pair may hold them) and the meshes are unlike,
+/// nodes are held: step 0 where `may_hold` (the pair may hold them) and the meshes are unlike,
 /// else the first measure (length, then mean edge) on which the two differ makes the smaller
 /// one's surface the slave.
-fn rule(slave: &Surface, master: &Surface, held: bool) -> (bool, String, bool) {
+fn rule(slave: &Surface, master: &Surface, may_hold: bool) -> (bool, String, bool) {
     type Why = fn(String, String) -> String;
     let finer: Why = |small, large| {
         format!("the meshes are unlike; the finer is the slave (edges of {small} against {large})")
@@ -193,7 +193,7 @@ fn rule(slave: &Surface, master: &Surface, held: bool) -> (bool, String, bool) {
             false,
         ),
     ];
-    for (measure, differs, why, hold) in steps.into_iter().skip(usize::from(!held)) {
+    for (measure, differs, why, hold) in steps.into_iter().skip(usize::from(!may_hold)) {
         let (a, b) = (measure(slave), measure(master));
         if a < differs * b || b < differs * a {
             let swap = b < a;
