@@ -162,43 +162,62 @@ fn closed(edges: &[[usize; 2]]) -> bool {
     !nodes.is_empty() && nodes.chunk_by(|a, b| a == b).all(|run| run.len() == 2)
 }
 
+/// One step of the rule: the measure it reads, the fraction below which two of them differ,
+/// what it says of the two values (smaller, larger), and whether it holds the master's nodes.
+struct Step {
+    measure: fn(&Surface) -> f64,
+    differs: f64,
+    why: fn(String, String) -> String,
+    holds: bool,
+}
+
+/// The rule's steps in order (module docs): step 0 first, read only where the pair may hold.
+const STEPS: [Step; 3] = [
+    Step {
+        measure: |s| s.mean_edge,
+        differs: UNLIKE,
+        why: |small, large| {
+            format!(
+                "the meshes are unlike; the finer is the slave (edges of {small} against {large})"
+            )
+        },
+        holds: true,
+    },
+    Step {
+        measure: |s| s.length,
+        differs: DIFFERS,
+        why: |small, large| {
+            format!("the shorter surface is the slave ({small} long against {large})")
+        },
+        holds: false,
+    },
+    Step {
+        measure: |s| s.mean_edge,
+        differs: DIFFERS,
+        why: |small, large| {
+            format!(
+                "the surfaces are as long; the finer is the slave (edges of {small} against {large})"
+            )
+        },
+        holds: false,
+    },
+];
+
 /// Whether the rule swaps the scene's `slave` and `master`, why, and whether the master's
 /// nodes are held: step 0 where `may_hold` (the pair may hold them) and the meshes are unlike,
 /// else the first measure (length, then mean edge) on which the two differ makes the smaller
 /// one's surface the slave.
 fn rule(slave: &Surface, master: &Surface, may_hold: bool) -> (bool, String, bool) {
-    type Why = fn(String, String) -> String;
-    let finer: Why = |small, large| {
-        format!("the meshes are unlike; the finer is the slave (edges of {small} against {large})")
-    };
-    let steps: [(fn(&Surface) -> f64, f64, Why, bool); 3] = [
-        (|s| s.mean_edge, UNLIKE, finer, true),
-        (
-            |s| s.length,
-            DIFFERS,
-            |small, large| {
-                format!("the shorter surface is the slave ({small} long against {large})")
-            },
-            false,
-        ),
-        (
-            |s| s.mean_edge,
-            DIFFERS,
-            |small, large| {
-                format!(
-                    "the surfaces are as long; the finer is the slave (edges of {small} against \
-                 {large})"
-                )
-            },
-            false,
-        ),
-    ];
-    for (measure, differs, why, hold) in steps.into_iter().skip(usize::from(!may_hold)) {
-        let (a, b) = (measure(slave), measure(master));
-        if a < differs * b || b < differs * a {
+    for step in STEPS.iter().skip(usize::from(!may_hold)) {
+        let (a, b) = ((step.measure)(slave), (step.measure)(master));
+        if a < step.differs * b || b < step.differs * a {
             let swap = b < a;
             let (small, large) = if swap { (b, a) } else { (a, b) };
-            return (swap, why(readable(small), readable(large)), hold);
+            return (
+                swap,
+                (step.why)(readable(small), readable(large)),
+                step.holds,
+            );
         }
     }
     (

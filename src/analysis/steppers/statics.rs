@@ -300,8 +300,8 @@ pub(super) fn held_hint(system: &System) -> &'static str {
 pub(super) enum Hold {
     /// Regular: it is factored now, at no increment.
     Regular,
-    /// Singular, and this many resting slaves closed to hold the body.
-    Closed(usize),
+    /// Singular, and resting slaves closed to hold the body.
+    Closed,
     /// Singular with nothing resting on a master (a mechanism), or not evaluable.
     Unheld,
 }
@@ -344,7 +344,7 @@ pub(super) fn hold_by_contact(
         "  the tangent is singular and {closed} slave(s) touch their master: they start \
          closed and hold the body (its diagonal raised by {HELD_SHIFT:e} of itself)"
     ));
-    Hold::Closed(closed)
+    Hold::Closed
 }
 
 impl Stepper for Statics<'_> {
@@ -432,7 +432,7 @@ impl Stepper for Statics<'_> {
                                 (&mut self.system, &mut self.solver),
                                 &mut self.contact,
                             ),
-                            Hold::Closed(_)
+                            Hold::Closed
                         )
                     {
                         continue;
