@@ -479,6 +479,40 @@ fn newmark_makes_a_finer_plate_the_slave_and_holds_the_block() {
     names_either_way_give_one_run("block_on_plate_newmark_fine_plate", &fine, 0.5e-3 / 3.0);
 }
 
+/// Goal: a master node that the hold lets into the slave body is named as such, not as a
+/// slave. Setup: the plate three times finer (240 x 24) on Newmark (dt 1e-7) with the block
+/// sliding at 50 m/s and mu = 0.2: the code makes the plate the slave and holds the block's
+/// nodes (theory 8.3d, step 0); the block's leading corner, its node 20, ploughs the fine
+/// plate and goes 18 um in before a plate element folds at 3.0 us (docs/validation.md 4.15).
+/// Reference: the roles the rule gives (`check_names_the_roles_the_code_chose`): node 20 of
+/// the block is a master node of `impact`, held by its rows, and no pair names it as a slave.
+/// Before, the warning called it "a slave" (the hold's own rows list it as theirs).
+#[test]
+fn a_held_master_node_that_went_in_is_named_as_one() {
+    let dir = common::out_dir("block_on_plate_newmark_held_corner");
+    let sets = [
+        "analysis.dt=1e-7",
+        "analysis.end_time=3.1e-6",
+        "body.plate.mesh.nx=240",
+        "body.plate.mesh.ny=24",
+        "body.block.velocity=[50.0, -150.0]",
+        "contact.impact.friction=0.2",
+    ];
+    let run = newmark_run(&dir, &sets);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    let named = "into body `plate` at t = 3.0";
+    let master = "it is a master node of contact `impact`; its row holds it where it enters the \
+                  slave body (`hold_master_nodes`";
+    for words in ["node 20 of body `block` went 1.8", named, master] {
+        assert!(stderr.contains(words), "{words}: {stderr}");
+    }
+    let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let deepest = &summary["contact"]["deepest"];
+    assert_eq!(deepest["held"], true, "{deepest}");
+    assert_eq!(deepest["slave"], false, "{deepest}");
+}
+
 /// Goal: `impact check` says which surface the code made the slave, and why, whichever the
 /// scene names. Setup: models/block_on_plate.toml on Newmark, as shipped and swapped, and
 /// with the plate three times finer (240 x 24). Reference: the rule (theory 8.3d): on like

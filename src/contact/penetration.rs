@@ -51,8 +51,13 @@ pub struct DeepestNode {
     pub node: usize,
     /// What it went into: "obstacle `NAME`" or "body `NAME`".
     pub into: String,
-    /// Whether a contact pair names the node as a slave.
+    /// Whether a contact pair names the node as a slave (a hold pair's slaves, the master
+    /// nodes it holds, are not).
     pub slave: bool,
+    /// Whether the node is a master node that a mortar pair holds where it enters the slave
+    /// body (`hold_master_nodes` on the implicit paths, docs/theory.md 8.3a-4).
+    #[serde(default)]
+    pub held: bool,
 }
 
 /// The deepest penetration of any body's node into an obstacle of `interfaces`' pairs or

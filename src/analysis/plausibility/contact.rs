@@ -213,6 +213,23 @@ fn master_node_cause(model: &Model, d: &DeepestNode, pair: &ContactPair) -> Stri
     const ALREADY: &str = "the code chose these roles (`impact check` says why): refine the \
         slave surface where this node meets it, or run central difference, whose balanced \
         pair checks both surfaces";
+    const HELD: &str = "its row holds it where it enters the slave body \
+        (`hold_master_nodes`, docs/theory.md 8.3a-4), and a row on a node does not keep a sharp \
+        corner out of a finer surface that wraps it (a corner ploughing the slave, docs/\
+        validation.md 4.15): round or refine the master surface at the corner, or run central \
+        difference, whose balanced pair checks both surfaces";
+    if d.held {
+        return format!(
+            "node {} of body `{}` went {} into {} at t = {}: it is a master node of contact \
+             `{}`; {HELD}",
+            d.node,
+            d.body,
+            readable(d.depth),
+            d.into,
+            readable(d.time),
+            pair.name
+        );
+    }
     let remedy = match (model.is_explicit(), pair.chosen_roles.is_some()) {
         (true, _) => BALANCED,
         (false, false) => CHOSEN,

@@ -201,7 +201,8 @@ fn past_end_named(model: &Model, p: &PastEnd, position: [f64; 2], time: f64) -> 
 }
 
 /// A deepest node in the words of summary.json: the body by name, its node by its number
-/// in the body, what it went into by name, whether a pair names it as a slave.
+/// in the body, what it went into by name, whether a pair names it as a slave or holds it as
+/// a master node.
 fn named(model: &Model, d: &penetration::Deepest, time: f64) -> DeepestNode {
     let body = &model.bodies[d.body];
     DeepestNode {
@@ -213,6 +214,7 @@ fn named(model: &Model, d: &penetration::Deepest, time: f64) -> DeepestNode {
             Intruded::Obstacle(name) => format!("obstacle `{name}`"),
             Intruded::Body(b) => format!("body `{}`", model.bodies[*b].name),
         },
-        slave: model.contacts.iter().any(|p| p.slaves.contains(&d.node)),
+        slave: (model.contacts.iter()).any(|p| !p.is_hold() && p.slaves.contains(&d.node)),
+        held: (model.contacts.iter()).any(|p| p.is_hold() && p.slaves.contains(&d.node)),
     }
 }
