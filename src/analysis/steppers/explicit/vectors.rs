@@ -173,29 +173,32 @@ impl StepEnd<'_> {
             .enumerate()
             .with_min_len(CHUNKS_PER_TASK)
             .map(|(k, (a, v, total, (x, u)))| {
-                let start = k * DOF_CHUNK;
-                move_by(x, u, &self.du[start..start + a.len()]);
+                let dofs = k * DOF_CHUNK..k * DOF_CHUNK + a.len();
+                // the chunk's slices, so that the loop indexes without bounds checks
+                let (free, m) = (&self.free[dofs.clone()], &self.m[dofs.clone()]);
+                let (external, internal) = (&self.external[dofs.clone()], &self.internal[dofs.clone()]);
+                let (v_half, du) = (&self.v_half[dofs.clone()], &self.du[dofs.clone()]);
+                let last_total = &self.last_total[dofs];
+                move_by(x, u, du);
                 let (mut work, mut kinetic, mut shadow) = (0.0, 0.0, 0.0);
                 for (j, ((a, v), total)) in a.iter_mut().zip(v).zip(total).enumerate() {
-                    let i = k * DOF_CHUNK + j;
-                    let m = self.m[i];
-                    let forces = (self.external[i], self.internal[i]);
-                    let motion = (self.v_half[i], *v, self.du[i]);
-                    (*a, *v) = end_motion(self.free[i], (m, forces), motion, (h, a_r));
-                    if self.free[i] {
-                        shadow += m * *a * *a;
+                    let forces = (external[j], internal[j]);
+                    let motion = (v_half[j], *v, du[j]);
+                    (*a, *v) = end_motion(free[j], (m[j], forces), motion, (h, a_r));
+                    if free[j] {
+                        shadow += m[j] * *a * *a;
                     }
                     let dof = Dof {
-                        free: self.free[i],
-                        external: self.external[i],
-                        internal: self.internal[i],
-                        m,
+                        free: free[j],
+                        external: external[j],
+                        internal: internal[j],
+                        m: m[j],
                         a: *a,
                         v: *v,
                     };
                     *total = total_at(dof, a_r);
-                    work += self.du[i] * (*total + self.last_total[i]);
-                    kinetic += m * *v * *v;
+                    work += du[j] * (*total + last_total[j]);
+                    kinetic += m[j] * *v * *v;
                 }
                 (work, kinetic, shadow)
             })
