@@ -203,7 +203,8 @@ fn unheld_node_cause(model: &Model, d: &DeepestNode, end: Option<&[[f64; 2]]>) -
 }
 
 /// The cause of `unheld_node_cause` for a master node of one-pass `pair`: one pass holds the
-/// slave's nodes only, and what mends it depends on the path and on who chose the roles.
+/// slave's nodes only, and what mends it depends on the path and on who chose the roles; a
+/// master node its hold (`d.held`) let in even so.
 fn master_node_cause(model: &Model, d: &DeepestNode, pair: &ContactPair) -> String {
     const BALANCED: &str = "leave `roles` out: under central difference the pair is then \
         balanced, each surface the slave of the other (docs/theory.md 8.3d)";
@@ -218,17 +219,17 @@ fn master_node_cause(model: &Model, d: &DeepestNode, pair: &ContactPair) -> Stri
         corner out of a finer surface that wraps it (a corner ploughing the slave, docs/\
         validation.md 4.15): round or refine the master surface at the corner, or run central \
         difference, whose balanced pair checks both surfaces";
+    let went = format!(
+        "node {} of body `{}` went {} into {} at t = {}: it is a master node of contact `{}`",
+        d.node,
+        d.body,
+        readable(d.depth),
+        d.into,
+        readable(d.time),
+        pair.name
+    );
     if d.held {
-        return format!(
-            "node {} of body `{}` went {} into {} at t = {}: it is a master node of contact \
-             `{}`; {HELD}",
-            d.node,
-            d.body,
-            readable(d.depth),
-            d.into,
-            readable(d.time),
-            pair.name
-        );
+        return format!("{went}; {HELD}");
     }
     let remedy = match (model.is_explicit(), pair.chosen_roles.is_some()) {
         (true, _) => BALANCED,
@@ -236,15 +237,8 @@ fn master_node_cause(model: &Model, d: &DeepestNode, pair: &ContactPair) -> Stri
         (false, true) => ALREADY,
     };
     format!(
-        "node {} of body `{}` went {} into {} at t = {}: it is a master node of contact `{}`, \
-         and one pass holds the slave's nodes only, so a master node that enters the slave \
-         body is not seen; {remedy}",
-        d.node,
-        d.body,
-        readable(d.depth),
-        d.into,
-        readable(d.time),
-        pair.name
+        "{went}, and one pass holds the slave's nodes only, so a master node that enters the \
+         slave body is not seen; {remedy}"
     )
 }
 

@@ -176,7 +176,8 @@ impl StepEnd<'_> {
                 let dofs = k * DOF_CHUNK..k * DOF_CHUNK + a.len();
                 // the chunk's slices, so that the loop indexes without bounds checks
                 let (free, m) = (&self.free[dofs.clone()], &self.m[dofs.clone()]);
-                let (external, internal) = (&self.external[dofs.clone()], &self.internal[dofs.clone()]);
+                let (external, internal) =
+                    (&self.external[dofs.clone()], &self.internal[dofs.clone()]);
                 let (v_half, du) = (&self.v_half[dofs.clone()], &self.du[dofs.clone()]);
                 let last_total = &self.last_total[dofs];
                 move_by(x, u, du);
